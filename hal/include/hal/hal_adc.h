@@ -1,0 +1,17 @@
+/* ADC frame of one sample tick: the drive and sense pickoff conversions. */
+#ifndef HAL_ADC_H
+#define HAL_ADC_H
+
+#include <stdint.h>
+#include "hal/hal_converters.h"
+
+typedef struct {
+  int16_t drive; /* drive-axis pickoff, ADC code */
+  int16_t sense; /* sense-axis pickoff, ADC code */
+} hal_adc_frame_t;
+
+/* The frame converted at the most recent sample tick. Called from the sample ISR only;
+ * never blocks (the conversion was started by the timer and moved by DMA). */
+void hal_adc_read_frame(hal_adc_frame_t *frame);
+
+#endif /* HAL_ADC_H */

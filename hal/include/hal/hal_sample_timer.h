@@ -1,0 +1,18 @@
+/* The sample clock: a hardware timer starts both conversions and raises the sample
+ * interrupt at fs. The ISR reads the ADC frame, runs the tick and writes the DAC frame. */
+#ifndef HAL_SAMPLE_TIMER_H
+#define HAL_SAMPLE_TIMER_H
+
+#include <stdint.h>
+
+typedef void (*hal_sample_isr_fn)(void *ctx);
+
+/* Start the sample clock at rate_hz, calling isr(ctx) once per sample at the highest
+ * interrupt priority. Returns 0, or a negative value if the rate cannot be made. */
+int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx);
+void hal_sample_timer_stop(void);
+
+/* Free-running cycle counter (DWT CYCCNT on the board) for self-measurement of the tick. */
+uint32_t hal_cycles_now(void);
+
+#endif /* HAL_SAMPLE_TIMER_H */
