@@ -8,7 +8,7 @@
 set(GYRO_COMMON_WARNINGS -Wall -Wextra -Werror -Wshadow -Wundef -Wpointer-arith
     -Wcast-qual -Wformat=2)
 set(GYRO_STRICT_C_WARNINGS ${GYRO_COMMON_WARNINGS} -Wdouble-promotion -Wconversion
-    -Wsign-conversion -Wfloat-equal -Wstrict-prototypes -Wmissing-prototypes
+    -Wsign-conversion -Wstrict-prototypes -Wmissing-prototypes
     -Wold-style-definition -Wvla -Wswitch-enum)
 
 function(gyro_strict_warnings target)

@@ -1,0 +1,60 @@
+/* Cascaded second-order IIR sections, transposed direct form II, single precision.
+ *
+ * Difference equation of one section (scipy's sign convention, a0 = 1):
+ *     y[n] = b0 x[n] + b1 x[n-1] + b2 x[n-2] - a1 y[n-1] - a2 y[n-2]
+ * TDF-II realisation, state {s1, s2}:
+ *     y  = b0 x + s1
+ *     s1 = b1 x - a1 y + s2
+ *     s2 = b2 x - a2 y
+ * A 4th-order 100 Hz low-pass at 50 kHz has poles within 1e-2 of z = 1; in direct form
+ * its single-precision coefficients put them outside the unit circle (thesis 5.5.1),
+ * which is why only cascades of sections are used (5-12, 5-13).
+ *
+ * The cascade owns a copy of its coefficients (they are designed at init or when a
+ * cut-off parameter changes, outside the ISR) and 2 floats of state per section.
+ */
+#ifndef BIQUAD_H
+#define BIQUAD_H
+
+#include <stdint.h>
+
+#define BIQUAD_MAX_SECTIONS 4u
+
+typedef struct {
+  float b0, b1, b2; /* numerator */
+  float a1, a2;     /* denominator, a0 = 1, scipy sign convention */
+} biquad_coeffs_t;
+
+typedef struct {
+  float s1, s2;
+} biquad_state_t;
+
+typedef struct {
+  uint32_t num_sections;
+  biquad_coeffs_t coeffs[BIQUAD_MAX_SECTIONS];
+  biquad_state_t state[BIQUAD_MAX_SECTIONS];
+} biquad_cascade_t;
+
+/* Copy n sections (1..BIQUAD_MAX_SECTIONS) and clear the state. Returns 0, or -1 (and
+ * leaves *bq unchanged) for a bad section count or a non-finite coefficient. */
+int biquad_cascade_init(biquad_cascade_t *bq, const biquad_coeffs_t *sections, uint32_t n);
+
+/* Clear the state, or preset it to the steady state of a constant input x (so that a
+ * filter started on a known DC level produces no start-up transient). */
+void biquad_cascade_reset(biquad_cascade_t *bq, float x_steady);
+
+/* One input sample through every section; returns the cascade output. */
+static inline float biquad_cascade_step(biquad_cascade_t *bq, float x)
+{
+  for (uint32_t i = 0; i < bq->num_sections; i++) {
+    const biquad_coeffs_t *c = &bq->coeffs[i];
+    biquad_state_t *s = &bq->state[i];
+    const float y = c->b0 * x + s->s1;
+    s->s1 = c->b1 * x - c->a1 * y + s->s2;
+    s->s2 = c->b2 * x - c->a2 * y;
+    x = y;
+  }
+  return x;
+}
+
+#endif /* BIQUAD_H */
