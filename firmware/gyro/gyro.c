@@ -56,7 +56,9 @@ int gyro_design(const gyro_cfg_t *c, gyro_design_t *d)
   const int n = butter_design(BUTTER_LOWPASS, c->rate_lpf_order, (double)c->rate_lpf_hz, 0.0,
                               fs / RATE_DECIM, t.rate_lpf, BIQUAD_MAX_SECTIONS);
   if (n <= 0) return -5;
-  t.rate.demod_phase_rad = c->demod_phase_deg * FM_RAD_PER_DEG_F;
+  const double phi_dm = (double)c->demod_phase_deg * FM_PI / 180.0;
+  t.rate.rot_c = (float)cos(phi_dm);
+  t.rate.rot_s = (float)sin(phi_dm);
   t.rate.scale_dps = c->rate_scale_dps;
   for (int i = 0; i < 4; i++) {
     t.rate.bias_c_dps[i] = c->bias_c_dps[i];

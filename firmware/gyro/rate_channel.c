@@ -1,6 +1,5 @@
 #include "gyro/rate_channel.h"
 
-#include <math.h>
 #include <stddef.h>
 
 #include "dsp/fastmath.h"
@@ -10,13 +9,31 @@ static int finite4(const float *c)
   return fm_isfinite(c[0]) && fm_isfinite(c[1]) && fm_isfinite(c[2]) && fm_isfinite(c[3]);
 }
 
+static int cfg_ok(const rate_channel_cfg_t *cfg)
+{
+  return cfg != NULL && cfg->lpf != NULL && fm_isfinite(cfg->rot_c) &&
+         fm_isfinite(cfg->rot_s) && fm_absf(cfg->rot_c * cfg->rot_c + cfg->rot_s * cfg->rot_s - 1.0f) < 1e-4f &&
+         fm_isfinite(cfg->scale_dps) && finite4(cfg->bias_c_dps) && finite4(cfg->sf_c) &&
+         cfg->p_lpf_alpha > 0.0f && cfg->p_lpf_alpha <= 1.0f && cfg->min_drive_v > 0.0f &&
+         fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg);
+}
+
+static void copy_coeffs(rate_channel_t *rc, const rate_channel_cfg_t *cfg)
+{
+  rc->rot_c = cfg->rot_c;
+  rc->rot_s = cfg->rot_s;
+  rc->scale_dps = cfg->scale_dps;
+  for (int i = 0; i < 4; i++) {
+    rc->bias_c_dps[i] = cfg->bias_c_dps[i];
+    rc->sf_c[i] = cfg->sf_c[i];
+  }
+  rc->p_lpf_alpha = cfg->p_lpf_alpha;
+  rc->min_drive_v2 = cfg->min_drive_v * cfg->min_drive_v;
+}
+
 int rate_channel_init(rate_channel_t *rc, const rate_channel_cfg_t *cfg)
 {
-  if (rc == NULL || cfg == NULL || cfg->lpf == NULL || !fm_isfinite(cfg->demod_phase_rad) ||
-      !fm_isfinite(cfg->scale_dps) || !finite4(cfg->bias_c_dps) || !finite4(cfg->sf_c) ||
-      !(cfg->p_lpf_alpha > 0.0f && cfg->p_lpf_alpha <= 1.0f) ||
-      !(cfg->min_drive_v > 0.0f) || !fm_isfinite(cfg->min_drive_v) ||
-      !fm_isfinite(cfg->p_ref_deg)) {
+  if (rc == NULL || !cfg_ok(cfg)) {
     return -1;
   }
   biquad_cascade_t a, b;
@@ -26,18 +43,38 @@ int rate_channel_init(rate_channel_t *rc, const rate_channel_cfg_t *cfg)
   }
   rc->lpf_rate = a;
   rc->lpf_quad = b;
-  /* Init-time trigonometry (libm allowed outside the sample path). */
-  rc->rot_c = cosf(cfg->demod_phase_rad);
-  rc->rot_s = sinf(cfg->demod_phase_rad);
-  rc->scale_dps = cfg->scale_dps;
-  for (int i = 0; i < 4; i++) {
-    rc->bias_c_dps[i] = cfg->bias_c_dps[i];
-    rc->sf_c[i] = cfg->sf_c[i];
-  }
-  rc->p_lpf_alpha = cfg->p_lpf_alpha;
+  copy_coeffs(rc, cfg);
   rc->p_ref_deg = cfg->p_ref_deg;
-  rc->min_drive_v2 = cfg->min_drive_v * cfg->min_drive_v;
-  rate_channel_reset(rc, 0.0f);
+  rate_channel_reset(rc, cfg->p_ref_deg);
+  return 0;
+}
+
+int rate_channel_retune(rate_channel_t *rc, const rate_channel_cfg_t *cfg)
+{
+  if (rc == NULL || !cfg_ok(cfg)) {
+    return -1;
+  }
+  biquad_cascade_t a = rc->lpf_rate, b = rc->lpf_quad;
+  const uint32_t old_n = a.num_sections;
+  if (biquad_cascade_init(&a, cfg->lpf, cfg->lpf_sections) != 0 ||
+      biquad_cascade_init(&b, cfg->lpf, cfg->lpf_sections) != 0) {
+    return -1;
+  }
+  if (cfg->lpf_sections == old_n) {
+    /* Same structure: keep the filter memory, swap only the coefficients. */
+    for (uint32_t i = 0; i < old_n; i++) {
+      a.state[i] = rc->lpf_rate.state[i];
+      b.state[i] = rc->lpf_quad.state[i];
+    }
+  }
+  rc->lpf_rate = a;
+  rc->lpf_quad = b;
+  copy_coeffs(rc, cfg);
+  /* P_f is kept as it is, re-expressed around the new reference. */
+  rc->p_dev_deg = rc->p_f_deg - cfg->p_ref_deg;
+  rc->p_ref_deg = cfg->p_ref_deg;
+  rc->p_acc_deg = 0.0f;
+  rc->p_count = 0u;
   return 0;
 }
 

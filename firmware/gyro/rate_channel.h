@@ -42,7 +42,7 @@
 #define RATE_P_DECIM 100u
 
 typedef struct {
-  float demod_phase_rad;
+  float rot_c, rot_s;         /* cos, sin of the demodulation phase phi_dm (designer) */
   float scale_dps;            /* deg/s per unit of Re(R) */
   float bias_c_dps[4];
   float sf_c[4];
@@ -79,6 +79,12 @@ typedef struct {
 
 /* Returns 0, or -1 (nothing changed) for a bad configuration. */
 int rate_channel_init(rate_channel_t *rc, const rate_channel_cfg_t *cfg);
+
+/* New coefficients without touching the state (bumpless; the ISR applies a published
+ * parameter change at a tick boundary). The filter state is kept when the number of
+ * sections is unchanged, cleared otherwise. No libm. Returns 0, or -1 (nothing
+ * changed) for a bad configuration. */
+int rate_channel_retune(rate_channel_t *rc, const rate_channel_cfg_t *cfg);
 
 /* Clear the filters; P_f starts at p_deg. */
 void rate_channel_reset(rate_channel_t *rc, float p_deg);

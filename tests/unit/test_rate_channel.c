@@ -13,7 +13,7 @@ static rate_channel_cfg_t base_cfg(biquad_coeffs_t *sec, float phi_dm)
 {
   const int n = butter_design(BUTTER_LOWPASS, 4u, 100.0, 0.0, 50000.0 / RATE_DECIM, sec, BIQUAD_MAX_SECTIONS);
   assert_int_equal(n, 2);
-  rate_channel_cfg_t c = {.demod_phase_rad = phi_dm, .scale_dps = 250.0f,
+  rate_channel_cfg_t c = {.rot_c = cosf(phi_dm), .rot_s = sinf(phi_dm), .scale_dps = 250.0f,
                           .bias_c_dps = {0, 0, 0, 0}, .sf_c = {0, 0, 0, 0},
                           .p_ref_deg = 0.0f, .p_lpf_alpha = 0.5f, .lpf = sec,
                           .lpf_sections = (uint32_t)n, .min_drive_v = 0.1f};
