@@ -147,31 +147,33 @@ param_store_status_t param_store_load(param_store_t *st, param_values_t *v, para
   memset(got, 0, sizeof got);
   uint8_t chunk[CHUNK_RECORDS * PARAM_STORE_REC_BYTES];
   const uint32_t sec = st->sector[s];
-  for (uint32_t r = 0; r < hdr[s].count; r += CHUNK_RECORDS) {
-    const uint32_t nrec = (hdr[s].count - r < CHUNK_RECORDS) ? hdr[s].count - r : CHUNK_RECORDS;
-    if (hal_flash_read(sec, PARAM_STORE_HDR_BYTES + r * PARAM_STORE_REC_BYTES, chunk,
-                       nrec * PARAM_STORE_REC_BYTES) != HAL_FLASH_OK) {
-      return PARAM_STORE_NONE;
-    }
-    for (uint32_t k = 0; k < nrec; k++) {
-      const uint8_t *rec = &chunk[k * PARAM_STORE_REC_BYTES];
-      const param_idx_t idx = param_lookup_id(get_u16(rec));
-      const param_info_t *pi = param_info(idx);
-      if (pi == NULL || (pi->flags & PF_PERSIST) == 0u) {
-        rep->dropped++;
-        continue;
+  for (uint32_t r = 0; r < hdr[s].count; r++) {
+    const uint32_t k = r % CHUNK_RECORDS;
+    if (k == 0u) {
+      const uint32_t left = hdr[s].count - r;
+      const uint32_t nrec = (left < CHUNK_RECORDS) ? left : CHUNK_RECORDS;
+      if (hal_flash_read(sec, PARAM_STORE_HDR_BYTES + r * PARAM_STORE_REC_BYTES, chunk,
+                         nrec * PARAM_STORE_REC_BYTES) != HAL_FLASH_OK) {
+        return PARAM_STORE_NONE;
       }
-      const param_value_t val = {.u = get_u32(&rec[4])};
-      if (got[idx] == 1u || !type_compatible(rec[2], pi->type) || param_check(idx, val) != PARAM_OK) {
-        rep->rejected++;
-        if (got[idx] == 0u) {
-          got[idx] = 2u;
-        }
-        continue;
-      }
-      got[idx] = 1u;
-      param_put(&out, idx, val);
     }
+    const uint8_t *rec = &chunk[k * PARAM_STORE_REC_BYTES];
+    const param_idx_t idx = param_lookup_id(get_u16(rec));
+    const param_info_t *pi = param_info(idx);
+    if (pi == NULL || (pi->flags & PF_PERSIST) == 0u) {
+      rep->dropped++;
+      continue;
+    }
+    const param_value_t val = {.u = get_u32(&rec[4])};
+    if (got[idx] == 1u || !type_compatible(rec[2], pi->type) || param_check(idx, val) != PARAM_OK) {
+      rep->rejected++;
+      if (got[idx] == 0u) {
+        got[idx] = 2u;
+      }
+      continue;
+    }
+    got[idx] = 1u;
+    param_put(&out, idx, val);
   }
   /* persistent parameters not validly in the image start from their defaults */
   for (unsigned i = 0; i < (unsigned)PARAM_COUNT; i++) {
