@@ -24,9 +24,10 @@ typedef struct {
   uint32_t erase_cut;       /* NO_LIMIT, or bytes erased by the next (interrupted) erase */
   bool power_down;
   hal_flash_host_stats_t stats;
-  uint8_t mem[HAL_FLASH_HOST_MAX_BYTES];
+  uint8_t *mem; /* g_flash_mem */
 } flash_sim_t;
 
+static uint8_t g_flash_mem[HAL_FLASH_HOST_MAX_BYTES];
 static flash_sim_t g_flash;
 
 static void add_busy(uint32_t us)
@@ -74,6 +75,7 @@ int hal_flash_host_configure(const hal_flash_host_cfg_t *cfg)
 {
   hal_flash_host_close();
   memset(&g_flash, 0, sizeof g_flash);
+  g_flash.mem = g_flash_mem;
   const hal_flash_host_cfg_t def = {0u, 0u, NULL, 0u, 0u};
   const hal_flash_host_cfg_t *c = (cfg != NULL) ? cfg : &def;
   const uint32_t n = (c->num_sectors != 0u) ? c->num_sectors : DEFAULT_SECTORS;
