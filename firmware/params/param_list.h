@@ -110,7 +110,7 @@
   /* 50 % over the setpoint: beyond any PI overshoot seen at lock (6.4), short of the stops */ \
   X(sup_amp_trip_rel, 0x0401u, "sup.amp_trip_rel", F32, "-", 1.05f, 5.0f, 1.5f, 0u, \
     PF_PERSIST | PF_LIVE, "over-amplitude trip, as a multiple of drive.amp_set_v") \
-  /* 2 %: well above the demodulated amplitude noise, below a meaningful scale error */ \
+  /* 2 %: well above the demodulated amplitude noise at mu = 0.03, tight enough that LOCKED means settled */ \
   X(sup_lock_tol_rel, 0x0402u, "sup.lock_tol_rel", F32, "-", 0.001f, 0.5f, 0.02f, 0u, \
     PF_PERSIST | PF_LIVE, "LOCKED when the relative amplitude error stays within this") \
   /* 100 Hz matches the 100 Hz output bandwidth */ \
