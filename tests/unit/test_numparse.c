@@ -156,7 +156,7 @@ static void test_random_decimals(void **state)
 {
   (void)state;
   char s[200];
-  for (int n = 0; n < 50000; n++) {
+  for (int n = 0; n < 30000; n++) {
     size_t o = 0;
     const uint32_t r = rnd();
     if (r & 1u) {
@@ -185,7 +185,7 @@ static void test_midpoints(void **state)
 {
   (void)state;
   char s[400];
-  for (int n = 0; n < 20000; n++) {
+  for (int n = 0; n < 10000; n++) {
     uint32_t b = rnd() & 0x7FFFFFFFu;
     if (b < 0x00800000u || b >= 0x7F7FFFFFu) {
       continue;
@@ -229,7 +229,7 @@ static void test_u32(void **state)
   assert_int_equal(numparse_u32("", 0u, &v), NUMPARSE_ERR_EMPTY);
   assert_int_equal(v, 7u);
   char s[32];
-  for (int n = 0; n < 100000; n++) {
+  for (int n = 0; n < 30000; n++) {
     const uint64_t x = ((uint64_t)rnd() << 21 ^ rnd()) % 10000000000ull;
     snprintf(s, sizeof s, "%llu", (unsigned long long)x);
     const numparse_status_t st = numparse_u32(s, strlen(s), &v);
@@ -280,7 +280,7 @@ static void test_format_round_trip_shortest(void **state)
 {
   (void)state;
   char buf[NUMFMT_F32_MAX];
-  for (int n = 0; n < 50000; n++) {
+  for (int n = 0; n < 20000; n++) {
     const uint32_t b = rnd();
     const float x = from_bits(b);
     if (!isnormal(x)) {
