@@ -91,7 +91,7 @@ stm32f4_clock_status_t stm32f4_clock_plan(uint32_t hse_hz, uint32_t sysclk_hz,
   return STM32F4_CLOCK_OK;
 }
 
-static int wait_set(volatile uint32_t *reg, uint32_t mask, uint32_t value)
+static int wait_set(const volatile uint32_t *reg, uint32_t mask, uint32_t value)
 {
   for (uint32_t i = 0u; i < CLOCK_POLL_LIMIT; ++i) {
     if ((*reg & mask) == value) return 1;

@@ -5,7 +5,6 @@
 #include "stm32f4_regs.h"
 
 #define DAC_STREAM 2u /* DMA2 stream 2 channel 7: TIM8_CH1 (RM0090 table 43) */
-#define SPI2_BR_DIV2 0u
 
 static volatile uint16_t s_words[HAL_DAC_NUM_CHANNELS]; /* SRAM: read by DMA */
 static volatile uint32_t s_overruns;
@@ -23,10 +22,11 @@ void stm32f4_dac_init(void)
   RCC->AHB1ENR |= RCC_AHB1ENR_DMA2EN;
   s_overruns = 0u;
 
-  /* SPI2: transmit-only master (bidirectional mode, output enabled), 16-bit, mode 0. */
+  /* SPI2: transmit-only master (bidirectional mode, output enabled), 16-bit, mode 0,
+   * BR = 000: PCLK1 / 2 = 21 MHz. */
   SPI2->CR1 = 0u;
   SPI2->CR1 = SPI_CR1_BIDIMODE | SPI_CR1_BIDIOE | SPI_CR1_MSTR | SPI_CR1_DFF |
-              (SPI2_BR_DIV2 << SPI_CR1_BR_POS) | SPI_CR1_SSM | SPI_CR1_SSI;
+              SPI_CR1_SSM | SPI_CR1_SSI;
   SPI2->CR2 = SPI_CR2_TXDMAEN;
   SPI2->CR1 |= SPI_CR1_SPE;
 
@@ -70,3 +70,10 @@ uint32_t stm32f4_dac_overruns(void)
 {
   return s_overruns;
 }
+
+#ifdef STM32F4_HOST_TEST
+volatile uint16_t *stm32f4_dac_host_words(void)
+{
+  return s_words;
+}
+#endif

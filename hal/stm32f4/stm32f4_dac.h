@@ -29,4 +29,9 @@ uint16_t stm32f4_dac_word(uint32_t channel, uint16_t code);
 /* Frames refused because the previous sequence was still running (ISR overran). */
 uint32_t stm32f4_dac_overruns(void);
 
+#ifdef STM32F4_HOST_TEST
+/* The four words DMA stream 2 sends (see stm32f4_sample_host_rx for why). */
+volatile uint16_t *stm32f4_dac_host_words(void);
+#endif
+
 #endif /* STM32F4_DAC_H */

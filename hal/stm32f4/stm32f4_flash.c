@@ -23,9 +23,9 @@
 static STM32F4_RAMFUNC int flash_wait_idle(void)
 {
   for (uint32_t i = 0u; i < FLASH_POLL_LIMIT; ++i) {
+    STM32F4_POLL_HOOK();
     if ((FLASH_R->SR & FLASH_SR_BSY) == 0u) return 1;
     IWDG->KR = IWDG_KEY_RELOAD;
-    STM32F4_POLL_HOOK();
   }
   return 0;
 }
@@ -36,7 +36,11 @@ static STM32F4_RAMFUNC int flash_unlock(void)
     FLASH_R->KEYR = FLASH_KEY1;
     FLASH_R->KEYR = FLASH_KEY2;
   }
-  /* A wrong sequence keeps the controller locked until the next reset. */
+  /* LOCK clears as soon as the keys are accepted; a wrong sequence keeps the controller
+   * locked until the next reset, which the bounded wait turns into an error. */
+  for (uint32_t i = 0u; i < 1000u && (FLASH_R->CR & FLASH_CR_LOCK) != 0u; ++i) {
+    STM32F4_POLL_HOOK();
+  }
   return (FLASH_R->CR & FLASH_CR_LOCK) == 0u;
 }
 

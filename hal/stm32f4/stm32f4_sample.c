@@ -175,3 +175,10 @@ void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
   stats->overruns = s_overruns;
   stats->dma_errors = s_dma_errors;
 }
+
+#ifdef STM32F4_HOST_TEST
+volatile int16_t *stm32f4_sample_host_rx(void)
+{
+  return s_adc_rx;
+}
+#endif

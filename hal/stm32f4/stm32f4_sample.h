@@ -54,4 +54,10 @@ void stm32f4_sample_stats(stm32f4_sample_stats_t *stats);
 
 void DMA2_Stream0_IRQHandler(void);
 
+#ifdef STM32F4_HOST_TEST
+/* The two-word buffer DMA stream 0 fills (the host's 64-bit pointers do not fit the
+ * 32-bit DMA address registers, so a test reaches it through this instead). */
+volatile int16_t *stm32f4_sample_host_rx(void);
+#endif
+
 #endif /* STM32F4_SAMPLE_H */
