@@ -2,7 +2,8 @@
 #
 # One firmware image for the Cortex-M4F board: links SOURCES and LIBS with the board's
 # linker script (default linker/stm32f405.ld) into <name>.elf, writes <name>.map,
-# <name>.bin (raw, from the first flash address) and <name>.hex next to it, and prints
+# <name>.bin (raw from 0x0800_0000; it spans the parameter sectors, filled with 0xFF)
+# and <name>.hex (sparse: leaves the parameter sectors alone) next to it, and prints
 # a size report at build time: the linker's per-region table (--print-memory-usage)
 # followed by flash / SRAM / CCM used vs available (linker/image_size.cmake).
 # Compiler and linker warnings are errors.
@@ -29,7 +30,7 @@ function(gyro_add_image name)
     # .ramfunc makes the SRAM segment writable and executable on purpose.
     -Wl,--no-warn-rwx-segments)
   add_custom_command(TARGET ${name} POST_BUILD
-    COMMAND ${CMAKE_OBJCOPY} -O binary $<TARGET_FILE:${name}> ${name}.bin
+    COMMAND ${CMAKE_OBJCOPY} -O binary --gap-fill 0xff $<TARGET_FILE:${name}> ${name}.bin
     COMMAND ${CMAKE_OBJCOPY} -O ihex $<TARGET_FILE:${name}> ${name}.hex
     COMMAND ${CMAKE_COMMAND} -DELF=$<TARGET_FILE:${name}> -DSIZE_TOOL=${CMAKE_SIZE}
             -DNAME=${name} -P ${GYRO_IMAGE_SIZE_SCRIPT}

@@ -8,6 +8,8 @@
 
 static volatile uint16_t s_words[HAL_DAC_NUM_CHANNELS]; /* SRAM: read by DMA */
 static volatile uint32_t s_overruns;
+static volatile uint32_t s_late;
+static volatile uint32_t s_deadline = 0xFFFFFFFFu;
 
 STM32F4_RAMFUNC uint16_t stm32f4_dac_word(uint32_t channel, uint16_t code)
 {
@@ -21,6 +23,7 @@ void stm32f4_dac_init(void)
   RCC->APB2ENR |= RCC_APB2ENR_TIM8EN;
   RCC->AHB1ENR |= RCC_AHB1ENR_DMA2EN;
   s_overruns = 0u;
+  s_late = 0u;
 
   /* SPI2: transmit-only master (bidirectional mode, output enabled), 16-bit, mode 0,
    * BR = 000: PCLK1 / 2 = 21 MHz. */
@@ -52,6 +55,10 @@ void stm32f4_dac_init(void)
 
 STM32F4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame)
 {
+  if (TIM1->CNT > s_deadline) {
+    ++s_late;
+    return;
+  }
   if ((TIM8->CR1 & TIM_CR1_CEN) != 0u || (DMA2->S[DAC_STREAM].CR & DMA_SXCR_EN) != 0u) {
     ++s_overruns;
     return;
@@ -69,6 +76,16 @@ STM32F4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame)
 uint32_t stm32f4_dac_overruns(void)
 {
   return s_overruns;
+}
+
+void stm32f4_dac_set_deadline(uint32_t tim1_count)
+{
+  s_deadline = tim1_count;
+}
+
+uint32_t stm32f4_dac_late(void)
+{
+  return s_late;
 }
 
 #ifdef STM32F4_HOST_TEST

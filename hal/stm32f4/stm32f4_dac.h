@@ -29,6 +29,13 @@ uint16_t stm32f4_dac_word(uint32_t channel, uint16_t code);
 /* Frames refused because the previous sequence was still running (ISR overran). */
 uint32_t stm32f4_dac_overruns(void);
 
+/* Latest TIM1 count at which a four-word sequence still ends before the next LDAC
+ * (set by the sample chain). A frame queued later is dropped and counted: the outputs
+ * hold the previous frame one tick longer instead of being updated half now, half at
+ * the tick after. */
+void stm32f4_dac_set_deadline(uint32_t tim1_count);
+uint32_t stm32f4_dac_late(void);
+
 #ifdef STM32F4_HOST_TEST
 /* The four words DMA stream 2 sends (see stm32f4_sample_host_rx for why). */
 volatile uint16_t *stm32f4_dac_host_words(void);

@@ -3,6 +3,7 @@
 #include "hal/hal_adc.h"
 #include "hal/hal_sample_timer.h"
 #include "stm32f4_core.h"
+#include "stm32f4_dac.h"
 #include "stm32f4_regs.h"
 
 #define ADC_RX_STREAM 0u   /* DMA2 stream 0 channel 3: SPI1_RX (RM0090 table 43) */
@@ -136,6 +137,11 @@ int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
   TIM1->BDTR = TIM_BDTR_MOE;
   TIM1->EGR = TIM_EGR_UG; /* load PSC, ARR and the CCR preloads */
   TIM1->SR = 0u;
+
+  /* The DAC words must all be in before LDAC falls at the next update event. */
+  stm32f4_dac_set_deadline(plan.arr + 1u -
+                           ns_to_ticks(STM32F4_DAC_SEQ_NS + STM32F4_DAC_GUARD_NS,
+                                       STM32F4_SAMPLE_TIM_HZ, plan.psc));
 
   stm32f4_nvic_enable(STM32F4_IRQ_DMA2_STREAM0, STM32F4_PRIO_SAMPLE);
   TIM1->CR1 = TIM_CR1_ARPE | TIM_CR1_CEN;

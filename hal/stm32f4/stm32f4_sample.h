@@ -28,6 +28,7 @@
 #define STM32F4_ADC_SPI_HZ 10500000u  /* PCLK2 84 MHz / 8; AD7606 f_SCLK max 17 MHz at VDRIVE 3.3 V */
 #define STM32F4_ADC_READ_NS 3250u     /* 32 SCLK at 10.5 MHz = 3048 ns + DMA latency */
 #define STM32F4_DAC_SEQ_NS 5000u      /* four 1.25 us AD5554 word slots (stm32f4_dac.h) */
+#define STM32F4_DAC_GUARD_NS 100u     /* DMA latency allowance before the next LDAC */
 #define STM32F4_MIN_TICK_NS 1000u     /* the least compute time a period must leave */
 
 typedef struct {

@@ -99,6 +99,22 @@ static void test_write_while_busy_is_refused(void **state)
   assert_int_equal(stm32f4_dac_host_words()[0], 9u);
 }
 
+static void test_late_frame_is_dropped(void **state)
+{
+  (void)state;
+  const hal_dac_frame_t a = {{5u, 6u, 7u, 8u}};
+  stm32f4_dac_set_deadline(2503u);
+  TIM1->CNT = 2504u; /* too late: the sequence would straddle the next LDAC */
+  hal_dac_write_frame(&a);
+  assert_int_equal(stm32f4_dac_late(), 1);
+  assert_int_equal(TIM8->CR1 & TIM_CR1_CEN, 0);
+  TIM1->CNT = 2503u;
+  hal_dac_write_frame(&a);
+  assert_int_equal(stm32f4_dac_late(), 1);
+  assert_int_equal(stm32f4_dac_host_words()[3], 0xC000u | 8u);
+  stm32f4_dac_set_deadline(0xFFFFFFFFu);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -107,6 +123,7 @@ int main(void)
       cmocka_unit_test_setup(test_init_registers, setup),
       cmocka_unit_test_setup(test_write_frame_arms_sequence, setup),
       cmocka_unit_test_setup(test_write_while_busy_is_refused, setup),
+      cmocka_unit_test_setup(test_late_frame_is_dropped, setup),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

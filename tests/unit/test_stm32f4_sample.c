@@ -9,6 +9,8 @@
 
 #include "hal/hal_adc.h"
 #include "hal/hal_sample_timer.h"
+#include "hal/hal_dac.h"
+#include "stm32f4_dac.h"
 #include "stm32f4_host_regs.h"
 #include "stm32f4_sample.h"
 
@@ -144,6 +146,24 @@ static void test_start_programs_hardware_chain(void **state)
   assert_int_equal(NVIC->IP[56], 0);
 }
 
+static void test_start_sets_dac_deadline(void **state)
+{
+  (void)state;
+  isr_probe_t probe = {0};
+  assert_int_equal(hal_sample_timer_start(50000u, probe_isr, &probe), 0);
+  /* Four 1.25 us DAC slots + 0.1 us guard must end by the next LDAC at 20 us:
+   * last start at 14.9 us = 2503.2 counts of 168 MHz. */
+  const hal_dac_frame_t f = {{1u, 2u, 3u, 4u}};
+  const uint32_t late0 = stm32f4_dac_late();
+  TIM1->CNT = 2504u;
+  hal_dac_write_frame(&f);
+  assert_int_equal(stm32f4_dac_late(), late0 + 1u);
+  TIM1->CNT = 2503u;
+  hal_dac_write_frame(&f);
+  assert_int_equal(stm32f4_dac_late(), late0 + 1u);
+  stm32f4_dac_set_deadline(0xFFFFFFFFu);
+}
+
 static void test_start_rejects(void **state)
 {
   (void)state;
@@ -219,6 +239,7 @@ int main(void)
       cmocka_unit_test(test_plan_slow_rate_uses_prescaler),
       cmocka_unit_test(test_plan_rejects),
       cmocka_unit_test_setup(test_start_programs_hardware_chain, setup),
+      cmocka_unit_test_setup(test_start_sets_dac_deadline, setup),
       cmocka_unit_test_setup(test_start_rejects, setup),
       cmocka_unit_test_setup(test_interrupt_rearms_and_calls_isr, setup),
       cmocka_unit_test_setup(test_stop_parks_outputs, setup),

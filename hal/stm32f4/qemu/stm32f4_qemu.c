@@ -124,6 +124,11 @@ uint32_t stm32f4_dac_overruns(void)
   return 0u;
 }
 
+uint32_t stm32f4_dac_late(void)
+{
+  return 0u;
+}
+
 void stm32f4_uptime_init(void)
 {
   TIM2->CR1 = 0u;
