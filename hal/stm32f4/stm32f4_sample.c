@@ -12,10 +12,12 @@
 #define CHSEL(n) ((uint32_t)(n) << DMA_SXCR_CHSEL_POS)
 #define SPI1_BR_DIV8 2u
 
-/* DMA targets live in SRAM (.bss/.data): the DMA streams cannot reach the CCM. */
+/* DMA sources and targets live in SRAM (.bss/.data), deliberately not const: the DMA
+ * streams cannot reach the CCM, and a DMA read from flash would stall for the whole of
+ * a parameter-sector erase, stopping the sample chain. */
 static volatile int16_t s_adc_rx[2];
-static const uint16_t s_adc_tx_dummy = 0u;
-static const uint16_t s_spi1_cr2_go = (uint16_t)(SPI_CR2_RXDMAEN | SPI_CR2_TXDMAEN);
+static volatile uint16_t s_adc_tx_dummy = 0u;
+static volatile uint16_t s_spi1_cr2_go = (uint16_t)(SPI_CR2_RXDMAEN | SPI_CR2_TXDMAEN);
 
 static hal_sample_isr_fn s_isr;
 static void *s_ctx;
