@@ -142,7 +142,8 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   (void)lmsd_set_mu(&g->lmsd_drive, d->lmsd_drive.mu);
   (void)lmsd_set_mu(&g->lmsd_sense, d->lmsd_sense.mu);
   drive_loop_retune(&g->drive, &d->drive);
-  if (d->synth.mode == g->synth.mode) {
+  /* The drive scheme only changes with the drive off (drive.mode is not live). */
+  if (d->synth.mode == g->synth.mode || !supervisor_drive_enabled(&g->sup)) {
     (void)drive_synth_init(&g->synth, &d->synth);
   }
   rate_channel_cfg_t rc = d->rate;

@@ -95,7 +95,7 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d);
 int gyro_init(gyro_t *g, const param_values_t *v);
 
 /* Apply a new design in the ISR at a tick boundary: coefficients change, loop state
- * carries on (bumpless). drive.mode changes only through gyro_init (PF_RESTART). */
+ * carries on (bumpless). The drive scheme changes only while the drive is off. */
 void gyro_apply(gyro_t *g, const gyro_design_t *d);
 
 /* One sample: ADC frame in, DAC frame out (latched by the HAL at the next tick). */

@@ -42,7 +42,7 @@
     PF_PERSIST | PF_LIVE, "drive frequency, fixed near the drive resonance found by the sweep") \
   /* half-frequency by default: 1/f voltage noise lands at wc/2, not wc (6-21, 6-23) */ \
   X(drive_mode, 0x0102u, "drive.mode", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
-    PF_PERSIST | PF_RESTART, "drive scheme: 0 half-frequency (6-18), 1 DC+AC (6-20)") \
+    PF_PERSIST, "drive scheme: 0 half-frequency (6-18), 1 DC+AC (6-20); drive off to change") \
   /* 10 um of drive motion (4.6.1) at the default plant's 1.8e5 V/m pickoff: 36 % of the ADC */ \
   X(drive_amp_set_v, 0x0103u, "drive.amp_set_v", F32, "V", 0.05f, 4.5f, 1.8f, 0u, \
     PF_PERSIST | PF_LIVE, "setpoint of the demodulated drive-pickoff amplitude at the ADC") \
