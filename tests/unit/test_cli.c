@@ -289,7 +289,7 @@ static void test_list(void **state)
   assert_string_equal(out + strlen(out) - strlen(tail), tail);
   assert_int_equal(g.cli.truncated, 0u);
   assert_non_null(strstr(out, "- drive.freq_hz 1489.9 Hz [500,5000] def=1489.9 flags=PL drive frequency"));
-  assert_non_null(strstr(out, "- drive.mode 0 - {0,1} def=0 flags=PB "));
+  assert_non_null(strstr(out, "- drive.mode 0 - {0,1} def=0 flags=P "));
   assert_non_null(strstr(out, "- sys.fs_hz 50000 Hz [50000,50000] def=50000 flags=R "));
   out = run("list rate.bias\n");
   assert_int_equal(check_grammar(out), 1);
