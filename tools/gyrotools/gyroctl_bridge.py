@@ -73,23 +73,24 @@ def _run(cmd, timeout_s):
     return p
 
 
-def write_bias_coeffs(port, coeffs, gyroctl=None, timeout_s=30.0):
-    """Set rate.bias_c0..c3 to coeffs (ascending, 1 to 4 values, rest 0), then save.
+def write_params(port, values, gyroctl=None, timeout_s=30.0):
+    """Set each parameter of values ({name: number}, in order) with gyroctl, then save.
 
     Returns the list of commands run. Raises GyroctlError (an InputError) before running
-    anything if the input is invalid, and on the first command that fails.
+    anything if the input is invalid, and on the first command that fails (naming what
+    was already set live but not saved).
     """
     if not isinstance(port, str) or not port.strip():
         raise GyroctlError("no serial port given")
-    coeffs = [float(c) for c in coeffs]
-    if not 1 <= len(coeffs) <= len(BIAS_PARAMS):
-        raise GyroctlError(f"{len(coeffs)} bias coefficients; expected 1 to {len(BIAS_PARAMS)}")
-    if not all(math.isfinite(c) for c in coeffs):
-        raise GyroctlError(f"non-finite bias coefficient in {coeffs}")
-    coeffs = coeffs + [0.0] * (len(BIAS_PARAMS) - len(coeffs))
+    items = [(str(k), float(v)) for k, v in values.items()]
+    if not items:
+        raise GyroctlError("nothing to write")
+    bad = [k for k, v in items if not math.isfinite(v)]
+    if bad:
+        raise GyroctlError(f"non-finite value for {', '.join(bad)}")
     exe = gyroctl or find_gyroctl()
     done = []
-    for name, value in zip(BIAS_PARAMS, coeffs):
+    for name, value in items:
         cmd = [exe, "--port", port, "set", name, format_value(value)]
         try:
             _run(cmd, timeout_s)
@@ -101,3 +102,14 @@ def write_bias_coeffs(port, coeffs, gyroctl=None, timeout_s=30.0):
     _run(cmd, timeout_s)
     done.append(cmd)
     return done
+
+
+def write_bias_coeffs(port, coeffs, gyroctl=None, timeout_s=30.0):
+    """Set rate.bias_c0..c3 to coeffs (ascending, 1 to 4 values, rest 0), then save."""
+    coeffs = [float(c) for c in coeffs]
+    if not 1 <= len(coeffs) <= len(BIAS_PARAMS):
+        raise GyroctlError(f"{len(coeffs)} bias coefficients; expected 1 to {len(BIAS_PARAMS)}")
+    if not all(math.isfinite(c) for c in coeffs):
+        raise GyroctlError(f"non-finite bias coefficient in {coeffs}")
+    coeffs = coeffs + [0.0] * (len(BIAS_PARAMS) - len(coeffs))
+    return write_params(port, dict(zip(BIAS_PARAMS, coeffs)), gyroctl, timeout_s)
