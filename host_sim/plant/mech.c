@@ -259,7 +259,7 @@ static void build_k(mech_t *m, double w, double a)
   m->k_valid = 1;
 }
 
-void mech_step(mech_t *m, double f_drive_n, double f_sense_n, double rate_rad_s,
+void mech_step(mech_t *m, double f_drive_mps2, double f_sense_mps2, double rate_rad_s,
                double rate_dot_rad_s2)
 {
   const double wr = m->wr;
@@ -268,14 +268,14 @@ void mech_step(mech_t *m, double f_drive_n, double f_sense_n, double rate_rad_s,
   if (!m->q_valid) build_q(m);
   if (!m->k_valid || w != m->coef[0] || a != m->coef[1]) build_k(m, w, a);
 
-  const double in_scale = 1.0 / (m->cfg.mass_kg * wr * wr);
+  const double in_scale = 1.0 / (wr * wr);
   double v[NA];
   v[0] = m->z[0];
   v[1] = m->z[1];
   v[2] = m->z[2];
   v[3] = m->z[3];
-  v[4] = f_drive_n * in_scale;
-  v[5] = f_sense_n * in_scale;
+  v[4] = f_drive_mps2 * in_scale;
+  v[5] = f_sense_mps2 * in_scale;
   if (m->cfg.brownian) {
     v[4] += m->noise_sd[0] * rng_gauss(&m->rng[0]);
     v[5] += m->noise_sd[1] * rng_gauss(&m->rng[1]);

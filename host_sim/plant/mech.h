@@ -87,7 +87,7 @@ typedef struct {
   double ket_per_k;    /* kET, temperature coefficient of Young's modulus (2-29) */
   double kq_per_s2;    /* k_q at T0: quadrature stiffness coupling per unit mass */
   double dq_per_s;     /* d_q at T0: damping coupling per unit mass */
-  double mass_kg;      /* proof mass m: Brownian noise and force -> acceleration */
+  double mass_kg;      /* proof mass m: sets the Brownian noise (4-20) */
   double fs_hz;        /* sample rate */
   double refresh_eps;  /* |wn(T)/wn(T_d) - 1| that triggers a re-discretisation */
   int full_kinematics; /* 1: reciprocal Coriolis, centrifugal and Euler terms (2-20) */
@@ -133,9 +133,10 @@ int mech_init(mech_t *m, const mech_cfg_t *cfg, double temp_k, uint64_t seed);
  * non-positive temperatures are ignored (returns -1). */
 int mech_set_temp(mech_t *m, double temp_k);
 
-/* Advance one sample. f_drive_n, f_sense_n: forces (N) held over the sample;
+/* Advance one sample. f_drive_mps2, f_sense_mps2: forces per unit mass (m/s^2, the
+ * f_y, f_x of (2-22); actuator and accel give them in this unit) held over the sample;
  * rate_rad_s, rate_dot_rad_s2: Omega and dOmega/dt at the middle of the sample. */
-void mech_step(mech_t *m, double f_drive_n, double f_sense_n, double rate_rad_s,
+void mech_step(mech_t *m, double f_drive_mps2, double f_sense_mps2, double rate_rad_s,
                double rate_dot_rad_s2);
 
 mech_state_t mech_state(const mech_t *m);

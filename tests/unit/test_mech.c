@@ -180,7 +180,7 @@ static void held_response(const lin_model_t *p, double w, double fs, double comp
   *x = sx;
 }
 
-/* Runs mech with held force F sin(w n T) (N) for n_total samples, and returns the
+/* Runs mech with held force F sin(w n T) (per unit mass) for n_total samples, and returns the
  * largest deviation of the last n_cmp samples from Im(Y e^{j w n T}) etc., relative
  * to |Y| and |X|. */
 static void run_and_compare(mech_t *m, double f_n, double w, double rate, double complex y,
@@ -190,7 +190,7 @@ static void run_and_compare(mech_t *m, double f_n, double w, double rate, double
   *ey = 0.0;
   *ex = 0.0;
   for (long n = 0; n < n_total; n++) {
-    mech_step(m, f_n * sin(w * n * T), 0.0, rate, 0.0);
+    mech_step(m, f_n / m->cfg.mass_kg * sin(w * n * T), 0.0, rate, 0.0);
     if (n >= n_total - n_cmp) {
       const long k = n + 1; /* state after the step is at sample n+1 */
       const double complex ph = cexp(I * w * k * T);
@@ -310,7 +310,7 @@ static void test_closed_drive_2_28(void **state)
   double ey = 0.0, ex = 0.0;
   const long n_total = 600000, n_cmp = 20000;
   for (long n = 0; n < n_total; n++) {
-    mech_step(&m, cimag(fph * cexp(I * wc * n * T)), 0.0, omega, 0.0);
+    mech_step(&m, cimag(fph * cexp(I * wc * n * T)) / c.mass_kg, 0.0, omega, 0.0);
     if (n >= n_total - n_cmp) {
       const double t = (n + 1) * T;
       const mech_state_t s = mech_state(&m);
@@ -383,7 +383,7 @@ static void varying_run(double kq_dps, int nsub, double *ey_out, double *ex_out,
     }
     const double f = f_n * sin(wc * n * T);
     const double tm = (n + 0.5) * T;
-    mech_step(&m, f, 0.0, rate_fn(tm), rate_dot_fn(tm));
+    mech_step(&m, f / c.mass_kg, 0.0, rate_fn(tm), rate_dot_fn(tm));
     /* reference: the rate re-evaluated at the middle of each of nsub sub-steps,
      * exact exponential of the exact model (wn(T)^2 not expanded) each time */
     const double u[2] = {f / c.mass_kg / (r.wsc * r.wsc), 0.0};
@@ -465,7 +465,7 @@ static double expansion_error(double eps, double *ex_out)
   const long n_total = 30000, n_cmp = 2000;
   for (long n = 0; n < n_total; n++) {
     const double f = 6.8e-6 * sin(wc * n * T);
-    mech_step(&m, f, 0.0, omega, 0.0);
+    mech_step(&m, f / c.mass_kg, 0.0, omega, 0.0);
     const double v[6] = {xr[0], xr[1], xr[2], xr[3], f / c.mass_kg / (r.wsc * r.wsc), 0.0};
     double nx[4];
     for (int i = 0; i < 4; i++) {
