@@ -6,6 +6,8 @@ set -euo pipefail
 APT_PKGS=(
   cmake ninja-build gcc g++ make pkg-config
   libcmocka-dev          # unit tests and HAL mocks
+  zlib1g-dev             # reference crc32() for the parameter-store CRC test
+  libclang-rt-14-dev     # libFuzzer and sanitizer runtimes for clang (tools/run-fuzz)
   libeigen3-dev          # host-only C++ reference implementations (tests/reference)
   libcjson-dev           # scenario-file parsing in gyro-sim
   cppcheck               # static analysis of firmware/ and hal/

@@ -29,9 +29,13 @@ int biquad_cascade_init(biquad_cascade_t *bq, const biquad_coeffs_t *sections, u
 
 void biquad_cascade_reset(biquad_cascade_t *bq, float x_steady)
 {
+  if (bq == NULL || bq->num_sections > BIQUAD_MAX_SECTIONS) {
+    return; /* not a cascade biquad_cascade_init accepted */
+  }
+  /* A non-finite level would poison the state until the next init: clear instead. */
+  float x = isfinite(x_steady) ? x_steady : 0.0f;
   /* Steady state of one section for constant input x: y = g x with the section's DC gain
    * g = (b0 + b1 + b2) / (1 + a1 + a2); then s2 = b2 x - a2 y and s1 = y - b0 x. */
-  float x = x_steady;
   for (uint32_t i = 0; i < bq->num_sections; i++) {
     const biquad_coeffs_t *c = &bq->coeffs[i];
     const float den = 1.0f + c->a1 + c->a2;

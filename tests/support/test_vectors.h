@@ -1,4 +1,4 @@
-/* Reading committed reference vectors (tests/vectors/*.csv, written by tools/ scripts
+/* Reading committed reference vectors (tests/vectors/NAME.csv, written by tools/ scripts
  * from scipy/numpy). Header-only; test code may allocate, firmware never does. */
 #ifndef TEST_VECTORS_H
 #define TEST_VECTORS_H

@@ -1,0 +1,222 @@
+/* Line discipline, tokenising, dispatch and reply framing of the command line; the
+ * built-in parameter commands live in cli_builtin.c. Grammar in cli.h. */
+#include "comm/cli.h"
+
+#include <string.h>
+
+#include "comm/cli_builtin.h"
+#include "comm/numfmt.h"
+
+static bool is_wsp(char c) { return c == ' ' || c == '\t'; }
+
+int cli_init(cli_t *cli, const cli_cfg_t *cfg)
+{
+  memset(cli, 0, sizeof *cli);
+  if (cfg == NULL || cfg->params == NULL || cfg->write == NULL) {
+    return -1;
+  }
+  cli->cfg = *cfg;
+  return 0;
+}
+
+static const cli_cmd_t *find_cmd(const cli_t *cli, const char *name)
+{
+  const cli_cmd_t *c = cli_builtin_find(name);
+  if (c != NULL) {
+    return c;
+  }
+  for (uint32_t i = 0; i < cli->n_app; i++) {
+    if (strcmp(cli->app[i]->name, name) == 0) {
+      return cli->app[i];
+    }
+  }
+  return NULL;
+}
+
+int cli_register(cli_t *cli, const cli_cmd_t *cmd)
+{
+  if (cmd == NULL || cmd->fn == NULL || cmd->name == NULL || cmd->name[0] == '\0' ||
+      cli->n_app >= CLI_MAX_APP_CMDS) {
+    return -1;
+  }
+  for (const char *p = cmd->name; *p != '\0'; p++) {
+    if (*p <= ' ' || *p > '~') {
+      return -1;
+    }
+  }
+  if (find_cmd(cli, cmd->name) != NULL) {
+    return -1;
+  }
+  cli->app[cli->n_app++] = cmd;
+  return 0;
+}
+
+uint32_t cli_app_count(const cli_t *cli) { return cli->n_app; }
+
+const cli_cmd_t *cli_app_cmd(const cli_t *cli, uint32_t i) { return (i < cli->n_app) ? cli->app[i] : NULL; }
+
+/* ---- reply framing ---- */
+
+void cli_put_n(cli_t *cli, const char *s, size_t n)
+{
+  for (size_t i = 0; i < n && s[i] != '\0'; i++) {
+    if (cli->out_len + 2u >= CLI_OUT_MAX) { /* keep room for CRLF */
+      cli->truncated++;
+      return;
+    }
+    const char c = s[i];
+    cli->out[cli->out_len++] = (c >= ' ' && c <= '~') ? c : '?';
+  }
+}
+
+void cli_put(cli_t *cli, const char *s)
+{
+  if (s != NULL) {
+    cli_put_n(cli, s, strlen(s));
+  }
+}
+
+void cli_put_f32(cli_t *cli, float x)
+{
+  char buf[NUMFMT_F32_MAX];
+  const size_t n = numfmt_f32(buf, sizeof buf, x);
+  cli_put_n(cli, buf, n);
+}
+
+void cli_put_u32(cli_t *cli, uint32_t x)
+{
+  char buf[NUMFMT_U32_MAX];
+  const size_t n = numfmt_u32(buf, sizeof buf, x);
+  cli_put_n(cli, buf, n);
+}
+
+/* Send prefix + the built text + CRLF, then clear the builder. */
+static void emit(cli_t *cli, const char *prefix, bool final)
+{
+  if (cli->replied) {
+    cli->out_len = 0u; /* the command already ended: keep the grammar */
+    return;
+  }
+  char line[CLI_OUT_MAX + 32u];
+  size_t n = strlen(prefix);
+  memcpy(line, prefix, n);
+  memcpy(&line[n], cli->out, cli->out_len);
+  n += cli->out_len;
+  line[n++] = '\r';
+  line[n++] = '\n';
+  cli->out_len = 0u;
+  cli->replied = final;
+  cli->cfg.write(cli->cfg.write_ctx, line, n);
+}
+
+void cli_emit_data(cli_t *cli) { emit(cli, "- ", false); }
+
+void cli_emit_ok(cli_t *cli) { emit(cli, (cli->out_len > 0u) ? "ok " : "ok", true); }
+
+void cli_emit_err(cli_t *cli, const char *code)
+{
+  char prefix[24] = "err ";
+  size_t n = 4u;
+  for (const char *p = code; p != NULL && *p != '\0' && n + 2u < sizeof prefix; p++) {
+    prefix[n++] = (*p >= 'A' && *p <= 'Z') ? *p : '?';
+  }
+  prefix[n++] = ' ';
+  prefix[n] = '\0';
+  emit(cli, prefix, true);
+}
+
+void cli_ok(cli_t *cli, const char *msg)
+{
+  cli->out_len = 0u;
+  cli_put(cli, msg);
+  cli_emit_ok(cli);
+}
+
+void cli_err(cli_t *cli, const char *code, const char *msg)
+{
+  cli->out_len = 0u;
+  cli_put(cli, msg);
+  cli_emit_err(cli, code);
+}
+
+/* ---- line discipline ---- */
+
+static void execute(cli_t *cli)
+{
+  const char *argv[CLI_MAX_ARGS + 1u];
+  uint32_t argc = 0u;
+  char *p = cli->line;
+  cli->line[cli->len] = '\0';
+  while (*p != '\0') {
+    while (is_wsp(*p)) {
+      *p++ = '\0';
+    }
+    if (*p == '\0') {
+      break;
+    }
+    if (argc == CLI_MAX_ARGS) {
+      cli_err(cli, "ARGS", "too many words on the line");
+      return;
+    }
+    argv[argc++] = p;
+    while (*p != '\0' && !is_wsp(*p)) {
+      p++;
+    }
+  }
+  if (argc == 0u) {
+    return; /* blank line: no reply */
+  }
+  argv[argc] = NULL;
+  const cli_cmd_t *cmd = find_cmd(cli, argv[0]);
+  if (cmd == NULL) {
+    cli->out_len = 0u;
+    cli_put(cli, "no command '");
+    cli_put(cli, argv[0]);
+    cli_put(cli, "'; try help");
+    cli_emit_err(cli, "UNKNOWN");
+    return;
+  }
+  cmd->fn(cli, cmd->ctx, argc, argv);
+  if (!cli->replied) {
+    cli_err(cli, "INTERNAL", "handler gave no reply");
+  }
+}
+
+static void end_of_line(cli_t *cli)
+{
+  cli->replied = false;
+  cli->out_len = 0u;
+  if (cli->discard == (uint8_t)CLI_DISCARD_TOOLONG) {
+    cli_put(cli, "line longer than ");
+    cli_put_u32(cli, CLI_LINE_MAX);
+    cli_put(cli, " bytes discarded");
+    cli_emit_err(cli, "TOOLONG");
+  } else if (cli->discard == (uint8_t)CLI_DISCARD_BADCHAR) {
+    cli_err(cli, "BADCHAR", "line with a non-printable byte discarded");
+  } else if (cli->len > 0u) {
+    execute(cli);
+  }
+  cli->len = 0u;
+  cli->discard = (uint8_t)CLI_DISCARD_NONE;
+}
+
+void cli_feed(cli_t *cli, const uint8_t *data, size_t len)
+{
+  for (size_t i = 0; i < len; i++) {
+    const uint8_t ch = data[i];
+    if (ch == '\r' || ch == '\n') {
+      end_of_line(cli);
+      continue;
+    }
+    if (cli->discard != (uint8_t)CLI_DISCARD_NONE) {
+      continue;
+    }
+    if (!((ch >= 0x20u && ch <= 0x7Eu) || ch == '\t')) {
+      cli->discard = (uint8_t)CLI_DISCARD_BADCHAR;
+    } else if (cli->len >= CLI_LINE_MAX) {
+      cli->discard = (uint8_t)CLI_DISCARD_TOOLONG;
+    } else {
+      cli->line[cli->len++] = (char)ch;
+    }
+  }
+}

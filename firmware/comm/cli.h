@@ -1,0 +1,127 @@
+/* Text command line on the tuning UART (thesis 7.3: parameters are read and written over
+ * the serial port while the gyro runs). Fed bytes by the background loop, never by the
+ * ISR; all replies go through one output callback.
+ *
+ * Input grammar
+ *   line    = *WSP [ word *( 1*WSP word ) ] *WSP EOL
+ *   EOL     = CR | LF | CR LF      (an empty or blank line, e.g. the LF of CR LF, is
+ *                                   ignored without a reply)
+ *   WSP     = SP | HTAB
+ *   word    = 1*( %x21-7E )
+ *   - at most CLI_LINE_MAX bytes before the EOL; a longer line is discarded whole and
+ *     answered "err TOOLONG ..." when its EOL arrives;
+ *   - any other byte (NUL, control characters, DEL, bytes >= 0x80) discards the whole
+ *     line, answered "err BADCHAR ..." at its EOL;
+ *   - no echo, no prompt, no line editing; names are case-sensitive.
+ *
+ * Reply grammar: every non-blank line gets exactly one reply,
+ *   reply   = *data-line final
+ *   data-line = "- " text CRLF        (list, diff, help: one item per line)
+ *   final   = "ok" [ SP text ] CRLF
+ *           | "err" SP CODE SP message CRLF
+ *   CODE    = ARGS | UNKNOWN | NAME | RO | VALUE | RANGE | BUSY | PENDING | REJECTED |
+ *             NOSTORE | FLASH | TOOLONG | BADCHAR | INTERNAL   (application handlers may
+ *             add their own upper-case codes)
+ *   text never contains CR or LF; a host reads lines until one starts with "ok" or "err".
+ *
+ * Built-in commands and their final lines
+ *   help                    - NAME ARGS : HELP ...            ok N commands
+ *   list [PREFIX]           - NAME VALUE UNIT RANGE def=DEFAULT flags=FLAGS HELP ...
+ *                           ok N parameters
+ *       RANGE is [MIN,MAX] or {A,B,...} for a choice; FLAGS letters: P persistent,
+ *       L live (may change while the drive runs), R read-only, B applies after a
+ *       restart (boot), "-" none; UNIT "-" for dimensionless; HELP is the rest.
+ *   get NAME                ok NAME VALUE UNIT
+ *   set NAME VALUE [NAME VALUE ...]
+ *                           ok NAME VALUE [NAME VALUE ...]   (values as now held)
+ *       all pairs are validated, staged and published together at one tick boundary,
+ *       or nothing changes; a bad value is answered with the allowed range.
+ *   save                    ok saved slot A|B seq N  |  ok unchanged slot A|B seq N
+ *   load                    ok loaded slot A|B seq N dropped D rejected R defaulted M
+ *   defaults                ok defaults applied (not saved)
+ *   diff                    - NAME VALUE default DEFAULT ...  ok N differ
+ *   version                 ok fw MAJOR.MINOR.PATCH layout L format F params N
+ * plus the application's registered commands (status, sweep, stream FIELD... @RATE_HZ,
+ * stop, ...), listed by help.
+ *
+ * The output callback receives whole lines (CRLF included) and must take all of them:
+ * the application queues them (a TX ring sized for the longest reply, about 4 KB for
+ * list) or drains the UART; the CLI keeps no output backlog.
+ */
+#ifndef CLI_H
+#define CLI_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "params/param_store.h"
+#include "params/params.h"
+
+#define CLI_LINE_MAX 120u
+#define CLI_MAX_ARGS 16u
+#define CLI_MAX_APP_CMDS 8u
+#define CLI_OUT_MAX 256u
+
+typedef struct cli cli_t;
+
+typedef void (*cli_write_fn)(void *ctx, const char *data, size_t len);
+/* argv[0] is the command name; every argv[i] is a NUL-terminated word. A handler ends
+ * with exactly one cli_ok/cli_err (or cli_emit_ok/cli_emit_err); missing that, the CLI
+ * answers "err INTERNAL"; output after the final line is dropped. */
+typedef void (*cli_handler_fn)(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv);
+
+typedef struct {
+  const char *name; /* one word */
+  const char *args; /* usage, e.g. "FIELD... @RATE_HZ" ("" if none) */
+  const char *help; /* one line */
+  cli_handler_fn fn;
+  void *ctx;
+} cli_cmd_t;
+
+typedef struct {
+  params_t *params;      /* required */
+  param_store_t *store;  /* NULL: save/load answer err NOSTORE */
+  cli_write_fn write;    /* required */
+  void *write_ctx;
+} cli_cfg_t;
+
+typedef enum { CLI_DISCARD_NONE = 0, CLI_DISCARD_TOOLONG, CLI_DISCARD_BADCHAR } cli_discard_t;
+
+struct cli {
+  cli_cfg_t cfg;
+  const cli_cmd_t *app[CLI_MAX_APP_CMDS];
+  uint32_t n_app;
+  char line[CLI_LINE_MAX + 1u];
+  uint32_t len;
+  uint8_t discard;   /* cli_discard_t of the line being received */
+  bool replied;      /* final line sent for the current command */
+  char out[CLI_OUT_MAX];
+  uint32_t out_len;
+  uint32_t truncated; /* reply lines cut at CLI_OUT_MAX (should stay 0) */
+};
+
+/* Returns 0, or -1 for a missing params/write. */
+int cli_init(cli_t *cli, const cli_cfg_t *cfg);
+/* Register an application command (kept by pointer). Returns 0, or -1 if the table is
+ * full, the name is empty, not one word, or already taken, or fn is NULL. */
+int cli_register(cli_t *cli, const cli_cmd_t *cmd);
+/* Registered application commands, for help. */
+uint32_t cli_app_count(const cli_t *cli);
+const cli_cmd_t *cli_app_cmd(const cli_t *cli, uint32_t i);
+/* Feed received bytes; complete lines are executed and answered before it returns. */
+void cli_feed(cli_t *cli, const uint8_t *data, size_t len);
+
+/* Reply building for handlers: append to the pending line, then emit it. Characters
+ * outside %x20-7E are replaced by '?', so a reply is always one line. */
+void cli_put(cli_t *cli, const char *s);
+void cli_put_n(cli_t *cli, const char *s, size_t n);
+void cli_put_f32(cli_t *cli, float x);
+void cli_put_u32(cli_t *cli, uint32_t x);
+void cli_emit_data(cli_t *cli);                  /* "- " text */
+void cli_emit_ok(cli_t *cli);                    /* "ok" [" " text], final */
+void cli_emit_err(cli_t *cli, const char *code); /* "err CODE " text, final */
+void cli_ok(cli_t *cli, const char *msg);        /* msg may be NULL */
+void cli_err(cli_t *cli, const char *code, const char *msg);
+
+#endif /* CLI_H */

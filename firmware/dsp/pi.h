@@ -1,0 +1,80 @@
+/* Discrete PI controller of the drive loop (thesis 6.4), single precision.
+ *
+ * Transfer function (6-26b), the discretisation of C(s) = Kp + Ki/s (6-26a) with
+ * sample time T used by the thesis:
+ *     C(z) = (Kp - (Kp - Ki T) z^-1) / (1 - z^-1) = Kp + Ki T z^-1 / (1 - z^-1)
+ * i.e. the integral acts on e(k-1) (forward rectangle). Realised in velocity
+ * (incremental) form, state {u(k-1), e(k-1)}:
+ *     u(k) = sat( u(k-1) + Kp (e(k) - e(k-1)) + Ki T e(k-1) ),  sat = clamp to [u_min, u_max]
+ * which is u(k-1) + b0 e(k) + b1 e(k-1) with b0 = Kp, b1 = Ki T - Kp, evaluated through
+ * the difference e(k) - e(k-1): with Ki T << Kp (1/200 in the example below) the sum
+ * b0 e(k) + b1 e(k-1) would cancel to Ki T e and lose its low bits in float.
+ * (The form u(k-1) + Kp (e(k) - e(k-1)) + Ki T e(k) would be the backward rectangle,
+ * b0 = Kp + Ki T, b1 = -Kp: not (6-26b), whose worked example below has b0 = Kp.)
+ * Sign convention: e = setpoint - measurement, u increases with a positive e for
+ * positive gains; negative gains are allowed for a plant of negative gain.
+ *
+ * Anti-windup: the only integrating state is the previous output itself, and it is
+ * stored after clamping. Saturation therefore stops the integration where it is: no
+ * hidden integrator winds up, and the output leaves the limit on the first sample the
+ * increment changes sign, however long it was saturated (the thesis loop has no limits;
+ * a real drive stage has them).
+ *
+ * Bumpless gain change: u(k-1) carries the whole past, so new gains act only on the
+ * next increment; a gain change makes no step in u.
+ *
+ * Worked example (6.4): C(s) = 2e-5 + 5.7e-3/s at 57 kHz gives
+ * C(z) = (2e-5 - 1.99e-5 z^-1) / (1 - z^-1).
+ */
+#ifndef PI_H
+#define PI_H
+
+typedef struct {
+  float kp;     /* proportional gain Kp */
+  float ki;     /* integral gain Ki, per second */
+  float dt_s;   /* sample time T, > 0 */
+  float u_min;  /* output limits, u_min < u_max */
+  float u_max;
+  float u_init; /* output at start, within the limits */
+} pi_cfg_t;
+
+typedef struct {
+  float u;      /* u(k-1), the clamped output (the integrator) */
+  float e_prev; /* e(k-1) */
+  float kp;     /* Kp = b0 */
+  float ki_t;   /* Ki T = b0 + b1 */
+  float u_min, u_max;
+  float ki;     /* Ki per second and T, kept to recompute Ki T */
+  float dt_s;
+} pi_t;
+
+/* Validate cfg (finite gains, 0 < dt_s, u_min < u_max, u_min <= u_init <= u_max);
+ * u = u_init, e(k-1) = 0. Returns 0, or -1 and leaves *pi unchanged. */
+int pi_init(pi_t *pi, const pi_cfg_t *cfg);
+
+/* New Kp, Ki without a step in u (bumpless). Returns 0, or -1 and changes nothing. */
+int pi_set_gains(pi_t *pi, float kp, float ki);
+
+/* New output limits; u is clamped into them. Returns 0, or -1 and changes nothing for
+ * u_min >= u_max or non-finite limits. */
+int pi_set_limits(pi_t *pi, float u_min, float u_max);
+
+/* Restart from output u (clamped into the limits) with e(k-1) = e_prev: pass the
+ * current error so that the first increment has no proportional kick. Returns 0, or -1
+ * and changes nothing for non-finite values. */
+int pi_reset(pi_t *pi, float u, float e_prev);
+
+/* One sample of (6-26b) in velocity form with clamping; returns u(k). */
+static inline float pi_step(pi_t *pi, float e)
+{
+  float u = pi->u + pi->kp * (e - pi->e_prev) + pi->ki_t * pi->e_prev;
+  u = (u > pi->u_max) ? pi->u_max : u;
+  u = (u < pi->u_min) ? pi->u_min : u;
+  pi->e_prev = e;
+  pi->u = u;
+  return u;
+}
+
+static inline float pi_output(const pi_t *pi) { return pi->u; }
+
+#endif /* PI_H */

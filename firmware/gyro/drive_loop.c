@@ -1,0 +1,91 @@
+#include "gyro/drive_loop.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#include "dsp/fastmath.h"
+
+#define DRIVE_P_LIMIT_RAD 6.2831853f
+
+int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t *out)
+{
+  if (in == NULL || out == NULL || !(in->plant_gain > 0.0) || !(in->tau_s > 0.0) ||
+      !(in->bw_hz > 0.0) || !(in->demod_bw_hz > 0.0) || !(in->fs_hz > 0.0) ||
+      !isfinite(in->plant_gain) || !isfinite(in->tau_s)) {
+    return -1;
+  }
+  /* Loop phase at crossover wc of the first-order open loop K Kp/(tau s) with the demod
+   * lag and 1.5 samples of delay (DAC latency + ZOH): 90 - atan(wc/wd) - 1.5 wc T. */
+  const double wd = 2.0 * FM_PI * in->demod_bw_hz;
+  const double delay_s = 1.5 / in->fs_hz;
+  double wc = 2.0 * FM_PI * in->bw_hz;
+  double pm = 0.0;
+  for (int i = 0; i < 60; i++) {
+    pm = 90.0 - (atan(wc / wd) + wc * delay_s) * 180.0 / FM_PI;
+    if (pm >= 60.0) break;
+    wc *= 0.9;
+  }
+  out->kp = wc * in->tau_s / in->plant_gain;
+  out->ki = out->kp / in->tau_s;
+  out->bw_hz = wc / (2.0 * FM_PI);
+  out->phase_margin_deg = pm;
+  return 0;
+}
+
+static int cfg_ok(const drive_loop_cfg_t *c)
+{
+  return c != NULL && c->dt_s > 0.0f && c->amp_set_v > 0.0f && c->f_cmd_max_v2 > 0.0f &&
+         fm_isfinite(c->amp_set_v) && fm_isfinite(c->phase_set_rad) &&
+         fm_isfinite(c->amp_kp) && fm_isfinite(c->amp_ki) && fm_isfinite(c->phase_kp) &&
+         fm_isfinite(c->phase_ki) && fm_isfinite(c->f_cmd_max_v2) &&
+         fm_isfinite(c->p_init_rad) && fm_absf(c->p_init_rad) <= DRIVE_P_LIMIT_RAD;
+}
+
+int drive_loop_init(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
+{
+  if (dl == NULL || !cfg_ok(cfg)) {
+    return -1;
+  }
+  const pi_cfg_t amp = {cfg->amp_kp, cfg->amp_ki, cfg->dt_s, 0.0f, cfg->f_cmd_max_v2, 0.0f};
+  const pi_cfg_t ph = {cfg->phase_kp, cfg->phase_ki, cfg->dt_s, -DRIVE_P_LIMIT_RAD,
+                       DRIVE_P_LIMIT_RAD, cfg->p_init_rad};
+  pi_t amp_pi, phase_pi;
+  if (pi_init(&amp_pi, &amp) != 0 || pi_init(&phase_pi, &ph) != 0) {
+    return -1;
+  }
+  dl->amp_pi = amp_pi;
+  dl->phase_pi = phase_pi;
+  dl->amp_set_v = cfg->amp_set_v;
+  dl->phase_set_rad = cfg->phase_set_rad;
+  dl->p_init_rad = cfg->p_init_rad;
+  drive_loop_reset(dl);
+  return 0;
+}
+
+void drive_loop_reset(drive_loop_t *dl)
+{
+  (void)pi_reset(&dl->amp_pi, 0.0f, 0.0f);
+  (void)pi_reset(&dl->phase_pi, dl->p_init_rad, 0.0f);
+  dl->amp_v = 0.0f;
+  dl->phase_rad = 0.0f;
+  dl->amp_err_v = 0.0f;
+  dl->phase_err_rad = 0.0f;
+  dl->f_cmd_v2 = 0.0f;
+  dl->p_rad = dl->p_init_rad;
+}
+
+void drive_loop_step(drive_loop_t *dl, float w_s, float w_c)
+{
+  dl->amp_v = fm_sqrtf(w_s * w_s + w_c * w_c);
+  dl->phase_rad = fm_atan2f(w_c, w_s);
+  dl->amp_err_v = dl->amp_set_v - dl->amp_v;
+  /* While the amplitude is still tiny its phase is noise; hold P until there is a
+   * vibration to measure (10 % of the setpoint). */
+  dl->phase_err_rad = fm_wrap_pi(dl->phase_set_rad - dl->phase_rad);
+  dl->f_cmd_v2 = pi_step(&dl->amp_pi, dl->amp_err_v);
+  if (dl->amp_v > 0.1f * dl->amp_set_v) {
+    dl->p_rad = pi_step(&dl->phase_pi, dl->phase_err_rad);
+  } else {
+    (void)pi_reset(&dl->phase_pi, dl->p_rad, dl->phase_err_rad);
+  }
+}

@@ -1,0 +1,87 @@
+/* Drive-mode amplitude and phase loops (thesis 6.4), one call per tick.
+ *
+ * Measurement: the drive pickoff phasor Z = w_s + j w_c from the drive LMSD (see
+ * gyro_cfg.h for the phasor convention). Amplitude |Z| by one VSQRT, phase arg(Z) by
+ * fm_atan2f.
+ *
+ * Amplitude loop: e_A = A_set - |Z| (V). The thesis linearises the measured amplitude
+ * around the setpoint, dA ~ d(A^2)/(2 A0) (6-24), and blames the overshoot of its real
+ * loop on that approximation being far off during start-up. Here the exact |Z| is used
+ * (a square root is one FPU instruction on the Cortex-M4F), and the PI's output is the
+ * force amplitude f_cmd in units of Ks*V^2 rather than a voltage: the square law of the
+ * electrostatic actuator (6-7) is then undone exactly by drive_synth (U = sqrt(f_cmd) for
+ * half-frequency drive), so the loop sees the linear first-order plant of (6-12) at every
+ * amplitude, and the clamped velocity-form PI cannot wind up while the drive is at its
+ * limit during start-up. Together these remove the start-up overshoot.
+ *
+ * Phase loop: e_P = wrap(phase_set - arg Z) (rad); the PI output is the force phase P
+ * (rad), whose effect on arg Z is one-to-one with the first-order lag of (6-17). P is
+ * not wrapped (its half drives the half-frequency voltage phase, (6-25), and wrapping P
+ * would flip both voltages); its range is limited to +-2 pi.
+ *
+ * Design (drive_loop_design): with the first-order plant K/(tau s + 1), tau = 2Q/wn
+ * (6-12, 6-17), the PI zero is put on the plant pole (Ki/Kp = 1/tau), leaving the
+ * open loop K Kp / (tau s): a first-order closed loop of bandwidth wc = K Kp / tau, with
+ * no overshoot. The demodulator's lag (a first-order lag of bandwidth lmsd_bw) and the
+ * one-sample DAC latency cost phase margin; wc is capped so that at least 60 deg remain.
+ */
+#ifndef DRIVE_LOOP_H
+#define DRIVE_LOOP_H
+
+#include <stdint.h>
+
+#include "dsp/pi.h"
+
+typedef struct {
+  float dt_s;
+  float amp_set_v;
+  float phase_set_rad;
+  float amp_kp, amp_ki;      /* f_cmd (Ks*V^2) per V; per V*s */
+  float phase_kp, phase_ki;  /* rad per rad; per rad*s */
+  float f_cmd_max_v2;        /* force command limit (u_max^2 for half-frequency drive) */
+  float p_init_rad;
+} drive_loop_cfg_t;
+
+typedef struct {
+  pi_t amp_pi;
+  pi_t phase_pi;
+  float amp_set_v;
+  float phase_set_rad;
+  float p_init_rad;
+  /* Latest measurement and outputs. */
+  float amp_v;
+  float phase_rad;
+  float amp_err_v;
+  float phase_err_rad;
+  float f_cmd_v2;  /* force amplitude command, Ks*V^2 */
+  float p_rad;     /* force phase P */
+} drive_loop_t;
+
+typedef struct {
+  double plant_gain;   /* K: loop output units -> measured units at resonance */
+  double tau_s;        /* 2 Q / wn */
+  double bw_hz;        /* wanted closed-loop bandwidth */
+  double demod_bw_hz;  /* LMSD bandwidth, (lmsd_bandwidth_hz) */
+  double fs_hz;
+} drive_loop_design_in_t;
+
+typedef struct {
+  double kp, ki;
+  double bw_hz;          /* achieved (after the phase-margin cap) */
+  double phase_margin_deg;
+} drive_loop_design_out_t;
+
+/* PI gains for one loop (amplitude: K in V per Ks*V^2; phase: K = 1). Init-time, double.
+ * Returns 0, or -1 for non-physical inputs. */
+int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t *out);
+
+/* Returns 0, or -1 (nothing changed) for a bad configuration. */
+int drive_loop_init(drive_loop_t *dl, const drive_loop_cfg_t *cfg);
+
+/* Drive off: force command 0, P back to its start value, integrators cleared. */
+void drive_loop_reset(drive_loop_t *dl);
+
+/* One tick: measurement from the drive LMSD weights, then both PIs. */
+void drive_loop_step(drive_loop_t *dl, float w_s, float w_c);
+
+#endif /* DRIVE_LOOP_H */

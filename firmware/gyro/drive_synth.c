@@ -1,0 +1,54 @@
+#include "gyro/drive_synth.h"
+
+#include <stddef.h>
+
+#include "dsp/fastmath.h"
+#include "dsp/sincos.h"
+
+int drive_synth_init(drive_synth_t *ds, const drive_synth_cfg_t *cfg)
+{
+  if (ds == NULL || cfg == NULL || !fm_isfinite(cfg->u_max_v) || !(cfg->u_max_v > 0.0f) ||
+      !fm_isfinite(cfg->dc_bias_v)) {
+    return -1;
+  }
+  if (cfg->mode == GYRO_DRIVE_DC_AC) {
+    if (!(cfg->dc_bias_v > 0.0f) || !(cfg->dc_bias_v < cfg->u_max_v)) {
+      return -1;
+    }
+  } else if (cfg->mode != GYRO_DRIVE_HALF_FREQ) {
+    return -1;
+  }
+  ds->mode = cfg->mode;
+  ds->dc_bias_v = cfg->dc_bias_v;
+  ds->u_max_v = cfg->u_max_v;
+  ds->inv_4d = (cfg->mode == GYRO_DRIVE_DC_AC) ? 0.25f / cfg->dc_bias_v : 0.0f;
+  return 0;
+}
+
+float drive_synth_f_cmd_max(const drive_synth_t *ds)
+{
+  if (ds->mode == GYRO_DRIVE_DC_AC) {
+    /* |U| <= D + A <= u_max  =>  A <= u_max - D, f = 4 D A. */
+    return 4.0f * ds->dc_bias_v * (ds->u_max_v - ds->dc_bias_v);
+  }
+  return ds->u_max_v * ds->u_max_v;
+}
+
+void drive_synth_step(const drive_synth_t *ds, float f_cmd_v2, float p_rad, uint32_t phase,
+                      uint32_t half_phase, float *u1_v, float *u2_v)
+{
+  float s, c;
+  const float f = f_cmd_v2 > 0.0f ? f_cmd_v2 : 0.0f;
+  if (ds->mode == GYRO_DRIVE_DC_AC) {
+    sincos_lut(phase + sincos_rad_to_phase(p_rad), &s, &c);
+    const float a = f * ds->inv_4d;
+    *u1_v = ds->dc_bias_v + a * c;
+    *u2_v = ds->dc_bias_v - a * c;
+  } else {
+    /* (6-25): the voltage phase is half the force phase. */
+    sincos_lut(half_phase + sincos_rad_to_phase(0.5f * p_rad), &s, &c);
+    const float a = fm_sqrtf(f);
+    *u1_v = a * c;
+    *u2_v = a * s;
+  }
+}

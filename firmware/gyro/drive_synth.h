@@ -1,0 +1,47 @@
+/* Drive voltage synthesis: force command (f_cmd, P) -> electrode voltages U1, U2.
+ *
+ * The electrostatic force is F = Ks (U1^2 - U2^2) (6-7); f_cmd is in Ks*V^2.
+ *   Half-frequency drive (6-18, 6-19, 6-25):
+ *     A = sqrt(f_cmd), U1 = A cos(phi/2 + P/2), U2 = A sin(phi/2 + P/2)
+ *     => U1^2 - U2^2 = A^2 cos(phi + P). The voltages sit at wc/2, so their feedthrough
+ *     into the pickoffs and their low-frequency noise land at wc/2 and are rejected by
+ *     demodulation at wc (thesis 6.3).
+ *   DC+AC drive (6-20, 6-21):
+ *     A = f_cmd / (4 D), U1 = D + A cos(phi + P), U2 = D - A cos(phi + P)
+ *     => U1^2 - U2^2 = 4 D A cos(phi + P) = f_cmd cos(phi + P).
+ * Both give the same force for the same (f_cmd, P), so the loops need no retuning when
+ * the scheme changes. The half phase comes from the NCO's half-rate accumulator, so the
+ * voltage phase stays continuous across the main accumulator's wrap.
+ */
+#ifndef DRIVE_SYNTH_H
+#define DRIVE_SYNTH_H
+
+#include <stdint.h>
+
+#include "gyro/gyro_cfg.h"
+
+typedef struct {
+  gyro_drive_mode_t mode;
+  float dc_bias_v;   /* D */
+  float u_max_v;     /* largest voltage magnitude on either electrode */
+  float inv_4d;      /* 1 / (4 D) */
+} drive_synth_t;
+
+typedef struct {
+  gyro_drive_mode_t mode;
+  float dc_bias_v;
+  float u_max_v;
+} drive_synth_cfg_t;
+
+/* Returns 0, or -1 (nothing changed) for a bad configuration (DC+AC needs
+ * 0 < D < u_max). */
+int drive_synth_init(drive_synth_t *ds, const drive_synth_cfg_t *cfg);
+
+/* Largest force command the electrodes can deliver (Ks*V^2). */
+float drive_synth_f_cmd_max(const drive_synth_t *ds);
+
+/* phase: NCO phase at wc of this sample; half_phase: its half-rate companion. */
+void drive_synth_step(const drive_synth_t *ds, float f_cmd_v2, float p_rad, uint32_t phase,
+                      uint32_t half_phase, float *u1_v, float *u2_v);
+
+#endif /* DRIVE_SYNTH_H */

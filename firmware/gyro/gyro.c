@@ -1,0 +1,213 @@
+#include "gyro/gyro.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "dsp/butter.h"
+#include "dsp/fastmath.h"
+
+int gyro_design(const gyro_cfg_t *c, gyro_design_t *d)
+{
+  if (c == NULL || d == NULL || !(c->fs_hz > 0.0f) || !(c->drive_freq_hz > 0.0f) ||
+      !(c->drive_freq_hz < 0.25f * c->fs_hz) || !(c->plant_q > 0.0f) ||
+      !(c->plant_f0_hz > 0.0f) || !(c->plant_gain_v_per_v2 > 0.0f)) {
+    return -1;
+  }
+  gyro_design_t t;
+  memset(&t, 0, sizeof t);
+  const double fs = (double)c->fs_hz;
+  t.nco.freq_hz = (double)c->drive_freq_hz;
+  t.nco.fs_hz = fs;
+  t.nco.phase_rad = 0.0;
+  t.lmsd_drive.mu = c->mu_drive;
+  t.lmsd_sense.mu = c->mu_sense;
+
+  t.synth.mode = c->drive_mode;
+  t.synth.dc_bias_v = c->drive_dc_bias_v;
+  t.synth.u_max_v = c->drive_u_max_v;
+  drive_synth_t probe;
+  if (drive_synth_init(&probe, &t.synth) != 0) return -2;
+
+  /* (6-12), (6-17): amplitude and phase of the drive vibration follow force amplitude
+   * and phase as first-order lags of time constant 2 Q / wn. */
+  const double tau = 2.0 * (double)c->plant_q / (2.0 * FM_PI * (double)c->plant_f0_hz);
+  const double demod_bw = lmsd_bandwidth_hz((double)c->mu_drive, fs);
+  if (!(demod_bw > 0.0)) return -3;
+  const drive_loop_design_in_t amp_in = {(double)c->plant_gain_v_per_v2, tau,
+                                         (double)c->amp_loop_bw_hz, demod_bw, fs};
+  const drive_loop_design_in_t ph_in = {1.0, tau, (double)c->phase_loop_bw_hz, demod_bw, fs};
+  if (drive_loop_design(&amp_in, &t.amp_design) != 0 ||
+      drive_loop_design(&ph_in, &t.phase_design) != 0) {
+    return -4;
+  }
+  t.drive.dt_s = 1.0f / c->fs_hz;
+  t.drive.amp_set_v = c->drive_amp_set_v;
+  t.drive.phase_set_rad = c->drive_phase_set_deg * FM_RAD_PER_DEG_F;
+  const int manual_amp = c->amp_kp != 0.0f || c->amp_ki != 0.0f;
+  const int manual_ph = c->phase_kp != 0.0f || c->phase_ki != 0.0f;
+  t.drive.amp_kp = manual_amp ? c->amp_kp : (float)t.amp_design.kp;
+  t.drive.amp_ki = manual_amp ? c->amp_ki : (float)t.amp_design.ki;
+  t.drive.phase_kp = manual_ph ? c->phase_kp : (float)t.phase_design.kp;
+  t.drive.phase_ki = manual_ph ? c->phase_ki : (float)t.phase_design.ki;
+  t.drive.f_cmd_max_v2 = drive_synth_f_cmd_max(&probe);
+  t.drive.p_init_rad = c->drive_p_init_deg * FM_RAD_PER_DEG_F;
+
+  const int n = butter_design(BUTTER_LOWPASS, c->rate_lpf_order, (double)c->rate_lpf_hz, 0.0,
+                              fs / RATE_DECIM, t.rate_lpf, BIQUAD_MAX_SECTIONS);
+  if (n <= 0) return -5;
+  const double phi_dm = (double)c->demod_phase_deg * FM_PI / 180.0;
+  t.rate.rot_c = (float)cos(phi_dm);
+  t.rate.rot_s = (float)sin(phi_dm);
+  t.rate.scale_dps = c->rate_scale_dps;
+  for (int i = 0; i < 4; i++) {
+    t.rate.bias_c_dps[i] = c->bias_c_dps[i];
+    t.rate.sf_c[i] = c->sf_c[i];
+  }
+  t.rate.p_ref_deg = c->drive_p_init_deg;
+  /* First-order low-pass of P at the decimated rate fs / RATE_P_DECIM. */
+  t.rate.p_lpf_alpha =
+      (float)(1.0 - exp(-2.0 * FM_PI * (double)c->p_lpf_hz * RATE_P_DECIM / fs));
+  t.rate.lpf = t.rate_lpf;
+  t.rate.lpf_sections = (uint32_t)n;
+  t.rate.min_drive_v = 0.05f * c->drive_amp_set_v;
+  t.rate_out_v_per_dps = c->rate_out_v_per_dps;
+
+  t.sup.dt_s = 1.0f / c->fs_hz;
+  t.sup.lock_tol_rel = c->lock_tol_rel;
+  t.sup.lock_phase_tol_rad = c->lock_phase_tol_deg * FM_RAD_PER_DEG_F;
+  t.sup.lock_hold_s = c->lock_hold_s;
+  t.sup.lost_tol_rel = c->lost_tol_rel;
+  t.sup.lost_hold_s = c->lost_hold_s;
+  t.sup.amp_trip_rel = c->amp_trip_rel;
+  t.sup.sat_hold_s = c->sat_hold_s;
+  t.sup.retry_s = c->retry_s;
+  t.sup.clip_max_count = c->clip_max_count;
+  *d = t;
+  return 0;
+}
+
+int gyro_init(gyro_t *g, const gyro_cfg_t *cfg)
+{
+  gyro_design_t d;
+  if (g == NULL || gyro_design(cfg, &d) != 0) {
+    return -1;
+  }
+  gyro_t t;
+  memset(&t, 0, sizeof t);
+  d.rate.lpf = d.rate_lpf; /* d was copied: point at its own sections */
+  if (nco_init(&t.nco, &d.nco) != 0 || lmsd_init(&t.lmsd_drive, &d.lmsd_drive) != 0 ||
+      lmsd_init(&t.lmsd_sense, &d.lmsd_sense) != 0 || drive_loop_init(&t.drive, &d.drive) != 0 ||
+      drive_synth_init(&t.synth, &d.synth) != 0 || rate_channel_init(&t.rate, &d.rate) != 0 ||
+      supervisor_init(&t.sup, &d.sup) != 0) {
+    return -2;
+  }
+  rate_channel_reset(&t.rate, cfg->drive_p_init_deg);
+  t.fs_hz = cfg->fs_hz;
+  t.adc_v_per_code = HAL_ADC_V_PER_CODE;
+  t.rate_out_v_per_dps = d.rate_out_v_per_dps;
+  t.f_cmd_max_v2 = d.drive.f_cmd_max_v2;
+  *g = t;
+  if (cfg->autostart != 0u) {
+    gyro_start(g);
+  }
+  return 0;
+}
+
+void gyro_start(gyro_t *g) { supervisor_start(&g->sup); }
+
+void gyro_stop(gyro_t *g)
+{
+  supervisor_stop(&g->sup);
+  drive_loop_reset(&g->drive);
+}
+
+uint16_t gyro_volts_to_dac(float v)
+{
+  float c = v * (1.0f / HAL_DAC_V_PER_CODE) + (float)HAL_DAC_CODE_MID + 0.5f;
+  c = fm_clampf(c, 0.0f, (float)HAL_DAC_CODE_MAX);
+  return (uint16_t)c;
+}
+
+/* Clear every integrating state: after a fault nothing of the old state (possibly NaN)
+ * may survive into the next acquisition. */
+static void clear_loop_state(gyro_t *g)
+{
+  lmsd_reset(&g->lmsd_drive);
+  lmsd_reset(&g->lmsd_sense);
+  drive_loop_reset(&g->drive);
+  rate_channel_reset(&g->rate, g->drive.p_init_rad * FM_DEG_PER_RAD_F);
+}
+
+void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
+{
+  nco_out_t ref;
+  nco_step(&g->nco, &ref);
+
+  const float v_drive = (float)adc->drive * g->adc_v_per_code;
+  const float v_sense = (float)adc->sense * g->adc_v_per_code;
+  lmsd_step(&g->lmsd_drive, v_drive, ref.sin_wc, ref.cos_wc);
+  lmsd_step(&g->lmsd_sense, v_sense, ref.sin_wc, ref.cos_wc);
+  const float d_s = g->lmsd_drive.w_i, d_c = g->lmsd_drive.w_q;
+  const float s_s = g->lmsd_sense.w_i, s_c = g->lmsd_sense.w_q;
+
+  const int drive_on = supervisor_drive_enabled(&g->sup);
+  float u1 = 0.0f, u2 = 0.0f;
+  if (drive_on) {
+    drive_loop_step(&g->drive, d_s, d_c);
+    drive_synth_step(&g->synth, g->drive.f_cmd_v2, g->drive.p_rad, ref.phase, ref.half_phase,
+                     &u1, &u2);
+  } else {
+    /* Measure only: the amplitude is still watched for the over-amplitude trip. */
+    g->drive.amp_v = fm_sqrtf(d_s * d_s + d_c * d_c);
+  }
+  rate_channel_step(&g->rate, d_s, d_c, s_s, s_c, g->drive.p_rad);
+
+  const int at_rail = adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN ||
+                      adc->sense == HAL_ADC_CODE_MAX || adc->sense == HAL_ADC_CODE_MIN;
+  const int at_limit = g->drive.f_cmd_v2 >= g->f_cmd_max_v2;
+  const float inv_set = 1.0f / g->drive.amp_set_v;
+  supervisor_in_t si;
+  si.amp_rel = g->drive.amp_v * inv_set;
+  si.amp_rel_err = si.amp_rel - 1.0f;
+  si.phase_err_rad = g->drive.phase_err_rad;
+  si.drive_at_limit = drive_on && at_limit;
+  si.adc_at_rail = at_rail;
+  si.state_finite = fm_isfinite(d_s + d_c + s_s + s_c) && fm_isfinite(g->drive.f_cmd_v2) &&
+                    fm_isfinite(g->drive.p_rad) && fm_isfinite(g->rate.rate_dps) &&
+                    fm_isfinite(g->rate.quad_dps);
+  if (supervisor_step(&g->sup, &si) != 0) {
+    clear_loop_state(g);
+    u1 = 0.0f;
+    u2 = 0.0f;
+  }
+  if (!supervisor_drive_enabled(&g->sup)) {
+    u1 = 0.0f;
+    u2 = 0.0f;
+  }
+
+  dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
+  dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
+  dac->code[HAL_DAC_RATE_OUT] = gyro_volts_to_dac(g->rate.rate_dps * g->rate_out_v_per_dps);
+  dac->code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID;
+
+  gyro_out_t *o = &g->out;
+  o->tick++;
+  o->rate_dps = g->rate.rate_dps;
+  o->rate_unc_dps = g->rate.rate_unc_dps;
+  o->quad_dps = g->rate.quad_dps;
+  o->drive_amp_v = g->drive.amp_v;
+  o->drive_phase_deg = g->drive.phase_rad * FM_DEG_PER_RAD_F;
+  o->p_deg = g->drive.p_rad * FM_DEG_PER_RAD_F;
+  o->p_f_deg = g->rate.p_f_deg;
+  o->f_cmd_v2 = g->drive.f_cmd_v2;
+  o->u1_v = u1;
+  o->u2_v = u2;
+  o->sense_i_v = s_s;
+  o->sense_q_v = s_c;
+  o->mode = (uint32_t)g->sup.mode;
+  o->fault = g->sup.fault;
+  o->flags = (g->sup.mode == GYRO_MODE_LOCKED ? GYRO_FLAG_LOCKED : 0u) |
+             (at_rail ? GYRO_FLAG_ADC_RAIL : 0u) | (at_limit ? GYRO_FLAG_DRIVE_LIMIT : 0u) |
+             (g->sup.mode == GYRO_MODE_FAULT ? GYRO_FLAG_FAULT : 0u);
+}

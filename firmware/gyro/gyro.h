@@ -1,0 +1,92 @@
+/* The gyro: everything the 50 kHz tick runs, as one instance.
+ *
+ * gyro_tick() is the whole sample path (architecture.md), the same code on host and
+ * target:
+ *   NCO -> LMSD(drive), LMSD(sense) -> drive loops -> drive synthesis -> rate channel
+ *   -> supervisor -> outputs (DAC frame, telemetry snapshot)
+ * Deterministic, allocation-free, single precision, no libm.
+ */
+#ifndef GYRO_H
+#define GYRO_H
+
+#include <stdint.h>
+
+#include "dsp/biquad.h"
+#include "dsp/lmsd.h"
+#include "dsp/nco.h"
+#include "gyro/drive_loop.h"
+#include "gyro/drive_synth.h"
+#include "gyro/gyro_cfg.h"
+#include "gyro/rate_channel.h"
+#include "gyro/supervisor.h"
+#include "hal/hal_adc.h"
+#include "hal/hal_dac.h"
+
+/* Everything gyro_cfg_t turns into (init-time, double precision design). */
+typedef struct {
+  nco_cfg_t nco;
+  lmsd_cfg_t lmsd_drive, lmsd_sense;
+  drive_loop_cfg_t drive;
+  drive_synth_cfg_t synth;
+  rate_channel_cfg_t rate;
+  biquad_coeffs_t rate_lpf[BIQUAD_MAX_SECTIONS];
+  supervisor_cfg_t sup;
+  drive_loop_design_out_t amp_design, phase_design; /* what the designer achieved */
+  float rate_out_v_per_dps;
+} gyro_design_t;
+
+/* A snapshot of the outputs of the latest tick (telemetry, status, the simulator). */
+typedef struct {
+  uint32_t tick;
+  float rate_dps;        /* compensated, filtered rate */
+  float rate_unc_dps;    /* before temperature compensation */
+  float quad_dps;        /* quadrature, equivalent rate */
+  float drive_amp_v;     /* demodulated drive pickoff amplitude */
+  float drive_phase_deg; /* arg of the drive phasor */
+  float p_deg;           /* force phase P: the temperature signal */
+  float p_f_deg;         /* P low-passed (what the compensation uses) */
+  float f_cmd_v2;        /* drive force command */
+  float u1_v, u2_v;      /* drive electrode voltages written this tick */
+  float sense_i_v, sense_q_v; /* sense LMSD phasor */
+  uint32_t mode;         /* gyro_mode_t */
+  uint32_t fault;        /* gyro_fault_t bits of the last fault */
+  uint32_t flags;        /* GYRO_FLAG_* */
+} gyro_out_t;
+
+#define GYRO_FLAG_LOCKED (1u << 0)
+#define GYRO_FLAG_ADC_RAIL (1u << 1)
+#define GYRO_FLAG_DRIVE_LIMIT (1u << 2)
+#define GYRO_FLAG_FAULT (1u << 3)
+
+typedef struct {
+  float fs_hz;
+  float adc_v_per_code;
+  float rate_out_v_per_dps;
+  nco_t nco;
+  lmsd_t lmsd_drive, lmsd_sense;
+  drive_loop_t drive;
+  drive_synth_t synth;
+  rate_channel_t rate;
+  supervisor_t sup;
+  float f_cmd_max_v2;
+  gyro_out_t out;
+} gyro_t;
+
+/* Turn a configuration into module configurations. Returns 0, or a negative value for
+ * an invalid configuration (nothing is half-designed: *d is only valid on 0). */
+int gyro_design(const gyro_cfg_t *cfg, gyro_design_t *d);
+
+/* Initialise from a configuration (design + module inits). Returns 0, or a negative
+ * value with *g unchanged. Starts acquiring at once if cfg->autostart. */
+int gyro_init(gyro_t *g, const gyro_cfg_t *cfg);
+
+/* One sample: ADC frame in, DAC frame out (latched by the HAL at the next tick). */
+void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac);
+
+void gyro_start(gyro_t *g);
+void gyro_stop(gyro_t *g);
+
+/* Volts to an offset-binary DAC code, clamped to the converter's range. */
+uint16_t gyro_volts_to_dac(float v);
+
+#endif /* GYRO_H */

@@ -1,0 +1,140 @@
+#include "gyro/rate_channel.h"
+
+#include <stddef.h>
+
+#include "dsp/fastmath.h"
+
+static int finite4(const float *c)
+{
+  return fm_isfinite(c[0]) && fm_isfinite(c[1]) && fm_isfinite(c[2]) && fm_isfinite(c[3]);
+}
+
+static int cfg_ok(const rate_channel_cfg_t *cfg)
+{
+  return cfg != NULL && cfg->lpf != NULL && fm_isfinite(cfg->rot_c) &&
+         fm_isfinite(cfg->rot_s) && fm_absf(cfg->rot_c * cfg->rot_c + cfg->rot_s * cfg->rot_s - 1.0f) < 1e-4f &&
+         fm_isfinite(cfg->scale_dps) && finite4(cfg->bias_c_dps) && finite4(cfg->sf_c) &&
+         cfg->p_lpf_alpha > 0.0f && cfg->p_lpf_alpha <= 1.0f && cfg->min_drive_v > 0.0f &&
+         fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg);
+}
+
+static void copy_coeffs(rate_channel_t *rc, const rate_channel_cfg_t *cfg)
+{
+  rc->rot_c = cfg->rot_c;
+  rc->rot_s = cfg->rot_s;
+  rc->scale_dps = cfg->scale_dps;
+  for (int i = 0; i < 4; i++) {
+    rc->bias_c_dps[i] = cfg->bias_c_dps[i];
+    rc->sf_c[i] = cfg->sf_c[i];
+  }
+  rc->p_lpf_alpha = cfg->p_lpf_alpha;
+  rc->min_drive_v2 = cfg->min_drive_v * cfg->min_drive_v;
+}
+
+int rate_channel_init(rate_channel_t *rc, const rate_channel_cfg_t *cfg)
+{
+  if (rc == NULL || !cfg_ok(cfg)) {
+    return -1;
+  }
+  biquad_cascade_t a, b;
+  if (biquad_cascade_init(&a, cfg->lpf, cfg->lpf_sections) != 0 ||
+      biquad_cascade_init(&b, cfg->lpf, cfg->lpf_sections) != 0) {
+    return -1;
+  }
+  rc->lpf_rate = a;
+  rc->lpf_quad = b;
+  copy_coeffs(rc, cfg);
+  rc->p_ref_deg = cfg->p_ref_deg;
+  rate_channel_reset(rc, cfg->p_ref_deg);
+  return 0;
+}
+
+int rate_channel_retune(rate_channel_t *rc, const rate_channel_cfg_t *cfg)
+{
+  if (rc == NULL || !cfg_ok(cfg)) {
+    return -1;
+  }
+  biquad_cascade_t a = rc->lpf_rate, b = rc->lpf_quad;
+  const uint32_t old_n = a.num_sections;
+  if (biquad_cascade_init(&a, cfg->lpf, cfg->lpf_sections) != 0 ||
+      biquad_cascade_init(&b, cfg->lpf, cfg->lpf_sections) != 0) {
+    return -1;
+  }
+  if (cfg->lpf_sections == old_n) {
+    /* Same structure: keep the filter memory, swap only the coefficients. */
+    for (uint32_t i = 0; i < old_n; i++) {
+      a.state[i] = rc->lpf_rate.state[i];
+      b.state[i] = rc->lpf_quad.state[i];
+    }
+  }
+  rc->lpf_rate = a;
+  rc->lpf_quad = b;
+  copy_coeffs(rc, cfg);
+  /* P_f is kept as it is, re-expressed around the new reference. */
+  rc->p_dev_deg = rc->p_f_deg - cfg->p_ref_deg;
+  rc->p_ref_deg = cfg->p_ref_deg;
+  rc->p_acc_deg = 0.0f;
+  rc->p_count = 0u;
+  return 0;
+}
+
+void rate_channel_reset(rate_channel_t *rc, float p_deg)
+{
+  biquad_cascade_reset(&rc->lpf_rate, 0.0f);
+  biquad_cascade_reset(&rc->lpf_quad, 0.0f);
+  rc->rate_raw = 0.0f;
+  rc->quad_raw = 0.0f;
+  rc->acc_re = 0.0f;
+  rc->acc_im = 0.0f;
+  rc->count = 0u;
+  rc->rate_unc_dps = 0.0f;
+  rc->quad_dps = 0.0f;
+  rc->p_acc_deg = 0.0f;
+  rc->p_count = 0u;
+  rc->p_dev_deg = p_deg - rc->p_ref_deg;
+  rc->p_f_deg = p_deg;
+  rc->rate_dps = 0.0f;
+}
+
+void rate_channel_step(rate_channel_t *rc, float d_s, float d_c, float s_s, float s_c,
+                       float p_rad)
+{
+  const float d2 = d_s * d_s + d_c * d_c;
+  float re = 0.0f, im = 0.0f;
+  if (d2 > rc->min_drive_v2) {
+    /* S conj(D) e^{-j phi_dm} / |D|^2 */
+    const float inv = 1.0f / d2;
+    const float a = s_s * d_s + s_c * d_c;
+    const float b = s_c * d_s - s_s * d_c;
+    re = (a * rc->rot_c + b * rc->rot_s) * inv;
+    im = (b * rc->rot_c - a * rc->rot_s) * inv;
+  }
+  rc->rate_raw = re;
+  rc->quad_raw = im;
+
+  rc->p_acc_deg += p_rad * FM_DEG_PER_RAD_F - rc->p_ref_deg;
+  if (++rc->p_count == RATE_P_DECIM) {
+    const float mean = rc->p_acc_deg * (1.0f / (float)RATE_P_DECIM);
+    rc->p_dev_deg += rc->p_lpf_alpha * (mean - rc->p_dev_deg);
+    rc->p_f_deg = rc->p_ref_deg + rc->p_dev_deg;
+    rc->p_acc_deg = 0.0f;
+    rc->p_count = 0u;
+  }
+  rc->acc_re += re;
+  rc->acc_im += im;
+  if (++rc->count < RATE_DECIM) {
+    return;
+  }
+  const float k = 1.0f / (float)RATE_DECIM;
+  rc->rate_unc_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_rate, rc->acc_re * k);
+  rc->quad_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_quad, rc->acc_im * k);
+  rc->acc_re = 0.0f;
+  rc->acc_im = 0.0f;
+  rc->count = 0u;
+
+  const float p = rc->p_f_deg;
+  const float *b3 = rc->bias_c_dps, *s3 = rc->sf_c;
+  const float bias = b3[0] + p * (b3[1] + p * (b3[2] + p * b3[3]));
+  const float sf = 1.0f + p * (s3[1] + p * (s3[2] + p * s3[3]));
+  rc->rate_dps = rc->rate_unc_dps * sf - bias;
+}

@@ -1,0 +1,97 @@
+/* Rate channel (thesis ch. 5, 7): sense phasor -> rate and quadrature, output low-pass,
+ * scale factor, temperature compensation in P.
+ *
+ * The sense LMSD gives the sense phasor S, the drive LMSD the drive phasor D (both in the
+ * NCO frame, gyro_cfg.h). The Coriolis acceleration 2 Omega y' is in phase with the
+ * drive velocity and the quadrature k_q y with the drive displacement (2-22), so in the
+ * frame of the drive motion
+ *     R = S conj(D) e^{-j phi_dm} / |D|^2
+ * puts the Coriolis part on the real axis and the quadrature on the imaginary axis once
+ * phi_dm (the demodulation phase: sense-mode and pickoff phase differences, calibrated)
+ * is right. Referencing to the measured drive phasor rather than to the NCO keeps the
+ * separation exact while the phase loop moves, and dividing by |D|^2 makes R a ratio of
+ * sense to drive amplitude: the Coriolis signal is proportional to the drive amplitude
+ * (2-28), so the ratio holds the scale factor when the drive amplitude drifts.
+ * A demodulation-phase error d_phi leaks quadrature into rate as Q sin(d_phi): with
+ * 1500 deg/s of quadrature, 0.01 deg is 0.26 deg/s of bias (system.md, 2.4.2 B).
+ *
+ * Output: rate = scale * Re(R_f) * sf(P_f) - bias(P_f), R_f the Butterworth-filtered R,
+ * P_f the low-passed force phase in degrees (temperature is slow: a 1 Hz low-pass keeps
+ * the phase loop's noise out of the bias correction, whose slope is tens of (deg/s)/deg); bias(P) = c0 + c1 P + c2 P^2 + c3 P^3 and
+ * sf(P) = 1 + c1 P + c2 P^2 + c3 P^3 (the thesis fits bias linear in P, 7.3.2).
+ */
+#ifndef RATE_CHANNEL_H
+#define RATE_CHANNEL_H
+
+#include <stdint.h>
+
+#include "dsp/biquad.h"
+
+/* The output low-pass runs on block means of RATE_DECIM ticks (fs / 10 = 5 kHz). A
+ * 100 Hz 4th-order Butterworth run at 50 kHz in float has a level-dependent DC error
+ * of about 1e-3 (each sample adds b0 x ~ 4e-5 x to a state the size of the output, and
+ * the rounding is amplified by 1/(1 + a1 + a2) ~ 6400, see dsp/biquad.h): that would be
+ * a 0.1 % scale-factor nonlinearity. At 5 kHz the same filter is accurate to 1e-7. The
+ * LMSD outputs are already band-limited to a few hundred Hz, and the boxcar's nulls at
+ * multiples of 5 kHz take what remains, so the decimation aliases nothing of note.
+ * It also runs the filters on a tenth of the ticks. */
+#define RATE_DECIM 10u
+/* P is averaged over this many ticks before its low-pass: at 500 Hz the float
+ * low-pass of P - p_ref has no dead band worth mentioning (at 50 kHz a 1 Hz first-order
+ * update is smaller than half an ulp of P and the filter would stick). */
+#define RATE_P_DECIM 100u
+
+typedef struct {
+  float rot_c, rot_s;         /* cos, sin of the demodulation phase phi_dm (designer) */
+  float scale_dps;            /* deg/s per unit of Re(R) */
+  float bias_c_dps[4];
+  float sf_c[4];
+  float p_ref_deg;            /* P around which its low-pass works (the start value) */
+  float p_lpf_alpha;          /* first-order low-pass of P at fs / RATE_P_DECIM */
+  const biquad_coeffs_t *lpf; /* output low-pass sections, designed for fs / RATE_DECIM */
+  uint32_t lpf_sections;
+  float min_drive_v;          /* below this drive amplitude the ratio is not formed */
+} rate_channel_cfg_t;
+
+typedef struct {
+  float rot_c, rot_s;         /* cos, sin of phi_dm */
+  float scale_dps;
+  float bias_c_dps[4];
+  float sf_c[4];
+  float p_ref_deg;
+  float p_lpf_alpha;
+  float p_acc_deg;            /* sum of (P - p_ref) over the current decimation block */
+  uint32_t p_count;
+  float p_dev_deg;            /* low-passed P - p_ref */
+  float min_drive_v2;
+  float acc_re, acc_im;       /* sums over the current decimation block */
+  uint32_t count;
+  biquad_cascade_t lpf_rate;
+  biquad_cascade_t lpf_quad;
+  /* Outputs of the latest tick. */
+  float rate_raw;             /* Re(R), unfiltered */
+  float quad_raw;             /* Im(R), unfiltered */
+  float rate_unc_dps;         /* filtered, scaled, not compensated */
+  float quad_dps;             /* filtered, scaled quadrature */
+  float p_f_deg;              /* low-passed P */
+  float rate_dps;             /* compensated rate output */
+} rate_channel_t;
+
+/* Returns 0, or -1 (nothing changed) for a bad configuration. */
+int rate_channel_init(rate_channel_t *rc, const rate_channel_cfg_t *cfg);
+
+/* New coefficients without touching the state (bumpless; the ISR applies a published
+ * parameter change at a tick boundary). The filter state is kept when the number of
+ * sections is unchanged, cleared otherwise. No libm. Returns 0, or -1 (nothing
+ * changed) for a bad configuration. */
+int rate_channel_retune(rate_channel_t *rc, const rate_channel_cfg_t *cfg);
+
+/* Clear the filters; P_f starts at p_deg. */
+void rate_channel_reset(rate_channel_t *rc, float p_deg);
+
+/* One tick. (d_s, d_c): drive phasor; (s_s, s_c): sense phasor; p_rad: force phase.
+ * The filtered outputs change once per RATE_DECIM ticks. */
+void rate_channel_step(rate_channel_t *rc, float d_s, float d_c, float s_s, float s_c,
+                       float p_rad);
+
+#endif /* RATE_CHANNEL_H */

@@ -1,0 +1,112 @@
+#include "gyro/supervisor.h"
+
+#include <stddef.h>
+
+#include "dsp/fastmath.h"
+
+static uint32_t ticks_of(float t_s, float dt_s)
+{
+  const float n = t_s / dt_s + 0.5f;
+  return n < 1.0f ? 1u : (uint32_t)n;
+}
+
+int supervisor_init(supervisor_t *sv, const supervisor_cfg_t *cfg)
+{
+  if (sv == NULL || cfg == NULL || !(cfg->dt_s > 0.0f) || !(cfg->lock_tol_rel > 0.0f) ||
+      !(cfg->lost_tol_rel >= cfg->lock_tol_rel) || !(cfg->lock_phase_tol_rad > 0.0f) ||
+      !(cfg->amp_trip_rel > 1.0f + cfg->lost_tol_rel) || !(cfg->lock_hold_s >= 0.0f) ||
+      !(cfg->lost_hold_s >= 0.0f) || !(cfg->sat_hold_s >= 0.0f) || !(cfg->retry_s >= 0.0f) ||
+      !(cfg->lock_hold_s < 1e4f && cfg->lost_hold_s < 1e4f && cfg->sat_hold_s < 1e4f &&
+        cfg->retry_s < 1e4f) ||
+      cfg->clip_max_count == 0u) {
+    return -1;
+  }
+  sv->mode = GYRO_MODE_OFF;
+  sv->fault = GYRO_FAULT_NONE;
+  sv->fault_count = 0u;
+  sv->lock_ticks_needed = ticks_of(cfg->lock_hold_s, cfg->dt_s);
+  sv->lost_ticks_needed = ticks_of(cfg->lost_hold_s, cfg->dt_s);
+  sv->sat_ticks_needed = ticks_of(cfg->sat_hold_s, cfg->dt_s);
+  sv->retry_ticks = ticks_of(cfg->retry_s, cfg->dt_s);
+  sv->clip_max_count = cfg->clip_max_count;
+  sv->lock_tol_rel = cfg->lock_tol_rel;
+  sv->lock_phase_tol_rad = cfg->lock_phase_tol_rad;
+  sv->lost_tol_rel = cfg->lost_tol_rel;
+  sv->amp_trip_rel = cfg->amp_trip_rel;
+  sv->in_tol_ticks = sv->out_tol_ticks = sv->sat_ticks = 0u;
+  sv->clip_run = sv->fault_ticks = sv->mode_ticks = 0u;
+  return 0;
+}
+
+static void set_mode(supervisor_t *sv, gyro_mode_t m)
+{
+  sv->mode = m;
+  sv->mode_ticks = 0u;
+  sv->in_tol_ticks = sv->out_tol_ticks = sv->sat_ticks = 0u;
+}
+
+void supervisor_start(supervisor_t *sv)
+{
+  if (sv->mode == GYRO_MODE_OFF) {
+    set_mode(sv, GYRO_MODE_ACQUIRE);
+  }
+}
+
+void supervisor_stop(supervisor_t *sv) { set_mode(sv, GYRO_MODE_OFF); }
+
+void supervisor_enter_sweep(supervisor_t *sv) { set_mode(sv, GYRO_MODE_SWEEP); }
+
+static int trip(supervisor_t *sv, uint32_t reason)
+{
+  sv->fault = reason;
+  sv->fault_count++;
+  sv->fault_ticks = 0u;
+  set_mode(sv, GYRO_MODE_FAULT);
+  return 1;
+}
+
+int supervisor_step(supervisor_t *sv, const supervisor_in_t *in)
+{
+  sv->mode_ticks++;
+  sv->clip_run = in->adc_at_rail ? sv->clip_run + 1u : 0u;
+
+  if (sv->mode == GYRO_MODE_FAULT) {
+    if (++sv->fault_ticks >= sv->retry_ticks) {
+      set_mode(sv, GYRO_MODE_ACQUIRE);
+      return 1;
+    }
+    return 0;
+  }
+  /* Faults that act in every mode but OFF. A NaN anywhere would otherwise stay in the
+   * integrators forever; clipping makes the demodulated amplitude meaningless. */
+  if (sv->mode != GYRO_MODE_OFF) {
+    if (!in->state_finite) return trip(sv, GYRO_FAULT_NAN);
+    if (sv->clip_run >= sv->clip_max_count) return trip(sv, GYRO_FAULT_ADC_CLIP);
+    if (sv->mode != GYRO_MODE_SWEEP && in->amp_rel > sv->amp_trip_rel) {
+      return trip(sv, GYRO_FAULT_OVER_AMP);
+    }
+  }
+
+  const float ae = fm_absf(in->amp_rel_err);
+  const float pe = fm_absf(in->phase_err_rad);
+  switch (sv->mode) {
+  case GYRO_MODE_ACQUIRE:
+    sv->in_tol_ticks = (ae <= sv->lock_tol_rel && pe <= sv->lock_phase_tol_rad)
+                           ? sv->in_tol_ticks + 1u : 0u;
+    if (sv->in_tol_ticks >= sv->lock_ticks_needed) {
+      set_mode(sv, GYRO_MODE_LOCKED);
+    }
+    break;
+  case GYRO_MODE_LOCKED:
+    sv->out_tol_ticks = (ae > sv->lost_tol_rel) ? sv->out_tol_ticks + 1u : 0u;
+    sv->sat_ticks = in->drive_at_limit ? sv->sat_ticks + 1u : 0u;
+    if (sv->out_tol_ticks >= sv->lost_ticks_needed) return trip(sv, GYRO_FAULT_LOST_LOCK);
+    if (sv->sat_ticks >= sv->sat_ticks_needed) return trip(sv, GYRO_FAULT_DRIVE_SAT);
+    break;
+  case GYRO_MODE_OFF:
+  case GYRO_MODE_SWEEP:
+  case GYRO_MODE_FAULT:
+    break;
+  }
+  return 0;
+}

@@ -1,0 +1,116 @@
+/* Parameter store: persistent parameters in two flash sectors (slots A and B) used in
+ * turn, so that a power cut at any byte of a save leaves the previous image loadable.
+ *
+ * Image (little-endian, every field 4-byte aligned; the STM32F4 programs 32-bit words):
+ *
+ *   offset      size  field
+ *   0           4     magic       0x4D524750 ("PGRM" in byte order)
+ *   4           2     format      1: this header and record encoding
+ *   6           2     layout      PARAM_LAYOUT_VERSION of the writer (diagnostic only)
+ *   8           4     fw_version  writer's firmware, MAJOR << 16 | MINOR << 8 | PATCH
+ *   12          4     seq         save counter; the newer of two valid images wins
+ *                                 (serial-number comparison, so a wrap is harmless)
+ *   16          4     count       number of records n
+ *   20          8n    records     {u16 id, u8 type (param_type_t), u8 0, u32 value}
+ *                                 value: IEEE-754 bits for F32, the integer otherwise
+ *   20+8n       4     crc         CRC-32 (crc32.h) of bytes [0, 20+8n)
+ *   24+8n       4     commit      0x5AFEC0DE, programmed last
+ *
+ * Save: refuse unless the loop is in a safe mode (see below); encode; if the newest
+ * valid image holds exactly these records, write nothing (PARAM_STORE_UNCHANGED);
+ * otherwise erase the other slot, program header + records + crc, then the commit word,
+ * then read back and validate. Until the commit word is complete the new slot is
+ * invalid (an erased or torn commit word never equals 0x5AFEC0DE, which has no 0xFF
+ * byte), and the old slot is never touched, so every cut leaves old or new.
+ *
+ * Load: an image is valid when magic, format, count (fits in the sector), commit word
+ * and CRC all check. The valid image with the higher seq wins; a corrupt newest image
+ * falls back to the other slot. Records are migrated field by field against the running
+ * table: unknown (or no longer persistent) ids are dropped and counted; a wrong type, a
+ * duplicate or a value failing param_check is rejected and counted, and that parameter
+ * keeps its default; persistent parameters missing from the image take their defaults.
+ * With no valid image, nothing is loaded and the caller keeps its values (defaults at
+ * boot), with the slot states in the report.
+ *
+ * Why save needs the loop safe: on a single-bank STM32F4 a 16 KB sector erase stalls
+ * every instruction fetch from flash for 250 ms typical (500 ms max), and the drive
+ * amplitude decays with tau = 2 Q1 / wn1 = 7 ms (6-12): a save while the gyro runs
+ * would stop the 50 kHz tick for ~35 time constants and drop the loop. Running the
+ * whole sample path from RAM would avoid the stall, but needs every function and
+ * constant the ISR touches (libgcc helpers, const tables) placed in RAM and kept there
+ * by the linker script - fragile for a rarely used command. So a save is refused unless
+ * the caller says the loop is safe (drive off / not LOCKED).
+ */
+#ifndef PARAM_STORE_H
+#define PARAM_STORE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "params/params.h"
+
+#define PARAM_STORE_MAGIC 0x4D524750u
+#define PARAM_STORE_FORMAT 1u
+#define PARAM_STORE_COMMIT 0x5AFEC0DEu
+#define PARAM_STORE_HDR_BYTES 20u
+#define PARAM_STORE_REC_BYTES 8u
+/* Largest image this firmware writes: every parameter persistent. */
+#define PARAM_STORE_IMAGE_MAX (PARAM_STORE_HDR_BYTES + PARAM_STORE_REC_BYTES * PARAM_COUNT + 8u)
+/* Largest record count a loader accepts (bounded further by the sector size). */
+#define PARAM_STORE_MAX_RECORDS 4096u
+
+typedef enum {
+  PARAM_STORE_OK = 0,
+  PARAM_STORE_UNCHANGED,   /* save: the newest image already holds these values */
+  PARAM_STORE_NONE,        /* load: no valid image; nothing loaded */
+  PARAM_STORE_ERR_BUSY,    /* save refused: the loop is not in a safe mode */
+  PARAM_STORE_ERR_FLASH,   /* erase/program failed (including a power cut) */
+  PARAM_STORE_ERR_VERIFY,  /* the written image did not read back valid */
+  PARAM_STORE_ERR_CONFIG   /* bad sectors or a sector too small for an image */
+} param_store_status_t;
+
+typedef enum {
+  PARAM_SLOT_EMPTY = 0,  /* header erased (all 0xFF) */
+  PARAM_SLOT_VALID,
+  PARAM_SLOT_CORRUPT     /* something there, but it does not check */
+} param_slot_state_t;
+
+typedef struct {
+  uint32_t sector_a; /* hal_flash sector numbers of the two slots */
+  uint32_t sector_b;
+} param_store_cfg_t;
+
+typedef struct {
+  uint32_t sector[2];
+  uint32_t sector_size;
+  uint8_t buf[PARAM_STORE_IMAGE_MAX]; /* encode buffer */
+} param_store_t;
+
+typedef struct {
+  uint8_t slot_state[2]; /* param_slot_state_t of A and B at the time of the call */
+  int8_t slot;           /* slot loaded or written (0 = A, 1 = B), -1 none */
+  uint32_t seq;          /* its sequence number */
+  uint32_t fw_version;   /* load: writer's firmware version */
+  uint16_t layout;       /* load: writer's PARAM_LAYOUT_VERSION */
+  uint16_t dropped;      /* load: records with unknown or non-persistent ids */
+  uint16_t rejected;     /* load: records with a bad type, duplicate id or bad value */
+  uint16_t defaulted;    /* load: persistent parameters missing from the image */
+  int32_t flash_status;  /* hal_flash_status_t of a failed operation, else 0 */
+} param_store_report_t;
+
+param_store_status_t param_store_init(param_store_t *st, const param_store_cfg_t *cfg);
+
+/* Load the newest valid image into *v: every persistent parameter is overwritten (from
+ * the image or its default); other members are left as the caller set them. Returns
+ * PARAM_STORE_OK, or PARAM_STORE_NONE with *v untouched. Never writes flash. */
+param_store_status_t param_store_load(param_store_t *st, param_values_t *v, param_store_report_t *rep);
+
+/* Save the persistent parameters of *v (all must pass param_check). loop_safe: the
+ * caller's word that the loop is in a safe mode; false -> PARAM_STORE_ERR_BUSY without
+ * touching flash. */
+param_store_status_t param_store_save(param_store_t *st, const param_values_t *v, bool loop_safe,
+                                      param_store_report_t *rep);
+
+const char *param_store_status_str(param_store_status_t s);
+
+#endif /* PARAM_STORE_H */

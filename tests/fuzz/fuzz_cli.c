@@ -1,0 +1,88 @@
+/* The command line fed arbitrary bytes. Byte 0 picks options: bit 0 the loop is safe
+ * (save, non-live sets allowed), bits 4-7 the chunk size the bytes arrive in, with an
+ * ISR tick between chunks. Invariants: every reply line is well formed, the held
+ * parameters always pass their checks, no staged edit is left behind. */
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "comm/cli.h"
+#include "fuzz_check.h"
+#include "hal_flash_host.h"
+
+typedef struct {
+  params_t bank;
+  param_store_t store;
+  cli_t cli;
+  bool safe;
+  int derived[2];
+} fx_t;
+
+static fx_t g;
+
+static void check_line(void *ctx, const char *d, size_t n)
+{
+  (void)ctx;
+  FUZZ_CHECK(n >= 4 && n <= CLI_OUT_MAX + 32u && d[n - 2] == '\r' && d[n - 1] == '\n');
+  for (size_t i = 0; i + 2 < n; i++) {
+    FUZZ_CHECK(d[i] >= 0x20 && d[i] <= 0x7E);
+  }
+  const bool data = d[0] == '-' && d[1] == ' ';
+  const bool ok = d[0] == 'o' && d[1] == 'k' && (d[2] == ' ' || d[2] == '\r');
+  bool err = n > 6 && memcmp(d, "err ", 4) == 0;
+  if (err) {
+    size_t i = 4;
+    while (i < n && d[i] >= 'A' && d[i] <= 'Z') {
+      i++;
+    }
+    err = i > 4 && d[i] == ' ';
+  }
+  FUZZ_CHECK(data || ok || err);
+}
+
+static int derive(void *ctx, const param_values_t *v, void *d, const char **why)
+{
+  (void)ctx;
+  if (v->drive_dc_bias_v >= v->drive_u_max_v) {
+    *why = "drive.dc_bias_v must stay below drive.u_max_v";
+    return 1;
+  }
+  *(int *)d = 1;
+  return 0;
+}
+
+static bool loop_safe(void *ctx) { return ((fx_t *)ctx)->safe; }
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+  memset(&g, 0, sizeof g);
+  const hal_flash_host_cfg_t fc = {2u, 1024u, NULL, 0u, 0u};
+  FUZZ_CHECK(hal_flash_host_configure(&fc) == 0);
+  const param_store_cfg_t sc = {0u, 1u};
+  FUZZ_CHECK(param_store_init(&g.store, &sc) == PARAM_STORE_OK);
+  const params_cfg_t pc = {derive, {&g.derived[0], &g.derived[1]}, loop_safe, &g};
+  FUZZ_CHECK(params_init(&g.bank, &pc, NULL, NULL) == PARAM_OK);
+  const cli_cfg_t cc = {&g.bank, &g.store, check_line, &g};
+  FUZZ_CHECK(cli_init(&g.cli, &cc) == 0);
+  if (size == 0) {
+    return 0;
+  }
+  g.safe = (data[0] & 1u) != 0;
+  const size_t chunk = 1u + (size_t)(data[0] >> 4) * 4u;
+  for (size_t off = 1; off < size; off += chunk) {
+    const size_t n = (size - off < chunk) ? size - off : chunk;
+    cli_feed(&g.cli, data + off, n);
+    (void)params_isr_acquire(&g.bank);
+    const param_values_t *cur = params_current(&g.bank);
+    for (int i = 0; i < PARAM_COUNT; i++) {
+      FUZZ_CHECK(param_check((param_idx_t)i, param_get(cur, (param_idx_t)i)) == PARAM_OK);
+    }
+    FUZZ_CHECK(memcmp(params_staged(&g.bank), cur, sizeof *cur) == 0);
+    FUZZ_CHECK(cur->sys_fs_hz == 50000u);
+  }
+  FUZZ_CHECK(g.cli.truncated == 0u);
+  return 0;
+}

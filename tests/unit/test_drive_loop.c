@@ -1,0 +1,159 @@
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <math.h>
+#include <cmocka.h>
+
+#include "gyro/drive_loop.h"
+
+/* The design puts the PI zero on the plant pole: Ki/Kp = 1/tau, Kp = wc tau / K. */
+static void test_design_formula(void **state)
+{
+  (void)state;
+  const drive_loop_design_in_t in = {0.03125, 0.00712, 30.0, 270.0, 50000.0};
+  drive_loop_design_out_t out;
+  assert_int_equal(drive_loop_design(&in, &out), 0);
+  const double wc = 2.0 * M_PI * 30.0;
+  assert_true(fabs(out.kp - wc * 0.00712 / 0.03125) < 1e-9 * out.kp);
+  assert_true(fabs(out.ki - out.kp / 0.00712) < 1e-9 * out.ki);
+  assert_true(fabs(out.bw_hz - 30.0) < 1e-9);
+  assert_true(out.phase_margin_deg > 80.0);
+}
+
+/* Asking for more bandwidth than the demodulator allows is capped at 60 deg margin. */
+static void test_design_caps_bandwidth(void **state)
+{
+  (void)state;
+  const drive_loop_design_in_t in = {1.0, 0.1, 1000.0, 270.0, 50000.0};
+  drive_loop_design_out_t out;
+  assert_int_equal(drive_loop_design(&in, &out), 0);
+  assert_true(out.bw_hz < 1000.0);
+  assert_true(out.phase_margin_deg >= 60.0);
+  const double wc = 2.0 * M_PI * out.bw_hz;
+  const double pm = 90.0 - (atan(wc / (2 * M_PI * 270.0)) + wc * 1.5 / 50000.0) * 180.0 / M_PI;
+  assert_true(fabs(pm - out.phase_margin_deg) < 1e-9);
+  drive_loop_design_in_t bad = in;
+  bad.tau_s = -1.0;
+  assert_int_equal(drive_loop_design(&bad, &out), -1);
+  bad = in;
+  bad.plant_gain = NAN;
+  assert_int_equal(drive_loop_design(&bad, &out), -1);
+}
+
+/* Envelope model of the drive mode near resonance (6-12, 6-17): the complex amplitude
+ * Z of the pickoff follows K f e^{jP} with a first-order lag tau, discretised exactly
+ * (ZOH). Z = w_s + j w_c as the LMSD reports it. */
+typedef struct {
+  double zr, zi, a, k;
+} env_plant_t;
+
+static void env_step(env_plant_t *p, double f, double p_rad)
+{
+  const double tr = p->k * f * cos(p_rad), ti = p->k * f * sin(p_rad);
+  p->zr = p->a * p->zr + (1.0 - p->a) * tr;
+  p->zi = p->a * p->zi + (1.0 - p->a) * ti;
+}
+
+/* Small steps (no saturation): amplitude and phase errors decay as the designed
+ * first-order closed loop, e^{-wc t}, to a few per cent of the step (the LMSD lag is
+ * not in this model, so the response is the ideal one). */
+static void test_closed_loop_first_order(void **state)
+{
+  (void)state;
+  const double fs = 50000.0, tau = 0.00712, k = 0.03125, bw = 30.0;
+  drive_loop_design_in_t in = {k, tau, bw, 270.0, fs};
+  drive_loop_design_out_t amp, ph;
+  in.plant_gain = k;
+  assert_int_equal(drive_loop_design(&in, &amp), 0);
+  in.plant_gain = 1.0;
+  assert_int_equal(drive_loop_design(&in, &ph), 0);
+
+  drive_loop_cfg_t c = {.dt_s = (float)(1.0 / fs), .amp_set_v = 2.0f, .phase_set_rad = 0.3f,
+                        .amp_kp = (float)amp.kp, .amp_ki = (float)amp.ki,
+                        .phase_kp = (float)ph.kp, .phase_ki = (float)ph.ki,
+                        .f_cmd_max_v2 = 196.0f, .p_init_rad = 0.3f};
+  drive_loop_t dl;
+  assert_int_equal(drive_loop_init(&dl, &c), 0);
+  /* Start in equilibrium at 1.9 V and phase 0.3, force matching. */
+  env_plant_t p = {1.9 * cos(0.3), 1.9 * sin(0.3), exp(-1.0 / (fs * tau)), k};
+  dl.amp_pi.u = (float)(1.9 / k);
+  dl.f_cmd_v2 = dl.amp_pi.u;
+  dl.phase_set_rad = 0.35f; /* 0.05 rad phase step together with the 0.1 V amplitude step */
+  const double wc = 2.0 * M_PI * bw;
+  double max_amp = 0.0;
+  for (int n = 1; n <= 10000; n++) {
+    drive_loop_step(&dl, (float)p.zr, (float)p.zi);
+    env_step(&p, dl.f_cmd_v2, dl.p_rad);
+    const double t = n / fs;
+    const double a = hypot(p.zr, p.zi), ph_now = atan2(p.zi, p.zr);
+    if (a > max_amp) max_amp = a;
+    if (n % 500 == 0) {
+      const double expect_a = 2.0 - 0.1 * exp(-wc * t);
+      const double expect_p = 0.35 - 0.05 * exp(-wc * t);
+      assert_true(fabs(a - expect_a) < 0.004);
+      assert_true(fabs(ph_now - expect_p) < 0.002);
+    }
+  }
+  assert_true(max_amp < 2.0 * 1.001); /* no overshoot */
+}
+
+/* From rest: the amplitude PI saturates at the drive limit, then comes off the limit
+ * without overshoot (no wind-up, exact square-law linearisation), within 1 % by 0.2 s. */
+static void test_startup_no_overshoot(void **state)
+{
+  (void)state;
+  const double fs = 50000.0, tau = 0.00712, k = 0.03125;
+  drive_loop_design_in_t in = {k, tau, 30.0, 270.0, fs};
+  drive_loop_design_out_t amp, ph;
+  assert_int_equal(drive_loop_design(&in, &amp), 0);
+  in.plant_gain = 1.0;
+  assert_int_equal(drive_loop_design(&in, &ph), 0);
+  drive_loop_cfg_t c = {.dt_s = (float)(1.0 / fs), .amp_set_v = 2.0f, .phase_set_rad = 0.0f,
+                        .amp_kp = (float)amp.kp, .amp_ki = (float)amp.ki,
+                        .phase_kp = (float)ph.kp, .phase_ki = (float)ph.ki,
+                        .f_cmd_max_v2 = 80.0f, .p_init_rad = 0.0f}; /* 2.5 V at the limit */
+  drive_loop_t dl;
+  assert_int_equal(drive_loop_init(&dl, &c), 0);
+  env_plant_t p = {1e-4, 0.0, exp(-1.0 / (fs * tau)), k};
+  double max_amp = 0.0;
+  int saturated = 0;
+  double t_in = -1.0;
+  for (int n = 1; n <= 20000; n++) {
+    drive_loop_step(&dl, (float)p.zr, (float)p.zi);
+    saturated |= dl.f_cmd_v2 >= 80.0f;
+    env_step(&p, dl.f_cmd_v2, dl.p_rad);
+    const double a = hypot(p.zr, p.zi);
+    if (a > max_amp) max_amp = a;
+    if (fabs(a - 2.0) > 0.02) t_in = -1.0;
+    else if (t_in < 0.0) t_in = n / fs;
+  }
+  assert_true(saturated);
+  assert_true(t_in > 0.0 && t_in < 0.2);
+  assert_true(max_amp < 2.0 * 1.01);
+}
+
+static void test_bad_cfg(void **state)
+{
+  (void)state;
+  drive_loop_t dl = {.amp_set_v = 5.0f};
+  drive_loop_cfg_t c = {.dt_s = 2e-5f, .amp_set_v = 0.0f, .f_cmd_max_v2 = 100.0f};
+  assert_int_equal(drive_loop_init(&dl, &c), -1);
+  c.amp_set_v = 1.0f;
+  c.amp_kp = NAN;
+  assert_int_equal(drive_loop_init(&dl, &c), -1);
+  c.amp_kp = 1.0f;
+  c.p_init_rad = 10.0f;
+  assert_int_equal(drive_loop_init(&dl, &c), -1);
+  assert_true(dl.amp_set_v == 5.0f);
+}
+
+int main(void)
+{
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_design_formula),        cmocka_unit_test(test_design_caps_bandwidth),
+      cmocka_unit_test(test_closed_loop_first_order), cmocka_unit_test(test_startup_no_overshoot),
+      cmocka_unit_test(test_bad_cfg),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

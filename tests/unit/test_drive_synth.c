@@ -1,0 +1,76 @@
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <math.h>
+#include <cmocka.h>
+
+#include "dsp/nco.h"
+#include "gyro/drive_synth.h"
+
+/* (6-7) with (6-18..6-21): U1^2 - U2^2 = f cos(phi + P) for both schemes, at every
+ * sample of a run of the real NCO through accumulator wraps. */
+static void check_force(gyro_drive_mode_t mode)
+{
+  drive_synth_t ds;
+  drive_synth_cfg_t c = {.mode = mode, .dc_bias_v = 7.0f, .u_max_v = 14.0f};
+  assert_int_equal(drive_synth_init(&ds, &c), 0);
+  nco_t nco;
+  nco_cfg_t nc = {.freq_hz = 1489.9, .fs_hz = 50000.0, .phase_rad = 0.0};
+  assert_int_equal(nco_init(&nco, &nc), 0);
+  const float f = 64.0f;
+  double max_err = 0.0, prev_u1 = 0.0;
+  double max_jump = 0.0;
+  for (int n = 0; n < 200000; n++) {
+    nco_out_t o;
+    nco_step(&nco, &o);
+    const float p = -2.0f + 4.0f * (float)n / 200000.0f; /* sweep P through +-2 rad */
+    float u1, u2;
+    drive_synth_step(&ds, f, p, o.phase, o.half_phase, &u1, &u2);
+    const double phi = 2.0 * M_PI * (double)o.phase / 4294967296.0; /* the NCO's own phase */
+    const double force = (double)u1 * u1 - (double)u2 * u2;
+    const double err = fabs(force - f * cos(phi + p));
+    if (err > max_err) max_err = err;
+    if (n > 0 && fabs(u1 - prev_u1) > max_jump) max_jump = fabs(u1 - prev_u1);
+    prev_u1 = u1;
+  }
+  assert_true(max_err < 64.0 * 2e-5);
+  /* Continuity: no step larger than one sample's advance of the waveform. */
+  const double slope = (mode == GYRO_DRIVE_DC_AC ? 2.0 * M_PI * 1489.9 * 64.0 / 28.0
+                                                 : M_PI * 1489.9 * 8.0) / 50000.0;
+  assert_true(max_jump < 1.05 * slope);
+}
+
+static void test_half_frequency_force(void **state) { (void)state; check_force(GYRO_DRIVE_HALF_FREQ); }
+static void test_dc_ac_force(void **state) { (void)state; check_force(GYRO_DRIVE_DC_AC); }
+
+/* Largest force each scheme can make within +-u_max on both electrodes. */
+static void test_limits(void **state)
+{
+  (void)state;
+  drive_synth_t ds;
+  drive_synth_cfg_t c = {.mode = GYRO_DRIVE_HALF_FREQ, .dc_bias_v = 0.0f, .u_max_v = 14.0f};
+  assert_int_equal(drive_synth_init(&ds, &c), 0);
+  assert_true(fabsf(drive_synth_f_cmd_max(&ds) - 196.0f) < 1e-4f);
+  c.mode = GYRO_DRIVE_DC_AC;
+  c.dc_bias_v = 7.0f;
+  assert_int_equal(drive_synth_init(&ds, &c), 0);
+  assert_true(fabsf(drive_synth_f_cmd_max(&ds) - 196.0f) < 1e-4f);
+  float u1, u2;
+  drive_synth_step(&ds, 196.0f, 0.0f, 0u, 0u, &u1, &u2);
+  assert_true(u1 <= 14.0f + 1e-4f && u2 >= -1e-4f);
+  c.dc_bias_v = 14.0f; /* no room for AC */
+  assert_int_equal(drive_synth_init(&ds, &c), -1);
+  c.mode = (gyro_drive_mode_t)7;
+  assert_int_equal(drive_synth_init(&ds, &c), -1);
+}
+
+int main(void)
+{
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_half_frequency_force),
+      cmocka_unit_test(test_dc_ac_force),
+      cmocka_unit_test(test_limits),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

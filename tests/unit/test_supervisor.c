@@ -1,0 +1,164 @@
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "gyro/supervisor.h"
+
+static supervisor_cfg_t cfg(void)
+{
+  supervisor_cfg_t c = {
+      .dt_s = 1e-3f, .lock_tol_rel = 0.01f, .lock_phase_tol_rad = 0.02f, .lock_hold_s = 0.01f,
+      .lost_tol_rel = 0.1f, .lost_hold_s = 0.005f, .amp_trip_rel = 1.5f, .sat_hold_s = 0.02f,
+      .retry_s = 0.1f, .clip_max_count = 3u};
+  return c;
+}
+
+static supervisor_in_t good(void)
+{
+  supervisor_in_t in = {.amp_rel_err = 0.0f, .amp_rel = 1.0f, .phase_err_rad = 0.0f,
+                        .drive_at_limit = 0, .adc_at_rail = 0, .state_finite = 1};
+  return in;
+}
+
+static void run(supervisor_t *sv, const supervisor_in_t *in, int n)
+{
+  for (int i = 0; i < n; i++) (void)supervisor_step(sv, in);
+}
+
+static void test_bad_cfg_rejected(void **state)
+{
+  (void)state;
+  supervisor_t sv = {.mode = GYRO_MODE_LOCKED, .fault_count = 77u};
+  supervisor_cfg_t c = cfg();
+  c.amp_trip_rel = 1.05f; /* inside the lost-lock band: could never see lost lock first */
+  assert_int_equal(supervisor_init(&sv, &c), -1);
+  c = cfg();
+  c.clip_max_count = 0u;
+  assert_int_equal(supervisor_init(&sv, &c), -1);
+  c = cfg();
+  c.dt_s = 0.0f;
+  assert_int_equal(supervisor_init(&sv, &c), -1);
+  assert_int_equal(sv.mode, GYRO_MODE_LOCKED);
+  assert_int_equal(sv.fault_count, 77u);
+}
+
+/* OFF until started; ACQUIRE -> LOCKED after lock_hold_s (10 ticks) inside tolerance;
+ * a tick outside restarts the count. */
+static void test_lock_sequence(void **state)
+{
+  (void)state;
+  supervisor_t sv;
+  supervisor_cfg_t c = cfg();
+  assert_int_equal(supervisor_init(&sv, &c), 0);
+  supervisor_in_t in = good();
+  run(&sv, &in, 50);
+  assert_int_equal(sv.mode, GYRO_MODE_OFF);
+  supervisor_start(&sv);
+  assert_int_equal(sv.mode, GYRO_MODE_ACQUIRE);
+  run(&sv, &in, 9);
+  in.amp_rel_err = 0.02f;
+  run(&sv, &in, 1);
+  in = good();
+  run(&sv, &in, 9);
+  assert_int_equal(sv.mode, GYRO_MODE_ACQUIRE);
+  run(&sv, &in, 1);
+  assert_int_equal(sv.mode, GYRO_MODE_LOCKED);
+  /* Phase outside tolerance also blocks lock. */
+  supervisor_stop(&sv);
+  supervisor_start(&sv);
+  in.phase_err_rad = 0.05f;
+  run(&sv, &in, 100);
+  assert_int_equal(sv.mode, GYRO_MODE_ACQUIRE);
+}
+
+/* Lost lock after lost_hold_s (5 ticks) outside 10 %; retry after retry_s (100 ticks)
+ * with a request to clear the loop state on both edges. */
+static void test_lost_lock_and_retry(void **state)
+{
+  (void)state;
+  supervisor_t sv;
+  supervisor_cfg_t c = cfg();
+  assert_int_equal(supervisor_init(&sv, &c), 0);
+  supervisor_start(&sv);
+  supervisor_in_t in = good();
+  run(&sv, &in, 10);
+  assert_int_equal(sv.mode, GYRO_MODE_LOCKED);
+  in.amp_rel_err = -0.2f;
+  in.amp_rel = 0.8f;
+  run(&sv, &in, 4);
+  assert_int_equal(sv.mode, GYRO_MODE_LOCKED);
+  assert_int_equal(supervisor_step(&sv, &in), 1);
+  assert_int_equal(sv.mode, GYRO_MODE_FAULT);
+  assert_int_equal(sv.fault, GYRO_FAULT_LOST_LOCK);
+  int cleared = 0;
+  for (int i = 0; i < 100; i++) cleared += supervisor_step(&sv, &in);
+  assert_int_equal(cleared, 1);
+  assert_int_equal(sv.mode, GYRO_MODE_ACQUIRE);
+  assert_int_equal(sv.fault_count, 1u);
+}
+
+static void test_immediate_faults(void **state)
+{
+  (void)state;
+  supervisor_t sv;
+  supervisor_cfg_t c = cfg();
+  supervisor_in_t in;
+
+  assert_int_equal(supervisor_init(&sv, &c), 0);
+  supervisor_start(&sv);
+  in = good();
+  in.amp_rel = 1.6f;
+  assert_int_equal(supervisor_step(&sv, &in), 1);
+  assert_int_equal(sv.fault, GYRO_FAULT_OVER_AMP);
+
+  assert_int_equal(supervisor_init(&sv, &c), 0);
+  supervisor_start(&sv);
+  in = good();
+  in.state_finite = 0;
+  assert_int_equal(supervisor_step(&sv, &in), 1);
+  assert_int_equal(sv.fault, GYRO_FAULT_NAN);
+
+  /* Clipping needs clip_max_count consecutive rail codes. */
+  assert_int_equal(supervisor_init(&sv, &c), 0);
+  supervisor_start(&sv);
+  in = good();
+  in.adc_at_rail = 1;
+  run(&sv, &in, 2);
+  in.adc_at_rail = 0;
+  run(&sv, &in, 1);
+  in.adc_at_rail = 1;
+  run(&sv, &in, 2);
+  assert_int_equal(sv.mode, GYRO_MODE_ACQUIRE);
+  run(&sv, &in, 1);
+  assert_int_equal(sv.mode, GYRO_MODE_FAULT);
+  assert_int_equal(sv.fault, GYRO_FAULT_ADC_CLIP);
+}
+
+/* Pinned at the drive limit while LOCKED for sat_hold_s (20 ticks): drive saturation. */
+static void test_drive_saturation(void **state)
+{
+  (void)state;
+  supervisor_t sv;
+  supervisor_cfg_t c = cfg();
+  assert_int_equal(supervisor_init(&sv, &c), 0);
+  supervisor_start(&sv);
+  supervisor_in_t in = good();
+  run(&sv, &in, 10);
+  in.drive_at_limit = 1;
+  run(&sv, &in, 19);
+  assert_int_equal(sv.mode, GYRO_MODE_LOCKED);
+  run(&sv, &in, 1);
+  assert_int_equal(sv.fault, GYRO_FAULT_DRIVE_SAT);
+}
+
+int main(void)
+{
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_bad_cfg_rejected),   cmocka_unit_test(test_lock_sequence),
+      cmocka_unit_test(test_lost_lock_and_retry), cmocka_unit_test(test_immediate_faults),
+      cmocka_unit_test(test_drive_saturation),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
