@@ -87,7 +87,7 @@ static int temp_ok(const mech_cfg_t *c, double temp_k)
          fabs(0.5 * c->ket_per_k * (temp_k - c->temp_ref_k)) < 0.2;
 }
 
-enum { M_1 = 0, M_E, M_E2, M_W, M_WE, M_WE2, M_W2, M_W2E, M_W3, M_A, M_WA, M_AE };
+enum { MONO_1 = 0, MONO_E, MONO_E2, MONO_W, MONO_WE, MONO_WE2, MONO_W2, MONO_W2E, MONO_W3, MONO_A, MONO_WA, MONO_AE };
 
 /* Continuous generator in scaled coordinates, one block per monomial: A(w,a,e) =
  * wr * sum_m Ahat_m * mono_m, augmented with the input columns (rows 4,5 zero). The
@@ -105,7 +105,7 @@ static void build_generator(const mech_t *m, double wn1, double wn2,
   const double kq = c->kq_per_s2 * s * s / (wr * wr);
   const double dq = c->dq_per_s * s / wr;
   memset(ahat, 0, sizeof(double) * MECH_NMONO * NA * NA);
-  double (*a0)[NA] = ahat[M_1];
+  double (*a0)[NA] = ahat[MONO_1];
   a0[0][1] = 1.0;
   a0[1][0] = -r1 * r1;
   a0[1][1] = -r1 / c->q1;
@@ -117,23 +117,23 @@ static void build_generator(const mech_t *m, double wn1, double wn2,
   a0[3][3] = -r2 / c->q2;
   a0[3][5] = 1.0;
   /* e: wn -> wn (1 + e) */
-  ahat[M_E][1][0] = -2.0 * r1 * r1;
-  ahat[M_E][1][1] = -r1 / c->q1;
-  ahat[M_E][3][0] = -2.0 * kq;
-  ahat[M_E][3][1] = -dq;
-  ahat[M_E][3][2] = -2.0 * r2 * r2;
-  ahat[M_E][3][3] = -r2 / c->q2;
-  ahat[M_E2][1][0] = -r1 * r1;
-  ahat[M_E2][3][0] = -kq;
-  ahat[M_E2][3][2] = -r2 * r2;
+  ahat[MONO_E][1][0] = -2.0 * r1 * r1;
+  ahat[MONO_E][1][1] = -r1 / c->q1;
+  ahat[MONO_E][3][0] = -2.0 * kq;
+  ahat[MONO_E][3][1] = -dq;
+  ahat[MONO_E][3][2] = -2.0 * r2 * r2;
+  ahat[MONO_E][3][3] = -r2 / c->q2;
+  ahat[MONO_E2][1][0] = -r1 * r1;
+  ahat[MONO_E2][3][0] = -kq;
+  ahat[MONO_E2][3][2] = -r2 * r2;
   /* w: Coriolis 2 Omega y' on the sense mode, (2-22) */
-  ahat[M_W][3][1] = 2.0;
+  ahat[MONO_W][3][1] = 2.0;
   if (c->full_kinematics) {
-    ahat[M_W][1][3] = -2.0; /* reciprocal Coriolis on the drive mode, (2-20) */
-    ahat[M_W2][1][0] = 1.0; /* centrifugal Omega^2 y, (2-20) */
-    ahat[M_W2][3][2] = 1.0; /* centrifugal Omega^2 x */
-    ahat[M_A][3][0] = 1.0;  /* Euler force +alpha y on the sense mode */
-    ahat[M_A][1][2] = -1.0; /* Euler force -alpha x on the drive mode */
+    ahat[MONO_W][1][3] = -2.0; /* reciprocal Coriolis on the drive mode, (2-20) */
+    ahat[MONO_W2][1][0] = 1.0; /* centrifugal Omega^2 y, (2-20) */
+    ahat[MONO_W2][3][2] = 1.0; /* centrifugal Omega^2 x */
+    ahat[MONO_A][3][0] = 1.0;  /* Euler force +alpha y on the sense mode */
+    ahat[MONO_A][1][2] = -1.0; /* Euler force -alpha x on the drive mode */
   }
 }
 
