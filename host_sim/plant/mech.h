@@ -49,13 +49,13 @@
  * per-sample Eigen expm of the exact model (test_mech): < 1e-9 relative with rate up
  * to 500 deg/s and 20 Hz, a 60 K temperature ramp and 1500 deg/s quadrature; the
  * temperature remainder is about 860 e^3 at resonance, so the blocks are recomputed
- * ("refresh") only when |e| exceeds cfg.refresh_eps (default 1e-3, i.e. every 40 K).
+ * ("refresh") only when |e| exceeds cfg.refresh_eps (default 1e-3, i.e. every 50 K).
  * The rate is taken at the middle of the sample, its slope as alpha (first order
  * within the sample); a sinusoidal rate at f_r then costs (2 pi f_r T)^2 / 24 of the
  * Coriolis response (1.7e-7 at 20 Hz against 4 reference sub-steps per sample).
  *
  * Per sample: one 4x6 matrix-vector product (24 multiply-adds) and two Gaussian
- * deviates; when the rate changes, 4x6x6 multiply-adds to re-sum the blocks; when the
+ * deviates (ziggurat, gauss_zig.h); when the rate changes, 4x6x6 multiply-adds to re-sum the blocks; when the
  * temperature changes (thermal update), 12x24.
  *
  * Internally the state is scaled to z = [y, y'/wr, x, x'/wr] with wr = wn1(T0) so
@@ -66,6 +66,7 @@
 
 #include <stdint.h>
 
+#include "plant/gauss_zig.h"
 #include "plant/rng.h"
 
 #define MECH_NMONO 12  /* Taylor blocks, see mech.c */
@@ -107,17 +108,19 @@ typedef struct {
   double eps;                 /* wn(temp_k)/wn(temp_disc_k) - 1 */
   double blk[MECH_NMONO][MECH_NS][MECH_NS + MECH_NU]; /* Taylor blocks [Phi Gamma] */
   double q[4][2][MECH_NS][MECH_NS + MECH_NU]; /* blocks of w^p a^r summed over e^k */
+  double qmax[4][2];          /* largest entry of each, to skip negligible terms */
   double k[MECH_NS][MECH_NS + MECH_NU];     /* [Phi Gamma] at the current (w, a, e) */
   double coef[2];             /* (w, a) that k[][] was built for */
   int q_valid, k_valid;
   double z[MECH_NS];          /* scaled state */
   double noise_sd[MECH_NU];   /* per-sample sd of the held noise, scaled units */
-  rng_t rng[MECH_NU];
+  rng_t rng[MECH_NU];         /* one source per mode */
+  gauss_zig_t zig;            /* normal deviates from them (gauss_zig.h) */
   uint64_t refresh_count;
 } mech_t;
 
 /* Defaults: the thesis linear gyro (fn1 1489.9 Hz, Q1 33.33, fn2 2000 Hz, Q2 3,
- * m 0.26 mg, kET 50 ppm/K, T0 298.15 K, 50 kHz), no quadrature, noise on. */
+ * m 0.26 mg, kET 40 ppm/K, T0 298.15 K, 50 kHz), no quadrature, noise on. */
 void mech_default_cfg(mech_cfg_t *cfg);
 
 /* Validates cfg; returns 0 or a negative value and, if key != NULL, the name of the

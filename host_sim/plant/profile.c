@@ -273,6 +273,10 @@ void accel_profile_mean(const accel_profile_t *a, double t0, double t1,
 {
   const double dt = t1 - t0;
   for (int i = 0; i < PROFILE_ACCEL_AXES; i++) {
+    if (a->amp_g[i] == 0.0) {
+      a_g[i] = a->const_g[i];
+      continue;
+    }
     const double w = kTwoPi * a->freq_hz[i];
     const double p = a->phase_rad[i];
     double m;

@@ -423,7 +423,7 @@ static void test_varying_rate_temperature_vs_eigen(void **state)
            "sense rel err %.2e, %llu refreshes\n", kq[i], ey, ex, (unsigned long long)nref);
     assert_true(ey < 1e-9);
     assert_true(ex < 1e-9);
-    assert_true(nref >= 1); /* the 60 K ramp passes the 40 K refresh threshold */
+    assert_true(nref >= 1); /* the 60 K ramp passes the 50 K refresh threshold */
     varying_run(kq[i], 4, &ey, &ex, &nref);
     printf("varying rate/temp, quadrature %4.0f deg/s, 4 sub-steps: drive rel err %.2e, "
            "sense rel err %.2e\n", kq[i], ey, ex);
@@ -515,13 +515,17 @@ static void test_refresh_is_rare(void **state)
   quiet_cfg(&c);
   static mech_t m;
   assert_int_equal(mech_init(&m, &c, c.temp_ref_k - 20.0, 6u), 0);
-  /* a 100 K chamber ramp in 1 mK steps: 100 K x 25 ppm/K = 2.5e-3 of wn -> 2
-   * refreshes at e = 1e-3 (each re-centres e at 0) */
-  for (int i = 1; i <= 100000; i++)
+  /* a 120 K chamber ramp in 1 mK steps moves wn by 0.5 kET 120 K; each refresh
+   * re-centres e at 0, so there is one per refresh_eps of that */
+  const double span = 120.0;
+  for (int i = 1; i <= 120000; i++)
     assert_int_equal(mech_set_temp(&m, c.temp_ref_k - 20.0 + 1e-3 * i), 0);
-  printf("100 K ramp in 1 mK steps: %llu refreshes\n", (unsigned long long)m.refresh_count);
-  assert_true(m.refresh_count == 2);
-  assert_true(fabs(mech_wn1(&m) - 2 * kPi * c.f1_hz * (1 - 0.5 * c.ket_per_k * 80.0)) < 1e-9);
+  const double expect = floor(0.5 * c.ket_per_k * span / c.refresh_eps);
+  printf("%.0f K ramp in 1 mK steps: %llu refreshes (expected %.0f)\n", span,
+         (unsigned long long)m.refresh_count, expect);
+  assert_true(expect >= 2.0);
+  assert_true((double)m.refresh_count == expect);
+  assert_true(fabs(mech_wn1(&m) - 2 * kPi * c.f1_hz * (1 - 0.5 * c.ket_per_k * 100.0)) < 1e-9);
 }
 
 /* ---------------------------------------------------------- noise --------------- */
