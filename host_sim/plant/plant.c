@@ -430,4 +430,9 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
   p->f_prev[0] = f;
 }
 
+void plant_step_hal(void *plant, const hal_dac_frame_t *dac, hal_adc_frame_t *adc)
+{
+  plant_step((plant_t *)plant, dac, adc);
+}
+
 const plant_truth_t *plant_truth(const plant_t *p) { return &p->truth; }

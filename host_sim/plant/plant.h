@@ -260,6 +260,10 @@ int plant_set_profiles(plant_t *p, const plant_profiles_t *prof);
  * frame held). adc: the frame sampled at the end of the interval. */
 void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc);
 
+/* The same step in the shape of hal_host_plant_step_fn (hal/host/hal_host.h), so the
+ * host HAL stub can attach a plant_t without a cast: plant is a plant_t *. */
+void plant_step_hal(void *plant, const hal_dac_frame_t *dac, hal_adc_frame_t *adc);
+
 /* The truth of the last completed sample. */
 const plant_truth_t *plant_truth(const plant_t *p);
 

@@ -454,10 +454,11 @@ static void test_temperature_plumbing(void **state)
   assert_true(fabs(p.pick[0].temp_k - t->circuit_k) <= c.pick_retemp_k);
   assert_true(t->ambient_k == c.temp_k + 20.0);
   assert_true(t->dac_rejects == 0);
-  /* a bad frame is rejected and counted */
+  /* a bad frame is rejected and counted, the previous one held */
   hal_dac_frame_t bad = {{HAL_DAC_CODE_MAX + 1u, 0, 0, 0}};
-  plant_step(&p, &bad, NULL);
+  plant_step_hal(&p, &bad, NULL);
   assert_true(plant_truth(&p)->dac_rejects == 1);
+  assert_true(plant_truth(&p)->dac_held_v[0] == 0.0); /* mid-scale */
 }
 
 int main(void)
