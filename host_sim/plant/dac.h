@@ -34,8 +34,12 @@
  * from the hold; the T/2 lead of "hold the mean of the coming sample" cancels the T/2
  * lag of the hold): no phase error, gain -0.29 % at 1490 Hz (force of a 745 Hz
  * half-frequency drive) at 50 kHz, plus images at k fs +- f that the resonator
- * rejects. Sampling v at the tick and squaring it instead would cost a T/2 lag
- * (5.4 deg at 1490 Hz) that is not in the real hardware.
+ * rejects. Conversely the true force has small components near k fs +- f (products of
+ * the staircase's images); their per-sample means are indistinguishable from a force at
+ * f, so held by the mechanics they act at f: -2.7e-4 of the drive force for a 745 Hz
+ * half-frequency drive with the default filter (test_actuator compares the held force
+ * with the exact spectrum). Sampling v at the tick and squaring it instead would cost a
+ * T/2 lag (5.4 deg at 1490 Hz) that is not in the real hardware.
  *
  * Voltages at the end of the sample (end_v, end_dvdt_v_per_s) are for the pickoff's
  * electrical feedthrough, which interpolates between ticks.
