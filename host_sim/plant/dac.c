@@ -56,7 +56,7 @@ static int cfg_ok(const dac_cfg_t *c)
 
 static double held_level(const dac_t *d, int c, uint16_t code)
 {
-  return d->cfg.gain[c] * dac_code_to_v(code) + d->cfg.offset_v[c];
+  return d->scale[c] * (double)code + d->zero[c];
 }
 
 /* Exact forms of the filter over one sample, in normalised time s = t / T. */
@@ -108,6 +108,12 @@ static int discretise(dac_t *d)
       d->msq[i][j] = m;
       d->msq[j][i] = m;
     }
+  d->q2[0] = d->msq[0][0];
+  d->q2[1] = 2.0 * d->msq[0][1];
+  d->q2[2] = 2.0 * d->msq[0][2];
+  d->q2[3] = d->msq[1][1];
+  d->q2[4] = 2.0 * d->msq[1][2];
+  d->q2[5] = d->msq[2][2];
   return 0;
 }
 
@@ -120,6 +126,11 @@ int dac_init(dac_t *d, const dac_cfg_t *cfg)
   t.filtered = cfg->recon_cutoff_hz > 0.0;
   t.w0 = 2.0 * k_pi * cfg->recon_cutoff_hz;
   if (t.filtered && discretise(&t) != 0) return -1;
+  const double lsb = 2.0 * (double)HAL_DAC_FULL_SCALE_V / 16384.0;
+  for (int c = 0; c < DAC_NCH; c++) {
+    t.scale[c] = cfg->gain[c] * lsb;
+    t.zero[c] = cfg->offset_v[c] - cfg->gain[c] * lsb * (double)HAL_DAC_CODE_MID;
+  }
   for (int c = 0; c < DAC_NCH; c++) {
     t.latched[c] = cfg->initial_code[c];
     t.pending[c] = cfg->initial_code[c];
@@ -141,27 +152,33 @@ int dac_write(dac_t *d, const hal_dac_frame_t *frame)
 
 void dac_step(dac_t *d, dac_out_t *out)
 {
-  for (int c = 0; c < DAC_NCH; c++) {
-    dac_chan_out_t *o = &out->ch[c];
-    const double u = held_level(d, c, d->latched[c]);
-    o->held_v = u;
-    if (!d->filtered) {
+  if (!d->filtered) {
+    for (int c = 0; c < DAC_NCH; c++) {
+      dac_chan_out_t *o = &out->ch[c];
+      const double u = held_level(d, c, d->latched[c]);
+      o->held_v = u;
       o->mean_v = u;
       o->mean_sq_v2 = u * u;
       o->end_v = u;
       o->end_dvdt_v_per_s = 0.0;
-      continue;
+      d->latched[c] = d->pending[c];
     }
+    return;
+  }
+  const double *q = d->q2;
+  for (int c = 0; c < DAC_NCH; c++) {
+    dac_chan_out_t *o = &out->ch[c];
+    const double u = held_level(d, c, d->latched[c]);
     const double z0 = d->x[c][0], z1 = d->x[c][1];
+    o->held_v = u;
     o->mean_v = d->mv[0] * z0 + d->mv[1] * z1 + d->mv[2] * u;
-    o->mean_sq_v2 = d->msq[0][0] * z0 * z0 + d->msq[1][1] * z1 * z1 + d->msq[2][2] * u * u +
-                    2.0 * (d->msq[0][1] * z0 * z1 + d->msq[0][2] * z0 * u + d->msq[1][2] * z1 * u);
+    o->mean_sq_v2 = z0 * (q[0] * z0 + q[1] * z1 + q[2] * u) + z1 * (q[3] * z1 + q[4] * u) + q[5] * u * u;
     const double n0 = d->ad[0][0] * z0 + d->ad[0][1] * z1 + d->bd[0] * u;
     const double n1 = d->ad[1][0] * z0 + d->ad[1][1] * z1 + d->bd[1] * u;
     d->x[c][0] = n0;
     d->x[c][1] = n1;
     o->end_v = n0;
     o->end_dvdt_v_per_s = d->w0 * n1;
+    d->latched[c] = d->pending[c];
   }
-  for (int c = 0; c < DAC_NCH; c++) d->latched[c] = d->pending[c];
 }

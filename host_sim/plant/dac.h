@@ -84,6 +84,9 @@ typedef struct {
   double ad[2][2], bd[2];       /* exact ZOH discretisation */
   double mv[3];                 /* mean form */
   double msq[3][3];             /* mean-square form */
+  double q2[6];                 /* msq as q00, 2q01, 2q02, q11, 2q12, q22 (per-sample use) */
+  double scale[DAC_NCH];        /* volts per code, gain included */
+  double zero[DAC_NCH];         /* volts at code 0, gain and offset included */
   double x[DAC_NCH][2];         /* filter states [v, v'/w0] */
   uint16_t latched[DAC_NCH];    /* code held over the current sample */
   uint16_t pending[DAC_NCH];    /* code latched at the end of the current sample */

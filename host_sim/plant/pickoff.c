@@ -120,7 +120,7 @@ static int phase_ok(const pickoff_cfg_t *c, double phi)
   return isfinite(phi) && phi > 1e-4 && phi < hi;
 }
 
-/* Build the chain at phase phi and discretise it into p (n, phi, g, crow, hb, d). */
+/* Build the chain at phase phi and discretise it into p (n, phi, g, output rows). */
 static int discretise(pickoff_t *p, double phi)
 {
   const pickoff_cfg_t *c = &p->cfg;
@@ -182,6 +182,8 @@ static int discretise(pickoff_t *p, double phi)
   static const double herm[4][4] = {
       {1.0, 0.0, 0.0, 0.0}, {0.0, 1.0, 0.0, 0.0}, {-6.0, -4.0, 6.0, -2.0}, {12.0, 6.0, -12.0, 6.0}};
   p->n = n;
+  memset(p->phi, 0, sizeof p->phi);
+  memset(p->g, 0, sizeof p->g);
   for (int i = 0; i < n; i++) {
     for (int j = 0; j < n; j++) p->phi[i][j] = e[i * na + j];
     for (int j = 0; j < 4; j++) {
@@ -190,21 +192,44 @@ static int discretise(pickoff_t *p, double phi)
       p->g[i][j] = s;
     }
   }
-  for (int i = 0; i < n; i++) p->crow[0][i] = chain.c[i];
+  /* output derivatives in normalised time: Y_j = crow_j z + sum_{i<j} hb_ji u_i + D u_j */
+  double crow[4][PICKOFF_MAX_N], hb[4][4];
+  memset(crow, 0, sizeof crow);
+  memset(hb, 0, sizeof hb);
+  for (int i = 0; i < n; i++) crow[0][i] = chain.c[i];
   for (int j = 1; j < 4; j++)
     for (int i = 0; i < n; i++) {
       double s = 0.0;
-      for (int k = 0; k < n; k++) s += p->crow[j - 1][k] * chain.a[k][i];
-      p->crow[j][i] = s;
+      for (int k = 0; k < n; k++) s += crow[j - 1][k] * chain.a[k][i];
+      crow[j][i] = s;
     }
-  memset(p->hb, 0, sizeof p->hb);
-  for (int j = 1; j < 4; j++)
+  for (int j = 0; j < 4; j++) {
     for (int i = 0; i < j; i++) {
       double s = 0.0;
-      for (int k = 0; k < n; k++) s += p->crow[j - 1 - i][k] * chain.b[k];
-      p->hb[j][i] = s;
+      for (int k = 0; k < n; k++) s += crow[j - 1 - i][k] * chain.b[k];
+      hb[j][i] = s;
     }
-  p->d = chain.d;
+    hb[j][j] = chain.d;
+  }
+  /* fold the Taylor series at the nominal delay dn = d / T into rows:
+   *   y(dn)  = sum_j dn^j / j! Y_j,   T y'(dn) = sum_{j>=1} dn^(j-1) / (j-1)! Y_j */
+  const double dn = c->sample_delay_s / T;
+  const double cy[4] = {1.0, dn, dn * dn / 2.0, dn * dn * dn / 6.0};
+  const double cd[4] = {0.0, 1.0, dn, dn * dn / 2.0};
+  memset(p->out_z, 0, sizeof p->out_z);
+  memset(p->out_u, 0, sizeof p->out_u);
+  memset(p->dout_z, 0, sizeof p->dout_z);
+  memset(p->dout_u, 0, sizeof p->dout_u);
+  for (int j = 0; j < 4; j++) {
+    for (int i = 0; i < PICKOFF_MAX_N; i++) {
+      p->out_z[i] += cy[j] * crow[j][i];
+      p->dout_z[i] += cd[j] * crow[j][i];
+    }
+    for (int i = 0; i < 4; i++) {
+      p->out_u[i] += cy[j] * hb[j][i];
+      p->dout_u[i] += cd[j] * hb[j][i];
+    }
+  }
   p->phi_rad = phi;
   return 0;
 }
@@ -219,6 +244,8 @@ int pickoff_init(pickoff_t *p, const pickoff_cfg_t *cfg, double temp_k, uint64_t
   t.cfg = *cfg;
   if (discretise(&t, phi) != 0) return -1;
   t.temp_k = temp_k;
+  t.t_s = 1.0 / cfg->fs_hz;
+  t.inv_t = cfg->fs_hz;
   t.gain_now = cfg->gain_v_per_m * (1.0 + cfg->gain_tc_per_k * (temp_k - cfg->temp_ref_k));
   t.noise_sd = cfg->noise_v_rthz * sqrt(cfg->fs_hz / 2.0);
   rng_seed(&t.rng_noise, seed, PICKOFF_RNG_STREAM_NOISE + (uint64_t)cfg->axis);
@@ -243,7 +270,6 @@ int pickoff_set_temp(pickoff_t *p, double temp_k)
 double pickoff_step(pickoff_t *p, double pos_m, double vel_mps, const dac_out_t *dac)
 {
   const pickoff_cfg_t *c = &p->cfg;
-  const double T = 1.0 / c->fs_hz;
   /* ring-diode output (4-12) plus feedthrough, and its slope */
   double s1 = p->gain_now * pos_m;
   double ds1 = p->gain_now * vel_mps;
@@ -254,42 +280,38 @@ double pickoff_step(pickoff_t *p, double pos_m, double vel_mps, const dac_out_t 
     ds1 += c->ft_u1 * u1->end_dvdt_v_per_s + c->ft_u2 * u2->end_dvdt_v_per_s +
            c->ft_spare * u3->end_dvdt_v_per_s;
   }
-  double m1 = T * ds1;
+  double m1 = p->t_s * ds1;
   if (s1 > c->preamp_rail_v || s1 < -c->preamp_rail_v) {
     s1 = (s1 > 0.0) ? c->preamp_rail_v : -c->preamp_rail_v;
     m1 = 0.0;
     p->preamp_clip_count++;
   }
   const double s0 = p->s_prev, m0 = p->m_prev;
-  const double h[4] = {s0, m0, s1, m1};
 
-  const int n = p->n;
+  /* fixed-size loops: unused states have zero rows and stay zero */
   double zn[PICKOFF_MAX_N];
-  for (int i = 0; i < n; i++) {
-    double acc = 0.0;
-    for (int j = 0; j < n; j++) acc += p->phi[i][j] * p->z[j];
-    for (int j = 0; j < 4; j++) acc += p->g[i][j] * h[j];
+  for (int i = 0; i < PICKOFF_MAX_N; i++) {
+    double acc = p->g[i][0] * s0 + p->g[i][1] * m0 + p->g[i][2] * s1 + p->g[i][3] * m1;
+    for (int j = 0; j < PICKOFF_MAX_N; j++) acc += p->phi[i][j] * p->z[j];
     zn[i] = acc;
   }
-  for (int i = 0; i < n; i++) p->z[i] = zn[i];
+  for (int i = 0; i < PICKOFF_MAX_N; i++) p->z[i] = zn[i];
   p->s_prev = s1;
   p->m_prev = m1;
 
-  /* output and its normalised-time derivatives at t_{k+1}; input derivatives from the
-   * cubic of the sample just finished, evaluated at its end */
+  /* output at t_{k+1} + d from the folded Taylor rows; input derivatives are those of
+   * the cubic of the sample just finished, at its end */
   const double u[4] = {s1, m1, 6.0 * (s0 - s1) + 2.0 * m0 + 4.0 * m1,
                        12.0 * (s0 - s1) + 6.0 * (m0 + m1)};
-  double y[4];
-  for (int j = 0; j < 4; j++) {
-    double acc = p->d * u[j];
-    for (int i = 0; i < n; i++) acc += p->crow[j][i] * p->z[i];
-    for (int i = 0; i < j; i++) acc += p->hb[j][i] * u[i];
-    y[j] = acc;
+  double v = 0.0;
+  for (int i = 0; i < PICKOFF_MAX_N; i++) v += p->out_z[i] * zn[i];
+  for (int i = 0; i < 4; i++) v += p->out_u[i] * u[i];
+  if (c->jitter_rms_s > 0.0) {
+    double dy = 0.0;
+    for (int i = 0; i < PICKOFF_MAX_N; i++) dy += p->dout_z[i] * zn[i];
+    for (int i = 0; i < 4; i++) dy += p->dout_u[i] * u[i];
+    v += c->jitter_rms_s * p->inv_t * rng_gauss(&p->rng_jitter) * dy;
   }
-  double delta = c->sample_delay_s;
-  if (c->jitter_rms_s > 0.0) delta += c->jitter_rms_s * rng_gauss(&p->rng_jitter);
-  const double dn = delta / T;
-  double v = y[0] + dn * (y[1] + dn * (0.5 * y[2] + dn * (y[3] / 6.0)));
   v += c->offset_v;
   if (p->noise_sd > 0.0) v += p->noise_sd * rng_gauss(&p->rng_noise);
   return v;

@@ -36,11 +36,13 @@
  * Feedthrough of the DAC's filtered staircase is interpolated the same way (its part
  * at wc under DC+AC comes out within 0.02 % of the closed form; see test_pickoff).
  *
- * Sampling instant: the output at t_k + delta is the Taylor series to third order of the
- * exact output, y^(j) = C A^j z + sum_i C A^(j-1-i) B s^(i) + D s^(j), with the input
- * derivatives of the last cubic: error (w delta)^4 / 24 relative in steady state
- * (1.9e-6 at 1.5 kHz for delta = 10 us). Jitter of rms sigma on a sine of amplitude a
- * adds noise of rms a w sigma / sqrt(2).
+ * Sampling instant: the output at t_k + d (d = sample_delay_s) is the Taylor series to
+ * third order of the exact output, y^(j) = C A^j z + sum_i C A^(j-1-i) B s^(i) + D s^(j),
+ * with the input derivatives of the last cubic: error (w d)^4 / 24 relative in steady
+ * state (3e-6 at 1.5 kHz for d = 10 us). The series is folded into one row at each
+ * discretisation, so the per-sample cost does not depend on d. Jitter e adds e y'(t_k + d)
+ * (first order; the neglected e^2 y''/2 is (w sigma)^2/2 = 4e-5 relative at the largest
+ * allowed sigma, T/20): on a sine of amplitude a, noise of rms a w sigma / sqrt(2).
  *
  * Temperature: pickoff_set_temp() re-discretises (a few microseconds: call it at the
  * thermal model's rate, e.g. every 1 ms, not every sample).
@@ -93,15 +95,17 @@ typedef struct {
 
 typedef struct {
   pickoff_cfg_t cfg;
-  int n;                         /* states */
+  int n;                         /* states in use (3 or 4; the rest stay zero) */
+  double t_s, inv_t;             /* sample period and its inverse */
   double temp_k;                 /* circuit temperature now */
   double phi_rad;                /* Phi_cir(temp_k) */
   double gain_now;               /* g(temp_k) */
   double phi[PICKOFF_MAX_N][PICKOFF_MAX_N];
   double g[PICKOFF_MAX_N][4];
-  double crow[4][PICKOFF_MAX_N]; /* C A^j, j = 0..3 (normalised time) */
-  double hb[4][3];               /* C A^(j-1-i) B, i < j */
-  double d;                      /* D */
+  double out_z[PICKOFF_MAX_N];    /* output at the nominal sampling instant: state row */
+  double out_u[4];               /* ... and weights of [s, T s', T^2 s'', T^3 s'''] */
+  double dout_z[PICKOFF_MAX_N];  /* T d(output)/dt there (for the jitter): state row */
+  double dout_u[4];              /* ... input weights */
   double z[PICKOFF_MAX_N];
   double s_prev, m_prev;         /* input and T * slope at the previous tick */
   double noise_sd;
