@@ -14,6 +14,7 @@ APT_PKGS=(
   gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi  # target build
   valgrind               # callgrind instruction counts (benchmarks)
   clang                  # libFuzzer harnesses
+  qemu-system-arm        # boots the emulator bring-up image (ctest label qemu)
   python3 python3-pip python3-venv
 )
 PIP_PKGS=(numpy scipy matplotlib allantools pyserial)

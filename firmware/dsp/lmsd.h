@@ -21,12 +21,13 @@
  * (1 - rho) / (1 - rho z^-1), whose -3 dB frequency is
  *     f_3dB = fs / (2 pi) * acos(1 - (1 - rho)^2 / (2 rho))  ~=  mu fs / (2 pi)
  * (lmsd_bandwidth_hz). Measured with AM tones at fc = 1750 Hz, fs = 50 kHz it holds to
- * about 1 % for mu <= 0.05 (the bandpass is slightly asymmetric about wc, which the
- * baseband model ignores); mu = 0.034 gives about 280 Hz and a time constant of 29
- * samples. The same update also puts a 2 wc ripple of amplitude about
- * mu |err| / (2 sin wc) on the weights (the cos 2wc part of r r' integrated), which is
- * there only while err is non-zero (transients, noise) and is 4 % of err at mu = 0.034:
- * a multiplicative demodulator leaves 100 % of the amplitude at 2 wc.
+ * 0.6 % at mu = 0.034 and 1.5 % at mu = 0.05 (the bandpass is slightly asymmetric
+ * about wc, which the baseband model ignores); mu = 0.034 gives 280 Hz by the formula,
+ * 282 Hz measured, and a time constant of 29 samples. The same update also puts a 2 wc
+ * ripple of amplitude about mu |err| / (2 sin wc) on the weights (the cos 2wc part of
+ * r r' integrated), which is there only while err is non-zero (transients, noise) and
+ * is 4 % of err at mu = 0.034: a multiplicative demodulator leaves 100 % of the
+ * amplitude at 2 wc.
  *
  * Stability: 0 < mu <= 0.5 (at 0.5 each step cancels the error along r; beyond it the
  * poles turn negative and the estimate rings). The inputs are ADC- and NCO-derived and

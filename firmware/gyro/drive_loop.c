@@ -62,6 +62,16 @@ int drive_loop_init(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
   return 0;
 }
 
+void drive_loop_retune(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
+{
+  (void)pi_set_gains(&dl->amp_pi, cfg->amp_kp, cfg->amp_ki);
+  (void)pi_set_gains(&dl->phase_pi, cfg->phase_kp, cfg->phase_ki);
+  (void)pi_set_limits(&dl->amp_pi, 0.0f, cfg->f_cmd_max_v2);
+  dl->amp_set_v = cfg->amp_set_v;
+  dl->phase_set_rad = cfg->phase_set_rad;
+  dl->p_init_rad = cfg->p_init_rad;
+}
+
 void drive_loop_reset(drive_loop_t *dl)
 {
   (void)pi_reset(&dl->amp_pi, 0.0f, 0.0f);

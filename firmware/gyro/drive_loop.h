@@ -78,6 +78,10 @@ int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t 
 /* Returns 0, or -1 (nothing changed) for a bad configuration. */
 int drive_loop_init(drive_loop_t *dl, const drive_loop_cfg_t *cfg);
 
+/* New gains, setpoints and limits with the loop state kept (bumpless). The cfg must have
+ * passed drive_loop_init once (the designer checks it); dt_s must not change. */
+void drive_loop_retune(drive_loop_t *dl, const drive_loop_cfg_t *cfg);
+
 /* Drive off: force command 0, P back to its start value, integrators cleared. */
 void drive_loop_reset(drive_loop_t *dl);
 

@@ -18,7 +18,10 @@
 
 #include <stdint.h>
 
-#include "gyro/gyro_cfg.h"
+typedef enum {
+  GYRO_DRIVE_HALF_FREQ = 0, /* U1 = A cos(phi/2 + P/2), U2 = A sin(phi/2 + P/2), (6-18) */
+  GYRO_DRIVE_DC_AC = 1      /* U1 = D + A cos(phi + P), U2 = D - A cos(phi + P), (6-20) */
+} gyro_drive_mode_t;
 
 typedef struct {
   gyro_drive_mode_t mode;

@@ -7,111 +7,151 @@
 #include "dsp/butter.h"
 #include "dsp/fastmath.h"
 
-int gyro_design(const gyro_cfg_t *c, gyro_design_t *d)
+int gyro_design(const param_values_t *v, gyro_design_t *d)
 {
-  if (c == NULL || d == NULL || !(c->fs_hz > 0.0f) || !(c->drive_freq_hz > 0.0f) ||
-      !(c->drive_freq_hz < 0.25f * c->fs_hz) || !(c->plant_q > 0.0f) ||
-      !(c->plant_f0_hz > 0.0f) || !(c->plant_gain_v_per_v2 > 0.0f)) {
+  if (v == NULL || d == NULL) {
+    return -1;
+  }
+  const float fs_f = (float)v->sys_fs_hz;
+  if (!(fs_f > 0.0f) || !(v->drive_freq_hz < 0.25f * fs_f)) {
     return -1;
   }
   gyro_design_t t;
   memset(&t, 0, sizeof t);
-  const double fs = (double)c->fs_hz;
-  t.nco.freq_hz = (double)c->drive_freq_hz;
-  t.nco.fs_hz = fs;
-  t.nco.phase_rad = 0.0;
-  t.lmsd_drive.mu = c->mu_drive;
-  t.lmsd_sense.mu = c->mu_sense;
+  const double fs = (double)v->sys_fs_hz;
+  t.fs_hz = fs_f;
+  const nco_cfg_t nc = {(double)v->drive_freq_hz, fs, 0.0};
+  nco_t probe_nco;
+  if (nco_init(&probe_nco, &nc) != 0) return -1;
+  t.nco = nc;
+  t.nco_half_step = probe_nco.half_step;
+  t.lmsd_drive.mu = v->demod_mu_drive;
+  t.lmsd_sense.mu = v->demod_mu_sense;
 
-  t.synth.mode = c->drive_mode;
-  t.synth.dc_bias_v = c->drive_dc_bias_v;
-  t.synth.u_max_v = c->drive_u_max_v;
+  t.synth.mode = v->drive_mode == 1u ? GYRO_DRIVE_DC_AC : GYRO_DRIVE_HALF_FREQ;
+  t.synth.dc_bias_v = v->drive_dc_bias_v;
+  t.synth.u_max_v = v->drive_u_max_v;
   drive_synth_t probe;
   if (drive_synth_init(&probe, &t.synth) != 0) return -2;
 
   /* (6-12), (6-17): amplitude and phase of the drive vibration follow force amplitude
    * and phase as first-order lags of time constant 2 Q / wn. */
-  const double tau = 2.0 * (double)c->plant_q / (2.0 * FM_PI * (double)c->plant_f0_hz);
-  const double demod_bw = lmsd_bandwidth_hz((double)c->mu_drive, fs);
+  const double tau = 2.0 * (double)v->drive_cal_q / (2.0 * FM_PI * (double)v->drive_cal_f0_hz);
+  const double demod_bw = lmsd_bandwidth_hz((double)v->demod_mu_drive, fs);
   if (!(demod_bw > 0.0)) return -3;
-  const drive_loop_design_in_t amp_in = {(double)c->plant_gain_v_per_v2, tau,
-                                         (double)c->amp_loop_bw_hz, demod_bw, fs};
-  const drive_loop_design_in_t ph_in = {1.0, tau, (double)c->phase_loop_bw_hz, demod_bw, fs};
+  const drive_loop_design_in_t amp_in = {(double)v->drive_cal_gain_v_per_v2, tau,
+                                         (double)v->drive_amp_bw_hz, demod_bw, fs};
+  const drive_loop_design_in_t ph_in = {1.0, tau, (double)v->drive_phase_bw_hz, demod_bw, fs};
   if (drive_loop_design(&amp_in, &t.amp_design) != 0 ||
       drive_loop_design(&ph_in, &t.phase_design) != 0) {
     return -4;
   }
-  t.drive.dt_s = 1.0f / c->fs_hz;
-  t.drive.amp_set_v = c->drive_amp_set_v;
-  t.drive.phase_set_rad = c->drive_phase_set_deg * FM_RAD_PER_DEG_F;
-  const int manual_amp = c->amp_kp != 0.0f || c->amp_ki != 0.0f;
-  const int manual_ph = c->phase_kp != 0.0f || c->phase_ki != 0.0f;
-  t.drive.amp_kp = manual_amp ? c->amp_kp : (float)t.amp_design.kp;
-  t.drive.amp_ki = manual_amp ? c->amp_ki : (float)t.amp_design.ki;
-  t.drive.phase_kp = manual_ph ? c->phase_kp : (float)t.phase_design.kp;
-  t.drive.phase_ki = manual_ph ? c->phase_ki : (float)t.phase_design.ki;
+  t.drive.dt_s = 1.0f / fs_f;
+  t.drive.amp_set_v = v->drive_amp_set_v;
+  t.drive.phase_set_rad = v->drive_phase_set_deg * FM_RAD_PER_DEG_F;
+  const int manual_amp = v->drive_amp_kp > 0.0f || v->drive_amp_ki > 0.0f;
+  const int manual_ph = v->drive_phase_kp > 0.0f || v->drive_phase_ki > 0.0f;
+  t.drive.amp_kp = manual_amp ? v->drive_amp_kp : (float)t.amp_design.kp;
+  t.drive.amp_ki = manual_amp ? v->drive_amp_ki : (float)t.amp_design.ki;
+  t.drive.phase_kp = manual_ph ? v->drive_phase_kp : (float)t.phase_design.kp;
+  t.drive.phase_ki = manual_ph ? v->drive_phase_ki : (float)t.phase_design.ki;
   t.drive.f_cmd_max_v2 = drive_synth_f_cmd_max(&probe);
-  t.drive.p_init_rad = c->drive_p_init_deg * FM_RAD_PER_DEG_F;
+  t.drive.p_init_rad = v->drive_p_init_deg * FM_RAD_PER_DEG_F;
 
-  const int n = butter_design(BUTTER_LOWPASS, c->rate_lpf_order, (double)c->rate_lpf_hz, 0.0,
-                              fs / RATE_DECIM, t.rate_lpf, BIQUAD_MAX_SECTIONS);
+  const int n = butter_design(BUTTER_LOWPASS, v->rate_lpf_order, (double)v->rate_lpf_cutoff_hz,
+                              0.0, fs / RATE_DECIM, t.rate_lpf, BIQUAD_MAX_SECTIONS);
   if (n <= 0) return -5;
-  const double phi_dm = (double)c->demod_phase_deg * FM_PI / 180.0;
+  const double phi_dm = (double)v->rate_demod_phase_deg * FM_PI / 180.0;
   t.rate.rot_c = (float)cos(phi_dm);
   t.rate.rot_s = (float)sin(phi_dm);
-  t.rate.scale_dps = c->rate_scale_dps;
-  for (int i = 0; i < 4; i++) {
-    t.rate.bias_c_dps[i] = c->bias_c_dps[i];
-    t.rate.sf_c[i] = c->sf_c[i];
-  }
-  t.rate.p_ref_deg = c->drive_p_init_deg;
+  t.rate.scale_dps = v->rate_scale_dps;
+  t.rate.bias_c_dps[0] = v->rate_bias_c0_dps;
+  t.rate.bias_c_dps[1] = v->rate_bias_c1_dps_per_deg;
+  t.rate.bias_c_dps[2] = v->rate_bias_c2_dps_per_deg2;
+  t.rate.bias_c_dps[3] = v->rate_bias_c3_dps_per_deg3;
+  t.rate.sf_c[1] = v->rate_sf_c1_per_deg;
+  t.rate.sf_c[2] = v->rate_sf_c2_per_deg2;
+  t.rate.sf_c[3] = v->rate_sf_c3_per_deg3;
+  t.rate.p_ref_deg = v->drive_p_init_deg;
   /* First-order low-pass of P at the decimated rate fs / RATE_P_DECIM. */
   t.rate.p_lpf_alpha =
-      (float)(1.0 - exp(-2.0 * FM_PI * (double)c->p_lpf_hz * RATE_P_DECIM / fs));
-  t.rate.lpf = t.rate_lpf;
+      (float)(1.0 - exp(-2.0 * FM_PI * (double)v->rate_p_lpf_hz * RATE_P_DECIM / fs));
+  t.rate.lpf = NULL; /* gyro_init/gyro_apply point it at t.rate_lpf where it is used */
   t.rate.lpf_sections = (uint32_t)n;
-  t.rate.min_drive_v = 0.05f * c->drive_amp_set_v;
-  t.rate_out_v_per_dps = c->rate_out_v_per_dps;
+  t.rate.min_drive_v = 0.05f * v->drive_amp_set_v;
+  t.rate_out_v_per_dps = v->rate_out_v_per_dps;
 
-  t.sup.dt_s = 1.0f / c->fs_hz;
-  t.sup.lock_tol_rel = c->lock_tol_rel;
-  t.sup.lock_phase_tol_rad = c->lock_phase_tol_deg * FM_RAD_PER_DEG_F;
-  t.sup.lock_hold_s = c->lock_hold_s;
-  t.sup.lost_tol_rel = c->lost_tol_rel;
-  t.sup.lost_hold_s = c->lost_hold_s;
-  t.sup.amp_trip_rel = c->amp_trip_rel;
-  t.sup.sat_hold_s = c->sat_hold_s;
-  t.sup.retry_s = c->retry_s;
-  t.sup.clip_max_count = c->clip_max_count;
+  t.sup.dt_s = 1.0f / fs_f;
+  t.sup.lock_tol_rel = v->sup_lock_tol_rel;
+  t.sup.lock_phase_tol_rad = v->sup_lock_phase_tol_deg * FM_RAD_PER_DEG_F;
+  t.sup.lock_hold_s = v->sup_lock_hold_s;
+  t.sup.lost_tol_rel = v->sup_lost_tol_rel;
+  t.sup.lost_hold_s = v->sup_lost_hold_s;
+  t.sup.amp_trip_rel = v->sup_amp_trip_rel;
+  t.sup.sat_hold_s = v->sup_sat_hold_s;
+  t.sup.retry_s = v->sup_retry_s;
+  t.sup.clip_max_count = v->sup_clip_count;
+  t.autostart = v->sys_autostart;
+  /* Every module must accept its part: a design that gyro_apply could not apply is
+   * rejected here, in the background, where the error can be reported. */
+  gyro_t scratch;
+  if (gyro_init_from_design(&scratch, &t) != 0) return -6;
   *d = t;
   return 0;
 }
 
-int gyro_init(gyro_t *g, const gyro_cfg_t *cfg)
+int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
 {
-  gyro_design_t d;
-  if (g == NULL || gyro_design(cfg, &d) != 0) {
+  if (g == NULL || d == NULL) {
     return -1;
   }
   gyro_t t;
   memset(&t, 0, sizeof t);
-  d.rate.lpf = d.rate_lpf; /* d was copied: point at its own sections */
-  if (nco_init(&t.nco, &d.nco) != 0 || lmsd_init(&t.lmsd_drive, &d.lmsd_drive) != 0 ||
-      lmsd_init(&t.lmsd_sense, &d.lmsd_sense) != 0 || drive_loop_init(&t.drive, &d.drive) != 0 ||
-      drive_synth_init(&t.synth, &d.synth) != 0 || rate_channel_init(&t.rate, &d.rate) != 0 ||
-      supervisor_init(&t.sup, &d.sup) != 0) {
+  rate_channel_cfg_t rc = d->rate;
+  rc.lpf = d->rate_lpf;
+  if (nco_init(&t.nco, &d->nco) != 0 || lmsd_init(&t.lmsd_drive, &d->lmsd_drive) != 0 ||
+      lmsd_init(&t.lmsd_sense, &d->lmsd_sense) != 0 || drive_loop_init(&t.drive, &d->drive) != 0 ||
+      drive_synth_init(&t.synth, &d->synth) != 0 || rate_channel_init(&t.rate, &rc) != 0 ||
+      supervisor_init(&t.sup, &d->sup) != 0) {
     return -2;
   }
-  rate_channel_reset(&t.rate, cfg->drive_p_init_deg);
-  t.fs_hz = cfg->fs_hz;
   t.adc_v_per_code = HAL_ADC_V_PER_CODE;
-  t.rate_out_v_per_dps = d.rate_out_v_per_dps;
-  t.f_cmd_max_v2 = d.drive.f_cmd_max_v2;
+  t.rate_out_v_per_dps = d->rate_out_v_per_dps;
+  t.f_cmd_max_v2 = d->drive.f_cmd_max_v2;
   *g = t;
-  if (cfg->autostart != 0u) {
+  if (d->autostart != 0u) {
     gyro_start(g);
   }
   return 0;
+}
+
+int gyro_init(gyro_t *g, const param_values_t *v)
+{
+  gyro_design_t d;
+  if (gyro_design(v, &d) != 0) {
+    return -1;
+  }
+  return gyro_init_from_design(g, &d);
+}
+
+void gyro_apply(gyro_t *g, const gyro_design_t *d)
+{
+  /* Coefficients only: the loop state carries on (bumpless). The design was validated
+   * by gyro_design, so the module calls below cannot fail on it. */
+  g->nco.half_step = d->nco_half_step;
+  (void)lmsd_set_mu(&g->lmsd_drive, d->lmsd_drive.mu);
+  (void)lmsd_set_mu(&g->lmsd_sense, d->lmsd_sense.mu);
+  drive_loop_retune(&g->drive, &d->drive);
+  /* The drive scheme only changes with the drive off (drive.mode is not live). */
+  if (d->synth.mode == g->synth.mode || !supervisor_drive_enabled(&g->sup)) {
+    (void)drive_synth_init(&g->synth, &d->synth);
+  }
+  rate_channel_cfg_t rc = d->rate;
+  rc.lpf = d->rate_lpf;
+  (void)rate_channel_retune(&g->rate, &rc);
+  supervisor_retune(&g->sup, &d->sup);
+  g->rate_out_v_per_dps = d->rate_out_v_per_dps;
+  g->f_cmd_max_v2 = d->drive.f_cmd_max_v2;
 }
 
 void gyro_start(gyro_t *g) { supervisor_start(&g->sup); }
@@ -136,7 +176,7 @@ static void clear_loop_state(gyro_t *g)
   lmsd_reset(&g->lmsd_drive);
   lmsd_reset(&g->lmsd_sense);
   drive_loop_reset(&g->drive);
-  rate_channel_reset(&g->rate, g->drive.p_init_rad * FM_DEG_PER_RAD_F);
+  rate_channel_reset(&g->rate, g->rate.p_ref_deg);
 }
 
 void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)

@@ -5,6 +5,16 @@
  *   NCO -> LMSD(drive), LMSD(sense) -> drive loops -> drive synthesis -> rate channel
  *   -> supervisor -> outputs (DAC frame, telemetry snapshot)
  * Deterministic, allocation-free, single precision, no libm.
+ *
+ * Phase conventions (used throughout firmware/gyro):
+ *   The NCO phase phi(k) = 2 pi f_drive k / fs defines the reference frame. A pickoff
+ *   voltage v = w_s sin(phi) + w_c cos(phi) (the LMSD weights, (5-1)) is the phasor
+ *   Z = w_s + j w_c, with v = Im{Z e^{j phi}}; its amplitude is |Z| and its phase
+ *   arg(Z) = atan2(w_c, w_s).
+ *   The drive force is F = f_cmd cos(phi + P) (in units of Ks * V^2): P is the force
+ *   phase, the output of the phase loop and the temperature signal of the sensorless
+ *   compensation (thesis 7.3). Half-frequency drive realises it with a voltage phase of
+ *   P/2 (6-25), DC+AC drive with a voltage phase of P.
  */
 #ifndef GYRO_H
 #define GYRO_H
@@ -16,15 +26,18 @@
 #include "dsp/nco.h"
 #include "gyro/drive_loop.h"
 #include "gyro/drive_synth.h"
-#include "gyro/gyro_cfg.h"
 #include "gyro/rate_channel.h"
 #include "gyro/supervisor.h"
 #include "hal/hal_adc.h"
 #include "hal/hal_dac.h"
+#include "params/params.h"
 
-/* Everything gyro_cfg_t turns into (init-time, double precision design). */
+/* Everything the parameters turn into (background, double-precision design): the
+ * derived block of the parameter bank, applied by the ISR at a tick boundary. */
 typedef struct {
+  float fs_hz;
   nco_cfg_t nco;
+  uint32_t nco_half_step;
   lmsd_cfg_t lmsd_drive, lmsd_sense;
   drive_loop_cfg_t drive;
   drive_synth_cfg_t synth;
@@ -33,6 +46,7 @@ typedef struct {
   supervisor_cfg_t sup;
   drive_loop_design_out_t amp_design, phase_design; /* what the designer achieved */
   float rate_out_v_per_dps;
+  uint32_t autostart;
 } gyro_design_t;
 
 /* A snapshot of the outputs of the latest tick (telemetry, status, the simulator). */
@@ -59,7 +73,6 @@ typedef struct {
 #define GYRO_FLAG_FAULT (1u << 3)
 
 typedef struct {
-  float fs_hz;
   float adc_v_per_code;
   float rate_out_v_per_dps;
   nco_t nco;
@@ -72,13 +85,18 @@ typedef struct {
   gyro_out_t out;
 } gyro_t;
 
-/* Turn a configuration into module configurations. Returns 0, or a negative value for
- * an invalid configuration (nothing is half-designed: *d is only valid on 0). */
-int gyro_design(const gyro_cfg_t *cfg, gyro_design_t *d);
+/* Turn parameter values into module configurations, checking that every module
+ * accepts its part. Returns 0, or a negative value (then *d is untouched). */
+int gyro_design(const param_values_t *v, gyro_design_t *d);
 
-/* Initialise from a configuration (design + module inits). Returns 0, or a negative
- * value with *g unchanged. Starts acquiring at once if cfg->autostart. */
-int gyro_init(gyro_t *g, const gyro_cfg_t *cfg);
+/* Initialise from a design / from parameter values. Returns 0, or a negative value with
+ * *g unchanged. Starts acquiring at once if sys.autostart. */
+int gyro_init_from_design(gyro_t *g, const gyro_design_t *d);
+int gyro_init(gyro_t *g, const param_values_t *v);
+
+/* Apply a new design in the ISR at a tick boundary: coefficients change, loop state
+ * carries on (bumpless). The drive scheme changes only while the drive is off. */
+void gyro_apply(gyro_t *g, const gyro_design_t *d);
 
 /* One sample: ADC frame in, DAC frame out (latched by the HAL at the next tick). */
 void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac);

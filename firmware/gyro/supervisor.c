@@ -24,6 +24,14 @@ int supervisor_init(supervisor_t *sv, const supervisor_cfg_t *cfg)
   sv->mode = GYRO_MODE_OFF;
   sv->fault = GYRO_FAULT_NONE;
   sv->fault_count = 0u;
+  sv->in_tol_ticks = sv->out_tol_ticks = sv->sat_ticks = 0u;
+  sv->clip_run = sv->fault_ticks = sv->mode_ticks = 0u;
+  supervisor_retune(sv, cfg);
+  return 0;
+}
+
+void supervisor_retune(supervisor_t *sv, const supervisor_cfg_t *cfg)
+{
   sv->lock_ticks_needed = ticks_of(cfg->lock_hold_s, cfg->dt_s);
   sv->lost_ticks_needed = ticks_of(cfg->lost_hold_s, cfg->dt_s);
   sv->sat_ticks_needed = ticks_of(cfg->sat_hold_s, cfg->dt_s);
@@ -33,9 +41,6 @@ int supervisor_init(supervisor_t *sv, const supervisor_cfg_t *cfg)
   sv->lock_phase_tol_rad = cfg->lock_phase_tol_rad;
   sv->lost_tol_rel = cfg->lost_tol_rel;
   sv->amp_trip_rel = cfg->amp_trip_rel;
-  sv->in_tol_ticks = sv->out_tol_ticks = sv->sat_ticks = 0u;
-  sv->clip_run = sv->fault_ticks = sv->mode_ticks = 0u;
-  return 0;
 }
 
 static void set_mode(supervisor_t *sv, gyro_mode_t m)

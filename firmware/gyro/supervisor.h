@@ -70,6 +70,10 @@ typedef struct {
 /* Returns 0, or -1 (nothing changed) for a bad configuration. */
 int supervisor_init(supervisor_t *sv, const supervisor_cfg_t *cfg);
 
+/* New thresholds and times; mode, fault record and running counts are kept. The cfg
+ * must have passed supervisor_init once (the designer checks it). */
+void supervisor_retune(supervisor_t *sv, const supervisor_cfg_t *cfg);
+
 /* Requests from the application (background loop or CLI). */
 void supervisor_start(supervisor_t *sv);
 void supervisor_stop(supervisor_t *sv);

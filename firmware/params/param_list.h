@@ -22,16 +22,16 @@
  * Bump PARAM_LAYOUT_VERSION whenever a row is added or removed; it is written into
  * flash images for diagnosis (loading migrates by id, not by this number).
  *
- * Controller defaults below assume the thesis part: drive resonance 1489.9 Hz,
- * Q1 = 33.33, so amplitude and phase both answer the drive force as a first-order lag
- * with tau = 2 Q1 / wn1 = 7.1 ms (6-12, 6-17). Each PI puts its zero on that pole
- * (ki / kp = 1 / tau) and crosses over at 30 rad/s, which locks in about 0.1-0.2 s like
- * the thesis's loop (6.4). The closed-loop design refines them from the sweep.
+ * The drive loops are designed by the firmware (gyro/drive_loop.h) from the identified
+ * drive-mode model (drive.cal_*: resonance, Q, gain, found by the self-calibration
+ * sweep) for the bandwidths drive.amp_bw_hz / drive.phase_bw_hz; nonzero manual gains
+ * drive.amp_kp ... override the design. Defaults: the thesis part, drive resonance
+ * 1489.9 Hz, Q1 = 33.33 (7.2.2), in the default simulator plant.
  */
 #ifndef PARAM_LIST_H
 #define PARAM_LIST_H
 
-#define PARAM_LAYOUT_VERSION 1u
+#define PARAM_LAYOUT_VERSION 2u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -42,50 +42,68 @@
     PF_PERSIST | PF_LIVE, "drive frequency, fixed near the drive resonance found by the sweep") \
   /* half-frequency by default: 1/f voltage noise lands at wc/2, not wc (6-21, 6-23) */ \
   X(drive_mode, 0x0102u, "drive.mode", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
-    PF_PERSIST | PF_RESTART, "drive scheme: 0 half-frequency (6-18), 1 DC+AC (6-20)") \
-  /* 1 V is 20 % of the +-5 V ADC: room for feedthrough and the start-up overshoot */ \
-  X(drive_amp_set_v, 0x0103u, "drive.amp_set_v", F32, "V", 0.05f, 4.5f, 1.0f, 0u, \
+    PF_PERSIST, "drive scheme: 0 half-frequency (6-18), 1 DC+AC (6-20); drive off to change") \
+  /* 10 um of drive motion (4.6.1) at the default plant's 1.8e5 V/m pickoff: 36 % of the ADC */ \
+  X(drive_amp_set_v, 0x0103u, "drive.amp_set_v", F32, "V", 0.05f, 4.5f, 1.8f, 0u, \
     PF_PERSIST | PF_LIVE, "setpoint of the demodulated drive-pickoff amplitude at the ADC") \
-  /* 7.2.2: -90 deg at resonance plus 9.56 deg circuit and algorithm lag */ \
-  X(drive_phase_set_deg, 0x0104u, "drive.phase_set_deg", F32, "deg", -180.0f, 180.0f, -99.56f, 0u, \
-    PF_PERSIST | PF_LIVE, "setpoint of the drive vibration phase against the force reference") \
-  /* kp = wc tau / G with wc = 30 rad/s, tau = 7.1 ms, small-signal gain G ~ 0.33 V/V */ \
-  X(drive_amp_kp, 0x0105u, "drive.amp_kp", F32, "V/V", 0.0f, 100.0f, 0.65f, 0u, \
-    PF_PERSIST | PF_LIVE, "amplitude PI proportional gain (drive volts per volt of error)") \
-  /* ki = kp / tau: the PI zero cancels the amplitude pole (6-12) */ \
-  X(drive_amp_ki, 0x0106u, "drive.amp_ki", F32, "V/V/s", 0.0f, 100000.0f, 91.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "amplitude PI integral gain") \
-  /* the phase plant has unit gain (6-17): kp = wc tau */ \
-  X(drive_phase_kp, 0x0107u, "drive.phase_kp", F32, "deg/deg", 0.0f, 100.0f, 0.21f, 0u, \
-    PF_PERSIST | PF_LIVE, "phase PI proportional gain (force-phase degrees per degree of error)") \
-  /* ki = kp / tau = wc */ \
-  X(drive_phase_ki, 0x0108u, "drive.phase_ki", F32, "deg/deg/s", 0.0f, 100000.0f, 30.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "phase PI integral gain") \
+  /* the phase of the drive pickoff against the NCO; any value works, P absorbs it */ \
+  X(drive_phase_set_deg, 0x0104u, "drive.phase_set_deg", F32, "deg", -180.0f, 180.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "setpoint of the drive pickoff phase against the NCO reference") \
+  /* 0: designed from drive.cal_* (6-12); nonzero overrides the design */ \
+  X(drive_amp_kp, 0x0105u, "drive.amp_kp", F32, "V^2/V", 0.0f, 100000.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "amplitude PI proportional gain, force (Ks V^2) per volt; 0 = designed") \
+  /* 0: designed, ki = kp / tau puts the PI zero on the amplitude pole */ \
+  X(drive_amp_ki, 0x0106u, "drive.amp_ki", F32, "V^2/V/s", 0.0f, 1.0e7f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "amplitude PI integral gain; 0 = designed") \
+  /* 0: designed from the unit-gain phase plant (6-17) */ \
+  X(drive_phase_kp, 0x0107u, "drive.phase_kp", F32, "rad/rad", 0.0f, 1000.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "phase PI proportional gain (force phase per phase error); 0 = designed") \
+  /* 0: designed */ \
+  X(drive_phase_ki, 0x0108u, "drive.phase_ki", F32, "rad/rad/s", 0.0f, 1.0e6f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "phase PI integral gain; 0 = designed") \
   /* table 7-1: 12.75 V drive amplitude; 15 V is the output stage's limit */ \
   X(drive_u_max_v, 0x0109u, "drive.u_max_v", F32, "V", 0.1f, 15.0f, 12.75f, 0u, \
     PF_PERSIST | PF_LIVE, "limit of each drive electrode voltage (PI output clamp)") \
   /* DC+AC only: force = 4 Ks D A (6-21); 5 V leaves headroom under u_max for A */ \
   X(drive_dc_bias_v, 0x010Au, "drive.dc_bias_v", F32, "V", 0.0f, 15.0f, 5.0f, 0u, \
     PF_PERSIST | PF_LIVE, "DC bias D of the DC+AC drive (unused in half-frequency mode)") \
-  /* 5.4: mu ~ 0.03 at 50 kHz; |r| = 1 makes it a normalised step (5-5) */ \
-  X(demod_mu_drive, 0x0201u, "demod.mu_drive", F32, "-", 0.0001f, 0.49f, 0.03f, 0u, \
+  /* the force phase P expected at lock (sweep); acquisition starts there */ \
+  X(drive_p_init_deg, 0x010Bu, "drive.p_init_deg", F32, "deg", -360.0f, 360.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "force phase P the phase loop starts from, and the reference of P's low-pass") \
+  /* 7.2.2 sweep */ \
+  X(drive_cal_f0_hz, 0x010Cu, "drive.cal_f0_hz", F32, "Hz", 100.0f, 20000.0f, 1489.9f, 0u, \
+    PF_PERSIST | PF_LIVE, "identified undamped drive resonance (self-calibration)") \
+  /* 7.2.2: Q from the -3 dB points, air package */ \
+  X(drive_cal_q, 0x010Du, "drive.cal_q", F32, "-", 1.0f, 1.0e6f, 33.33f, 0u, \
+    PF_PERSIST | PF_LIVE, "identified drive-mode quality factor") \
+  /* the default plant: 1.8 V of pickoff for 64 Ks V^2 of force at resonance */ \
+  X(drive_cal_gain_v_per_v2, 0x010Eu, "drive.cal_gain_v_per_v2", F32, "V/V^2", 1.0e-6f, 100.0f, 0.028125f, 0u, \
+    PF_PERSIST | PF_LIVE, "identified drive gain at resonance, pickoff volts per Ks V^2 of force") \
+  /* 30 Hz: 1 % in about 25 ms after the drive comes off its limit, 80 deg of margin */ \
+  X(drive_amp_bw_hz, 0x010Fu, "drive.amp_bw_hz", F32, "Hz", 0.1f, 1000.0f, 30.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "designed closed-loop bandwidth of the amplitude loop") \
+  /* as the amplitude loop */ \
+  X(drive_phase_bw_hz, 0x0110u, "drive.phase_bw_hz", F32, "Hz", 0.1f, 1000.0f, 30.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "designed closed-loop bandwidth of the phase loop") \
+  /* 5.4: mu = 0.034 at 50 kHz; |r| = 1 makes it a normalised step (5-5) */ \
+  X(demod_mu_drive, 0x0201u, "demod.mu_drive", F32, "-", 0.0001f, 0.49f, 0.034f, 0u, \
     PF_PERSIST | PF_LIVE, "LMS demodulator step size, drive pickoff (sets its bandwidth)") \
   /* same bandwidth as the drive channel */ \
-  X(demod_mu_sense, 0x0202u, "demod.mu_sense", F32, "-", 0.0001f, 0.49f, 0.03f, 0u, \
+  X(demod_mu_sense, 0x0202u, "demod.mu_sense", F32, "-", 0.0001f, 0.49f, 0.034f, 0u, \
     PF_PERSIST | PF_LIVE, "LMS demodulator step size, sense pickoff") \
-  /* calibrated per part; 0 until the quadrature-nulling calibration has run */ \
+  /* calibrated per part (rate table or injected force) */ \
   X(rate_demod_phase_deg, 0x0301u, "rate.demod_phase_deg", F32, "deg", -180.0f, 180.0f, 0.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "rotation of sense I/Q that separates rate from quadrature") \
+    PF_PERSIST | PF_LIVE, "angle of the Coriolis phasor against the drive phasor (separates rate from quadrature)") \
   /* 5.4.3: 100 Hz output low-pass */ \
   X(rate_lpf_cutoff_hz, 0x0302u, "rate.lpf_cutoff_hz", F32, "Hz", 1.0f, 1000.0f, 100.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "rate output low-pass cut-off (Butterworth)") \
+    PF_PERSIST | PF_LIVE, "rate output low-pass cut-off (Butterworth, run at fs/10)") \
   /* 5.4.3: 4th order as two biquads (5-12, 5-13) */ \
   X(rate_lpf_order, 0x0303u, "rate.lpf_order", ENUM, "-", 2u, 8u, 4u, \
     PARAM_CHOICE(2) | PARAM_CHOICE(4) | PARAM_CHOICE(6) | PARAM_CHOICE(8), \
     PF_PERSIST | PF_LIVE, "rate output low-pass order (2 per biquad section)") \
-  /* 4.6.1: 1 deg/s gives about 2.5 mV at the ADC */ \
-  X(rate_scale_dps_per_v, 0x0304u, "rate.scale_dps_per_v", F32, "deg/s/V", -100000.0f, 100000.0f, 400.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "rate scale factor from demodulated sense volts") \
+  /* uncalibrated: 1 (rate.* are then in sense/drive ratio units) */ \
+  X(rate_scale_dps, 0x0310u, "rate.scale_dps", F32, "deg/s", -1.0e7f, 1.0e7f, 1.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "scale factor: deg/s per unit of the sense/drive phasor ratio") \
   /* uncalibrated: 0 (the thesis part's fit was B = 34.59 P + 58.533, 7.3.2) */ \
   X(rate_bias_c0_dps, 0x0305u, "rate.bias_c0_dps", F32, "deg/s", -2000.0f, 2000.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "bias polynomial B(P) = c0 + c1 P + c2 P^2 + c3 P^3, constant term") \
@@ -107,12 +125,42 @@
   /* uncalibrated: 0 */ \
   X(rate_sf_c3_per_deg3, 0x030Bu, "rate.sf_c3_per_deg3", F32, "1/deg^3", -1.0f, 1.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "scale-factor polynomial, cubic term") \
-  /* 50 % over the setpoint: beyond any PI overshoot seen at lock (6.4), short of the stops */ \
-  X(sup_amp_trip_rel, 0x0401u, "sup.amp_trip_rel", F32, "-", 1.05f, 5.0f, 1.5f, 0u, \
+  /* temperature is slow; 1 Hz keeps the phase loop's noise out of the bias correction */ \
+  X(rate_p_lpf_hz, 0x030Cu, "rate.p_lpf_hz", F32, "Hz", 0.01f, 50.0f, 1.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "low-pass of P before it is used as the temperature") \
+  /* 7.2.4: 7.25 mV/(deg/s) at the analog output */ \
+  X(rate_out_v_per_dps, 0x030Du, "rate.out_v_per_dps", F32, "V/(deg/s)", -1.0f, 1.0f, 0.00725f, 0u, \
+    PF_PERSIST | PF_LIVE, "analog rate output scale on the DAC") \
+  /* 50 % over the setpoint: beyond any PI overshoot, short of the stops */ \
+  X(sup_amp_trip_rel, 0x0401u, "sup.amp_trip_rel", F32, "-", 1.2f, 5.0f, 1.5f, 0u, \
     PF_PERSIST | PF_LIVE, "over-amplitude trip, as a multiple of drive.amp_set_v") \
-  /* 2 %: well above the demodulated amplitude noise at mu = 0.03, tight enough that LOCKED means settled */ \
-  X(sup_lock_tol_rel, 0x0402u, "sup.lock_tol_rel", F32, "-", 0.001f, 0.5f, 0.02f, 0u, \
+  /* "within 1 % of its setpoint" (issue figure); well above the amplitude noise */ \
+  X(sup_lock_tol_rel, 0x0402u, "sup.lock_tol_rel", F32, "-", 0.001f, 0.1f, 0.01f, 0u, \
     PF_PERSIST | PF_LIVE, "LOCKED when the relative amplitude error stays within this") \
+  /* 1 deg: P settles to a fraction of that in a few loop time constants */ \
+  X(sup_lock_phase_tol_deg, 0x0403u, "sup.lock_phase_tol_deg", F32, "deg", 0.01f, 90.0f, 1.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "LOCKED also needs the phase error within this") \
+  /* 20 ms: several loop time constants inside the tolerance */ \
+  X(sup_lock_hold_s, 0x0404u, "sup.lock_hold_s", F32, "s", 0.0f, 10.0f, 0.02f, 0u, \
+    PF_PERSIST | PF_LIVE, "time inside tolerance before LOCKED") \
+  /* 10 %: ten times the lock tolerance */ \
+  X(sup_lost_tol_rel, 0x0405u, "sup.lost_tol_rel", F32, "-", 0.01f, 0.19f, 0.1f, 0u, \
+    PF_PERSIST | PF_LIVE, "lock is lost when the relative amplitude error stays beyond this") \
+  /* 50 ms: longer than a loop's recovery from a resonance step */ \
+  X(sup_lost_hold_s, 0x0406u, "sup.lost_hold_s", F32, "s", 0.0f, 10.0f, 0.05f, 0u, \
+    PF_PERSIST | PF_LIVE, "time beyond the lost tolerance before a LOST_LOCK fault") \
+  /* 0.5 s at the drive limit while LOCKED: the part no longer fits the drive */ \
+  X(sup_sat_hold_s, 0x0407u, "sup.sat_hold_s", F32, "s", 0.0f, 10.0f, 0.5f, 0u, \
+    PF_PERSIST | PF_LIVE, "time at the drive limit while LOCKED before a DRIVE_SAT fault") \
+  /* 0.3 s: 40 ring-down time constants at Q = 33, 2.3 at Q = 600 */ \
+  X(sup_retry_s, 0x0408u, "sup.retry_s", F32, "s", 0.0f, 60.0f, 0.3f, 0u, \
+    PF_PERSIST | PF_LIVE, "drive-off time after a fault before re-acquiring") \
+  /* 1 ms of consecutive rail codes */ \
+  X(sup_clip_count, 0x0409u, "sup.clip_count", U32, "-", 1u, 1000000u, 50u, 0u, \
+    PF_PERSIST | PF_LIVE, "consecutive ADC rail codes that make an ADC_CLIP fault") \
+  /* start the drive at power-on */ \
+  X(sys_autostart, 0x0602u, "sys.autostart", ENUM, "-", 0u, 1u, 1u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
+    PF_PERSIST | PF_RESTART, "start acquiring at power-on") \
   /* 100 Hz matches the 100 Hz output bandwidth */ \
   X(tlm_rate_hz, 0x0501u, "tlm.rate_hz", U32, "Hz", 1u, 5000u, 100u, 0u, \
     PF_PERSIST | PF_LIVE, "telemetry frame rate") \

@@ -7,7 +7,7 @@
  *      structure / circuit / board-sensor temperatures (thermal.h); the structure
  *      temperature moves the resonances (2-32) (mech.h), the circuit temperature (of
  *      the node chosen by pick_*_temp_node) the pickoff phases and gains (2-40)
- *      (pickoff.h, re-discretised when it moved by pick_retemp_k);
+ *      (pickoff.h, re-discretised when the phase moved by pick_phase_step_rad);
  *   2. DAC (dac.h): the frame passed in is the one on the converter outputs during
  *      this interval (the host HAL stub applies the board's one-sample latency: it
  *      passes the frame the firmware wrote at the previous tick); zero-order hold,
@@ -133,7 +133,7 @@
   X(double, pick_sense_delay_s, DOUBLE, -1e-3, 1e-3, "s", "sense sampling instant after the tick (|.| <= T/2)") \
   X(double, pick_sense_jitter_s, DOUBLE, 0.0, 1e-3, "s", "sense sampling jitter rms (<= T/20)") \
   X(double, pick_lag_ref_hz, DOUBLE, 1.0, 1e6, "Hz", "frequency at which the circuit lags equal phi (< fs/2)") \
-  X(double, pick_retemp_k, DOUBLE, 0.0, 10.0, "K", "circuit temperature change that re-discretises a pickoff") \
+  X(double, pick_phase_step_rad, DOUBLE, 0.0, 0.01, "rad", "circuit phase change that re-discretises a pickoff") \
   /* ADC (adc.h) */                                                                       \
   X(double, adc_full_scale_v, DOUBLE, 0.01, 100.0, "V", "ADC full scale, +-")            \
   /* acceleration (accel.h): force per unit mass per g */                                 \
@@ -219,7 +219,6 @@ typedef struct {
   double T;                   /* sample period */
   uint64_t k;                 /* samples done */
   int thermal_every;          /* samples per thermal update */
-  double pick_temp_k[2];      /* circuit temperature of the current pickoff discretisation */
   int accel_any, accel_dynamic; /* acceleration profile non-zero / has a sine */
   /* truth: drive-frequency estimate from the force samples */
   double f_prev[2];           /* F_{k-1}, F_{k-2} */

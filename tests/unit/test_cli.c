@@ -132,7 +132,7 @@ static void test_get_set(void **state)
   expect("set tlm.rate_hz 250\n", "ok tlm.rate_hz 250\r\n");
   assert_int_equal(cur()->tlm_rate_hz, 250u);
   expect("get sys.fs_hz\n", "ok sys.fs_hz 50000 Hz\r\n");
-  expect("get demod.mu_drive\n", "ok demod.mu_drive 0.03 -\r\n");
+  expect("get demod.mu_drive\n", "ok demod.mu_drive 0.034 -\r\n");
   expect("get nope\n", "err NAME unknown parameter 'nope'; try list\r\n");
   expect("get\n", "err ARGS usage: get NAME\r\n");
 }
@@ -155,7 +155,7 @@ static void test_bad_values_change_nothing(void **state)
   expect("set drive.freq_hz 1 2\n", "err ARGS usage: set NAME VALUE [NAME VALUE ...]\r\n");
   /* all or nothing: the good first pair is not applied either */
   expect("set drive.amp_kp 2 drive.amp_ki -1\n",
-         "err RANGE drive.amp_ki: '-1' is out of range; allowed [0,100000] V/V/s\r\n");
+         "err RANGE drive.amp_ki: '-1' is out of range; allowed [0,10000000] V^2/V/s\r\n");
   expect("set drive.amp_kp 2 bogus 1\n", "err NAME unknown parameter 'bogus'; try list\r\n");
   assert_memory_equal(cur(), &before, sizeof before);
   assert_memory_equal(params_staged(&g.bank), &before, sizeof before);
@@ -289,7 +289,7 @@ static void test_list(void **state)
   assert_string_equal(out + strlen(out) - strlen(tail), tail);
   assert_int_equal(g.cli.truncated, 0u);
   assert_non_null(strstr(out, "- drive.freq_hz 1489.9 Hz [500,5000] def=1489.9 flags=PL drive frequency"));
-  assert_non_null(strstr(out, "- drive.mode 0 - {0,1} def=0 flags=PB "));
+  assert_non_null(strstr(out, "- drive.mode 0 - {0,1} def=0 flags=P "));
   assert_non_null(strstr(out, "- sys.fs_hz 50000 Hz [50000,50000] def=50000 flags=R "));
   out = run("list rate.bias\n");
   assert_int_equal(check_grammar(out), 1);

@@ -10,11 +10,7 @@
 
 #include "dsp/multdemod.h"
 #include "ref_signal.h"
-/* test_vectors.h's first comment contains a slash-star sequence (-Wcomment); harmless. */
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wcomment"
 #include "test_vectors.h"
-#pragma GCC diagnostic pop
 
 #define FS_HZ 50000.0
 #define FC_HZ 1750.0

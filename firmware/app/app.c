@@ -1,0 +1,127 @@
+#include "app/app.h"
+
+#include <stddef.h>
+#include <string.h>
+
+#include "hal/hal_adc.h"
+#include "hal/hal_dac.h"
+#include "hal/hal_flash.h"
+#include "hal/hal_sample_timer.h"
+#include "hal/hal_uart.h"
+#include "app/app_cmds.h"
+
+static int derive(void *ctx, const param_values_t *v, void *derived, const char **why)
+{
+  (void)ctx;
+  gyro_design_t *d = derived;
+  const int rc = gyro_design(v, d);
+  if (rc != 0) {
+    if (why != NULL) {
+      *why = "the drive or output filter cannot be designed from these values";
+    }
+    return rc;
+  }
+  return 0;
+}
+
+/* Non-live parameters and flash saves need the drive off: an erase stalls every flash
+ * fetch for hundreds of ms while the drive decays in a few (param_store.h). */
+static bool loop_safe(void *ctx)
+{
+  const app_t *a = ctx;
+  return !supervisor_drive_enabled(&a->gyro.sup);
+}
+
+static void cli_write(void *ctx, const char *data, size_t len)
+{
+  (void)ctx;
+  const uint8_t *p = (const uint8_t *)data;
+  /* The TX ring is sized for the longest reply; what does not fit is lost rather than
+   * blocking the background loop. */
+  (void)hal_uart_write(p, len);
+}
+
+int app_init(app_t *a)
+{
+  memset(a, 0, sizeof *a);
+  param_values_t initial;
+  param_values_defaults(&initial);
+
+  hal_flash_geometry_t geo;
+  hal_flash_geometry(&geo);
+  const param_store_cfg_t sc = {0u, 1u};
+  a->store_status = PARAM_STORE_ERR_CONFIG;
+  if (geo.num_sectors >= 2u && param_store_init(&a->store, &sc) == PARAM_STORE_OK) {
+    param_values_t loaded = initial; /* non-persistent values come from here */
+    param_store_report_t rep;
+    a->store_status = param_store_load(&a->store, &loaded, &rep);
+    if (a->store_status == PARAM_STORE_OK) {
+      initial = loaded;
+    }
+  }
+
+  const params_cfg_t pc = {derive, {&a->derived[0], &a->derived[1]}, loop_safe, a};
+  params_err_t err;
+  if (params_init(&a->params, &pc, &initial, &err) != PARAM_OK) {
+    /* A stored set that loads but cannot be designed: fall back to the defaults. */
+    if (params_init(&a->params, &pc, NULL, &err) != PARAM_OK) {
+      return -1;
+    }
+  }
+  const params_view_t view = params_isr_acquire(&a->params);
+  if (gyro_init_from_design(&a->gyro, view.derived) != 0) {
+    return -2;
+  }
+  a->applied = view.derived;
+
+  const cli_cfg_t cc = {&a->params, &a->store, cli_write, a};
+  if (cli_init(&a->cli, &cc) != 0 || app_cmds_register(a) != 0) {
+    return -3;
+  }
+  return 0;
+}
+
+void app_sample_isr(void *ctx)
+{
+  app_t *a = ctx;
+  const uint32_t c0 = hal_cycles_now();
+
+  const params_view_t view = params_isr_acquire(&a->params);
+  if (view.derived != a->applied) {
+    gyro_apply(&a->gyro, view.derived);
+    a->applied = view.derived;
+  }
+  const uint32_t req = a->request;
+  if (req != APP_REQ_NONE) {
+    if (req == APP_REQ_DRIVE_ON) {
+      gyro_start(&a->gyro);
+    } else {
+      gyro_stop(&a->gyro);
+    }
+    a->request = APP_REQ_NONE;
+  }
+
+  hal_adc_frame_t adc;
+  hal_dac_frame_t dac;
+  hal_adc_read_frame(&adc);
+  gyro_tick(&a->gyro, &adc, &dac);
+  hal_dac_write_frame(&dac);
+
+  const uint32_t dc = hal_cycles_now() - c0;
+  a->isr_cycles_last = dc;
+  if (dc > a->isr_cycles_max) {
+    a->isr_cycles_max = dc;
+  }
+  a->isr_ticks++;
+}
+
+void app_cli_feed(app_t *a, const uint8_t *data, size_t len) { cli_feed(&a->cli, data, len); }
+
+void app_poll(app_t *a)
+{
+  uint8_t buf[64];
+  size_t n;
+  while ((n = hal_uart_read(buf, sizeof buf)) > 0u) {
+    cli_feed(&a->cli, buf, n);
+  }
+}

@@ -1,0 +1,60 @@
+/* The application: the parameter bank, its flash store, the gyro, the command line, and
+ * the glue between them and the HAL. The same code runs on the board and on the host.
+ *
+ *   app_sample_isr (50 kHz, highest priority): take this tick's parameter view (apply a
+ *     newly published design at the tick boundary), read the ADC frame, gyro_tick, write
+ *     the DAC frame, measure its own cycles.
+ *   app_poll (background loop): UART bytes -> command line -> parameter bank / store.
+ * Requests from the background to the loop (drive on/off) are single-word flags the ISR
+ * takes at its next tick, so the ISR never sees a half-made change.
+ */
+#ifndef APP_H
+#define APP_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "comm/cli.h"
+#include "gyro/gyro.h"
+#include "params/param_store.h"
+#include "params/params.h"
+
+#define APP_MAX_CMDS 8u
+
+typedef enum {
+  APP_REQ_NONE = 0u,
+  APP_REQ_DRIVE_ON = 1u,
+  APP_REQ_DRIVE_OFF = 2u
+} app_req_t;
+
+typedef struct {
+  params_t params;
+  gyro_design_t derived[2];  /* the bank's derived blocks */
+  const void *applied;       /* derived block the ISR runs with */
+  gyro_t gyro;
+  param_store_t store;
+  param_store_status_t store_status; /* result of the boot-time load */
+  cli_t cli;
+  cli_cmd_t cmds[APP_MAX_CMDS]; /* the application's command rows (app_cmds.c) */
+  volatile uint32_t request; /* app_req_t, written by the background, taken by the ISR */
+  /* Self-measurement of the sample ISR (DWT cycles on the board). */
+  uint32_t isr_cycles_last;
+  uint32_t isr_cycles_max;
+  uint32_t isr_ticks;
+} app_t;
+
+/* Load the stored parameters (defaults if the store is empty or corrupt), design, init
+ * the gyro and the command line. Returns 0, or a negative value if even the defaults
+ * cannot be designed. Does not start the sample clock. */
+int app_init(app_t *a);
+
+/* The sample ISR: register with hal_sample_timer_start(fs, app_sample_isr, a). */
+void app_sample_isr(void *ctx);
+
+/* One pass of the background loop: never blocks. */
+void app_poll(app_t *a);
+
+/* Feed command-line bytes directly (host programs and tests; the board uses the UART). */
+void app_cli_feed(app_t *a, const uint8_t *data, size_t len);
+
+#endif /* APP_H */

@@ -1,0 +1,119 @@
+#include "app/app_cmds.h"
+
+#include <string.h>
+
+static const char *mode_name(uint32_t m)
+{
+  switch ((gyro_mode_t)m) {
+  case GYRO_MODE_OFF: return "OFF";
+  case GYRO_MODE_SWEEP: return "SWEEP";
+  case GYRO_MODE_ACQUIRE: return "ACQUIRE";
+  case GYRO_MODE_LOCKED: return "LOCKED";
+  case GYRO_MODE_FAULT: return "FAULT";
+  }
+  return "?";
+}
+
+static void put_faults(cli_t *cli, uint32_t f)
+{
+  static const struct {
+    uint32_t bit;
+    const char *name;
+  } names[] = {{GYRO_FAULT_ADC_CLIP, "ADC_CLIP"},   {GYRO_FAULT_NAN, "NAN"},
+               {GYRO_FAULT_LOST_LOCK, "LOST_LOCK"}, {GYRO_FAULT_DRIVE_SAT, "DRIVE_SAT"},
+               {GYRO_FAULT_OVER_AMP, "OVER_AMP"}};
+  if (f == 0u) {
+    cli_put(cli, "none");
+    return;
+  }
+  int first = 1;
+  for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+    if ((f & names[i].bit) != 0u) {
+      if (!first) cli_put(cli, ",");
+      cli_put(cli, names[i].name);
+      first = 0;
+    }
+  }
+}
+
+static void kv_f(cli_t *cli, const char *k, float v)
+{
+  cli_put(cli, k);
+  cli_put(cli, " ");
+  cli_put_f32(cli, v);
+  cli_emit_data(cli);
+}
+
+static void kv_u(cli_t *cli, const char *k, uint32_t v)
+{
+  cli_put(cli, k);
+  cli_put(cli, " ");
+  cli_put_u32(cli, v);
+  cli_emit_data(cli);
+}
+
+/* status: one data line per figure, then ok MODE. The snapshot is copied field by
+ * field while the ISR may update it; each figure is one aligned word, so each line is a
+ * consistent value (lines may come from adjacent ticks). */
+static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
+{
+  (void)argv;
+  app_t *a = ctx;
+  if (argc != 1u) {
+    cli_err(cli, "ARGS", "usage: status");
+    return;
+  }
+  const gyro_out_t *o = &a->gyro.out;
+  cli_put(cli, "mode ");
+  cli_put(cli, mode_name(o->mode));
+  cli_emit_data(cli);
+  cli_put(cli, "fault ");
+  put_faults(cli, o->fault);
+  cli_emit_data(cli);
+  kv_u(cli, "fault_count", a->gyro.sup.fault_count);
+  kv_f(cli, "rate_dps", o->rate_dps);
+  kv_f(cli, "quad_dps", o->quad_dps);
+  kv_f(cli, "drive_amp_v", o->drive_amp_v);
+  kv_f(cli, "drive_phase_deg", o->drive_phase_deg);
+  kv_f(cli, "p_deg", o->p_deg);
+  kv_f(cli, "p_f_deg", o->p_f_deg);
+  kv_f(cli, "f_cmd_v2", o->f_cmd_v2);
+  kv_u(cli, "ticks", a->isr_ticks);
+  kv_u(cli, "isr_cycles_last", a->isr_cycles_last);
+  kv_u(cli, "isr_cycles_max", a->isr_cycles_max);
+  cli_put(cli, "store ");
+  cli_put(cli, param_store_status_str(a->store_status));
+  cli_emit_data(cli);
+  cli_ok(cli, mode_name(o->mode));
+}
+
+/* drive on|off: the request is taken by the ISR at its next tick. */
+static void cmd_drive(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
+{
+  app_t *a = ctx;
+  if (argc != 2u || (strcmp(argv[1], "on") != 0 && strcmp(argv[1], "off") != 0)) {
+    cli_err(cli, "ARGS", "usage: drive on|off");
+    return;
+  }
+  const int on = strcmp(argv[1], "on") == 0;
+  a->request = on ? APP_REQ_DRIVE_ON : APP_REQ_DRIVE_OFF;
+  cli_ok(cli, on ? "drive on" : "drive off");
+}
+
+int app_cmds_register(app_t *a)
+{
+  /* The CLI keeps the rows by pointer: they live in the application instance. */
+  cli_cmd_t *cmds = a->cmds;
+  const cli_cmd_t status = {"status", "", "mode, faults, drive and rate figures, ISR cycles",
+                            cmd_status, a};
+  const cli_cmd_t drive = {"drive", "on|off", "start or stop the drive (acquire / safe mode)",
+                           cmd_drive, a};
+  cmds[0] = status;
+  cmds[1] = drive;
+  for (size_t i = 0; i < 2u; i++) {
+    if (cli_register(&a->cli, &cmds[i]) != 0) {
+      return -1;
+    }
+  }
+  return 0;
+}

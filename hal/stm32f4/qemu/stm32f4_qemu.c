@@ -1,0 +1,143 @@
+/* Emulator variant of the board layer for QEMU's netduinoplus2 machine (an STM32F405
+ * model: Cortex-M4F with FPU and SysTick, USART1 with RX interrupts; no RCC, no DAC, a
+ * ramp for an ADC, and a TIM2 that only behaves while EGR and CNT are never written).
+ *
+ *   sample clock  SysTick from the 168 MHz core clock, reload 3360 -> 50 kHz, priority 0
+ *   converters    loopback: the ADC frame of a tick is the DAC drive pair of the tick
+ *                 before (codes rescaled 14 -> 16 bit, mid-scale -> 0), so the ISR path
+ *                 reads and writes real data
+ *   cycles        SysTick periods elapsed x 3360 + SysTick count (no DWT in QEMU)
+ *   uptime        TIM2 free running, prescaled to 1 MHz of emulated time
+ * Everything else (UART driver, fault capture, start-up, flash driver) is the board's. */
+#include "hal/hal_adc.h"
+#include "hal/hal_dac.h"
+#include "hal/hal_sample_timer.h"
+#include "stm32f4_board.h"
+#include "stm32f4_core.h"
+#include "stm32f4_dac.h"
+#include "stm32f4_fault.h"
+#include "stm32f4_sample.h"
+#include "stm32f4_uart.h"
+#include "stm32f4_uptime.h"
+
+#define QEMU_SYSCLK_HZ 168000000u
+#define QEMU_TIM_HZ 1000000000u /* QEMU's STM32 timer model counts its input at 1 GHz */
+#define SYSTICK_SHPR_INDEX 11u  /* SysTick = exception 15 -> SHPR3 byte 3 */
+
+static stm32f4_board_info_t s_info;
+static hal_sample_isr_fn s_isr;
+static void *s_ctx;
+static volatile uint32_t s_wraps;
+static volatile uint32_t s_ticks;
+static hal_dac_frame_t s_dac;
+
+void stm32f4_system_init(void)
+{
+  s_info.reset_flags = RCC->CSR;
+  /* No RCC model: the core runs at the machine's fixed 168 MHz. Report the plan the
+   * board would program. */
+  s_info.clock_status = stm32f4_clock_plan(STM32F4_HSE_HZ, STM32F4_SYSCLK_HZ, &s_info.clock);
+  stm32f4_fault_enable();
+}
+
+const stm32f4_board_info_t *stm32f4_board_info(void)
+{
+  return &s_info;
+}
+
+int stm32f4_board_init(void)
+{
+  for (uint32_t ch = 0u; ch < HAL_DAC_NUM_CHANNELS; ++ch) {
+    s_dac.code[ch] = (uint16_t)HAL_DAC_CODE_MID;
+  }
+  return stm32f4_uart_init(s_info.clock.pclk2_hz, STM32F4_UART_BAUD);
+}
+
+int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
+{
+  if (isr == 0 || rate_hz == 0u || QEMU_SYSCLK_HZ % rate_hz != 0u ||
+      QEMU_SYSCLK_HZ / rate_hz > 0x1000000u) {
+    return -1;
+  }
+  hal_sample_timer_stop();
+  s_isr = isr;
+  s_ctx = ctx;
+  s_ticks = 0u;
+  SCB->SHPR[SYSTICK_SHPR_INDEX] = (uint8_t)(STM32F4_PRIO_SAMPLE << 4);
+  SYSTICK->LOAD = QEMU_SYSCLK_HZ / rate_hz - 1u;
+  SYSTICK->VAL = 0u;
+  SYSTICK->CTRL = SYSTICK_CTRL_CLKSOURCE | SYSTICK_CTRL_TICKINT | SYSTICK_CTRL_ENABLE;
+  return 0;
+}
+
+void hal_sample_timer_stop(void)
+{
+  SYSTICK->CTRL = 0u;
+}
+
+void SysTick_Handler(void);
+STM32F4_RAMFUNC void SysTick_Handler(void)
+{
+  s_wraps = s_wraps + 1u;
+  s_ticks = s_ticks + 1u;
+  if (s_isr != 0) s_isr(s_ctx);
+}
+
+STM32F4_RAMFUNC uint32_t hal_cycles_now(void)
+{
+  uint32_t w1, w2, val;
+  do {
+    w1 = s_wraps;
+    val = SYSTICK->VAL;
+    w2 = s_wraps;
+  } while (w1 != w2);
+  const uint32_t load = SYSTICK->LOAD;
+  return w1 * (load + 1u) + (load - val);
+}
+
+static int16_t loopback_code(uint16_t dac_code)
+{
+  return (int16_t)(((int32_t)dac_code - (int32_t)HAL_DAC_CODE_MID) * 4);
+}
+
+STM32F4_RAMFUNC void hal_adc_read_frame(hal_adc_frame_t *frame)
+{
+  frame->drive = loopback_code(s_dac.code[HAL_DAC_DRIVE_U1]);
+  frame->sense = loopback_code(s_dac.code[HAL_DAC_DRIVE_U2]);
+}
+
+STM32F4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame)
+{
+  s_dac = *frame;
+}
+
+void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
+{
+  if (stats == 0) return;
+  stats->ticks = s_ticks;
+  stats->overruns = 0u;
+  stats->dma_errors = 0u;
+}
+
+uint32_t stm32f4_dac_overruns(void)
+{
+  return 0u;
+}
+
+uint32_t stm32f4_dac_late(void)
+{
+  return 0u;
+}
+
+void stm32f4_uptime_init(void)
+{
+  TIM2->CR1 = 0u;
+  TIM2->PSC = QEMU_TIM_HZ / 1000000u - 1u;
+  TIM2->ARR = 0xFFFFFFFFu;
+  TIM2->CR1 = TIM_CR1_CEN;
+}
+
+uint32_t stm32f4_uptime_us(void)
+{
+  return TIM2->CNT;
+}

@@ -1,0 +1,192 @@
+#include "stm32f4_sample.h"
+
+#include "hal/hal_adc.h"
+#include "hal/hal_sample_timer.h"
+#include "stm32f4_core.h"
+#include "stm32f4_dac.h"
+#include "stm32f4_regs.h"
+
+#define ADC_RX_STREAM 0u   /* DMA2 stream 0 channel 3: SPI1_RX (RM0090 table 43) */
+#define ADC_TX_STREAM 5u   /* DMA2 stream 5 channel 3: SPI1_TX */
+#define ADC_GATE_STREAM 6u /* DMA2 stream 6 channel 6: TIM1_CH3 */
+#define CHSEL(n) ((uint32_t)(n) << DMA_SXCR_CHSEL_POS)
+#define SPI1_BR_DIV8 2u
+
+/* DMA sources and targets live in SRAM (.bss/.data), deliberately not const: the DMA
+ * streams cannot reach the CCM, and a DMA read from flash would stall for the whole of
+ * a parameter-sector erase, stopping the sample chain. */
+static volatile int16_t s_adc_rx[2];
+static volatile uint16_t s_adc_tx_dummy = 0u;
+static volatile uint16_t s_spi1_cr2_go = (uint16_t)(SPI_CR2_RXDMAEN | SPI_CR2_TXDMAEN);
+
+static hal_sample_isr_fn s_isr;
+static void *s_ctx;
+static volatile uint32_t s_ticks;
+static volatile uint32_t s_overruns;
+static volatile uint32_t s_dma_errors;
+
+static uint32_t ns_to_ticks(uint32_t ns, uint32_t tim_hz, uint32_t psc)
+{
+  const uint64_t den = 1000000000ull * (psc + 1u);
+  return (uint32_t)(((uint64_t)ns * tim_hz + den - 1u) / den);
+}
+
+int stm32f4_sample_plan(uint32_t tim_hz, uint32_t rate_hz, stm32f4_sample_plan_t *plan)
+{
+  if (plan == 0 || rate_hz == 0u || tim_hz == 0u || tim_hz % rate_hz != 0u) return -1;
+  const uint32_t min_ns = STM32F4_ADC_READ_START_NS + STM32F4_ADC_READ_NS +
+                          STM32F4_DAC_SEQ_NS + STM32F4_MIN_TICK_NS;
+  if ((uint64_t)rate_hz * min_ns > 1000000000ull) return -1;
+  const uint32_t total = tim_hz / rate_hz;
+  for (uint32_t psc = 0u; psc <= 0xFFFFu; ++psc) {
+    if (total % (psc + 1u) != 0u || total / (psc + 1u) > 0x10000u) continue;
+    plan->psc = psc;
+    plan->arr = total / (psc + 1u) - 1u;
+    plan->ccr_strobe = ns_to_ticks(STM32F4_STROBE_NS, tim_hz, psc);
+    plan->ccr_read = ns_to_ticks(STM32F4_ADC_READ_START_NS, tim_hz, psc);
+    return 0;
+  }
+  return -1;
+}
+
+static void dma_stream_reset(uint32_t n)
+{
+  DMA2->S[n].CR = 0u;
+  for (uint32_t i = 0u; i < 10000u && (DMA2->S[n].CR & DMA_SXCR_EN) != 0u; ++i) {
+    STM32F4_POLL_HOOK();
+  }
+  stm32f4_dma_clear(DMA2, n, DMA_FLAG_ALL);
+}
+
+void hal_sample_timer_stop(void)
+{
+  TIM1->CR1 = 0u;
+  /* Force all three outputs to their inactive (high) level: CONVST and CS idle high,
+   * LDAC high keeps the DAC outputs latched. */
+  TIM1->CCMR1 = (4u << TIM_CCMR_OC1M_POS) | (4u << TIM_CCMR_OC2M_POS);
+  TIM1->CCMR2 = (4u << TIM_CCMR_OC1M_POS);
+  TIM1->CCER = TIM_CCER_CC1E | TIM_CCER_CC1P | TIM_CCER_CC2E | TIM_CCER_CC2P |
+               TIM_CCER_CC3E | TIM_CCER_CC3P;
+  TIM1->BDTR = TIM_BDTR_MOE;
+  TIM1->DIER = 0u;
+  stm32f4_nvic_disable(STM32F4_IRQ_DMA2_STREAM0);
+  dma_stream_reset(ADC_GATE_STREAM);
+  dma_stream_reset(ADC_TX_STREAM);
+  dma_stream_reset(ADC_RX_STREAM);
+  SPI1->CR2 = 0u;
+}
+
+int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
+{
+  stm32f4_sample_plan_t plan;
+  if (isr == 0 || stm32f4_sample_plan(STM32F4_SAMPLE_TIM_HZ, rate_hz, &plan) != 0) return -1;
+  RCC->APB2ENR |= RCC_APB2ENR_TIM1EN | RCC_APB2ENR_SPI1EN;
+  RCC->AHB1ENR |= RCC_AHB1ENR_DMA2EN;
+  hal_sample_timer_stop();
+  s_isr = isr;
+  s_ctx = ctx;
+  s_ticks = 0u;
+  s_overruns = 0u;
+  s_dma_errors = 0u;
+
+  /* SPI1 master, mode 2 (AD7606: MSB valid at the first SCLK falling edge after CS,
+   * later bits shifted out on rising edges), 16-bit frames, CS driven by TIM1_CH3. */
+  SPI1->CR1 = 0u;
+  SPI1->CR1 = SPI_CR1_MSTR | SPI_CR1_CPOL | SPI_CR1_DFF | (SPI1_BR_DIV8 << SPI_CR1_BR_POS) |
+              SPI_CR1_SSM | SPI_CR1_SSI;
+  SPI1->CR2 = SPI_CR2_RXDMAEN;
+  SPI1->CR1 |= SPI_CR1_SPE;
+
+  /* Stream 0: SPI1 RX -> frame, circular (re-arms itself), interrupt on completion. */
+  DMA2->S[ADC_RX_STREAM].PAR = (uint32_t)(uintptr_t)&SPI1->DR;
+  DMA2->S[ADC_RX_STREAM].M0AR = (uint32_t)(uintptr_t)s_adc_rx;
+  DMA2->S[ADC_RX_STREAM].NDTR = 2u;
+  DMA2->S[ADC_RX_STREAM].CR = CHSEL(3) | DMA_SXCR_PL_VERY_HIGH | DMA_SXCR_MSIZE_16 |
+                              DMA_SXCR_PSIZE_16 | DMA_SXCR_MINC | DMA_SXCR_CIRC |
+                              DMA_SXCR_DIR_P2M | DMA_SXCR_TCIE | DMA_SXCR_TEIE;
+  DMA2->S[ADC_RX_STREAM].CR |= DMA_SXCR_EN;
+
+  /* Stream 5: two dummy half-words into SPI1 TX: the 32 clocks of the read. */
+  DMA2->S[ADC_TX_STREAM].PAR = (uint32_t)(uintptr_t)&SPI1->DR;
+  DMA2->S[ADC_TX_STREAM].M0AR = (uint32_t)(uintptr_t)&s_adc_tx_dummy;
+  DMA2->S[ADC_TX_STREAM].NDTR = 2u;
+  DMA2->S[ADC_TX_STREAM].CR = CHSEL(3) | DMA_SXCR_PL_VERY_HIGH | DMA_SXCR_MSIZE_16 |
+                              DMA_SXCR_PSIZE_16 | DMA_SXCR_DIR_M2P;
+  DMA2->S[ADC_TX_STREAM].CR |= DMA_SXCR_EN;
+
+  /* Stream 6: on TIM1 CC3, write the "go" value into SPI1_CR2 (opens the TX gate). */
+  DMA2->S[ADC_GATE_STREAM].PAR = (uint32_t)(uintptr_t)&SPI1->CR2;
+  DMA2->S[ADC_GATE_STREAM].M0AR = (uint32_t)(uintptr_t)&s_spi1_cr2_go;
+  DMA2->S[ADC_GATE_STREAM].NDTR = 1u;
+  DMA2->S[ADC_GATE_STREAM].CR = CHSEL(6) | DMA_SXCR_PL_HIGH | DMA_SXCR_MSIZE_16 |
+                                DMA_SXCR_PSIZE_16 | DMA_SXCR_CIRC | DMA_SXCR_DIR_M2P;
+  DMA2->S[ADC_GATE_STREAM].CR |= DMA_SXCR_EN;
+
+  /* TIM1: CH1 and CH2 PWM1 active low (low until CCR), CH3 PWM2 active low (low from
+   * CCR3 on), preloaded; CC3 raises the DMA request; MOE enables the outputs. */
+  TIM1->PSC = plan.psc;
+  TIM1->ARR = plan.arr;
+  TIM1->RCR = 0u;
+  TIM1->CCR1 = plan.ccr_strobe;
+  TIM1->CCR2 = plan.ccr_strobe;
+  TIM1->CCR3 = plan.ccr_read;
+  TIM1->CCMR1 = (TIM_OCM_PWM1 << TIM_CCMR_OC1M_POS) | TIM_CCMR_OC1PE |
+                (TIM_OCM_PWM1 << TIM_CCMR_OC2M_POS) | TIM_CCMR_OC2PE;
+  TIM1->CCMR2 = (TIM_OCM_PWM2 << TIM_CCMR_OC1M_POS) | TIM_CCMR_OC1PE;
+  TIM1->CCER = TIM_CCER_CC1E | TIM_CCER_CC1P | TIM_CCER_CC2E | TIM_CCER_CC2P |
+               TIM_CCER_CC3E | TIM_CCER_CC3P;
+  TIM1->DIER = TIM_DIER_CC3DE;
+  TIM1->BDTR = TIM_BDTR_MOE;
+  TIM1->EGR = TIM_EGR_UG; /* load PSC, ARR and the CCR preloads */
+  TIM1->SR = 0u;
+
+  /* The DAC words must all be in before LDAC falls at the next update event. */
+  stm32f4_dac_set_deadline(plan.arr + 1u -
+                           ns_to_ticks(STM32F4_DAC_SEQ_NS + STM32F4_DAC_GUARD_NS,
+                                       STM32F4_SAMPLE_TIM_HZ, plan.psc));
+
+  stm32f4_nvic_enable(STM32F4_IRQ_DMA2_STREAM0, STM32F4_PRIO_SAMPLE);
+  TIM1->CR1 = TIM_CR1_ARPE | TIM_CR1_CEN;
+  return 0;
+}
+
+STM32F4_RAMFUNC void DMA2_Stream0_IRQHandler(void)
+{
+  const uint32_t flags = stm32f4_dma_flags(DMA2, ADC_RX_STREAM);
+  stm32f4_dma_clear(DMA2, ADC_RX_STREAM, flags);
+  if ((flags & (DMA_FLAG_TEIF | DMA_FLAG_DMEIF)) != 0u) ++s_dma_errors;
+  if ((flags & DMA_FLAG_TCIF) == 0u) return;
+
+  /* Close the TX gate, then re-arm stream 5 for the next CC3 (it stopped after its two
+   * half-words; with the gate closed it waits for the next CC3 instead of starting). */
+  SPI1->CR2 = SPI_CR2_RXDMAEN;
+  if ((DMA2->S[ADC_TX_STREAM].CR & DMA_SXCR_EN) != 0u) ++s_dma_errors;
+  stm32f4_dma_clear(DMA2, ADC_TX_STREAM, DMA_FLAG_ALL);
+  DMA2->S[ADC_TX_STREAM].NDTR = 2u;
+  DMA2->S[ADC_TX_STREAM].CR |= DMA_SXCR_EN;
+
+  ++s_ticks;
+  s_isr(s_ctx);
+  if ((stm32f4_dma_flags(DMA2, ADC_RX_STREAM) & DMA_FLAG_TCIF) != 0u) ++s_overruns;
+}
+
+STM32F4_RAMFUNC void hal_adc_read_frame(hal_adc_frame_t *frame)
+{
+  frame->drive = s_adc_rx[0];
+  frame->sense = s_adc_rx[1];
+}
+
+void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
+{
+  if (stats == 0) return;
+  stats->ticks = s_ticks;
+  stats->overruns = s_overruns;
+  stats->dma_errors = s_dma_errors;
+}
+
+#ifdef STM32F4_HOST_TEST
+volatile int16_t *stm32f4_sample_host_rx(void)
+{
+  return s_adc_rx;
+}
+#endif

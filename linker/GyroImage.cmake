@@ -1,0 +1,41 @@
+# gyro_add_image(<name> SOURCES <src>... LIBS <lib>... [LINKER_SCRIPT <file>])
+#
+# One firmware image for the Cortex-M4F board: links SOURCES and LIBS with the board's
+# linker script (default linker/stm32f405.ld) into <name>.elf, writes <name>.map,
+# <name>.bin (raw from 0x0800_0000; it spans the parameter sectors, filled with 0xFF)
+# and <name>.hex (sparse: leaves the parameter sectors alone) next to it, and prints
+# a size report at build time: the linker's per-region table (--print-memory-usage)
+# followed by flash / SRAM / CCM used vs available (linker/image_size.cmake).
+# Compiler and linker warnings are errors.
+set(GYRO_DEFAULT_LINKER_SCRIPT ${CMAKE_CURRENT_LIST_DIR}/stm32f405.ld)
+set(GYRO_IMAGE_SIZE_SCRIPT ${CMAKE_CURRENT_LIST_DIR}/image_size.cmake)
+
+function(gyro_add_image name)
+  cmake_parse_arguments(IMG "" "LINKER_SCRIPT" "SOURCES;LIBS" ${ARGN})
+  if(NOT IMG_SOURCES)
+    message(FATAL_ERROR "gyro_add_image(${name}): SOURCES is required")
+  endif()
+  if(NOT IMG_LINKER_SCRIPT)
+    set(IMG_LINKER_SCRIPT ${GYRO_DEFAULT_LINKER_SCRIPT})
+  endif()
+  add_executable(${name} ${IMG_SOURCES})
+  set_target_properties(${name} PROPERTIES SUFFIX ".elf" LINK_DEPENDS ${IMG_LINKER_SCRIPT})
+  target_link_libraries(${name} PRIVATE ${IMG_LIBS})
+  gyro_strict_warnings(${name})
+  target_link_options(${name} PRIVATE
+    -T${IMG_LINKER_SCRIPT}
+    -Wl,-Map=${CMAKE_CURRENT_BINARY_DIR}/${name}.map,--cref
+    -Wl,--print-memory-usage
+    -Wl,--fatal-warnings
+    # .ramfunc makes the SRAM segment writable and executable on purpose.
+    -Wl,--no-warn-rwx-segments)
+  add_custom_command(TARGET ${name} POST_BUILD
+    COMMAND ${CMAKE_OBJCOPY} -O binary --gap-fill 0xff $<TARGET_FILE:${name}> ${name}.bin
+    COMMAND ${CMAKE_OBJCOPY} -O ihex $<TARGET_FILE:${name}> ${name}.hex
+    COMMAND ${CMAKE_COMMAND} -DELF=$<TARGET_FILE:${name}> -DSIZE_TOOL=${CMAKE_SIZE}
+            -DNAME=${name} -P ${GYRO_IMAGE_SIZE_SCRIPT}
+    WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}
+    BYPRODUCTS ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin ${CMAKE_CURRENT_BINARY_DIR}/${name}.hex
+               ${CMAKE_CURRENT_BINARY_DIR}/${name}.map
+    VERBATIM)
+endfunction()

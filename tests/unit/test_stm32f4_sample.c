@@ -1,0 +1,248 @@
+/* The sample chain (hal/stm32f4/stm32f4_sample.c): TIM1 timing plan for 84 and 168 MHz
+ * timer clocks, the registers that make TIM1 start conversions and reads in hardware,
+ * and the DMA-complete interrupt that serves the tick. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "hal/hal_adc.h"
+#include "hal/hal_sample_timer.h"
+#include "hal/hal_dac.h"
+#include "stm32f4_dac.h"
+#include "stm32f4_host_regs.h"
+#include "stm32f4_sample.h"
+
+#define LOW32(p) ((uint32_t)(uintptr_t)(p))
+
+static void assert_plan(uint32_t tim_hz, uint32_t rate_hz, const stm32f4_sample_plan_t *p)
+{
+  /* f_sample = f_tim / ((PSC + 1)(ARR + 1)), exactly. */
+  assert_int_equal((uint64_t)rate_hz * (p->psc + 1u) * (p->arr + 1u), tim_hz);
+  assert_true(p->arr <= 0xFFFFu);
+  const double tick_s = (double)(p->psc + 1u) / tim_hz;
+  /* CONVST low for at least the strobe; the read starts after the slowest conversion
+   * (AD7606 t_CONV max 4.15 us after the CONVST rising edge). */
+  assert_true(p->ccr_strobe * tick_s >= 250e-9);
+  assert_true(p->ccr_read * tick_s >= p->ccr_strobe * tick_s + 4.15e-6);
+  assert_true(p->ccr_read < p->arr);
+}
+
+static void test_plan_50khz_168mhz(void **state)
+{
+  (void)state;
+  stm32f4_sample_plan_t p;
+  assert_int_equal(stm32f4_sample_plan(168000000u, 50000u, &p), 0);
+  assert_int_equal(p.psc, 0);
+  assert_int_equal(p.arr, 3359); /* 168 MHz / 3360 = 50 kHz */
+  assert_int_equal(p.ccr_strobe, 42);
+  assert_int_equal(p.ccr_read, 807);
+  assert_plan(168000000u, 50000u, &p);
+}
+
+static void test_plan_50khz_84mhz(void **state)
+{
+  (void)state;
+  stm32f4_sample_plan_t p;
+  assert_int_equal(stm32f4_sample_plan(84000000u, 50000u, &p), 0);
+  assert_int_equal(p.psc, 0);
+  assert_int_equal(p.arr, 1679); /* 84 MHz / 1680 = 50 kHz */
+  assert_plan(84000000u, 50000u, &p);
+}
+
+static void test_plan_slow_rate_uses_prescaler(void **state)
+{
+  (void)state;
+  stm32f4_sample_plan_t p;
+  assert_int_equal(stm32f4_sample_plan(168000000u, 1000u, &p), 0);
+  assert_int_equal(p.psc, 2);
+  assert_int_equal(p.arr, 55999);
+  assert_plan(168000000u, 1000u, &p);
+}
+
+static void test_plan_rejects(void **state)
+{
+  (void)state;
+  stm32f4_sample_plan_t p = {7u, 7u, 7u, 7u};
+  assert_int_equal(stm32f4_sample_plan(168000000u, 50001u, &p), -1); /* not exact */
+  assert_int_equal(stm32f4_sample_plan(168000000u, 100000u, &p), -1); /* 10 us too short */
+  assert_int_equal(stm32f4_sample_plan(168000000u, 0u, &p), -1);
+  assert_int_equal(stm32f4_sample_plan(168000000u, 50000u, NULL), -1);
+  assert_int_equal(p.arr, 7); /* unchanged */
+}
+
+/* ---- the running chain ---- */
+typedef struct {
+  int calls;
+  uint32_t spi_cr2_seen;
+  uint32_t tx_ndtr_seen;
+  uint32_t tx_cr_seen;
+  int leave_tc_pending;
+  hal_adc_frame_t frame;
+} isr_probe_t;
+
+static void probe_isr(void *ctx)
+{
+  isr_probe_t *p = (isr_probe_t *)ctx;
+  p->calls++;
+  p->spi_cr2_seen = SPI1->CR2;
+  p->tx_ndtr_seen = DMA2->S[5].NDTR;
+  p->tx_cr_seen = DMA2->S[5].CR;
+  hal_adc_read_frame(&p->frame);
+  /* Hardware clears LISR on the LIFCR write; a frame landing meanwhile sets it again. */
+  DMA2->LISR = p->leave_tc_pending ? DMA_FLAG_TCIF : 0u;
+}
+
+static int setup(void **state)
+{
+  (void)state;
+  stm32f4_host_reset();
+  return 0;
+}
+
+static void test_start_programs_hardware_chain(void **state)
+{
+  (void)state;
+  isr_probe_t probe = {0};
+  assert_int_equal(hal_sample_timer_start(50000u, probe_isr, &probe), 0);
+  /* TIM1: 50 kHz, CONVST/LDAC PWM1 active low, CS PWM2 active low, CC3 -> DMA. */
+  assert_int_equal(TIM1->PSC, 0);
+  assert_int_equal(TIM1->ARR, 3359);
+  assert_int_equal(TIM1->CCR1, 42);
+  assert_int_equal(TIM1->CCR2, 42);
+  assert_int_equal(TIM1->CCR3, 807);
+  assert_int_equal((TIM1->CCMR1 >> 4) & 7u, 6u);
+  assert_int_equal((TIM1->CCMR1 >> 12) & 7u, 6u);
+  assert_int_equal((TIM1->CCMR2 >> 4) & 7u, 7u);
+  assert_int_equal(TIM1->CCER, 0x333u); /* CC1E|CC1P|CC2E|CC2P|CC3E|CC3P */
+  assert_int_equal(TIM1->DIER, TIM_DIER_CC3DE);
+  assert_true((TIM1->BDTR & TIM_BDTR_MOE) != 0u);
+  assert_true((TIM1->CR1 & TIM_CR1_CEN) != 0u);
+  /* SPI1: master, mode 2, 16 bit, PCLK2/8 = 10.5 MHz, software NSS, enabled; only the
+   * RX DMA request open until TIM1 CC3 opens TX. */
+  assert_int_equal(SPI1->CR1 & (SPI_CR1_CPOL | SPI_CR1_CPHA), SPI_CR1_CPOL);
+  assert_int_equal((SPI1->CR1 >> SPI_CR1_BR_POS) & 7u, 2u);
+  assert_true((SPI1->CR1 & (SPI_CR1_MSTR | SPI_CR1_DFF | SPI_CR1_SSM | SPI_CR1_SSI |
+                            SPI_CR1_SPE)) ==
+              (SPI_CR1_MSTR | SPI_CR1_DFF | SPI_CR1_SSM | SPI_CR1_SSI | SPI_CR1_SPE));
+  assert_int_equal(SPI1->CR2, SPI_CR2_RXDMAEN);
+  /* DMA2: stream 0 ch 3 SPI1_RX circular, stream 5 ch 3 SPI1_TX, stream 6 ch 6 TIM1_CH3
+   * writing into SPI1_CR2 (RM0090 table 43). */
+  assert_int_equal(DMA2->S[0].CR >> 25, 3u);
+  assert_true((DMA2->S[0].CR & (DMA_SXCR_CIRC | DMA_SXCR_TCIE | DMA_SXCR_EN)) ==
+              (DMA_SXCR_CIRC | DMA_SXCR_TCIE | DMA_SXCR_EN));
+  assert_int_equal((DMA2->S[0].CR >> 6) & 3u, 0u); /* peripheral -> memory */
+  assert_int_equal(DMA2->S[0].PAR, LOW32(&SPI1->DR));
+  assert_int_equal(DMA2->S[0].NDTR, 2);
+  assert_int_equal(DMA2->S[5].CR >> 25, 3u);
+  assert_int_equal((DMA2->S[5].CR >> 6) & 3u, 1u); /* memory -> peripheral */
+  assert_int_equal(DMA2->S[5].PAR, LOW32(&SPI1->DR));
+  assert_int_equal(DMA2->S[5].NDTR, 2);
+  assert_int_equal(DMA2->S[6].CR >> 25, 6u);
+  assert_int_equal(DMA2->S[6].PAR, LOW32(&SPI1->CR2));
+  /* The sample interrupt: DMA2 stream 0 (IRQ 56) at priority 0. */
+  assert_true((NVIC->ISER[56 / 32] & (1u << (56 % 32))) != 0u);
+  assert_int_equal(NVIC->IP[56], 0);
+}
+
+static void test_start_sets_dac_deadline(void **state)
+{
+  (void)state;
+  isr_probe_t probe = {0};
+  assert_int_equal(hal_sample_timer_start(50000u, probe_isr, &probe), 0);
+  /* Four 1.25 us DAC slots + 0.1 us guard must end by the next LDAC at 20 us:
+   * last start at 14.9 us = 2503.2 counts of 168 MHz. */
+  const hal_dac_frame_t f = {{1u, 2u, 3u, 4u}};
+  const uint32_t late0 = stm32f4_dac_late();
+  TIM1->CNT = 2504u;
+  hal_dac_write_frame(&f);
+  assert_int_equal(stm32f4_dac_late(), late0 + 1u);
+  TIM1->CNT = 2503u;
+  hal_dac_write_frame(&f);
+  assert_int_equal(stm32f4_dac_late(), late0 + 1u);
+  stm32f4_dac_set_deadline(0xFFFFFFFFu);
+}
+
+static void test_start_rejects(void **state)
+{
+  (void)state;
+  isr_probe_t probe = {0};
+  assert_int_equal(hal_sample_timer_start(50000u, NULL, &probe), -1);
+  assert_int_equal(hal_sample_timer_start(12345u, probe_isr, &probe), -1);
+  assert_int_equal(TIM1->CR1, 0u);
+}
+
+static void test_interrupt_rearms_and_calls_isr(void **state)
+{
+  (void)state;
+  isr_probe_t probe = {0};
+  assert_int_equal(hal_sample_timer_start(50000u, probe_isr, &probe), 0);
+  volatile int16_t *rx = stm32f4_sample_host_rx();
+  rx[0] = -12345; /* V1: drive pickoff */
+  rx[1] = 321;    /* V2: sense pickoff */
+  SPI1->CR2 = SPI_CR2_RXDMAEN | SPI_CR2_TXDMAEN; /* the gate the DMA opened */
+  DMA2->S[5].CR &= ~DMA_SXCR_EN;                 /* TX stream finished */
+  DMA2->S[5].NDTR = 0u;
+  DMA2->LISR = DMA_FLAG_TCIF;                    /* stream 0 complete */
+  DMA2_Stream0_IRQHandler();
+  assert_int_equal(probe.calls, 1);
+  assert_int_equal(probe.spi_cr2_seen, SPI_CR2_RXDMAEN); /* gate closed first */
+  assert_int_equal(probe.tx_ndtr_seen, 2);
+  assert_true((probe.tx_cr_seen & DMA_SXCR_EN) != 0u);   /* re-armed for the next CC3 */
+  assert_int_equal(DMA2->LIFCR, DMA_FLAG_TCIF);          /* stream 0 flags cleared */
+  assert_int_equal(probe.frame.drive, -12345);
+  assert_int_equal(probe.frame.sense, 321);
+  stm32f4_sample_stats_t st;
+  stm32f4_sample_stats(&st);
+  assert_int_equal(st.ticks, 1);
+  assert_int_equal(st.overruns, 0);
+  assert_int_equal(st.dma_errors, 0);
+
+  /* A frame that completes while the ISR still runs is counted as an overrun. */
+  probe.leave_tc_pending = 1;
+  DMA2->S[5].CR &= ~DMA_SXCR_EN;
+  DMA2->LISR = DMA_FLAG_TCIF;
+  DMA2_Stream0_IRQHandler();
+  stm32f4_sample_stats(&st);
+  assert_int_equal(st.ticks, 2);
+  assert_int_equal(st.overruns, 1);
+
+  /* A transfer error is counted; without TC no tick is served. */
+  DMA2->LISR = DMA_FLAG_TEIF;
+  DMA2_Stream0_IRQHandler();
+  stm32f4_sample_stats(&st);
+  assert_int_equal(st.ticks, 2);
+  assert_int_equal(st.dma_errors, 1);
+}
+
+static void test_stop_parks_outputs(void **state)
+{
+  (void)state;
+  isr_probe_t probe = {0};
+  assert_int_equal(hal_sample_timer_start(50000u, probe_isr, &probe), 0);
+  hal_sample_timer_stop();
+  assert_int_equal(TIM1->CR1 & TIM_CR1_CEN, 0);
+  /* OCxM = 100 "force inactive": with active-low polarity every line idles high. */
+  assert_int_equal((TIM1->CCMR1 >> 4) & 7u, 4u);
+  assert_int_equal((TIM1->CCMR1 >> 12) & 7u, 4u);
+  assert_int_equal((TIM1->CCMR2 >> 4) & 7u, 4u);
+  assert_int_equal(DMA2->S[0].CR & DMA_SXCR_EN, 0);
+  assert_true((NVIC->ICER[56 / 32] & (1u << (56 % 32))) != 0u);
+}
+
+int main(void)
+{
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_plan_50khz_168mhz),
+      cmocka_unit_test(test_plan_50khz_84mhz),
+      cmocka_unit_test(test_plan_slow_rate_uses_prescaler),
+      cmocka_unit_test(test_plan_rejects),
+      cmocka_unit_test_setup(test_start_programs_hardware_chain, setup),
+      cmocka_unit_test_setup(test_start_sets_dac_deadline, setup),
+      cmocka_unit_test_setup(test_start_rejects, setup),
+      cmocka_unit_test_setup(test_interrupt_rearms_and_calls_isr, setup),
+      cmocka_unit_test_setup(test_stop_parks_outputs, setup),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
