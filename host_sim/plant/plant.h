@@ -29,10 +29,11 @@
  *
  * Configuration: plant_cfg_t is flat and generated from the list PLANT_PARAMS, which
  * also generates the descriptor table (plant_param_*: name = field name, snake case
- * with unit suffix, type, range, unit, one-line doc), so every field is a parameter. plant_default_cfg() is the table "thesis linear gyro, air package" of
- * the system spec, each value with its source. Input profiles (rate, ambient,
- * acceleration) are set separately (plant_set_profiles), defaulting to constants from
- * rate_dps and temp_k.
+ * with unit suffix, type, range, unit, one-line doc), so every field is a parameter.
+ * plant_default_cfg() is the table "thesis linear gyro, air package" of the system
+ * spec, each value with its source. Input profiles (rate, ambient, acceleration) are
+ * set separately (plant_set_profiles), defaulting to constants from rate_dps and
+ * temp_k.
  */
 #ifndef PLANT_PLANT_H
 #define PLANT_PLANT_H
