@@ -45,6 +45,21 @@
  * electrical feedthrough, which interpolates between ticks.
  *
  * Channels (hal_converters.h): 0 drive U1, 1 drive U2, 2 analog rate output, 3 spare.
+ *
+ * One plant sample [t_k, t_k+1) with the electrical modules (the top level's order):
+ *   dac_step(&dac, &dout)                         voltages over the sample
+ *   actuator_step(&act, &dout, &f)                mean forces per unit mass, m/s^2
+ *   accel_step(&acc, a_g, &fa)                    + g-sensitivity forces, m/s^2
+ *   mechanics: hold f + fa (+ Brownian) over the sample, state at t_k+1
+ *   vd = pickoff_step(&pd, y, y', &dout)          drive pickoff at its sampling instant
+ *   vs = pickoff_step(&ps, x, x', &dout)          sense pickoff
+ *   adc_convert_frame(&adc, vd, vs, &frame)       -> firmware ISR of tick k+1
+ *   dac_write(&dac, &firmware_frame)              latched at the end of the next step
+ * Lag from a code written by the ISR to the force (both schemes, 1490 Hz force):
+ * 1.5 samples of the voltage (one latency + half a hold: 8.0 deg at 745 Hz, doubled by
+ * the square law to 16.1 deg at 1490 Hz) plus the filter (3.0 deg at 745 Hz, 6.0 deg in
+ * force), about 22 deg in total; these are real hardware lags for the drive loop to
+ * absorb, not artefacts.
  */
 #ifndef PLANT_DAC_H
 #define PLANT_DAC_H

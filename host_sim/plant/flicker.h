@@ -18,7 +18,7 @@
  *     y[n] = b0 x[n] + b1 x[n-1] - a1 y[n-1]
  * and g is the least-squares (in dB) fit of the discrete |H|^2 to S(f) over
  * [10 fmin, 0.45 fs]. One Gaussian and 3 multiply-adds per section per sample (about
- * 7 sections for fmin 1 mHz, fc 100 Hz).
+ * 6 sections for fmin 1 mHz, fc 100 Hz).
  *
  * The cascade starts at rest: spectral content below f needs about 1/(2 pi f) seconds
  * to reach its stationary level.

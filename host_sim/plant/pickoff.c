@@ -56,6 +56,7 @@ void pickoff_default_cfg(pickoff_cfg_t *cfg, pickoff_axis_t axis)
   cfg->lp_q = 0.70710678118654752;
   cfg->noise_v_rthz = 2e-6;
   cfg->jitter_rms_s = 0.0;
+  cfg->phase_step_rad = 1e-6;
   if (axis == PICKOFF_SENSE) {
     cfg->gain_v_per_m = 6.18e7;
     cfg->ft_u1 = 1e-4;
@@ -88,7 +89,7 @@ static int cfg_ok(const pickoff_cfg_t *c)
                          c->ft_u1, c->ft_u2, c->ft_spare, c->lag_ref_hz, c->temp_ref_k,
                          c->phi0_rad, c->phi1_rad_per_k, c->phi2_rad_per_k2, c->hp_hz,
                          c->lp_hz, c->lp_q, c->offset_v, c->noise_v_rthz,
-                         c->sample_delay_s, c->jitter_rms_s};
+                         c->sample_delay_s, c->jitter_rms_s, c->phase_step_rad};
   if (!finite_all(vals, (int)(sizeof vals / sizeof vals[0]))) return 0;
   if (c->axis != PICKOFF_DRIVE && c->axis != PICKOFF_SENSE) return 0;
   if (c->lag_kind != PICKOFF_LAG_LOWPASS && c->lag_kind != PICKOFF_LAG_ALLPASS) return 0;
@@ -101,7 +102,9 @@ static int cfg_ok(const pickoff_cfg_t *c)
   if (!(c->hp_hz >= 0.0 && c->hp_hz < c->fs_hz / 2.0)) return 0;
   if (!(c->lp_hz > 0.0 && c->lp_hz <= 10.0 * c->fs_hz && c->lp_q >= 0.1 && c->lp_q <= 10.0))
     return 0;
-  if (!(fabs(c->offset_v) <= 10.0 && c->noise_v_rthz >= 0.0)) return 0;
+  if (!(fabs(c->offset_v) <= 10.0 && c->noise_v_rthz >= 0.0 && c->phase_step_rad >= 0.0 &&
+        c->phase_step_rad <= 0.01))
+    return 0;
   if (!(fabs(c->sample_delay_s) <= 0.5 * T && c->jitter_rms_s >= 0.0 &&
         c->jitter_rms_s <= 0.05 * T))
     return 0;
@@ -259,11 +262,14 @@ int pickoff_set_temp(pickoff_t *p, double temp_k)
   if (p == NULL || !isfinite(temp_k)) return -1;
   const double phi = phase_at(&p->cfg, temp_k);
   if (!phase_ok(&p->cfg, phi)) return -1;
-  pickoff_t t = *p;
-  if (discretise(&t, phi) != 0) return -1;
-  t.temp_k = temp_k;
-  t.gain_now = p->cfg.gain_v_per_m * (1.0 + p->cfg.gain_tc_per_k * (temp_k - p->cfg.temp_ref_k));
-  *p = t;
+  if (fabs(phi - p->phi_rad) >= p->cfg.phase_step_rad) {
+    pickoff_t t = *p;
+    if (discretise(&t, phi) != 0) return -1;
+    t.rediscretise_count++;
+    *p = t;
+  }
+  p->temp_k = temp_k;
+  p->gain_now = p->cfg.gain_v_per_m * (1.0 + p->cfg.gain_tc_per_k * (temp_k - p->cfg.temp_ref_k));
   return 0;
 }
 

@@ -99,6 +99,7 @@ static void make_pickoff_cfg(const plant_cfg_t *c, int axis, pickoff_cfg_t *q)
   q->fs_hz = c->fs_hz;
   q->lag_ref_hz = c->pick_lag_ref_hz;
   q->temp_ref_k = c->temp_ref_k;
+  q->phase_step_rad = c->pick_phase_step_rad;
   if (axis == 0) {
     q->gain_v_per_m = c->pick_drive_gain_v_per_m;
     q->gain_tc_per_k = c->pick_drive_gain_tc_per_k;
@@ -219,8 +220,7 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   else if (adc_init(&n.adc, &adcc) != 0) what = "ADC (adc_full_scale_v)";
   else if (accel_init(&n.accel, &gc) != 0) what = "g-sensitivity (gs_*)";
   for (int i = 0; what == NULL && i < 2; i++) {
-    n.pick_temp_k[i] = thermal_temp(&n.thermal, pick_node(cfg, i));
-    if (pickoff_init(&n.pick[i], &pc[i], n.pick_temp_k[i], seed) != 0)
+    if (pickoff_init(&n.pick[i], &pc[i], thermal_temp(&n.thermal, pick_node(cfg, i)), seed) != 0)
       what = i == 0 ? "drive pickoff (pick_drive_*: phase law at this temperature?)"
                     : "sense pickoff (pick_sense_*: phase law at this temperature?)";
   }
@@ -284,13 +284,10 @@ static void thermal_update(plant_t *p, double t0)
   if (!(amb > 1.0 && amb < 2000.0)) amb = p->truth.ambient_k; /* keep the last sane one */
   thermal_step(&p->thermal, amb);
   (void)mech_set_temp(&p->mech, thermal_temp(&p->thermal, THERMAL_STRUCT));
-  for (int i = 0; i < 2; i++) {
-    const double tc = thermal_temp(&p->thermal, pick_node(&p->cfg, i));
-    /* re-discretising a pickoff costs microseconds: only when it moved enough */
-    if (fabs(tc - p->pick_temp_k[i]) > p->cfg.pick_retemp_k &&
-        pickoff_set_temp(&p->pick[i], tc) == 0)
-      p->pick_temp_k[i] = tc;
-  }
+  /* the gain follows at once; the phase re-discretises (microseconds) only when it moved
+   * by pick_phase_step_rad. A law driven out of its range keeps the last phase. */
+  for (int i = 0; i < 2; i++)
+    (void)pickoff_set_temp(&p->pick[i], thermal_temp(&p->thermal, pick_node(&p->cfg, i)));
   truth_temps(p, amb);
 }
 
@@ -428,6 +425,11 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
   }
   p->f_prev[1] = p->f_prev[0];
   p->f_prev[0] = f;
+}
+
+void plant_step_hal(void *plant, const hal_dac_frame_t *dac, hal_adc_frame_t *adc)
+{
+  plant_step((plant_t *)plant, dac, adc);
 }
 
 const plant_truth_t *plant_truth(const plant_t *p) { return &p->truth; }

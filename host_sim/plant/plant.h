@@ -7,7 +7,7 @@
  *      structure / circuit / board-sensor temperatures (thermal.h); the structure
  *      temperature moves the resonances (2-32) (mech.h), the circuit temperature (of
  *      the node chosen by pick_*_temp_node) the pickoff phases and gains (2-40)
- *      (pickoff.h, re-discretised when it moved by pick_retemp_k);
+ *      (pickoff.h, re-discretised when the phase moved by pick_phase_step_rad);
  *   2. DAC (dac.h): the frame passed in is the one on the converter outputs during
  *      this interval (the host HAL stub applies the board's one-sample latency: it
  *      passes the frame the firmware wrote at the previous tick); zero-order hold,
@@ -29,10 +29,11 @@
  *
  * Configuration: plant_cfg_t is flat and generated from the list PLANT_PARAMS, which
  * also generates the descriptor table (plant_param_*: name = field name, snake case
- * with unit suffix, type, range, unit, one-line doc), so every field is a parameter. plant_default_cfg() is the table "thesis linear gyro, air package" of
- * the system spec, each value with its source. Input profiles (rate, ambient,
- * acceleration) are set separately (plant_set_profiles), defaulting to constants from
- * rate_dps and temp_k.
+ * with unit suffix, type, range, unit, one-line doc), so every field is a parameter.
+ * plant_default_cfg() is the table "thesis linear gyro, air package" of the system
+ * spec, each value with its source. Input profiles (rate, ambient, acceleration) are
+ * set separately (plant_set_profiles), defaulting to constants from rate_dps and
+ * temp_k.
  */
 #ifndef PLANT_PLANT_H
 #define PLANT_PLANT_H
@@ -133,7 +134,7 @@
   X(double, pick_sense_delay_s, DOUBLE, -1e-3, 1e-3, "s", "sense sampling instant after the tick (|.| <= T/2)") \
   X(double, pick_sense_jitter_s, DOUBLE, 0.0, 1e-3, "s", "sense sampling jitter rms (<= T/20)") \
   X(double, pick_lag_ref_hz, DOUBLE, 1.0, 1e6, "Hz", "frequency at which the circuit lags equal phi (< fs/2)") \
-  X(double, pick_retemp_k, DOUBLE, 0.0, 10.0, "K", "circuit temperature change that re-discretises a pickoff") \
+  X(double, pick_phase_step_rad, DOUBLE, 0.0, 0.01, "rad", "circuit phase change that re-discretises a pickoff") \
   /* ADC (adc.h) */                                                                       \
   X(double, adc_full_scale_v, DOUBLE, 0.01, 100.0, "V", "ADC full scale, +-")            \
   /* acceleration (accel.h): force per unit mass per g */                                 \
@@ -219,7 +220,6 @@ typedef struct {
   double T;                   /* sample period */
   uint64_t k;                 /* samples done */
   int thermal_every;          /* samples per thermal update */
-  double pick_temp_k[2];      /* circuit temperature of the current pickoff discretisation */
   int accel_any, accel_dynamic; /* acceleration profile non-zero / has a sine */
   /* truth: drive-frequency estimate from the force samples */
   double f_prev[2];           /* F_{k-1}, F_{k-2} */
@@ -259,6 +259,10 @@ int plant_set_profiles(plant_t *p, const plant_profiles_t *prof);
  * this interval; a frame with an out-of-range code is rejected (counted, the previous
  * frame held). adc: the frame sampled at the end of the interval. */
 void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc);
+
+/* The same step in the shape of hal_host_plant_step_fn (hal/host/hal_host.h), so the
+ * host HAL stub can attach a plant_t without a cast: plant is a plant_t *. */
+void plant_step_hal(void *plant, const hal_dac_frame_t *dac, hal_adc_frame_t *adc);
 
 /* The truth of the last completed sample. */
 const plant_truth_t *plant_truth(const plant_t *p);

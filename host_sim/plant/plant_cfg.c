@@ -225,12 +225,11 @@ void plant_default_cfg(plant_cfg_t *c)
   c->pick_sense_jitter_s = 0.0;
   c->pick_sense_temp_node = THERMAL_CIRCUIT;
   c->pick_lag_ref_hz = 1489.9;
-  /* A pickoff re-discretisation costs ~10 us (measured, host-release), so the circuit
-   * temperature is applied in steps of 1 mK: 1e-4 deg of sense phase, a bias staircase
-   * of 2.6e-3 deg/s steps (9 deg/h) through 1500 deg/s of quadrature, only while the
-   * temperature moves (2.7 deg/s per K then). Cost in a 0.03 K/s cool-down: 2 pickoffs
-   * every 33 ms, 12 ns per sample; 1e-4 K would cost 120 ns per sample. */
-  c->pick_retemp_k = 1e-3;
+  /* A pickoff re-discretisation costs ~10 us (measured, host-release); it happens when
+   * the circuit phase has moved by this step: 1e-6 rad (pickoff.h default) is a bias
+   * step of 1.5e-3 deg/s (5 deg/h) through 1500 deg/s of quadrature, 0.57 mK of sense
+   * circuit temperature. In a 0.03 K/s cool-down: 52 per second, 10 ns per sample. */
+  c->pick_phase_step_rad = 1e-6;
   /* ADC: hal_converters.h, +-5 V (§4.4.2) */
   c->adc_full_scale_v = 5.0;
   /* g-sensitivity: a single proof mass on springs feels -m a along its own axis;

@@ -297,6 +297,31 @@ static void test_preamp_clip(void **state)
   assert_true(peak < 1.5 * c.preamp_rail_v);
 }
 
+/* Temperature updates: the gain follows every call; the chain is re-discretised only when
+ * Phi_cir has moved by phase_step_rad, so the realised phase stays within one step of
+ * (2-40) however often set_temp is called. */
+static void test_phase_step(void **state)
+{
+  (void)state;
+  pickoff_cfg_t c;
+  quiet(&c, PICKOFF_SENSE);
+  c.gain_tc_per_k = 1e-3;
+  pickoff_t p;
+  assert_int_equal(pickoff_init(&p, &c, T0_K, 3u), 0);
+  /* 0.1 deg/K and 1e-6 rad: one step per 0.573 mK; ramp 20 mK in 0.1 mK increments */
+  for (int i = 1; i <= 200; i++) {
+    const double tk = T0_K + 1e-4 * i;
+    assert_int_equal(pickoff_set_temp(&p, tk), 0);
+    const double law = c.phi0_rad + c.phi1_rad_per_k * (tk - T0_K);
+    assert_true(fabs(p.phi_rad - law) < c.phase_step_rad);
+    assert_true(fabs(p.gain_now - c.gain_v_per_m * (1.0 + 1e-3 * (tk - T0_K))) < 1e-9 * c.gain_v_per_m);
+  }
+  const double steps = 0.02 * c.phi1_rad_per_k / c.phase_step_rad; /* 34.9 */
+  print_message("re-discretisations over 20 mK: %llu (phase moved %.1f steps)\n",
+                (unsigned long long)p.rediscretise_count, steps);
+  assert_true(p.rediscretise_count >= (uint64_t)floor(steps) - 1 && p.rediscretise_count <= (uint64_t)ceil(steps));
+}
+
 /* Bad configurations and temperatures are refused and change nothing. */
 static void test_bad_input(void **state)
 {
@@ -322,6 +347,9 @@ static void test_bad_input(void **state)
   c.phi0_rad = 0.0;
   assert_int_equal(pickoff_init(&p, &c, T0_K, 1u), -1);
   c = good;
+  c.phase_step_rad = -1.0;
+  assert_int_equal(pickoff_init(&p, &c, T0_K, 1u), -1);
+  c = good;
   c.axis = (pickoff_axis_t)5;
   assert_int_equal(pickoff_init(&p, &c, T0_K, 1u), -1);
   assert_int_equal(pickoff_init(&p, &good, NAN, 1u), -1);
@@ -343,7 +371,8 @@ int main(void)
       cmocka_unit_test(test_phase_vs_temperature), cmocka_unit_test(test_allpass),
       cmocka_unit_test(test_sample_delay),         cmocka_unit_test(test_jitter),
       cmocka_unit_test(test_noise),                cmocka_unit_test(test_feedthrough),
-      cmocka_unit_test(test_preamp_clip),          cmocka_unit_test(test_bad_input),
+      cmocka_unit_test(test_preamp_clip),          cmocka_unit_test(test_phase_step),
+      cmocka_unit_test(test_bad_input),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -450,14 +450,18 @@ static void test_temperature_plumbing(void **state)
   assert_true(fabs(t->board_k - thermal_temp(&ref, THERMAL_BOARD)) < 1e-9);
   const double wn = 2 * kPi * c.f_drive_hz * (1.0 - 0.5 * c.ket_per_k * (t->struct_k - c.temp_ref_k));
   assert_true(fabs(t->wn_drive_rad_s / wn - 1.0) < 1e-12);
-  assert_true(fabs(p.pick[1].temp_k - t->board_k) <= c.pick_retemp_k);
-  assert_true(fabs(p.pick[0].temp_k - t->circuit_k) <= c.pick_retemp_k);
+  assert_true(p.pick[1].temp_k == t->board_k);
+  assert_true(p.pick[0].temp_k == t->circuit_k);
+  /* the sense phase follows (2-40) to within the step */
+  const double phi = (c.pick_sense_phi0_deg + c.pick_sense_phi1_deg_per_k * (t->board_k - c.temp_ref_k)) * kDeg;
+  assert_true(fabs(p.pick[1].phi_rad - phi) <= c.pick_phase_step_rad);
   assert_true(t->ambient_k == c.temp_k + 20.0);
   assert_true(t->dac_rejects == 0);
-  /* a bad frame is rejected and counted */
+  /* a bad frame is rejected and counted, the previous one held */
   hal_dac_frame_t bad = {{HAL_DAC_CODE_MAX + 1u, 0, 0, 0}};
-  plant_step(&p, &bad, NULL);
+  plant_step_hal(&p, &bad, NULL);
   assert_true(plant_truth(&p)->dac_rejects == 1);
+  assert_true(plant_truth(&p)->dac_held_v[0] == 0.0); /* mid-scale */
 }
 
 int main(void)
