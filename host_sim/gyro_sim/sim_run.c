@@ -15,11 +15,6 @@
 #include "sim.h"
 #include "sim_out.h"
 
-static void plant_adapter(void *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc)
-{
-  plant_step(p, dac, adc);
-}
-
 static double wall_now(void)
 {
   struct timespec ts;
@@ -145,7 +140,7 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
   }
   (void)hal_flash_host_configure(NULL);
   hal_uart_host_reset();
-  hal_host_attach(plant_adapter, plant);
+  hal_host_attach(plant_step_hal, plant);
   if (app_init_with(app, &fw) != 0 ||
       hal_sample_timer_start(fw.sys_fs_hz, app_sample_isr, app) != 0) {
     snprintf(err, err_len, "firmware: application did not start");
@@ -310,7 +305,7 @@ int sim_run_open_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_resul
   ol_t o;
   memset(&o, 0, sizeof o);
   o.v_per_code = pc.adc_full_scale_v / 32768.0;
-  hal_host_attach(plant_adapter, plant);
+  hal_host_attach(plant_step_hal, plant);
   (void)hal_sample_timer_start((uint32_t)llround(fs), ol_isr, &o);
   sim_csv_t csv;
   memset(&csv, 0, sizeof csv);

@@ -106,6 +106,7 @@ int flicker_init(flicker_t *f, const flicker_spec_t *spec, double fs_hz, uint64_
     t.nsec = 0;
     t.in_sd = unit_sd * sqrt(w2);
   }
+  gauss_zig_init(&t.zig);
   rng_seed(&t.rng, seed, stream);
   *f = t;
   return 0;
@@ -114,7 +115,7 @@ int flicker_init(flicker_t *f, const flicker_spec_t *spec, double fs_hz, uint64_
 double flicker_step(flicker_t *f)
 {
   if (!f->active) return 0.0;
-  double x = f->in_sd * rng_gauss(&f->rng);
+  double x = f->in_sd * gauss_zig(&f->zig, &f->rng);
   for (int i = 0; i < f->nsec; i++) {
     const double y = f->b0[i] * x + f->b1[i] * f->xp[i] - f->a1[i] * f->yp[i];
     f->xp[i] = x;

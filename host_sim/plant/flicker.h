@@ -28,6 +28,7 @@
 
 #include <stdint.h>
 
+#include "plant/gauss_zig.h"
 #include "plant/rng.h"
 
 #define FLICKER_MAX_SECTIONS 16
@@ -46,6 +47,7 @@ typedef struct {
   double b0[FLICKER_MAX_SECTIONS], b1[FLICKER_MAX_SECTIONS], a1[FLICKER_MAX_SECTIONS];
   double xp[FLICKER_MAX_SECTIONS], yp[FLICKER_MAX_SECTIONS];
   rng_t rng;
+  gauss_zig_t zig; /* normal deviates by the ziggurat: no log per sample (gauss_zig.h) */
 } flicker_t;
 
 /* Validates spec (finite, W, K >= 0, fs > 0; if K > 0: 0 < fmin <= fs/1000 and fc/fmin small

@@ -251,6 +251,7 @@ int pickoff_init(pickoff_t *p, const pickoff_cfg_t *cfg, double temp_k, uint64_t
   t.inv_t = cfg->fs_hz;
   t.gain_now = cfg->gain_v_per_m * (1.0 + cfg->gain_tc_per_k * (temp_k - cfg->temp_ref_k));
   t.noise_sd = cfg->noise_v_rthz * sqrt(cfg->fs_hz / 2.0);
+  gauss_zig_init(&t.zig);
   rng_seed(&t.rng_noise, seed, PICKOFF_RNG_STREAM_NOISE + (uint64_t)cfg->axis);
   rng_seed(&t.rng_jitter, seed, PICKOFF_RNG_STREAM_JITTER + (uint64_t)cfg->axis);
   *p = t;
@@ -316,9 +317,9 @@ double pickoff_step(pickoff_t *p, double pos_m, double vel_mps, const dac_out_t 
     double dy = 0.0;
     for (int i = 0; i < PICKOFF_MAX_N; i++) dy += p->dout_z[i] * zn[i];
     for (int i = 0; i < 4; i++) dy += p->dout_u[i] * u[i];
-    v += c->jitter_rms_s * p->inv_t * rng_gauss(&p->rng_jitter) * dy;
+    v += c->jitter_rms_s * p->inv_t * gauss_zig(&p->zig, &p->rng_jitter) * dy;
   }
   v += c->offset_v;
-  if (p->noise_sd > 0.0) v += p->noise_sd * rng_gauss(&p->rng_noise);
+  if (p->noise_sd > 0.0) v += p->noise_sd * gauss_zig(&p->zig, &p->rng_noise);
   return v;
 }

@@ -59,6 +59,7 @@
 #include <stdint.h>
 
 #include "plant/dac.h"
+#include "plant/gauss_zig.h"
 #include "plant/rng.h"
 
 #define PICKOFF_RNG_STREAM_NOISE 0x7001u  /* + axis */
@@ -115,6 +116,7 @@ typedef struct {
   double s_prev, m_prev;         /* input and T * slope at the previous tick */
   double noise_sd;
   rng_t rng_noise, rng_jitter;
+  gauss_zig_t zig; /* normal deviates by the ziggurat: no log per sample (gauss_zig.h) */
   uint64_t preamp_clip_count;
 } pickoff_t;
 
