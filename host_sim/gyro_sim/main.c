@@ -335,7 +335,7 @@ int main(int argc, char **argv)
 
   if (need_tools && sc.mode == SIM_CLOSED_LOOP) {
     if (sc.analyses & SIM_AN_RATE_TABLE) {
-      const char *args[] = {csv_path, "--settle", "0.5", NULL};
+      const char *args[] = {csv_path, "--settle", "0.5", "--min-avg", "0.5", NULL};
       cJSON *j = post_run_tool("gyro-scalefactor", args, out_dir, "scalefactor.json", err, sizeof err);
       if (j == NULL) { fprintf(stderr, "gyro-sim: %s\n", err); failed = 1; }
       else {
@@ -363,7 +363,7 @@ int main(int argc, char **argv)
       cJSON *j = post_run_tool("gyro-allan", args, out_dir, "allan.json", err, sizeof err);
       double sf = 1.0;
       if (j != NULL && sc.has_rate && sc.rate_dps.kind == PROFILE_STEPS && sc.rate_dps.n_steps > 1) {
-        const char *a2[] = {csv_path, "--t-start", tend, "--settle", "0.5", NULL};
+        const char *a2[] = {csv_path, "--t-start", tend, "--settle", "0.5", "--min-avg", "0.5", NULL};
         cJSON *s = post_run_tool("gyro-scalefactor", a2, out_dir, "scalefactor.json", err, sizeof err);
         if (s != NULL) {
           sf = post_num(s, "scale_factor_out_per_dps");

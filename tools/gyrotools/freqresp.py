@@ -73,23 +73,42 @@ def model(f_hz, f0_hz, q, k, phi0_deg, tau_s=0.0):
     return k * w0 ** 2 * np.exp(-1j * lag) / (w0 ** 2 - w ** 2 + 1j * w * w0 / q)
 
 
-def _initial(f, h):
-    """Linear complex least squares on 1/H (tau = 0)."""
+def _linear_fit(f, h):
+    """Linear complex least squares on 1/H = a0 + a1 (j w) + a2 w^2 (normalised w)."""
     w_ref = 2 * np.pi * float(np.median(f))
     wn = 2 * np.pi * f / w_ref
     wt = np.abs(h)
     a = np.column_stack([np.ones_like(wn), 1j * wn, wn ** 2]).astype(complex) * wt[:, None]
     coef, *_ = np.linalg.lstsq(a, wt / h, rcond=None)
-    a0, a1, a2 = coef
-    ratio = -(a0 / a2).real
-    if not (ratio > 0 and abs(a1) > 0 and abs(a2) > 0):
+    resid = float(np.linalg.norm(a @ coef - wt / h))
+    return coef, w_ref, resid
+
+
+def _initial(f, h, lag="linear"):
+    """Starting point of the nonlinear fit: the linear fit on 1/H after removing a trial
+    pure delay tau (0..200 us on a 1 us grid for the "linear" lag model). A delay makes
+    the lag grow linearly with frequency; over a sweep that covers only the resonance the
+    basis {1, j w, w^2} is nearly collinear and the delay's slope would otherwise be
+    absorbed into nonsense coefficients (a board's 1.5-sample DAC latency is 30 us)."""
+    taus = np.arange(0.0, 200e-6 + 1e-12, 1e-6) if lag == "linear" else np.array([0.0])
+    best = None
+    for tau in taus:
+        hc = h * np.exp(1j * 2 * np.pi * f * tau)
+        coef, w_ref, res = _linear_fit(f, hc)
+        a0, a1, a2 = coef
+        if abs(a2) == 0.0 or abs(a1) == 0.0 or not (-(a0 / a2).real > 0):
+            continue
+        if best is None or res < best[0]:
+            best = (res, coef, w_ref, tau)
+    if best is None:
         raise InputError("the sweep does not look like a second-order resonance "
                          "(no peak to fit)")
-    w0n = math.sqrt(ratio)
+    _, (a0, a1, a2), w_ref, tau = best
+    w0n = math.sqrt(-(a0 / a2).real)
     q = abs(a2) * w0n / abs(a1)
     k = 1.0 / (abs(a2) * w0n ** 2)
     phi0 = math.degrees(np.angle(-a2))
-    return w0n * w_ref / (2 * np.pi), q, k, phi0
+    return w0n * w_ref / (2 * np.pi), q, k, phi0, tau
 
 
 @dataclasses.dataclass
@@ -141,7 +160,7 @@ def fit(f_hz, amp, phase_deg, lag="linear"):
         raise InputError(f"{np.unique(f).size} distinct frequencies; the fit needs at least "
                          f"{MIN_POINTS // 2} (and {MIN_POINTS} points)")
     h = amp * np.exp(1j * np.deg2rad(ph))
-    f0, q, k, phi0 = _initial(f, h)
+    f0, q, k, phi0, tau0 = _initial(f, h, lag)
     span = f.max() - f.min()
     tau_scale = 1.0 / (2 * np.pi * max(f.max(), 1e-9))   # 1 rad of lag at the top freq
 
@@ -155,7 +174,7 @@ def fit(f_hz, amp, phase_deg, lag="linear"):
         return np.concatenate([np.log(np.abs(hm) / amp),
                                np.angle(hm / h)])
 
-    x0 = np.array([f0, q, math.log(k), phi0, 0.0])
+    x0 = np.array([f0, q, math.log(k), phi0, tau0 / tau_scale])
     if lag == "const":
         x0 = x0[:4]
 
