@@ -131,7 +131,7 @@ typedef enum { MODE_FULL, MODE_QUICK, MODE_TRACE } bench_mode_t;
 
 static bench_mode_t bench_mode(void)
 {
-  static char cmd[64];
+  static char cmd[512]; /* "<image path> <mode>" */
   struct {
     char *buf;
     uint32_t len;
