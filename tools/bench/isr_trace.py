@@ -182,8 +182,9 @@ class CycleModel:
             n += (int(r.group(3)) - int(r.group(2)) + 1) if r else 1
         return n
 
-    def cost(self, pcs, flash=True, cold=True, icache=None, dcache=None):
-        """Cycles of one interrupt body (without exception entry/exit)."""
+    def cost(self, pcs, flash=True, cold=True, icache=None, dcache=None, attrib=None):
+        """Cycles of one interrupt body (without exception entry/exit). attrib: (Counter,
+        FuncMap) to add each instruction's cycles to its function."""
         icache = OrderedDict() if (icache is None or cold) else icache
         dcache = OrderedDict() if (dcache is None or cold) else dcache
         total = 0
@@ -256,6 +257,8 @@ class CycleModel:
                 cur_line = None
             line_cycles += c
             total += c
+            if attrib is not None:
+                attrib[0][attrib[1].name(pc)] += c
             prev_load = is_load and not refill
         return total, icache, dcache
 
@@ -283,12 +286,16 @@ class CycleModel:
 # context the first FP instruction of the handler stacks S0-S15 and FPSCR, 17 words, and
 # the return unstacks them).
 EXC_ENTRY, EXC_EXIT, FP_LAZY_SAVE, FP_RESTORE = 12, 10, 17, 17
-# Peripheral accesses of the handler and the HAL calls per tick, counted in the source
-# (stm32f4_sample.c DMA2_Stream0_IRQHandler, stm32f4_dac.c hal_dac_write_frame,
-# stm32f4_cycles.c hal_cycles_now): reads of DMA2 (AHB1) 5, of TIM1/TIM8 (APB2) 2, of
-# DWT (PPB) 2; writes to DMA2 8, to SPI1/TIM8 (APB2) 2. Assumed extra cycles over an SRAM
-# access: AHB1 read +2, APB2 read +4 (bridge at HCLK/2), PPB read +1, write +1.
-PERIPH_EXTRA = 5 * 2 + 2 * 4 + 2 * 1 + (8 + 2) * 1
+# Peripheral accesses of the handler and the HAL calls per tick, counted in the source:
+#   DMA2_Stream0_IRQHandler (stm32f4_sample.c): reads DMA2 LISR twice and S5.CR twice
+#     (test, read-modify-write); writes DMA2 LIFCR, HIFCR, S5.NDTR, S5.CR and SPI1 CR2;
+#   hal_dac_write_frame (stm32f4_dac.c): reads TIM1 CNT, TIM8 CR1, DMA2 S2.CR; writes
+#     DMA2 LIFCR, S2.NDTR, S2.CR and TIM8 CR1;
+#   hal_cycles_now (stm32f4_cycles.c), twice: reads DWT CYCCNT.
+# Reads: DMA2 (AHB1) 5, TIM1/TIM8 (APB2) 2, DWT (PPB) 2; writes: DMA2 7, APB2 2.
+# Assumed extra cycles over an SRAM access: AHB1 read +2, APB2 read +4 (bridge at
+# HCLK/2), PPB read +1, write +1.
+PERIPH_EXTRA = 5 * 2 + 2 * 4 + 2 * 1 + (7 + 2) * 1
 
 
 def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm"):
@@ -319,8 +326,9 @@ def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm"):
     for pcs in isrs:
         cyc, ic, dc = model.cost(pcs, flash=True, cold=False, icache=ic, dcache=dc)
         warm.append(cyc)
-    cold = [model.cost(p, flash=True, cold=True)[0] for p in isrs]
-    sram = [model.cost(p, flash=False)[0] for p in isrs]
+    cyc_cold, cyc_sram = Counter(), Counter()
+    cold = [model.cost(p, flash=True, cold=True, attrib=(cyc_cold, fmap))[0] for p in isrs]
+    sram = [model.cost(p, flash=False, attrib=(cyc_sram, fmap))[0] for p in isrs]
     lines_touched = len({pc >> 4 for pc in isrs[worst] if CycleModel.FLASH_LO <= pc < CycleModel.FLASH_HI})
     overhead_best = EXC_ENTRY + EXC_EXIT
     overhead_worst = EXC_ENTRY + EXC_EXIT + FP_LAZY_SAVE + FP_RESTORE
@@ -338,6 +346,8 @@ def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm"):
         "insns_max": max(counts),
         "insns_each": counts,
         "per_function_mean": {k: v / n for k, v in per_func.most_common()},
+        "per_function_cycles_mean": {k: {"flash_cold": cyc_cold[k] / n, "zero_wait": cyc_sram[k] / n}
+                                     for k, _ in cyc_cold.most_common()},
         "mix_mean": {k: v / n for k, v in mix.most_common()},
         "flash_lines_touched_worst": lines_touched,
         "exception_overhead": {"entry": EXC_ENTRY, "exit": EXC_EXIT, "fp_lazy_save": FP_LAZY_SAVE,
