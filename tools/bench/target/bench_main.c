@@ -1,0 +1,352 @@
+/* gyro-bench-qemu: instruction counts of the sample-path kernels, gyro_tick and the
+ * whole sample interrupt on QEMU's netduinoplus2 (STM32F405, Cortex-M4F), run as
+ *     qemu-system-arm -M netduinoplus2 -nographic -monitor none -icount shift=0 \
+ *         -semihosting-config enable=on,target=native -kernel gyro-bench-qemu.elf
+ * (tools/bench/run-bench does this). Results go out as lines on the semihosting console
+ * and the image ends with a semihosting exit; tools/bench/run-bench parses the lines:
+ *   calib nops=100 delta=D            D must be 100: one count per instruction
+ *   case NAME n=N k_sum= k_min= k_max= b_sum= b_min= b_max= locked=L
+ *     (k: counter deltas around the kernel call, b: around an empty call, same loop)
+ *   done | error WHAT CODE
+ *
+ * Besides the kernels (tools/bench/common), it counts:
+ *   app_sample_isr      called directly, with the board HAL calls (hal_adc_read_frame,
+ *                       hal_dac_write_frame, hal_cycles_now)
+ *   isr_app_cb          the real DMA2_Stream0_IRQHandler pended through the NVIC, its
+ *                       callback being bench_cb = app_sample_isr + clearing the fake
+ *                       TCIF; baseline: an IRQ whose handler is a lone BX LR
+ *   isr_empty_cb        the same with bench_cb_empty (handler alone + wrapper)
+ *   cb_wrap             bench_cb_empty against bench_empty, called directly: the cost of
+ *                       the wrapper, subtracted by run-bench
+ * The semihosting command line (-append) selects the mode: "quick" runs fewer
+ * iterations; "trace" runs only the locked-up application and BENCH_N_TRACE pended
+ * sample interrupts, for an instruction trace (QEMU -singlestep -d exec,nochain) that
+ * tools/bench/isr_trace.py turns into a per-function breakdown and a cycle estimate. */
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "app/app.h"
+#include "bench_isr_board.h"
+#include "bench_kernels.h"
+#include "bench_now.h"
+#include "bench_plant.h"
+#include "hal/hal_sample_timer.h"
+#include "stm32f4_board.h"
+#include "stm32f4_core.h"
+#include "stm32f4_fault.h"
+#include "stm32f4_regs.h"
+
+#define BENCH_N_FULL 2000u
+#define BENCH_N_QUICK 200u
+#define BENCH_FS_HZ 50000u
+#define BENCH_SPARE_IRQ 57u /* DMA2 stream 1: unused by the port; the baseline IRQ */
+#define BENCH_WARMUP_MAX 400000u
+#define BENCH_SETTLE 5000u
+#define BENCH_N_TRACE 100u      /* traced ISRs: ten rate-filter ticks, one P-filter tick */
+#define BENCH_SETTLE_TRACE 500u
+
+#define SYS_WRITE0 0x04u
+#define SYS_GET_CMDLINE 0x15u
+#define SYS_EXIT 0x18u
+#define ADP_STOPPED_APPLICATION_EXIT 0x20026u
+#define ADP_STOPPED_RUNTIME_ERROR 0x20023u
+
+/* ---- semihosting (QEMU -semihosting-config enable=on,target=native) ---- */
+
+static uint32_t semihost(uint32_t op, const void *arg)
+{
+  register uint32_t r0 __asm__("r0") = op;
+  register const void *r1 __asm__("r1") = arg;
+  __asm__ volatile("bkpt 0xab" : "+r"(r0) : "r"(r1) : "memory");
+  return r0;
+}
+
+typedef struct {
+  char buf[200];
+  size_t len;
+} line_t;
+
+static void put_str(line_t *l, const char *s)
+{
+  while (*s != '\0' && l->len + 1u < sizeof l->buf) l->buf[l->len++] = *s++;
+}
+
+static void put_u64(line_t *l, uint64_t v)
+{
+  char tmp[20];
+  size_t n = 0u;
+  do {
+    tmp[n++] = (char)('0' + (char)(v % 10u));
+    v /= 10u;
+  } while (v != 0u);
+  while (n > 0u && l->len + 1u < sizeof l->buf) l->buf[l->len++] = tmp[--n];
+}
+
+static void put_kv(line_t *l, const char *k, uint64_t v)
+{
+  put_str(l, " ");
+  put_str(l, k);
+  put_str(l, "=");
+  put_u64(l, v);
+}
+
+static void emit(line_t *l)
+{
+  put_str(l, "\n");
+  l->buf[l->len] = '\0';
+  (void)semihost(SYS_WRITE0, l->buf);
+  l->len = 0u;
+}
+
+static void report(const char *name, const bk_result_t *r)
+{
+  line_t l = {{0}, 0u};
+  put_str(&l, "case ");
+  put_str(&l, name);
+  put_kv(&l, "n", r->kern.n);
+  put_kv(&l, "k_sum", r->kern.sum);
+  put_kv(&l, "k_min", r->kern.min);
+  put_kv(&l, "k_max", r->kern.max);
+  put_kv(&l, "b_sum", r->base.sum);
+  put_kv(&l, "b_min", r->base.min);
+  put_kv(&l, "b_max", r->base.max);
+  put_kv(&l, "locked", r->locked);
+  emit(&l);
+}
+
+static void fail(const char *what, int code)
+{
+  line_t l = {{0}, 0u};
+  put_str(&l, "error ");
+  put_str(&l, what);
+  put_kv(&l, "code", (uint64_t)(uint32_t)code);
+  emit(&l);
+  (void)semihost(SYS_EXIT, (const void *)ADP_STOPPED_RUNTIME_ERROR);
+  for (;;) {
+  }
+}
+
+typedef enum { MODE_FULL, MODE_QUICK, MODE_TRACE } bench_mode_t;
+
+static bench_mode_t bench_mode(void)
+{
+  static char cmd[512]; /* "<image path> <mode>" */
+  struct {
+    char *buf;
+    uint32_t len;
+  } blk = {cmd, sizeof cmd - 1u};
+  if (semihost(SYS_GET_CMDLINE, &blk) != 0u) return MODE_FULL;
+  cmd[sizeof cmd - 1u] = '\0';
+  if (strstr(cmd, "trace") != NULL) return MODE_TRACE;
+  return strstr(cmd, "quick") != NULL ? MODE_QUICK : MODE_FULL;
+}
+
+/* ---- board bring-up for the bench: QEMU has no RCC, so no clock tree; no DWT ---- */
+
+void stm32f4_system_init(void) { stm32f4_fault_enable(); }
+
+static void counter_init(void)
+{
+  TIM2->CR1 = 0u;
+  TIM2->PSC = 0u;
+  TIM2->ARR = 0xFFFFFFFFu;
+  TIM2->CR1 = TIM_CR1_CEN;
+}
+
+/* Two counter reads back to back, and with 100 NOPs between them, in one asm block each
+ * so that the compiler cannot put anything else in between: the difference must be 100. */
+static uint32_t reads_around(int nops)
+{
+  volatile uint32_t *cnt = &TIM2->CNT;
+  uint32_t t0, t1;
+  if (nops != 0) {
+    __asm__ volatile("ldr %0, [%2]\n .rept 100\n nop\n .endr\n ldr %1, [%2]"
+                     : "=&r"(t0), "=&r"(t1) : "r"(cnt) : "memory");
+  } else {
+    __asm__ volatile("ldr %0, [%2]\n ldr %1, [%2]" : "=&r"(t0), "=&r"(t1) : "r"(cnt) : "memory");
+  }
+  return t1 - t0;
+}
+
+static void calibrate(void)
+{
+  const uint32_t d0 = reads_around(0);
+  const uint32_t d100 = reads_around(1);
+  line_t l = {{0}, 0u};
+  put_str(&l, "calib");
+  put_kv(&l, "nops", 100u);
+  put_kv(&l, "delta", (uint64_t)(d100 - d0));
+  emit(&l);
+}
+
+/* ---- the application and its sample interrupt ---- */
+
+static app_t s_app;
+static bench_plant_t s_plant;
+static uint32_t s_n;    /* iterations per case */
+static int s_each;      /* trace mode: print every interrupt's count */
+
+typedef void (*isr_fn)(void *);
+
+__attribute__((noipa)) static void bench_empty(void *ctx) { (void)ctx; }
+
+__attribute__((noipa)) static void bench_cb(void *ctx)
+{
+  app_sample_isr(ctx);
+  bench_board_clear_tc();
+}
+
+__attribute__((noipa)) static void bench_cb_empty(void *ctx)
+{
+  bench_empty(ctx);
+  bench_board_clear_tc();
+}
+
+static void next_frame(void)
+{
+  hal_adc_frame_t adc;
+  bench_plant_frame(&s_plant, &s_app.gyro, &adc);
+  bench_board_set_frame(&adc);
+}
+
+/* Direct calls: app_sample_isr vs an empty call; bench_cb_empty vs bench_empty. */
+__attribute__((noipa)) static uint32_t run_direct(isr_fn fn, uint32_t n, bk_stat_t *st)
+{
+  uint32_t locked = 1u;
+  for (uint32_t i = 0u; i < n; i++) {
+    next_frame();
+    const uint32_t t0 = bk_now();
+    fn(&s_app);
+    const uint32_t t1 = bk_now();
+    bk_stat_add(st, t1 - t0);
+    if (s_app.gyro.sup.mode != GYRO_MODE_LOCKED) locked = 0u;
+  }
+  return locked;
+}
+
+__attribute__((noipa)) static void bench_spare_handler(void) {}
+
+/* Pend irq through the NVIC and count from just before to just after the interrupt. */
+__attribute__((noipa)) static uint32_t run_irq(uint32_t irq, uint32_t n, bk_stat_t *st)
+{
+  uint32_t locked = 1u;
+  for (uint32_t i = 0u; i < n; i++) {
+    next_frame();
+    bench_board_arm();
+    const uint32_t t0 = bk_now();
+    NVIC->ISPR[irq >> 5] = 1u << (irq & 31u);
+    stm32f4_dsb();
+    stm32f4_isb();
+    const uint32_t t1 = bk_now();
+    bk_stat_add(st, t1 - t0);
+    if (s_app.gyro.sup.mode != GYRO_MODE_LOCKED) locked = 0u;
+    if (s_each) {
+      line_t l = {{0}, 0u};
+      put_str(&l, "irq");
+      put_kv(&l, "i", i);
+      put_kv(&l, "delta", t1 - t0);
+      emit(&l);
+    }
+  }
+  return locked;
+}
+
+static void start_chain(isr_fn cb)
+{
+  const int rc = hal_sample_timer_start(BENCH_FS_HZ, cb, &s_app);
+  if (rc != 0) fail("hal_sample_timer_start", rc);
+}
+
+static void direct_case(const char *name, isr_fn fn)
+{
+  bk_result_t r;
+  bk_stat_reset(&r.kern);
+  bk_stat_reset(&r.base);
+  r.locked = run_direct(fn, s_n, &r.kern);
+  (void)run_direct(bench_empty, s_n, &r.base);
+  if (fn != app_sample_isr) r.locked = 0u;
+  report(name, &r);
+}
+
+static void irq_case(const char *name, isr_fn cb)
+{
+  bk_result_t r;
+  start_chain(cb);
+  bk_stat_reset(&r.kern);
+  bk_stat_reset(&r.base);
+  r.locked = run_irq(STM32F4_IRQ_DMA2_STREAM0, s_n, &r.kern);
+  (void)run_irq(BENCH_SPARE_IRQ, s_n, &r.base);
+  if (cb != bench_cb) r.locked = 0u;
+  report(name, &r);
+  hal_sample_timer_stop();
+}
+
+/* The application at lock, then: app_sample_isr called directly; the wrapper cost;
+ * the whole interrupt with bench_cb and with bench_cb_empty. In trace mode only the
+ * interrupt with bench_cb (first, so that the trace's first interrupts are these) and
+ * the wrapper cost, for the cross-check of the trace against the counter. */
+static void bench_app(uint32_t settle, int trace)
+{
+  const int rc = app_init(&s_app);
+  if (rc != 0) fail("app_init", rc);
+  param_values_t v;
+  param_values_defaults(&v);
+  if (bench_plant_init(&s_plant, (const gyro_design_t *)s_app.applied, &v) != 0) {
+    fail("plant_init", -1);
+  }
+  gyro_start(&s_app.gyro);
+  uint32_t settled = 0u;
+  for (uint32_t i = 0u; i < BENCH_WARMUP_MAX && settled < settle; i++) {
+    next_frame();
+    app_sample_isr(&s_app);
+    settled = s_app.gyro.sup.mode == GYRO_MODE_LOCKED ? settled + 1u : 0u;
+  }
+  if (settled < settle) fail("app_not_locked", (int)s_app.gyro.sup.mode);
+
+  /* Baseline interrupt: a spare vector with a lone BX LR, same priority. */
+  volatile uint32_t *vtor = (volatile uint32_t *)(uintptr_t)SCB->VTOR;
+  vtor[16u + BENCH_SPARE_IRQ] = (uint32_t)(uintptr_t)bench_spare_handler;
+  stm32f4_dsb();
+  stm32f4_nvic_enable(BENCH_SPARE_IRQ, STM32F4_PRIO_SAMPLE);
+
+  if (trace) {
+    s_each = 1;
+    irq_case("isr_app_cb", bench_cb);
+    s_each = 0;
+    direct_case("cb_wrap", bench_cb_empty);
+    return;
+  }
+  direct_case("app_sample_isr", app_sample_isr);
+  direct_case("cb_wrap", bench_cb_empty);
+  irq_case("isr_app_cb", bench_cb);
+  irq_case("isr_empty_cb", bench_cb_empty);
+}
+
+int main(void)
+{
+  counter_init();
+  const bench_mode_t mode = bench_mode();
+  if (mode == MODE_TRACE) {
+    s_n = BENCH_N_TRACE;
+    bench_app(BENCH_SETTLE_TRACE, 1);
+  } else {
+    s_n = mode == MODE_QUICK ? BENCH_N_QUICK : BENCH_N_FULL;
+    calibrate();
+    const int rc = bk_setup();
+    if (rc != 0) fail("bk_setup", rc);
+    for (uint32_t id = 0u; id < (uint32_t)BK_COUNT; id++) {
+      bk_result_t r;
+      const int e = bk_run((bk_id_t)id, s_n, &r);
+      if (e != 0) fail(bk_name((bk_id_t)id), e);
+      report(bk_name((bk_id_t)id), &r);
+    }
+    bench_app(BENCH_SETTLE, 0);
+  }
+  line_t l = {{0}, 0u};
+  put_str(&l, "done");
+  emit(&l);
+  (void)semihost(SYS_EXIT, (const void *)ADP_STOPPED_APPLICATION_EXIT);
+  for (;;) {
+  }
+}
