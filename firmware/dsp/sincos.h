@@ -29,8 +29,37 @@
  * tools/gen_sine_table.py into dsp/sine_table.c). */
 extern const float sincos_table[SINCOS_TABLE_SIZE + 1u];
 
-/* sin and cos of a phase (2^32 = 2*pi). Both pointers must be valid. */
-void sincos_lut(uint32_t phase, float *sin_out, float *cos_out);
+/* Bits of the phase below the table index: the interpolation position; its scale to
+ * [0, 1) is exact in float. cos(t) = sin(t + pi/2): the quarter turn's low bits are
+ * zero, so the cosine shares the sine's interpolation position. */
+#define SINCOS_FRAC_BITS (32u - SINCOS_TABLE_BITS)
+#define SINCOS_FRAC_MASK ((1u << SINCOS_FRAC_BITS) - 1u)
+#define SINCOS_FRAC_SCALE (1.0f / (float)(1u << SINCOS_FRAC_BITS))
+#define SINCOS_QUARTER_TURN 0x40000000u
+
+/* sin and cos of a phase (2^32 = 2*pi). Both pointers must be valid. Inline: it runs
+ * twice per tick (NCO and drive synthesis) and a call costs a third of its body. */
+static inline void sincos_lut(uint32_t phase, float *sin_out, float *cos_out)
+{
+  const uint32_t is = phase >> SINCOS_FRAC_BITS;
+  const uint32_t ic = (phase + SINCOS_QUARTER_TURN) >> SINCOS_FRAC_BITS;
+  /* The low bits are < 2^20, so the conversion to float is exact. */
+  const float x = (float)(phase & SINCOS_FRAC_MASK) * SINCOS_FRAC_SCALE;
+  const float s0 = sincos_table[is];
+  const float c0 = sincos_table[ic];
+  *sin_out = s0 + x * (sincos_table[is + 1u] - s0); /* (5-14) */
+  *cos_out = c0 + x * (sincos_table[ic + 1u] - c0);
+}
+
+/* Half an angle in radians to a phase (2^32 = 2 pi) of rad / 2: one multiply and one
+ * conversion, for the per-tick drive phase. The caller guarantees |rad| < 2 pi (the
+ * drive loop limits P to +-6.2 rad); sincos_rad_to_phase reduces any angle and is for
+ * everything else. */
+static inline uint32_t sincos_half_rad_to_phase(float rad)
+{
+  /* rad / 2 in counts of 2^32 per turn: rad * 2^31 / (2 pi) = rad * 2^30 / pi. */
+  return (uint32_t)(int32_t)(rad * 341782637.8f);
+}
 
 /* Angle in radians (any sign, any number of turns) to a phase, wrapped modulo 2*pi.
  * The angle is reduced in single precision: the phase error is about 2^-24 of the

@@ -5,7 +5,8 @@
 
 #include "dsp/fastmath.h"
 
-#define DRIVE_P_LIMIT_RAD 6.2831853f
+/* Just inside +-2 pi: drive synthesis converts P/2 to a phase with one int32 conversion. */
+#define DRIVE_P_LIMIT_RAD 6.2f
 
 int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t *out)
 {

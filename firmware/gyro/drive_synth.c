@@ -40,13 +40,14 @@ void drive_synth_step(const drive_synth_t *ds, float f_cmd_v2, float p_rad, uint
   float s, c;
   const float f = f_cmd_v2 > 0.0f ? f_cmd_v2 : 0.0f;
   if (ds->mode == GYRO_DRIVE_DC_AC) {
-    sincos_lut(phase + sincos_rad_to_phase(p_rad), &s, &c);
+    /* Force phase P = twice the half-angle phase: exact modulo 2^32. */
+    sincos_lut(phase + 2u * sincos_half_rad_to_phase(p_rad), &s, &c);
     const float a = f * ds->inv_4d;
     *u1_v = ds->dc_bias_v + a * c;
     *u2_v = ds->dc_bias_v - a * c;
   } else {
     /* (6-25): the voltage phase is half the force phase. */
-    sincos_lut(half_phase + sincos_rad_to_phase(0.5f * p_rad), &s, &c);
+    sincos_lut(half_phase + sincos_half_rad_to_phase(p_rad), &s, &c);
     const float a = fm_sqrtf(f);
     *u1_v = a * c;
     *u2_v = a * s;
