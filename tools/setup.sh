@@ -17,7 +17,7 @@ APT_PKGS=(
   qemu-system-arm        # boots the emulator bring-up image (ctest label qemu)
   python3 python3-pip python3-venv
 )
-PIP_PKGS=(numpy scipy matplotlib allantools pyserial)
+PIP_PKGS=(numpy scipy matplotlib allantools pyserial pytest)
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
@@ -37,7 +37,7 @@ fi
 
 PY=${PYTHON:-python3}
 need_pip=0
-for m in numpy scipy matplotlib allantools serial; do
+for m in numpy scipy matplotlib allantools serial pytest; do
   if ! "$PY" -c "import $m" >/dev/null 2>&1; then need_pip=1; fi
 done
 if [ "$need_pip" -eq 1 ]; then

@@ -17,7 +17,9 @@
  *       70 % of the UART: the message gives the load and the limit).
  *   stop                            ok stop ID records R lost L frames F dropped D
  *                                   | ok not streaming
- *       stops the stream; its last frames are sent before the ok line.
+ *       stops the stream; its last frames are sent before the ok line. R records were
+ *       framed, L lost to ring overruns (the background loop fell behind), F frames
+ *       sent, D frames dropped (the UART could not take them at stop).
  */
 #ifndef APP_TLM_H
 #define APP_TLM_H

@@ -1,9 +1,13 @@
 /* The telemetry receiver fed arbitrary bytes, then one good header + data frame pair from
- * the real encoder. Byte 0 picks the chunk size the bytes arrive in (bits 0-5).
+ * the real encoder. Byte 0 picks the mode: bit 6 clear, the rest is fed as it is, in
+ * chunks of a size chosen by bits 0-5; bit 6 set ("sealed"), the rest is a sequence of
+ * [length][type, seq, payload...] records that the harness turns into frames with a
+ * correct CRC and COBS, so the fuzzer reaches the header and data payload checks that
+ * random bytes almost never get past the CRC to.
  * Invariants: every delivered line holds only text bytes; every delivered header is a
  * well-formed layout; every delivered data frame matches its layout's record size; the
  * counters never go back; and after any garbage the good frames that follow are decoded
- * exactly (the parser is back in step at the next frame's leading 0x00). */
+ * exactly (the parser is back in step at the next 0x00). */
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -116,6 +120,29 @@ static void build_good(void)
   FUZZ_CHECK(g_good_records > 0u && g_good[0] == 0u && g_good[1] == 0x01u);
 }
 
+/* Sealed mode: [len][body...] -> 00 COBS(00 body CRC) 00, body = type, seq, payload. */
+static void feed_sealed(const uint8_t *data, size_t size)
+{
+  static uint8_t raw[TLM_FRAME_MAX], wire[TLM_WIRE_MAX];
+  size_t off = 0u;
+  while (off < size) {
+    size_t len = data[off++];
+    if (len > size - off) len = size - off;
+    if (len > TLM_FRAME_MAX - TLM_FRAME_OVERHEAD + 3u) len = TLM_FRAME_MAX - TLM_FRAME_OVERHEAD + 3u;
+    raw[0] = 0u;
+    memset(&raw[1], 0, 3u);
+    memcpy(&raw[1], data + off, len);
+    off += len;
+    const size_t body = (len < 3u) ? 3u : len; /* type and seq, zero if missing */
+    const uint16_t crc = tlm_crc16(TLM_CRC16_INIT, raw, 1u + body);
+    raw[1u + body] = (uint8_t)(crc >> 8);
+    raw[2u + body] = (uint8_t)(crc & 0xFFu);
+    const size_t wn = tlm_frame_to_wire(raw, 3u + body, wire, sizeof wire);
+    FUZZ_CHECK(wn > 0u);
+    tlm_decode_feed(&g_rx, wire, wn);
+  }
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -124,9 +151,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
   memset(&g_seen, 0, sizeof g_seen);
   const tlm_decode_cfg_t cfg = {on_text, on_header, on_data, &g_seen};
   tlm_decode_init(&g_rx, &cfg);
+  const bool sealed = size > 0u && (data[0] & 0x40u) != 0u;
   const size_t chunk = (size > 0u) ? 1u + (size_t)(data[0] & 0x3Fu) * 7u : 1u;
   tlm_decode_stats_t prev = g_rx.st;
-  for (size_t off = (size > 0u) ? 1u : 0u; off < size; off += chunk) {
+  if (sealed) {
+    feed_sealed(data + 1, size - 1u);
+    FUZZ_CHECK(g_rx.st.corrupt == 0u); /* every sealed frame passes COBS and CRC */
+  }
+  for (size_t off = (size > 0u) ? 1u : 0u; !sealed && off < size; off += chunk) {
     const size_t n = (size - off < chunk) ? size - off : chunk;
     tlm_decode_feed(&g_rx, data + off, n);
     const tlm_decode_stats_t *st = &g_rx.st;
@@ -137,7 +169,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     prev = *st;
   }
   FUZZ_CHECK(g_seen.headers == g_rx.st.headers && g_seen.data == g_rx.st.data);
-  /* whatever came before: the good pair decodes exactly */
+  /* whatever came before: after a delimiter (the input may end with a complete frame
+   * that only lacks its closing 0x00), the good pair decodes exactly */
+  tlm_decode_feed(&g_rx, (const uint8_t *)"", 1u);
   const seen_t before = g_seen;
   tlm_decode_feed(&g_rx, g_good, g_good_len);
   FUZZ_CHECK(g_seen.headers == before.headers + 1u);
