@@ -109,13 +109,17 @@ class Link:
         return len(data)
 
     def drain(self, quiet_s: float = 0.05, max_s: float = 1.0):
-        """Read and drop text until the line has been quiet for quiet_s (frames still go
-        to the listeners)."""
+        """Read and drop text until no line has arrived for quiet_s (frames of a running
+        stream still go to the listeners and do not keep it waiting)."""
         t_end = time.monotonic() + max_s
+        st = self.decoder.stats
+        seen = (st.lines, st.lines_bad)
         last = time.monotonic()
         while time.monotonic() < t_end:
-            if self.poll() > 0:
-                last = time.monotonic()
+            self.poll()
+            now = (st.lines, st.lines_bad)
+            if now != seen:
+                seen, last = now, time.monotonic()
             elif time.monotonic() - last >= quiet_s:
                 break
         self._lines.clear()
