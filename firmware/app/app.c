@@ -41,7 +41,7 @@ static void cli_write(void *ctx, const char *data, size_t len)
   (void)hal_uart_write(p, len);
 }
 
-int app_init(app_t *a)
+int app_init_with(app_t *a, const param_values_t *values)
 {
   memset(a, 0, sizeof *a);
   param_values_t initial;
@@ -52,19 +52,27 @@ int app_init(app_t *a)
   const param_store_cfg_t sc = {0u, 1u};
   a->store_status = PARAM_STORE_ERR_CONFIG;
   if (geo.num_sectors >= 2u && param_store_init(&a->store, &sc) == PARAM_STORE_OK) {
-    param_values_t loaded = initial; /* non-persistent values come from here */
-    param_store_report_t rep;
-    a->store_status = param_store_load(&a->store, &loaded, &rep);
-    if (a->store_status == PARAM_STORE_OK) {
-      initial = loaded;
+    if (values != NULL) {
+      a->store_status = PARAM_STORE_NONE; /* given values: the store is not read */
+    } else {
+      param_values_t loaded = initial; /* non-persistent values come from here */
+      param_store_report_t rep;
+      a->store_status = param_store_load(&a->store, &loaded, &rep);
+      if (a->store_status == PARAM_STORE_OK) {
+        initial = loaded;
+      }
     }
+  }
+  if (values != NULL) {
+    initial = *values;
   }
 
   const params_cfg_t pc = {derive, {&a->derived[0], &a->derived[1]}, loop_safe, a};
   params_err_t err;
   if (params_init(&a->params, &pc, &initial, &err) != PARAM_OK) {
-    /* A stored set that loads but cannot be designed: fall back to the defaults. */
-    if (params_init(&a->params, &pc, NULL, &err) != PARAM_OK) {
+    /* Values that load but cannot be designed: fall back to the defaults, unless the
+     * caller insisted on its own. */
+    if (values != NULL || params_init(&a->params, &pc, NULL, &err) != PARAM_OK) {
       return -1;
     }
   }
@@ -81,6 +89,8 @@ int app_init(app_t *a)
   }
   return 0;
 }
+
+int app_init(app_t *a) { return app_init_with(a, NULL); }
 
 void app_sample_isr(void *ctx)
 {

@@ -49,6 +49,9 @@ typedef struct {
  * the gyro and the command line. Returns 0, or a negative value if even the defaults
  * cannot be designed. Does not start the sample clock. */
 int app_init(app_t *a);
+/* The same with given parameter values instead of the stored ones (the simulator and
+ * tests). Returns -1 if they cannot be designed (no fallback to defaults). */
+int app_init_with(app_t *a, const param_values_t *values);
 
 /* The sample ISR: register with hal_sample_timer_start(fs, app_sample_isr, a). */
 void app_sample_isr(void *ctx);

@@ -43,8 +43,8 @@
   /* half-frequency by default: 1/f voltage noise lands at wc/2, not wc (6-21, 6-23) */ \
   X(drive_mode, 0x0102u, "drive.mode", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
     PF_PERSIST, "drive scheme: 0 half-frequency (6-18), 1 DC+AC (6-20); drive off to change") \
-  /* 10 um of drive motion (4.6.1) at the default plant's 1.8e5 V/m pickoff: 36 % of the ADC */ \
-  X(drive_amp_set_v, 0x0103u, "drive.amp_set_v", F32, "V", 0.05f, 4.5f, 1.8f, 0u, \
+  /* 10 um of drive motion (4.6.1) at the default plant's 3.49e4 V/m drive pickoff */ \
+  X(drive_amp_set_v, 0x0103u, "drive.amp_set_v", F32, "V", 0.01f, 4.5f, 0.349f, 0u, \
     PF_PERSIST | PF_LIVE, "setpoint of the demodulated drive-pickoff amplitude at the ADC") \
   /* the phase of the drive pickoff against the NCO; any value works, P absorbs it */ \
   X(drive_phase_set_deg, 0x0104u, "drive.phase_set_deg", F32, "deg", -180.0f, 180.0f, 0.0f, 0u, \
@@ -67,8 +67,8 @@
   /* DC+AC only: force = 4 Ks D A (6-21); 5 V leaves headroom under u_max for A */ \
   X(drive_dc_bias_v, 0x010Au, "drive.dc_bias_v", F32, "V", 0.0f, 15.0f, 5.0f, 0u, \
     PF_PERSIST | PF_LIVE, "DC bias D of the DC+AC drive (unused in half-frequency mode)") \
-  /* the force phase P expected at lock (sweep); acquisition starts there */ \
-  X(drive_p_init_deg, 0x010Bu, "drive.p_init_deg", F32, "deg", -360.0f, 360.0f, 0.0f, 0u, \
+  /* the force phase P at lock on the default plant at 25 degC; acquisition starts there */ \
+  X(drive_p_init_deg, 0x010Bu, "drive.p_init_deg", F32, "deg", -360.0f, 360.0f, 25.7f, 0u, \
     PF_PERSIST | PF_LIVE, "force phase P the phase loop starts from, and the reference of P's low-pass") \
   /* 7.2.2 sweep */ \
   X(drive_cal_f0_hz, 0x010Cu, "drive.cal_f0_hz", F32, "Hz", 100.0f, 20000.0f, 1489.9f, 0u, \
@@ -76,8 +76,8 @@
   /* 7.2.2: Q from the -3 dB points, air package */ \
   X(drive_cal_q, 0x010Du, "drive.cal_q", F32, "-", 1.0f, 1.0e6f, 33.33f, 0u, \
     PF_PERSIST | PF_LIVE, "identified drive-mode quality factor") \
-  /* the default plant: 1.8 V of pickoff for 64 Ks V^2 of force at resonance */ \
-  X(drive_cal_gain_v_per_v2, 0x010Eu, "drive.cal_gain_v_per_v2", F32, "V/V^2", 1.0e-6f, 100.0f, 0.028125f, 0u, \
+  /* the default plant: 0.349 V of pickoff for 64 Ks V^2 of force at resonance (table 7-1: 8 V) */ \
+  X(drive_cal_gain_v_per_v2, 0x010Eu, "drive.cal_gain_v_per_v2", F32, "V/V^2", 1.0e-6f, 100.0f, 0.00546f, 0u, \
     PF_PERSIST | PF_LIVE, "identified drive gain at resonance, pickoff volts per Ks V^2 of force") \
   /* 30 Hz: 1 % in about 25 ms after the drive comes off its limit, 80 deg of margin */ \
   X(drive_amp_bw_hz, 0x010Fu, "drive.amp_bw_hz", F32, "Hz", 0.1f, 1000.0f, 30.0f, 0u, \
@@ -91,8 +91,8 @@
   /* same bandwidth as the drive channel */ \
   X(demod_mu_sense, 0x0202u, "demod.mu_sense", F32, "-", 0.0001f, 0.49f, 0.034f, 0u, \
     PF_PERSIST | PF_LIVE, "LMS demodulator step size, sense pickoff") \
-  /* calibrated per part (rate table or injected force) */ \
-  X(rate_demod_phase_deg, 0x0301u, "rate.demod_phase_deg", F32, "deg", -180.0f, 180.0f, 0.0f, 0u, \
+  /* calibrated per part with tools/gyro-demodcal; this is the default simulator plant's */ \
+  X(rate_demod_phase_deg, 0x0301u, "rate.demod_phase_deg", F32, "deg", -180.0f, 180.0f, 63.16f, 0u, \
     PF_PERSIST | PF_LIVE, "angle of the Coriolis phasor against the drive phasor (separates rate from quadrature)") \
   /* 5.4.3: 100 Hz output low-pass */ \
   X(rate_lpf_cutoff_hz, 0x0302u, "rate.lpf_cutoff_hz", F32, "Hz", 1.0f, 1000.0f, 100.0f, 0u, \
@@ -101,8 +101,8 @@
   X(rate_lpf_order, 0x0303u, "rate.lpf_order", ENUM, "-", 2u, 8u, 4u, \
     PARAM_CHOICE(2) | PARAM_CHOICE(4) | PARAM_CHOICE(6) | PARAM_CHOICE(8), \
     PF_PERSIST | PF_LIVE, "rate output low-pass order (2 per biquad section)") \
-  /* uncalibrated: 1 (rate.* are then in sense/drive ratio units) */ \
-  X(rate_scale_dps, 0x0310u, "rate.scale_dps", F32, "deg/s", -1.0e7f, 1.0e7f, 1.0f, 0u, \
+  /* calibrated with tools/gyro-demodcal; the default simulator plant's */ \
+  X(rate_scale_dps, 0x0310u, "rate.scale_dps", F32, "deg/s", -1.0e7f, 1.0e7f, 139.23f, 0u, \
     PF_PERSIST | PF_LIVE, "scale factor: deg/s per unit of the sense/drive phasor ratio") \
   /* uncalibrated: 0 (the thesis part's fit was B = 34.59 P + 58.533, 7.3.2) */ \
   X(rate_bias_c0_dps, 0x0305u, "rate.bias_c0_dps", F32, "deg/s", -2000.0f, 2000.0f, 0.0f, 0u, \

@@ -1,0 +1,454 @@
+/* gyro-sim: run a scenario of the gyro plant with the real firmware in closed loop (or
+ * the bare plant in open loop), print its figures, write a CSV trace and a JSON of the
+ * parameters and figures.
+ *
+ *   gyro-sim --scenario FILE [--duration S] [--seed N] [--csv FILE] [--csv-rate HZ]
+ *            [--json FILE] [--out DIR] [--set plant.KEY=V | firmware.NAME=V ...]
+ *            [--no-analysis] [--quiet]
+ *   gyro-sim --list-params
+ */
+#include <cJSON.h>
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "post.h"
+#include "scenario.h"
+#include "sim.h"
+
+#define KB_J_PER_K 1.380649e-23
+
+static void usage(FILE *f)
+{
+  fputs("usage: gyro-sim --scenario FILE [--duration S] [--seed N] [--csv FILE]\n"
+        "                [--csv-rate HZ] [--json FILE] [--out DIR]\n"
+        "                [--set plant.KEY=VALUE | --set firmware.NAME=VALUE ...]\n"
+        "                [--no-analysis] [--quiet]\n"
+        "       gyro-sim --list-params\n"
+        "Runs a scenario (host_sim/scenarios/*.json) of the plant with the firmware in\n"
+        "closed loop and prints its figures. --out keeps the analysis plots (PNG) and\n"
+        "tool outputs; --set overrides any plant or firmware parameter.\n",
+        f);
+}
+
+static void list_params(void)
+{
+  printf("# plant parameters (plant.KEY)\n");
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  for (size_t i = 0; i < plant_param_count(); i++) {
+    const plant_param_desc_t *d = plant_param_at(i);
+    printf("plant.%-34s %-12g [%g, %g] %s  %s\n", d->name, plant_param_get(&c, d), d->min,
+           d->max, d->unit, d->doc);
+  }
+  printf("# firmware parameters (firmware.NAME)\n");
+  param_values_t v;
+  param_values_defaults(&v);
+  for (unsigned i = 0; i < (unsigned)PARAM_COUNT; i++) {
+    const param_info_t *pi = param_info((param_idx_t)i);
+    const param_value_t x = param_get(&v, (param_idx_t)i);
+    if (pi->type == PARAM_T_F32) {
+      printf("firmware.%-31s %-12g [%g, %g] %s  %s\n", pi->name, (double)x.f,
+             (double)pi->min.f, (double)pi->max.f, pi->unit, pi->help);
+    } else {
+      printf("firmware.%-31s %-12u [%u, %u] %s  %s\n", pi->name, x.u, pi->min.u, pi->max.u,
+             pi->unit, pi->help);
+    }
+  }
+}
+
+/* Brownian floor of the rate (4-24) at the run's actual drive frequency, amplitude and
+ * structure temperature: the white-rate coefficient N of the Allan deviation (IEEE,
+ * two-sided; a one-sided spectrum shows sqrt(2) N), in deg/h/sqrt(Hz). */
+static double brownian_floor_dph(const plant_cfg_t *pc, double f_drive_hz, double amp_m,
+                                 double t_k)
+{
+  const double w1 = 2.0 * M_PI * f_drive_hz;
+  const double w2 = 2.0 * M_PI * pc->f_sense_hz * (1.0 - 0.5 * pc->ket_per_k * (t_k - pc->temp_ref_k));
+  const double om = sqrt(4.0 * KB_J_PER_K * t_k * w2 / (pc->mass_kg * pc->q_sense)) / (2.0 * amp_m * w1);
+  return om * 180.0 / M_PI * 3600.0;
+}
+
+static void add_num(cJSON *o, const char *k, double v)
+{
+  if (isfinite(v)) cJSON_AddNumberToObject(o, k, v);
+  else cJSON_AddNullToObject(o, k);
+}
+
+static int mkdir_p(const char *d)
+{
+  char buf[1024];
+  snprintf(buf, sizeof buf, "%s", d);
+  for (char *p = buf + 1; *p; p++) {
+    if (*p == '/') {
+      *p = '\0';
+      mkdir(buf, 0777);
+      *p = '/';
+    }
+  }
+  return (mkdir(buf, 0777) == 0 || errno == EEXIST) ? 0 : -1;
+}
+
+int main(int argc, char **argv)
+{
+  static sim_scenario_t sc;
+  scenario_defaults(&sc);
+  const char *scen_path = NULL, *csv_path = NULL, *json_path = NULL, *out_dir = NULL;
+  double duration = -1.0, csv_rate = -1.0;
+  long long seed = -1;
+  int quiet = 0, analysis = 1;
+  static const struct option lo[] = {
+      {"scenario", required_argument, 0, 's'}, {"duration", required_argument, 0, 'd'},
+      {"seed", required_argument, 0, 'S'},     {"csv", required_argument, 0, 'c'},
+      {"csv-rate", required_argument, 0, 'r'}, {"json", required_argument, 0, 'j'},
+      {"out", required_argument, 0, 'o'},      {"set", required_argument, 0, 'x'},
+      {"quiet", no_argument, 0, 'q'},          {"no-analysis", no_argument, 0, 'n'},
+      {"list-params", no_argument, 0, 'L'},    {"help", no_argument, 0, 'h'},
+      {0, 0, 0, 0}};
+  static char sets[SIM_MAX_SETS][160];
+  int n_sets = 0;
+  int opt;
+  char *end;
+  while ((opt = getopt_long(argc, argv, "", lo, NULL)) != -1) {
+    switch (opt) {
+    case 's': scen_path = optarg; break;
+    case 'd':
+      errno = 0;
+      duration = strtod(optarg, &end);
+      if (*end || errno || !(duration > 0.0) || duration > 1e6) {
+        fprintf(stderr, "gyro-sim: --duration: '%s' is not a number of seconds in (0, 1e6]\n", optarg);
+        return 2;
+      }
+      break;
+    case 'S':
+      errno = 0;
+      seed = strtoll(optarg, &end, 10);
+      if (*end || errno || seed < 0) {
+        fprintf(stderr, "gyro-sim: --seed: '%s' is not a non-negative integer\n", optarg);
+        return 2;
+      }
+      break;
+    case 'c': csv_path = optarg; break;
+    case 'r':
+      errno = 0;
+      csv_rate = strtod(optarg, &end);
+      if (*end || errno || !(csv_rate > 0.0) || csv_rate > 50000.0) {
+        fprintf(stderr, "gyro-sim: --csv-rate: '%s' is not a rate in (0, 50000] Hz\n", optarg);
+        return 2;
+      }
+      break;
+    case 'j': json_path = optarg; break;
+    case 'o': out_dir = optarg; break;
+    case 'x':
+      if (n_sets >= SIM_MAX_SETS || strlen(optarg) >= sizeof sets[0]) {
+        fprintf(stderr, "gyro-sim: too many or too long --set\n");
+        return 2;
+      }
+      snprintf(sets[n_sets++], sizeof sets[0], "%s", optarg);
+      break;
+    case 'q': quiet = 1; break;
+    case 'n': analysis = 0; break;
+    case 'L': list_params(); return 0;
+    case 'h': usage(stdout); return 0;
+    default: usage(stderr); return 2;
+    }
+  }
+  if (scen_path == NULL || optind != argc) {
+    usage(stderr);
+    return 2;
+  }
+  char err[512];
+  if (scenario_load(&sc, scen_path, err, sizeof err) != 0) {
+    fprintf(stderr, "gyro-sim: %s\n", err);
+    return 2;
+  }
+  for (int i = 0; i < n_sets; i++) {
+    if (scenario_add_override(&sc, sets[i], err, sizeof err) != 0) {
+      fprintf(stderr, "gyro-sim: %s\n", err);
+      return 2;
+    }
+  }
+  if (duration > 0.0) sc.duration_s = duration;
+  if (seed >= 0) sc.seed = (uint64_t)seed;
+  if (csv_rate > 0.0) sc.csv_rate_hz = csv_rate;
+
+  /* Analyses by the tools need a trace and a folder; without --out they use a temporary
+   * one that is removed afterwards. */
+  const uint32_t tool_analyses = SIM_AN_RATE_TABLE | SIM_AN_NOISE | SIM_AN_ALLAN |
+                                 SIM_AN_DRIVE_NOISE | SIM_AN_TEMP | SIM_AN_SWEEP;
+  const int need_tools = analysis && (sc.analyses & tool_analyses) != 0u;
+  char tmpdir[] = "/tmp/gyro-sim-XXXXXX";
+  int tmp_used = 0;
+  if (out_dir == NULL && need_tools) {
+    if (mkdtemp(tmpdir) == NULL) {
+      fprintf(stderr, "gyro-sim: cannot make a temporary folder: %s\n", strerror(errno));
+      return 1;
+    }
+    out_dir = tmpdir;
+    tmp_used = 1;
+  } else if (out_dir != NULL && mkdir_p(out_dir) != 0) {
+    fprintf(stderr, "gyro-sim: --out %s: %s\n", out_dir, strerror(errno));
+    return 2;
+  }
+  char trace[1100];
+  if (csv_path == NULL && need_tools && sc.mode == SIM_CLOSED_LOOP) {
+    snprintf(trace, sizeof trace, "%s/trace.csv", out_dir);
+    csv_path = trace;
+  }
+
+  plant_cfg_t pc;
+  plant_profiles_t prof;
+  param_values_t fw;
+  if (sim_plant_cfg(&sc, &pc, &prof, err, sizeof err) != 0 ||
+      sim_fw_params(&sc, &fw, err, sizeof err) != 0) {
+    fprintf(stderr, "gyro-sim: %s\n", err);
+    return 2;
+  }
+  const sim_opts_t so = {csv_path, sc.csv_rate_hz, !quiet && isatty(2) && sc.duration_s > 2.0, NULL};
+  static sim_result_t res;
+  static sim_sweep_t sweep;
+  static sim_square_t sq;
+  int rc;
+  if (sc.mode == SIM_CLOSED_LOOP) rc = sim_run_closed_loop(&sc, &so, &res, err, sizeof err);
+  else rc = sim_run_open_loop(&sc, &so, &res, &sweep, &sq, err, sizeof err);
+  if (rc != 0) {
+    fprintf(stderr, "gyro-sim: %s\n", err);
+    return 1;
+  }
+
+  cJSON *root = cJSON_CreateObject();
+  cJSON_AddStringToObject(root, "scenario", sc.name);
+  cJSON *params = cJSON_AddObjectToObject(root, "params");
+  for (size_t i = 0; i < plant_param_count(); i++) {
+    const plant_param_desc_t *d = plant_param_at(i);
+    add_num(params, d->name, plant_param_get(&pc, d));
+  }
+  for (unsigned i = 0; i < (unsigned)PARAM_COUNT; i++) {
+    const param_info_t *pi = param_info((param_idx_t)i);
+    const param_value_t x = param_get(&fw, (param_idx_t)i);
+    add_num(params, pi->name, pi->type == PARAM_T_F32 ? (double)x.f : (double)x.u);
+  }
+  add_num(params, "duration_s", sc.duration_s);
+  add_num(params, "seed", (double)sc.seed);
+  cJSON *fig = cJSON_AddObjectToObject(root, "figures");
+  int failed = 0;
+
+  if (!quiet) {
+    printf("scenario %s: %s\n", sc.name, sc.description);
+    printf("  simulated %.1f s in %.2f s wall: %.0fx real time\n", res.sim_s, res.wall_s,
+           res.realtime_factor);
+  }
+  if (sc.analyses & SIM_AN_STARTUP) {
+    const sim_startup_t *s = &res.startup;
+    add_num(fig, "lock_time_s", s->lock_time_s);
+    add_num(fig, "overshoot_pct", s->overshoot_pct);
+    add_num(fig, "amp_err_rms_pct", s->amp_err_rms_pct);
+    add_num(fig, "phase_err_rms_deg", s->phase_err_rms_deg);
+    add_num(fig, "fw_lock_time_s", s->fw_lock_time_s);
+    add_num(fig, "drive_amp_true_m", s->final_amp_m);
+    if (!quiet) {
+      printf("  start-up (true motion): within 1 %% and held from %.3f s; overshoot %.2f %%\n",
+             s->lock_time_s, s->overshoot_pct);
+      printf("  after lock, 0.1-100 Hz: amplitude error %.4f %% rms, phase error %.5f deg rms\n",
+             s->amp_err_rms_pct, s->phase_err_rms_deg);
+      printf("  firmware LOCKED at %.3f s; drive amplitude %.3f um\n", s->fw_lock_time_s,
+             1e6 * s->final_amp_m);
+    }
+  }
+  if (sc.mode == SIM_CLOSED_LOOP) {
+    add_num(fig, "faults", res.faults);
+    add_num(fig, "final_mode", res.final_mode);
+    add_num(fig, "mean_drive_freq_hz", res.mean_drive_freq_hz);
+    add_num(fig, "mean_drive_amp_m", res.mean_drive_amp_m);
+    add_num(fig, "mean_struct_temp_k", res.mean_struct_k);
+  }
+  add_num(fig, "adc_fraction_drive", res.adc_fraction[0]);
+  add_num(fig, "adc_fraction_sense", res.adc_fraction[1]);
+  add_num(fig, "adc_clips_drive", (double)res.adc_clips[0]);
+  add_num(fig, "adc_clips_sense", (double)res.adc_clips[1]);
+
+  if (sc.mode == SIM_OPEN_LOOP_SWEEP && sweep.n > 0) {
+    char sp[1100];
+    snprintf(sp, sizeof sp, "%s/sweep.csv", out_dir ? out_dir : ".");
+    FILE *f = fopen(sp, "w");
+    if (f != NULL) {
+      fputs("f_hz,amp,phase_deg\n", f);
+      for (int i = 0; i < sweep.n; i++) fprintf(f, "%.6f,%.9g,%.6f\n", sweep.f_hz[i], sweep.amp_v[i], sweep.phase_deg[i]);
+      fclose(f);
+    }
+    if (analysis && (sc.analyses & SIM_AN_SWEEP)) {
+      const char *args[] = {sp, NULL};
+      cJSON *j = post_run_tool("gyro-freqresp", args, out_dir, "freqresp.json", err, sizeof err);
+      if (j == NULL) { fprintf(stderr, "gyro-sim: %s\n", err); failed = 1; }
+      else {
+        add_num(fig, "f0_hz", post_num(j, "f0_hz"));
+        add_num(fig, "q", post_num(j, "q"));
+        add_num(fig, "phase_at_f0_deg", post_num(j, "phase_at_f0_deg"));
+        add_num(fig, "peak_gain_v", post_num(j, "peak_gain"));
+        add_num(fig, "f_3db_lo_hz", post_num(j, "f_3db_lo_hz"));
+        add_num(fig, "f_3db_hi_hz", post_num(j, "f_3db_hi_hz"));
+        if (!quiet) {
+          printf("  identified drive resonance %.3f Hz (plant %.3f Hz), Q %.2f (plant %.2f),\n"
+                 "    phase at resonance %.2f deg, -3 dB %.2f..%.2f Hz\n",
+                 post_num(j, "f0_hz"), pc.f_drive_hz, post_num(j, "q"), pc.q_drive,
+                 post_num(j, "phase_at_f0_deg"), post_num(j, "f_3db_lo_hz"), post_num(j, "f_3db_hi_hz"));
+        }
+        cJSON_Delete(j);
+      }
+    }
+  }
+  if (sc.mode == SIM_OPEN_LOOP && sq.n > 1) {
+    /* Table 7-1: the half-frequency drive's amplitude goes with U^2 (6-19). Fit
+     * amp = k U^2 through the origin and report the largest deviation. */
+    double sxy = 0, sxx = 0, amax = 0, dmax = 0;
+    for (int i = 0; i < sq.n; i++) {
+      const double u2 = sq.u_v[i] * sq.u_v[i];
+      sxy += u2 * sq.amp_v[i];
+      sxx += u2 * u2;
+      if (sq.amp_v[i] > amax) amax = sq.amp_v[i];
+    }
+    const double k = sxy / sxx;
+    cJSON *tab = cJSON_AddArrayToObject(fig, "square_law");
+    if (!quiet) printf("  square law (table 7-1): U (V) -> drive pickoff (V), displacement (um), fit k U^2\n");
+    for (int i = 0; i < sq.n; i++) {
+      const double fit = k * sq.u_v[i] * sq.u_v[i];
+      if (fabs(sq.amp_v[i] - fit) > dmax) dmax = fabs(sq.amp_v[i] - fit);
+      cJSON *row = cJSON_CreateObject();
+      add_num(row, "u_v", sq.u_v[i]);
+      add_num(row, "amp_v", sq.amp_v[i]);
+      add_num(row, "amp_m", sq.amp_m[i]);
+      cJSON_AddItemToArray(tab, row);
+      if (!quiet) printf("    %6.2f  %8.4f  %8.4f  %8.4f\n", sq.u_v[i], sq.amp_v[i], 1e6 * sq.amp_m[i], fit);
+    }
+    add_num(fig, "square_law_k_v_per_v2", k);
+    add_num(fig, "square_law_nonlinearity_pct", 100.0 * dmax / amax);
+    if (!quiet) printf("  k = %.6g V/V^2, largest deviation %.3f %% of the largest amplitude\n", k, 100.0 * dmax / amax);
+  } else if (sc.mode == SIM_OPEN_LOOP && sq.n == 1) {
+    add_num(fig, "drive_amp_v", sq.amp_v[0]);
+    add_num(fig, "drive_amp_m", sq.amp_m[0]);
+  }
+
+  if (need_tools && sc.mode == SIM_CLOSED_LOOP) {
+    if (sc.analyses & SIM_AN_RATE_TABLE) {
+      const char *args[] = {csv_path, "--settle", "0.5", NULL};
+      cJSON *j = post_run_tool("gyro-scalefactor", args, out_dir, "scalefactor.json", err, sizeof err);
+      if (j == NULL) { fprintf(stderr, "gyro-sim: %s\n", err); failed = 1; }
+      else {
+        add_num(fig, "scale_factor", post_num(j, "scale_factor_out_per_dps"));
+        add_num(fig, "bias_dps", post_num(j, "bias_out"));
+        add_num(fig, "nonlinearity_pct", post_num(j, "nonlinearity_rms_percent_of_fs"));
+        add_num(fig, "nonlinearity_max_pct", post_num(j, "nonlinearity_max_percent_of_fs"));
+        add_num(fig, "asymmetry", post_num(j, "asymmetry_fraction"));
+        if (!quiet) {
+          printf("  rate table: scale factor %.6f (deg/s)/(deg/s), bias %.4f deg/s, nonlinearity %.4f %% FS rms\n",
+                 post_num(j, "scale_factor_out_per_dps"), post_num(j, "bias_out"),
+                 post_num(j, "nonlinearity_rms_percent_of_fs"));
+        }
+        cJSON_Delete(j);
+      }
+    }
+    if (sc.analyses & (SIM_AN_NOISE | SIM_AN_ALLAN)) {
+      char tend[32];
+      /* Allan on the static part of the run: the scenario's last rate step (if any) is
+       * its scale-factor check and is left out. */
+      double t_end = sc.duration_s;
+      if (sc.has_rate && sc.rate_dps.kind == PROFILE_STEPS && sc.rate_dps.n_steps > 1) t_end = sc.rate_dps.step_s[0];
+      snprintf(tend, sizeof tend, "%.6f", t_end);
+      const char *args[] = {csv_path, "--t-start", "1", "--t-end", tend, NULL};
+      cJSON *j = post_run_tool("gyro-allan", args, out_dir, "allan.json", err, sizeof err);
+      double sf = 1.0;
+      if (j != NULL && sc.has_rate && sc.rate_dps.kind == PROFILE_STEPS && sc.rate_dps.n_steps > 1) {
+        const char *a2[] = {csv_path, "--t-start", tend, "--settle", "0.5", NULL};
+        cJSON *s = post_run_tool("gyro-scalefactor", a2, out_dir, "scalefactor.json", err, sizeof err);
+        if (s != NULL) {
+          sf = post_num(s, "scale_factor_out_per_dps");
+          add_num(fig, "scale_factor", sf);
+          cJSON_Delete(s);
+        }
+      }
+      if (j == NULL) { fprintf(stderr, "gyro-sim: %s\n", err); failed = 1; }
+      else {
+        if (sc.analyses & SIM_AN_NOISE) {
+          const double n_in = post_num(j, "arw_dph_per_rthz") / sf;
+          const double floor = brownian_floor_dph(&pc, res.mean_drive_freq_hz, res.mean_drive_amp_m, res.mean_struct_k);
+          add_num(fig, "arw_coeff_dph_rthz", n_in);
+          add_num(fig, "adev_1s_dph", post_num(j, "adev_at_1s_dph") / sf);
+          add_num(fig, "brownian_floor_dph_rthz", floor);
+          add_num(fig, "arw_over_floor", n_in / floor);
+          if (!quiet) {
+            printf("  rate noise N = %.3f deg/h/rtHz (Allan -1/2 slope, two-sided; one-sided ASD %.3f),\n"
+                   "    Brownian floor (4-24) at %.3f Hz, %.3f um, %.2f K: %.3f deg/h/rtHz; ratio %.3f\n",
+                   n_in, sqrt(2.0) * n_in, res.mean_drive_freq_hz, 1e6 * res.mean_drive_amp_m,
+                   res.mean_struct_k, floor, n_in / floor);
+          }
+        }
+        if (sc.analyses & SIM_AN_ALLAN) {
+          add_num(fig, "arw_deg_rth", post_num(j, "arw_deg_per_rth") / sf);
+          add_num(fig, "bias_instability_dph", post_num(j, "bias_instability_dph") / sf);
+          add_num(fig, "rate_ramp_dph_per_h", post_num(j, "rate_ramp_dph_per_h") / sf);
+          if (!quiet) {
+            printf("  Allan: ARW %.4f deg/rt(h), bias instability %.3f deg/h, rate ramp %.3f deg/h/h\n",
+                   post_num(j, "arw_deg_per_rth") / sf, post_num(j, "bias_instability_dph") / sf,
+                   post_num(j, "rate_ramp_dph_per_h") / sf);
+          }
+        }
+        cJSON_Delete(j);
+      }
+    }
+    if (sc.analyses & SIM_AN_DRIVE_NOISE) {
+      const char *args[] = {csv_path, "--column", "drive_amp_true_m", "--band", "1", "10", "--t-start", "2", NULL};
+      cJSON *j = post_run_tool("gyro-psd", args, out_dir, "psd.json", err, sizeof err);
+      if (j == NULL) { fprintf(stderr, "gyro-sim: %s\n", err); failed = 1; }
+      else {
+        const double rel = post_num(j, "white_asd_one_sided_per_rthz") / res.mean_drive_amp_m;
+        add_num(fig, "drive_amp_noise_lf_rel", rel);
+        if (!quiet) printf("  drive amplitude noise over 1-10 Hz: %.3g /rtHz relative (one-sided)\n", rel);
+        cJSON_Delete(j);
+      }
+    }
+    if (sc.analyses & SIM_AN_TEMP) {
+      const char *args[] = {csv_path, "--column", "rate_dps", "--temp-column", "t_board_c", NULL};
+      cJSON *j = post_run_tool("gyro-tempcomp", args, out_dir, "tempcomp.json", err, sizeof err);
+      if (j == NULL) { fprintf(stderr, "gyro-sim: %s\n", err); failed = 1; }
+      else {
+        add_num(fig, "residual_bias_p_dps", post_num(j, "p_fit.residual_std_dps"));
+        add_num(fig, "residual_bias_sensor_dps", post_num(j, "t_fit.residual_std_dps"));
+        add_num(fig, "residual_bias_p_pp_dps", post_num(j, "p_fit.residual_p2p_dps"));
+        add_num(fig, "residual_bias_sensor_pp_dps", post_num(j, "t_fit.residual_p2p_dps"));
+        add_num(fig, "bias_p_order", post_num(j, "p_fit.order"));
+        if (!quiet) {
+          printf("  temperature compensation: residual bias with P %.4f deg/s (p-p %.4f), with the board sensor %.4f deg/s (p-p %.4f)\n",
+                 post_num(j, "p_fit.residual_std_dps"), post_num(j, "p_fit.residual_p2p_dps"),
+                 post_num(j, "t_fit.residual_std_dps"), post_num(j, "t_fit.residual_p2p_dps"));
+        }
+        cJSON_Delete(j);
+      }
+    }
+  }
+  add_num(root, "realtime_factor", res.realtime_factor);
+  if (json_path != NULL) {
+    char *txt = cJSON_Print(root);
+    FILE *f = fopen(json_path, "w");
+    if (f == NULL || txt == NULL) {
+      fprintf(stderr, "gyro-sim: --json %s: %s\n", json_path, strerror(errno));
+      failed = 1;
+    } else {
+      fputs(txt, f);
+      fputc('\n', f);
+      fclose(f);
+    }
+    free(txt);
+  }
+  cJSON_Delete(root);
+  if (tmp_used) {
+    char cmd[1200];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    if (system(cmd) != 0) fprintf(stderr, "gyro-sim: could not remove %s\n", tmpdir);
+  }
+  return failed ? 1 : 0;
+}

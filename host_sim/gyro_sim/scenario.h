@@ -1,0 +1,105 @@
+/* gyro-sim scenario files (JSON, parsed with cJSON) and command-line overrides.
+ *
+ * A scenario names its plant, firmware and input settings; everything not given keeps
+ * its default (plant_default_cfg, the firmware parameter table). Layout:
+ *   {
+ *     "name": "startup", "description": "...", "duration_s": 1.0, "seed": 1,
+ *     "mode": "closed_loop" | "open_loop" | "open_loop_sweep",
+ *     "analyses": ["startup", "rate_table", ...],
+ *     "csv_rate_hz": 1000,
+ *     "plant":    { "<plant parameter>": number, ... },       (plant.h descriptor table)
+ *     "firmware": { "<firmware parameter>": number, ... },    (params/param_list.h)
+ *     "rate_dps":  PROFILE, "ambient_c": PROFILE,             (input profiles)
+ *     "accel_g": { "const": [x,y,z], "amp": [x,y,z], "freq_hz": [x,y,z] },
+ *     "open_loop": { "u_amp_v": 8, "freq_hz": 1489.9,
+ *                    "sweep": { "f_start_hz": 1400, "f_stop_hz": 1600, "points": 81,
+ *                               "dwell_s": 0.2, "settle_s": 0.1 } },
+ *     "notes": { "<parameter>": "how its value was chosen", ... }  (documentation only)
+ *   }
+ *   PROFILE: { "kind": "const", "value": v }
+ *          | { "kind": "steps", "steps": [[duration_s, value], ...], "edge_s": e, "repeat": false }
+ *          | { "kind": "sine", "value": offset, "amp": a, "freq_hz": f, "phase_rad": p }
+ *          | { "kind": "ramp", "value": start, "slope_per_s": s, "t_start_s": t0, "t_end_s": t1 }
+ *          | { "kind": "heat_cool", "value": base, "hot_value": hot, "t_start_s": t0,
+ *              "heat_s": h, "tau_heat_s": th, "tau_cool_s": tc }
+ * Unknown keys are errors (a misspelt key must not silently do nothing). Every error
+ * names the key and, for numbers, the allowed range; nothing is half-applied.
+ */
+#ifndef SIM_SCENARIO_H
+#define SIM_SCENARIO_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "plant/profile.h"
+
+#define SIM_MAX_SETS 160
+#define SIM_NAME_MAX 64
+
+typedef enum {
+  SIM_CLOSED_LOOP = 0,
+  SIM_OPEN_LOOP = 1,       /* fixed half-frequency drive, no firmware */
+  SIM_OPEN_LOOP_SWEEP = 2  /* stepped half-frequency drive across a band, no firmware */
+} sim_mode_t;
+
+typedef enum {
+  SIM_AN_STARTUP = 1u << 0,
+  SIM_AN_RATE_TABLE = 1u << 1,
+  SIM_AN_NOISE = 1u << 2,      /* Brownian floor comparison (brownian_only) */
+  SIM_AN_ALLAN = 1u << 3,      /* static Allan figures */
+  SIM_AN_DRIVE_NOISE = 1u << 4,
+  SIM_AN_TEMP = 1u << 5,       /* temperature chamber / cool-down compensation */
+  SIM_AN_SWEEP = 1u << 6,      /* open-loop frequency response */
+  SIM_AN_SQUARE_LAW = 1u << 7  /* table 7-1: amplitude versus drive voltage */
+} sim_analysis_t;
+
+typedef struct {
+  char key[SIM_NAME_MAX];
+  double value;
+} sim_set_t;
+
+typedef struct {
+  double u_amp_v;     /* half-frequency voltage amplitude */
+  double freq_hz;     /* drive (force) frequency */
+  double f_start_hz, f_stop_hz;
+  int points;
+  double dwell_s, settle_s;
+  int n_amps;         /* square law: voltage amplitudes stepped at freq_hz */
+  double amps_v[16];
+} sim_open_loop_t;
+
+typedef struct {
+  char name[SIM_NAME_MAX];
+  char description[256];
+  double duration_s;
+  uint64_t seed;
+  sim_mode_t mode;
+  uint32_t analyses;
+  double csv_rate_hz;
+  sim_set_t plant_set[SIM_MAX_SETS];
+  int n_plant_set;
+  sim_set_t fw_set[SIM_MAX_SETS];
+  int n_fw_set;
+  int has_rate, has_ambient, has_accel;
+  profile_t rate_dps;
+  profile_t ambient_c;
+  accel_profile_t accel_g;
+  sim_open_loop_t ol;
+} sim_scenario_t;
+
+/* Defaults: closed loop, 1 s, seed 1, no analyses, CSV at 1 kHz. */
+void scenario_defaults(sim_scenario_t *sc);
+
+/* Parse a JSON scenario into sc (on top of its current content). Returns 0, or -1 with
+ * a one-line message in err naming the key. */
+int scenario_parse(sim_scenario_t *sc, const char *json, char *err, size_t err_len);
+int scenario_load(sim_scenario_t *sc, const char *path, char *err, size_t err_len);
+
+/* A command-line override "plant.KEY=VALUE" or "firmware.KEY=VALUE" (the firmware key
+ * is the parameter's own dotted name, e.g. firmware.drive.amp_bw_hz=20). Only the
+ * syntax and the number are checked here; the key and range when applied. */
+int scenario_add_override(sim_scenario_t *sc, const char *arg, char *err, size_t err_len);
+
+const char *scenario_analysis_name(sim_analysis_t a);
+
+#endif /* SIM_SCENARIO_H */

@@ -1,0 +1,81 @@
+/* gyro-sim: one run of a scenario - the plant (host_sim/plant) behind the host HAL stub,
+ * with the real firmware application (firmware/app) in closed loop, or an open-loop
+ * drive generated here for the characterisation of the bare plant (§7.2.2, table 7-1).
+ *
+ * The run writes a CSV trace (stable columns, see sim_csv_header) and collects the
+ * figures that need the plant's truth (start-up on the true motion); figures that need
+ * spectra, Allan deviation or fits are computed by the analysis tools (tools/gyro-*)
+ * on the trace, so each is implemented once.
+ */
+#ifndef SIM_H
+#define SIM_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#include "app/app.h"
+#include "plant/plant.h"
+#include "scenario.h"
+
+/* Start-up of the drive, measured on the plant's true motion (not on the firmware's own
+ * estimate, which a high gain simply zeroes). */
+typedef struct {
+  int valid;
+  double lock_time_s;       /* true amplitude within 1 % of its final value from here on */
+  double overshoot_pct;     /* peak true amplitude over the final one, -1, in % */
+  double amp_err_rms_pct;   /* true amplitude, 0.1-100 Hz, after lock, % of the mean */
+  double phase_err_rms_deg; /* true drive phase against the NCO, 0.1-100 Hz, after lock */
+  double fw_lock_time_s;    /* first LOCKED of the firmware's supervisor */
+  double final_amp_m;
+} sim_startup_t;
+
+typedef struct {
+  int n;
+  double f_hz[10000];
+  double amp_v[10000];
+  double phase_deg[10000];  /* drive pickoff against the drive force cos(wt) */
+} sim_sweep_t;
+
+typedef struct {
+  int n;
+  double u_v[16];
+  double amp_v[16];
+  double amp_m[16];         /* true displacement amplitude */
+} sim_square_t;
+
+typedef struct {
+  double sim_s;
+  double wall_s;
+  double realtime_factor;
+  uint64_t ticks;
+  sim_startup_t startup;
+  double adc_fraction[2];   /* worst-case budget from plant_adc_fraction */
+  uint64_t adc_clips[2];
+  uint32_t faults;
+  uint32_t final_mode;
+  double mean_struct_k;
+  double mean_drive_freq_hz;
+  double mean_drive_amp_m;
+  double isr_instr_est;     /* not measured here: see tools/bench */
+} sim_result_t;
+
+typedef struct {
+  const char *csv_path;     /* NULL: no trace */
+  double csv_rate_hz;
+  int progress;             /* progress bar on stderr */
+  const char *uart_pty_link; /* reserved for the pty bridge */
+} sim_opts_t;
+
+/* Build the plant configuration and profiles from the scenario (defaults + overrides).
+ * Returns 0, or -1 with the offending key in err. */
+int sim_plant_cfg(const sim_scenario_t *sc, plant_cfg_t *cfg, plant_profiles_t *prof,
+                  char *err, size_t err_len);
+/* The firmware parameters from the scenario: defaults + overrides, each checked. */
+int sim_fw_params(const sim_scenario_t *sc, param_values_t *v, char *err, size_t err_len);
+
+int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_result_t *res,
+                        char *err, size_t err_len);
+int sim_run_open_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_result_t *res,
+                      sim_sweep_t *sweep, sim_square_t *sq, char *err, size_t err_len);
+
+#endif /* SIM_H */

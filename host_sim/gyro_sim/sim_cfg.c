@@ -1,0 +1,91 @@
+/* Scenario -> plant configuration, input profiles and firmware parameters. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "sim.h"
+
+int sim_plant_cfg(const sim_scenario_t *sc, plant_cfg_t *cfg, plant_profiles_t *prof,
+                  char *err, size_t err_len)
+{
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  for (int i = 0; i < sc->n_plant_set; i++) {
+    const sim_set_t *s = &sc->plant_set[i];
+    /* "thermal_preset" selects a coupling preset (tight/loose/default) by number. */
+    if (strcmp(s->key, "thermal_preset") == 0) {
+      static const char *const names[] = {"default", "tight", "loose"};
+      const int k = (int)s->value;
+      if (s->value != (double)k || k < 0 || k > 2 || plant_thermal_preset(&c, names[k]) != 0) {
+        snprintf(err, err_len, "plant.thermal_preset: %g is not 0 (default), 1 (tight) or 2 (loose)", s->value);
+        return -1;
+      }
+      continue;
+    }
+    char why[256];
+    if (plant_param_set(&c, s->key, s->value, why, sizeof why) != 0) {
+      snprintf(err, err_len, "plant.%s", why);
+      return -1;
+    }
+  }
+  char why[256];
+  if (plant_cfg_check(&c, why, sizeof why) != 0) {
+    snprintf(err, err_len, "plant: %s", why);
+    return -1;
+  }
+  memset(prof, 0, sizeof *prof);
+  if (sc->has_rate) prof->rate_dps = sc->rate_dps;
+  else profile_const(&prof->rate_dps, c.rate_dps);
+  if (sc->has_ambient) prof->ambient_k = sc->ambient_c; /* parsed into kelvin */
+  else profile_const(&prof->ambient_k, c.temp_k);
+  if (sc->has_accel) prof->accel_g = sc->accel_g;
+  else accel_profile_zero(&prof->accel_g);
+  /* The run starts with the thermal nodes settled at the ambient of t = 0. */
+  c.temp_k = profile_eval(&prof->ambient_k, 0.0, NULL);
+  *cfg = c;
+  return 0;
+}
+
+int sim_fw_params(const sim_scenario_t *sc, param_values_t *v, char *err, size_t err_len)
+{
+  param_values_t t;
+  param_values_defaults(&t);
+  for (int i = 0; i < sc->n_fw_set; i++) {
+    const sim_set_t *s = &sc->fw_set[i];
+    const param_idx_t idx = param_lookup(s->key, strlen(s->key));
+    const param_info_t *pi = param_info(idx);
+    if (pi == NULL) {
+      snprintf(err, err_len, "firmware.%s: unknown parameter", s->key);
+      return -1;
+    }
+    param_value_t val;
+    if (pi->type == PARAM_T_F32) {
+      val.f = (float)s->value;
+    } else {
+      if (s->value < 0.0 || s->value > 4294967295.0 || s->value != floor(s->value)) {
+        snprintf(err, err_len, "firmware.%s: %g is not an unsigned integer", s->key, s->value);
+        return -1;
+      }
+      val.u = (uint32_t)s->value;
+    }
+    const param_status_t st = param_check(idx, val);
+    if (st != PARAM_OK) {
+      if (pi->type == PARAM_T_F32) {
+        snprintf(err, err_len, "firmware.%s: %g is not allowed (%s); range [%g, %g] %s", s->key,
+                 s->value, param_status_str(st), (double)pi->min.f, (double)pi->max.f, pi->unit);
+      } else {
+        snprintf(err, err_len, "firmware.%s: %g is not allowed (%s); range [%u, %u] %s", s->key,
+                 s->value, param_status_str(st), pi->min.u, pi->max.u, pi->unit);
+      }
+      return -1;
+    }
+    param_put(&t, idx, val);
+  }
+  gyro_design_t d;
+  if (gyro_design(&t, &d) != 0) {
+    snprintf(err, err_len, "firmware: these parameter values cannot be designed (drive loops or output filter)");
+    return -1;
+  }
+  *v = t;
+  return 0;
+}

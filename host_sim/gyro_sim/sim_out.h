@@ -1,0 +1,28 @@
+/* gyro-sim outputs: the CSV trace and the JSON of parameters and figures.
+ *
+ * CSV columns (stable; more may be appended, never reordered):
+ *   t_s, rate_true_dps, rate_dps, quad_dps, drive_amp, drive_phase_deg, p_deg,
+ *   t_ambient_c, t_struct_c, t_board_c, u1_v, u2_v, adc_drive_v, adc_sense_v, flags,
+ *   mode, t_circuit_c, rate_unc_dps, p_f_deg, drive_amp_true_m, f_cmd_v2
+ * drive_amp (V) and drive_phase_deg are the firmware's demodulated drive pickoff
+ * (amplitude and arg against the NCO); u1_v/u2_v what it wrote to the drive DAC; adc_*
+ * the analog voltages at the ADC inputs; flags the GYRO_FLAG_* bits. In open-loop runs
+ * the firmware columns are 0.
+ */
+#ifndef SIM_OUT_H
+#define SIM_OUT_H
+
+#include <stdio.h>
+
+#include "gyro/gyro.h"
+#include "plant/plant.h"
+
+typedef struct {
+  FILE *f;
+} sim_csv_t;
+
+int sim_csv_open(sim_csv_t *c, const char *path, char *err, size_t err_len);
+void sim_csv_row(sim_csv_t *c, const plant_truth_t *tr, const gyro_out_t *o);
+void sim_csv_close(sim_csv_t *c);
+
+#endif /* SIM_OUT_H */

@@ -1,0 +1,357 @@
+/* The simulation loops: closed loop (plant + firmware application through the host HAL)
+ * and open loop (the plant driven by a fixed or stepped half-frequency drive). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "dsp/butter.h"
+#include "hal/hal_sample_timer.h"
+#include "hal_flash_host.h"
+#include "hal_host.h"
+#include "hal_uart_host.h"
+#include "sim.h"
+#include "sim_out.h"
+
+static double wall_now(void)
+{
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+typedef struct {
+  int enabled;
+  double t0_wall, last_wall;
+  double total_s;
+} progress_t;
+
+static void progress_update(progress_t *pr, double sim_s, int final)
+{
+  if (!pr->enabled) return;
+  const double now = wall_now();
+  if (!final && now - pr->last_wall < 0.25) return;
+  pr->last_wall = now;
+  const double frac = pr->total_s > 0.0 ? sim_s / pr->total_s : 1.0;
+  const int width = 30, fill = (int)(frac * width + 0.5);
+  const double el = now - pr->t0_wall;
+  const double eta = frac > 1e-6 ? el * (1.0 - frac) / frac : 0.0;
+  fprintf(stderr, "\r[%.*s%*s] %5.1f%%  sim %.1f/%.1f s  %.0fx real time  eta %.0f s ",
+          fill, "##############################", width - fill, "", 100.0 * frac, sim_s,
+          pr->total_s, el > 0.0 ? sim_s / el : 0.0, eta);
+  if (final) fputc('\n', stderr);
+  fflush(stderr);
+}
+
+/* RMS of x[i0..n) after removing its linear trend (the 0.1 Hz lower band edge of the
+ * drive figures is approximated by the detrend over a window of a few seconds) and a
+ * 100 Hz low-pass (the upper band edge), at sample rate fs. */
+static double band_rms(const double *x, size_t i0, size_t n, double fs)
+{
+  if (n <= i0 + 16) return NAN;
+  const size_t m = n - i0;
+  double st = 0, sx = 0, stt = 0, stx = 0;
+  for (size_t i = 0; i < m; i++) {
+    const double t = (double)i;
+    st += t; sx += x[i0 + i]; stt += t * t; stx += t * x[i0 + i];
+  }
+  const double den = (double)m * stt - st * st;
+  const double b = den != 0.0 ? ((double)m * stx - st * sx) / den : 0.0;
+  const double a = (sx - b * st) / (double)m;
+  butter_sos_f64_t sos[2];
+  const int ns = butter_design_f64(BUTTER_LOWPASS, 2u, 100.0, 0.0, fs, sos, 2u);
+  double s1 = 0, s2 = 0, acc = 0;
+  size_t cnt = 0;
+  const size_t skip = (size_t)(0.02 * fs); /* the low-pass's own start-up */
+  for (size_t i = 0; i < m; i++) {
+    double v = x[i0 + i] - (a + b * (double)i);
+    if (ns == 1) {
+      const double y = sos[0].b0 * v + s1;
+      s1 = sos[0].b1 * v - sos[0].a1 * y + s2;
+      s2 = sos[0].b2 * v - sos[0].a2 * y;
+      v = y;
+    }
+    if (i >= skip) { acc += v * v; cnt++; }
+  }
+  return cnt ? sqrt(acc / (double)cnt) : NAN;
+}
+
+static void startup_figures(const double *amp, const double *ph, size_t n, double fs,
+                            sim_startup_t *st)
+{
+  memset(st, 0, sizeof *st);
+  if (n < 100) return;
+  const size_t tail = n / 10;
+  double af = 0.0;
+  for (size_t i = n - tail; i < n; i++) af += amp[i];
+  af /= (double)tail;
+  double peak = 0.0;
+  size_t last_out = 0;
+  for (size_t i = 0; i < n; i++) {
+    if (amp[i] > peak) peak = amp[i];
+    if (fabs(amp[i] / af - 1.0) > 0.01) last_out = i + 1;
+  }
+  st->valid = 1;
+  st->final_amp_m = af;
+  st->lock_time_s = (double)last_out / fs;
+  st->overshoot_pct = peak > af ? 100.0 * (peak / af - 1.0) : 0.0;
+  /* Loop figures from 0.1 s after lock (the last of the acquisition transient). */
+  const size_t i0 = last_out + (size_t)(0.1 * fs);
+  st->amp_err_rms_pct = 100.0 * band_rms(amp, i0, n, fs) / af;
+  st->phase_err_rms_deg = band_rms(ph, i0, n, fs) * 180.0 / M_PI;
+}
+
+int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_result_t *res,
+                        char *err, size_t err_len)
+{
+  memset(res, 0, sizeof *res);
+  plant_cfg_t pc;
+  plant_profiles_t prof;
+  param_values_t fw;
+  if (sim_plant_cfg(sc, &pc, &prof, err, err_len) != 0) return -1;
+  if (sim_fw_params(sc, &fw, err, err_len) != 0) return -1;
+  if (fabs(pc.fs_hz - (double)fw.sys_fs_hz) > 1e-9) {
+    snprintf(err, err_len, "plant.fs_hz %g differs from the firmware's sys.fs_hz %u", pc.fs_hz, fw.sys_fs_hz);
+    return -1;
+  }
+  plant_t *plant = calloc(1, sizeof *plant);
+  app_t *app = calloc(1, sizeof *app);
+  const double fs = pc.fs_hz;
+  const uint64_t n_ticks = (uint64_t)llround(sc->duration_s * fs);
+  const int want_startup = (sc->analyses & SIM_AN_STARTUP) != 0u;
+  const size_t tdec = (size_t)llround(fs / 1000.0); /* truth samples at 1 kHz */
+  const size_t n_truth = want_startup ? (size_t)(n_ticks / tdec) + 1u : 0u;
+  double *amp = want_startup ? calloc(n_truth, sizeof *amp) : NULL;
+  double *ph = want_startup ? calloc(n_truth, sizeof *ph) : NULL;
+  sim_csv_t csv;
+  memset(&csv, 0, sizeof csv);
+  int rc = 0;
+  if (plant == NULL || app == NULL || (want_startup && (amp == NULL || ph == NULL))) {
+    snprintf(err, err_len, "out of memory");
+    rc = -1;
+    goto out;
+  }
+  if (plant_init(plant, &pc, sc->seed) != 0 || plant_set_profiles(plant, &prof) != 0) {
+    snprintf(err, err_len, "plant: %s", plant_error(plant));
+    rc = -1;
+    goto out;
+  }
+  (void)hal_flash_host_configure(NULL);
+  hal_uart_host_reset();
+  hal_host_attach(plant_step_hal, plant);
+  if (app_init_with(app, &fw) != 0 ||
+      hal_sample_timer_start(fw.sys_fs_hz, app_sample_isr, app) != 0) {
+    snprintf(err, err_len, "firmware: application did not start");
+    rc = -1;
+    goto out;
+  }
+  if (opt->csv_path != NULL && sim_csv_open(&csv, opt->csv_path, err, err_len) != 0) {
+    rc = -1;
+    goto out;
+  }
+  const uint64_t csv_every = (uint64_t)fmax(1.0, llround(fs / opt->csv_rate_hz));
+  progress_t pr = {opt->progress, wall_now(), 0.0, sc->duration_s};
+  const double t_wall0 = wall_now();
+  double fw_lock = -1.0, sum_tk = 0.0, sum_f = 0.0, sum_a = 0.0;
+  uint64_t n_mean = 0;
+  size_t it = 0;
+  double ph_prev = 0.0, ph_unwrap = 0.0;
+  const double w_fw = 2.0 * M_PI * (double)fw.drive_freq_hz;
+  for (uint64_t k = 0; k < n_ticks; k++) {
+    hal_host_run(1u);
+    const plant_truth_t *tr = plant_truth(plant);
+    if (fw_lock < 0.0 && app->gyro.sup.mode == GYRO_MODE_LOCKED) fw_lock = (double)(k + 1u) / fs;
+    if (want_startup && (k + 1u) % tdec == 0u && it < n_truth) {
+      /* The true drive phasor in the firmware's NCO frame: y = Im{Z e^{j phi}}, so
+       * Z = (y'/w + j y) e^{-j phi} with phi the NCO phase of the next tick. */
+      const uint32_t phase_u = app->gyro.nco.half_phase << 1;
+      const double phi = 2.0 * M_PI * (double)phase_u / 4294967296.0;
+      const double re = tr->vy_mps / w_fw, im = tr->y_m;
+      const double c = cos(phi), s = sin(phi);
+      const double zr = re * c + im * s, zi = im * c - re * s;
+      amp[it] = hypot(zr, zi);
+      const double p = atan2(zi, zr);
+      double d = p - ph_prev;
+      d -= 2.0 * M_PI * floor((d + M_PI) / (2.0 * M_PI));
+      ph_unwrap += d;
+      ph_prev = p;
+      ph[it] = ph_unwrap;
+      it++;
+    }
+    if (k % csv_every == 0u) {
+      if (csv.f != NULL) sim_csv_row(&csv, tr, &app->gyro.out);
+      sum_tk += tr->struct_k;
+      sum_f += tr->drive_freq_hz;
+      sum_a += tr->drive_amp_m;
+      n_mean++;
+    }
+    if ((k & 1023u) == 0u) {
+      app_poll(app);
+      progress_update(&pr, (double)k / fs, 0);
+    }
+  }
+  progress_update(&pr, sc->duration_s, 1);
+  res->wall_s = wall_now() - t_wall0;
+  res->ticks = n_ticks;
+  res->sim_s = (double)n_ticks / fs;
+  res->realtime_factor = res->wall_s > 0.0 ? res->sim_s / res->wall_s : 0.0;
+  if (want_startup) {
+    startup_figures(amp, ph, it, 1000.0, &res->startup);
+    res->startup.fw_lock_time_s = fw_lock;
+  }
+  {
+    const plant_truth_t *tr = plant_truth(plant);
+    res->adc_clips[0] = tr->adc_clip[0];
+    res->adc_clips[1] = tr->adc_clip[1];
+  }
+  (void)plant_adc_fraction(&pc, res->adc_fraction);
+  res->faults = app->gyro.sup.fault_count;
+  res->final_mode = (uint32_t)app->gyro.sup.mode;
+  res->mean_struct_k = n_mean ? sum_tk / (double)n_mean : NAN;
+  res->mean_drive_freq_hz = n_mean ? sum_f / (double)n_mean : NAN;
+  res->mean_drive_amp_m = n_mean ? sum_a / (double)n_mean : NAN;
+out:
+  sim_csv_close(&csv);
+  hal_sample_timer_stop();
+  free(amp);
+  free(ph);
+  free(plant);
+  free(app);
+  return rc;
+}
+
+/* ------------------------------------------------------------------ open loop -- */
+
+typedef struct {
+  double psi, dpsi;         /* half-frequency voltage phase and its advance per tick */
+  double u_amp_v;
+  int measuring;
+  double acc_i, acc_q, acc_am;
+  uint64_t acc_n;
+  double v_per_code;
+} ol_t;
+
+/* The open-loop "firmware": half-frequency drive U1 = A cos(psi), U2 = A sin(psi), so
+ * the force is Ks A^2 cos(2 psi) (6-18, 6-19); the drive pickoff is demodulated against
+ * the same phase as a firmware sweep would (through the board's DAC latency). */
+static void ol_isr(void *ctx)
+{
+  ol_t *o = ctx;
+  hal_adc_frame_t adc;
+  hal_adc_read_frame(&adc);
+  const double phi = 2.0 * o->psi;
+  if (o->measuring) {
+    const double v = (double)adc.drive * o->v_per_code;
+    o->acc_i += v * cos(phi);
+    o->acc_q += v * sin(phi);
+    o->acc_n++;
+  }
+  hal_dac_frame_t dac;
+  dac.code[HAL_DAC_DRIVE_U1] = dac_v_to_code(o->u_amp_v * cos(o->psi));
+  dac.code[HAL_DAC_DRIVE_U2] = dac_v_to_code(o->u_amp_v * sin(o->psi));
+  dac.code[HAL_DAC_RATE_OUT] = (uint16_t)HAL_DAC_CODE_MID;
+  dac.code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID;
+  hal_dac_write_frame(&dac);
+  o->psi += o->dpsi;
+  if (o->psi > 2.0 * M_PI) o->psi -= 2.0 * M_PI;
+}
+
+/* Drive at f_hz with amplitude u for dwell_s; measure over the whole cycles after
+ * settle_s. Returns amplitude (V at the ADC) and phase against the force. */
+static void ol_point(ol_t *o, plant_t *plant, double fs, double f_hz, double u, double settle_s,
+                     double dwell_s, double *amp_v, double *phase_deg, double *amp_m,
+                     sim_csv_t *csv, uint64_t *k, uint64_t csv_every)
+{
+  o->dpsi = M_PI * f_hz / fs;
+  o->u_amp_v = u;
+  const uint64_t n_settle = (uint64_t)llround(settle_s * fs);
+  const double cycles = floor((dwell_s - settle_s) * f_hz);
+  const uint64_t n_meas = (uint64_t)llround(fmax(cycles, 1.0) * fs / f_hz);
+  o->measuring = 0;
+  o->acc_i = o->acc_q = 0.0;
+  o->acc_n = 0;
+  double sum_am = 0.0;
+  for (uint64_t i = 0; i < n_settle + n_meas; i++) {
+    if (i == n_settle) o->measuring = 1;
+    hal_host_run(1u);
+    if (o->measuring) sum_am += plant_truth(plant)->drive_amp_m;
+    if (csv->f != NULL && (*k)++ % csv_every == 0u) sim_csv_row(csv, plant_truth(plant), NULL);
+  }
+  const double n = (double)o->acc_n;
+  *amp_v = 2.0 * hypot(o->acc_i, o->acc_q) / n;
+  *phase_deg = atan2(-o->acc_q, o->acc_i) * 180.0 / M_PI;
+  *amp_m = sum_am / n;
+}
+
+int sim_run_open_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_result_t *res,
+                      sim_sweep_t *sweep, sim_square_t *sq, char *err, size_t err_len)
+{
+  memset(res, 0, sizeof *res);
+  sweep->n = 0;
+  sq->n = 0;
+  plant_cfg_t pc;
+  plant_profiles_t prof;
+  if (sim_plant_cfg(sc, &pc, &prof, err, err_len) != 0) return -1;
+  plant_t *plant = calloc(1, sizeof *plant);
+  if (plant == NULL) { snprintf(err, err_len, "out of memory"); return -1; }
+  if (plant_init(plant, &pc, sc->seed) != 0 || plant_set_profiles(plant, &prof) != 0) {
+    snprintf(err, err_len, "plant: %s", plant_error(plant));
+    free(plant);
+    return -1;
+  }
+  const double fs = pc.fs_hz;
+  ol_t o;
+  memset(&o, 0, sizeof o);
+  o.v_per_code = pc.adc_full_scale_v / 32768.0;
+  hal_host_attach(plant_step_hal, plant);
+  (void)hal_sample_timer_start((uint32_t)llround(fs), ol_isr, &o);
+  sim_csv_t csv;
+  memset(&csv, 0, sizeof csv);
+  if (opt->csv_path != NULL && sim_csv_open(&csv, opt->csv_path, err, err_len) != 0) {
+    free(plant);
+    return -1;
+  }
+  const uint64_t csv_every = (uint64_t)fmax(1.0, llround(fs / opt->csv_rate_hz));
+  uint64_t k = 0;
+  const double t_wall0 = wall_now();
+  progress_t pr = {opt->progress, t_wall0, 0.0, 0.0};
+  double am;
+  if (sc->mode == SIM_OPEN_LOOP_SWEEP) {
+    const int np = sc->ol.points > 10000 ? 10000 : sc->ol.points;
+    pr.total_s = np * sc->ol.dwell_s;
+    for (int i = 0; i < np; i++) {
+      const double f = sc->ol.f_start_hz + (sc->ol.f_stop_hz - sc->ol.f_start_hz) * i / (np - 1);
+      ol_point(&o, plant, fs, f, sc->ol.u_amp_v, sc->ol.settle_s, sc->ol.dwell_s,
+               &sweep->amp_v[i], &sweep->phase_deg[i], &am, &csv, &k, csv_every);
+      sweep->f_hz[i] = f;
+      sweep->n = i + 1;
+      progress_update(&pr, (double)hal_host_ticks() / fs, 0);
+    }
+  } else {
+    const int na = sc->ol.n_amps > 0 ? sc->ol.n_amps : 1;
+    pr.total_s = na * sc->ol.dwell_s;
+    for (int i = 0; i < na; i++) {
+      const double u = sc->ol.n_amps > 0 ? sc->ol.amps_v[i] : sc->ol.u_amp_v;
+      double ph;
+      ol_point(&o, plant, fs, sc->ol.freq_hz, u, sc->ol.settle_s, sc->ol.dwell_s,
+               &sq->amp_v[i], &ph, &sq->amp_m[i], &csv, &k, csv_every);
+      sq->u_v[i] = u;
+      sq->n = i + 1;
+      progress_update(&pr, (double)hal_host_ticks() / fs, 0);
+    }
+  }
+  progress_update(&pr, (double)hal_host_ticks() / fs, 1);
+  res->wall_s = wall_now() - t_wall0;
+  res->ticks = hal_host_ticks();
+  res->sim_s = (double)res->ticks / fs;
+  res->realtime_factor = res->wall_s > 0.0 ? res->sim_s / res->wall_s : 0.0;
+  res->adc_clips[0] = plant_truth(plant)->adc_clip[0];
+  res->adc_clips[1] = plant_truth(plant)->adc_clip[1];
+  (void)plant_adc_fraction(&pc, res->adc_fraction);
+  sim_csv_close(&csv);
+  hal_sample_timer_stop();
+  free(plant);
+  return 0;
+}

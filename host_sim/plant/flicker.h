@@ -1,0 +1,66 @@
+/* Seeded 1/f (flicker) plus white noise generator for the plant's voltage-noise sources
+ * (thesis §6.3.2: the drive voltages carry 1/f noise, fig. 6-5, 7-6, 7-7).
+ *
+ * Target one-sided PSD (unit^2/Hz), f above fmin_hz:
+ *     S(f) = W^2 + K^2 / f,   W = white_rthz, K = flicker_1hz_rthz,
+ * flat below about fmin_hz. The corner where the two meet is fc = (K / W)^2 (capped at
+ * fs/20; with W = 0 the spectrum is 1/f up to fs/20 and white above).
+ *
+ * Method: one Gaussian white sequence per sample (variance fs/2, i.e. unit one-sided
+ * density) through a cascade of first-order shelving sections
+ *     H(s) = g prod_i (1 + s/z_i) / (1 + s/p_i),
+ * zeros and poles interleaved one per decade from fmin up to the corner (slope
+ * -10 dB/decade), the top two pairs placed relative to fc so the cascade also gives the
+ * knee and the white floor (tools/flicker_design.py: peak error +-0.28 dB of the analog
+ * layout against W^2 + K^2/f from four decades below to four above fc). Each section
+ * is discretised by the bilinear transform (its flat top maps onto Nyquist, so the
+ * white floor stays flat up to fs/2):
+ *     y[n] = b0 x[n] + b1 x[n-1] - a1 y[n-1]
+ * and g is the least-squares (in dB) fit of the discrete |H|^2 to S(f) over
+ * [10 fmin, 0.45 fs]. One Gaussian and 3 multiply-adds per section per sample (about
+ * 6 sections for fmin 1 mHz, fc 100 Hz).
+ *
+ * The cascade starts at rest: spectral content below f needs about 1/(2 pi f) seconds
+ * to reach its stationary level.
+ */
+#ifndef PLANT_FLICKER_H
+#define PLANT_FLICKER_H
+
+#include <stdint.h>
+
+#include "plant/gauss_zig.h"
+#include "plant/rng.h"
+
+#define FLICKER_MAX_SECTIONS 16
+
+typedef struct {
+  double white_rthz;       /* one-sided white density W, unit/sqrt(Hz); >= 0 */
+  double flicker_1hz_rthz; /* one-sided density of the 1/f part at 1 Hz, K; >= 0 */
+  double fmin_hz;          /* 1/f spectrum flattens below this; > 0 */
+} flicker_spec_t;
+
+typedef struct {
+  int active;        /* 0: W = K = 0, output 0, no random draws */
+  int nsec;          /* 0: white only */
+  double in_sd;      /* sd of the section input per sample, gain included */
+  double corner_hz;  /* fc actually used (0 for white only) */
+  double b0[FLICKER_MAX_SECTIONS], b1[FLICKER_MAX_SECTIONS], a1[FLICKER_MAX_SECTIONS];
+  double xp[FLICKER_MAX_SECTIONS], yp[FLICKER_MAX_SECTIONS];
+  rng_t rng;
+  gauss_zig_t zig; /* normal deviates by the ziggurat: no log per sample (gauss_zig.h) */
+} flicker_t;
+
+/* Validates spec (finite, W, K >= 0, fs > 0; if K > 0: 0 < fmin <= fs/1000 and fc/fmin small
+ * enough for FLICKER_MAX_SECTIONS, about 1e13), designs the cascade and seeds the
+ * generator with rng_seed(seed, stream). Returns 0, or -1 with f unchanged. */
+int flicker_init(flicker_t *f, const flicker_spec_t *spec, double fs_hz, uint64_t seed,
+                 uint64_t stream);
+
+/* Next sample (unit of the spec). */
+double flicker_step(flicker_t *f);
+
+/* The analytic target W^2 + K^2/f of the spec (fc cap applied), one-sided unit^2/Hz,
+ * valid above about 10 fmin (for tests and reports). */
+double flicker_target_psd(const flicker_spec_t *spec, double fs_hz, double f_hz);
+
+#endif /* PLANT_FLICKER_H */

@@ -1,0 +1,325 @@
+#include "plant/pickoff.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "plant/lti_disc.h"
+
+static const double k_pi = 3.14159265358979323846;
+static const double k_deg = 3.14159265358979323846 / 180.0;
+
+/* SISO state space in time normalised to the sample period. */
+typedef struct {
+  int n;
+  double a[PICKOFF_MAX_N][PICKOFF_MAX_N];
+  double b[PICKOFF_MAX_N];
+  double c[PICKOFF_MAX_N];
+  double d;
+} ss_t;
+
+/* acc <- next(acc(.)) : acc's output feeds next's input */
+static void series(ss_t *acc, const ss_t *next)
+{
+  ss_t r;
+  memset(&r, 0, sizeof r);
+  const int n1 = acc->n, n2 = next->n;
+  r.n = n1 + n2;
+  for (int i = 0; i < n1; i++) {
+    for (int j = 0; j < n1; j++) r.a[i][j] = acc->a[i][j];
+    r.b[i] = acc->b[i];
+    r.c[i] = next->d * acc->c[i];
+  }
+  for (int i = 0; i < n2; i++) {
+    for (int j = 0; j < n1; j++) r.a[n1 + i][j] = next->b[i] * acc->c[j];
+    for (int j = 0; j < n2; j++) r.a[n1 + i][n1 + j] = next->a[i][j];
+    r.b[n1 + i] = next->b[i] * acc->d;
+    r.c[n1 + i] = next->c[i];
+  }
+  r.d = next->d * acc->d;
+  *acc = r;
+}
+
+void pickoff_default_cfg(pickoff_cfg_t *cfg, pickoff_axis_t axis)
+{
+  memset(cfg, 0, sizeof *cfg);
+  cfg->axis = axis;
+  cfg->fs_hz = 50000.0;
+  cfg->gain_tc_per_k = 0.0;
+  cfg->preamp_rail_v = 13.5;
+  cfg->lag_kind = PICKOFF_LAG_LOWPASS;
+  cfg->lag_ref_hz = 1489.9;
+  cfg->temp_ref_k = 298.15;
+  cfg->phi0_rad = 3.0 * k_deg;
+  cfg->phi2_rad_per_k2 = 0.0;
+  cfg->hp_hz = 100.0;
+  cfg->lp_hz = 8000.0;
+  cfg->lp_q = 0.70710678118654752;
+  cfg->noise_v_rthz = 2e-6;
+  cfg->jitter_rms_s = 0.0;
+  cfg->phase_step_rad = 1e-6;
+  if (axis == PICKOFF_SENSE) {
+    cfg->gain_v_per_m = 6.18e7;
+    cfg->ft_u1 = 1e-4;
+    cfg->ft_u2 = 6e-5;
+    cfg->ft_spare = 1e-3;
+    cfg->phi1_rad_per_k = 0.1 * k_deg;
+    cfg->offset_v = -3e-3;
+    cfg->sample_delay_s = 4e-6;
+  } else {
+    cfg->gain_v_per_m = 3.0e5;
+    cfg->ft_u1 = 2e-4;
+    cfg->ft_u2 = -1.5e-4;
+    cfg->ft_spare = 0.0;
+    cfg->phi1_rad_per_k = 0.01 * k_deg;
+    cfg->offset_v = 5e-3;
+    cfg->sample_delay_s = 0.0;
+  }
+}
+
+static int finite_all(const double *v, int n)
+{
+  for (int i = 0; i < n; i++)
+    if (!isfinite(v[i])) return 0;
+  return 1;
+}
+
+static int cfg_ok(const pickoff_cfg_t *c)
+{
+  const double vals[] = {c->fs_hz, c->gain_v_per_m, c->gain_tc_per_k, c->preamp_rail_v,
+                         c->ft_u1, c->ft_u2, c->ft_spare, c->lag_ref_hz, c->temp_ref_k,
+                         c->phi0_rad, c->phi1_rad_per_k, c->phi2_rad_per_k2, c->hp_hz,
+                         c->lp_hz, c->lp_q, c->offset_v, c->noise_v_rthz,
+                         c->sample_delay_s, c->jitter_rms_s, c->phase_step_rad};
+  if (!finite_all(vals, (int)(sizeof vals / sizeof vals[0]))) return 0;
+  if (c->axis != PICKOFF_DRIVE && c->axis != PICKOFF_SENSE) return 0;
+  if (c->lag_kind != PICKOFF_LAG_LOWPASS && c->lag_kind != PICKOFF_LAG_ALLPASS) return 0;
+  if (!(c->fs_hz > 0.0 && c->fs_hz <= 1e7)) return 0;
+  const double T = 1.0 / c->fs_hz;
+  if (!(c->gain_v_per_m > 0.0 && fabs(c->gain_tc_per_k) < 0.1 && c->preamp_rail_v > 0.0))
+    return 0;
+  if (!(fabs(c->ft_u1) <= 1.0 && fabs(c->ft_u2) <= 1.0 && fabs(c->ft_spare) <= 1.0)) return 0;
+  if (!(c->lag_ref_hz > 0.0 && c->lag_ref_hz < c->fs_hz / 2.0 && c->temp_ref_k > 0.0)) return 0;
+  if (!(c->hp_hz >= 0.0 && c->hp_hz < c->fs_hz / 2.0)) return 0;
+  if (!(c->lp_hz > 0.0 && c->lp_hz <= 10.0 * c->fs_hz && c->lp_q >= 0.1 && c->lp_q <= 10.0))
+    return 0;
+  if (!(fabs(c->offset_v) <= 10.0 && c->noise_v_rthz >= 0.0 && c->phase_step_rad >= 0.0 &&
+        c->phase_step_rad <= 0.01))
+    return 0;
+  if (!(fabs(c->sample_delay_s) <= 0.5 * T && c->jitter_rms_s >= 0.0 &&
+        c->jitter_rms_s <= 0.05 * T))
+    return 0;
+  return 1;
+}
+
+static double phase_at(const pickoff_cfg_t *c, double temp_k)
+{
+  const double dt = temp_k - c->temp_ref_k;
+  return c->phi0_rad + c->phi1_rad_per_k * dt + 0.5 * c->phi2_rad_per_k2 * dt * dt; /* (2-40) */
+}
+
+static int phase_ok(const pickoff_cfg_t *c, double phi)
+{
+  const double hi = (c->lag_kind == PICKOFF_LAG_ALLPASS) ? 2.8 : 1.4;
+  return isfinite(phi) && phi > 1e-4 && phi < hi;
+}
+
+/* Build the chain at phase phi and discretise it into p (n, phi, g, output rows). */
+static int discretise(pickoff_t *p, double phi)
+{
+  const pickoff_cfg_t *c = &p->cfg;
+  const double T = 1.0 / c->fs_hz;
+  const double wref = 2.0 * k_pi * c->lag_ref_hz;
+  ss_t chain, sec;
+
+  /* circuit lag (2-40) realised as a real filter */
+  memset(&chain, 0, sizeof chain);
+  chain.n = 1;
+  if (c->lag_kind == PICKOFF_LAG_ALLPASS) {
+    const double tau = tan(0.5 * phi) / wref / T;
+    chain.a[0][0] = -1.0 / tau;
+    chain.b[0] = 1.0 / tau;
+    chain.c[0] = 2.0;
+    chain.d = -1.0;
+  } else {
+    const double tau = tan(phi) / wref / T;
+    chain.a[0][0] = -1.0 / tau;
+    chain.b[0] = 1.0 / tau;
+    chain.c[0] = 1.0;
+    chain.d = 0.0;
+  }
+  if (c->hp_hz > 0.0) {
+    const double tau = 1.0 / (2.0 * k_pi * c->hp_hz) / T;
+    memset(&sec, 0, sizeof sec);
+    sec.n = 1;
+    sec.a[0][0] = -1.0 / tau;
+    sec.b[0] = 1.0 / tau;
+    sec.c[0] = -1.0;
+    sec.d = 1.0;
+    series(&chain, &sec);
+  }
+  {
+    const double w = 2.0 * k_pi * c->lp_hz * T;
+    memset(&sec, 0, sizeof sec);
+    sec.n = 2;
+    sec.a[0][1] = w;
+    sec.a[1][0] = -w;
+    sec.a[1][1] = -w / c->lp_q;
+    sec.b[1] = w;
+    sec.c[0] = 1.0;
+    sec.d = 0.0;
+    series(&chain, &sec);
+  }
+
+  /* augmented generator: chain driven by the cubic q = [u, u_s, u_ss, u_sss] */
+  const int n = chain.n, na = n + 4;
+  double f[LTI_MAX_N * LTI_MAX_N], e[LTI_MAX_N * LTI_MAX_N];
+  memset(f, 0, sizeof f);
+  for (int i = 0; i < n; i++) {
+    for (int j = 0; j < n; j++) f[i * na + j] = chain.a[i][j];
+    f[i * na + n] = chain.b[i];
+  }
+  for (int j = 0; j < 3; j++) f[(n + j) * na + n + j + 1] = 1.0;
+  if (lti_expm(na, f, e) != 0) return -1;
+
+  /* Hermite data [s0, m0, s1, m1] (m = T s') -> Taylor coefficients at s = 0 */
+  static const double herm[4][4] = {
+      {1.0, 0.0, 0.0, 0.0}, {0.0, 1.0, 0.0, 0.0}, {-6.0, -4.0, 6.0, -2.0}, {12.0, 6.0, -12.0, 6.0}};
+  p->n = n;
+  memset(p->phi, 0, sizeof p->phi);
+  memset(p->g, 0, sizeof p->g);
+  for (int i = 0; i < n; i++) {
+    for (int j = 0; j < n; j++) p->phi[i][j] = e[i * na + j];
+    for (int j = 0; j < 4; j++) {
+      double s = 0.0;
+      for (int k = 0; k < 4; k++) s += e[i * na + n + k] * herm[k][j];
+      p->g[i][j] = s;
+    }
+  }
+  /* output derivatives in normalised time: Y_j = crow_j z + sum_{i<j} hb_ji u_i + D u_j */
+  double crow[4][PICKOFF_MAX_N], hb[4][4];
+  memset(crow, 0, sizeof crow);
+  memset(hb, 0, sizeof hb);
+  for (int i = 0; i < n; i++) crow[0][i] = chain.c[i];
+  for (int j = 1; j < 4; j++)
+    for (int i = 0; i < n; i++) {
+      double s = 0.0;
+      for (int k = 0; k < n; k++) s += crow[j - 1][k] * chain.a[k][i];
+      crow[j][i] = s;
+    }
+  for (int j = 0; j < 4; j++) {
+    for (int i = 0; i < j; i++) {
+      double s = 0.0;
+      for (int k = 0; k < n; k++) s += crow[j - 1 - i][k] * chain.b[k];
+      hb[j][i] = s;
+    }
+    hb[j][j] = chain.d;
+  }
+  /* fold the Taylor series at the nominal delay dn = d / T into rows:
+   *   y(dn)  = sum_j dn^j / j! Y_j,   T y'(dn) = sum_{j>=1} dn^(j-1) / (j-1)! Y_j */
+  const double dn = c->sample_delay_s / T;
+  const double cy[4] = {1.0, dn, dn * dn / 2.0, dn * dn * dn / 6.0};
+  const double cd[4] = {0.0, 1.0, dn, dn * dn / 2.0};
+  memset(p->out_z, 0, sizeof p->out_z);
+  memset(p->out_u, 0, sizeof p->out_u);
+  memset(p->dout_z, 0, sizeof p->dout_z);
+  memset(p->dout_u, 0, sizeof p->dout_u);
+  for (int j = 0; j < 4; j++) {
+    for (int i = 0; i < PICKOFF_MAX_N; i++) {
+      p->out_z[i] += cy[j] * crow[j][i];
+      p->dout_z[i] += cd[j] * crow[j][i];
+    }
+    for (int i = 0; i < 4; i++) {
+      p->out_u[i] += cy[j] * hb[j][i];
+      p->dout_u[i] += cd[j] * hb[j][i];
+    }
+  }
+  p->phi_rad = phi;
+  return 0;
+}
+
+int pickoff_init(pickoff_t *p, const pickoff_cfg_t *cfg, double temp_k, uint64_t seed)
+{
+  if (p == NULL || cfg == NULL || !cfg_ok(cfg) || !isfinite(temp_k)) return -1;
+  const double phi = phase_at(cfg, temp_k);
+  if (!phase_ok(cfg, phi)) return -1;
+  pickoff_t t;
+  memset(&t, 0, sizeof t);
+  t.cfg = *cfg;
+  if (discretise(&t, phi) != 0) return -1;
+  t.temp_k = temp_k;
+  t.t_s = 1.0 / cfg->fs_hz;
+  t.inv_t = cfg->fs_hz;
+  t.gain_now = cfg->gain_v_per_m * (1.0 + cfg->gain_tc_per_k * (temp_k - cfg->temp_ref_k));
+  t.noise_sd = cfg->noise_v_rthz * sqrt(cfg->fs_hz / 2.0);
+  gauss_zig_init(&t.zig);
+  rng_seed(&t.rng_noise, seed, PICKOFF_RNG_STREAM_NOISE + (uint64_t)cfg->axis);
+  rng_seed(&t.rng_jitter, seed, PICKOFF_RNG_STREAM_JITTER + (uint64_t)cfg->axis);
+  *p = t;
+  return 0;
+}
+
+int pickoff_set_temp(pickoff_t *p, double temp_k)
+{
+  if (p == NULL || !isfinite(temp_k)) return -1;
+  const double phi = phase_at(&p->cfg, temp_k);
+  if (!phase_ok(&p->cfg, phi)) return -1;
+  if (fabs(phi - p->phi_rad) >= p->cfg.phase_step_rad) {
+    pickoff_t t = *p;
+    if (discretise(&t, phi) != 0) return -1;
+    t.rediscretise_count++;
+    *p = t;
+  }
+  p->temp_k = temp_k;
+  p->gain_now = p->cfg.gain_v_per_m * (1.0 + p->cfg.gain_tc_per_k * (temp_k - p->cfg.temp_ref_k));
+  return 0;
+}
+
+double pickoff_step(pickoff_t *p, double pos_m, double vel_mps, const dac_out_t *dac)
+{
+  const pickoff_cfg_t *c = &p->cfg;
+  /* ring-diode output (4-12) plus feedthrough, and its slope */
+  double s1 = p->gain_now * pos_m;
+  double ds1 = p->gain_now * vel_mps;
+  if (dac != NULL) {
+    const dac_chan_out_t *u1 = &dac->ch[HAL_DAC_DRIVE_U1], *u2 = &dac->ch[HAL_DAC_DRIVE_U2];
+    const dac_chan_out_t *u3 = &dac->ch[HAL_DAC_SPARE];
+    s1 += c->ft_u1 * u1->end_v + c->ft_u2 * u2->end_v + c->ft_spare * u3->end_v;
+    ds1 += c->ft_u1 * u1->end_dvdt_v_per_s + c->ft_u2 * u2->end_dvdt_v_per_s +
+           c->ft_spare * u3->end_dvdt_v_per_s;
+  }
+  double m1 = p->t_s * ds1;
+  if (s1 > c->preamp_rail_v || s1 < -c->preamp_rail_v) {
+    s1 = (s1 > 0.0) ? c->preamp_rail_v : -c->preamp_rail_v;
+    m1 = 0.0;
+    p->preamp_clip_count++;
+  }
+  const double s0 = p->s_prev, m0 = p->m_prev;
+
+  /* fixed-size loops: unused states have zero rows and stay zero */
+  double zn[PICKOFF_MAX_N];
+  for (int i = 0; i < PICKOFF_MAX_N; i++) {
+    double acc = p->g[i][0] * s0 + p->g[i][1] * m0 + p->g[i][2] * s1 + p->g[i][3] * m1;
+    for (int j = 0; j < PICKOFF_MAX_N; j++) acc += p->phi[i][j] * p->z[j];
+    zn[i] = acc;
+  }
+  for (int i = 0; i < PICKOFF_MAX_N; i++) p->z[i] = zn[i];
+  p->s_prev = s1;
+  p->m_prev = m1;
+
+  /* output at t_{k+1} + d from the folded Taylor rows; input derivatives are those of
+   * the cubic of the sample just finished, at its end */
+  const double u[4] = {s1, m1, 6.0 * (s0 - s1) + 2.0 * m0 + 4.0 * m1,
+                       12.0 * (s0 - s1) + 6.0 * (m0 + m1)};
+  double v = 0.0;
+  for (int i = 0; i < PICKOFF_MAX_N; i++) v += p->out_z[i] * zn[i];
+  for (int i = 0; i < 4; i++) v += p->out_u[i] * u[i];
+  if (c->jitter_rms_s > 0.0) {
+    double dy = 0.0;
+    for (int i = 0; i < PICKOFF_MAX_N; i++) dy += p->dout_z[i] * zn[i];
+    for (int i = 0; i < 4; i++) dy += p->dout_u[i] * u[i];
+    v += c->jitter_rms_s * p->inv_t * gauss_zig(&p->zig, &p->rng_jitter) * dy;
+  }
+  v += c->offset_v;
+  if (p->noise_sd > 0.0) v += p->noise_sd * gauss_zig(&p->zig, &p->rng_noise);
+  return v;
+}

@@ -1,0 +1,152 @@
+/* Pickoff front end of one axis (drive or sense), from mode displacement to the voltage
+ * at the ADC input at the sampling instant (thesis §4.3.2, §4.4.2; host plant, double).
+ *
+ * Signal chain (continuous time):
+ *   s(t) = g(T) pos(t) + ft_u1 U1(t) + ft_u2 U2(t) + ft_spare U3(t)   ring-diode output
+ *          g(T) = gain_v_per_m (1 + gain_tc_per_k (T - T0))          (4-12): gain ~ Vc - V_D
+ *          clipped at +-preamp_rail_v (preamp saturation, counted)
+ *   -> circuit lag section, phase Phi_cir(T) at lag_ref_hz                  (2-40)
+ *          Phi_cir(T) = phi0 + phi1 (T - T0) + 0.5 phi2 (T - T0)^2   (rad, lag positive)
+ *          LAG_LOWPASS: 1 / (1 + s tau), tau = tan(Phi) / w_ref  (the ring diode's R//C
+ *                       hold network, fig. 4-9: gain cos(Phi) at w_ref, drifts with it)
+ *          LAG_ALLPASS: (1 - s tau) / (1 + s tau), tau = tan(Phi/2) / w_ref (pure phase)
+ *   -> anti-alias band-pass (fig. 4-13): first-order high-pass at hp_hz (0: none)
+ *      times second-order low-pass at lp_hz, quality lp_q.
+ *          Why a band-pass: the useful band is 1-3 kHz; the low-pass keeps ~20 dB at
+ *          25 kHz (8 kHz Butterworth: 19.8 dB), and the high-pass keeps slow
+ *          acceleration/shaking signals (< 10 Hz, §4.4.2) from pushing the ADC out of
+ *          range: a static 1 g on the sense axis moves the ring-diode output by
+ *          ~3.8 V with the default gain, which the high-pass removes.
+ *   -> + offset_v + white noise (noise_v_rthz, one-sided, as seen in the sampled data)
+ *   -> sampled at t_k + sample_delay_s + jitter (jitter ~ N(0, jitter_rms_s^2), drawn
+ *      per sample per channel).
+ * Default phases at 1489.9 Hz: lag 3 deg, high-pass +3.8 deg, low-pass -15.3 deg.
+ *
+ * Electrical feedthrough: the electrode voltages couple into the ring-diode output
+ * (§1.4.3 item 4, §6.3.2). Under half-frequency drive it sits at wc/2, which the
+ * firmware's demodulation at wc rejects; under DC+AC it sits at wc, in band.
+ *
+ * Discretisation. The chain is one LTI system, state z (n = 3 or 4, time normalised to
+ * the sample period T), z' = A z + B s, y = C z + D s. Between ticks the input s is the
+ * cubic Hermite interpolant of its values and slopes at both ticks (the mechanics gives
+ * displacement and velocity at the ticks, the DAC its output and slope), and the state
+ * is advanced exactly for that cubic (augmented exponential):
+ *   z_{k+1} = Phi z_k + G [s_k, T s'_k, s_{k+1}, T s'_{k+1}]^T
+ * Interpolation error for a sinusoid: (wT)^4/384 = 3e-6 relative at 1.5 kHz, 50 kHz.
+ * Feedthrough of the DAC's filtered staircase is interpolated the same way (its part
+ * at wc under DC+AC comes out within 0.02 % of the closed form; see test_pickoff).
+ *
+ * Sampling instant: the output at t_k + d (d = sample_delay_s) is the Taylor series to
+ * third order of the exact output, y^(j) = C A^j z + sum_i C A^(j-1-i) B s^(i) + D s^(j),
+ * with the input derivatives of the last cubic: error (w d)^4 / 24 relative in steady
+ * state (3e-6 at 1.5 kHz for d = 10 us). The series is folded into one row at each
+ * discretisation, so the per-sample cost does not depend on d. Jitter e adds e y'(t_k + d)
+ * (first order; the neglected e^2 y''/2 is (w sigma)^2/2 = 4e-5 relative at the largest
+ * allowed sigma, T/20): on a sine of amplitude a, noise of rms a w sigma / sqrt(2).
+ *
+ * Temperature: pickoff_set_temp() updates the gain at once and re-discretises the chain
+ * (about 5-10 us) only when Phi_cir has moved by phase_step_rad or more since the last
+ * discretisation; it may be called every sample. The default step, 1e-6 rad, is a bias
+ * step of 1.5e-3 deg/s on 1500 deg/s of quadrature (0.57 mK at 0.1 deg/K); a 10 K/min
+ * ramp then re-discretises about 300 times per simulated second.
+ *
+ * Noise streams: rng_seed(seed, PICKOFF_RNG_STREAM_NOISE + axis) for the white noise and
+ * rng_seed(seed, PICKOFF_RNG_STREAM_JITTER + axis) for the jitter.
+ */
+#ifndef PLANT_PICKOFF_H
+#define PLANT_PICKOFF_H
+
+#include <stdint.h>
+
+#include "plant/dac.h"
+#include "plant/gauss_zig.h"
+#include "plant/rng.h"
+
+#define PICKOFF_RNG_STREAM_NOISE 0x7001u  /* + axis */
+#define PICKOFF_RNG_STREAM_JITTER 0x7011u /* + axis */
+#define PICKOFF_MAX_N 4
+
+typedef enum { PICKOFF_DRIVE = 0, PICKOFF_SENSE = 1 } pickoff_axis_t;
+typedef enum { PICKOFF_LAG_LOWPASS = 0, PICKOFF_LAG_ALLPASS = 1 } pickoff_lag_kind_t;
+
+typedef struct {
+  pickoff_axis_t axis;
+  double fs_hz;
+  /* ring-diode front end */
+  double gain_v_per_m;       /* output volts per metre of mode displacement at T0 */
+  double gain_tc_per_k;      /* relative gain change per kelvin (diode drop); 0 default */
+  double preamp_rail_v;      /* preamp output saturates at +-this, V (> 0) */
+  double ft_u1;              /* feedthrough, V at the preamp output per V on U1 */
+  double ft_u2;              /* ... per V on U2 */
+  double ft_spare;           /* ... per V on the spare (sense feedback) DAC channel */
+  /* circuit phase (2-40) */
+  pickoff_lag_kind_t lag_kind;
+  double lag_ref_hz;         /* frequency at which the lag equals Phi_cir (drive freq) */
+  double temp_ref_k;         /* T0 */
+  double phi0_rad;           /* Phi_cir(T0), lag positive */
+  double phi1_rad_per_k;     /* dPhi/dT at T0 */
+  double phi2_rad_per_k2;    /* d2Phi/dT2 at T0 */
+  /* anti-alias band-pass */
+  double hp_hz;              /* first-order high-pass corner; 0: none */
+  double lp_hz;              /* second-order low-pass natural frequency */
+  double lp_q;               /* its quality factor */
+  /* ADC input */
+  double offset_v;           /* added after the filters, V */
+  double noise_v_rthz;       /* white, one-sided, V/sqrt(Hz) */
+  double sample_delay_s;     /* fixed sampling instant after the tick, |.| <= T/2 */
+  double jitter_rms_s;       /* rms random timing error, <= T/20 */
+  double phase_step_rad;     /* Phi_cir change that triggers a re-discretisation, >= 0 */
+} pickoff_cfg_t;
+
+typedef struct {
+  pickoff_cfg_t cfg;
+  int n;                         /* states in use (3 or 4; the rest stay zero) */
+  double t_s, inv_t;             /* sample period and its inverse */
+  double temp_k;                 /* circuit temperature now */
+  double phi_rad;                /* Phi_cir realised by the current discretisation */
+  uint64_t rediscretise_count;   /* re-discretisations by pickoff_set_temp */
+  double gain_now;               /* g(temp_k) */
+  double phi[PICKOFF_MAX_N][PICKOFF_MAX_N];
+  double g[PICKOFF_MAX_N][4];
+  double out_z[PICKOFF_MAX_N];    /* output at the nominal sampling instant: state row */
+  double out_u[4];               /* ... and weights of [s, T s', T^2 s'', T^3 s'''] */
+  double dout_z[PICKOFF_MAX_N];  /* T d(output)/dt there (for the jitter): state row */
+  double dout_u[4];              /* ... input weights */
+  double z[PICKOFF_MAX_N];
+  double s_prev, m_prev;         /* input and T * slope at the previous tick */
+  double noise_sd;
+  rng_t rng_noise, rng_jitter;
+  gauss_zig_t zig; /* normal deviates by the ziggurat: no log per sample (gauss_zig.h) */
+  uint64_t preamp_clip_count;
+} pickoff_t;
+
+/* Defaults for one axis (thesis linear gyro, 1489.9 Hz drive, 50 kHz):
+ *   drive: 3.0e5 V/m (10 um -> 2.99 V at the ADC), feedthrough U1 2e-4, U2 -1.5e-4,
+ *          phi0 3 deg, phi1 0.01 deg/K, offset +5 mV, sampled at the tick;
+ *   sense: 6.18e7 V/m, so 1 deg/s of Coriolis motion (4.06e-11 m at 10 um drive
+ *          amplitude, (2-28)) gives 2.5 mV at the ADC (§4.6.1) and 1500 deg/s of
+ *          quadrature 3.75 V; feedthrough U1 1e-4, U2 6e-5, spare 1e-3, phi0 3 deg,
+ *          phi1 0.1 deg/K (table 7-4), offset -3 mV, sampled 4 us after the drive
+ *          channel (multiplexed converter);
+ *   both: low-pass lag referred to 1489.9 Hz, T0 298.15 K, high-pass 100 Hz, low-pass
+ *         8 kHz Butterworth, preamp rail 13.5 V, noise 2 uV/sqrt(Hz), no jitter,
+ *         phase step 1e-6 rad.
+ * The feedthrough, offsets, phases and noise are placeholders for calibration. */
+void pickoff_default_cfg(pickoff_cfg_t *cfg, pickoff_axis_t axis);
+
+/* Validates cfg, discretises at the circuit temperature temp_k, zero state, seeds the
+ * noise and jitter sources. Returns 0, or -1 (bad cfg or temperature) with p unchanged. */
+int pickoff_init(pickoff_t *p, const pickoff_cfg_t *cfg, double temp_k, uint64_t seed);
+
+/* New circuit temperature (K): the gain follows at once, Phi_cir (2-40) to within
+ * phase_step_rad. Returns 0, or -1 if temp_k is not finite or Phi_cir leaves
+ * (1e-4, 1.4) rad (low-pass) or (1e-4, 2.8) rad (all-pass); p is then unchanged. */
+int pickoff_set_temp(pickoff_t *p, double temp_k);
+
+/* Advance one sample to tick t_{k+1}: pos_m, vel_mps are the mode displacement and
+ * velocity at t_{k+1}; dac the DAC output of the sample just finished (its end values
+ * are the electrode voltages at t_{k+1}), or NULL for no feedthrough. Returns the
+ * voltage at the ADC input sampled at t_{k+1} + delay + jitter. */
+double pickoff_step(pickoff_t *p, double pos_m, double vel_mps, const dac_out_t *dac);
+
+#endif /* PLANT_PICKOFF_H */

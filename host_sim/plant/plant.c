@@ -1,0 +1,435 @@
+/* Top level of the plant: builds the modules from plant_cfg_t and runs one sample. */
+#include "plant/plant.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+static const double kPi = 3.14159265358979323846;
+static const double kDeg = 3.14159265358979323846 / 180.0;
+
+__attribute__((format(printf, 2, 3))) static void set_err(plant_t *p, const char *fmt, ...)
+{
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(p->err, sizeof p->err, fmt, ap);
+  va_end(ap);
+}
+
+const char *plant_error(const plant_t *p) { return p->err; }
+
+/* ---------------------------------------------------------- module configs ---- */
+
+static void make_mech_cfg(const plant_cfg_t *c, mech_cfg_t *m)
+{
+  mech_default_cfg(m);
+  m->f1_hz = c->f_drive_hz;
+  m->q1 = c->q_drive;
+  m->f2_hz = c->f_sense_hz;
+  m->q2 = c->q_sense;
+  m->temp_ref_k = c->temp_ref_k;
+  m->ket_per_k = c->ket_per_k;
+  /* equivalent rate of k_q y against 2 Omega y' at the drive frequency: k_q/(2 wc) */
+  m->kq_per_s2 = 2.0 * (2.0 * kPi * c->f_drive_hz) * c->quad_dps * kDeg;
+  m->dq_per_s = 2.0 * c->inphase_bias_dps * kDeg;
+  m->mass_kg = c->mass_kg;
+  m->fs_hz = c->fs_hz;
+  m->refresh_eps = c->mech_refresh_eps;
+  m->full_kinematics = c->full_kinematics ? 1 : 0;
+  m->brownian = c->brownian ? 1 : 0;
+}
+
+static int thermal_every(const plant_cfg_t *c)
+{
+  const double n = floor(c->thermal_dt_s * c->fs_hz + 0.5);
+  return n < 1.0 ? 1 : (int)n;
+}
+
+static void make_thermal_cfg(const plant_cfg_t *c, thermal_cfg_t *t)
+{
+  thermal_default_cfg(t);
+  t->tau_s[THERMAL_STRUCT] = c->tau_struct_s;
+  t->tau_s[THERMAL_CIRCUIT] = c->tau_circuit_s;
+  t->tau_s[THERMAL_BOARD] = c->tau_board_s;
+  t->couple_per_s[THERMAL_PAIR_SC] = c->couple_sc_per_s;
+  t->couple_per_s[THERMAL_PAIR_SB] = c->couple_sb_per_s;
+  t->couple_per_s[THERMAL_PAIR_CB] = c->couple_cb_per_s;
+  t->rise_k[THERMAL_STRUCT] = c->rise_struct_k;
+  t->rise_k[THERMAL_CIRCUIT] = c->rise_circuit_k;
+  t->rise_k[THERMAL_BOARD] = c->rise_board_k;
+  t->dt_s = thermal_every(c) / c->fs_hz;
+}
+
+static void make_dac_cfg(const plant_cfg_t *c, dac_cfg_t *d)
+{
+  dac_default_cfg(d);
+  d->fs_hz = c->fs_hz;
+  d->recon_cutoff_hz = c->dac_recon_hz;
+  d->recon_q = c->dac_recon_q;
+  d->gain[HAL_DAC_DRIVE_U1] = c->dac_gain_u1;
+  d->gain[HAL_DAC_DRIVE_U2] = c->dac_gain_u2;
+  d->gain[HAL_DAC_RATE_OUT] = c->dac_gain_rate;
+  d->gain[HAL_DAC_SPARE] = c->dac_gain_spare;
+  d->offset_v[HAL_DAC_DRIVE_U1] = c->dac_offset_u1_v;
+  d->offset_v[HAL_DAC_DRIVE_U2] = c->dac_offset_u2_v;
+  d->offset_v[HAL_DAC_RATE_OUT] = c->dac_offset_rate_v;
+  d->offset_v[HAL_DAC_SPARE] = c->dac_offset_spare_v;
+}
+
+static void make_actuator_cfg(const plant_cfg_t *c, actuator_cfg_t *a)
+{
+  actuator_default_cfg(a);
+  a->fs_hz = c->fs_hz;
+  a->ks_drive_mps2_per_v2 = c->ks_drive_mps2_per_v2;
+  a->drive_noise.white_rthz = c->drive_noise_white_v_rthz;
+  a->drive_noise.flicker_1hz_rthz = c->drive_noise_1hz_v_rthz;
+  a->drive_noise.fmin_hz = c->drive_noise_fmin_hz;
+  a->fb_mode = (actuator_fb_mode_t)c->fb_mode;
+  a->ks_fb_mps2_per_v2 = c->ks_fb_mps2_per_v2;
+  a->fb_bias_v = c->fb_bias_v;
+  a->fb_noise.white_rthz = c->fb_noise_white_v_rthz;
+  a->fb_noise.flicker_1hz_rthz = c->fb_noise_1hz_v_rthz;
+  a->fb_noise.fmin_hz = c->fb_noise_fmin_hz;
+}
+
+static void make_pickoff_cfg(const plant_cfg_t *c, int axis, pickoff_cfg_t *q)
+{
+  pickoff_default_cfg(q, axis == 0 ? PICKOFF_DRIVE : PICKOFF_SENSE);
+  q->fs_hz = c->fs_hz;
+  q->lag_ref_hz = c->pick_lag_ref_hz;
+  q->temp_ref_k = c->temp_ref_k;
+  q->phase_step_rad = c->pick_phase_step_rad;
+  if (axis == 0) {
+    q->gain_v_per_m = c->pick_drive_gain_v_per_m;
+    q->gain_tc_per_k = c->pick_drive_gain_tc_per_k;
+    q->preamp_rail_v = c->pick_drive_rail_v;
+    q->ft_u1 = c->pick_drive_ft_u1;
+    q->ft_u2 = c->pick_drive_ft_u2;
+    q->ft_spare = c->pick_drive_ft_spare;
+    q->lag_kind = c->pick_drive_lag_allpass ? PICKOFF_LAG_ALLPASS : PICKOFF_LAG_LOWPASS;
+    q->phi0_rad = c->pick_drive_phi0_deg * kDeg;
+    q->phi1_rad_per_k = c->pick_drive_phi1_deg_per_k * kDeg;
+    q->phi2_rad_per_k2 = c->pick_drive_phi2_deg_per_k2 * kDeg;
+    q->hp_hz = c->pick_drive_hp_hz;
+    q->lp_hz = c->pick_drive_lp_hz;
+    q->lp_q = c->pick_drive_lp_q;
+    q->offset_v = c->pick_drive_offset_v;
+    q->noise_v_rthz = c->pick_drive_noise_v_rthz;
+    q->sample_delay_s = c->pick_drive_delay_s;
+    q->jitter_rms_s = c->pick_drive_jitter_s;
+  } else {
+    q->gain_v_per_m = c->pick_sense_gain_v_per_m;
+    q->gain_tc_per_k = c->pick_sense_gain_tc_per_k;
+    q->preamp_rail_v = c->pick_sense_rail_v;
+    q->ft_u1 = c->pick_sense_ft_u1;
+    q->ft_u2 = c->pick_sense_ft_u2;
+    q->ft_spare = c->pick_sense_ft_spare;
+    q->lag_kind = c->pick_sense_lag_allpass ? PICKOFF_LAG_ALLPASS : PICKOFF_LAG_LOWPASS;
+    q->phi0_rad = c->pick_sense_phi0_deg * kDeg;
+    q->phi1_rad_per_k = c->pick_sense_phi1_deg_per_k * kDeg;
+    q->phi2_rad_per_k2 = c->pick_sense_phi2_deg_per_k2 * kDeg;
+    q->hp_hz = c->pick_sense_hp_hz;
+    q->lp_hz = c->pick_sense_lp_hz;
+    q->lp_q = c->pick_sense_lp_q;
+    q->offset_v = c->pick_sense_offset_v;
+    q->noise_v_rthz = c->pick_sense_noise_v_rthz;
+    q->sample_delay_s = c->pick_sense_delay_s;
+    q->jitter_rms_s = c->pick_sense_jitter_s;
+  }
+}
+
+static void make_accel_cfg(const plant_cfg_t *c, accel_cfg_t *a)
+{
+  accel_default_cfg(a);
+  a->drive_mps2_per_g[ACCEL_AXIS_DRIVE] = c->gs_drive_from_drive_mps2_per_g;
+  a->drive_mps2_per_g[ACCEL_AXIS_SENSE] = c->gs_drive_from_sense_mps2_per_g;
+  a->drive_mps2_per_g[ACCEL_AXIS_NORMAL] = c->gs_drive_from_normal_mps2_per_g;
+  a->sense_mps2_per_g[ACCEL_AXIS_DRIVE] = c->gs_sense_from_drive_mps2_per_g;
+  a->sense_mps2_per_g[ACCEL_AXIS_SENSE] = c->gs_sense_from_sense_mps2_per_g;
+  a->sense_mps2_per_g[ACCEL_AXIS_NORMAL] = c->gs_sense_from_normal_mps2_per_g;
+}
+
+static int pick_node(const plant_cfg_t *c, int axis)
+{
+  return axis == 0 ? c->pick_drive_temp_node : c->pick_sense_temp_node;
+}
+
+/* ------------------------------------------------------------------ init ------ */
+
+static void accel_flags(plant_t *p)
+{
+  const accel_profile_t *a = &p->prof.accel_g;
+  p->accel_dynamic = 0;
+  p->accel_any = 0;
+  for (int i = 0; i < PROFILE_ACCEL_AXES; i++) {
+    if (a->amp_g[i] != 0.0) p->accel_dynamic = 1;
+    if (a->amp_g[i] != 0.0 || a->const_g[i] != 0.0) p->accel_any = 1;
+  }
+}
+
+static void truth_temps(plant_t *p, double ambient_k)
+{
+  plant_truth_t *t = &p->truth;
+  t->ambient_k = ambient_k;
+  t->struct_k = thermal_temp(&p->thermal, THERMAL_STRUCT);
+  t->circuit_k = thermal_temp(&p->thermal, THERMAL_CIRCUIT);
+  t->board_k = thermal_temp(&p->thermal, THERMAL_BOARD);
+  t->wn_drive_rad_s = mech_wn1(&p->mech);
+  t->wn_sense_rad_s = mech_wn2(&p->mech);
+}
+
+int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
+{
+  if (p == NULL) return -1;
+  char msg[sizeof p->err];
+  if (plant_cfg_check(cfg, msg, sizeof msg) != 0) {
+    memcpy(p->err, msg, sizeof msg);
+    return -1;
+  }
+  /* build into a scratch plant: p changes only on success (besides p->err) */
+  plant_t n;
+  memset(&n, 0, sizeof n);
+  n.cfg = *cfg;
+  n.T = 1.0 / cfg->fs_hz;
+  n.thermal_every = thermal_every(cfg);
+  const char *what = NULL;
+
+  thermal_cfg_t thc;
+  make_thermal_cfg(cfg, &thc);
+  mech_cfg_t mc;
+  make_mech_cfg(cfg, &mc);
+  dac_cfg_t dc;
+  make_dac_cfg(cfg, &dc);
+  actuator_cfg_t ac;
+  make_actuator_cfg(cfg, &ac);
+  pickoff_cfg_t pc[2];
+  make_pickoff_cfg(cfg, 0, &pc[0]);
+  make_pickoff_cfg(cfg, 1, &pc[1]);
+  adc_cfg_t adcc;
+  adc_default_cfg(&adcc);
+  adcc.full_scale_v = cfg->adc_full_scale_v;
+  accel_cfg_t gc;
+  make_accel_cfg(cfg, &gc);
+
+  if (thermal_init(&n.thermal, &thc, cfg->temp_k) != 0) what = "thermal (tau_*, couple_*, rise_*)";
+  else if (mech_init(&n.mech, &mc, thermal_temp(&n.thermal, THERMAL_STRUCT), seed) != 0)
+    what = "mechanics (f_*_hz, q_*, ket_per_k, temp_k)";
+  else if (dac_init(&n.dac, &dc) != 0) what = "DAC (dac_*)";
+  else if (actuator_init(&n.act, &ac, seed) != 0) what = "actuator (ks_*, *_noise_*, fb_*)";
+  else if (adc_init(&n.adc, &adcc) != 0) what = "ADC (adc_full_scale_v)";
+  else if (accel_init(&n.accel, &gc) != 0) what = "g-sensitivity (gs_*)";
+  for (int i = 0; what == NULL && i < 2; i++) {
+    if (pickoff_init(&n.pick[i], &pc[i], thermal_temp(&n.thermal, pick_node(cfg, i)), seed) != 0)
+      what = i == 0 ? "drive pickoff (pick_drive_*: phase law at this temperature?)"
+                    : "sense pickoff (pick_sense_*: phase law at this temperature?)";
+  }
+  if (what != NULL) {
+    set_err(p, "plant_init: %s rejected the configuration", what);
+    return -2;
+  }
+
+  profile_const(&n.prof.rate_dps, cfg->rate_dps);
+  profile_const(&n.prof.ambient_k, cfg->temp_k);
+  accel_profile_zero(&n.prof.accel_g);
+  accel_flags(&n);
+
+  /* truth at t = 0 */
+  n.est_alpha = 1.0 - exp(-n.T / cfg->truth_tau_s);
+  const double wt = 2.0 * kPi * cfg->f_drive_hz * n.T;
+  n.est_num = 2.0 * cos(wt); /* prior: the nominal drive frequency, weight of one */
+  n.est_den = 2.0;
+  n.truth.drive_freq_hz = cfg->f_drive_hz;
+  n.cw = cos(wt);
+  n.sw = sin(wt);
+  n.inv_sw = 1.0 / n.sw;
+  n.thermal_countdown = 0; /* first update at the first sample */
+  n.truth_countdown = cfg->truth_decim;
+  n.fz_alpha = 1.0 - exp(-n.T / cfg->truth_force_tau_s);
+  truth_temps(&n, cfg->temp_k);
+  *p = n;
+  return 0;
+}
+
+int plant_set_profiles(plant_t *p, const plant_profiles_t *prof)
+{
+  if (p == NULL || prof == NULL) return -1;
+  const char *key = NULL;
+  if (profile_check(&prof->rate_dps, &key) != 0) {
+    set_err(p, "rate profile: %s invalid", key);
+    return -1;
+  }
+  if (profile_check(&prof->ambient_k, &key) != 0) {
+    set_err(p, "ambient profile: %s invalid", key);
+    return -1;
+  }
+  if (accel_profile_check(&prof->accel_g, &key) != 0) {
+    set_err(p, "acceleration profile: %s invalid", key);
+    return -1;
+  }
+  p->prof = *prof;
+  accel_flags(p);
+  return 0;
+}
+
+/* ------------------------------------------------------------------ step ------ */
+
+/* Thermal update over [t0, t0 + dt): ambient at mid-interval (thermal.h). The new
+ * node temperatures apply from this sample on (half an update period early, 0.5 ms
+ * against time constants of minutes). */
+static void thermal_update(plant_t *p, double t0)
+{
+  const double dt = p->thermal_every * p->T;
+  double amb = profile_eval(&p->prof.ambient_k, t0 + 0.5 * dt, NULL);
+  if (!(amb > 1.0 && amb < 2000.0)) amb = p->truth.ambient_k; /* keep the last sane one */
+  thermal_step(&p->thermal, amb);
+  (void)mech_set_temp(&p->mech, thermal_temp(&p->thermal, THERMAL_STRUCT));
+  /* the gain follows at once; the phase re-discretises (microseconds) only when it moved
+   * by pick_phase_step_rad. A law driven out of its range keeps the last phase. */
+  for (int i = 0; i < 2; i++)
+    (void)pickoff_set_temp(&p->pick[i], thermal_temp(&p->thermal, pick_node(&p->cfg, i)));
+  truth_temps(p, amb);
+}
+
+/* Phasors at the drive frequency (plant.h, plant_truth_t): the frequency from the
+ * force samples (a sampled sinusoid obeys F_k + F_k-2 = 2 cos(wT) F_k-1 exactly, so
+ * the ratio of the two smoothed sums is exact for a steady tone), the force phasor
+ * from its last two samples, the motion phasors from position and velocity. */
+static void truth_phasors(plant_t *p)
+{
+  plant_truth_t *t = &p->truth;
+  double c = p->est_den > 0.0 ? p->est_num / p->est_den : 2.0;
+  if (!(c > -0.999999) || !(c < 0.999999)) c = cos(2.0 * kPi * p->cfg.f_drive_hz * p->T);
+  const double s = sqrt(1.0 - c * c);
+  p->cw = c;
+  p->sw = s;
+  p->inv_sw = 1.0 / s;
+  const double w = atan2(s, c) / p->T;
+  t->drive_freq_hz = w / (2.0 * kPi);
+  /* motion: Z = v/w + j pos = amplitude e^{j theta} with pos = amplitude sin(theta) */
+  const double yr = t->vy_mps / w, yi = t->y_m;
+  const double amp = sqrt(yr * yr + yi * yi);
+  t->drive_amp_m = amp;
+  /* force phasor at mid-sample k, rotated by wT/2 to t_k+1 */
+  const double ch = sqrt(0.5 * (1.0 + c)), sh = sqrt(0.5 * (1.0 - c));
+  const double gr = p->fz_re * ch - p->fz_im * sh, gi = p->fz_re * sh + p->fz_im * ch;
+  /* the samples carry sinc(wT/2) of the force; the hold multiplies by it once more */
+  t->drive_force_mps2 = sqrt(gr * gr + gi * gi) * sh / (0.5 * w * p->T);
+  if (t->drive_force_mps2 > 0.0 && amp > 0.0) {
+    const double re = yr * gr + yi * gi, im = yi * gr - yr * gi; /* Zy conj(ZF) */
+    t->drive_phase_rad = atan2(im, re);
+  } else {
+    t->drive_phase_rad = 0.0;
+  }
+  if (amp > 0.0) {
+    const double xr = t->vx_mps / w, xi = t->x_m;
+    t->sense_disp_m = (xr * yr + xi * yi) / amp; /* along sin(theta): with y */
+    t->sense_vel_m = (xi * yr - xr * yi) / amp;  /* along cos(theta): with y' */
+  } else {
+    t->sense_disp_m = t->sense_vel_m = 0.0;
+  }
+}
+
+/* Force phasor, every sample: the actuator gives per-sample means,
+ * F_k = F0 sinc sin(theta(t_k + T/2)); with F_k-1 = F0 sinc sin(theta - wT) the phasor is
+ * F0 sinc [ (F_k cos wT - F_k-1) / sin wT, F_k ]. The 14-bit DAC codes put ~1e-4 of
+ * distortion on F, which the division by sin wT amplifies: the phasor is averaged over
+ * truth_force_tau_s while being rotated along at w. */
+static void truth_force(plant_t *p, double f)
+{
+  const double ir = (f * p->cw - p->f_prev[0]) * p->inv_sw, ii = f;
+  const double rr = p->fz_re * p->cw - p->fz_im * p->sw;
+  const double ri = p->fz_re * p->sw + p->fz_im * p->cw;
+  p->fz_re = rr + p->fz_alpha * (ir - rr);
+  p->fz_im = ri + p->fz_alpha * (ii - ri);
+}
+
+void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out)
+{
+  const double T = p->T;
+  const double t0 = (double)p->k * T;
+  plant_truth_t *t = &p->truth;
+  if (p->thermal_countdown <= 0) {
+    thermal_update(p, t0);
+    p->thermal_countdown = p->thermal_every;
+  }
+  p->thermal_countdown--;
+
+  /* The frame passed in is on the outputs during this interval (the host HAL applies
+   * the board's latency), so it is latched now: dac_write validates it, then the
+   * queued codes are moved to the held ones (dac.h's own one-sample queue would add a
+   * second sample of latency). */
+  if (dac != NULL) {
+    if (dac_write(&p->dac, dac) == 0) memcpy(p->dac.latched, p->dac.pending, sizeof p->dac.latched);
+    else t->dac_rejects++;
+  }
+  dac_out_t dout;
+  dac_step(&p->dac, &dout);
+  actuator_out_t aout;
+  actuator_step(&p->act, &dout, &aout);
+  double fd = aout.f_drive_mps2, fsn = aout.f_sense_mps2;
+  if (p->accel_any) {
+    if (p->accel_dynamic) accel_profile_mean(&p->prof.accel_g, t0, t0 + T, t->accel_g);
+    else memcpy(t->accel_g, p->prof.accel_g.const_g, sizeof t->accel_g);
+    accel_out_t gout;
+    accel_step(&p->accel, t->accel_g, &gout);
+    fd += gout.f_drive_mps2;
+    fsn += gout.f_sense_mps2;
+  }
+
+  double slope_dps;
+  const double rate_dps = profile_eval(&p->prof.rate_dps, t0 + 0.5 * T, &slope_dps);
+  mech_step(&p->mech, fd, fsn, rate_dps * kDeg, slope_dps * kDeg);
+  const mech_state_t s = mech_state(&p->mech);
+
+  const double vd = pickoff_step(&p->pick[0], s.y_m, s.vy_mps, &dout);
+  const double vs = pickoff_step(&p->pick[1], s.x_m, s.vx_mps, &dout);
+  adc_convert_frame(&p->adc, vd, vs, &t->adc);
+  if (adc_out != NULL) *adc_out = t->adc;
+  p->k++;
+
+  /* truth: cheap fields every sample */
+  t->sample = p->k;
+  t->t_s = (double)p->k * T;
+  t->rate_dps = rate_dps;
+  t->rate_rad_s = rate_dps * kDeg;
+  t->rate_dot_rad_s2 = slope_dps * kDeg;
+  t->y_m = s.y_m;
+  t->vy_mps = s.vy_mps;
+  t->x_m = s.x_m;
+  t->vx_mps = s.vx_mps;
+  t->f_drive_mps2 = fd;
+  t->f_sense_mps2 = fsn;
+  for (int i = 0; i < DAC_NCH; i++) {
+    t->dac_held_v[i] = dout.ch[i].held_v;
+    t->dac_mean_v[i] = dout.ch[i].mean_v;
+  }
+  t->adc_v[0] = vd;
+  t->adc_v[1] = vs;
+  for (int i = 0; i < 2; i++) {
+    t->adc_clip[i] = p->adc.clip_count[i];
+    t->adc_fault[i] = p->adc.fault_count[i];
+    t->preamp_clip[i] = p->pick[i].preamp_clip_count;
+  }
+  t->mech_refreshes = p->mech.refresh_count;
+
+  /* drive-frequency estimate from the actuator's drive force (without accelerations) */
+  const double f = aout.f_drive_mps2;
+  const double a = p->est_alpha;
+  p->est_num += a * ((f + p->f_prev[1]) * p->f_prev[0] - p->est_num);
+  p->est_den += a * (2.0 * p->f_prev[0] * p->f_prev[0] - p->est_den);
+  truth_force(p, f);
+  if (--p->truth_countdown <= 0) {
+    truth_phasors(p);
+    p->truth_countdown = p->cfg.truth_decim;
+  }
+  p->f_prev[1] = p->f_prev[0];
+  p->f_prev[0] = f;
+}
+
+void plant_step_hal(void *plant, const hal_dac_frame_t *dac, hal_adc_frame_t *adc)
+{
+  plant_step((plant_t *)plant, dac, adc);
+}
+
+const plant_truth_t *plant_truth(const plant_t *p) { return &p->truth; }

@@ -1,0 +1,372 @@
+"""Allan deviation of the rate output and its noise read-offs (thesis 7.2.1, (7-1)..(7-11)).
+
+Convention (IEEE Std 952 / 1431, the two-sided one of the thesis (7-4)..(7-10)); every
+deviation is in deg/h, every tau in s:
+
+    angle random walk   sigma(tau) = N / sqrt(tau)         (7-6), slope -1/2
+    bias instability    sigma floor = sqrt(2 ln2 / pi) B = 0.664 B   (7-8), slope 0
+    rate random walk    sigma(tau) = K sqrt(tau / 3)       slope +1/2
+    rate ramp           sigma(tau) = R tau / sqrt(2)       (7-10), slope +1
+
+N in deg/h/sqrt(Hz) equals N in deg/h*sqrt(s); N / 60 is deg/sqrt(h). A one-sided
+spectrum (analyser, Welch) shows sqrt(2) N for the same noise (see psd.py).
+
+Method
+------
+1. Overlapping ADEV by allantools.oadev with the rate as FREQUENCY data
+   (data_type="freq", rate = sample rate): the rate is the derivative of the angle, so
+   the angle is the "phase". Feeding rate as phase data is a common bench mistake and
+   gives a different, wrong curve.
+2. The variance model sigma^2 = N^2/tau + F^2 + R^2 tau^2/2 (the sum (7-11); the rate
+   random walk term K^2 tau/3 only on request) is fitted by weighted least squares on
+   log sigma^2 (weights edf/2: the relative variance of an Allan variance estimate is
+   2/edf), coefficients kept >= 0.
+3. Confidence intervals: Greenhall's equivalent degrees of freedom
+   (allantools.edf_greenhall, overlapping ADEV) with the noise type at each tau taken
+   from the model term that dominates there, then allantools.confidence_interval
+   (chi-squared, 68.3 %).
+4. Read-offs, each from its own slope region:
+   N  least-squares fit of slope -1/2 over the taus where the white term is at least
+      half the fitted variance, after subtracting the other fitted terms. Reading
+      sigma(1 s) instead is biased high when flicker is present (with the thesis's
+      figures, N = 18.7 and 0.664 B = 20.8 deg/h, by about 50 %); it is reported only
+      for comparison.
+   B  the flat minimum of the fitted curve / 0.664 (IEEE read-off: it includes what the
+      neighbouring terms add at the minimum). The minimum of the raw points is given
+      too; it is biased low by the scatter of the points, so it is not the read-off.
+      When the curve still falls at the longest tau, B is only an upper bound and is
+      flagged.
+   R  least-squares fit of slope +1 over the taus where the ramp term is at least half
+      the fitted variance, other terms subtracted.
+5. Leading taus that the output low-pass smooths (there the curve rises or is flat
+   before the -1/2 region) are excluded from the fit: if the curve starts with an
+   octave slope above -0.35 and later reaches -0.35, the fit starts ten times later
+   than that point (a low-pass of cutoff fc still lowers sigma by about 1 % at
+   tau = 7/fc). `tau_min_s` overrides.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import allantools
+import numpy as np
+from scipy import optimize
+
+from .errors import InputError
+
+DPH_PER_DPS = 3600.0
+FLICKER_FLOOR = math.sqrt(2.0 * math.log(2.0) / math.pi)  # 0.6643, (7-8) for x -> inf
+CI_LEVEL = 0.6826894921370859                              # one sigma
+MIN_SAMPLES = 256
+# Noise type (allantools alpha: S_y(f) ~ f^alpha) of each model term, rate as frequency.
+_ALPHA = {"white": 0, "flicker": -1, "rrw": -2, "ramp": -2}
+_TERMS = ("white", "flicker", "rrw", "ramp")
+
+
+@dataclasses.dataclass
+class AllanCurve:
+    tau_s: np.ndarray
+    adev_dph: np.ndarray
+    m: np.ndarray           # averaging factors, tau = m / fs
+    n_samples: int
+    fs_hz: float
+
+
+@dataclasses.dataclass
+class AllanResult:
+    curve: AllanCurve
+    ci_lo_dph: np.ndarray
+    ci_hi_dph: np.ndarray
+    edf: np.ndarray
+    fit_mask: np.ndarray            # taus used by the model fit
+    model: dict                     # N_dph_rthz, F_dph, K_dph_rts, R_dph_per_s (SI time)
+    arw_dph_rthz: float             # N (two-sided), deg/h/sqrt(Hz) = deg/h*sqrt(s)
+    arw_source: str                 # "slope -1/2 region" or why it is None
+    arw_tau_range_s: tuple
+    bias_instability_dph: float     # fitted-curve minimum / 0.664
+    bias_instability_upper_bound: bool
+    tau_at_min_s: float
+    adev_min_model_dph: float
+    adev_min_measured_dph: float
+    adev_min_measured_ci_dph: tuple
+    tau_at_min_measured_s: float
+    rate_ramp_dph_per_s: float      # R in deg/h per s; None if not resolved
+    ramp_source: str
+    ramp_tau_range_s: tuple
+    rrw_dph_rts: float              # K in deg/h/sqrt(s)
+    adev_at_1s_dph: float           # measured, for comparison only; None if out of range
+    tau_min_fit_s: float
+
+
+def adev_curve(rate_dps, fs_hz, taus="log", per_decade=10, max_frac=0.25):
+    """Overlapping ADEV (deg/h) of a rate series (deg/s) sampled at fs_hz.
+
+    taus: "log" (per_decade log-spaced averaging factors) or "octave" (1, 2, 4, ...);
+    the longest tau is max_frac of the record.
+    """
+    rate_dps = np.asarray(rate_dps, dtype=float)
+    n = rate_dps.size
+    if n < MIN_SAMPLES:
+        raise InputError(f"{n} samples; the Allan deviation needs at least {MIN_SAMPLES}")
+    if not np.all(np.isfinite(rate_dps)):
+        raise InputError("rate contains non-finite values")
+    if not (fs_hz > 0 and math.isfinite(fs_hz)):
+        raise InputError(f"sample rate {fs_hz} Hz is not positive")
+    m_max = max(1, int(n * max_frac))
+    if taus == "octave":
+        m = 2 ** np.arange(0, int(math.floor(math.log2(m_max))) + 1)
+    elif taus == "log":
+        k = max(2, int(round(per_decade * math.log10(m_max))) + 1)
+        m = np.unique(np.round(np.logspace(0.0, math.log10(m_max), k)).astype(int))
+    else:
+        raise InputError(f"unknown tau spacing '{taus}' (use log or octave)")
+    rate_dph = rate_dps * DPH_PER_DPS
+    # Rate is the time derivative of angle: it is FREQUENCY-type data for allantools.
+    tau, ad, _err, _ns = allantools.oadev(rate_dph, rate=fs_hz, data_type="freq",
+                                          taus=m / fs_hz)
+    m_used = np.round(tau * fs_hz).astype(int)
+    ok = np.isfinite(ad) & (ad > 0)
+    if np.count_nonzero(ok) < 6:
+        raise InputError("the rate does not vary (Allan deviation zero at most taus): "
+                         "nothing to analyse")
+    return AllanCurve(tau_s=tau[ok], adev_dph=ad[ok], m=m_used[ok], n_samples=n,
+                      fs_hz=float(fs_hz))
+
+
+def model_terms(tau_s, model):
+    """Variance of each model term at tau_s, as a dict of arrays ((deg/h)^2)."""
+    tau_s = np.asarray(tau_s, dtype=float)
+    return {
+        "white": model["N_dph_rthz"] ** 2 / tau_s,
+        "flicker": np.full_like(tau_s, model["F_dph"] ** 2),
+        "rrw": model["K_dph_rts"] ** 2 * tau_s / 3.0,
+        "ramp": model["R_dph_per_s"] ** 2 * tau_s ** 2 / 2.0,
+    }
+
+
+def model_adev(tau_s, model):
+    """Fitted total Allan deviation (deg/h) at tau_s: the sum (7-11)."""
+    return np.sqrt(sum(model_terms(tau_s, model).values()))
+
+
+def _edf(curve, alphas):
+    n_phase = curve.n_samples + 1  # allantools integrates n rates into n + 1 phases
+    return np.array([allantools.edf_greenhall(alpha=int(a), d=2, m=int(m), N=n_phase,
+                                              overlapping=True, modified=False)
+                     for a, m in zip(alphas, curve.m)])
+
+
+def _fit(tau, var, edf, include_rrw):
+    """Non-negative (N^2, F^2, K^2, R^2) minimising sum edf/2 (ln var - ln model)^2."""
+    cols = [1.0 / tau, np.ones_like(tau), tau / 3.0, tau ** 2 / 2.0]
+    scale = np.array([np.max(var * tau), np.max(var), np.max(3 * var / tau),
+                      np.max(2 * var / tau ** 2)])
+    active = [0, 1, 2, 3] if include_rrw else [0, 1, 3]
+    basis = np.column_stack([cols[i] for i in active])
+    scale = scale[active]
+    w = np.sqrt(edf / 2.0)
+    # Linear start: relative residuals in the variance domain, solved by NNLS.
+    p0, _ = optimize.nnls(basis * (w / var)[:, None], w)
+    p0 = np.maximum(p0, 1e-9 * scale)
+
+    def resid(p):
+        return w * (np.log(basis @ p) - np.log(var))
+
+    sol = optimize.least_squares(resid, p0, bounds=(0.0, np.inf), x_scale=scale,
+                                 method="trf")
+    p = sol.x
+    # A term the data does not support is set to exactly zero.
+    for i in range(len(active)):
+        trial = p.copy()
+        trial[i] = 0.0
+        if np.sum(resid(trial) ** 2) <= np.sum(resid(p) ** 2) * (1 + 1e-9):
+            p = trial
+    full = np.zeros(4)
+    full[active] = p
+    return full
+
+
+def _auto_tau_min(curve):
+    """Start of the fit: past the low-pass-smoothed leading taus (see module doc)."""
+    tau, ad = curve.tau_s, curve.adev_dph
+    lt, la = np.log(tau), np.log(ad)
+    record_s = curve.n_samples / curve.fs_hz
+    usable = (tau * 2.0 <= tau[-1]) & (tau <= record_s / 100.0)  # high-edf taus only
+    if not usable.any():
+        return float(tau[0])
+    slope = (np.interp(lt + math.log(2.0), lt, la) - la) / math.log(2.0)
+    idx = np.flatnonzero(usable)
+    if slope[idx[0]] <= -0.35:
+        return float(tau[0])
+    white = idx[slope[idx] <= -0.35]
+    if white.size == 0:
+        return float(tau[0])
+    return float(min(tau[white[0]] * 10.0, tau[-1] / 8.0))
+
+
+def _region_fit(tau, var, edf, terms, name, power):
+    """Fixed-slope fit of term `name` (variance ~ tau^power) where it is >= half."""
+    total = sum(terms.values())
+    own = terms[name]
+    region = own >= 0.5 * total
+    if np.count_nonzero(region) < 3:
+        return None, (None, None)
+    rest = total - own
+    resid_var = var[region] - rest[region]
+    good = resid_var > 0
+    if np.count_nonzero(good) < 3:
+        return None, (None, None)
+    t, v, w = tau[region][good], resid_var[good], edf[region][good] / 2.0
+    # ln v = ln c + power ln t with the slope fixed: ln c is the weighted mean.
+    ln_c = np.sum(w * (np.log(v) - power * np.log(t))) / np.sum(w)
+    return math.exp(ln_c), (float(t[0]), float(t[-1]))
+
+
+def analyse(rate_dps, fs_hz, taus="log", per_decade=10, max_frac=0.25, tau_min_s=None,
+            include_rrw=False):
+    """Allan deviation, confidence intervals, fitted model and the N, B, R read-offs.
+
+    The model has the three terms of the thesis (7-11) - white, flicker, ramp - and a
+    rate-random-walk term only with include_rrw: on a record of ordinary length the
+    +1/2 and +1 slopes share the few long taus and trade off against each other.
+    """
+    curve = adev_curve(rate_dps, fs_hz, taus=taus, per_decade=per_decade,
+                       max_frac=max_frac)
+    tau, ad = curve.tau_s, curve.adev_dph
+    var = ad ** 2
+    tmin = _auto_tau_min(curve) if tau_min_s is None else float(tau_min_s)
+    mask = tau >= tmin * (1 - 1e-9)
+    if np.count_nonzero(mask) < 6:
+        raise InputError(
+            f"only {np.count_nonzero(mask)} taus at or above tau_min = {tmin:.4g} s; the "
+            "log is too short for an Allan fit (need 6)")
+    # Two passes: white-noise edf for the first fit, then the edf of the noise type the
+    # first fit says dominates each tau.
+    edf = _edf(curve, np.zeros(tau.size))
+    model = None
+    for _ in range(2):
+        p = _fit(tau[mask], var[mask], edf[mask], include_rrw)
+        model = {"N_dph_rthz": math.sqrt(p[0]), "F_dph": math.sqrt(p[1]),
+                 "K_dph_rts": math.sqrt(p[2]), "R_dph_per_s": math.sqrt(p[3])}
+        terms = model_terms(tau, model)
+        dominant = np.argmax(np.vstack([terms[t] for t in _TERMS]), axis=0)
+        edf = _edf(curve, [_ALPHA[_TERMS[i]] for i in dominant])
+    ci = [allantools.confidence_interval(a, e, ci=CI_LEVEL) for a, e in zip(ad, edf)]
+    lo, hi = (np.array([c[k] for c in ci], dtype=float) for k in (0, 1))
+
+    terms_fit = {k: v[mask] for k, v in model_terms(tau, model).items()}
+    n_reg, n_range = _region_fit(tau[mask], var[mask], edf[mask], terms_fit, "white", -1.0)
+    if n_reg is not None:
+        arw, arw_src = math.sqrt(n_reg), "slope -1/2 region"
+    else:
+        arw, arw_src = None, "not resolved: white noise never dominates the fitted taus"
+    r_reg, r_range = _region_fit(tau[mask], var[mask], edf[mask], terms_fit, "ramp", 2.0)
+    if r_reg is not None:
+        ramp, ramp_src = math.sqrt(2.0 * r_reg), "slope +1 region"
+    else:
+        ramp, ramp_src = None, "not resolved: the ramp never dominates the fitted taus"
+
+    # Flat minimum of the fitted curve over the fitted tau range (dense log grid).
+    grid = np.logspace(math.log10(tau[mask][0]), math.log10(tau[mask][-1]), 400)
+    fitted = model_adev(grid, model)
+    i_min = int(np.argmin(fitted))
+    # Still falling at the longest tau (log slope below -0.1): only an upper bound.
+    end_slope = math.log(fitted[-1] / fitted[-2]) / math.log(grid[-1] / grid[-2])
+    upper = end_slope < -0.1
+    j = int(np.argmin(np.where(mask, ad, np.inf)))
+    at1 = None
+    if tau[0] <= 1.0 <= tau[-1]:
+        at1 = float(math.exp(np.interp(0.0, np.log(tau), np.log(ad))))
+    return AllanResult(
+        curve=curve, ci_lo_dph=lo, ci_hi_dph=hi, edf=edf, fit_mask=mask, model=model,
+        arw_dph_rthz=arw, arw_source=arw_src, arw_tau_range_s=n_range,
+        bias_instability_dph=float(fitted[i_min] / FLICKER_FLOOR),
+        bias_instability_upper_bound=bool(upper), tau_at_min_s=float(grid[i_min]),
+        adev_min_model_dph=float(fitted[i_min]), adev_min_measured_dph=float(ad[j]),
+        adev_min_measured_ci_dph=(float(lo[j]), float(hi[j])),
+        tau_at_min_measured_s=float(tau[j]),
+        rate_ramp_dph_per_s=ramp, ramp_source=ramp_src, ramp_tau_range_s=r_range,
+        rrw_dph_rts=model["K_dph_rts"], adev_at_1s_dph=at1, tau_min_fit_s=tmin)
+
+
+def summary(res):
+    """Flat dict of the figures (units in the names), for JSON and printing."""
+    arw = res.arw_dph_rthz
+    ramp = res.rate_ramp_dph_per_s
+    m = res.model
+    return {
+        "convention": "IEEE two-sided: sigma=N/sqrt(tau), floor=0.664*B, "
+                      "sigma=K*sqrt(tau/3), sigma=R*tau/sqrt(2)",
+        "n_samples": res.curve.n_samples,
+        "fs_hz": res.curve.fs_hz,
+        "duration_s": res.curve.n_samples / res.curve.fs_hz,
+        "input_data_type": "freq (rate), allantools.oadev",
+        "arw_dph_per_rthz": arw,
+        "arw_deg_per_rth": None if arw is None else arw / 60.0,
+        "arw_one_sided_asd_dph_per_rthz": None if arw is None else arw * math.sqrt(2.0),
+        "arw_source": res.arw_source,
+        "arw_fit_tau_range_s": list(res.arw_tau_range_s),
+        "adev_at_1s_dph": res.adev_at_1s_dph,
+        "bias_instability_dph": res.bias_instability_dph,
+        "bias_instability_is_upper_bound": res.bias_instability_upper_bound,
+        "bias_instability_floor_term_dph": m["F_dph"] / FLICKER_FLOOR,
+        "adev_min_fit_dph": res.adev_min_model_dph,
+        "tau_at_min_s": res.tau_at_min_s,
+        "adev_min_measured_dph": res.adev_min_measured_dph,
+        "adev_min_measured_ci68_dph": list(res.adev_min_measured_ci_dph),
+        "tau_at_min_measured_s": res.tau_at_min_measured_s,
+        "rate_ramp_dph_per_h": None if ramp is None else ramp * 3600.0,
+        "rate_ramp_dps_per_h": None if ramp is None else ramp,
+        "rate_ramp_source": res.ramp_source,
+        "rate_ramp_fit_tau_range_s": list(res.ramp_tau_range_s),
+        "rate_random_walk_dph_per_rth": m["K_dph_rts"] * 60.0,
+        "fit_tau_min_s": res.tau_min_fit_s,
+        "model_N_dph_per_rthz": m["N_dph_rthz"],
+        "model_B_dph": m["F_dph"] / FLICKER_FLOOR,
+        "model_K_dph_per_rth": m["K_dph_rts"] * 60.0,
+        "model_R_dph_per_h": m["R_dph_per_s"] * 3600.0,
+        "tau_s": res.curve.tau_s.tolist(),
+        "adev_dph": res.curve.adev_dph.tolist(),
+        "adev_ci68_lo_dph": res.ci_lo_dph.tolist(),
+        "adev_ci68_hi_dph": res.ci_hi_dph.tolist(),
+        "edf": res.edf.tolist(),
+    }
+
+
+def plot(res, out_dir, name="allan.png", title=""):
+    """Log-log ADEV with 68 % CIs, the fitted sum and its asymptotes (fig. 7-1, 7-11)."""
+    from . import plotting
+
+    tau, ad = res.curve.tau_s, res.curve.adev_dph
+    fig, ax = plotting.figure()
+    ax.fill_between(tau, res.ci_lo_dph, res.ci_hi_dph, color="C0", alpha=0.25,
+                    label="68 % confidence interval")
+    ax.loglog(tau, ad, "o", ms=3, color="C0", label="overlapping ADEV")
+    grid = np.logspace(math.log10(tau[0]), math.log10(tau[-1]), 300)
+    ax.loglog(grid, model_adev(grid, res.model), "-", color="k", lw=1,
+              label="fitted sum (7-11)")
+    top = ad.max() * 3
+    bottom = ad.min() / 3
+    if res.arw_dph_rthz is not None:
+        ax.loglog(grid, res.arw_dph_rthz / np.sqrt(grid), "--", color="C1",
+                  label=f"N = {res.arw_dph_rthz:.3g} deg/h/rtHz  (slope -1/2)")
+    b = res.bias_instability_dph
+    ax.axhline(FLICKER_FLOOR * b, ls="--", color="C2",
+               label=("B < " if res.bias_instability_upper_bound else "B = ")
+               + f"{b:.3g} deg/h  (0.664 B)")
+    if res.rate_ramp_dph_per_s is not None:
+        r = res.rate_ramp_dph_per_s
+        ax.loglog(grid, r * grid / math.sqrt(2.0), "--", color="C3",
+                  label=f"R = {r * 3600:.3g} deg/h/h  (slope +1)")
+    if res.model["K_dph_rts"] > 0:
+        k = res.model["K_dph_rts"]
+        ax.loglog(grid, k * np.sqrt(grid / 3.0), ":", color="C4",
+                  label=f"K = {k * 60:.3g} deg/h/rth  (slope +1/2)")
+    ax.plot([res.tau_at_min_s], [res.adev_min_model_dph], "v", color="C2")
+    ax.axvspan(tau[0], res.tau_min_fit_s, color="0.85", alpha=0.5, lw=0)
+    ax.set_ylim(bottom, top)
+    plotting.finish(ax, title=title or "Allan deviation of the rate output",
+                    xlabel="averaging time tau (s)", ylabel="Allan deviation (deg/h)")
+    return plotting.save(fig, out_dir, name)
