@@ -5,8 +5,8 @@ description, one header row `t_s,<columns>`, one row per record, and '#' comment
 with the loss accounting at the end. t_s is the stream's own clock, record index *
 decim / fs_hz from the stream's first record, so rows are exactly 1/rate apart and a
 lost record shows as a gap. Columns are the firmware's field names, except where the
-analysis tools know the quantity by another name (drive_amp_v -> drive_amp); flags and
-fault are hexadecimal (0x...), like the simulator's logs.
+analysis tools know the quantity by another name (drive_amp_v -> drive_amp); integers
+(flags, mode, fault, tick) are decimal, as in gyro-sim's logs.
 
 --duration is stream time, not wall time: the file holds the records with index
 0 .. round(duration * rate) - 1, however fast the link or the simulator runs.
@@ -25,7 +25,6 @@ from .link import CommandError, LinkError
 # firmware field name -> column name of the analysis tools' logs
 COLUMN_NAMES = {"drive_amp_v": "drive_amp"}
 FIELD_NAMES = {v: k for k, v in COLUMN_NAMES.items()}
-HEX_FIELDS = {"flags", "fault"}
 
 
 def column_name(field: str) -> str:
@@ -40,8 +39,6 @@ def field_name(arg: str) -> str:
 def format_value(name: str, ftype: int, v) -> str:
     if ftype == frames.T_F32:
         return "%.9g" % v  # nine significant digits round-trip a float32
-    if name in HEX_FIELDS:
-        return "0x%x" % v
     return "%d" % v
 
 

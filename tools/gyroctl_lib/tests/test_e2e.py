@@ -75,27 +75,30 @@ def test_tuning_session(host, gyroctl, fw_pty_host, tmp_path, capsys, monkeypatc
     port = host.port
     g = InProcess(capsys, monkeypatch, port)
 
+    # the parameters under test: the rate bias polynomial (live, persistent, default 0)
+    c0, c1 = "rate.bias_c0_dps", "rate.bias_c1_dps_per_deg"
+    default = g("list", c0)[1].split(" ")[4].removeprefix("def=")
+
     # the executable: value on stdout, exit 0; an err line on stderr, exit 1
-    r = run(gyroctl, port, "get", "drive.amp_set_v")
-    assert (r.returncode, r.stdout) == (0, "1.8\n")
-    r = run(gyroctl, port, "set", "drive.amp_set_v", "abc")
+    r = run(gyroctl, port, "get", c0)
+    assert (r.returncode, r.stdout) == (0, default + "\n")
+    r = run(gyroctl, port, "set", c0, "abc")
     assert r.returncode == 1 and r.stderr.startswith("err VALUE"), r
 
-    rc, out, _ = g("set", "drive.amp_set_v", "2.5", "rate.bias_c0_dps", "-1.25e-3")
-    assert (rc, out) == (0, "drive.amp_set_v 2.5 rate.bias_c0_dps -0.00125\n")
-    assert g("get", "drive.amp_set_v")[1] == "2.5\n"
+    rc, out, _ = g("set", c0, "12.5", c1, "-1.25e-3")
+    assert (rc, out) == (0, f"{c0} 12.5 {c1} -0.00125\n")
+    assert g("get", c0)[1] == "12.5\n"
     diff_before = g("diff")[1]
-    assert "drive.amp_set_v 2.5 default 1.8" in diff_before
+    assert f"{c0} 12.5 default {default}" in diff_before
 
     # bad values: err on stderr, exit 1, nothing changed (pairs are all or nothing)
-    for args, code in [(("drive.amp_set_v", "1e999"), None), (("drive.amp_set_v", "nan"), "VALUE"),
-                       (("drive.amp_set_v", "99"), "RANGE"), (("nosuch.param", "1"), "NAME"),
-                       (("rate.bias_c0_dps", "7", "drive.amp_set_v", "inf"), None),
+    for args, code in [((c0, "1e999"), None), ((c0, "nan"), "VALUE"), ((c0, "1e30"), "RANGE"),
+                       (("nosuch.param", "1"), "NAME"), ((c1, "7", c0, "inf"), None),
                        (("sys.fs_hz", "1000"), "RO")]:
         rc, _, err = g("set", *args)
         assert rc == 1 and err.startswith("err " + (code or "")), (args, err)
     with pytest.raises(SystemExit) as e:  # odd number of words: refused before sending
-        g("set", "drive.amp_set_v")
+        g("set", c0)
     assert e.value.code == 2
     assert g("diff")[1] == diff_before
 
@@ -103,13 +106,13 @@ def test_tuning_session(host, gyroctl, fw_pty_host, tmp_path, capsys, monkeypatc
     with Link(port) as link:
         link.sync()
         assert link.command("x" * 200).final.startswith("err TOOLONG")
-        link.write(b"set drive.amp_set_v\x00 3\n")
+        link.write(b"set rate.bias_c0_dps\x00 3\n")
         assert link.read_reply().final.startswith("err BADCHAR")
         link.write(bytes(b for b in range(256) if b not in (10, 13)) + b"\n")
         assert link.read_reply().final.startswith("err BADCHAR")
         link.write(bytes([0x00, 0x01, 0xFF, 0x00]) * 50 + b"\r\n")
         assert link.read_reply().final.startswith("err BADCHAR")
-        assert link.command("get drive.amp_set_v").final == "ok drive.amp_set_v 2.5 V"
+        assert link.command(f"get {c0}").final == f"ok {c0} 12.5 deg/s"
     assert g("diff")[1] == diff_before
 
     # a stream logged to CSV: columns as the analysis tools name them, nothing lost
@@ -124,7 +127,7 @@ def test_tuning_session(host, gyroctl, fw_pty_host, tmp_path, capsys, monkeypatc
     data = rows[1:]
     assert len(data) == 500
     assert [float(x[0]) for x in data] == pytest.approx([k / 1000.0 for k in range(500)], abs=1e-12)
-    assert all(x[5].startswith("0x") for x in data)
+    assert all(x[5].isdigit() for x in data)  # flags: decimal, as gyro-sim writes them
     png = tmp_path / "log.png"
     assert cli.main(["plot", str(out), "--out", str(png)]) == 0 and png.stat().st_size > 1000
 
@@ -135,8 +138,8 @@ def test_tuning_session(host, gyroctl, fw_pty_host, tmp_path, capsys, monkeypatc
     assert rc == 1 and err.startswith("err BANDWIDTH")
 
     # the shell, scripted through stdin
-    rc, out, _ = g("shell", stdin="get drive.amp_set_v\nstatus\nbogus\n")
-    assert "ok drive.amp_set_v 2.5 V\n" in out
+    rc, out, _ = g("shell", stdin=f"get {c0}\nstatus\nbogus\n")
+    assert f"ok {c0} 12.5 deg/s\n" in out
     assert "- mode " in out and "err UNKNOWN" in out
     assert rc == 1  # one command answered err
 
@@ -153,8 +156,8 @@ def test_tuning_session(host, gyroctl, fw_pty_host, tmp_path, capsys, monkeypatc
     h2 = Host(fw_pty_host, flash)
     try:
         g2 = InProcess(capsys, monkeypatch, h2.port)
-        assert g2("get", "drive.amp_set_v")[1] == "2.5\n"
-        assert g2("get", "rate.bias_c0_dps")[1] == "-0.00125\n"
+        assert g2("get", c0)[1] == "12.5\n"
+        assert g2("get", c1)[1] == "-0.00125\n"
     finally:
         h2.stop()
 

@@ -78,7 +78,7 @@ def test_logger_with_scripted_port(tmp_path):
     body = [r.split(",") for r in rows[1:]]
     idx = [round(float(r[0]) * 1000) for r in body]
     assert idx == [k for k in range(100) if not 30 <= k < 40]  # 0.1 s at 1 kHz, gap kept
-    assert all(float(r[1]) == 0.5 * k and r[2] == "0x%x" % k for r, k in zip(body, idx))
+    assert all(float(r[1]) == 0.5 * k and r[2] == "%d" % k for r, k in zip(body, idx))
     assert (res.wanted, res.rows, res.missing, res.frames_missing) == (100, 90, 10, 1)
     assert not res.clean
     assert "missing records 10, frames missing 1" in out.read_text()
@@ -109,7 +109,7 @@ def test_columns_and_values():
     assert logger.column_name("drive_amp_v") == "drive_amp"
     assert logger.column_name("rate_dps") == "rate_dps"
     assert logger.field_name("drive_amp") == "drive_amp_v"
-    assert logger.format_value("flags", frames.T_U32, 9) == "0x9"
+    assert logger.format_value("flags", frames.T_U32, 9) == "9"
     assert logger.format_value("tick", frames.T_U32, 9) == "9"
     x = struct.unpack("<f", struct.pack("<f", 0.1))[0]
     assert struct.unpack("<f", struct.pack("<f", float(logger.format_value("p_deg", frames.T_F32, x))))[0] == x
