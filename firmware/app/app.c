@@ -83,7 +83,8 @@ int app_init_with(app_t *a, const param_values_t *values)
   a->applied = view.derived;
 
   const cli_cfg_t cc = {&a->params, &a->store, cli_write, a};
-  if (cli_init(&a->cli, &cc) != 0 || app_cmds_register(a) != 0) {
+  if (cli_init(&a->cli, &cc) != 0 || app_cmds_register(a) != 0 ||
+      app_tlm_init(&a->tlm, &a->cli, &a->params) != 0) {
     return -3;
   }
   return 0;
@@ -116,6 +117,7 @@ void app_sample_isr(void *ctx)
   hal_adc_read_frame(&adc);
   gyro_tick(&a->gyro, &adc, &dac);
   hal_dac_write_frame(&dac);
+  app_tlm_isr(&a->tlm, &a->gyro.out);
 
   const uint32_t dc = hal_cycles_now() - c0;
   a->isr_cycles_last = dc;
@@ -134,4 +136,5 @@ void app_poll(app_t *a)
   while ((n = hal_uart_read(buf, sizeof buf)) > 0u) {
     cli_feed(&a->cli, buf, n);
   }
+  app_tlm_poll(&a->tlm);
 }

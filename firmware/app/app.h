@@ -14,6 +14,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "app/app_tlm.h"
 #include "comm/cli.h"
 #include "gyro/gyro.h"
 #include "params/param_store.h"
@@ -37,6 +38,7 @@ typedef struct {
   cli_t cli;
   cli_cmd_t cmds[APP_MAX_CMDS]; /* the application's command rows (app_cmds.c) */
   volatile uint32_t request; /* app_req_t, written by the background, taken by the ISR */
+  app_tlm_t tlm;             /* telemetry stream and its commands (app_tlm.c) */
   /* Self-measurement of the sample ISR (DWT cycles on the board). */
   uint32_t isr_cycles_last;
   uint32_t isr_cycles_max;

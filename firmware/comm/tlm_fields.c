@@ -1,0 +1,34 @@
+#include "comm/tlm_fields.h"
+
+#include <string.h>
+
+#include "gyro/gyro.h"
+
+#define TLM_X_ROW(member, type, unit) \
+  {#member, unit, (uint16_t)offsetof(gyro_out_t, member), (uint8_t)TLM_T_##type},
+static const tlm_field_t k_fields[TLM_FIELD_COUNT] = {TLM_FIELD_LIST(TLM_X_ROW)};
+#undef TLM_X_ROW
+
+/* Every field is one aligned 4-byte word of the snapshot, so the ISR copies words and a
+ * record never holds a torn value; the type letter must match the member's C type. */
+#define TLM_X_CHECK(member, type, unit)                                                   \
+  _Static_assert(sizeof(((gyro_out_t *)0)->member) == 4u, #member " is not 4 bytes");    \
+  _Static_assert(offsetof(gyro_out_t, member) % 4u == 0u, #member " is not aligned");    \
+  _Static_assert(_Generic(((gyro_out_t *)0)->member, float: TLM_T_F32, uint32_t: TLM_T_U32) \
+                     == TLM_T_##type, #member " has another type");
+TLM_FIELD_LIST(TLM_X_CHECK)
+#undef TLM_X_CHECK
+/* The selection is a 16-bit mask in the ISR's configuration word (tlm.h). */
+_Static_assert(TLM_FIELD_COUNT <= 16, "the selection mask has 16 bits");
+
+const tlm_field_t *tlm_field(uint32_t i) { return (i < (uint32_t)TLM_FIELD_COUNT) ? &k_fields[i] : NULL; }
+
+uint32_t tlm_field_lookup(const char *name, size_t len)
+{
+  for (uint32_t i = 0; i < (uint32_t)TLM_FIELD_COUNT; i++) {
+    if (strlen(k_fields[i].name) == len && memcmp(k_fields[i].name, name, len) == 0) {
+      return i;
+    }
+  }
+  return (uint32_t)TLM_FIELD_COUNT;
+}

@@ -1,0 +1,125 @@
+"""The `gyroctl` command: tune, save and log the gyro over its UART.
+
+    gyroctl --port PORT shell                    interactive command line, tab completion
+    gyroctl --port PORT get NAME                 prints the value
+    gyroctl --port PORT set NAME VALUE [NAME VALUE ...]   all or nothing, one tick
+    gyroctl --port PORT save | load | defaults | diff | status | version | help | stop
+    gyroctl --port PORT list [PREFIX]
+    gyroctl --port PORT drive on|off
+    gyroctl --port PORT log FIELD... [--rate HZ] --duration S --out FILE.csv
+    gyroctl plot FILE.csv [--out FILE.png]
+
+PORT: a serial device, a pty (gyro-sim, fw_pty_host) or a pyserial URL
+(socket://127.0.0.1:PORT); default $GYROCTL_PORT.
+
+Exit status: 0 the gyro answered ok; 1 it answered err (the err line is on stderr);
+2 usage; 3 the port cannot be opened or the gyro does not answer; 4 a log or plot failed.
+Data lines of a reply are printed without their "- " prefix, then the ok text.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from . import logger, plot as plot_mod, shell
+from .client import Client
+from .link import CommandError, Link, LinkError
+
+SIMPLE = ("save", "load", "defaults", "diff", "status", "version", "help", "stop")
+
+
+def _parser():
+    ap = argparse.ArgumentParser(prog="gyroctl", description="Tune, save and log the gyro over its UART.",
+                                 epilog="Exit status: 0 ok, 1 the gyro answered err, 2 usage, "
+                                        "3 no port or no answer, 4 log/plot failure.")
+    ap.add_argument("--port", default=os.environ.get("GYROCTL_PORT"),
+                    help="device, pty path or pyserial URL (default $GYROCTL_PORT)")
+    ap.add_argument("--timeout", type=float, default=3.0, help="seconds to wait for a reply")
+    sub = ap.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
+    sub.add_parser("shell", help="interactive command line")
+    p = sub.add_parser("get", help="print a parameter's value")
+    p.add_argument("name")
+    p = sub.add_parser("set", help="set parameters (all or nothing)")
+    p.add_argument("pairs", nargs=argparse.REMAINDER, metavar="NAME VALUE")
+    for c in SIMPLE:
+        sub.add_parser(c, help=f"the gyro's `{c}` command")
+    p = sub.add_parser("list", help="parameters with value, unit, range, default, flags")
+    p.add_argument("prefix", nargs="?")
+    p = sub.add_parser("drive", help="start or stop the drive")
+    p.add_argument("state", choices=("on", "off"))
+    p = sub.add_parser("log", help="record a telemetry stream to CSV")
+    p.add_argument("fields", nargs="+", metavar="FIELD")
+    p.add_argument("--rate", type=float, default=None, help="Hz (default: the gyro's tlm.rate_hz)")
+    p.add_argument("--duration", type=float, required=True, help="seconds of stream time")
+    p.add_argument("--out", required=True, help="CSV file")
+    p.add_argument("--strict", action="store_true", help="exit 4 if any record or frame was lost")
+    p = sub.add_parser("plot", help="draw a CSV log to PNG")
+    p.add_argument("csv")
+    p.add_argument("--out", default=None, help="PNG file (default: the CSV's name with .png)")
+    return ap
+
+
+def _print_reply(r):
+    for d in r.data:
+        print(d)
+    if r.text:
+        print(r.text)
+
+
+def main(argv=None) -> int:
+    ap = _parser()
+    args = ap.parse_args(argv)
+    if args.cmd == "plot":
+        try:
+            out = plot_mod.plot(args.csv, args.out)
+        except plot_mod.PlotError as e:
+            print(f"gyroctl: {e}", file=sys.stderr)
+            return 4
+        print(out)
+        return 0
+    if not args.port:
+        ap.error("--port is required (or set GYROCTL_PORT)")
+    if args.cmd == "set" and (len(args.pairs) == 0 or len(args.pairs) % 2 != 0):
+        ap.error("set takes NAME VALUE pairs")
+    try:
+        with Link(args.port, timeout_s=args.timeout) as link:
+            link.sync()
+            return _run(args, link)
+    except CommandError as e:
+        print(e.reply.final, file=sys.stderr)
+        return 1
+    except LinkError as e:
+        print(f"gyroctl: {e}", file=sys.stderr)
+        return 3
+    except (logger.LogError, OSError) as e:
+        print(f"gyroctl: {e}", file=sys.stderr)
+        return 4
+
+
+def _run(args, link) -> int:
+    client = Client(link)
+    if args.cmd == "shell":
+        return shell.run(link)
+    if args.cmd == "log":
+        res = logger.log(link, args.fields, args.rate, args.duration, args.out,
+                         progress=logger.progress_for(sys.stderr))
+        print(f"gyroctl: log: {res.summary()}", file=sys.stderr)
+        return 4 if (args.strict and not res.clean) else 0
+    if args.cmd == "get":
+        print(client.get(args.name))
+        return 0
+    if args.cmd == "set":
+        line = "set " + " ".join(args.pairs)
+    elif args.cmd == "list":
+        line = "list" + (f" {args.prefix}" if args.prefix else "")
+    elif args.cmd == "drive":
+        line = f"drive {args.state}"
+    else:
+        line = args.cmd
+    r = link.command(line)
+    if not r.ok:
+        raise CommandError(r)
+    _print_reply(r)
+    return 0
