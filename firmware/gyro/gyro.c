@@ -138,6 +138,11 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
 {
   /* Coefficients only: the loop state carries on (bumpless). The design was validated
    * by gyro_design, so the module calls below cannot fail on it. */
+  /* A new amplitude setpoint is a commanded move, not a loss of lock: re-acquire
+   * instead of letting the lost-lock detector trip on the step. */
+  if (fm_absf(d->drive.amp_set_v - g->drive.amp_set_v) > g->sup.lock_tol_rel * g->drive.amp_set_v) {
+    supervisor_reacquire(&g->sup);
+  }
   g->nco.half_step = d->nco_half_step;
   (void)lmsd_set_mu(&g->lmsd_drive, d->lmsd_drive.mu);
   (void)lmsd_set_mu(&g->lmsd_sense, d->lmsd_sense.mu);

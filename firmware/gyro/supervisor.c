@@ -22,6 +22,8 @@ int supervisor_init(supervisor_t *sv, const supervisor_cfg_t *cfg)
     return -1;
   }
   sv->mode = GYRO_MODE_OFF;
+  sv->primed = 0u;
+  sv->amp_err_f = sv->phase_err_f = 0.0f;
   sv->fault = GYRO_FAULT_NONE;
   sv->fault_count = 0u;
   sv->in_tol_ticks = sv->out_tol_ticks = sv->sat_ticks = 0u;
@@ -32,6 +34,8 @@ int supervisor_init(supervisor_t *sv, const supervisor_cfg_t *cfg)
 
 void supervisor_retune(supervisor_t *sv, const supervisor_cfg_t *cfg)
 {
+  /* 100 Hz first-order low-pass: k = 1 - exp(-2 pi 100 dt) ~ 2 pi 100 dt. */
+  sv->err_lpf_k = fm_clampf(628.3185f * cfg->dt_s, 1e-6f, 1.0f);
   sv->lock_ticks_needed = ticks_of(cfg->lock_hold_s, cfg->dt_s);
   sv->lost_ticks_needed = ticks_of(cfg->lost_hold_s, cfg->dt_s);
   sv->sat_ticks_needed = ticks_of(cfg->sat_hold_s, cfg->dt_s);
@@ -45,6 +49,7 @@ void supervisor_retune(supervisor_t *sv, const supervisor_cfg_t *cfg)
 
 static void set_mode(supervisor_t *sv, gyro_mode_t m)
 {
+  sv->primed = 0u;
   sv->mode = m;
   sv->mode_ticks = 0u;
   sv->in_tol_ticks = sv->out_tol_ticks = sv->sat_ticks = 0u;
@@ -60,6 +65,13 @@ void supervisor_start(supervisor_t *sv)
 void supervisor_stop(supervisor_t *sv) { set_mode(sv, GYRO_MODE_OFF); }
 
 void supervisor_enter_sweep(supervisor_t *sv) { set_mode(sv, GYRO_MODE_SWEEP); }
+
+void supervisor_reacquire(supervisor_t *sv)
+{
+  if (sv->mode == GYRO_MODE_LOCKED) {
+    set_mode(sv, GYRO_MODE_ACQUIRE);
+  }
+}
 
 static int trip(supervisor_t *sv, uint32_t reason)
 {
@@ -92,8 +104,16 @@ int supervisor_step(supervisor_t *sv, const supervisor_in_t *in)
     }
   }
 
-  const float ae = fm_absf(in->amp_rel_err);
-  const float pe = fm_absf(in->phase_err_rad);
+  if (sv->primed == 0u) {
+    sv->amp_err_f = in->amp_rel_err;
+    sv->phase_err_f = in->phase_err_rad;
+    sv->primed = 1u;
+  } else {
+    sv->amp_err_f += sv->err_lpf_k * (in->amp_rel_err - sv->amp_err_f);
+    sv->phase_err_f += sv->err_lpf_k * (in->phase_err_rad - sv->phase_err_f);
+  }
+  const float ae = fm_absf(sv->amp_err_f);
+  const float pe = fm_absf(sv->phase_err_f);
   switch (sv->mode) {
   case GYRO_MODE_ACQUIRE:
     sv->in_tol_ticks = (ae <= sv->lock_tol_rel && pe <= sv->lock_phase_tol_rad)

@@ -7,6 +7,10 @@
  *   (clip_max_count consecutive rail codes), a non-finite value in the loop state.
  *   FAULT: drive off for retry_s (the drive mode rings down with tau = 2Q/wn), loop state
  *   cleared, then ACQUIRE again by itself. SWEEP belongs to self-calibration.
+ * Lock is judged on the amplitude and phase errors low-passed at about 100 Hz: the
+ * demodulated drive amplitude carries the residue of the drive-voltage feedthrough at
+ * wc/2 (an LMSD of a few hundred Hz bandwidth passes part of a 745 Hz offset) and of
+ * the pickoff noise, which would otherwise break the consecutive-tick count.
  * The supervisor only decides; gyro_tick acts on its decisions.
  */
 #ifndef SUPERVISOR_H
@@ -55,6 +59,9 @@ typedef struct {
   uint32_t clip_run;       /* consecutive rail codes */
   uint32_t fault_ticks;    /* ticks spent in FAULT */
   uint32_t mode_ticks;     /* ticks spent in the current mode */
+  float err_lpf_k;         /* first-order low-pass (~100 Hz) of the lock errors */
+  float amp_err_f, phase_err_f;
+  uint32_t primed;         /* the low-pass starts from the first error seen in a mode */
 } supervisor_t;
 
 /* What one tick saw, for the supervisor to judge. */
@@ -78,6 +85,8 @@ void supervisor_retune(supervisor_t *sv, const supervisor_cfg_t *cfg);
 void supervisor_start(supervisor_t *sv);
 void supervisor_stop(supervisor_t *sv);
 void supervisor_enter_sweep(supervisor_t *sv);
+/* LOCKED -> ACQUIRE (e.g. a new setpoint): lock is declared again once inside tolerance. */
+void supervisor_reacquire(supervisor_t *sv);
 
 /* One tick. Returns 1 when the loop state must be cleared (entering FAULT or leaving it
  * to re-acquire), else 0. */

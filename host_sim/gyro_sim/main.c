@@ -4,7 +4,7 @@
  *
  *   gyro-sim --scenario FILE [--duration S] [--seed N] [--csv FILE] [--csv-rate HZ]
  *            [--json FILE] [--out DIR] [--set plant.KEY=V | firmware.NAME=V ...]
- *            [--no-analysis] [--quiet]
+ *            [--no-analysis] [--quiet] [--uart-pty[=LINK]]
  *   gyro-sim --list-params
  */
 #include <cJSON.h>
@@ -28,11 +28,13 @@ static void usage(FILE *f)
   fputs("usage: gyro-sim --scenario FILE [--duration S] [--seed N] [--csv FILE]\n"
         "                [--csv-rate HZ] [--json FILE] [--out DIR]\n"
         "                [--set plant.KEY=VALUE | --set firmware.NAME=VALUE ...]\n"
-        "                [--no-analysis] [--quiet]\n"
+        "                [--no-analysis] [--quiet] [--uart-pty[=LINK]]\n"
         "       gyro-sim --list-params\n"
         "Runs a scenario (host_sim/scenarios/*.json) of the plant with the firmware in\n"
         "closed loop and prints its figures. --out keeps the analysis plots (PNG) and\n"
-        "tool outputs; --set overrides any plant or firmware parameter.\n",
+        "tool outputs; --set overrides any plant or firmware parameter. --uart-pty runs\n"
+        "in real time with the tuning UART on a pseudo-terminal (path printed as\n"
+        "'pty PATH'; optional symlink LINK) for gyroctl; SIGINT/SIGTERM end the run.\n",
         f);
 }
 
@@ -101,7 +103,8 @@ int main(int argc, char **argv)
   const char *scen_path = NULL, *csv_path = NULL, *json_path = NULL, *out_dir = NULL;
   double duration = -1.0, csv_rate = -1.0;
   long long seed = -1;
-  int quiet = 0, analysis = 1;
+  int quiet = 0, analysis = 1, uart_pty = 0;
+  const char *uart_pty_link = NULL;
   static const struct option lo[] = {
       {"scenario", required_argument, 0, 's'}, {"duration", required_argument, 0, 'd'},
       {"seed", required_argument, 0, 'S'},     {"csv", required_argument, 0, 'c'},
@@ -109,6 +112,7 @@ int main(int argc, char **argv)
       {"out", required_argument, 0, 'o'},      {"set", required_argument, 0, 'x'},
       {"quiet", no_argument, 0, 'q'},          {"no-analysis", no_argument, 0, 'n'},
       {"list-params", no_argument, 0, 'L'},    {"help", no_argument, 0, 'h'},
+      {"uart-pty", optional_argument, 0, 'u'},
       {0, 0, 0, 0}};
   static char sets[SIM_MAX_SETS][160];
   int n_sets = 0;
@@ -152,6 +156,10 @@ int main(int argc, char **argv)
       snprintf(sets[n_sets++], sizeof sets[0], "%s", optarg);
       break;
     case 'q': quiet = 1; break;
+    case 'u':
+      uart_pty = 1;
+      uart_pty_link = optarg;
+      break;
     case 'n': analysis = 0; break;
     case 'L': list_params(); return 0;
     case 'h': usage(stdout); return 0;
@@ -209,7 +217,12 @@ int main(int argc, char **argv)
     fprintf(stderr, "gyro-sim: %s\n", err);
     return 2;
   }
-  const sim_opts_t so = {csv_path, sc.csv_rate_hz, !quiet && isatty(2) && sc.duration_s > 2.0, NULL};
+  if (uart_pty && sc.mode != SIM_CLOSED_LOOP) {
+    fprintf(stderr, "gyro-sim: --uart-pty needs a closed-loop scenario\n");
+    return 2;
+  }
+  const sim_opts_t so = {csv_path, sc.csv_rate_hz, !quiet && isatty(2) && sc.duration_s > 2.0,
+                         uart_pty, uart_pty_link};
   static sim_result_t res;
   static sim_sweep_t sweep;
   static sim_square_t sq;

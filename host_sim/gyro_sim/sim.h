@@ -63,7 +63,8 @@ typedef struct {
   const char *csv_path;     /* NULL: no trace */
   double csv_rate_hz;
   int progress;             /* progress bar on stderr */
-  const char *uart_pty_link; /* reserved for the pty bridge */
+  int uart_pty;             /* expose the tuning UART as a pty, run paced in real time */
+  const char *uart_pty_link; /* optional symlink to the pty */
 } sim_opts_t;
 
 /* Build the plant configuration and profiles from the scenario (defaults + overrides).

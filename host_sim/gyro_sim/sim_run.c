@@ -14,6 +14,15 @@
 #include "hal_uart_host.h"
 #include "sim.h"
 #include "sim_out.h"
+#include "sim/uart_pty.h"
+
+#include <errno.h>
+#include <poll.h>
+#include <signal.h>
+
+/* SIGINT/SIGTERM end a paced (pty) run cleanly; a flag is all a handler may touch. */
+static volatile sig_atomic_t stop_requested;
+static void on_signal(int sig) { (void)sig; stop_requested = 1; }
 
 static double wall_now(void)
 {
@@ -119,7 +128,7 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
   plant_t *plant = calloc(1, sizeof *plant);
   app_t *app = calloc(1, sizeof *app);
   const double fs = pc.fs_hz;
-  const uint64_t n_ticks = (uint64_t)llround(sc->duration_s * fs);
+  uint64_t n_ticks = (uint64_t)llround(sc->duration_s * fs);
   const int want_startup = (sc->analyses & SIM_AN_STARTUP) != 0u;
   const size_t tdec = (size_t)llround(fs / 1000.0); /* truth samples at 1 kHz */
   const size_t n_truth = want_startup ? (size_t)(n_ticks / tdec) + 1u : 0u;
@@ -127,6 +136,9 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
   double *ph = want_startup ? calloc(n_truth, sizeof *ph) : NULL;
   sim_csv_t csv;
   memset(&csv, 0, sizeof csv);
+  uart_pty_t pty;
+  memset(&pty, 0, sizeof pty);
+  pty.master_fd = -1;
   int rc = 0;
   if (plant == NULL || app == NULL || (want_startup && (amp == NULL || ph == NULL))) {
     snprintf(err, err_len, "out of memory");
@@ -152,7 +164,21 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
     goto out;
   }
   const uint64_t csv_every = (uint64_t)fmax(1.0, llround(fs / opt->csv_rate_hz));
-  progress_t pr = {opt->progress, wall_now(), 0.0, sc->duration_s};
+  progress_t pr = {opt->progress && !opt->uart_pty, wall_now(), 0.0, sc->duration_s};
+  if (opt->uart_pty) {
+    char path[UART_PTY_PATH_MAX];
+    if (uart_pty_open(&pty, path, sizeof path) != 0 ||
+        (opt->uart_pty_link != NULL && uart_pty_link(&pty, opt->uart_pty_link) != 0)) {
+      snprintf(err, err_len, "--uart-pty: %s", strerror(errno));
+      rc = -1;
+      goto out;
+    }
+    stop_requested = 0;
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
+    printf("pty %s\n", opt->uart_pty_link != NULL ? opt->uart_pty_link : path);
+    fflush(stdout);
+  }
   const double t_wall0 = wall_now();
   double fw_lock = -1.0, sum_tk = 0.0, sum_f = 0.0, sum_a = 0.0;
   uint64_t n_mean = 0;
@@ -190,6 +216,23 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
     if ((k & 1023u) == 0u) {
       app_poll(app);
       progress_update(&pr, (double)k / fs, 0);
+      if (opt->uart_pty) {
+        /* Paced run: the firmware meets a person or a tool in real time. Sleep on the
+         * pty until the simulated time has caught up with the wall clock. */
+        uart_pty_pump(&pty);
+        const double ahead = (double)(k + 1u) / fs - (wall_now() - t_wall0);
+        if (ahead > 0.0) {
+          struct pollfd pfd = {uart_pty_fd(&pty), POLLIN, 0};
+          (void)poll(&pfd, 1, (int)(ahead * 1000.0));
+          uart_pty_pump(&pty);
+          app_poll(app);
+          uart_pty_pump(&pty);
+        }
+        if (stop_requested) {
+          n_ticks = k + 1u;
+          break;
+        }
+      }
     }
   }
   progress_update(&pr, sc->duration_s, 1);
@@ -213,6 +256,7 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
   res->mean_drive_freq_hz = n_mean ? sum_f / (double)n_mean : NAN;
   res->mean_drive_amp_m = n_mean ? sum_a / (double)n_mean : NAN;
 out:
+  if (pty.master_fd >= 0) uart_pty_close(&pty);
   sim_csv_close(&csv);
   hal_sample_timer_stop();
   free(amp);

@@ -57,6 +57,7 @@ static void test_set_applies_at_tick(void **state)
   assert_true(app.gyro.drive.amp_set_v == before);
   hal_host_run(1u);
   assert_true(app.gyro.drive.amp_set_v == 2.5f);
+  assert_int_equal(app.gyro.sup.fault_count, 0u);
   /* Designed gains follow a new model: doubling the identified gain halves Kp. */
   const float kp = app.gyro.drive.amp_pi.kp;
   assert_true(strncmp(cmd("set drive.cal_gain_v_per_v2 0.01092\n"), "ok", 2) == 0);
