@@ -253,8 +253,8 @@ int main(int argc, char **argv)
 
   if (!quiet) {
     printf("scenario %s: %s\n", sc.name, sc.description);
-    printf("  simulated %.1f s in %.2f s wall: %.0fx real time\n", res.sim_s, res.wall_s,
-           res.realtime_factor);
+    printf("  simulated %.1f s in %.2f s wall (%.2f s CPU): %.0fx real time (%.0fx per CPU second)\n",
+           res.sim_s, res.wall_s, res.cpu_s, res.realtime_factor, res.realtime_factor_cpu);
   }
   if (sc.analyses & SIM_AN_STARTUP) {
     const sim_startup_t *s = &res.startup;
@@ -444,6 +444,7 @@ int main(int argc, char **argv)
     }
   }
   add_num(root, "realtime_factor", res.realtime_factor);
+  add_num(root, "realtime_factor_cpu", res.realtime_factor_cpu);
   if (json_path != NULL) {
     char *txt = cJSON_Print(root);
     FILE *f = fopen(json_path, "w");
