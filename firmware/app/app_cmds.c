@@ -65,10 +65,10 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   }
   const gyro_out_t *o = &a->gyro.out;
   cli_put(cli, "mode ");
-  cli_put(cli, mode_name(o->mode));
+  cli_put(cli, mode_name((uint32_t)a->gyro.sup.mode));
   cli_emit_data(cli);
   cli_put(cli, "fault ");
-  put_faults(cli, o->fault);
+  put_faults(cli, a->gyro.sup.fault);
   cli_emit_data(cli);
   kv_u(cli, "fault_count", a->gyro.sup.fault_count);
   kv_f(cli, "rate_dps", o->rate_dps);
@@ -84,7 +84,7 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   cli_put(cli, "store ");
   cli_put(cli, param_store_status_str(a->store_status));
   cli_emit_data(cli);
-  cli_ok(cli, mode_name(o->mode));
+  cli_ok(cli, mode_name((uint32_t)a->gyro.sup.mode));
 }
 
 /* drive on|off: the request is taken by the ISR at its next tick. */

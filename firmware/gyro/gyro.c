@@ -116,6 +116,8 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
     return -2;
   }
   t.adc_v_per_code = HAL_ADC_V_PER_CODE;
+  t.inv_amp_set = 1.0f / d->drive.amp_set_v;
+  t.rate_code = (uint16_t)HAL_DAC_CODE_MID;
   t.rate_out_v_per_dps = d->rate_out_v_per_dps;
   t.f_cmd_max_v2 = d->drive.f_cmd_max_v2;
   *g = t;
@@ -147,6 +149,7 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   (void)lmsd_set_mu(&g->lmsd_drive, d->lmsd_drive.mu);
   (void)lmsd_set_mu(&g->lmsd_sense, d->lmsd_sense.mu);
   drive_loop_retune(&g->drive, &d->drive);
+  g->inv_amp_set = 1.0f / d->drive.amp_set_v;
   /* The drive scheme only changes with the drive off (drive.mode is not live). */
   if (d->synth.mode == g->synth.mode || !supervisor_drive_enabled(&g->sup)) {
     (void)drive_synth_init(&g->synth, &d->synth);
@@ -211,16 +214,24 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
   const int at_rail = adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN ||
                       adc->sense == HAL_ADC_CODE_MAX || adc->sense == HAL_ADC_CODE_MIN;
   const int at_limit = g->drive.f_cmd_v2 >= g->f_cmd_max_v2;
-  const float inv_set = 1.0f / g->drive.amp_set_v;
+  /* Work that needs no per-sample rate runs on one tick in GYRO_SLOW_DECIM, offset from
+   * the rate channel's filter tick so the two never fall on the same tick. */
+  if (++g->slow_count == GYRO_SLOW_DECIM) {
+    g->slow_count = 0u;
+  }
+  const int slow = g->slow_count == GYRO_SLOW_PHASE;
+  g->flags_acc |= (at_rail ? GYRO_FLAG_ADC_RAIL : 0u) | (at_limit ? GYRO_FLAG_DRIVE_LIMIT : 0u);
   supervisor_in_t si;
-  si.amp_rel = g->drive.amp_v * inv_set;
+  si.amp_rel = g->drive.amp_v * g->inv_amp_set;
   si.amp_rel_err = si.amp_rel - 1.0f;
   si.phase_err_rad = g->drive.phase_err_rad;
   si.drive_at_limit = drive_on && at_limit;
   si.adc_at_rail = at_rail;
-  si.state_finite = fm_isfinite(d_s + d_c + s_s + s_c) && fm_isfinite(g->drive.f_cmd_v2) &&
-                    fm_isfinite(g->drive.p_rad) && fm_isfinite(g->rate.rate_dps) &&
-                    fm_isfinite(g->rate.quad_dps);
+  /* A NaN anywhere propagates into these within a tick, and is caught within
+   * GYRO_SLOW_DECIM ticks (0.2 ms): long before it could reach the structure. */
+  si.state_finite = !slow || (fm_isfinite(d_s + d_c + s_s + s_c) && fm_isfinite(g->drive.f_cmd_v2) &&
+                              fm_isfinite(g->drive.p_rad) && fm_isfinite(g->rate.rate_dps) &&
+                              fm_isfinite(g->rate.quad_dps));
   if (supervisor_step(&g->sup, &si) != 0) {
     clear_loop_state(g);
     u1 = 0.0f;
@@ -233,11 +244,17 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
 
   dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
-  dac->code[HAL_DAC_RATE_OUT] = gyro_volts_to_dac(g->rate.rate_dps * g->rate_out_v_per_dps);
+  dac->code[HAL_DAC_RATE_OUT] = g->rate_code; /* the rate changes at fs / RATE_DECIM */
   dac->code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID;
 
   gyro_out_t *o = &g->out;
   o->tick++;
+  if (!slow) {
+    return;
+  }
+  /* The snapshot for telemetry and status, at fs / GYRO_SLOW_DECIM (5 kHz: the
+   * telemetry's highest rate); flags hold what happened over the whole block. */
+  g->rate_code = gyro_volts_to_dac(g->rate.rate_dps * g->rate_out_v_per_dps);
   o->rate_dps = g->rate.rate_dps;
   o->rate_unc_dps = g->rate.rate_unc_dps;
   o->quad_dps = g->rate.quad_dps;
@@ -252,7 +269,7 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
   o->sense_q_v = s_c;
   o->mode = (uint32_t)g->sup.mode;
   o->fault = g->sup.fault;
-  o->flags = (g->sup.mode == GYRO_MODE_LOCKED ? GYRO_FLAG_LOCKED : 0u) |
-             (at_rail ? GYRO_FLAG_ADC_RAIL : 0u) | (at_limit ? GYRO_FLAG_DRIVE_LIMIT : 0u) |
+  o->flags = (g->sup.mode == GYRO_MODE_LOCKED ? GYRO_FLAG_LOCKED : 0u) | g->flags_acc |
              (g->sup.mode == GYRO_MODE_FAULT ? GYRO_FLAG_FAULT : 0u);
+  g->flags_acc = 0u;
 }

@@ -82,8 +82,19 @@ typedef struct {
   rate_channel_t rate;
   supervisor_t sup;
   float f_cmd_max_v2;
-  gyro_out_t out;
+  float inv_amp_set;     /* 1 / drive amplitude setpoint: no divide per tick */
+  uint32_t slow_count;   /* tick counter modulo GYRO_SLOW_DECIM */
+  uint32_t flags_acc;    /* GYRO_FLAG_* seen since the last snapshot */
+  uint16_t rate_code;    /* analog rate output DAC code, updated with the snapshot */
+  gyro_out_t out;        /* updated every GYRO_SLOW_DECIM ticks (tick: every tick) */
 } gyro_t;
+
+/* Work without a per-sample need (output snapshot, analog rate code, the finiteness
+ * check of the loop state) runs on one tick in GYRO_SLOW_DECIM, on the tick
+ * GYRO_SLOW_PHASE of the block: half a block away from the rate channel's filter tick
+ * (rate_channel.h, RATE_DECIM), so the worst-case tick carries only one of them. */
+#define GYRO_SLOW_DECIM 10u
+#define GYRO_SLOW_PHASE 5u
 
 /* Turn parameter values into module configurations, checking that every module
  * accepts its part. Returns 0, or a negative value (then *d is untouched). */

@@ -425,7 +425,15 @@ int main(int argc, char **argv)
       }
     }
     if (sc.analyses & SIM_AN_TEMP) {
-      const char *args[] = {csv_path, "--column", "rate_dps", "--temp-column", "t_board_c", NULL};
+      /* Fit against the firmware's own low-passed P (what its compensation uses; the
+       * instantaneous P carries the phase loop's ripple) and, for a heat-gun run, on
+       * the cool-down only, as the thesis does (7.3.2). */
+      char t0[32] = "0";
+      if (sc.has_ambient && sc.ambient_c.kind == PROFILE_HEAT_COOL) {
+        snprintf(t0, sizeof t0, "%.3f", sc.ambient_c.t_start_s + sc.ambient_c.heat_s);
+      }
+      const char *args[] = {csv_path, "--column", "rate_dps", "--p-column", "p_f_deg",
+                            "--temp-column", "t_board_c", "--t-start", t0, NULL};
       cJSON *j = post_run_tool("gyro-tempcomp", args, out_dir, "tempcomp.json", err, sizeof err);
       if (j == NULL) { fprintf(stderr, "gyro-sim: %s\n", err); failed = 1; }
       else {
