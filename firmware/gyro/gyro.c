@@ -61,9 +61,12 @@ int gyro_design(const param_values_t *v, gyro_design_t *d)
   const int n = butter_design(BUTTER_LOWPASS, v->rate_lpf_order, (double)v->rate_lpf_cutoff_hz,
                               0.0, fs / RATE_DECIM, t.rate_lpf, BIQUAD_MAX_SECTIONS);
   if (n <= 0) return -5;
-  const double phi_dm = (double)v->rate_demod_phase_deg * FM_PI / 180.0;
-  t.rate.rot_c = (float)cos(phi_dm);
-  t.rate.rot_s = (float)sin(phi_dm);
+  /* Reference of the rate channel: the drive motion as the loops hold it (phase at
+   * its setpoint, amplitude at its setpoint), turned by the demodulation phase. */
+  const double psi =
+      ((double)v->rate_demod_phase_deg + (double)v->drive_phase_set_deg) * FM_PI / 180.0;
+  t.rate.ref_re = (float)(cos(psi) / (double)v->drive_amp_set_v);
+  t.rate.ref_im = (float)(sin(psi) / (double)v->drive_amp_set_v);
   t.rate.scale_dps = v->rate_scale_dps;
   t.rate.bias_c_dps[0] = v->rate_bias_c0_dps;
   t.rate.bias_c_dps[1] = v->rate_bias_c1_dps_per_deg;

@@ -11,8 +11,8 @@ static int finite4(const float *c)
 
 static int cfg_ok(const rate_channel_cfg_t *cfg)
 {
-  return cfg != NULL && cfg->lpf != NULL && fm_isfinite(cfg->rot_c) &&
-         fm_isfinite(cfg->rot_s) && fm_absf(cfg->rot_c * cfg->rot_c + cfg->rot_s * cfg->rot_s - 1.0f) < 1e-4f &&
+  return cfg != NULL && cfg->lpf != NULL && fm_isfinite(cfg->ref_re) &&
+         fm_isfinite(cfg->ref_im) && cfg->ref_re * cfg->ref_re + cfg->ref_im * cfg->ref_im > 0.0f &&
          fm_isfinite(cfg->scale_dps) && finite4(cfg->bias_c_dps) && finite4(cfg->sf_c) &&
          cfg->p_lpf_alpha > 0.0f && cfg->p_lpf_alpha <= 1.0f && cfg->min_drive_v > 0.0f &&
          fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg);
@@ -20,8 +20,8 @@ static int cfg_ok(const rate_channel_cfg_t *cfg)
 
 static void copy_coeffs(rate_channel_t *rc, const rate_channel_cfg_t *cfg)
 {
-  rc->rot_c = cfg->rot_c;
-  rc->rot_s = cfg->rot_s;
+  rc->ref_re = cfg->ref_re;
+  rc->ref_im = cfg->ref_im;
   rc->scale_dps = cfg->scale_dps;
   for (int i = 0; i < 4; i++) {
     rc->bias_c_dps[i] = cfg->bias_c_dps[i];
@@ -99,15 +99,11 @@ void rate_channel_reset(rate_channel_t *rc, float p_deg)
 void rate_channel_step(rate_channel_t *rc, float d_s, float d_c, float s_s, float s_c,
                        float p_rad)
 {
-  const float d2 = d_s * d_s + d_c * d_c;
   float re = 0.0f, im = 0.0f;
-  if (d2 > rc->min_drive_v2) {
-    /* S conj(D) e^{-j phi_dm} / |D|^2 */
-    const float inv = 1.0f / d2;
-    const float a = s_s * d_s + s_c * d_c;
-    const float b = s_c * d_s - s_s * d_c;
-    re = (a * rc->rot_c + b * rc->rot_s) * inv;
-    im = (b * rc->rot_c - a * rc->rot_s) * inv;
+  if (d_s * d_s + d_c * d_c > rc->min_drive_v2) {
+    /* S conj(e^{j psi} / A_set) */
+    re = s_s * rc->ref_re + s_c * rc->ref_im;
+    im = s_c * rc->ref_re - s_s * rc->ref_im;
   }
   rc->rate_raw = re;
   rc->quad_raw = im;

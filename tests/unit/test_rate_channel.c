@@ -13,30 +13,30 @@ static rate_channel_cfg_t base_cfg(biquad_coeffs_t *sec, float phi_dm)
 {
   const int n = butter_design(BUTTER_LOWPASS, 4u, 100.0, 0.0, 50000.0 / RATE_DECIM, sec, BIQUAD_MAX_SECTIONS);
   assert_int_equal(n, 2);
-  rate_channel_cfg_t c = {.rot_c = cosf(phi_dm), .rot_s = sinf(phi_dm), .scale_dps = 250.0f,
+  rate_channel_cfg_t c = {.ref_re = cosf(phi_dm), .ref_im = sinf(phi_dm), .scale_dps = 250.0f,
                           .bias_c_dps = {0, 0, 0, 0}, .sf_c = {0, 0, 0, 0},
                           .p_ref_deg = 0.0f, .p_lpf_alpha = 0.5f, .lpf = sec,
                           .lpf_sections = (uint32_t)n, .min_drive_v = 0.1f};
   return c;
 }
 
-/* A sense phasor built as (r + j q) D e^{j phi_dm} must come out as rate r and
- * quadrature q, for any drive phase, drive amplitude and demodulation phase. */
+/* A sense phasor built as (r + j q) A_set e^{j psi} must come out as rate r and
+ * quadrature q, for any reference phase and amplitude setpoint, whatever the measured
+ * drive phasor (it only gates the output). */
 static void test_phasor_separation(void **state)
 {
   (void)state;
   biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
   for (int i = 0; i < 200; i++) {
-    const double phi_dm = -3.0 + 0.03 * i, th = 0.7 * i, amp = 0.5 + 0.01 * i;
+    const double psi = -3.0 + 0.03 * i, th = 0.7 * i, amp = 0.5 + 0.01 * i;
     const double r = 1e-3 * (i - 100), q = 0.02 - 1e-4 * i;
-    rate_channel_cfg_t c = base_cfg(sec, (float)phi_dm);
+    rate_channel_cfg_t c = base_cfg(sec, 0.0f);
+    c.ref_re = (float)(cos(psi) / amp);
+    c.ref_im = (float)(sin(psi) / amp);
     rate_channel_t rc;
     assert_int_equal(rate_channel_init(&rc, &c), 0);
-    const double dr = amp * cos(th), di = amp * sin(th);
-    /* S = (r + jq) * D * e^{j phi_dm} */
-    const double er = r * dr - q * di, ei = r * di + q * dr;
-    const double sr = er * cos(phi_dm) - ei * sin(phi_dm), si = er * sin(phi_dm) + ei * cos(phi_dm);
-    rate_channel_step(&rc, (float)dr, (float)di, (float)sr, (float)si, 0.0f);
+    const double er = amp * (r * cos(psi) - q * sin(psi)), ei = amp * (r * sin(psi) + q * cos(psi));
+    rate_channel_step(&rc, (float)(0.3 * cos(th)), (float)(0.3 * sin(th)), (float)er, (float)ei, 0.0f);
     assert_true(fabs((double)rc.rate_raw - r) < 2e-6);
     assert_true(fabs((double)rc.quad_raw - q) < 2e-6);
   }
@@ -139,10 +139,14 @@ static void test_no_drive(void **state)
   rate_channel_cfg_t c = base_cfg(sec, 0.0f);
   rate_channel_t rc;
   assert_int_equal(rate_channel_init(&rc, &c), 0);
-  rate_channel_step(&rc, 0.0f, 0.0f, 1.0f, 1.0f, 0.0f);
+  rate_channel_step(&rc, 0.0f, 0.0f, 1.0f, 1.0f, 0.0f); /* drive below min_drive_v */
   assert_true(rc.rate_raw == 0.0f && rc.quad_raw == 0.0f);
   assert_true(isfinite(rc.rate_dps));
   c.p_lpf_alpha = 0.0f;
+  assert_int_equal(rate_channel_init(&rc, &c), -1);
+  c = base_cfg(sec, 0.0f);
+  c.ref_re = 0.0f;
+  c.ref_im = 0.0f;
   assert_int_equal(rate_channel_init(&rc, &c), -1);
   c = base_cfg(sec, NAN);
   assert_int_equal(rate_channel_init(&rc, &c), -1);
