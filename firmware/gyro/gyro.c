@@ -80,6 +80,7 @@ int gyro_design(const param_values_t *v, gyro_design_t *d)
   t.rate.p_lpf_alpha =
       (float)(1.0 - exp(-2.0 * FM_PI * (double)v->rate_p_lpf_hz * RATE_P_DECIM / fs));
   t.rate.lpf = NULL; /* gyro_init/gyro_apply point it at t.rate_lpf where it is used */
+  t.rate.p_mode_k = (float)(1.0 - exp(-1.0 / (fs * tau)));
   t.rate.lpf_sections = (uint32_t)n;
   t.rate.min_drive_v = 0.05f * v->drive_amp_set_v;
   t.rate_out_v_per_dps = v->rate_out_v_per_dps;

@@ -15,7 +15,8 @@ static int cfg_ok(const rate_channel_cfg_t *cfg)
          fm_isfinite(cfg->ref_im) && cfg->ref_re * cfg->ref_re + cfg->ref_im * cfg->ref_im > 0.0f &&
          fm_isfinite(cfg->scale_dps) && finite4(cfg->bias_c_dps) && finite4(cfg->sf_c) &&
          cfg->p_lpf_alpha > 0.0f && cfg->p_lpf_alpha <= 1.0f && cfg->min_drive_v > 0.0f &&
-         fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg);
+         fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg) &&
+         cfg->p_mode_k > 0.0f && cfg->p_mode_k <= 1.0f;
 }
 
 static void copy_coeffs(rate_channel_t *rc, const rate_channel_cfg_t *cfg)
@@ -28,6 +29,7 @@ static void copy_coeffs(rate_channel_t *rc, const rate_channel_cfg_t *cfg)
     rc->sf_c[i] = cfg->sf_c[i];
   }
   rc->p_lpf_alpha = cfg->p_lpf_alpha;
+  rc->p_mode_k = cfg->p_mode_k;
   rc->min_drive_v2 = cfg->min_drive_v * cfg->min_drive_v;
 }
 
@@ -92,6 +94,7 @@ void rate_channel_reset(rate_channel_t *rc, float p_deg)
   rc->p_acc_deg = 0.0f;
   rc->p_count = 0u;
   rc->p_dev_deg = p_deg - rc->p_ref_deg;
+  rc->p_mode_rad = rc->p_dev_deg * FM_RAD_PER_DEG_F;
   rc->p_f_deg = p_deg;
   rc->rate_dps = 0.0f;
 }
@@ -99,11 +102,18 @@ void rate_channel_reset(rate_channel_t *rc, float p_deg)
 void rate_channel_step(rate_channel_t *rc, float d_s, float d_c, float s_s, float s_c,
                        float p_rad)
 {
+  /* (6-17): the true drive phase follows P through the mode's lag. Work on P - p_ref
+   * (small) so the float low-pass has no dead band. */
+  const float p_dev_rad = p_rad - rc->p_ref_deg * FM_RAD_PER_DEG_F;
+  rc->p_mode_rad += rc->p_mode_k * (p_dev_rad - rc->p_mode_rad);
+  const float delta = rc->p_mode_rad - rc->p_dev_deg * FM_RAD_PER_DEG_F;
   float re = 0.0f, im = 0.0f;
   if (d_s * d_s + d_c * d_c > rc->min_drive_v2) {
-    /* S conj(e^{j psi} / A_set) */
-    re = s_s * rc->ref_re + s_c * rc->ref_im;
-    im = s_c * rc->ref_re - s_s * rc->ref_im;
+    /* S conj(e^{j psi} / A_set), then turned by -delta (small angle: e^{-j delta} ~ 1 - j delta) */
+    const float r0 = s_s * rc->ref_re + s_c * rc->ref_im;
+    const float i0 = s_c * rc->ref_re - s_s * rc->ref_im;
+    re = r0 + delta * i0;
+    im = i0 - delta * r0;
   }
   rc->rate_raw = re;
   rc->quad_raw = im;

@@ -50,6 +50,7 @@ typedef struct {
   float sf_c[4];
   float p_ref_deg;            /* P around which its low-pass works (the start value) */
   float p_lpf_alpha;          /* first-order low-pass of P at fs / RATE_P_DECIM */
+  float p_mode_k;             /* per-tick factor of the mode's lag: dt / (2Q/wn) */
   const biquad_coeffs_t *lpf; /* output low-pass sections, designed for fs / RATE_DECIM */
   uint32_t lpf_sections;
   float min_drive_v;          /* below this measured drive amplitude no rate is formed */
@@ -65,6 +66,8 @@ typedef struct {
   float p_acc_deg;            /* sum of (P - p_ref) over the current decimation block */
   uint32_t p_count;
   float p_dev_deg;            /* low-passed P - p_ref */
+  float p_mode_k;
+  float p_mode_rad;           /* P - p_ref through the mode's lag, rad */
   float min_drive_v2;
   float acc_re, acc_im;       /* sums over the current decimation block */
   uint32_t count;

@@ -15,7 +15,7 @@ static rate_channel_cfg_t base_cfg(biquad_coeffs_t *sec, float phi_dm)
   assert_int_equal(n, 2);
   rate_channel_cfg_t c = {.ref_re = cosf(phi_dm), .ref_im = sinf(phi_dm), .scale_dps = 250.0f,
                           .bias_c_dps = {0, 0, 0, 0}, .sf_c = {0, 0, 0, 0},
-                          .p_ref_deg = 0.0f, .p_lpf_alpha = 0.5f, .lpf = sec,
+                          .p_ref_deg = 0.0f, .p_lpf_alpha = 0.5f, .p_mode_k = 2.8e-3f, .lpf = sec,
                           .lpf_sections = (uint32_t)n, .min_drive_v = 0.1f};
   return c;
 }
@@ -131,6 +131,32 @@ static void test_dc_linearity(void **state)
   }
 }
 
+/* The phase loop's jitter reaches the true drive phase through the mode's lag (6-17);
+ * the sense quadrature turns with the true drive phase. A step of P, passed on through
+ * that lag to the sense phasor, must leave the rate output unchanged (before P's own
+ * 1 Hz low-pass follows), where an uncorrected reference would show q * dP. */
+static void test_reference_follows_drive_jitter(void **state)
+{
+  (void)state;
+  biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
+  rate_channel_cfg_t c = base_cfg(sec, 0.0f);
+  c.p_lpf_alpha = 1.25e-2f; /* 1 Hz at fs / RATE_P_DECIM */
+  rate_channel_t rc;
+  assert_int_equal(rate_channel_init(&rc, &c), 0);
+  const double q = 0.5, dp = 1e-3, k = 2.8e-3;
+  double lag = 0.0, worst = 0.0;
+  for (int n = 0; n < 2500; n++) { /* 50 ms after the step */
+    const double p = dp;           /* P stepped at n = 0 */
+    lag += k * (p - lag);          /* the structure's response (6-17) */
+    const double sr = -q * sin(lag), si = q * cos(lag); /* quadrature turned by the true phase */
+    rate_channel_step(&rc, 1.0f, 0.0f, (float)sr, (float)si, (float)p);
+    if (n > 100 && fabs((double)rc.rate_raw) > worst) worst = fabs((double)rc.rate_raw);
+  }
+  /* Left: P's 1 Hz low-pass moving over 50 ms (2 pi 1 Hz 0.05 s ~ 0.3 of dp at most). */
+  assert_true(worst < 0.35 * q * dp);
+  assert_true(worst < q * dp); /* uncorrected it would be q * dp */
+}
+
 /* No drive: no ratio is formed and the outputs stay finite. */
 static void test_no_drive(void **state)
 {
@@ -160,6 +186,7 @@ int main(void)
       cmocka_unit_test(test_compensation_polynomials),
       cmocka_unit_test(test_p_lowpass_resolution),
       cmocka_unit_test(test_dc_linearity),
+      cmocka_unit_test(test_reference_follows_drive_jitter),
       cmocka_unit_test(test_no_drive),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
