@@ -54,7 +54,13 @@ void app_selfcal_poll(app_t *a)
   selfcal_t *s = &a->selfcal;
   if (!selfcal_running(s)) return;
   const int sweeping = a->gyro.sup.mode == GYRO_MODE_SWEEP && a->request == APP_REQ_NONE;
-  if (selfcal_background(s, sweeping) != SELFCAL_READY || a->request != APP_REQ_NONE) return;
+  const selfcal_state_t st0 = selfcal_background(s, sweeping);
+  if (st0 == SELFCAL_FAILED && sweeping) {
+    /* A failed sweep leaves the electrodes off (safe mode); status says why. */
+    a->request = APP_REQ_DRIVE_OFF;
+    return;
+  }
+  if (st0 != SELFCAL_READY || a->request != APP_REQ_NONE) return;
   param_status_t st = stage_f(a, PARAM_drive_freq_hz, (double)s->f0_hz_f);
   if (st == PARAM_OK) st = stage_f(a, PARAM_drive_cal_f0_hz, (double)s->f0_hz_f);
   if (st == PARAM_OK) st = stage_f(a, PARAM_drive_cal_q, s->fit.q);

@@ -243,12 +243,17 @@ static void on_steps(selfcal_t *s, const selfcal_result_t *r)
     pts[i].h_im = (double)r->z_im[i] / f;
   }
   selfcal_fit_t fit;
-  if (selfcal_fit(pts, j->n_pts, c->delay_s, &fit) != 0 || !(fit.rms_rel < 0.05) ||
+  double delay_s = c->delay_s;
+  /* The converter delay is known; what the analog chain adds (up to 8 samples) is
+   * identified with the model (selfcal_fit_delay). */
+  if (selfcal_fit_delay(pts, j->n_pts, c->delay_s, c->delay_s + 8.0 / c->fs_hz, &fit, &delay_s) != 0 ||
+      !(fit.rms_rel < 0.05) ||
       !(fit.f0_hz > c->f_lo_hz && fit.f0_hz < c->f_hi_hz) || !(fit.q >= 1.0 && fit.q < 1.0e6)) {
     fail(s, "frequency response does not fit a resonance");
     return;
   }
   s->fit = fit;
+  s->delay_s = delay_s;
   const double hb = fit.f0_hz / (2.0 * fit.q);
   const double tau = 2.0 * fit.q / (2.0 * FM_PI * fit.f0_hz);
   if ((fabs(fit.f0_hz - s->plan_f_hz) > 0.25 * hb || fabs(hb / s->plan_hb_hz - 1.0) > 0.2) &&

@@ -13,7 +13,9 @@
  *      the free frequency f_d.
  *   3. STEPS: 7 points at f_d + {-2,-1,-0.5,0,0.5,1,2} f_d/(2 Q_rd), each settled for
  *      7 tau, averaged 0.1 s, at a force that puts the peak at amp_meas_v; the linear
- *      least-squares fit of selfcal_fit.h gives wn, Q, |H(wn)| and arg H(wn). If the
+ *      least-squares fit of selfcal_fit.h (known converter delay of 1.5 samples plus up
+ *      to 8 samples of unknown analog-chain delay, searched) gives wn, Q, |H(wn)| and
+ *      arg H(wn). If the
  *      fit moves the centre by more than a quarter bandwidth or Q by more than 20 %, the
  *      points are placed again around the fit (once).
  *   4. HOLD at wn with the force phase P = phase_set - arg H(wn) and the force
@@ -69,6 +71,7 @@ typedef struct {
   double rd_f_hz, rd_q, rd_gain;
   double plan_f_hz, plan_hb_hz, plan_tau_s; /* centre, half bandwidth, tau of the steps */
   selfcal_fit_t fit;
+  double delay_s;                 /* total chain delay found by the fit */
   double hold_f_cmd_v2, hold_p_rad;
   float f0_hz_f;                  /* wn/2pi as the float parameter value */
   uint32_t ticks;                 /* sweep length so far, samples */

@@ -108,3 +108,39 @@ int selfcal_fit(const selfcal_point_t *pts, uint32_t n, double delay_s, selfcal_
   out->rms_rel = sqrt(rss / (double)n);
   return 0;
 }
+
+int selfcal_fit_delay(const selfcal_point_t *pts, uint32_t n, double delay_min_s,
+                      double delay_max_s, selfcal_fit_t *out, double *delay_s_out)
+{
+  if (out == NULL || delay_s_out == NULL || !(delay_min_s >= 0.0) ||
+      !(delay_max_s >= delay_min_s) || !isfinite(delay_max_s) || n < 3u) {
+    return -1;
+  }
+  /* 4 unknowns + D from 2n >= 6 equations. */
+  const double g = 0.6180339887498949;
+  double a = delay_min_s, b = delay_max_s;
+  double x1 = b - g * (b - a), x2 = a + g * (b - a);
+  selfcal_fit_t f1, f2;
+  if (selfcal_fit(pts, n, x1, &f1) != 0 || selfcal_fit(pts, n, x2, &f2) != 0) return -1;
+  for (int it = 0; it < 60 && (b - a) > 1e-10; it++) {
+    if (f1.rms_rel <= f2.rms_rel) {
+      b = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = b - g * (b - a);
+      if (selfcal_fit(pts, n, x1, &f1) != 0) return -1;
+    } else {
+      a = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = a + g * (b - a);
+      if (selfcal_fit(pts, n, x2, &f2) != 0) return -1;
+    }
+  }
+  const double d = f1.rms_rel <= f2.rms_rel ? x1 : x2;
+  selfcal_fit_t best;
+  if (selfcal_fit(pts, n, d, &best) != 0) return -1;
+  *out = best;
+  *delay_s_out = d;
+  return 0;
+}

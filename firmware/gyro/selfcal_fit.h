@@ -35,4 +35,14 @@ typedef struct {
  * input or a non-physical result (wn^2 <= 0, Q <= 0, singular system). */
 int selfcal_fit(const selfcal_point_t *pts, uint32_t n, double delay_s, selfcal_fit_t *out);
 
+/* The same with the delay unknown in [delay_min_s, delay_max_s]: the analog chain
+ * (anti-alias and reconstruction filters, pickoff circuit) adds a group delay the
+ * firmware does not know, and a phase slope left in the data reads as a steeper
+ * resonance: Q comes out high (+1.2 % at Q = 24 on the simulator's default chain, about
+ * 1.5 samples beyond the converter's). The magnitude of H fixes
+ * Q without the phase, so D is identifiable: golden-section search of the relative
+ * residual over D (each step one linear fit). *delay_s_out gets the delay found. */
+int selfcal_fit_delay(const selfcal_point_t *pts, uint32_t n, double delay_min_s,
+                      double delay_max_s, selfcal_fit_t *out, double *delay_s_out);
+
 #endif /* SELFCAL_FIT_H */

@@ -58,6 +58,28 @@ static void test_exact_points(void **state)
   check_case(1999.0, 20.0, 4.0e-7, -1.0e-7, 0.0, 4.0 / 20.0);
 }
 
+/* An unknown extra delay: found by the search, and Q unbiased. A fit with only the
+ * known part of the delay over-estimates Q (the extra phase slope reads as a steeper
+ * resonance). */
+static void test_unknown_delay(void **state)
+{
+  (void)state;
+  const double fs = 50000.0, f0 = 1837.5, q = 23.7, d = 3.1 / fs, d_known = 1.5 / fs;
+  selfcal_point_t p[7];
+  make_points(p, 7u, f0, q, 7.0e-7, 2.0e-7, d, 4.0 / q);
+  selfcal_fit_t fit;
+  double d_found = 0.0;
+  assert_int_equal(selfcal_fit_delay(p, 7u, d_known, d_known + 8.0 / fs, &fit, &d_found), 0);
+  assert_true(fabs(d_found - d) * fs < 1e-4);
+  assert_true(fabs(fit.q / q - 1.0) < 1e-6);
+  assert_true(fabs(fit.f0_hz / f0 - 1.0) < 1e-9);
+  selfcal_fit_t biased;
+  assert_int_equal(selfcal_fit(p, 7u, d_known, &biased), 0);
+  assert_true(biased.q / q - 1.0 > 0.01);
+  double dd;
+  assert_int_equal(selfcal_fit_delay(p, 7u, d_known, 0.5 * d_known, &fit, &dd), -1);
+}
+
 static void test_bad_input(void **state)
 {
   (void)state;
@@ -115,6 +137,7 @@ int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_exact_points),
+      cmocka_unit_test(test_unknown_delay),
       cmocka_unit_test(test_bad_input),
       cmocka_unit_test(test_exec_refuses_bad_jobs),
   };
