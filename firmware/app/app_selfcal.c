@@ -1,5 +1,6 @@
 #include "app/app_selfcal.h"
 
+#include <stdatomic.h>
 #include <stddef.h>
 
 #include "dsp/fastmath.h"
@@ -82,5 +83,8 @@ void app_selfcal_poll(app_t *a)
   }
   selfcal_finish(s, 1, NULL);
   a->selfcal_ticks = a->isr_ticks - a->selfcal_t0_ticks;
+  /* The ISR must see the published design no later than the request: it applies the
+   * new block at the start of the tick, then takes the request (app_sample_isr). */
+  atomic_signal_fence(memory_order_release);
   a->request = APP_REQ_SWEEP_HANDOVER;
 }
