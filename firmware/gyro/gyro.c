@@ -174,6 +174,30 @@ void gyro_stop(gyro_t *g)
   drive_loop_reset(&g->drive);
 }
 
+void gyro_sweep_begin(gyro_t *g)
+{
+  gyro_stop(g);
+  supervisor_enter_sweep(&g->sup);
+  selfcal_exec_reset(&g->cal, g->nco.half_step);
+}
+
+int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d)
+{
+  if (g->sup.mode != GYRO_MODE_SWEEP) {
+    return -1;
+  }
+  g->nco.half_step = d->nco_half_step;
+  /* The sweep's last job held the vibration at the set point with (f_cmd, P): the
+   * integrators continue from there instead of from zero force. */
+  (void)pi_reset(&g->drive.amp_pi, g->cal.f_cmd_v2, 0.0f);
+  (void)pi_reset(&g->drive.phase_pi, g->cal.p_rad, 0.0f);
+  g->drive.f_cmd_v2 = g->drive.amp_pi.u;
+  g->drive.p_rad = g->drive.phase_pi.u;
+  supervisor_stop(&g->sup);
+  supervisor_start(&g->sup);
+  return 0;
+}
+
 uint16_t gyro_volts_to_dac(float v)
 {
   float c = v * (1.0f / HAL_DAC_V_PER_CODE) + (float)HAL_DAC_CODE_MID + 0.5f;
@@ -212,6 +236,13 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
   } else {
     /* Measure only: the amplitude is still watched for the over-amplitude trip. */
     g->drive.amp_v = fm_sqrtf(d_s * d_s + d_c * d_c);
+    if (g->sup.mode == GYRO_MODE_SWEEP) {
+      float f_cmd, p;
+      uint32_t half_step;
+      selfcal_exec_tick(&g->cal, d_s, d_c, &half_step, &f_cmd, &p);
+      drive_synth_step(&g->synth, f_cmd, p, ref.phase, ref.half_phase, &u1, &u2);
+      g->nco.half_step = half_step; /* from the next sample on */
+    }
   }
   rate_channel_step(&g->rate, d_s, d_c, s_s, s_c, g->drive.p_rad);
 
@@ -241,7 +272,7 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
     u1 = 0.0f;
     u2 = 0.0f;
   }
-  if (!supervisor_drive_enabled(&g->sup)) {
+  if (!supervisor_drive_enabled(&g->sup) && g->sup.mode != GYRO_MODE_SWEEP) {
     u1 = 0.0f;
     u2 = 0.0f;
   }

@@ -27,6 +27,7 @@
 #include "gyro/drive_loop.h"
 #include "gyro/drive_synth.h"
 #include "gyro/rate_channel.h"
+#include "gyro/selfcal_exec.h"
 #include "gyro/supervisor.h"
 #include "hal/hal_adc.h"
 #include "hal/hal_dac.h"
@@ -81,6 +82,7 @@ typedef struct {
   drive_synth_t synth;
   rate_channel_t rate;
   supervisor_t sup;
+  selfcal_exec_t cal; /* self-calibration jobs, run while the supervisor is in SWEEP */
   float f_cmd_max_v2;
   float inv_amp_set;     /* 1 / drive amplitude setpoint: no divide per tick */
   uint32_t slow_count;   /* tick counter modulo GYRO_SLOW_DECIM */
@@ -114,6 +116,14 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac);
 
 void gyro_start(gyro_t *g);
 void gyro_stop(gyro_t *g);
+
+/* Enter SWEEP (from any mode): loops off and cleared, the self-calibration jobs
+ * (selfcal_exec.h) drive the electrodes and the NCO frequency. */
+void gyro_sweep_begin(gyro_t *g);
+/* SWEEP -> ACQUIRE with the design d (already applied): the NCO goes to d's frequency
+ * and both PIs start from the excitation the sweep ended with (bumpless). Returns 0,
+ * or -1 (nothing changed) when not in SWEEP. */
+int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d);
 
 /* Volts to an offset-binary DAC code, clamped to the converter's range. */
 uint16_t gyro_volts_to_dac(float v);
