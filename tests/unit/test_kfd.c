@@ -9,40 +9,11 @@
 
 #include "demod_ref.h"
 #include "dsp/kfd.h"
-#include "ref_signal.h"
+#include "demod_test_signal.h"
 
-#define FS_HZ 50000.0
-#define FC_HZ 1750.0
-#define A1 0.01
-#define A2 (-0.004)
-#define SIGMA 0.002
+static double rel_err_x(const kfd_t *s, const double x[2]) { return rel_err_vec(s->x_i, s->x_q, x); }
 
-typedef struct {
-  float d, s, c;
-} sample_t;
-
-static sample_t make_sample(uint64_t k, ref_rng_t *g)
-{
-  double rs, rc;
-  ref_carrier(k, FC_HZ, FS_HZ, &rs, &rc);
-  const sample_t x = {(float)(A1 * rs + A2 * rc + SIGMA * ref_rng_gauss(g)), (float)rs,
-                      (float)rc};
-  return x;
-}
-
-static double rel_err_x(const kfd_t *s, const double x[2])
-{
-  const double di = (double)s->x_i - x[0], dq = (double)s->x_q - x[1];
-  return sqrt(di * di + dq * dq) / sqrt(x[0] * x[0] + x[1] * x[1]);
-}
-
-static double rel_err_p(const kfd_t *s, const double p[4])
-{
-  const double e11 = (double)s->p11 - p[0], e12 = (double)s->p12 - p[1],
-               e22 = (double)s->p22 - p[3];
-  const double n = sqrt(p[0] * p[0] + 2.0 * p[1] * p[1] + p[3] * p[3]);
-  return sqrt(e11 * e11 + 2.0 * e12 * e12 + e22 * e22) / n;
-}
+static double rel_err_p(const kfd_t *s, const double p[4]) { return rel_err_cov(s->p11, s->p12, s->p22, p); }
 
 static void init_default(kfd_t *s)
 {
