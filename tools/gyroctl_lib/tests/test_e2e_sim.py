@@ -83,24 +83,27 @@ def test_setpoint_moves_the_loop(sim, gyroctl, tmp_path):
 
 
 def test_gain_changes_the_loop(sim, gyroctl):
-    """Set a loop gain over the serial port and see the loop answer differently: at the
-    designed 30 Hz a setpoint step is done by the time the next command gets an answer
-    (a gyroctl call takes a few hundred ms); with the amplitude loop's bandwidth cut to
-    0.1 Hz (time constant 1.6 s) it is still far from done."""
+    """Set the loop gains over the serial port and see the loop answer differently: at
+    the designed 30 Hz a setpoint step is done by the time the next command gets an
+    answer (a gyroctl call takes a few hundred ms); with manual amplitude-PI gains for a
+    0.05 Hz loop (time constant 3.2 s) it is still far from done."""
     wait_locked(gyroctl, sim)
     assert ctl(gyroctl, sim, "set", "drive.amp_set_v", "0.30").returncode == 0
     fast = float(status(gyroctl, sim)["drive_amp_v"])
     assert abs(fast / 0.30 - 1.0) < 0.03
     time.sleep(0.3)
-    assert ctl(gyroctl, sim, "set", "drive.amp_bw_hz", "0.1").returncode == 0
-    assert ctl(gyroctl, sim, "get", "drive.amp_bw_hz").stdout.strip() == "0.1"
+    # Manual PI gains for a 0.05 Hz loop: kp = wc tau / K, ki = kp / tau with the
+    # default model (tau = 2Q/wn = 7.12 ms, K = 0.00546 V/V^2), wc = 2 pi 0.05.
+    r = ctl(gyroctl, sim, "set", "drive.amp_kp", "0.41", "drive.amp_ki", "57.6")
+    assert r.returncode == 0, r.stderr
+    assert ctl(gyroctl, sim, "get", "drive.amp_kp").stdout.strip() == "0.41"
     t0 = time.time()
     assert ctl(gyroctl, sim, "set", "drive.amp_set_v", "0.349").returncode == 0
     slow = float(status(gyroctl, sim)["drive_amp_v"])
     elapsed = time.time() - t0
-    # After `elapsed` seconds a 0.1 Hz first-order loop has covered 1 - exp(-elapsed/1.6)
+    # After `elapsed` seconds a 0.05 Hz first-order loop has covered 1 - exp(-elapsed/3.2)
     # of the step; allow for the time the two calls took to start.
     done = (slow - 0.30) / (0.349 - 0.30)
-    assert done < 1.0 - math.exp(-(elapsed + 0.2) / 1.6) + 0.1
+    assert done < 1.0 - math.exp(-(elapsed + 0.2) / 3.2) + 0.1
     assert done < 0.8
     assert status(gyroctl, sim)["fault_count"] == "0"
