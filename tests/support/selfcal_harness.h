@@ -139,6 +139,27 @@ static inline void check_lock(void)
   assert_true(fabs(a_end / 10.0e-6 - 1.0) < 0.02);
 }
 
+/* A +-1 Hz step of the drive resonance (the structure's thermal nodes stepped by the
+ * temperature that moves it 1 Hz by (2-32)) with the loops the sweep designed: lock
+ * holds, no fault, the true amplitude stays within 1 % of its setpoint. */
+static inline void check_resonance_step(const plant_cfg_t *pc, double df_hz)
+{
+  const double dk = -df_hz / (0.5 * pc->ket_per_k * pc->f_drive_hz);
+  double t[THERMAL_NODES];
+  for (int i = 0; i < THERMAL_NODES; i++) t[i] = thermal_temp(&plant.thermal, i) + dk;
+  thermal_set(&plant.thermal, t);
+  double worst = 0.0;
+  for (int i = 0; i < 50; i++) {
+    run_s(0.01);
+    if (i >= 20) worst = fmax(worst, fabs(amp_m() / 10.0e-6 - 1.0));
+  }
+  printf("# resonance step %+.1f Hz: mode %u faults %u, amplitude within %.3f %% from 0.2 s\n",
+         df_hz, (unsigned)app.gyro.sup.mode, (unsigned)app.gyro.sup.fault_count, 100.0 * worst);
+  assert_int_equal(app.gyro.sup.fault_count, 0u);
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
+  assert_true(worst < 0.01);
+}
+
 static inline void values_no_autostart(param_values_t *v)
 {
   param_values_defaults(v);
@@ -159,6 +180,8 @@ static inline void random_plant_case(double f_hz, double q)
   assert_true(t <= 60.0);
   check_identified(&pc);
   check_lock();
+  check_resonance_step(&pc, +1.0);
+  check_resonance_step(&pc, -2.0);
 }
 
 /* Negative control: the default (thesis part) loop design does not lock on the part. */
