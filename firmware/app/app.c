@@ -113,6 +113,8 @@ void app_sample_isr(void *ctx)
     } else if (req == APP_REQ_SWEEP_HANDOVER) {
       /* The design committed with the identified model was applied above. */
       (void)gyro_sweep_handover(&a->gyro, a->applied);
+    } else if (req == APP_REQ_SELFTEST) {
+      selftest_start(&a->gyro.selftest);
     } else {
       gyro_stop(&a->gyro);
     }

@@ -28,7 +28,8 @@ typedef enum {
   APP_REQ_DRIVE_ON = 1u,
   APP_REQ_DRIVE_OFF = 2u,
   APP_REQ_SWEEP = 3u,         /* enter SWEEP: self-calibration (app_selfcal.h) */
-  APP_REQ_SWEEP_HANDOVER = 4u /* SWEEP -> ACQUIRE with the newly applied design */
+  APP_REQ_SWEEP_HANDOVER = 4u, /* SWEEP -> ACQUIRE with the newly applied design */
+  APP_REQ_SELFTEST = 5u        /* run the built-in self-test (selftest.h) */
 } app_req_t;
 
 typedef struct {

@@ -116,7 +116,28 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   cli_put(cli, param_store_status_str(a->store_status));
   cli_emit_data(cli);
   put_selfcal(cli, a);
+  cli_put(cli, "selftest ");
+  cli_put(cli, selftest_state_name(a->gyro.selftest.state));
+  cli_emit_data(cli);
+  kv_f(cli, "selftest_dps", a->gyro.selftest.result_dps);
   cli_ok(cli, mode_name((uint32_t)a->gyro.sup.mode));
+}
+
+/* selftest: the built-in self-test runs in the ISR (0.5 s); status shows the result. */
+static void cmd_selftest(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
+{
+  (void)argv;
+  app_t *a = ctx;
+  if (argc != 1u) {
+    cli_err(cli, "ARGS", "usage: selftest");
+    return;
+  }
+  if (a->gyro.sup.mode != GYRO_MODE_LOCKED) {
+    cli_err(cli, "BUSY", "the self-test needs the drive LOCKED");
+    return;
+  }
+  a->request = APP_REQ_SELFTEST;
+  cli_ok(cli, "selftest started: see status in 0.5 s");
 }
 
 /* drive on|off: the request is taken by the ISR at its next tick. */
@@ -160,8 +181,11 @@ int app_cmds_register(app_t *a)
                             "the loops, then acquire", cmd_sweep, a};
   cmds[0] = status;
   cmds[1] = drive;
+  const cli_cmd_t selftest = {"selftest", "", "built-in self-test: a known force on the sense "
+                               "mode, checked on the rate output", cmd_selftest, a};
   cmds[2] = sweep;
-  for (size_t i = 0; i < 3u; i++) {
+  cmds[3] = selftest;
+  for (size_t i = 0; i < 4u; i++) {
     if (cli_register(&a->cli, &cmds[i]) != 0) {
       return -1;
     }

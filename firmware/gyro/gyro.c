@@ -96,6 +96,13 @@ int gyro_design(const param_values_t *v, gyro_design_t *d)
   t.sup.retry_s = v->sup_retry_s;
   t.sup.clip_max_count = v->sup_clip_count;
   t.autostart = v->sys_autostart;
+  {
+    const double th = (double)v->drive_phase_set_deg * FM_PI / 180.0;
+    selftest_cfg_t st = {v->selftest_amp_v, v->selftest_expect_dps, v->selftest_tol_rel,
+                         (float)cos(th), (float)sin(th), v->rate_scale_dps,
+                         v->sys_fs_hz / 5u, v->sys_fs_hz / 10u, v->sys_fs_hz / 5u};
+    t.selftest = st;
+  }
   /* Every module must accept its part: a design that gyro_apply could not apply is
    * rejected here, in the background, where the error can be reported. */
   gyro_t scratch;
@@ -121,6 +128,7 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   }
   t.adc_v_per_code = HAL_ADC_V_PER_CODE;
   t.inv_amp_set = 1.0f / d->drive.amp_set_v;
+  selftest_init(&t.selftest, &d->selftest);
   t.rate_code = (uint16_t)HAL_DAC_CODE_MID;
   t.rate_out_v_per_dps = d->rate_out_v_per_dps;
   t.f_cmd_max_v2 = d->drive.f_cmd_max_v2;
@@ -154,6 +162,7 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   (void)lmsd_set_mu(&g->lmsd_sense, d->lmsd_sense.mu);
   drive_loop_retune(&g->drive, &d->drive);
   g->inv_amp_set = 1.0f / d->drive.amp_set_v;
+  selftest_retune(&g->selftest, &d->selftest);
   /* The drive scheme only changes with the drive off (drive.mode is not live). */
   if (d->synth.mode == g->synth.mode || !supervisor_drive_enabled(&g->sup)) {
     (void)drive_synth_init(&g->synth, &d->synth);
@@ -280,7 +289,11 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
   dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
   dac->code[HAL_DAC_RATE_OUT] = g->rate_code; /* the rate changes at fs / RATE_DECIM */
-  dac->code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID;
+  /* Built-in self-test force on the sense feedback electrodes (selftest.h). */
+  const float u_st = selftest_step(&g->selftest, g->sup.mode == GYRO_MODE_LOCKED,
+                                   g->rate.rate_raw, ref.sin_wc, ref.cos_wc);
+  dac->code[HAL_DAC_SPARE] = gyro_volts_to_dac(u_st);
+  if (selftest_running(&g->selftest)) g->flags_acc |= GYRO_FLAG_SELFTEST;
 
   gyro_out_t *o = &g->out;
   o->tick++;

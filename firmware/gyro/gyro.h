@@ -28,6 +28,7 @@
 #include "gyro/drive_synth.h"
 #include "gyro/rate_channel.h"
 #include "gyro/selfcal_exec.h"
+#include "gyro/selftest.h"
 #include "gyro/supervisor.h"
 #include "hal/hal_adc.h"
 #include "hal/hal_dac.h"
@@ -48,6 +49,7 @@ typedef struct {
   drive_loop_design_out_t amp_design, phase_design; /* what the designer achieved */
   float rate_out_v_per_dps;
   uint32_t autostart;
+  selftest_cfg_t selftest;
 } gyro_design_t;
 
 /* A snapshot of the outputs of the latest tick (telemetry, status, the simulator). */
@@ -72,6 +74,7 @@ typedef struct {
 #define GYRO_FLAG_ADC_RAIL (1u << 1)
 #define GYRO_FLAG_DRIVE_LIMIT (1u << 2)
 #define GYRO_FLAG_FAULT (1u << 3)
+#define GYRO_FLAG_SELFTEST (1u << 4) /* the self-test force is on: rate output not valid */
 
 typedef struct {
   float adc_v_per_code;
@@ -88,6 +91,7 @@ typedef struct {
   uint32_t slow_count;   /* tick counter modulo GYRO_SLOW_DECIM */
   uint32_t flags_acc;    /* GYRO_FLAG_* seen since the last snapshot */
   uint16_t rate_code;    /* analog rate output DAC code, updated with the snapshot */
+  selftest_t selftest;
   gyro_out_t out;        /* updated every GYRO_SLOW_DECIM ticks (tick: every tick) */
 } gyro_t;
 
