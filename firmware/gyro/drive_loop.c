@@ -16,9 +16,14 @@ int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t 
     return -1;
   }
   /* Loop phase at crossover wc of the first-order open loop K Kp/(tau s) with the demod
-   * lag and 1.5 samples of delay (DAC latency + ZOH): 90 - atan(wc/wd) - 1.5 wc T. */
+   * lag and the delay of one sample (DAC latency) plus the hold of a loop period N T
+   * (N T / 2): 90 - atan(wc/wd) - (1 + N/2) wc T. */
+  if (!(in->loop_decim >= 0.0) || !(in->loop_decim <= 1000.0)) {
+    return -1;
+  }
+  const double n_hold = in->loop_decim > 1.0 ? in->loop_decim : 1.0;
   const double wd = 2.0 * FM_PI * in->demod_bw_hz;
-  const double delay_s = 1.5 / in->fs_hz;
+  const double delay_s = (1.0 + 0.5 * n_hold) / in->fs_hz;
   double wc = 2.0 * FM_PI * in->bw_hz;
   double pm = 0.0;
   for (int i = 0; i < 60; i++) {
