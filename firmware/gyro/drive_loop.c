@@ -90,18 +90,28 @@ void drive_loop_reset(drive_loop_t *dl)
   dl->p_rad = dl->p_init_rad;
 }
 
-void drive_loop_step(drive_loop_t *dl, float w_s, float w_c)
+void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c)
 {
   dl->amp_v = fm_sqrtf(w_s * w_s + w_c * w_c);
-  dl->phase_rad = fm_atan2f(w_c, w_s);
   dl->amp_err_v = dl->amp_set_v - dl->amp_v;
+  dl->f_cmd_v2 = pi_step(&dl->amp_pi, dl->amp_err_v);
+}
+
+void drive_loop_step_phase(drive_loop_t *dl, float w_s, float w_c)
+{
+  dl->phase_rad = fm_atan2f(w_c, w_s);
+  dl->phase_err_rad = fm_wrap_pi(dl->phase_set_rad - dl->phase_rad);
   /* While the amplitude is still tiny its phase is noise; hold P until there is a
    * vibration to measure (10 % of the setpoint). */
-  dl->phase_err_rad = fm_wrap_pi(dl->phase_set_rad - dl->phase_rad);
-  dl->f_cmd_v2 = pi_step(&dl->amp_pi, dl->amp_err_v);
   if (dl->amp_v > 0.1f * dl->amp_set_v) {
     dl->p_rad = pi_step(&dl->phase_pi, dl->phase_err_rad);
   } else {
     (void)pi_reset(&dl->phase_pi, dl->p_rad, dl->phase_err_rad);
   }
+}
+
+void drive_loop_step(drive_loop_t *dl, float w_s, float w_c)
+{
+  drive_loop_step_amp(dl, w_s, w_c);
+  drive_loop_step_phase(dl, w_s, w_c);
 }

@@ -92,5 +92,10 @@ void drive_loop_reset(drive_loop_t *dl);
 
 /* One tick: measurement from the drive LMSD weights, then both PIs. */
 void drive_loop_step(drive_loop_t *dl, float w_s, float w_c);
+/* The two halves of drive_loop_step, for a caller that spreads them over two ticks:
+ * the amplitude loop (|Z|, f_cmd) and the phase loop (arg Z, P; it uses the latest
+ * amplitude to tell whether there is a vibration to measure). */
+void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c);
+void drive_loop_step_phase(drive_loop_t *dl, float w_s, float w_c);
 
 #endif /* DRIVE_LOOP_H */

@@ -230,15 +230,20 @@ static void clear_loop_state(gyro_t *g)
   drive_synth_set(&g->synth, 0.0f, g->drive.p_rad);
 }
 
-/* Block work, one job per tick slot (gyro.h): the drive loops and their command. */
-static void block_drive(gyro_t *g, float d_s, float d_c)
+/* Block work, one job per tick slot (gyro.h): the drive loops and their command, the
+ * amplitude loop and the phase loop on two consecutive ticks. */
+static void block_drive(gyro_t *g, float d_s, float d_c, int phase)
 {
   if (!supervisor_drive_enabled(&g->sup)) {
     return;
   }
-  drive_loop_step(&g->drive, d_s, d_c);
+  if (phase) {
+    drive_loop_step_phase(&g->drive, d_s, d_c);
+  } else {
+    drive_loop_step_amp(&g->drive, d_s, d_c);
+    if (g->drive.f_cmd_v2 >= g->f_cmd_max_v2) g->flags_acc |= GYRO_FLAG_DRIVE_LIMIT;
+  }
   drive_synth_set(&g->synth, g->drive.f_cmd_v2, g->drive.p_rad);
-  if (g->drive.f_cmd_v2 >= g->f_cmd_max_v2) g->flags_acc |= GYRO_FLAG_DRIVE_LIMIT;
 }
 
 /* The supervisor on the block's evidence. Returns nonzero when it cleared the loops. */
@@ -320,13 +325,17 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
    * job on its own tick so that no tick carries two of them. */
   const uint32_t slot = g->slot;
   g->slot = slot + 1u == GYRO_BLOCK ? 0u : slot + 1u;
-  if (slot == GYRO_SLOT_DRIVE) {
-    block_drive(g, d_s, d_c);
+  if (slot == GYRO_SLOT_DRIVE_AMP) {
+    block_drive(g, d_s, d_c, 0);
+  } else if (slot == GYRO_SLOT_DRIVE_PHASE) {
+    block_drive(g, d_s, d_c, 1);
   } else if (slot == GYRO_SLOT_SUPERVISE) {
     (void)block_supervise(g, d_s, d_c, s_s, s_c);
   } else if (slot == GYRO_SLOT_RATE) {
     rate_channel_update(&g->rate, d_s, d_c, g->drive.p_rad);
     selftest_update(&g->selftest, g->sup.mode == GYRO_MODE_LOCKED, g->rate.rate_raw);
+  } else if (slot == GYRO_SLOT_QUAD) {
+    rate_channel_update_quad(&g->rate);
   }
 
   float u1 = 0.0f, u2 = 0.0f;

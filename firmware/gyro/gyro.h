@@ -107,9 +107,11 @@ typedef struct {
  * the block so that the worst tick carries one job: the interrupt's budget is set by
  * its worst tick (tools/bench/README.md). */
 #define GYRO_BLOCK RATE_DECIM
-#define GYRO_SLOT_DRIVE 0u
+#define GYRO_SLOT_DRIVE_AMP 0u
+#define GYRO_SLOT_DRIVE_PHASE 1u
 #define GYRO_SLOT_SUPERVISE 3u
 #define GYRO_SLOT_RATE 5u
+#define GYRO_SLOT_QUAD 7u
 #define GYRO_SLOT_OUTPUT 8u
 
 /* Turn parameter values into module configurations, checking that every module

@@ -133,11 +133,15 @@ void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad)
     rc->p_count = 0u;
   }
   rc->rate_unc_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_rate, re);
-  rc->quad_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_quad, im);
 
   const float p = rc->p_f_deg;
   const float *b3 = rc->bias_c_dps, *s3 = rc->sf_c;
   const float bias = b3[0] + p * (b3[1] + p * (b3[2] + p * b3[3]));
   const float sf = 1.0f + p * (s3[1] + p * (s3[2] + p * s3[3]));
   rc->rate_dps = rc->rate_unc_dps * sf - bias;
+}
+
+void rate_channel_update_quad(rate_channel_t *rc)
+{
+  rc->quad_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_quad, rc->quad_raw);
 }

@@ -109,4 +109,8 @@ static inline void rate_channel_accumulate(rate_channel_t *rc, float s_s, float 
  * holds it over the block). */
 void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad);
 
+/* The quadrature's output filter, once per block after rate_channel_update (on another
+ * tick of the block: it only feeds telemetry). */
+void rate_channel_update_quad(rate_channel_t *rc);
+
 #endif /* RATE_CHANNEL_H */

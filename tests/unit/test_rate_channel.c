@@ -25,6 +25,7 @@ static void block(rate_channel_t *rc, float d_s, float d_c, float s_s, float s_c
 {
   for (uint32_t i = 0; i < RATE_DECIM; i++) rate_channel_accumulate(rc, s_s, s_c);
   rate_channel_update(rc, d_s, d_c, p_rad);
+  rate_channel_update_quad(rc);
 }
 
 /* A sense phasor built as (r + j q) A_set e^{j psi} must come out as rate r and
@@ -76,14 +77,15 @@ static void test_compensation_polynomials(void **state)
   rate_channel_t rc;
   assert_int_equal(rate_channel_init(&rc, &c), 0);
   rate_channel_reset(&rc, -1.5f);
-  const double p_deg = -1.7, r = 0.2;
+  const double p_deg = -1.7, r = 0.2, q = -0.05;
   for (int n = 0; n < 5000; n++) {
-    block(&rc, 1.0f, 0.0f, (float)r, 0.0f, (float)(p_deg * M_PI / 180.0));
+    block(&rc, 1.0f, 0.0f, (float)r, (float)q, (float)(p_deg * M_PI / 180.0));
   }
   const double sf = 1.0 + 1e-3 * p_deg - 2e-6 * p_deg * p_deg * p_deg;
   const double bias = 58.533 + 34.59 * p_deg + 0.1 * p_deg * p_deg;
   assert_true(fabs((double)rc.p_f_deg - p_deg) < 1e-5);
   assert_true(fabs((double)rc.rate_unc_dps - 250.0 * r) < 250.0 * r * 1e-5);
+  assert_true(fabs((double)rc.quad_dps - 250.0 * q) < 250.0 * fabs(q) * 1e-5); /* not compensated */
   assert_true(fabs((double)rc.rate_dps - (250.0 * r * sf - bias)) < 1e-3);
 }
 
