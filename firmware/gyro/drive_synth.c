@@ -37,7 +37,12 @@ float drive_synth_f_cmd_max(const drive_synth_t *ds)
 
 void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad)
 {
-  const float f = f_cmd_v2 > 0.0f ? f_cmd_v2 : 0.0f;
+  /* A non-finite command (a NaN the supervisor has not caught yet: it looks once per
+   * block) drives nothing rather than a rail voltage; a non-finite P leaves the phase. */
+  if (!fm_isfinite(p_rad) || fm_absf(p_rad) > 7.0f) {
+    p_rad = 0.0f;
+  }
+  const float f = (f_cmd_v2 > 0.0f && fm_isfinite(f_cmd_v2)) ? f_cmd_v2 : 0.0f;
   if (ds->mode == GYRO_DRIVE_DC_AC) {
     /* Force phase P = twice the half-angle phase: exact modulo 2^32. */
     ds->off = 2u * sincos_half_rad_to_phase(p_rad);
