@@ -4,6 +4,11 @@
 
 #include "dsp/fastmath.h"
 
+/* Fast start of P's low-pass after a hold (rate_channel_hold_p): the held value counts
+ * as RATE_P_PRIOR means; the running mean ends after RATE_P_FAST_MAX means at most. */
+#define RATE_P_PRIOR 4u
+#define RATE_P_FAST_MAX 1000u
+
 static int finite4(const float *c)
 {
   return fm_isfinite(c[0]) && fm_isfinite(c[1]) && fm_isfinite(c[2]) && fm_isfinite(c[3]);
@@ -47,6 +52,8 @@ int rate_channel_init(rate_channel_t *rc, const rate_channel_cfg_t *cfg)
   rc->lpf_quad = b;
   copy_coeffs(rc, cfg);
   rc->p_ref_deg = cfg->p_ref_deg;
+  rc->p_hold = 0u;
+  rc->p_n = RATE_P_FAST_MAX; /* no fast start without a hold */
   rate_channel_reset(rc, cfg->p_ref_deg);
   return 0;
 }
@@ -124,13 +131,28 @@ void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad)
   rc->rate_raw = re;
   rc->quad_raw = im;
 
-  rc->p_acc_deg += p_rad * FM_DEG_PER_RAD_F - rc->p_ref_deg;
-  if (++rc->p_count == RATE_P_BLOCKS) {
-    const float mean = rc->p_acc_deg * (1.0f / (float)RATE_P_BLOCKS);
-    rc->p_dev_deg += rc->p_lpf_alpha * (mean - rc->p_dev_deg);
-    rc->p_f_deg = rc->p_ref_deg + rc->p_dev_deg;
+  if (rc->p_hold != 0u) {
     rc->p_acc_deg = 0.0f;
     rc->p_count = 0u;
+    rc->p_n = 0u;
+  } else {
+    rc->p_acc_deg += p_rad * FM_DEG_PER_RAD_F - rc->p_ref_deg;
+    if (++rc->p_count == RATE_P_BLOCKS) {
+      const float mean = rc->p_acc_deg * (1.0f / (float)RATE_P_BLOCKS);
+      /* Fast start after a hold: the running mean of the means seen since the release
+       * (the held value weighing as RATE_P_PRIOR of them) until its weight falls to the
+       * low-pass's own, then the low-pass. */
+      float a = rc->p_lpf_alpha;
+      if (rc->p_n < RATE_P_FAST_MAX) {
+        rc->p_n++;
+        const float a_mean = 1.0f / (float)(rc->p_n + RATE_P_PRIOR);
+        if (a_mean > a) a = a_mean;
+      }
+      rc->p_dev_deg += a * (mean - rc->p_dev_deg);
+      rc->p_f_deg = rc->p_ref_deg + rc->p_dev_deg;
+      rc->p_acc_deg = 0.0f;
+      rc->p_count = 0u;
+    }
   }
   rc->rate_unc_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_rate, re);
 

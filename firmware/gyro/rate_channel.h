@@ -73,6 +73,8 @@ typedef struct {
   float p_mode_k;
   float p_mode_rad;           /* P - p_ref through the mode's lag, rad */
   float min_drive_v2;
+  uint32_t p_hold;            /* nonzero: P is not the temperature yet, P_f holds */
+  uint32_t p_n;               /* P means since the last hold (fast start) */
   float acc_re, acc_im;       /* sense phasor summed over the current block */
   biquad_cascade_t lpf_rate;
   biquad_cascade_t lpf_quad;
@@ -102,6 +104,16 @@ static inline void rate_channel_accumulate(rate_channel_t *rc, float s_s, float 
 {
   rc->acc_re += s_s;
   rc->acc_im += s_c;
+}
+
+/* P is a temperature signal only while the phase loop holds the drive phase: during
+ * acquisition it swings by degrees (the loop pulling the phase in), and at the bias
+ * slope of tens of (deg/s)/deg a 1 Hz low-pass fed with that would carry a bias of
+ * several deg/s for a second after lock. While held, P_f keeps its value (the start
+ * value, or the last locked one after a fault) and P's average restarts on release. */
+static inline void rate_channel_hold_p(rate_channel_t *rc, int hold)
+{
+  rc->p_hold = hold ? 1u : 0u;
 }
 
 /* Once per RATE_DECIM ticks, after the block's last accumulate. (d_s, d_c): measured

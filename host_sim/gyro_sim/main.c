@@ -287,14 +287,16 @@ int main(int argc, char **argv)
     add_num(fig, "amp_err_rms_pct", s->amp_err_rms_pct);
     add_num(fig, "phase_err_rms_deg", s->phase_err_rms_deg);
     add_num(fig, "fw_lock_time_s", s->fw_lock_time_s);
+    add_num(fig, "rate_settle_s", s->rate_settle_s);
     add_num(fig, "drive_amp_true_m", s->final_amp_m);
     if (!quiet) {
       printf("  start-up (true motion): within 1 %% and held from %.3f s; overshoot %.2f %%\n",
              s->lock_time_s, s->overshoot_pct);
       printf("  after lock, 0.1-100 Hz: amplitude error %.4f %% rms, phase error %.5f deg rms\n",
              s->amp_err_rms_pct, s->phase_err_rms_deg);
-      printf("  firmware LOCKED at %.3f s; drive amplitude %.3f um\n", s->fw_lock_time_s,
-             1e6 * s->final_amp_m);
+      printf("  firmware LOCKED at %.3f s; drive amplitude %.3f um; rate output within 0.5 deg/s "
+             "of its final error from %.3f s\n", s->fw_lock_time_s, 1e6 * s->final_amp_m,
+             s->rate_settle_s);
     }
   }
   if (sc.mode == SIM_CLOSED_LOOP) {

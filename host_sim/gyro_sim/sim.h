@@ -26,6 +26,7 @@ typedef struct {
   double amp_err_rms_pct;   /* true amplitude, 0.1-100 Hz, after lock, % of the mean */
   double phase_err_rms_deg; /* true drive phase against the NCO, 0.1-100 Hz, after lock */
   double fw_lock_time_s;    /* first LOCKED of the firmware's supervisor */
+  double rate_settle_s;     /* rate output error within 0.5 deg/s of its final value */
   double final_amp_m;
 } sim_startup_t;
 

@@ -96,8 +96,8 @@ static double band_rms(const double *x, size_t i0, size_t n, double fs)
   return cnt ? sqrt(acc / (double)cnt) : NAN;
 }
 
-static void startup_figures(const double *amp, const double *ph, size_t n, double fs,
-                            sim_startup_t *st)
+static void startup_figures(const double *amp, const double *ph, const double *rerr, size_t n,
+                            double fs, sim_startup_t *st)
 {
   memset(st, 0, sizeof *st);
   if (n < 100) return;
@@ -119,6 +119,16 @@ static void startup_figures(const double *amp, const double *ph, size_t n, doubl
   const size_t i0 = last_out + (size_t)(0.1 * fs);
   st->amp_err_rms_pct = 100.0 * band_rms(amp, i0, n, fs) / af;
   st->phase_err_rms_deg = band_rms(ph, i0, n, fs) * 180.0 / M_PI;
+  /* Turn-on of the rate output: from here on its error stays within 0.5 deg/s of the
+   * error it ends with (bias, filter and P-compensation transients settled). */
+  double ef = 0.0;
+  for (size_t i = n - tail; i < n; i++) ef += rerr[i];
+  ef /= (double)tail;
+  size_t last_rate_out = 0;
+  for (size_t i = 0; i < n; i++) {
+    if (!(fabs(rerr[i] - ef) <= 0.5)) last_rate_out = i + 1;
+  }
+  st->rate_settle_s = (double)last_rate_out / fs;
 }
 
 int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_result_t *res,
@@ -143,6 +153,7 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
   const size_t n_truth = want_startup ? (size_t)(n_ticks / tdec) + 1u : 0u;
   double *amp = want_startup ? calloc(n_truth, sizeof *amp) : NULL;
   double *ph = want_startup ? calloc(n_truth, sizeof *ph) : NULL;
+  double *rerr = want_startup ? calloc(n_truth, sizeof *rerr) : NULL;
   sim_csv_t csv;
   memset(&csv, 0, sizeof csv);
   uart_pty_t pty;
@@ -213,6 +224,7 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
       ph_unwrap += d;
       ph_prev = p;
       ph[it] = ph_unwrap;
+      rerr[it] = (double)app->gyro.out.rate_dps - tr->rate_dps;
       it++;
     }
     if (k % csv_every == 0u) {
@@ -252,7 +264,7 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
   res->realtime_factor = res->wall_s > 0.0 ? res->sim_s / res->wall_s : 0.0;
   res->realtime_factor_cpu = res->cpu_s > 0.0 ? res->sim_s / res->cpu_s : 0.0;
   if (want_startup) {
-    startup_figures(amp, ph, it, 1000.0, &res->startup);
+    startup_figures(amp, ph, rerr, it, 1000.0, &res->startup);
     res->startup.fw_lock_time_s = fw_lock;
   }
   {
@@ -272,6 +284,7 @@ out:
   hal_sample_timer_stop();
   free(amp);
   free(ph);
+  free(rerr);
   free(plant);
   free(app);
   return rc;

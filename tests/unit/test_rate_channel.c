@@ -169,6 +169,38 @@ static void test_reference_follows_drive_jitter(void **state)
   assert_true(worst < q * dp); /* uncorrected it would be q * dp */
 }
 
+/* While held (acquisition), P's swings do not reach P_f; after the release P_f starts
+ * as a running mean (the held value weighing as 4 means) and reaches a new level in a
+ * few tens of ms, where the plain 1 Hz low-pass would still be 80 % short of it. */
+static void test_p_hold_and_fast_start(void **state)
+{
+  (void)state;
+  biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
+  rate_channel_cfg_t c = base_cfg(sec, 0.0f);
+  c.p_ref_deg = 25.7f;
+  c.p_lpf_alpha = 1.25e-2f; /* 1 Hz at fs / RATE_P_DECIM */
+  rate_channel_t rc;
+  assert_int_equal(rate_channel_init(&rc, &c), 0);
+  rate_channel_hold_p(&rc, 1);
+  for (int n = 0; n < 500; n++) { /* 0.1 s of acquisition: P swings by +-5 deg */
+    const double p_deg = 25.7 + 5.0 * sin(0.05 * n);
+    block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, (float)(p_deg * M_PI / 180.0));
+  }
+  assert_true(rc.p_f_deg == 25.7f);
+  rate_channel_hold_p(&rc, 0);
+  const double p_locked = 25.75;
+  for (int n = 0; n < 200; n++) { /* 40 ms = 20 means of P */
+    block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, (float)(p_locked * M_PI / 180.0));
+  }
+  /* running mean with the prior as 4 of 24: 1/6 of the 0.05 deg step left */
+  assert_true(fabs((double)rc.p_f_deg - p_locked) < 0.05 / 6.0 + 1e-4);
+  assert_true(fabs((double)rc.p_f_deg - p_locked) > 0.05 / 6.0 - 1e-3);
+  for (int n = 0; n < 20000; n++) {
+    block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, (float)(p_locked * M_PI / 180.0));
+  }
+  assert_true(fabs((double)rc.p_f_deg - p_locked) < 1e-4);
+}
+
 /* No drive: no ratio is formed and the outputs stay finite. */
 static void test_no_drive(void **state)
 {
@@ -199,6 +231,7 @@ int main(void)
       cmocka_unit_test(test_p_lowpass_resolution),
       cmocka_unit_test(test_dc_linearity),
       cmocka_unit_test(test_reference_follows_drive_jitter),
+      cmocka_unit_test(test_p_hold_and_fast_start),
       cmocka_unit_test(test_no_drive),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
