@@ -8,7 +8,14 @@
  *                 reads and writes real data
  *   cycles        SysTick periods elapsed x 3360 + SysTick count (no DWT in QEMU)
  *   uptime        TIM2 free running, prescaled to 1 MHz of emulated time
- * Everything else (UART driver, fault capture, start-up, flash driver) is the board's. */
+ * Everything else (UART driver, fault capture, start-up, flash driver) is the board's.
+ *
+ * With STM32F4_QEMU_PLANT (gyro-fw-qemu) the converters are the plant model instead
+ * (stm32f4_qemu_plant.c), stepped after the application's ISR in the SysTick handler,
+ * and the SysTick period is STM32F4_QEMU_TICK_STRETCH times the requested one: the
+ * double-precision plant runs in software on the single-precision FPU and needs far more
+ * than the 3360 cycles of a 20 us tick. The firmware and the plant still advance one
+ * 50 kHz sample per tick; only emulated wall time runs slower. */
 #include "hal/hal_adc.h"
 #include "hal/hal_dac.h"
 #include "hal/hal_sample_timer.h"
@@ -19,6 +26,13 @@
 #include "stm32f4_sample.h"
 #include "stm32f4_uart.h"
 #include "stm32f4_uptime.h"
+#ifdef STM32F4_QEMU_PLANT
+#include "stm32f4_qemu_plant.h"
+#endif
+
+#ifndef STM32F4_QEMU_TICK_STRETCH
+#define STM32F4_QEMU_TICK_STRETCH 1u
+#endif
 
 #define QEMU_SYSCLK_HZ 168000000u
 #define QEMU_TIM_HZ 1000000000u /* QEMU's STM32 timer model counts its input at 1 GHz */
@@ -29,7 +43,9 @@ static hal_sample_isr_fn s_isr;
 static void *s_ctx;
 static volatile uint32_t s_wraps;
 static volatile uint32_t s_ticks;
+#ifndef STM32F4_QEMU_PLANT
 static hal_dac_frame_t s_dac;
+#endif
 
 void stm32f4_system_init(void)
 {
@@ -47,16 +63,20 @@ const stm32f4_board_info_t *stm32f4_board_info(void)
 
 int stm32f4_board_init(void)
 {
+#ifdef STM32F4_QEMU_PLANT
+  if (stm32f4_qemu_plant_init() != 0) return -1;
+#else
   for (uint32_t ch = 0u; ch < HAL_DAC_NUM_CHANNELS; ++ch) {
     s_dac.code[ch] = (uint16_t)HAL_DAC_CODE_MID;
   }
+#endif
   return stm32f4_uart_init(s_info.clock.pclk2_hz, STM32F4_UART_BAUD);
 }
 
 int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
 {
   if (isr == 0 || rate_hz == 0u || QEMU_SYSCLK_HZ % rate_hz != 0u ||
-      QEMU_SYSCLK_HZ / rate_hz > 0x1000000u) {
+      QEMU_SYSCLK_HZ / rate_hz > 0x1000000u / STM32F4_QEMU_TICK_STRETCH) {
     return -1;
   }
   hal_sample_timer_stop();
@@ -64,7 +84,7 @@ int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
   s_ctx = ctx;
   s_ticks = 0u;
   SCB->SHPR[SYSTICK_SHPR_INDEX] = (uint8_t)(STM32F4_PRIO_SAMPLE << 4);
-  SYSTICK->LOAD = QEMU_SYSCLK_HZ / rate_hz - 1u;
+  SYSTICK->LOAD = QEMU_SYSCLK_HZ / rate_hz * STM32F4_QEMU_TICK_STRETCH - 1u;
   SYSTICK->VAL = 0u;
   SYSTICK->CTRL = SYSTICK_CTRL_CLKSOURCE | SYSTICK_CTRL_TICKINT | SYSTICK_CTRL_ENABLE;
   return 0;
@@ -81,6 +101,9 @@ STM32F4_RAMFUNC void SysTick_Handler(void)
   s_wraps = s_wraps + 1u;
   s_ticks = s_ticks + 1u;
   if (s_isr != 0) s_isr(s_ctx);
+#ifdef STM32F4_QEMU_PLANT
+  stm32f4_qemu_plant_tick();
+#endif
 }
 
 STM32F4_RAMFUNC uint32_t hal_cycles_now(void)
@@ -95,6 +118,7 @@ STM32F4_RAMFUNC uint32_t hal_cycles_now(void)
   return w1 * (load + 1u) + (load - val);
 }
 
+#ifndef STM32F4_QEMU_PLANT
 static int16_t loopback_code(uint16_t dac_code)
 {
   return (int16_t)(((int32_t)dac_code - (int32_t)HAL_DAC_CODE_MID) * 4);
@@ -110,6 +134,7 @@ STM32F4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame)
 {
   s_dac = *frame;
 }
+#endif
 
 void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
 {

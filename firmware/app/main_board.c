@@ -1,0 +1,84 @@
+/* Entry point of the product image gyro-fw (and of its emulator twin gyro-fw-qemu, which
+ * links the same file against the QEMU board layer with the plant model in place of the
+ * converters).
+ *
+ *   boot: Reset_Handler (clock tree, .data/.bss/.ccm) -> main: board (pins, converter
+ *   resets, DAC sequencer, UART), app_init (parameters from the flash store, or the
+ *   defaults; loop design), watchdog, then the 50 kHz sample clock with app_sample_isr.
+ *   background: app_poll (command line, telemetry), watchdog reload; the core sleeps
+ *   until the next interrupt (at the latest the next sample tick).
+ *
+ * app_t lives in the core-coupled RAM: the ISR and the background loop are the only
+ * users (no DMA stream reaches CCM and none needs to: the converter frames go through
+ * the HAL's own SRAM buffers), and CCM has no contention with the DMA traffic of the
+ * sample chain (not in QEMU, which models no CCM). The watchdog starts after app_init, whose init-time design (double
+ * precision, libm) is not bounded by the 250 ms timeout; a parameter save reloads it
+ * from the flash driver's wait loop (stm32f4_flash.c). */
+#include <stdint.h>
+
+#include "app/app.h"
+#include "hal/hal_sample_timer.h"
+#include "hal/hal_uart.h"
+#include "stm32f4_board.h"
+#include "stm32f4_core.h"
+#include "stm32f4_iwdg.h"
+#include "stm32f4_uart.h"
+
+#define SAMPLE_RATE_HZ 50000u
+#define WATCHDOG_MS 250u
+
+/* QEMU's netduinoplus2 maps no CCM (a write there is a bus fault): ordinary SRAM. */
+#ifdef STM32F4_QEMU
+#define APP_STATE_RAM
+#else
+#define APP_STATE_RAM STM32F4_CCM_BSS
+#endif
+
+static APP_STATE_RAM app_t s_app;
+
+static void say(const char *s)
+{
+  uint32_t n = 0u;
+  while (s[n] != '\0') ++n;
+  (void)hal_uart_write((const uint8_t *)s, n);
+}
+
+int main(void)
+{
+  app_t *a = &s_app;
+  (void)stm32f4_board_init();
+  const int rc = app_init(a);
+
+  stm32f4_iwdg_plan_t wd;
+  if (stm32f4_iwdg_plan(STM32F4_LSI_HZ, WATCHDOG_MS, &wd) == 0) {
+    stm32f4_iwdg_start(&wd);
+  }
+  if (rc != 0) {
+    /* Not even the defaults could be designed: there is no loop to run. Keep the
+     * watchdog fed and say so; the command line is not up. */
+    say("gyro-fw error: app_init failed\r\n");
+    for (;;) {
+#ifdef STM32F4_QEMU
+      stm32f4_uart_poll_tx();
+#endif
+      stm32f4_iwdg_kick();
+    }
+  }
+  say("gyro-fw ready\r\n");
+  if (hal_sample_timer_start(SAMPLE_RATE_HZ, app_sample_isr, a) != 0) {
+    say("gyro-fw error: sample clock did not start\r\n");
+  }
+  for (;;) {
+    app_poll(a);
+#ifdef STM32F4_QEMU
+    stm32f4_uart_poll_tx();
+#endif
+    stm32f4_iwdg_kick();
+#ifndef STM32F4_QEMU
+    /* Nothing to do until the next interrupt. Not in QEMU: with -icount a sleeping
+     * core lets virtual time jump and QEMU's SysTick then drops periods
+     * (hal/stm32f4/README.md). */
+    stm32f4_wfi();
+#endif
+  }
+}
