@@ -9,6 +9,7 @@
 #include "hal/hal_sample_timer.h"
 #include "hal/hal_uart.h"
 #include "app/app_cmds.h"
+#include "app/app_selfcal.h"
 
 static int derive(void *ctx, const param_values_t *v, void *derived, const char **why)
 {
@@ -84,7 +85,8 @@ int app_init_with(app_t *a, const param_values_t *values)
 
   const cli_cfg_t cc = {&a->params, &a->store, cli_write, a};
   if (cli_init(&a->cli, &cc) != 0 || app_cmds_register(a) != 0 ||
-      app_tlm_init(&a->tlm, &a->cli, &a->params) != 0) {
+      app_tlm_init(&a->tlm, &a->cli, &a->params) != 0 ||
+      selfcal_init(&a->selfcal, &a->gyro.cal) != 0) {
     return -3;
   }
   return 0;
@@ -106,6 +108,13 @@ void app_sample_isr(void *ctx)
   if (req != APP_REQ_NONE) {
     if (req == APP_REQ_DRIVE_ON) {
       gyro_start(&a->gyro);
+    } else if (req == APP_REQ_SWEEP) {
+      gyro_sweep_begin(&a->gyro);
+    } else if (req == APP_REQ_SWEEP_HANDOVER) {
+      /* The design committed with the identified model was applied above. */
+      (void)gyro_sweep_handover(&a->gyro, a->applied);
+    } else if (req == APP_REQ_SELFTEST) {
+      selftest_start(&a->gyro.selftest);
     } else {
       gyro_stop(&a->gyro);
     }
@@ -137,4 +146,5 @@ void app_poll(app_t *a)
     cli_feed(&a->cli, buf, n);
   }
   app_tlm_poll(&a->tlm);
+  app_selfcal_poll(a);
 }

@@ -17,6 +17,7 @@
 #include "app/app_tlm.h"
 #include "comm/cli.h"
 #include "gyro/gyro.h"
+#include "gyro/selfcal.h"
 #include "params/param_store.h"
 #include "params/params.h"
 
@@ -25,7 +26,10 @@
 typedef enum {
   APP_REQ_NONE = 0u,
   APP_REQ_DRIVE_ON = 1u,
-  APP_REQ_DRIVE_OFF = 2u
+  APP_REQ_DRIVE_OFF = 2u,
+  APP_REQ_SWEEP = 3u,         /* enter SWEEP: self-calibration (app_selfcal.h) */
+  APP_REQ_SWEEP_HANDOVER = 4u, /* SWEEP -> ACQUIRE with the newly applied design */
+  APP_REQ_SELFTEST = 5u        /* run the built-in self-test (selftest.h) */
 } app_req_t;
 
 typedef struct {
@@ -39,6 +43,9 @@ typedef struct {
   cli_cmd_t cmds[APP_MAX_CMDS]; /* the application's command rows (app_cmds.c) */
   volatile uint32_t request; /* app_req_t, written by the background, taken by the ISR */
   app_tlm_t tlm;             /* telemetry stream and its commands (app_tlm.c) */
+  selfcal_t selfcal;         /* self-calibration sequencer (background, app_selfcal.c) */
+  uint32_t selfcal_t0_ticks; /* isr_ticks when the sweep was requested */
+  uint32_t selfcal_ticks;    /* its length up to the hand-over */
   /* Self-measurement of the sample ISR (DWT cycles on the board). */
   uint32_t isr_cycles_last;
   uint32_t isr_cycles_max;

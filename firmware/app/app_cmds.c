@@ -2,6 +2,8 @@
 
 #include <string.h>
 
+#include "app/app_selfcal.h"
+
 static const char *mode_name(uint32_t m)
 {
   switch ((gyro_mode_t)m) {
@@ -52,6 +54,35 @@ static void kv_u(cli_t *cli, const char *k, uint32_t v)
   cli_emit_data(cli);
 }
 
+/* Self-calibration progress and result (the figures of the latest sweep). */
+static void put_selfcal(cli_t *cli, const app_t *a)
+{
+  const selfcal_t *s = &a->selfcal;
+  cli_put(cli, "selfcal ");
+  cli_put(cli, selfcal_state_name(s->state));
+  cli_emit_data(cli);
+  if (s->state == SELFCAL_IDLE) return;
+  if (s->state == SELFCAL_FAILED && s->why != NULL) {
+    cli_put(cli, "selfcal_why ");
+    cli_put(cli, s->why);
+    cli_emit_data(cli);
+  }
+  const uint32_t t = selfcal_running(s) ? a->isr_ticks - a->selfcal_t0_ticks : a->selfcal_ticks;
+  kv_f(cli, "selfcal_s", (float)t / (float)params_current(&a->params)->sys_fs_hz);
+  if (s->f_coarse_hz > 0.0) kv_f(cli, "selfcal_coarse_hz", (float)s->f_coarse_hz);
+  if (s->rd_q > 0.0) {
+    kv_f(cli, "selfcal_ringdown_hz", (float)s->rd_f_hz);
+    kv_f(cli, "selfcal_ringdown_q", (float)s->rd_q);
+  }
+  if (s->fit.q > 0.0) {
+    kv_f(cli, "selfcal_f0_hz", (float)s->fit.f0_hz);
+    kv_f(cli, "selfcal_q", (float)s->fit.q);
+    kv_f(cli, "selfcal_gain_v_per_v2", (float)s->fit.gain_v_per_v2);
+    kv_f(cli, "selfcal_p_init_deg", (float)(s->hold_p_rad * 57.29577951308232));
+    kv_f(cli, "selfcal_fit_rms_rel", (float)s->fit.rms_rel);
+  }
+}
+
 /* status: one data line per figure, then ok MODE. The snapshot is copied field by
  * field while the ISR may update it; each figure is one aligned word, so each line is a
  * consistent value (lines may come from adjacent ticks). */
@@ -65,10 +96,10 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   }
   const gyro_out_t *o = &a->gyro.out;
   cli_put(cli, "mode ");
-  cli_put(cli, mode_name(o->mode));
+  cli_put(cli, mode_name((uint32_t)a->gyro.sup.mode));
   cli_emit_data(cli);
   cli_put(cli, "fault ");
-  put_faults(cli, o->fault);
+  put_faults(cli, a->gyro.sup.fault);
   cli_emit_data(cli);
   kv_u(cli, "fault_count", a->gyro.sup.fault_count);
   kv_f(cli, "rate_dps", o->rate_dps);
@@ -84,7 +115,29 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   cli_put(cli, "store ");
   cli_put(cli, param_store_status_str(a->store_status));
   cli_emit_data(cli);
-  cli_ok(cli, mode_name(o->mode));
+  put_selfcal(cli, a);
+  cli_put(cli, "selftest ");
+  cli_put(cli, selftest_state_name(a->gyro.selftest.state));
+  cli_emit_data(cli);
+  kv_f(cli, "selftest_dps", a->gyro.selftest.result_dps);
+  cli_ok(cli, mode_name((uint32_t)a->gyro.sup.mode));
+}
+
+/* selftest: the built-in self-test runs in the ISR (0.5 s); status shows the result. */
+static void cmd_selftest(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
+{
+  (void)argv;
+  app_t *a = ctx;
+  if (argc != 1u) {
+    cli_err(cli, "ARGS", "usage: selftest");
+    return;
+  }
+  if (a->gyro.sup.mode != GYRO_MODE_LOCKED) {
+    cli_err(cli, "BUSY", "the self-test needs the drive LOCKED");
+    return;
+  }
+  a->request = APP_REQ_SELFTEST;
+  cli_ok(cli, "selftest started: see status in 0.5 s");
 }
 
 /* drive on|off: the request is taken by the ISR at its next tick. */
@@ -100,6 +153,22 @@ static void cmd_drive(cli_t *cli, void *ctx, uint32_t argc, const char *const *a
   cli_ok(cli, on ? "drive on" : "drive off");
 }
 
+/* sweep: self-calibration; the drive goes SWEEP -> ACQUIRE with the identified model. */
+static void cmd_sweep(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
+{
+  (void)argv;
+  app_t *a = ctx;
+  if (argc != 1u) {
+    cli_err(cli, "ARGS", "usage: sweep");
+    return;
+  }
+  if (app_selfcal_start(a) != 0) {
+    cli_err(cli, "BUSY", "a sweep or a drive request is in progress");
+    return;
+  }
+  cli_ok(cli, "sweep started");
+}
+
 int app_cmds_register(app_t *a)
 {
   /* The CLI keeps the rows by pointer: they live in the application instance. */
@@ -108,9 +177,15 @@ int app_cmds_register(app_t *a)
                             cmd_status, a};
   const cli_cmd_t drive = {"drive", "on|off", "start or stop the drive (acquire / safe mode)",
                            cmd_drive, a};
+  const cli_cmd_t sweep = {"sweep", "", "self-calibration: identify the drive mode, redesign "
+                            "the loops, then acquire", cmd_sweep, a};
   cmds[0] = status;
   cmds[1] = drive;
-  for (size_t i = 0; i < 2u; i++) {
+  const cli_cmd_t selftest = {"selftest", "", "built-in self-test: a known force on the sense "
+                               "mode, checked on the rate output", cmd_selftest, a};
+  cmds[2] = sweep;
+  cmds[3] = selftest;
+  for (size_t i = 0; i < 4u; i++) {
     if (cli_register(&a->cli, &cmds[i]) != 0) {
       return -1;
     }

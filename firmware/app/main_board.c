@@ -1,6 +1,6 @@
-/* Entry point of the product image gyro-fw (and of its emulator twin gyro-fw-qemu, which
- * links the same file against the QEMU board layer with the plant model in place of the
- * converters).
+/* Entry point of the product image gyro-fw. Built with STM32F4_QEMU (the QEMU board
+ * layer) it also runs in the emulator as gyro-fw-qemu, the plant model in place of the
+ * converters: no WFI, the UART drained from the loop, SRAM instead of CCM.
  *
  *   boot: Reset_Handler (clock tree, .data/.bss/.ccm) -> main: board (pins, converter
  *   resets, DAC sequencer, UART), app_init (parameters from the flash store, or the
@@ -11,9 +11,10 @@
  * app_t lives in the core-coupled RAM: the ISR and the background loop are the only
  * users (no DMA stream reaches CCM and none needs to: the converter frames go through
  * the HAL's own SRAM buffers), and CCM has no contention with the DMA traffic of the
- * sample chain (not in QEMU, which models no CCM). The watchdog starts after app_init, whose init-time design (double
+ * sample chain. The watchdog starts after app_init, whose init-time design (double
  * precision, libm) is not bounded by the 250 ms timeout; a parameter save reloads it
- * from the flash driver's wait loop (stm32f4_flash.c). */
+ * from the flash driver's wait loop (stm32f4_flash.c), and is refused while the drive
+ * runs (param_store), so an erase never stalls a running loop. */
 #include <stdint.h>
 
 #include "app/app.h"

@@ -73,7 +73,7 @@ static double section_gain(butter_type_t type, double a1, double a2, double w0)
     return hypot(re, im) / (2.0 * sin(w0));
   }
   default:
-    return NAN;
+    return (double)NAN;
   }
 }
 

@@ -61,9 +61,12 @@ int gyro_design(const param_values_t *v, gyro_design_t *d)
   const int n = butter_design(BUTTER_LOWPASS, v->rate_lpf_order, (double)v->rate_lpf_cutoff_hz,
                               0.0, fs / RATE_DECIM, t.rate_lpf, BIQUAD_MAX_SECTIONS);
   if (n <= 0) return -5;
-  const double phi_dm = (double)v->rate_demod_phase_deg * FM_PI / 180.0;
-  t.rate.rot_c = (float)cos(phi_dm);
-  t.rate.rot_s = (float)sin(phi_dm);
+  /* Reference of the rate channel: the drive motion as the loops hold it (phase at
+   * its setpoint, amplitude at its setpoint), turned by the demodulation phase. */
+  const double psi =
+      ((double)v->rate_demod_phase_deg + (double)v->drive_phase_set_deg) * FM_PI / 180.0;
+  t.rate.ref_re = (float)(cos(psi) / (double)v->drive_amp_set_v);
+  t.rate.ref_im = (float)(sin(psi) / (double)v->drive_amp_set_v);
   t.rate.scale_dps = v->rate_scale_dps;
   t.rate.bias_c_dps[0] = v->rate_bias_c0_dps;
   t.rate.bias_c_dps[1] = v->rate_bias_c1_dps_per_deg;
@@ -77,6 +80,7 @@ int gyro_design(const param_values_t *v, gyro_design_t *d)
   t.rate.p_lpf_alpha =
       (float)(1.0 - exp(-2.0 * FM_PI * (double)v->rate_p_lpf_hz * RATE_P_DECIM / fs));
   t.rate.lpf = NULL; /* gyro_init/gyro_apply point it at t.rate_lpf where it is used */
+  t.rate.p_mode_k = (float)(1.0 - exp(-1.0 / (fs * tau)));
   t.rate.lpf_sections = (uint32_t)n;
   t.rate.min_drive_v = 0.05f * v->drive_amp_set_v;
   t.rate_out_v_per_dps = v->rate_out_v_per_dps;
@@ -92,6 +96,13 @@ int gyro_design(const param_values_t *v, gyro_design_t *d)
   t.sup.retry_s = v->sup_retry_s;
   t.sup.clip_max_count = v->sup_clip_count;
   t.autostart = v->sys_autostart;
+  {
+    const double th = (double)v->drive_phase_set_deg * FM_PI / 180.0;
+    selftest_cfg_t st = {v->selftest_amp_v, v->selftest_expect_dps, v->selftest_tol_rel,
+                         (float)cos(th), (float)sin(th), v->rate_scale_dps,
+                         v->sys_fs_hz / 5u, v->sys_fs_hz / 10u, v->sys_fs_hz / 5u};
+    t.selftest = st;
+  }
   /* Every module must accept its part: a design that gyro_apply could not apply is
    * rejected here, in the background, where the error can be reported. */
   gyro_t scratch;
@@ -116,6 +127,9 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
     return -2;
   }
   t.adc_v_per_code = HAL_ADC_V_PER_CODE;
+  t.inv_amp_set = 1.0f / d->drive.amp_set_v;
+  selftest_init(&t.selftest, &d->selftest);
+  t.rate_code = (uint16_t)HAL_DAC_CODE_MID;
   t.rate_out_v_per_dps = d->rate_out_v_per_dps;
   t.f_cmd_max_v2 = d->drive.f_cmd_max_v2;
   *g = t;
@@ -147,6 +161,8 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   (void)lmsd_set_mu(&g->lmsd_drive, d->lmsd_drive.mu);
   (void)lmsd_set_mu(&g->lmsd_sense, d->lmsd_sense.mu);
   drive_loop_retune(&g->drive, &d->drive);
+  g->inv_amp_set = 1.0f / d->drive.amp_set_v;
+  selftest_retune(&g->selftest, &d->selftest);
   /* The drive scheme only changes with the drive off (drive.mode is not live). */
   if (d->synth.mode == g->synth.mode || !supervisor_drive_enabled(&g->sup)) {
     (void)drive_synth_init(&g->synth, &d->synth);
@@ -165,6 +181,30 @@ void gyro_stop(gyro_t *g)
 {
   supervisor_stop(&g->sup);
   drive_loop_reset(&g->drive);
+}
+
+void gyro_sweep_begin(gyro_t *g)
+{
+  gyro_stop(g);
+  supervisor_enter_sweep(&g->sup);
+  selfcal_exec_reset(&g->cal, g->nco.half_step);
+}
+
+int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d)
+{
+  if (g->sup.mode != GYRO_MODE_SWEEP) {
+    return -1;
+  }
+  g->nco.half_step = d->nco_half_step;
+  /* The sweep's last job held the vibration at the set point with (f_cmd, P): the
+   * integrators continue from there instead of from zero force. */
+  (void)pi_reset(&g->drive.amp_pi, g->cal.f_cmd_v2, 0.0f);
+  (void)pi_reset(&g->drive.phase_pi, g->cal.p_rad, 0.0f);
+  g->drive.f_cmd_v2 = g->drive.amp_pi.u;
+  g->drive.p_rad = g->drive.phase_pi.u;
+  supervisor_stop(&g->sup);
+  supervisor_start(&g->sup);
+  return 0;
 }
 
 uint16_t gyro_volts_to_dac(float v)
@@ -205,39 +245,64 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
   } else {
     /* Measure only: the amplitude is still watched for the over-amplitude trip. */
     g->drive.amp_v = fm_sqrtf(d_s * d_s + d_c * d_c);
+    if (g->sup.mode == GYRO_MODE_SWEEP) {
+      float f_cmd, p;
+      uint32_t half_step;
+      selfcal_exec_tick(&g->cal, d_s, d_c, &half_step, &f_cmd, &p);
+      drive_synth_step(&g->synth, f_cmd, p, ref.phase, ref.half_phase, &u1, &u2);
+      g->nco.half_step = half_step; /* from the next sample on */
+    }
   }
   rate_channel_step(&g->rate, d_s, d_c, s_s, s_c, g->drive.p_rad);
 
   const int at_rail = adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN ||
                       adc->sense == HAL_ADC_CODE_MAX || adc->sense == HAL_ADC_CODE_MIN;
   const int at_limit = g->drive.f_cmd_v2 >= g->f_cmd_max_v2;
-  const float inv_set = 1.0f / g->drive.amp_set_v;
+  /* Work that needs no per-sample rate runs on one tick in GYRO_SLOW_DECIM, offset from
+   * the rate channel's filter tick so the two never fall on the same tick. */
+  if (++g->slow_count == GYRO_SLOW_DECIM) {
+    g->slow_count = 0u;
+  }
+  const int slow = g->slow_count == GYRO_SLOW_PHASE;
+  g->flags_acc |= (at_rail ? GYRO_FLAG_ADC_RAIL : 0u) | (at_limit ? GYRO_FLAG_DRIVE_LIMIT : 0u);
   supervisor_in_t si;
-  si.amp_rel = g->drive.amp_v * inv_set;
+  si.amp_rel = g->drive.amp_v * g->inv_amp_set;
   si.amp_rel_err = si.amp_rel - 1.0f;
   si.phase_err_rad = g->drive.phase_err_rad;
   si.drive_at_limit = drive_on && at_limit;
   si.adc_at_rail = at_rail;
-  si.state_finite = fm_isfinite(d_s + d_c + s_s + s_c) && fm_isfinite(g->drive.f_cmd_v2) &&
-                    fm_isfinite(g->drive.p_rad) && fm_isfinite(g->rate.rate_dps) &&
-                    fm_isfinite(g->rate.quad_dps);
+  /* A NaN anywhere propagates into these within a tick, and is caught within
+   * GYRO_SLOW_DECIM ticks (0.2 ms): long before it could reach the structure. */
+  si.state_finite = !slow || (fm_isfinite(d_s + d_c + s_s + s_c) && fm_isfinite(g->drive.f_cmd_v2) &&
+                              fm_isfinite(g->drive.p_rad) && fm_isfinite(g->rate.rate_dps) &&
+                              fm_isfinite(g->rate.quad_dps));
   if (supervisor_step(&g->sup, &si) != 0) {
     clear_loop_state(g);
     u1 = 0.0f;
     u2 = 0.0f;
   }
-  if (!supervisor_drive_enabled(&g->sup)) {
+  if (!supervisor_drive_enabled(&g->sup) && g->sup.mode != GYRO_MODE_SWEEP) {
     u1 = 0.0f;
     u2 = 0.0f;
   }
 
   dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
-  dac->code[HAL_DAC_RATE_OUT] = gyro_volts_to_dac(g->rate.rate_dps * g->rate_out_v_per_dps);
-  dac->code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID;
+  dac->code[HAL_DAC_RATE_OUT] = g->rate_code; /* the rate changes at fs / RATE_DECIM */
+  /* Built-in self-test force on the sense feedback electrodes (selftest.h). */
+  const float u_st = selftest_step(&g->selftest, g->sup.mode == GYRO_MODE_LOCKED,
+                                   g->rate.rate_raw, ref.sin_wc, ref.cos_wc);
+  dac->code[HAL_DAC_SPARE] = gyro_volts_to_dac(u_st);
+  if (selftest_running(&g->selftest)) g->flags_acc |= GYRO_FLAG_SELFTEST;
 
   gyro_out_t *o = &g->out;
   o->tick++;
+  if (!slow) {
+    return;
+  }
+  /* The snapshot for telemetry and status, at fs / GYRO_SLOW_DECIM (5 kHz: the
+   * telemetry's highest rate); flags hold what happened over the whole block. */
+  g->rate_code = gyro_volts_to_dac(g->rate.rate_dps * g->rate_out_v_per_dps);
   o->rate_dps = g->rate.rate_dps;
   o->rate_unc_dps = g->rate.rate_unc_dps;
   o->quad_dps = g->rate.quad_dps;
@@ -252,7 +317,7 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
   o->sense_q_v = s_c;
   o->mode = (uint32_t)g->sup.mode;
   o->fault = g->sup.fault;
-  o->flags = (g->sup.mode == GYRO_MODE_LOCKED ? GYRO_FLAG_LOCKED : 0u) |
-             (at_rail ? GYRO_FLAG_ADC_RAIL : 0u) | (at_limit ? GYRO_FLAG_DRIVE_LIMIT : 0u) |
+  o->flags = (g->sup.mode == GYRO_MODE_LOCKED ? GYRO_FLAG_LOCKED : 0u) | g->flags_acc |
              (g->sup.mode == GYRO_MODE_FAULT ? GYRO_FLAG_FAULT : 0u);
+  g->flags_acc = 0u;
 }

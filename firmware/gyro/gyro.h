@@ -27,6 +27,8 @@
 #include "gyro/drive_loop.h"
 #include "gyro/drive_synth.h"
 #include "gyro/rate_channel.h"
+#include "gyro/selfcal_exec.h"
+#include "gyro/selftest.h"
 #include "gyro/supervisor.h"
 #include "hal/hal_adc.h"
 #include "hal/hal_dac.h"
@@ -47,6 +49,7 @@ typedef struct {
   drive_loop_design_out_t amp_design, phase_design; /* what the designer achieved */
   float rate_out_v_per_dps;
   uint32_t autostart;
+  selftest_cfg_t selftest;
 } gyro_design_t;
 
 /* A snapshot of the outputs of the latest tick (telemetry, status, the simulator). */
@@ -71,6 +74,7 @@ typedef struct {
 #define GYRO_FLAG_ADC_RAIL (1u << 1)
 #define GYRO_FLAG_DRIVE_LIMIT (1u << 2)
 #define GYRO_FLAG_FAULT (1u << 3)
+#define GYRO_FLAG_SELFTEST (1u << 4) /* the self-test force is on: rate output not valid */
 
 typedef struct {
   float adc_v_per_code;
@@ -81,9 +85,22 @@ typedef struct {
   drive_synth_t synth;
   rate_channel_t rate;
   supervisor_t sup;
+  selfcal_exec_t cal; /* self-calibration jobs, run while the supervisor is in SWEEP */
   float f_cmd_max_v2;
-  gyro_out_t out;
+  float inv_amp_set;     /* 1 / drive amplitude setpoint: no divide per tick */
+  uint32_t slow_count;   /* tick counter modulo GYRO_SLOW_DECIM */
+  uint32_t flags_acc;    /* GYRO_FLAG_* seen since the last snapshot */
+  uint16_t rate_code;    /* analog rate output DAC code, updated with the snapshot */
+  selftest_t selftest;
+  gyro_out_t out;        /* updated every GYRO_SLOW_DECIM ticks (tick: every tick) */
 } gyro_t;
+
+/* Work without a per-sample need (output snapshot, analog rate code, the finiteness
+ * check of the loop state) runs on one tick in GYRO_SLOW_DECIM, on the tick
+ * GYRO_SLOW_PHASE of the block: half a block away from the rate channel's filter tick
+ * (rate_channel.h, RATE_DECIM), so the worst-case tick carries only one of them. */
+#define GYRO_SLOW_DECIM 10u
+#define GYRO_SLOW_PHASE 5u
 
 /* Turn parameter values into module configurations, checking that every module
  * accepts its part. Returns 0, or a negative value (then *d is untouched). */
@@ -103,6 +120,14 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac);
 
 void gyro_start(gyro_t *g);
 void gyro_stop(gyro_t *g);
+
+/* Enter SWEEP (from any mode): loops off and cleared, the self-calibration jobs
+ * (selfcal_exec.h) drive the electrodes and the NCO frequency. */
+void gyro_sweep_begin(gyro_t *g);
+/* SWEEP -> ACQUIRE with the design d (already applied): the NCO goes to d's frequency
+ * and both PIs start from the excitation the sweep ended with (bumpless). Returns 0,
+ * or -1 (nothing changed) when not in SWEEP. */
+int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d);
 
 /* Volts to an offset-binary DAC code, clamped to the converter's range. */
 uint16_t gyro_volts_to_dac(float v);

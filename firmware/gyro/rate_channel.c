@@ -11,23 +11,25 @@ static int finite4(const float *c)
 
 static int cfg_ok(const rate_channel_cfg_t *cfg)
 {
-  return cfg != NULL && cfg->lpf != NULL && fm_isfinite(cfg->rot_c) &&
-         fm_isfinite(cfg->rot_s) && fm_absf(cfg->rot_c * cfg->rot_c + cfg->rot_s * cfg->rot_s - 1.0f) < 1e-4f &&
+  return cfg != NULL && cfg->lpf != NULL && fm_isfinite(cfg->ref_re) &&
+         fm_isfinite(cfg->ref_im) && cfg->ref_re * cfg->ref_re + cfg->ref_im * cfg->ref_im > 0.0f &&
          fm_isfinite(cfg->scale_dps) && finite4(cfg->bias_c_dps) && finite4(cfg->sf_c) &&
          cfg->p_lpf_alpha > 0.0f && cfg->p_lpf_alpha <= 1.0f && cfg->min_drive_v > 0.0f &&
-         fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg);
+         fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg) &&
+         cfg->p_mode_k > 0.0f && cfg->p_mode_k <= 1.0f;
 }
 
 static void copy_coeffs(rate_channel_t *rc, const rate_channel_cfg_t *cfg)
 {
-  rc->rot_c = cfg->rot_c;
-  rc->rot_s = cfg->rot_s;
+  rc->ref_re = cfg->ref_re;
+  rc->ref_im = cfg->ref_im;
   rc->scale_dps = cfg->scale_dps;
   for (int i = 0; i < 4; i++) {
     rc->bias_c_dps[i] = cfg->bias_c_dps[i];
     rc->sf_c[i] = cfg->sf_c[i];
   }
   rc->p_lpf_alpha = cfg->p_lpf_alpha;
+  rc->p_mode_k = cfg->p_mode_k;
   rc->min_drive_v2 = cfg->min_drive_v * cfg->min_drive_v;
 }
 
@@ -92,6 +94,7 @@ void rate_channel_reset(rate_channel_t *rc, float p_deg)
   rc->p_acc_deg = 0.0f;
   rc->p_count = 0u;
   rc->p_dev_deg = p_deg - rc->p_ref_deg;
+  rc->p_mode_rad = rc->p_dev_deg * FM_RAD_PER_DEG_F;
   rc->p_f_deg = p_deg;
   rc->rate_dps = 0.0f;
 }
@@ -99,15 +102,18 @@ void rate_channel_reset(rate_channel_t *rc, float p_deg)
 void rate_channel_step(rate_channel_t *rc, float d_s, float d_c, float s_s, float s_c,
                        float p_rad)
 {
-  const float d2 = d_s * d_s + d_c * d_c;
+  /* (6-17): the true drive phase follows P through the mode's lag. Work on P - p_ref
+   * (small) so the float low-pass has no dead band. */
+  const float p_dev_rad = p_rad - rc->p_ref_deg * FM_RAD_PER_DEG_F;
+  rc->p_mode_rad += rc->p_mode_k * (p_dev_rad - rc->p_mode_rad);
+  const float delta = rc->p_mode_rad - rc->p_dev_deg * FM_RAD_PER_DEG_F;
   float re = 0.0f, im = 0.0f;
-  if (d2 > rc->min_drive_v2) {
-    /* S conj(D) e^{-j phi_dm} / |D|^2 */
-    const float inv = 1.0f / d2;
-    const float a = s_s * d_s + s_c * d_c;
-    const float b = s_c * d_s - s_s * d_c;
-    re = (a * rc->rot_c + b * rc->rot_s) * inv;
-    im = (b * rc->rot_c - a * rc->rot_s) * inv;
+  if (d_s * d_s + d_c * d_c > rc->min_drive_v2) {
+    /* S conj(e^{j psi} / A_set), then turned by -delta (small angle: e^{-j delta} ~ 1 - j delta) */
+    const float r0 = s_s * rc->ref_re + s_c * rc->ref_im;
+    const float i0 = s_c * rc->ref_re - s_s * rc->ref_im;
+    re = r0 + delta * i0;
+    im = i0 - delta * r0;
   }
   rc->rate_raw = re;
   rc->quad_raw = im;

@@ -1,17 +1,19 @@
 /* Rate channel (thesis ch. 5, 7): sense phasor -> rate and quadrature, output low-pass,
  * scale factor, temperature compensation in P.
  *
- * The sense LMSD gives the sense phasor S, the drive LMSD the drive phasor D (both in the
- * NCO frame, gyro_cfg.h). The Coriolis acceleration 2 Omega y' is in phase with the
- * drive velocity and the quadrature k_q y with the drive displacement (2-22), so in the
- * frame of the drive motion
- *     R = S conj(D) e^{-j phi_dm} / |D|^2
+ * The sense LMSD gives the sense phasor S in the NCO frame (gyro.h). The Coriolis
+ * acceleration 2 Omega y' is in phase with the drive velocity and the quadrature k_q y
+ * with the drive displacement (2-22), so in the frame of the drive motion
+ *     R = S e^{-j psi} / A_set,     psi = phase_set + phi_dm
  * puts the Coriolis part on the real axis and the quadrature on the imaginary axis once
  * phi_dm (the demodulation phase: sense-mode and pickoff phase differences, calibrated)
- * is right. Referencing to the measured drive phasor rather than to the NCO keeps the
- * separation exact while the phase loop moves, and dividing by |D|^2 makes R a ratio of
- * sense to drive amplitude: the Coriolis signal is proportional to the drive amplitude
- * (2-28), so the ratio holds the scale factor when the drive amplitude drifts.
+ * is right. The drive motion is referenced through the phase loop's setpoint, not
+ * through the measured drive phasor D: the loop holds the true drive phase at the
+ * setpoint to a few thousandths of a degree, while D carries the drive pickoff's noise,
+ * and every radian of reference phase noise multiplies the 1500 deg/s quadrature (2
+ * uV/rtHz on a 0.35 V pickoff is 5.7e-6 rad/rtHz, 31 deg/h/rtHz of rate noise: more
+ * than the Brownian floor). Likewise A_set (held by the amplitude loop) normalises the
+ * Coriolis signal, which is proportional to the drive amplitude (2-28).
  * A demodulation-phase error d_phi leaks quadrature into rate as Q sin(d_phi): with
  * 1500 deg/s of quadrature, 0.01 deg is 0.26 deg/s of bias (system.md, 2.4.2 B).
  *
@@ -42,19 +44,20 @@
 #define RATE_P_DECIM 100u
 
 typedef struct {
-  float rot_c, rot_s;         /* cos, sin of the demodulation phase phi_dm (designer) */
+  float ref_re, ref_im;       /* e^{j psi} / A_set (designer, gyro_design) */
   float scale_dps;            /* deg/s per unit of Re(R) */
   float bias_c_dps[4];
   float sf_c[4];
   float p_ref_deg;            /* P around which its low-pass works (the start value) */
   float p_lpf_alpha;          /* first-order low-pass of P at fs / RATE_P_DECIM */
+  float p_mode_k;             /* per-tick factor of the mode's lag: dt / (2Q/wn) */
   const biquad_coeffs_t *lpf; /* output low-pass sections, designed for fs / RATE_DECIM */
   uint32_t lpf_sections;
-  float min_drive_v;          /* below this drive amplitude the ratio is not formed */
+  float min_drive_v;          /* below this measured drive amplitude no rate is formed */
 } rate_channel_cfg_t;
 
 typedef struct {
-  float rot_c, rot_s;         /* cos, sin of phi_dm */
+  float ref_re, ref_im;       /* e^{j psi} / A_set */
   float scale_dps;
   float bias_c_dps[4];
   float sf_c[4];
@@ -63,6 +66,8 @@ typedef struct {
   float p_acc_deg;            /* sum of (P - p_ref) over the current decimation block */
   uint32_t p_count;
   float p_dev_deg;            /* low-passed P - p_ref */
+  float p_mode_k;
+  float p_mode_rad;           /* P - p_ref through the mode's lag, rad */
   float min_drive_v2;
   float acc_re, acc_im;       /* sums over the current decimation block */
   uint32_t count;
@@ -89,7 +94,8 @@ int rate_channel_retune(rate_channel_t *rc, const rate_channel_cfg_t *cfg);
 /* Clear the filters; P_f starts at p_deg. */
 void rate_channel_reset(rate_channel_t *rc, float p_deg);
 
-/* One tick. (d_s, d_c): drive phasor; (s_s, s_c): sense phasor; p_rad: force phase.
+/* One tick. (d_s, d_c): measured drive phasor (only to tell that the drive runs);
+ * (s_s, s_c): sense phasor; p_rad: force phase.
  * The filtered outputs change once per RATE_DECIM ticks. */
 void rate_channel_step(rate_channel_t *rc, float d_s, float d_c, float s_s, float s_c,
                        float p_rad);

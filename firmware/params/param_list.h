@@ -31,7 +31,7 @@
 #ifndef PARAM_LIST_H
 #define PARAM_LIST_H
 
-#define PARAM_LAYOUT_VERSION 2u
+#define PARAM_LAYOUT_VERSION 3u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -158,6 +158,16 @@
   /* 1 ms of consecutive rail codes */ \
   X(sup_clip_count, 0x0409u, "sup.clip_count", U32, "-", 1u, 1000000u, 50u, 0u, \
     PF_PERSIST | PF_LIVE, "consecutive ADC rail codes that make an ADC_CLIP fault") \
+  /* 0.1 V on the differential sense electrodes (5 V bias): about 5.5 deg/s equivalent */ \
+  X(selftest_amp_v, 0x0701u, "selftest.amp_v", F32, "V", 0.0f, 5.0f, 0.1f, 0u, \
+    PF_PERSIST | PF_LIVE, "self-test force: voltage amplitude on the sense feedback electrodes") \
+  /* calibrated on the part: 5.49 deg/s measured on the default simulator plant
+   * (test_cl_selftest; 0.017 deg/s with the electrodes dead, feedthrough only) */ \
+  X(selftest_expect_dps, 0x0702u, "selftest.expect_dps", F32, "deg/s", -1000.0f, 1000.0f, 5.49f, 0u, \
+    PF_PERSIST | PF_LIVE, "self-test: expected rate-axis response to the test force") \
+  /* 10 %: well outside the test's own noise, well inside a broken channel */ \
+  X(selftest_tol_rel, 0x0703u, "selftest.tol_rel", F32, "-", 0.001f, 1.0f, 0.1f, 0u, \
+    PF_PERSIST | PF_LIVE, "self-test pass band, relative to the expected response") \
   /* start the drive at power-on */ \
   X(sys_autostart, 0x0602u, "sys.autostart", ENUM, "-", 0u, 1u, 1u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
     PF_PERSIST | PF_RESTART, "start acquiring at power-on") \

@@ -46,7 +46,9 @@ typedef struct {
 typedef struct {
   double sim_s;
   double wall_s;
-  double realtime_factor;
+  double cpu_s;
+  double realtime_factor;      /* simulated / wall-clock time */
+  double realtime_factor_cpu;  /* simulated / CPU time of the run (one core) */
   uint64_t ticks;
   sim_startup_t startup;
   double adc_fraction[2];   /* worst-case budget from plant_adc_fraction */

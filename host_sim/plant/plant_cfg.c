@@ -154,7 +154,8 @@ void plant_default_cfg(plant_cfg_t *c)
   c->drive_noise_white_v_rthz = 200e-9;
   c->drive_noise_1hz_v_rthz = 2e-6;
   c->drive_noise_fmin_hz = 1e-3;
-  c->fb_mode = 0;              /* the thesis's sense axis is open loop */
+  c->fb_mode = 2;              /* differential sense electrodes, biased: the self-test
+                                  force (the thesis's sense axis is otherwise open loop) */
   c->ks_fb_mps2_per_v2 = 0.01;
   c->fb_bias_v = 5.0;
   c->fb_noise_white_v_rthz = 200e-9;

@@ -9,46 +9,9 @@
 
 #include "demod_ref.h"
 #include "dsp/kfd.h"
-#include "ref_signal.h"
+#include "demod_test_signal.h"
+#include "kfd_long_run.h"
 
-#define FS_HZ 50000.0
-#define FC_HZ 1750.0
-#define A1 0.01
-#define A2 (-0.004)
-#define SIGMA 0.002
-
-typedef struct {
-  float d, s, c;
-} sample_t;
-
-static sample_t make_sample(uint64_t k, ref_rng_t *g)
-{
-  double rs, rc;
-  ref_carrier(k, FC_HZ, FS_HZ, &rs, &rc);
-  const sample_t x = {(float)(A1 * rs + A2 * rc + SIGMA * ref_rng_gauss(g)), (float)rs,
-                      (float)rc};
-  return x;
-}
-
-static double rel_err_x(const kfd_t *s, const double x[2])
-{
-  const double di = (double)s->x_i - x[0], dq = (double)s->x_q - x[1];
-  return sqrt(di * di + dq * dq) / sqrt(x[0] * x[0] + x[1] * x[1]);
-}
-
-static double rel_err_p(const kfd_t *s, const double p[4])
-{
-  const double e11 = (double)s->p11 - p[0], e12 = (double)s->p12 - p[1],
-               e22 = (double)s->p22 - p[3];
-  const double n = sqrt(p[0] * p[0] + 2.0 * p[1] * p[1] + p[3] * p[3]);
-  return sqrt(e11 * e11 + 2.0 * e12 * e12 + e22 * e22) / n;
-}
-
-static void init_default(kfd_t *s)
-{
-  assert_int_equal(
-      kfd_init(s, &(kfd_cfg_t){.q = KFD_Q_DEFAULT, .r = KFD_R_DEFAULT, .p0 = 1.0f}), 0);
-}
 
 static void test_converges_to_true_amplitudes(void **state)
 {
@@ -125,47 +88,6 @@ static void test_steady_state_covariance_matches_analysis(void **state)
   assert_true(fabs(sum_tr / m / (2.0 * p_ss) - 1.0) < 0.05);
 }
 
-/* Long run: P positive definite and bounded at every sample, never restarted, and the
- * end state equals a fresh double-precision Kalman filter started 2000 samples earlier
- * (the filter forgets its start at the rate of its pole, 0.982^2000 = 1.6e-16). */
-static void run_long(uint64_t n)
-{
-  kfd_t s;
-  init_default(&s);
-  ref_rng_t g;
-  ref_rng_seed(&g, 34u);
-  ref_kf_t r;
-  const uint64_t ref_start = n - 2000u;
-  float min_det_ratio = 1.0f, max_trace = 0.0f;
-  for (uint64_t k = 0; k < n; k++) {
-    const sample_t x = make_sample(k, &g);
-    kfd_step(&s, x.d, x.s, x.c);
-    if (k == ref_start) {
-      ref_kf_init(&r, (double)KFD_Q_DEFAULT, (double)KFD_R_DEFAULT, 1.0);
-    }
-    if (k >= ref_start) {
-      ref_kf_step(&r, x.d, x.s, x.c);
-    }
-    const float tr = s.p11 + s.p22;
-    const float ratio = (s.p11 * s.p22 - s.p12 * s.p12) / (0.25f * tr * tr);
-    if (!(s.p11 > 0.0f && s.p22 > 0.0f && ratio > 0.0f)) {
-      fail_msg("P not positive definite at sample %llu", (unsigned long long)k);
-    }
-    if (k > 1000u) { /* steady state: the 2 wc ripple makes P mildly anisotropic */
-      min_det_ratio = fminf(min_det_ratio, ratio);
-      max_trace = fmaxf(max_trace, tr);
-    }
-  }
-  print_message("%llu samples: min det/(tr/2)^2 %.3f, max trace %.4g, end P %.4g %.4g %.4g\n",
-                (unsigned long long)n, (double)min_det_ratio, (double)max_trace,
-                (double)s.p11, (double)s.p12, (double)s.p22);
-  assert_int_equal(s.cov_resets, 0);
-  assert_int_equal(s.skipped, 0);
-  assert_true(min_det_ratio > 0.9f);
-  assert_true(max_trace < 0.05f);
-  assert_true(rel_err_p(&s, r.p) < 1e-4);
-  assert_true(rel_err_x(&s, r.x) < 1e-4);
-}
 
 /* 1e6 samples here (well under a second with ASan); the 1e7-sample run of the same
  * check is tests/slow/test_kfd_long_run.c (ctest -L slow). */

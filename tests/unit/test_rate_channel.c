@@ -13,30 +13,30 @@ static rate_channel_cfg_t base_cfg(biquad_coeffs_t *sec, float phi_dm)
 {
   const int n = butter_design(BUTTER_LOWPASS, 4u, 100.0, 0.0, 50000.0 / RATE_DECIM, sec, BIQUAD_MAX_SECTIONS);
   assert_int_equal(n, 2);
-  rate_channel_cfg_t c = {.rot_c = cosf(phi_dm), .rot_s = sinf(phi_dm), .scale_dps = 250.0f,
+  rate_channel_cfg_t c = {.ref_re = cosf(phi_dm), .ref_im = sinf(phi_dm), .scale_dps = 250.0f,
                           .bias_c_dps = {0, 0, 0, 0}, .sf_c = {0, 0, 0, 0},
-                          .p_ref_deg = 0.0f, .p_lpf_alpha = 0.5f, .lpf = sec,
+                          .p_ref_deg = 0.0f, .p_lpf_alpha = 0.5f, .p_mode_k = 2.8e-3f, .lpf = sec,
                           .lpf_sections = (uint32_t)n, .min_drive_v = 0.1f};
   return c;
 }
 
-/* A sense phasor built as (r + j q) D e^{j phi_dm} must come out as rate r and
- * quadrature q, for any drive phase, drive amplitude and demodulation phase. */
+/* A sense phasor built as (r + j q) A_set e^{j psi} must come out as rate r and
+ * quadrature q, for any reference phase and amplitude setpoint, whatever the measured
+ * drive phasor (it only gates the output). */
 static void test_phasor_separation(void **state)
 {
   (void)state;
   biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
   for (int i = 0; i < 200; i++) {
-    const double phi_dm = -3.0 + 0.03 * i, th = 0.7 * i, amp = 0.5 + 0.01 * i;
+    const double psi = -3.0 + 0.03 * i, th = 0.7 * i, amp = 0.5 + 0.01 * i;
     const double r = 1e-3 * (i - 100), q = 0.02 - 1e-4 * i;
-    rate_channel_cfg_t c = base_cfg(sec, (float)phi_dm);
+    rate_channel_cfg_t c = base_cfg(sec, 0.0f);
+    c.ref_re = (float)(cos(psi) / amp);
+    c.ref_im = (float)(sin(psi) / amp);
     rate_channel_t rc;
     assert_int_equal(rate_channel_init(&rc, &c), 0);
-    const double dr = amp * cos(th), di = amp * sin(th);
-    /* S = (r + jq) * D * e^{j phi_dm} */
-    const double er = r * dr - q * di, ei = r * di + q * dr;
-    const double sr = er * cos(phi_dm) - ei * sin(phi_dm), si = er * sin(phi_dm) + ei * cos(phi_dm);
-    rate_channel_step(&rc, (float)dr, (float)di, (float)sr, (float)si, 0.0f);
+    const double er = amp * (r * cos(psi) - q * sin(psi)), ei = amp * (r * sin(psi) + q * cos(psi));
+    rate_channel_step(&rc, (float)(0.3 * cos(th)), (float)(0.3 * sin(th)), (float)er, (float)ei, 0.0f);
     assert_true(fabs((double)rc.rate_raw - r) < 2e-6);
     assert_true(fabs((double)rc.quad_raw - q) < 2e-6);
   }
@@ -131,6 +131,32 @@ static void test_dc_linearity(void **state)
   }
 }
 
+/* The phase loop's jitter reaches the true drive phase through the mode's lag (6-17);
+ * the sense quadrature turns with the true drive phase. A step of P, passed on through
+ * that lag to the sense phasor, must leave the rate output unchanged (before P's own
+ * 1 Hz low-pass follows), where an uncorrected reference would show q * dP. */
+static void test_reference_follows_drive_jitter(void **state)
+{
+  (void)state;
+  biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
+  rate_channel_cfg_t c = base_cfg(sec, 0.0f);
+  c.p_lpf_alpha = 1.25e-2f; /* 1 Hz at fs / RATE_P_DECIM */
+  rate_channel_t rc;
+  assert_int_equal(rate_channel_init(&rc, &c), 0);
+  const double q = 0.5, dp = 1e-3, k = 2.8e-3;
+  double lag = 0.0, worst = 0.0;
+  for (int n = 0; n < 2500; n++) { /* 50 ms after the step */
+    const double p = dp;           /* P stepped at n = 0 */
+    lag += k * (p - lag);          /* the structure's response (6-17) */
+    const double sr = -q * sin(lag), si = q * cos(lag); /* quadrature turned by the true phase */
+    rate_channel_step(&rc, 1.0f, 0.0f, (float)sr, (float)si, (float)p);
+    if (n > 100 && fabs((double)rc.rate_raw) > worst) worst = fabs((double)rc.rate_raw);
+  }
+  /* Left: P's 1 Hz low-pass moving over 50 ms (2 pi 1 Hz 0.05 s ~ 0.3 of dp at most). */
+  assert_true(worst < 0.35 * q * dp);
+  assert_true(worst < q * dp); /* uncorrected it would be q * dp */
+}
+
 /* No drive: no ratio is formed and the outputs stay finite. */
 static void test_no_drive(void **state)
 {
@@ -139,10 +165,14 @@ static void test_no_drive(void **state)
   rate_channel_cfg_t c = base_cfg(sec, 0.0f);
   rate_channel_t rc;
   assert_int_equal(rate_channel_init(&rc, &c), 0);
-  rate_channel_step(&rc, 0.0f, 0.0f, 1.0f, 1.0f, 0.0f);
+  rate_channel_step(&rc, 0.0f, 0.0f, 1.0f, 1.0f, 0.0f); /* drive below min_drive_v */
   assert_true(rc.rate_raw == 0.0f && rc.quad_raw == 0.0f);
   assert_true(isfinite(rc.rate_dps));
   c.p_lpf_alpha = 0.0f;
+  assert_int_equal(rate_channel_init(&rc, &c), -1);
+  c = base_cfg(sec, 0.0f);
+  c.ref_re = 0.0f;
+  c.ref_im = 0.0f;
   assert_int_equal(rate_channel_init(&rc, &c), -1);
   c = base_cfg(sec, NAN);
   assert_int_equal(rate_channel_init(&rc, &c), -1);
@@ -156,6 +186,7 @@ int main(void)
       cmocka_unit_test(test_compensation_polynomials),
       cmocka_unit_test(test_p_lowpass_resolution),
       cmocka_unit_test(test_dc_linearity),
+      cmocka_unit_test(test_reference_follows_drive_jitter),
       cmocka_unit_test(test_no_drive),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -6,12 +6,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* xoshiro256** seeded through splitmix64; Box-Muller for the normal deviates. */
-typedef struct {
-  uint64_t s[4];
-  double spare;
-  int has_spare;
-} noise_rng_t;
+#include "plant/rng.h"
+
+/* The simulator's seeded generator (host_sim/plant/rng.h: xoshiro256**, polar normals). */
+typedef rng_t noise_rng_t;
 
 void noise_seed(noise_rng_t *g, uint64_t seed);
 

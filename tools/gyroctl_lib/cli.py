@@ -27,7 +27,8 @@ from . import logger, plot as plot_mod, shell
 from .client import Client
 from .link import CommandError, Link, LinkError
 
-SIMPLE = ("save", "load", "defaults", "diff", "status", "version", "help", "stop")
+SIMPLE = ("save", "load", "defaults", "diff", "status", "version", "help", "stop", "sweep",
+          "selftest")
 
 
 def _parser():

@@ -3,6 +3,7 @@
 ctest passes their paths in the environment (tools/gyroctl_lib/CMakeLists.txt):
     TLM_VECTORS   tlm-vectors (firmware telemetry encoder/receiver as a program)
     FW_PTY_HOST   tests/e2e/fw_pty_host (the real application behind a pty)
+    GYRO_SIM      host_sim/gyro-sim (the application on the plant, --uart-pty)
 Run by hand from a configured tree, e.g.
     TLM_VECTORS=build/host/tools/gyroctl_lib/tlm-vectors \
     FW_PTY_HOST=build/host/tests/fw_pty_host python3 -m pytest tools/gyroctl_lib/tests
@@ -32,6 +33,11 @@ def tlm_vectors():
 @pytest.fixture(scope="session")
 def fw_pty_host():
     return _exe("FW_PTY_HOST")
+
+
+@pytest.fixture(scope="session")
+def gyro_sim():
+    return _exe("GYRO_SIM")
 
 
 @pytest.fixture(scope="session")

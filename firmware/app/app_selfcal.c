@@ -1,0 +1,90 @@
+#include "app/app_selfcal.h"
+
+#include <stdatomic.h>
+#include <stddef.h>
+
+#include "dsp/fastmath.h"
+#include "hal/hal_converters.h"
+
+/* Search range of the drive resonance: the part family's 1.3-2.0 kHz with margin. */
+#define SC_F_LO_HZ 1250.0
+#define SC_F_HI_HZ 2050.0
+/* Chirp rate: 2.7 s per direction over the range; the resulting envelope-peak lag
+ * (~15 Hz at Q = 600) cancels between the up and down chirps. */
+#define SC_CHIRP_HZ_PER_S 300.0
+/* Quiet time before a chirp: 7 time constants at Q = 600, 1.3 kHz. */
+#define SC_QUIET_S 1.0
+/* First chirp force: 8 Ks*V^2 stays inside the ADC budget at Q = 600 with the default
+ * actuator and pickoff gains; weaker responses raise it. */
+#define SC_F_CMD_START_V2 8.0
+
+int app_selfcal_start(app_t *a)
+{
+  if (selfcal_running(&a->selfcal) || a->request != APP_REQ_NONE) return -1;
+  const param_values_t *v = params_current(&a->params);
+  selfcal_cfg_t c;
+  c.fs_hz = (double)v->sys_fs_hz;
+  c.f_lo_hz = SC_F_LO_HZ;
+  c.f_hi_hz = SC_F_HI_HZ;
+  c.chirp_hz_per_s = SC_CHIRP_HZ_PER_S;
+  c.quiet_s = SC_QUIET_S;
+  c.amp_max_v = 0.5 * (double)HAL_ADC_FULL_SCALE_V;
+  c.amp_meas_v = 0.25 * (double)HAL_ADC_FULL_SCALE_V;
+  c.f_cmd_start_v2 = SC_F_CMD_START_V2;
+  c.f_cmd_max_v2 = (double)a->gyro.f_cmd_max_v2;
+  c.amp_set_v = (double)v->drive_amp_set_v;
+  c.phase_set_rad = (double)v->drive_phase_set_deg * FM_PI / 180.0;
+  /* One sample of DAC latency plus half a sample of zero-order hold. */
+  c.delay_s = 1.5 / c.fs_hz;
+  if (selfcal_start(&a->selfcal, &c) != 0) return -1;
+  a->selfcal_t0_ticks = a->isr_ticks;
+  a->selfcal_ticks = 0u;
+  a->request = APP_REQ_SWEEP;
+  return 0;
+}
+
+static param_status_t stage_f(app_t *a, param_idx_t i, double v)
+{
+  param_value_t pv;
+  pv.f = (float)v;
+  return params_stage(&a->params, i, pv);
+}
+
+void app_selfcal_poll(app_t *a)
+{
+  selfcal_t *s = &a->selfcal;
+  if (!selfcal_running(s)) return;
+  const int sweeping = a->gyro.sup.mode == GYRO_MODE_SWEEP && a->request == APP_REQ_NONE;
+  const selfcal_state_t st0 = selfcal_background(s, sweeping);
+  if (st0 == SELFCAL_FAILED && sweeping) {
+    /* A failed sweep leaves the electrodes off (safe mode); status says why. */
+    a->request = APP_REQ_DRIVE_OFF;
+    return;
+  }
+  if (st0 != SELFCAL_READY || a->request != APP_REQ_NONE) return;
+  param_status_t st = stage_f(a, PARAM_drive_freq_hz, (double)s->f0_hz_f);
+  if (st == PARAM_OK) st = stage_f(a, PARAM_drive_cal_f0_hz, (double)s->f0_hz_f);
+  if (st == PARAM_OK) st = stage_f(a, PARAM_drive_cal_q, s->fit.q);
+  if (st == PARAM_OK) st = stage_f(a, PARAM_drive_cal_gain_v_per_v2, s->fit.gain_v_per_v2);
+  if (st == PARAM_OK) st = stage_f(a, PARAM_drive_p_init_deg, s->hold_p_rad * 180.0 / FM_PI);
+  if (st != PARAM_OK) {
+    params_discard(&a->params);
+    selfcal_finish(s, 0, param_status_str(st));
+    a->request = APP_REQ_DRIVE_OFF;
+    return;
+  }
+  params_err_t err;
+  st = params_commit(&a->params, &err);
+  if (st == PARAM_ERR_PENDING) return; /* the ISR has not taken the last change: retry */
+  if (st != PARAM_OK) {
+    selfcal_finish(s, 0, err.why != NULL ? err.why : param_status_str(st));
+    a->request = APP_REQ_DRIVE_OFF;
+    return;
+  }
+  selfcal_finish(s, 1, NULL);
+  a->selfcal_ticks = a->isr_ticks - a->selfcal_t0_ticks;
+  /* The ISR must see the published design no later than the request: it applies the
+   * new block at the start of the tick, then takes the request (app_sample_isr). */
+  atomic_signal_fence(memory_order_release);
+  a->request = APP_REQ_SWEEP_HANDOVER;
+}

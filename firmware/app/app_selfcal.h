@@ -1,0 +1,18 @@
+/* The application side of self-calibration: starting a sweep, and handing its result
+ * to the parameter bank (params_stage / params_commit, never live variables) and the
+ * loops to the drive (SWEEP -> ACQUIRE). */
+#ifndef APP_SELFCAL_H
+#define APP_SELFCAL_H
+
+#include "app/app.h"
+
+/* Request SWEEP and start the sequencer. Returns 0, or -1 (nothing changed) when a
+ * sweep is running, a request is pending or the configuration is refused. */
+int app_selfcal_start(app_t *a);
+
+/* Background pass (from app_poll): sequencer step; on READY stage and commit
+ * drive.freq_hz, drive.cal_f0_hz, drive.cal_q, drive.cal_gain_v_per_v2,
+ * drive.p_init_deg, then request the hand-over. */
+void app_selfcal_poll(app_t *a);
+
+#endif /* APP_SELFCAL_H */

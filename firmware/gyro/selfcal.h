@@ -1,0 +1,95 @@
+/* Self-calibration sequencer (background loop): identifies the drive mode through the
+ * firmware's own signal chain and prepares the hand-over to the drive loops.
+ *
+ * The thesis (7.2.2) sweeps in 2 Hz steps; at Q = 600 one step would need seconds to
+ * settle and the 2-3 Hz bandwidth would fall between two steps. Instead:
+ *   1. QUIET, CHIRP up f_lo -> f_hi, QUIET, CHIRP down: the envelope peak of a fast
+ *      chirp lags the resonance by about the same amount in either direction, so the
+ *      mean of the two peak frequencies is the coarse resonance f_c. Over-amplitude
+ *      aborts a chirp and it is repeated at a quarter of the force; too small a peak
+ *      repeats it with more force.
+ *   2. RINGDOWN at f_c: excite, stop, follow the free decay to 1/e: the time constant
+ *      tau = 2Q/wn (6-12) gives Q_rd = pi f tau, the rotation of the LMSD phasor gives
+ *      the free frequency f_d.
+ *   3. STEPS: 7 points at f_d + {-2,-1,-0.5,0,0.5,1,2} f_d/(2 Q_rd), each settled for
+ *      7 tau, averaged 0.1 s, at a force that puts the peak at amp_meas_v; the linear
+ *      least-squares fit of selfcal_fit.h (known converter delay of 1.5 samples plus up
+ *      to 8 samples of unknown analog-chain delay, searched) gives wn, Q, |H(wn)| and
+ *      arg H(wn). If the
+ *      fit moves the centre by more than a quarter bandwidth or Q by more than 20 %, the
+ *      points are placed again around the fit (once).
+ *   4. HOLD at wn with the force phase P = phase_set - arg H(wn) and the force
+ *      amplitude_set / |H(wn)| for 6 tau: the vibration is then at the loop's set point,
+ *      and the loops start from that excitation (bumpless).
+ * Then READY: the application stages drive.freq_hz = drive.cal_f0_hz = wn/2pi,
+ * drive.cal_q, drive.cal_gain_v_per_v2, drive.p_init_deg through the parameter bank
+ * and requests the hand-over (SWEEP -> ACQUIRE).
+ */
+#ifndef SELFCAL_H
+#define SELFCAL_H
+
+#include <stdint.h>
+
+#include "gyro/selfcal_exec.h"
+#include "gyro/selfcal_fit.h"
+
+typedef struct {
+  double fs_hz;
+  double f_lo_hz, f_hi_hz;   /* search range of the resonance */
+  double chirp_hz_per_s;
+  double quiet_s;            /* ring-down wait before each chirp */
+  double amp_max_v;          /* back-off threshold: 50 % of the ADC range */
+  double amp_meas_v;         /* peak amplitude aimed at by the measurements */
+  double f_cmd_start_v2;     /* first chirp force (low) */
+  double f_cmd_max_v2;       /* what the drive synthesis can deliver */
+  double amp_set_v;          /* the amplitude loop's set point */
+  double phase_set_rad;      /* the phase loop's set point */
+  double delay_s;            /* DAC latency + zero-order hold: 1.5 samples */
+} selfcal_cfg_t;
+
+typedef enum {
+  SELFCAL_IDLE = 0,
+  SELFCAL_WAIT_SWEEP,
+  SELFCAL_QUIET_UP,
+  SELFCAL_CHIRP_UP,
+  SELFCAL_QUIET_DOWN,
+  SELFCAL_CHIRP_DOWN,
+  SELFCAL_RINGDOWN,
+  SELFCAL_FINE,
+  SELFCAL_HOLD,
+  SELFCAL_READY,
+  SELFCAL_DONE,
+  SELFCAL_FAILED
+} selfcal_state_t;
+
+typedef struct {
+  selfcal_cfg_t cfg;
+  selfcal_exec_t *x;
+  selfcal_state_t state;
+  double f_cmd_v2;
+  double f_up_hz, f_down_hz, f_coarse_hz, chirp_peak_v;
+  double rd_f_hz, rd_q, rd_gain;
+  double plan_f_hz, plan_hb_hz, plan_tau_s; /* centre, half bandwidth, tau of the steps */
+  selfcal_fit_t fit;
+  double delay_s;                 /* total chain delay found by the fit */
+  double hold_f_cmd_v2, hold_p_rad;
+  float f0_hz_f;                  /* wn/2pi as the float parameter value */
+  uint32_t ticks;                 /* sweep length so far, samples */
+  uint32_t retries, refits;
+  const char *why;                /* reason of FAILED */
+} selfcal_t;
+
+/* Bind to the ISR half. Returns 0, or -1 for NULL. State IDLE. */
+int selfcal_init(selfcal_t *s, selfcal_exec_t *x);
+/* Begin (the application has requested SWEEP). Returns 0, or -1 (nothing changed) for
+ * a bad configuration or a sweep already running. */
+int selfcal_start(selfcal_t *s, const selfcal_cfg_t *cfg);
+/* One background pass. sweeping: the ISR is in SWEEP and has taken the request. A sweep
+ * that stops being active before READY fails. Returns the state after the pass. */
+selfcal_state_t selfcal_background(selfcal_t *s, int sweeping);
+/* The application's verdict on READY: ok -> DONE, else FAILED with why. */
+void selfcal_finish(selfcal_t *s, int ok, const char *why);
+int selfcal_running(const selfcal_t *s);
+const char *selfcal_state_name(selfcal_state_t st);
+
+#endif /* SELFCAL_H */

@@ -1,0 +1,77 @@
+#include "gyro/selftest.h"
+
+#include <stddef.h>
+
+#include "dsp/fastmath.h"
+
+void selftest_init(selftest_t *st, const selftest_cfg_t *cfg)
+{
+  st->cfg = *cfg;
+  st->state = SELFTEST_IDLE;
+  st->count = 0u;
+  st->acc_base = st->acc_meas = 0.0f;
+  st->result_dps = 0.0f;
+  st->runs = 0u;
+}
+
+void selftest_retune(selftest_t *st, const selftest_cfg_t *cfg) { st->cfg = *cfg; }
+
+void selftest_start(selftest_t *st)
+{
+  if (selftest_running(st)) {
+    return;
+  }
+  st->state = SELFTEST_BASE;
+  st->count = 0u;
+  st->acc_base = st->acc_meas = 0.0f;
+}
+
+float selftest_step(selftest_t *st, int locked, float rate_raw, float sin_wc, float cos_wc)
+{
+  if (!selftest_running(st)) {
+    return 0.0f;
+  }
+  if (!locked) {
+    st->state = SELFTEST_ABORTED;
+    return 0.0f;
+  }
+  const selftest_cfg_t *c = &st->cfg;
+  st->count++;
+  if (st->state == SELFTEST_BASE) {
+    st->acc_base += rate_raw;
+    if (st->count >= c->base_ticks) {
+      st->state = SELFTEST_FORCE;
+      st->count = 0u;
+    }
+    return 0.0f;
+  }
+  /* FORCE: A cos(phi + theta_set), in phase with the drive velocity (gyro.h phasor
+   * convention: the velocity of y = Im{Z e^{j phi}} is Re{Z e^{j phi}}). */
+  const float u = c->amp_v * (c->ref_c * cos_wc - c->ref_s * sin_wc);
+  if (st->count > c->settle_ticks) {
+    st->acc_meas += rate_raw;
+  }
+  if (st->count >= c->settle_ticks + c->meas_ticks) {
+    const float base = st->acc_base / (float)c->base_ticks;
+    const float meas = st->acc_meas / (float)c->meas_ticks;
+    st->result_dps = (meas - base) * c->scale_dps;
+    const float e = c->expect_dps != 0.0f ? fm_absf(st->result_dps / c->expect_dps - 1.0f) : 1.0f;
+    st->state = e <= c->tol_rel ? SELFTEST_PASS : SELFTEST_FAIL;
+    st->runs++;
+    return 0.0f;
+  }
+  return u;
+}
+
+const char *selftest_state_name(uint32_t state)
+{
+  switch ((selftest_state_t)state) {
+  case SELFTEST_IDLE: return "idle";
+  case SELFTEST_BASE: return "baseline";
+  case SELFTEST_FORCE: return "force";
+  case SELFTEST_PASS: return "PASS";
+  case SELFTEST_FAIL: return "FAIL";
+  case SELFTEST_ABORTED: return "aborted";
+  }
+  return "?";
+}

@@ -1,0 +1,204 @@
+/* Harness of the self-calibration closed-loop tests: the application and the host
+ * plant through the host HAL, the `sweep` command, and the checks against the plant's
+ * own parameters and motion. Header-only (static functions), one instance per test. */
+#ifndef SELFCAL_HARNESS_H
+#define SELFCAL_HARNESS_H
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "app/app.h"
+#include "hal/hal_sample_timer.h"
+#include "hal_flash_host.h"
+#include "hal_host.h"
+#include "hal_uart_host.h"
+#include "plant/plant.h"
+
+static plant_t plant;
+static app_t app;
+
+static inline const char *cmd(const char *line)
+{
+  static char reply[4096];
+  hal_uart_host_rx_push((const uint8_t *)line, strlen(line));
+  app_poll(&app);
+  const size_t n = hal_uart_host_tx_pop((uint8_t *)reply, sizeof reply - 1u);
+  reply[n] = '\0';
+  return reply;
+}
+
+static inline void start(const plant_cfg_t *pc, const param_values_t *v)
+{
+  assert_int_equal(plant_init(&plant, pc, 23u), 0);
+  assert_int_equal(hal_flash_host_configure(NULL), 0);
+  hal_uart_host_reset();
+  hal_host_attach(plant_step_hal, &plant);
+  assert_int_equal(app_init_with(&app, v), 0);
+  assert_int_equal(hal_sample_timer_start(50000u, app_sample_isr, &app), 0);
+}
+
+/* Run with the background loop polled every millisecond. */
+static inline void run_s(double s)
+{
+  const uint64_t n = (uint64_t)(s * 1000.0 + 0.5);
+  for (uint64_t i = 0; i < n; i++) {
+    hal_host_run(50u);
+    app_poll(&app);
+  }
+}
+
+/* `sweep`, then run until the sequencer is done or failed (at most 70 s). Returns the
+ * simulated length of the sweep in seconds. */
+static inline double sweep_report(uint64_t t0);
+/* Run until the sweep started by the caller is done or failed; its length from the
+ * request (app.selfcal_t0_ticks). */
+static inline double sweep_wait(void)
+{
+  return sweep_report(plant_truth(&plant)->sample - (app.isr_ticks - app.selfcal_t0_ticks));
+}
+
+static inline double sweep(void)
+{
+  assert_true(strncmp(cmd("sweep\n"), "ok", 2) == 0);
+  return sweep_report(plant_truth(&plant)->sample);
+}
+
+static inline double sweep_report(uint64_t t0)
+{
+  for (int i = 0; i < 70000 && (app.selfcal.state != SELFCAL_DONE &&
+                                app.selfcal.state != SELFCAL_FAILED); i++) {
+    run_s(0.001);
+  }
+  const double t = (double)(plant_truth(&plant)->sample - t0) / 50000.0;
+  printf("# sweep %s in %.2f s (%s): coarse %.2f Hz, ring-down %.3f Hz Q %.1f, fit %.4f Hz "
+         "Q %.2f gain %.5g V/V^2 P %.2f deg rms %.2g delay %.2f samples\n",
+         selfcal_state_name(app.selfcal.state), t, app.selfcal.why ? app.selfcal.why : "-",
+         app.selfcal.f_coarse_hz, app.selfcal.rd_f_hz, app.selfcal.rd_q, app.selfcal.fit.f0_hz,
+         app.selfcal.fit.q, app.selfcal.fit.gain_v_per_v2, app.selfcal.hold_p_rad * 180.0 / M_PI,
+         app.selfcal.fit.rms_rel, app.selfcal.delay_s * 50000.0);
+  return t;
+}
+
+/* The plant's undamped drive resonance now: (2-32) at the structure temperature. */
+static inline double true_f0(const plant_cfg_t *pc)
+{
+  const double t = plant_truth(&plant)->struct_k;
+  return pc->f_drive_hz * (1.0 - 0.5 * pc->ket_per_k * (t - pc->temp_ref_k));
+}
+
+static inline void check_identified(const plant_cfg_t *pc)
+{
+  const double f0 = true_f0(pc);
+  const double bw = f0 / pc->q_drive;
+  const selfcal_t *s = &app.selfcal;
+  printf("# plant f0 %.4f Hz Q %.2f: error %.4f Hz (tolerance %.3f), Q %+.3f %%\n", f0,
+         pc->q_drive, s->fit.f0_hz - f0, fmax(0.1, bw / 100.0),
+         100.0 * (s->fit.q / pc->q_drive - 1.0));
+  assert_true(fabs(s->fit.f0_hz - f0) <= fmax(0.1, bw / 100.0));
+  assert_true(fabs(s->fit.q / pc->q_drive - 1.0) <= 0.02);
+  const param_values_t *v = params_current(&app.params);
+  assert_true(fabs((double)v->drive_cal_f0_hz - s->fit.f0_hz) < 1e-3);
+  assert_true(fabs((double)v->drive_freq_hz - s->fit.f0_hz) < 1e-3);
+  assert_true(fabs((double)v->drive_cal_q / s->fit.q - 1.0) < 1e-6);
+}
+
+/* True drive amplitude from the plant's position and velocity at the operating
+ * frequency. (plant_truth()->drive_amp_m uses the frequency estimated from the force
+ * samples, which the loops' response to the pickoff ripple at wc/2 phase-modulates at
+ * high Q: that estimate then swings by 2 % while the motion does not.) */
+static inline double amp_m(void)
+{
+  const plant_truth_t *t = plant_truth(&plant);
+  const double w = 2.0 * M_PI * (double)params_current(&app.params)->drive_freq_hz;
+  return hypot(t->y_m, t->vy_mps / w);
+}
+
+/* After the hand-over: the true drive amplitude within 1 % of its final value in 0.2 s
+ * and staying there; locked, no fault. */
+static inline void check_lock(void)
+{
+  assert_int_equal(app.selfcal.state, SELFCAL_DONE);
+  run_s(0.2);
+  const double a02 = amp_m();
+  double amin = a02, amax = a02;
+  for (int i = 0; i < 40; i++) {
+    run_s(0.02);
+    const double a = amp_m();
+    amin = fmin(amin, a);
+    amax = fmax(amax, a);
+  }
+  const double a_end = amp_m();
+  printf("# after hand-over: amplitude %.4f um at 0.2 s, %.4f..%.4f um to 1 s, mode %u faults %u\n",
+         a02 * 1e6, amin * 1e6, amax * 1e6, (unsigned)app.gyro.sup.mode,
+         (unsigned)app.gyro.sup.fault_count);
+  assert_true(fabs(amin / a_end - 1.0) < 0.01 && fabs(amax / a_end - 1.0) < 0.01);
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
+  assert_int_equal(app.gyro.sup.fault_count, 0u);
+  /* The amplitude set point is the default 0.349 V = 10 um through the pickoff gain. */
+  assert_true(fabs(a_end / 10.0e-6 - 1.0) < 0.02);
+}
+
+/* A +-1 Hz step of the drive resonance (the structure's thermal nodes stepped by the
+ * temperature that moves it 1 Hz by (2-32)) with the loops the sweep designed: lock
+ * holds, no fault, the true amplitude stays within 1 % of its setpoint. */
+static inline void check_resonance_step(const plant_cfg_t *pc, double df_hz)
+{
+  const double dk = -df_hz / (0.5 * pc->ket_per_k * pc->f_drive_hz);
+  double t[THERMAL_NODES];
+  for (int i = 0; i < THERMAL_NODES; i++) t[i] = thermal_temp(&plant.thermal, i) + dk;
+  thermal_set(&plant.thermal, t);
+  double worst = 0.0;
+  for (int i = 0; i < 50; i++) {
+    run_s(0.01);
+    if (i >= 20) worst = fmax(worst, fabs(amp_m() / 10.0e-6 - 1.0));
+  }
+  printf("# resonance step %+.1f Hz: mode %u faults %u, amplitude within %.3f %% from 0.2 s\n",
+         df_hz, (unsigned)app.gyro.sup.mode, (unsigned)app.gyro.sup.fault_count, 100.0 * worst);
+  assert_int_equal(app.gyro.sup.fault_count, 0u);
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
+  assert_true(worst < 0.01);
+}
+
+static inline void values_no_autostart(param_values_t *v)
+{
+  param_values_defaults(v);
+  v->sys_autostart = 0u;
+}
+
+static inline void random_plant_case(double f_hz, double q)
+{
+  plant_cfg_t pc;
+  plant_default_cfg(&pc);
+  pc.f_drive_hz = f_hz;
+  pc.q_drive = q;
+  param_values_t v;
+  values_no_autostart(&v);
+  start(&pc, &v);
+  const double t = sweep();
+  assert_int_equal(app.selfcal.state, SELFCAL_DONE);
+  assert_true(t <= 60.0);
+  check_identified(&pc);
+  check_lock();
+  check_resonance_step(&pc, +1.0);
+  check_resonance_step(&pc, -2.0);
+}
+
+/* Negative control: the default (thesis part) loop design does not lock on the part. */
+static inline int fixed_design_fails(double f_hz, double q)
+{
+  plant_cfg_t pc;
+  plant_default_cfg(&pc);
+  pc.f_drive_hz = f_hz;
+  pc.q_drive = q;
+  param_values_t v;
+  param_values_defaults(&v);
+  start(&pc, &v);
+  run_s(1.2);
+  const double a = amp_m();
+  printf("# fixed design on f %.1f Hz Q %.0f: mode %u faults %u amplitude %.3f um\n", f_hz, q,
+         (unsigned)app.gyro.sup.mode, (unsigned)app.gyro.sup.fault_count, a * 1e6);
+  return app.gyro.sup.mode != GYRO_MODE_LOCKED || fabs(a / 10.0e-6 - 1.0) > 0.01;
+}
+
+#endif /* SELFCAL_HARNESS_H */
