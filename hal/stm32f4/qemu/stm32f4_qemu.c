@@ -15,8 +15,11 @@
  * and the SysTick period is STM32F4_QEMU_TICK_STRETCH times the requested one: the
  * double-precision plant runs in software on the single-precision FPU and needs far more
  * than the 3360 cycles of a 20 us tick. The firmware and the plant still advance one
- * 50 kHz sample per tick; only emulated wall time runs slower. */
+ * 50 kHz sample per tick; only emulated wall time runs slower. The handler times the
+ * application's ISR and the plant with TIM2 as an emulated-nanosecond counter and counts
+ * overrun and lost ticks (stm32f4_qemu.h). */
 #include "hal/hal_adc.h"
+#include "hal/hal_critical.h"
 #include "hal/hal_dac.h"
 #include "hal/hal_sample_timer.h"
 #include "stm32f4_board.h"
@@ -27,6 +30,7 @@
 #include "stm32f4_uart.h"
 #include "stm32f4_uptime.h"
 #ifdef STM32F4_QEMU_PLANT
+#include "stm32f4_qemu.h"
 #include "stm32f4_qemu_plant.h"
 #endif
 
@@ -43,7 +47,11 @@ static hal_sample_isr_fn s_isr;
 static void *s_ctx;
 static volatile uint32_t s_wraps;
 static volatile uint32_t s_ticks;
-#ifndef STM32F4_QEMU_PLANT
+#ifdef STM32F4_QEMU_PLANT
+static stm32f4_qemu_tick_stats_t s_tick;
+static uint32_t s_t_prev_ns;  /* TIM2 at the previous handler entry */
+static uint64_t s_elapsed_ns; /* from the first handler entry to the latest */
+#else
 static hal_dac_frame_t s_dac;
 #endif
 
@@ -65,6 +73,11 @@ int stm32f4_board_init(void)
 {
 #ifdef STM32F4_QEMU_PLANT
   if (stm32f4_qemu_plant_init() != 0) return -1;
+  /* TIM2 undivided: QEMU's timer input is 1 GHz of emulated time (stm32f4_qemu.h). */
+  TIM2->CR1 = 0u;
+  TIM2->PSC = 0u;
+  TIM2->ARR = 0xFFFFFFFFu;
+  TIM2->CR1 = TIM_CR1_CEN;
 #else
   for (uint32_t ch = 0u; ch < HAL_DAC_NUM_CHANNELS; ++ch) {
     s_dac.code[ch] = (uint16_t)HAL_DAC_CODE_MID;
@@ -83,6 +96,12 @@ int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
   s_isr = isr;
   s_ctx = ctx;
   s_ticks = 0u;
+#ifdef STM32F4_QEMU_PLANT
+  s_tick = (stm32f4_qemu_tick_stats_t){0};
+  s_tick.stretch = STM32F4_QEMU_TICK_STRETCH;
+  s_tick.period_ns = 1000000000u / rate_hz * STM32F4_QEMU_TICK_STRETCH;
+  s_elapsed_ns = 0u;
+#endif
   SCB->SHPR[SYSTICK_SHPR_INDEX] = (uint8_t)(STM32F4_PRIO_SAMPLE << 4);
   SYSTICK->LOAD = QEMU_SYSCLK_HZ / rate_hz * STM32F4_QEMU_TICK_STRETCH - 1u;
   SYSTICK->VAL = 0u;
@@ -96,15 +115,48 @@ void hal_sample_timer_stop(void)
 }
 
 void SysTick_Handler(void);
+#ifdef STM32F4_QEMU_PLANT
+STM32F4_RAMFUNC void SysTick_Handler(void)
+{
+  const uint32_t t0 = TIM2->CNT;
+  (void)SYSTICK->CTRL; /* clears COUNTFLAG, set by the wrap that raised this tick */
+  s_wraps = s_wraps + 1u;
+  s_ticks = s_ticks + 1u;
+  if (s_isr != 0) s_isr(s_ctx);
+  const uint32_t t1 = TIM2->CNT;
+  stm32f4_qemu_plant_tick();
+  const uint32_t t2 = TIM2->CNT;
+
+  stm32f4_qemu_tick_stats_t *st = &s_tick;
+  if (st->ticks > 0u) s_elapsed_ns += t0 - s_t_prev_ns; /* < 4.3 s between ticks */
+  s_t_prev_ns = t0;
+  st->ticks++;
+  const uint64_t periods = (s_elapsed_ns + st->period_ns / 2u) / st->period_ns;
+  st->lost = (uint32_t)(periods + 1u - st->ticks);
+  if ((SYSTICK->CTRL & SYSTICK_CTRL_COUNTFLAG) != 0u) st->overruns++;
+  st->isr_ns_last = t1 - t0;
+  st->plant_ns_last = t2 - t1;
+  st->isr_ns_sum += st->isr_ns_last;
+  st->plant_ns_sum += st->plant_ns_last;
+  if (st->isr_ns_last > st->isr_ns_max) st->isr_ns_max = st->isr_ns_last;
+  if (st->plant_ns_last > st->plant_ns_max) st->plant_ns_max = st->plant_ns_last;
+}
+
+void stm32f4_qemu_tick_stats(stm32f4_qemu_tick_stats_t *s)
+{
+  if (s == 0) return;
+  const uint32_t pm = hal_critical_enter();
+  *s = s_tick;
+  hal_critical_exit(pm);
+}
+#else
 STM32F4_RAMFUNC void SysTick_Handler(void)
 {
   s_wraps = s_wraps + 1u;
   s_ticks = s_ticks + 1u;
   if (s_isr != 0) s_isr(s_ctx);
-#ifdef STM32F4_QEMU_PLANT
-  stm32f4_qemu_plant_tick();
-#endif
 }
+#endif
 
 STM32F4_RAMFUNC uint32_t hal_cycles_now(void)
 {
@@ -140,7 +192,11 @@ void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
 {
   if (stats == 0) return;
   stats->ticks = s_ticks;
+#ifdef STM32F4_QEMU_PLANT
+  stats->overruns = s_tick.overruns;
+#else
   stats->overruns = 0u;
+#endif
   stats->dma_errors = 0u;
 }
 

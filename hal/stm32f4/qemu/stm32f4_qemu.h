@@ -1,0 +1,38 @@
+/* Figures of the emulator image's sample clock (gyro-fw-qemu: SysTick, stretched by
+ * STM32F4_QEMU_TICK_STRETCH, with the plant stepped after the application's ISR).
+ *
+ * Times are emulated nanoseconds from TIM2 counting QEMU's 1 GHz timer input undivided
+ * (only CR1, PSC and ARR are written: QEMU's TIM2 misbehaves when EGR or CNT is). Under
+ * `-icount shift=0` QEMU advances emulated time by exactly 1 ns per instruction, so these
+ * figures are instruction counts (tools/bench/target uses the same counter); under
+ * shift=auto they are emulated time, 2^shift ns per instruction.
+ *   isr_ns     SysTick entry to the return of the application's ISR (the handler's own
+ *              bookkeeping, hal_adc_read_frame, app_sample_isr, hal_dac_write_frame):
+ *              what the board's sample interrupt runs, without the plant
+ *   plant_ns   the plant's step after it (emulator only)
+ *   overruns   ticks whose handler was still running when the next period began
+ *              (SysTick COUNTFLAG set again before the handler returned)
+ *   lost       periods of the emulated clock without a handler run: emulated time since
+ *              the first tick over the period, against the ticks counted (a period lost
+ *              to an overrun, or to QEMU delivering SysTick late) */
+#ifndef STM32F4_QEMU_H
+#define STM32F4_QEMU_H
+
+#include <stdint.h>
+
+typedef struct {
+  uint32_t stretch;        /* SysTick period in 50 kHz sample periods */
+  uint32_t period_ns;      /* emulated time between ticks */
+  uint32_t ticks;
+  uint32_t overruns;
+  uint32_t lost;
+  uint32_t isr_ns_last, isr_ns_max;
+  uint64_t isr_ns_sum;
+  uint32_t plant_ns_last, plant_ns_max;
+  uint64_t plant_ns_sum;
+} stm32f4_qemu_tick_stats_t;
+
+/* A consistent copy (taken with the sample interrupt masked). */
+void stm32f4_qemu_tick_stats(stm32f4_qemu_tick_stats_t *s);
+
+#endif /* STM32F4_QEMU_H */
