@@ -4,12 +4,9 @@
 #include <stddef.h>
 #include <string.h>
 
-#include "plant/expm.h"
-
 static const double kPi = 3.14159265358979323846;
 
 #define NA (MECH_NS + MECH_NU)           /* augmented [state; input] size */
-#define NBIG (MECH_NMONO * NA)           /* 72: block representation */
 
 /* Monomials of the truncated algebra, exponents of (w, a, e). The set is closed under
  * taking divisors, so the monomials outside it span an ideal and truncation is an
@@ -44,8 +41,8 @@ void mech_default_cfg(mech_cfg_t *cfg)
   /* Measured (test_mech, test_refresh_threshold_error): with e expanded to second
    * order the steady-state error of the drive at resonance (Q1 = 33) is about
    * 860 e^3 (8.6e-10 at e = 1e-3, 6.9e-9 at 2e-3). 1e-3 keeps it 100x below 1e-7 and
-   * is 50 K at 40 ppm/K: a refresh (one 72x72 exponential, 0.2-0.4 ms) at most once or
-   * twice in a whole chamber run. */
+   * is 50 K at 40 ppm/K: a refresh (one exponential in the truncated algebra) at most
+   * once or twice in a whole chamber run. */
   cfg->refresh_eps = 1e-3;
   cfg->full_kinematics = 1;
   cfg->brownian = 1;
@@ -90,11 +87,12 @@ static int temp_ok(const mech_cfg_t *c, double temp_k)
 enum { MONO_1 = 0, MONO_E, MONO_E2, MONO_W, MONO_WE, MONO_WE2, MONO_W2, MONO_W2E, MONO_W3, MONO_A, MONO_WA, MONO_AE };
 
 /* Continuous generator in scaled coordinates, one block per monomial: A(w,a,e) =
- * wr * sum_m Ahat_m * mono_m, augmented with the input columns (rows 4,5 zero). The
- * generator is exactly polynomial in (w, a, e): stiffness r^2 (1+e)^2, damping
- * r (1+e), Coriolis and Euler linear, centrifugal quadratic. */
+ * wr * sum_m Ahat_m * mono_m, augmented with the input columns. Only the four state
+ * rows are stored: the input rows of [A B; 0 0] are zero. The generator is exactly
+ * polynomial in (w, a, e): stiffness r^2 (1+e)^2, damping r (1+e), Coriolis and Euler
+ * linear, centrifugal quadratic. */
 static void build_generator(const mech_t *m, double wn1, double wn2,
-                            double ahat[MECH_NMONO][NA][NA])
+                            double ahat[MECH_NMONO][MECH_NS][NA])
 {
   const mech_cfg_t *c = &m->cfg;
   const double wr = m->wr;
@@ -104,7 +102,7 @@ static void build_generator(const mech_t *m, double wn1, double wn2,
   const double s = wn1 / wn_at(c, c->f1_hz, c->temp_ref_k);
   const double kq = c->kq_per_s2 * s * s / (wr * wr);
   const double dq = c->dq_per_s * s / wr;
-  memset(ahat, 0, sizeof(double) * MECH_NMONO * NA * NA);
+  memset(ahat, 0, sizeof(double) * MECH_NMONO * MECH_NS * NA);
   double (*a0)[NA] = ahat[MONO_1];
   a0[0][1] = 1.0;
   a0[1][0] = -r1 * r1;
@@ -137,41 +135,105 @@ static void build_generator(const mech_t *m, double wn1, double wn2,
   }
 }
 
-/* Taylor blocks at structure temperature temp_k (e = 0 there). */
+/* Arithmetic in the truncated algebra. An element X = sum_i mono_i X_i has one 6x6
+ * block per monomial; (XY)_i = sum over (g, j) with mono_g mono_j = mono_i of X_g Y_j.
+ * Every element used here has input rows [0 I] in the unit block and zero elsewhere
+ * (exp of [A B; 0 0] and its Taylor partial sums), so only the four state rows are
+ * stored: the state rows of X_g Y_j are X_g[:, 0:4] Y_j[0:4, :] plus, for j = unit,
+ * X_g[:, 4:6] in the input columns.
+ *
+ * kMono lists every monomial after its divisors, so block i of a product needs only
+ * blocks <= i of either factor: computing the blocks from the last to the first lets
+ * the product overwrite its right factor (and the left one, when squaring). */
+typedef double alg_t[MECH_NMONO][MECH_NS][NA];
+
+/* y <- c0 * 1 + scale * (x y), in place in y; x may be y. */
+static void alg_mul_acc(const alg_t x, alg_t y, double c0, double scale)
+{
+  for (int i = MECH_NMONO - 1; i >= 0; i--) {
+    double t[MECH_NS][NA] = {{0.0}};
+    for (int g = 0; g <= i; g++) {
+      for (int j = 0; j <= i; j++) {
+        if (mono_index(kMono[g][0] + kMono[j][0], kMono[g][1] + kMono[j][1],
+                       kMono[g][2] + kMono[j][2]) != i)
+          continue;
+        for (int r = 0; r < MECH_NS; r++) {
+          for (int k = 0; k < MECH_NS; k++) {
+            const double xrk = x[g][r][k];
+            if (xrk == 0.0) continue; /* the generator is mostly zero */
+            for (int q = 0; q < NA; q++) t[r][q] += xrk * y[j][k][q];
+          }
+          if (j == MONO_1)
+            for (int q = MECH_NS; q < NA; q++) t[r][q] += x[g][r][q];
+        }
+      }
+    }
+    for (int r = 0; r < MECH_NS; r++)
+      for (int q = 0; q < NA; q++) y[i][r][q] = scale * t[r][q];
+    if (i == MONO_1)
+      for (int r = 0; r < MECH_NS; r++) y[i][r][r] += c0;
+  }
+}
+
+/* Norm of an element: sum over the blocks of the 1-norm of the full 6x6 block (the
+ * input rows of a generator are zero). Submultiplicative for the product above (each
+ * block product is bounded by the product of the norms, truncation only drops terms),
+ * and an upper bound of the 1-norm of the 72x72 left-regular representation. */
+static double alg_norm(const alg_t x)
+{
+  double s = 0.0;
+  for (int i = 0; i < MECH_NMONO; i++) {
+    double best = 0.0;
+    for (int q = 0; q < NA; q++) {
+      double col = 0.0;
+      for (int r = 0; r < MECH_NS; r++) col += fabs(x[i][r][q]);
+      best = fmax(best, col);
+    }
+    s += best;
+  }
+  return s;
+}
+
+/* e = exp(b) in the algebra (b: generator, zero input rows; overwritten by its scaled
+ * copy). Scaling and squaring: b / 2^s with norm <= 1/2, Taylor to degree 18 by
+ * Horner (remainder below 0.5^19 / 19! = 1.6e-23 of the norm, and the series
+ * converges in the algebra because the norm is submultiplicative), then s squarings.
+ * Returns -1 for a non-finite generator (e untouched). */
+static int alg_exp(alg_t b, alg_t e)
+{
+  enum { kDegree = 18 };
+  const double nrm = alg_norm(b);
+  if (!isfinite(nrm)) return -1;
+  int s = 0;
+  if (nrm > 0.5) s = (int)ceil(log2(nrm / 0.5));
+  const double scale = ldexp(1.0, -s);
+  for (int i = 0; i < MECH_NMONO; i++)
+    for (int r = 0; r < MECH_NS; r++)
+      for (int q = 0; q < NA; q++) b[i][r][q] *= scale;
+  /* Horner: e = 1 + b/1 (1 + b/2 (1 + ... (1 + b/18))) */
+  for (int i = 0; i < MECH_NMONO; i++)
+    for (int r = 0; r < MECH_NS; r++)
+      for (int q = 0; q < NA; q++) e[i][r][q] = b[i][r][q] / kDegree;
+  for (int r = 0; r < MECH_NS; r++) e[MONO_1][r][r] += 1.0;
+  for (int k = kDegree - 1; k >= 1; k--) alg_mul_acc(b, e, 1.0, 1.0 / k);
+  for (int k = 0; k < s; k++) alg_mul_acc(e, e, 0.0, 1.0);
+  return 0;
+}
+
+/* Taylor blocks at structure temperature temp_k (e = 0 there): exp(h A) in the
+ * truncated algebra is sum_i mono_i P_i, the P_i being the blocks [Phi Gamma]. */
 static int discretise(mech_t *m, double temp_k)
 {
   const mech_cfg_t *c = &m->cfg;
   const double wn1 = wn_at(c, c->f1_hz, temp_k), wn2 = wn_at(c, c->f2_hz, temp_k);
   const double h = m->wr / c->fs_hz;
 
-  double ahat[MECH_NMONO][NA][NA];
+  alg_t ahat; /* 2.3 kB: the only scratch */
   build_generator(m, wn1, wn2, ahat);
-
-  /* Left-regular representation: block (i, j) = sum over monomials g with
-   * g * mono_j = mono_i of h * Ahat_g. exp of it = representation of exp(A T); its
-   * first block column holds the Taylor coefficients. */
-  static const int n = NBIG;
-  /* ~370 kB of scratch on the stack, only here (init and rare refreshes) */
-  struct {
-    double big[NBIG * NBIG];
-    double e[NBIG * NBIG];
-    expm_work_t w;
-  } ws;
-  memset(ws.big, 0, sizeof(ws.big));
-  for (int g = 0; g < MECH_NMONO; g++) {
-    for (int j = 0; j < MECH_NMONO; j++) {
-      const int i = mono_index(kMono[g][0] + kMono[j][0], kMono[g][1] + kMono[j][1],
-                               kMono[g][2] + kMono[j][2]);
-      if (i < 0) continue;
-      for (int r = 0; r < NA; r++)
-        for (int q = 0; q < NA; q++) ws.big[(i * NA + r) * n + (j * NA + q)] += h * ahat[g][r][q];
-    }
-  }
-  const int rc = expm(n, ws.big, ws.e, &ws.w);
-  if (rc != 0) return -2;
   for (int i = 0; i < MECH_NMONO; i++)
     for (int r = 0; r < MECH_NS; r++)
-      for (int q = 0; q < NA; q++) m->blk[i][r][q] = ws.e[(i * NA + r) * n + q];
+      for (int q = 0; q < NA; q++) ahat[i][r][q] *= h;
+  if (alg_exp(ahat, m->blk) != 0) return -2;
 
   m->temp_disc_k = temp_k;
   m->eps = 0.0;
@@ -215,9 +277,9 @@ int mech_set_temp(mech_t *m, double temp_k)
   m->temp_k = temp_k;
   const double e = wn_at(&m->cfg, 1.0, temp_k) / wn_at(&m->cfg, 1.0, m->temp_disc_k) - 1.0;
   if (fabs(e) > m->cfg.refresh_eps) {
-    mech_t keep = *m;
     if (discretise(m, temp_k) != 0) {
-      *m = keep; /* cannot happen for a validated cfg; stay on the old blocks */
+      /* cannot happen for a validated cfg (discretise fails before it writes
+       * anything); stay on the old blocks */
       m->eps = e;
       m->q_valid = 0;
       return -2;

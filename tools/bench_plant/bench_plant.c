@@ -7,7 +7,7 @@
  *            to 0.2 K/s and the pickoffs are re-discretised every 5 ms
  *   vibe     rate sine + sense-axis vibration (0.25 g, 100 Hz)
  *   mech     the mechanics alone (mech_step with a varying rate)
- * plus the cost of one re-discretisation of the mechanics (72x72 exponential).
+ * plus the cost of one re-discretisation of the mechanics (algebra exponential).
  * Usage: bench_plant [samples]   (default 2,000,000; CPU time of this process) */
 #define _POSIX_C_SOURCE 199309L /* clock_gettime */
 #include <math.h>
@@ -107,7 +107,7 @@ int main(int argc, char **argv)
   }
   const double nm = run_mech(n);
   printf("mech alone (rate changing every sample): %.1f ns/sample\n", nm);
-  /* one refresh: re-initialise the mechanics (dominated by the 72x72 exponential) */
+  /* one refresh: re-initialise the mechanics (dominated by the algebra exponential) */
   mech_cfg_t mc;
   mech_default_cfg(&mc);
   static mech_t m;
