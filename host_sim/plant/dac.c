@@ -3,7 +3,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "plant/lti_disc.h"
+#include "plant/expm.h"
 
 static const double k_pi = 3.14159265358979323846;
 
@@ -68,7 +68,7 @@ static int discretise(dac_t *d)
   /* X = F T, F = [[A, B], [0, 0]], A = w0 [[0, 1], [-1, -1/Q]], B = w0 [0, 1]^T */
   double x[9] = {0.0, wt, 0.0, -wt, -wt * iq, wt, 0.0, 0.0, 0.0};
   double e[9];
-  if (lti_expm(3, x, e) != 0) return -1;
+  if (expm(3, x, e) != 0) return -1;
   d->ad[0][0] = e[0];
   d->ad[0][1] = e[1];
   d->ad[1][0] = e[3];
@@ -83,7 +83,7 @@ static int discretise(dac_t *d)
     for (int j = 0; j < 3; j++) g[i * 6 + j] = x[i * 3 + j];
     g[i * 6 + 3 + i] = 1.0;
   }
-  if (lti_expm(6, g, ge) != 0) return -1;
+  if (expm(6, g, ge) != 0) return -1;
   for (int j = 0; j < 3; j++) d->mv[j] = ge[0 * 6 + 3 + j]; /* h^T picks row 0 */
 
   /* Van Loan: exp([[-X^T, h h^T], [0, X]]) = [[., G], [0, E]], int = E^T G */
@@ -94,7 +94,7 @@ static int discretise(dac_t *d)
       g[(3 + i) * 6 + 3 + j] = x[i * 3 + j];
     }
   g[0 * 6 + 3] = 1.0; /* h h^T with h = e1 */
-  if (lti_expm(6, g, ge) != 0) return -1;
+  if (expm(6, g, ge) != 0) return -1;
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++) {
       double s = 0.0;

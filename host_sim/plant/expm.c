@@ -1,6 +1,7 @@
 #include "plant/expm.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 /* [13/13] Pade coefficients b_k = (26-k)! 13! / (26! k! (13-k)!) scaled by 26!/13!
@@ -13,7 +14,7 @@ static const double kPade13[14] = {
     182.0,               1.0};
 static const double kTheta13 = 5.371920351148152;
 
-void expm_matmul(int n, const double *a, const double *b, double *c)
+static void matmul(int n, const double *a, const double *b, double *c)
 {
   for (int i = 0; i < n; i++) {
     double *ci = c + i * n;
@@ -39,7 +40,7 @@ static double norm1(int n, const double *a)
 }
 
 /* Solve M X = R in place (M overwritten by its LU factors, R by X). */
-static int lu_solve(int n, double *m, double *r, int *piv)
+static int lu_solve(int n, double *m, double *r)
 {
   for (int k = 0; k < n; k++) {
     int p = k;
@@ -52,7 +53,6 @@ static int lu_solve(int n, double *m, double *r, int *piv)
       }
     }
     if (!(big > 0.0)) return -2;
-    piv[k] = p;
     if (p != k) {
       for (int j = 0; j < n; j++) {
         double t = m[k * n + j];
@@ -83,36 +83,38 @@ static int lu_solve(int n, double *m, double *r, int *piv)
   return 0;
 }
 
-int expm(int n, const double *a, double *e, expm_work_t *w)
+int expm(int n, const double *a, double *e)
 {
-  if (n < 1 || n > EXPM_MAX_N || a == NULL || e == NULL || w == NULL) return -1;
+  if (n < 1 || n > EXPM_MAX_N || a == NULL || e == NULL) return -1;
   const int nn = n * n;
   for (int i = 0; i < nn; i++)
     if (!isfinite(a[i])) return -1;
 
-  double *b = w->m[0], *b2 = w->m[1], *b4 = w->m[2], *b6 = w->m[3];
-  double *u = w->m[4], *v = w->m[5], *t = w->m[6];
+  double m[7][EXPM_MAX_N * EXPM_MAX_N];
+  double *b = m[0], *b2 = m[1], *b4 = m[2], *b6 = m[3];
+  double *u = m[4], *v = m[5], *t = m[6];
 
   const double nrm = norm1(n, a);
+  if (!isfinite(nrm)) return -1; /* finite entries, but beyond any scaling */
   int s = 0;
   if (nrm > kTheta13) s = (int)ceil(log2(nrm / kTheta13));
   const double scale = ldexp(1.0, -s);
   for (int i = 0; i < nn; i++) b[i] = a[i] * scale;
 
-  expm_matmul(n, b, b, b2);
-  expm_matmul(n, b2, b2, b4);
-  expm_matmul(n, b4, b2, b6);
+  matmul(n, b, b, b2);
+  matmul(n, b2, b2, b4);
+  matmul(n, b4, b2, b6);
 
   const double *c = kPade13;
   /* t = b13 B6 + b11 B4 + b9 B2 ; u_inner = B6 t + b7 B6 + b5 B4 + b3 B2 + b1 I */
   for (int i = 0; i < nn; i++) t[i] = c[13] * b6[i] + c[11] * b4[i] + c[9] * b2[i];
-  expm_matmul(n, b6, t, v); /* v used as scratch */
+  matmul(n, b6, t, v); /* v used as scratch */
   for (int i = 0; i < nn; i++) v[i] += c[7] * b6[i] + c[5] * b4[i] + c[3] * b2[i];
   for (int i = 0; i < n; i++) v[i * n + i] += c[1];
-  expm_matmul(n, b, v, u);
+  matmul(n, b, v, u);
   /* V = B6 (b12 B6 + b10 B4 + b8 B2) + b6 B6 + b4 B4 + b2 B2 + b0 I */
   for (int i = 0; i < nn; i++) t[i] = c[12] * b6[i] + c[10] * b4[i] + c[8] * b2[i];
-  expm_matmul(n, b6, t, v);
+  matmul(n, b6, t, v);
   for (int i = 0; i < nn; i++) v[i] += c[6] * b6[i] + c[4] * b4[i] + c[2] * b2[i];
   for (int i = 0; i < n; i++) v[i * n + i] += c[0];
 
@@ -121,12 +123,12 @@ int expm(int n, const double *a, double *e, expm_work_t *w)
     b2[i] = v[i] - u[i];
     t[i] = v[i] + u[i];
   }
-  const int rc = lu_solve(n, b2, t, w->piv);
+  const int rc = lu_solve(n, b2, t);
   if (rc != 0) return rc;
 
   double *cur = t, *nxt = b4;
   for (int k = 0; k < s; k++) {
-    expm_matmul(n, cur, cur, nxt);
+    matmul(n, cur, cur, nxt);
     double *tmp = cur;
     cur = nxt;
     nxt = tmp;

@@ -1,5 +1,5 @@
-/* Dense real matrix exponential for the plant's exact discretisations (host only,
- * double precision).
+/* Dense real matrix exponential for the plant's exact discretisations (host plant,
+ * double precision; the one exponential of host_sim/plant).
  *
  * Method: scaling and squaring with the diagonal [13/13] Pade approximant
  * (N. J. Higham, "The scaling and squaring method for the matrix exponential
@@ -12,27 +12,21 @@
  *   exp(A) = r13(B)^(2^s)                 (s squarings)
  * Backward error below the unit roundoff for every ||B||_1 <= theta13.
  *
- * Layout: row-major n x n, element (i, j) at a[i*n + j]. The caller owns the
- * workspace, so the module has no hidden state and allocates nothing; the result may
- * not alias the input. Used at init time and on rare re-discretisations, never per
- * sample.
+ * Layout: row-major n x n, element (i, j) at a[i*n + j], n <= EXPM_MAX_N (the
+ * plant's largest argument is the pickoff chain driven by a cubic, 4 + 4 states). The
+ * workspace (7 matrices of EXPM_MAX_N^2, 3.6 kB) is on the stack: no hidden state,
+ * no allocation, and small enough for the plant on a Cortex-M4 target. The result may
+ * not alias the input. Used at init time and on rare re-discretisations (thermal
+ * network, DAC reconstruction filter, pickoff chains), never per sample.
  */
 #ifndef PLANT_EXPM_H
 #define PLANT_EXPM_H
 
-#define EXPM_MAX_N 72
+#define EXPM_MAX_N 8
 
-typedef struct {
-  double m[7][EXPM_MAX_N * EXPM_MAX_N];
-  int piv[EXPM_MAX_N];
-} expm_work_t;
-
-/* e = exp(a). Returns 0 on success, -1 on bad size or a non-finite input (e then
- * untouched), -2 if the Pade denominator is numerically singular (cannot happen for
- * finite input within theta13, kept as a guard). */
-int expm(int n, const double *a, double *e, expm_work_t *w);
-
-/* c = a * b, all n x n row-major; c must not alias a or b. */
-void expm_matmul(int n, const double *a, const double *b, double *c);
+/* e = exp(a). Returns 0 on success, -1 on bad size, a NULL pointer or a non-finite
+ * input (e then untouched), -2 if the Pade denominator is numerically singular (cannot
+ * happen for finite input within theta13, kept as a guard; e untouched). */
+int expm(int n, const double *a, double *e);
 
 #endif /* PLANT_EXPM_H */

@@ -3,7 +3,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "plant/lti_disc.h"
+#include "plant/expm.h"
 
 static const double k_pi = 3.14159265358979323846;
 static const double k_deg = 3.14159265358979323846 / 180.0;
@@ -171,15 +171,16 @@ static int discretise(pickoff_t *p, double phi)
   }
 
   /* augmented generator: chain driven by the cubic q = [u, u_s, u_ss, u_sss] */
+  _Static_assert(PICKOFF_MAX_N + 4 <= EXPM_MAX_N, "augmented pickoff chain exceeds expm");
   const int n = chain.n, na = n + 4;
-  double f[LTI_MAX_N * LTI_MAX_N], e[LTI_MAX_N * LTI_MAX_N];
+  double f[EXPM_MAX_N * EXPM_MAX_N], e[EXPM_MAX_N * EXPM_MAX_N];
   memset(f, 0, sizeof f);
   for (int i = 0; i < n; i++) {
     for (int j = 0; j < n; j++) f[i * na + j] = chain.a[i][j];
     f[i * na + n] = chain.b[i];
   }
   for (int j = 0; j < 3; j++) f[(n + j) * na + n + j + 1] = 1.0;
-  if (lti_expm(na, f, e) != 0) return -1;
+  if (expm(na, f, e) != 0) return -1;
 
   /* Hermite data [s0, m0, s1, m1] (m = T s') -> Taylor coefficients at s = 0 */
   static const double herm[4][4] = {

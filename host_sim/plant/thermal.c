@@ -125,8 +125,7 @@ int thermal_init(thermal_t *th, const thermal_cfg_t *cfg, double ambient_k)
     for (int j = 0; j < 3; j++) aug[i * 6 + j] = -l[i][j] * cfg->dt_s;
     aug[i * 6 + 3 + i] = cfg->dt_s;
   }
-  expm_work_t w;
-  if (expm(6, aug, e, &w) != 0) return -2;
+  if (expm(6, aug, e) != 0) return -2;
   thermal_t tmp;
   memset(&tmp, 0, sizeof tmp);
   tmp.cfg = *cfg;

@@ -1,5 +1,7 @@
 /* Matrix exponential by Eigen's MatrixFunctions module (Pade, scaling and squaring),
- * an independent reference for host_sim/plant/lti_disc. Host only. */
+ * any size (heap storage): an independent reference for host_sim/plant/expm and for the
+ * 72 x 72 left-regular representation behind host_sim/plant/mech's Taylor blocks
+ * (test_mech_alg). Host only. */
 #ifndef MATEXP_REF_H
 #define MATEXP_REF_H
 

@@ -1,5 +1,4 @@
 /* Mechanics of the two-mode gyro (host_sim/plant/mech) against independent references:
- *  - the matrix exponential against Eigen's MatrixFunctions and closed forms;
  *  - open-loop steady states (2-24), (2-25) with rate, quadrature and damping coupling,
  *    at the production rate 50 kHz, with the held force expanded in its Fourier
  *    series (every harmonic through the continuous transfer functions of (2-22));
@@ -20,70 +19,11 @@
 #include <complex.h>
 #include <cmocka.h>
 
-#include "plant/expm.h"
 #include "plant/mech.h"
-#include "plant/rng.h"
 #include "expm_ref.h"
 
 static const double kPi = 3.14159265358979323846;
 static const double kDeg = 3.14159265358979323846 / 180.0;
-
-/* ---------------------------------------------------------------- expm ---------- */
-
-static double rel_err_mat(int n, const double *a, const double *b)
-{
-  double num = 0.0, den = 0.0;
-  for (int i = 0; i < n * n; i++) {
-    num = fmax(num, fabs(a[i] - b[i]));
-    den = fmax(den, fabs(b[i]));
-  }
-  return num / den;
-}
-
-static void test_expm_vs_eigen(void **state)
-{
-  (void)state;
-  static expm_work_t w;
-  static double a[60 * 60], e[60 * 60], r[60 * 60];
-  rng_t g;
-  rng_seed(&g, 42u, 7u);
-  const int sizes[] = {1, 2, 3, 6, 13, 36, 60};
-  const double norms[] = {1e-3, 0.5, 3.0, 40.0, 400.0};
-  for (size_t si = 0; si < sizeof sizes / sizeof sizes[0]; si++) {
-    for (size_t ni = 0; ni < sizeof norms / sizeof norms[0]; ni++) {
-      const int n = sizes[si];
-      for (int i = 0; i < n * n; i++) a[i] = rng_gauss(&g) * norms[ni] / n;
-      /* keep the spectrum in the left half plane for the large norms, as in the plant
-       * (exp of a matrix with large positive eigenvalues is ill-conditioned for both
-       * implementations) */
-      if (norms[ni] > 10.0)
-        for (int i = 0; i < n; i++) a[i * n + i] -= norms[ni];
-      assert_int_equal(expm(n, a, e, &w), 0);
-      assert_int_equal(expm_ref(n, a, r), 0);
-      /* exp is conditioned like its argument: allow eps * ||A|| growth */
-      const double err = rel_err_mat(n, e, r), tol = 1e-13 * (1.0 + norms[ni]);
-      if (err > tol) printf("expm n=%d norm=%g rel err %.3e\n", n, norms[ni], err);
-      assert_true(err < tol);
-    }
-  }
-  /* closed form: exp([[0, t], [-t, 0]]) = rotation by t */
-  const double t = 37.3;
-  const double rot[4] = {0.0, t, -t, 0.0};
-  assert_int_equal(expm(2, rot, e, &w), 0);
-  assert_true(fabs(e[0] - cos(t)) < 1e-13 && fabs(e[1] - sin(t)) < 1e-13);
-  assert_true(fabs(e[2] + sin(t)) < 1e-13 && fabs(e[3] - cos(t)) < 1e-13);
-  /* nilpotent: exp([[0,1,0],[0,0,1],[0,0,0]]) = [[1,1,1/2],[0,1,1],[0,0,1]] */
-  const double nil[9] = {0, 1, 0, 0, 0, 1, 0, 0, 0};
-  const double nil_e[9] = {1, 1, 0.5, 0, 1, 1, 0, 0, 1};
-  assert_int_equal(expm(3, nil, e, &w), 0);
-  for (int i = 0; i < 9; i++) assert_true(fabs(e[i] - nil_e[i]) < 1e-15);
-  /* bad input leaves the result untouched */
-  double bad[4] = {1.0, NAN, 0.0, 1.0}, out[4] = {7, 7, 7, 7};
-  assert_int_equal(expm(2, bad, out, &w), -1);
-  assert_true(out[0] == 7.0 && out[3] == 7.0);
-  assert_int_equal(expm(0, bad, out, &w), -1);
-  assert_int_equal(expm(EXPM_MAX_N + 1, bad, out, &w), -1);
-}
 
 /* -------------------------------------------------------- configuration -------- */
 
@@ -582,7 +522,6 @@ static void test_brownian_equipartition(void **state)
 int main(void)
 {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_expm_vs_eigen),
       cmocka_unit_test(test_cfg_validation),
       cmocka_unit_test(test_open_loop_2_24_2_25),
       cmocka_unit_test(test_full_kinematics_steady),

@@ -19,7 +19,7 @@
 #include <cmocka.h>
 
 #include "plant/mech.h"
-#include "expm_large_ref.h"
+#include "matexp_ref.h"
 
 enum { NS = 4, NA = 6, NM = 12, NBIG = NM * NA };
 
@@ -119,7 +119,7 @@ static double compare_with_rep(const mech_t *m, const mech_cfg_t *c, double tk, 
       for (int r = 0; r < NA; r++)
         for (int q = 0; q < NA; q++) big[(i * NA + r) * NBIG + j * NA + q] += cf[g][r][q];
     }
-  assert_int_equal(expm_large_ref(NBIG, big, ebig), 0);
+  assert_int_equal(ref_matexp(NBIG, big, ebig), 0);
   double worst = 0.0, dmax = 0.0, amax = 0.0;
   for (int i = 0; i < NM; i++) {
     double d = 0.0, mx = 0.0;
