@@ -27,20 +27,19 @@ int actuator_init(actuator_t *a, const actuator_cfg_t *cfg, uint64_t seed)
   if (cfg->fb_mode != ACTUATOR_FB_OFF && cfg->fb_mode != ACTUATOR_FB_SINGLE &&
       cfg->fb_mode != ACTUATOR_FB_DIFFERENTIAL)
     return -1;
-  actuator_t t;
-  memset(&t, 0, sizeof t);
-  t.cfg = *cfg;
   const flicker_spec_t off = {0.0, 0.0, 0.0};
   const flicker_spec_t *spec[4] = {&cfg->drive_noise, &cfg->drive_noise, &cfg->fb_noise,
                                    &cfg->fb_noise};
   /* the grounded electrode of FB_SINGLE and both electrodes of FB_OFF carry no noise */
   if (cfg->fb_mode == ACTUATOR_FB_OFF) spec[2] = &off;
   if (cfg->fb_mode != ACTUATOR_FB_DIFFERENTIAL) spec[3] = &off;
-  for (int i = 0; i < 4; i++) {
-    if (flicker_init(&t.noise[i], spec[i], cfg->fs_hz, seed, ACTUATOR_RNG_STREAM_U1 + (uint64_t)i) != 0)
-      return -1;
-  }
-  *a = t;
+  /* everything that can fail is checked before a is touched; then built in place */
+  for (int i = 0; i < 4; i++)
+    if (flicker_check(spec[i], cfg->fs_hz) != 0) return -1;
+  a->cfg = *cfg;
+  for (int i = 0; i < 4; i++)
+    (void)flicker_init(&a->noise[i], spec[i], a->cfg.fs_hz, seed,
+                       ACTUATOR_RNG_STREAM_U1 + (uint64_t)i);
   return 0;
 }
 

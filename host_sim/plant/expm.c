@@ -90,9 +90,10 @@ int expm(int n, const double *a, double *e)
   for (int i = 0; i < nn; i++)
     if (!isfinite(a[i])) return -1;
 
-  double m[7][EXPM_MAX_N * EXPM_MAX_N];
-  double *b = m[0], *b2 = m[1], *b4 = m[2], *b6 = m[3];
-  double *u = m[4], *v = m[5], *t = m[6];
+  /* six n x n slots, reused as the terms are consumed (same operations, in the same
+   * order, as the textbook layout with seven) */
+  double m[6][EXPM_MAX_N * EXPM_MAX_N];
+  double *b = m[0], *b2 = m[1], *b4 = m[2], *b6 = m[3], *t = m[4], *v = m[5];
 
   const double nrm = norm1(n, a);
   if (!isfinite(nrm)) return -1; /* finite entries, but beyond any scaling */
@@ -106,27 +107,29 @@ int expm(int n, const double *a, double *e)
   matmul(n, b4, b2, b6);
 
   const double *c = kPade13;
-  /* t = b13 B6 + b11 B4 + b9 B2 ; u_inner = B6 t + b7 B6 + b5 B4 + b3 B2 + b1 I */
-  for (int i = 0; i < nn; i++) t[i] = c[13] * b6[i] + c[11] * b4[i] + c[9] * b2[i];
-  matmul(n, b6, t, v); /* v used as scratch */
-  for (int i = 0; i < nn; i++) v[i] += c[7] * b6[i] + c[5] * b4[i] + c[3] * b2[i];
-  for (int i = 0; i < n; i++) v[i * n + i] += c[1];
-  matmul(n, b, v, u);
   /* V = B6 (b12 B6 + b10 B4 + b8 B2) + b6 B6 + b4 B4 + b2 B2 + b0 I */
   for (int i = 0; i < nn; i++) t[i] = c[12] * b6[i] + c[10] * b4[i] + c[8] * b2[i];
   matmul(n, b6, t, v);
   for (int i = 0; i < nn; i++) v[i] += c[6] * b6[i] + c[4] * b4[i] + c[2] * b2[i];
   for (int i = 0; i < n; i++) v[i * n + i] += c[0];
+  /* U = B [B6 (b13 B6 + b11 B4 + b9 B2) + b7 B6 + b5 B4 + b3 B2 + b1 I]: the bracket
+   * is built in b4, the low-order sum kept in b2, U lands in t */
+  for (int i = 0; i < nn; i++) t[i] = c[13] * b6[i] + c[11] * b4[i] + c[9] * b2[i];
+  for (int i = 0; i < nn; i++) b2[i] = c[7] * b6[i] + c[5] * b4[i] + c[3] * b2[i];
+  matmul(n, b6, t, b4);
+  for (int i = 0; i < nn; i++) b4[i] += b2[i];
+  for (int i = 0; i < n; i++) b4[i * n + i] += c[1];
+  matmul(n, b, b4, t);
 
-  /* (V - U) X = (V + U): denominator into b2, numerator into t. */
+  /* (V - U) X = (V + U): denominator into b2, numerator into b4. */
   for (int i = 0; i < nn; i++) {
-    b2[i] = v[i] - u[i];
-    t[i] = v[i] + u[i];
+    b2[i] = v[i] - t[i];
+    b4[i] = v[i] + t[i];
   }
-  const int rc = lu_solve(n, b2, t);
+  const int rc = lu_solve(n, b2, b4);
   if (rc != 0) return rc;
 
-  double *cur = t, *nxt = b4;
+  double *cur = b4, *nxt = b6;
   for (int k = 0; k < s; k++) {
     matmul(n, cur, cur, nxt);
     double *tmp = cur;

@@ -14,7 +14,7 @@
  *
  * Layout: row-major n x n, element (i, j) at a[i*n + j], n <= EXPM_MAX_N (the
  * plant's largest argument is the pickoff chain driven by a cubic, 4 + 4 states). The
- * workspace (7 matrices of EXPM_MAX_N^2, 3.6 kB) is on the stack: no hidden state,
+ * workspace (6 matrices of EXPM_MAX_N^2, 3 kB) is on the stack: no hidden state,
  * no allocation, and small enough for the plant on a Cortex-M4 target. The result may
  * not alias the input. Used at init time and on rare re-discretisations (thermal
  * network, DAC reconstruction filter, pickoff chains), never per sample.

@@ -2,6 +2,7 @@
 
 #include <complex.h>
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 static const double k_pi = 3.14159265358979323846;
@@ -44,46 +45,67 @@ static void bilinear(double z_hz, double p_hz, double fs_hz, double *b0, double 
   *a1 = (1.0 - kp) / den;
 }
 
-int flicker_init(flicker_t *f, const flicker_spec_t *spec, double fs_hz, uint64_t seed,
-                 uint64_t stream)
+/* Zeros and poles of the cascade (knee pairs, then one pair per decade down to fmin).
+ * Returns the number of sections, or -1 if they do not fit FLICKER_MAX_SECTIONS. */
+static int design_sections(const flicker_spec_t *spec, double fc, double zs[FLICKER_MAX_SECTIONS],
+                           double ps[FLICKER_MAX_SECTIONS])
 {
-  if (f == NULL || spec == NULL) return -1;
+  int n = 0;
+  for (int i = 0; i < 2; i++) {
+    zs[n] = fc * pow(10.0, k_knee_zero_log10[i]);
+    ps[n] = fc * pow(10.0, k_knee_pole_log10[i]);
+    n++;
+  }
+  /* regular pairs one per decade below the knee, down to fmin */
+  double z = ps[1] / sqrt(10.0);
+  for (;;) {
+    const double p = z / sqrt(10.0);
+    if (n >= FLICKER_MAX_SECTIONS) return -1;
+    zs[n] = z;
+    ps[n] = p;
+    n++;
+    if (p <= spec->fmin_hz) break;
+    z /= 10.0;
+  }
+  return n;
+}
+
+int flicker_check(const flicker_spec_t *spec, double fs_hz)
+{
+  if (spec == NULL) return -1;
   if (!(isfinite(fs_hz) && fs_hz > 0.0)) return -1;
   if (!(isfinite(spec->white_rthz) && spec->white_rthz >= 0.0)) return -1;
   if (!(isfinite(spec->flicker_1hz_rthz) && spec->flicker_1hz_rthz >= 0.0)) return -1;
   if (spec->flicker_1hz_rthz > 0.0 &&
       !(isfinite(spec->fmin_hz) && spec->fmin_hz > 0.0 && spec->fmin_hz <= fs_hz / 1000.0))
     return -1;
-
-  flicker_t t;
-  memset(&t, 0, sizeof t);
   double w2;
   const double fc = corner_hz(spec, fs_hz, &w2);
-  t.corner_hz = fc;
-  t.active = (w2 > 0.0);
+  if (fc > 0.0 && fc > 10.0 * spec->fmin_hz) {
+    double zs[FLICKER_MAX_SECTIONS], ps[FLICKER_MAX_SECTIONS];
+    if (design_sections(spec, fc, zs, ps) < 0) return -1;
+  }
+  return 0;
+}
+
+int flicker_init(flicker_t *f, const flicker_spec_t *spec, double fs_hz, uint64_t seed,
+                 uint64_t stream)
+{
+  /* everything that can fail is checked first, then f is built in place */
+  if (f == NULL || flicker_check(spec, fs_hz) != 0) return -1;
+
+  memset(f, 0, sizeof *f);
+  double w2;
+  const double fc = corner_hz(spec, fs_hz, &w2);
+  f->corner_hz = fc;
+  f->active = (w2 > 0.0);
   const double unit_sd = sqrt(fs_hz / 2.0); /* unit one-sided density */
 
   if (fc > 0.0 && fc > 10.0 * spec->fmin_hz) {
     double zs[FLICKER_MAX_SECTIONS], ps[FLICKER_MAX_SECTIONS];
-    int n = 0;
-    for (int i = 0; i < 2; i++) {
-      zs[n] = fc * pow(10.0, k_knee_zero_log10[i]);
-      ps[n] = fc * pow(10.0, k_knee_pole_log10[i]);
-      n++;
-    }
-    /* regular pairs one per decade below the knee, down to fmin */
-    double z = ps[1] / sqrt(10.0);
-    for (;;) {
-      const double p = z / sqrt(10.0);
-      if (n >= FLICKER_MAX_SECTIONS) return -1;
-      zs[n] = z;
-      ps[n] = p;
-      n++;
-      if (p <= spec->fmin_hz) break;
-      z /= 10.0;
-    }
-    t.nsec = n;
-    for (int i = 0; i < n; i++) bilinear(zs[i], ps[i], fs_hz, &t.b0[i], &t.b1[i], &t.a1[i]);
+    const int n = design_sections(spec, fc, zs, ps);
+    f->nsec = n;
+    for (int i = 0; i < n; i++) bilinear(zs[i], ps[i], fs_hz, &f->b0[i], &f->b1[i], &f->a1[i]);
 
     /* least-squares gain in dB over a log grid of the discrete response */
     const int npts = 240;
@@ -94,21 +116,20 @@ int flicker_init(flicker_t *f, const flicker_spec_t *spec, double fs_hz, uint64_
       const double complex q = cexp(-I * 2.0 * k_pi * fj / fs_hz);
       double h2 = 1.0;
       for (int i = 0; i < n; i++) {
-        const double complex h = (t.b0[i] + t.b1[i] * q) / (1.0 + t.a1[i] * q);
+        const double complex h = (f->b0[i] + f->b1[i] * q) / (1.0 + f->a1[i] * q);
         h2 *= creal(h * conj(h));
       }
       acc += log(flicker_target_psd(spec, fs_hz, fj) / h2);
     }
-    t.in_sd = unit_sd * exp(0.5 * acc / (double)npts);
+    f->in_sd = unit_sd * exp(0.5 * acc / (double)npts);
   } else {
     /* corner within a decade of fmin (or no 1/f part): the band above 10 fmin is
      * white within 3 dB; realise the white floor only */
-    t.nsec = 0;
-    t.in_sd = unit_sd * sqrt(w2);
+    f->nsec = 0;
+    f->in_sd = unit_sd * sqrt(w2);
   }
-  gauss_zig_init(&t.zig);
-  rng_seed(&t.rng, seed, stream);
-  *f = t;
+  gauss_zig_init(&f->zig);
+  rng_seed(&f->rng, seed, stream);
   return 0;
 }
 

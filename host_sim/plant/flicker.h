@@ -50,9 +50,14 @@ typedef struct {
   gauss_zig_t zig; /* normal deviates by the ziggurat: no log per sample (gauss_zig.h) */
 } flicker_t;
 
-/* Validates spec (finite, W, K >= 0, fs > 0; if K > 0: 0 < fmin <= fs/1000 and fc/fmin small
- * enough for FLICKER_MAX_SECTIONS, about 1e13), designs the cascade and seeds the
- * generator with rng_seed(seed, stream). Returns 0, or -1 with f unchanged. */
+/* 0 if flicker_init would accept (spec, fs_hz): finite, W, K >= 0, fs > 0; if K > 0:
+ * 0 < fmin <= fs/1000 and fc/fmin small enough for FLICKER_MAX_SECTIONS, about 1e13.
+ * -1 otherwise (also for spec == NULL). */
+int flicker_check(const flicker_spec_t *spec, double fs_hz);
+
+/* Validates (flicker_check), designs the cascade and seeds the generator with
+ * rng_seed(seed, stream). Returns 0, or -1 with f unchanged. Built in place (no copy of
+ * flicker_t on the stack). */
 int flicker_init(flicker_t *f, const flicker_spec_t *spec, double fs_hz, uint64_t seed,
                  uint64_t stream);
 

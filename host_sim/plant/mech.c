@@ -91,11 +91,9 @@ enum { MONO_1 = 0, MONO_E, MONO_E2, MONO_W, MONO_WE, MONO_WE2, MONO_W2, MONO_W2E
  * rows are stored: the input rows of [A B; 0 0] are zero. The generator is exactly
  * polynomial in (w, a, e): stiffness r^2 (1+e)^2, damping r (1+e), Coriolis and Euler
  * linear, centrifugal quadratic. */
-static void build_generator(const mech_t *m, double wn1, double wn2,
+static void build_generator(const mech_cfg_t *c, double wr, double wn1, double wn2,
                             double ahat[MECH_NMONO][MECH_NS][NA])
 {
-  const mech_cfg_t *c = &m->cfg;
-  const double wr = m->wr;
   const double r1 = wn1 / wr, r2 = wn2 / wr;
   /* cross couplings follow the structure temperature like the modes: stiffness with
    * wn^2, damping with wn (Q constant) */
@@ -221,20 +219,25 @@ static int alg_exp(alg_t b, alg_t e)
 }
 
 /* Taylor blocks at structure temperature temp_k (e = 0 there): exp(h A) in the
- * truncated algebra is sum_i mono_i P_i, the P_i being the blocks [Phi Gamma]. */
-static int discretise(mech_t *m, double temp_k)
+ * truncated algebra is sum_i mono_i P_i, the P_i being the blocks [Phi Gamma].
+ * Returns -2 (blk untouched) for a non-finite generator. */
+static int discretise_blocks(const mech_cfg_t *c, double wr, double temp_k, alg_t blk)
 {
-  const mech_cfg_t *c = &m->cfg;
   const double wn1 = wn_at(c, c->f1_hz, temp_k), wn2 = wn_at(c, c->f2_hz, temp_k);
-  const double h = m->wr / c->fs_hz;
+  const double h = wr / c->fs_hz;
 
   alg_t ahat; /* 2.3 kB: the only scratch */
-  build_generator(m, wn1, wn2, ahat);
+  build_generator(c, wr, wn1, wn2, ahat);
   for (int i = 0; i < MECH_NMONO; i++)
     for (int r = 0; r < MECH_NS; r++)
       for (int q = 0; q < NA; q++) ahat[i][r][q] *= h;
-  if (alg_exp(ahat, m->blk) != 0) return -2;
+  return alg_exp(ahat, blk) != 0 ? -2 : 0;
+}
 
+/* Re-discretise at temp_k; m unchanged on failure. */
+static int discretise(mech_t *m, double temp_k)
+{
+  if (discretise_blocks(&m->cfg, m->wr, temp_k, m->blk) != 0) return -2;
   m->temp_disc_k = temp_k;
   m->eps = 0.0;
   m->q_valid = 0;
@@ -255,18 +258,28 @@ static void update_noise(mech_t *m)
 int mech_init(mech_t *m, const mech_cfg_t *cfg, double temp_k, uint64_t seed)
 {
   if (m == NULL || mech_cfg_check(cfg, NULL) != 0 || !temp_ok(cfg, temp_k)) return -1;
-  mech_t tmp;
-  memset(&tmp, 0, sizeof(tmp));
-  tmp.cfg = *cfg;
-  tmp.wr = 2.0 * kPi * cfg->f1_hz;
-  tmp.temp_k = temp_k;
-  if (discretise(&tmp, temp_k) != 0) return -2;
-  tmp.refresh_count = 0;
-  rng_seed(&tmp.rng[0], seed, MECH_RNG_STREAM_DRIVE);
-  rng_seed(&tmp.rng[1], seed, MECH_RNG_STREAM_SENSE);
-  gauss_zig_init(&tmp.zig);
-  update_noise(&tmp);
-  *m = tmp;
+  /* built in place: the only step that can fail (the exponential) writes m->blk alone
+   * and only on success; cfg is copied first in case it lives inside m */
+  const mech_cfg_t c = *cfg;
+  const double wr = 2.0 * kPi * c.f1_hz;
+  if (discretise_blocks(&c, wr, temp_k, m->blk) != 0) return -2;
+  m->cfg = c;
+  m->wr = wr;
+  m->temp_k = temp_k;
+  m->temp_disc_k = temp_k;
+  m->eps = 0.0;
+  memset(m->q, 0, sizeof m->q);
+  memset(m->qmax, 0, sizeof m->qmax);
+  memset(m->k, 0, sizeof m->k);
+  m->coef[0] = m->coef[1] = 0.0;
+  m->q_valid = 0;
+  m->k_valid = 0;
+  memset(m->z, 0, sizeof m->z);
+  m->refresh_count = 0;
+  rng_seed(&m->rng[0], seed, MECH_RNG_STREAM_DRIVE);
+  rng_seed(&m->rng[1], seed, MECH_RNG_STREAM_SENSE);
+  gauss_zig_init(&m->zig);
+  update_noise(m);
   return 0;
 }
 

@@ -123,10 +123,10 @@ static int phase_ok(const pickoff_cfg_t *c, double phi)
   return isfinite(phi) && phi > 1e-4 && phi < hi;
 }
 
-/* Build the chain at phase phi and discretise it into p (n, phi, g, output rows). */
-static int discretise(pickoff_t *p, double phi)
+/* Build the chain of c at phase phi and discretise it into p (n, phi, g, output rows,
+ * phi_rad). The only failure (the exponential) comes before the first write to p. */
+static int discretise(pickoff_t *p, const pickoff_cfg_t *c, double phi)
 {
-  const pickoff_cfg_t *c = &p->cfg;
   const double T = 1.0 / c->fs_hz;
   const double wref = 2.0 * k_pi * c->lag_ref_hz;
   ss_t chain, sec;
@@ -243,19 +243,24 @@ int pickoff_init(pickoff_t *p, const pickoff_cfg_t *cfg, double temp_k, uint64_t
   if (p == NULL || cfg == NULL || !cfg_ok(cfg) || !isfinite(temp_k)) return -1;
   const double phi = phase_at(cfg, temp_k);
   if (!phase_ok(cfg, phi)) return -1;
-  pickoff_t t;
-  memset(&t, 0, sizeof t);
-  t.cfg = *cfg;
-  if (discretise(&t, phi) != 0) return -1;
-  t.temp_k = temp_k;
-  t.t_s = 1.0 / cfg->fs_hz;
-  t.inv_t = cfg->fs_hz;
-  t.gain_now = cfg->gain_v_per_m * (1.0 + cfg->gain_tc_per_k * (temp_k - cfg->temp_ref_k));
-  t.noise_sd = cfg->noise_v_rthz * sqrt(cfg->fs_hz / 2.0);
-  gauss_zig_init(&t.zig);
-  rng_seed(&t.rng_noise, seed, PICKOFF_RNG_STREAM_NOISE + (uint64_t)cfg->axis);
-  rng_seed(&t.rng_jitter, seed, PICKOFF_RNG_STREAM_JITTER + (uint64_t)cfg->axis);
-  *p = t;
+  /* built in place: discretise fails (if ever) before it writes; cfg is copied first in
+   * case it lives inside p */
+  const pickoff_cfg_t c = *cfg;
+  if (discretise(p, &c, phi) != 0) return -1;
+  p->cfg = c;
+  p->t_s = 1.0 / c.fs_hz;
+  p->inv_t = c.fs_hz;
+  p->temp_k = temp_k;
+  p->rediscretise_count = 0;
+  p->gain_now = c.gain_v_per_m * (1.0 + c.gain_tc_per_k * (temp_k - c.temp_ref_k));
+  memset(p->z, 0, sizeof p->z);
+  p->s_prev = 0.0;
+  p->m_prev = 0.0;
+  p->noise_sd = c.noise_v_rthz * sqrt(c.fs_hz / 2.0);
+  rng_seed(&p->rng_noise, seed, PICKOFF_RNG_STREAM_NOISE + (uint64_t)c.axis);
+  rng_seed(&p->rng_jitter, seed, PICKOFF_RNG_STREAM_JITTER + (uint64_t)c.axis);
+  gauss_zig_init(&p->zig);
+  p->preamp_clip_count = 0;
   return 0;
 }
 
@@ -265,10 +270,8 @@ int pickoff_set_temp(pickoff_t *p, double temp_k)
   const double phi = phase_at(&p->cfg, temp_k);
   if (!phase_ok(&p->cfg, phi)) return -1;
   if (fabs(phi - p->phi_rad) >= p->cfg.phase_step_rad) {
-    pickoff_t t = *p;
-    if (discretise(&t, phi) != 0) return -1;
-    t.rediscretise_count++;
-    *p = t;
+    if (discretise(p, &p->cfg, phi) != 0) return -1; /* p unchanged then */
+    p->rediscretise_count++;
   }
   p->temp_k = temp_k;
   p->gain_now = p->cfg.gain_v_per_m * (1.0 + p->cfg.gain_tc_per_k * (temp_k - p->cfg.temp_ref_k));

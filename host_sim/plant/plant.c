@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -187,67 +188,70 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
     memcpy(p->err, msg, sizeof msg);
     return -1;
   }
-  /* build into a scratch plant: p changes only on success (besides p->err) */
-  plant_t n;
-  memset(&n, 0, sizeof n);
-  n.cfg = *cfg;
-  n.T = 1.0 / cfg->fs_hz;
-  n.thermal_every = thermal_every(cfg);
+  /* Built in place (a scratch plant_t would be 28 kB of stack on the target): from
+   * here on only a module rejecting a configuration that plant_cfg_check passed can
+   * fail, and the plant is then left zeroed (see plant.h). cfg may be &p->cfg. */
+  if (cfg != &p->cfg) p->cfg = *cfg;
+  const plant_cfg_t *c = &p->cfg;
+  memset(&p->prof, 0, offsetof(plant_t, err) - offsetof(plant_t, prof));
+  p->T = 1.0 / c->fs_hz;
+  p->thermal_every = thermal_every(c);
   const char *what = NULL;
 
   thermal_cfg_t thc;
-  make_thermal_cfg(cfg, &thc);
+  make_thermal_cfg(c, &thc);
   mech_cfg_t mc;
-  make_mech_cfg(cfg, &mc);
+  make_mech_cfg(c, &mc);
   dac_cfg_t dc;
-  make_dac_cfg(cfg, &dc);
+  make_dac_cfg(c, &dc);
   actuator_cfg_t ac;
-  make_actuator_cfg(cfg, &ac);
+  make_actuator_cfg(c, &ac);
   pickoff_cfg_t pc[2];
-  make_pickoff_cfg(cfg, 0, &pc[0]);
-  make_pickoff_cfg(cfg, 1, &pc[1]);
+  make_pickoff_cfg(c, 0, &pc[0]);
+  make_pickoff_cfg(c, 1, &pc[1]);
   adc_cfg_t adcc;
   adc_default_cfg(&adcc);
-  adcc.full_scale_v = cfg->adc_full_scale_v;
+  adcc.full_scale_v = c->adc_full_scale_v;
   accel_cfg_t gc;
-  make_accel_cfg(cfg, &gc);
+  make_accel_cfg(c, &gc);
 
-  if (thermal_init(&n.thermal, &thc, cfg->temp_k) != 0) what = "thermal (tau_*, couple_*, rise_*)";
-  else if (mech_init(&n.mech, &mc, thermal_temp(&n.thermal, THERMAL_STRUCT), seed) != 0)
+  if (thermal_init(&p->thermal, &thc, c->temp_k) != 0) what = "thermal (tau_*, couple_*, rise_*)";
+  else if (mech_init(&p->mech, &mc, thermal_temp(&p->thermal, THERMAL_STRUCT), seed) != 0)
     what = "mechanics (f_*_hz, q_*, ket_per_k, temp_k)";
-  else if (dac_init(&n.dac, &dc) != 0) what = "DAC (dac_*)";
-  else if (actuator_init(&n.act, &ac, seed) != 0) what = "actuator (ks_*, *_noise_*, fb_*)";
-  else if (adc_init(&n.adc, &adcc) != 0) what = "ADC (adc_full_scale_v)";
-  else if (accel_init(&n.accel, &gc) != 0) what = "g-sensitivity (gs_*)";
+  else if (dac_init(&p->dac, &dc) != 0) what = "DAC (dac_*)";
+  else if (actuator_init(&p->act, &ac, seed) != 0) what = "actuator (ks_*, *_noise_*, fb_*)";
+  else if (adc_init(&p->adc, &adcc) != 0) what = "ADC (adc_full_scale_v)";
+  else if (accel_init(&p->accel, &gc) != 0) what = "g-sensitivity (gs_*)";
   for (int i = 0; what == NULL && i < 2; i++) {
-    if (pickoff_init(&n.pick[i], &pc[i], thermal_temp(&n.thermal, pick_node(cfg, i)), seed) != 0)
+    if (pickoff_init(&p->pick[i], &pc[i], thermal_temp(&p->thermal, pick_node(c, i)), seed) != 0)
       what = i == 0 ? "drive pickoff (pick_drive_*: phase law at this temperature?)"
                     : "sense pickoff (pick_sense_*: phase law at this temperature?)";
   }
   if (what != NULL) {
+    memset(p, 0, offsetof(plant_t, err));
     set_err(p, "plant_init: %s rejected the configuration", what);
     return -2;
   }
 
-  profile_const(&n.prof.rate_dps, cfg->rate_dps);
-  profile_const(&n.prof.ambient_k, cfg->temp_k);
-  accel_profile_zero(&n.prof.accel_g);
-  accel_flags(&n);
+  profile_const(&p->prof.rate_dps, c->rate_dps);
+  profile_const(&p->prof.ambient_k, c->temp_k);
+  accel_profile_zero(&p->prof.accel_g);
+  accel_flags(p);
 
   /* truth at t = 0 */
-  n.est_alpha = 1.0 - exp(-n.T / cfg->truth_tau_s);
-  const double wt = 2.0 * kPi * cfg->f_drive_hz * n.T;
-  n.est_num = 2.0 * cos(wt); /* prior: the nominal drive frequency, weight of one */
-  n.est_den = 2.0;
-  n.truth.drive_freq_hz = cfg->f_drive_hz;
-  n.cw = cos(wt);
-  n.sw = sin(wt);
-  n.inv_sw = 1.0 / n.sw;
-  n.thermal_countdown = 0; /* first update at the first sample */
-  n.truth_countdown = cfg->truth_decim;
-  n.fz_alpha = 1.0 - exp(-n.T / cfg->truth_force_tau_s);
-  truth_temps(&n, cfg->temp_k);
-  *p = n;
+  p->est_alpha = 1.0 - exp(-p->T / c->truth_tau_s);
+  const double wt = 2.0 * kPi * c->f_drive_hz * p->T;
+  p->est_num = 2.0 * cos(wt); /* prior: the nominal drive frequency, weight of one */
+  p->est_den = 2.0;
+  p->truth.drive_freq_hz = c->f_drive_hz;
+  p->cw = cos(wt);
+  p->sw = sin(wt);
+  p->inv_sw = 1.0 / p->sw;
+  p->thermal_countdown = 0; /* first update at the first sample */
+  p->truth_countdown = c->truth_decim;
+  p->fz_alpha = 1.0 - exp(-p->T / c->truth_force_tau_s);
+  truth_temps(p, c->temp_k);
+  p->err[0] = '\0';
   return 0;
 }
 

@@ -245,8 +245,12 @@ int plant_cfg_check(const plant_cfg_t *cfg, char *errbuf, size_t errlen);
 
 /* Validates and builds every module at the start of a run: thermal nodes settled at
  * the ambient temp_k, converters at mid-scale, motion at rest, constant profiles from
- * rate_dps and temp_k. Returns 0; or -1 (bad cfg) / -2 (a module refused it) with the
- * reason in plant_error(p) and nothing else in p changed. */
+ * rate_dps and temp_k. Returns 0; or -1 (bad cfg: plant_cfg_check) with the reason in
+ * plant_error(p) and nothing else in p changed; or -2 if a module refused a cfg that
+ * plant_cfg_check passed (a gap in the checks, not expected), reason in plant_error(p)
+ * and p zeroed (not usable until a successful plant_init). The plant is built in
+ * place, without a scratch copy on the stack (a target has little of it); cfg may be
+ * &p->cfg. */
 int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed);
 const char *plant_error(const plant_t *p);
 

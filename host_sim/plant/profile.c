@@ -12,7 +12,9 @@ static const char *const kKindNames[PROFILE_NKINDS] = {"const", "steps", "sine",
 
 const char *profile_kind_name(profile_kind_t kind)
 {
-  if ((int)kind < 0 || (int)kind >= PROFILE_NKINDS) return "?";
+  /* unsigned: also rejects negatives, and stays meaningful where the enum is a short
+   * unsigned type (arm-none-eabi) */
+  if ((unsigned)kind >= (unsigned)PROFILE_NKINDS) return "?";
   return kKindNames[kind];
 }
 
@@ -116,7 +118,7 @@ int profile_check(const profile_t *p, const char **key)
       "step_value[60]", "step_value[61]", "step_value[62]", "step_value[63]"};
   const char *bad = NULL;
   if (p == NULL) bad = "profile";
-  else if ((int)p->kind < 0 || (int)p->kind >= PROFILE_NKINDS) bad = "kind";
+  else if ((unsigned)p->kind >= (unsigned)PROFILE_NKINDS) bad = "kind";
   else if (!fin(p->value)) bad = "value";
   else if (p->kind == PROFILE_SINE) {
     if (!fin(p->amp)) bad = "amp";
