@@ -31,6 +31,9 @@
 #include "stm32f4_sample.h"
 #include "stm32f4_stack.h"
 #include "stm32f4_uart.h"
+#ifdef STM32F4_QEMU
+#include "stm32f4_qemu.h"
+#endif
 #ifdef STM32F4_QEMU_PLANT
 #include "main_board_emu.h"
 #endif
@@ -111,6 +114,7 @@ int main(void)
     app_poll(a);
 #ifdef STM32F4_QEMU
     stm32f4_uart_poll_tx();
+    stm32f4_qemu_idle(); /* fewer register polls per emulated instruction (stm32f4_qemu.h) */
 #endif
     stm32f4_iwdg_kick();
 #ifndef STM32F4_QEMU

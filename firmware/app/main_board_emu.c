@@ -69,6 +69,18 @@ static void emu_rate(cli_t *cli, const char *arg)
   cli_emit_ok(cli);
 }
 
+static void emu_stretch(cli_t *cli, const char *arg)
+{
+  uint32_t n;
+  if (numparse_u32(arg, strlen(arg), &n) != NUMPARSE_OK || stm32f4_qemu_set_stretch(n) != 0) {
+    cli_err(cli, "RANGE", "stretch N: 1..4993 sample periods per tick");
+    return;
+  }
+  cli_put(cli, "stretch ");
+  cli_put_u32(cli, n);
+  cli_emit_ok(cli);
+}
+
 static void emu_trace(cli_t *cli, const char *arg)
 {
   uint32_t from;
@@ -95,10 +107,12 @@ static void cmd_emu(cli_t *cli, void *ctx, uint32_t argc, const char *const *arg
     emu_figures(cli);
   } else if (argc == 3u && strcmp(argv[1], "rate") == 0) {
     emu_rate(cli, argv[2]);
+  } else if (argc == 3u && strcmp(argv[1], "stretch") == 0) {
+    emu_stretch(cli, argv[2]);
   } else if (argc == 3u && strcmp(argv[1], "trace") == 0) {
     emu_trace(cli, argv[2]);
   } else {
-    cli_err(cli, "ARGS", "usage: emu | emu rate DPS | emu trace FROM");
+    cli_err(cli, "ARGS", "usage: emu | emu rate DPS | emu stretch N | emu trace FROM");
   }
 }
 
@@ -106,7 +120,7 @@ static cli_cmd_t s_emu_cmd; /* the CLI keeps rows by pointer */
 
 int main_board_emu_init(app_t *a)
 {
-  const cli_cmd_t row = {"emu", "[rate DPS | trace FROM]",
+  const cli_cmd_t row = {"emu", "[rate DPS | stretch N | trace FROM]",
                          "emulator: tick and plant figures, input rate, rate trace", cmd_emu,
                          NULL};
   s_emu_cmd = row;

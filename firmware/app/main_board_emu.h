@@ -6,6 +6,8 @@
  *                         stm32f4_qemu.h), plant_rate_dps, trace n/len/every   ok emu
  *   emu rate DPS        ok rate DPS: move the plant's input rate to DPS (a 10 ms
  *                         rate-table ramp from the next tick); err VALUE / RANGE / BUSY
+ *   emu stretch N       ok stretch N: SysTick period of N sample periods from the next
+ *                         tick (stm32f4_qemu_set_stretch); err RANGE
  *   emu trace FROM      - I VALUE for up to 16 entries of the rate-output trace from
  *                         index FROM (qemu_plant_setup.h), ok trace N; err ARGS/RANGE
  * and the plant in place of the converters (hal/stm32f4/qemu/stm32f4_qemu_plant.h). */

@@ -15,7 +15,11 @@ CASE
            trace, `emu trace`) against the host twin's (tests/qemu/fw_qemu_twin.c: the
            same application, plant, seed and rate step through the host HAL): every
            entry within EQUIV_REL of the larger of |host| and the applied step; reports
-           how many entries are bit-identical.
+           how many entries are bit-identical. The trace is indexed by tick, not by
+           time, so this case runs for speed and exact counts: -icount shift=0 (1 ns of
+           emulated time per instruction) and `emu stretch EQUIV_STRETCH` (a period of
+           100000 instructions, above the ISR and plant's worst tick), and prints the
+           instructions per tick of the ISR without the plant and of the plant.
   gyroctl  tools/gyroctl over socket://127.0.0.1:PORT: get, set (and the effect of a
            bias change on the rate output), log (a short telemetry stream decoded to
            CSV), save (QEMU models no flash programming: the image must answer
@@ -40,6 +44,8 @@ RATE_TOL_DPS = 0.5     # bias and noise of a 1 s mean, with margin
 RATE_TOL_REL = 0.005   # scale-factor error of the default calibration, with margin
 SF_TOL = 0.005
 EQUIV_REL = 1e-4
+EQUIV_STRETCH = 3      # x 20000 instructions per tick under -icount shift=0
+ICOUNT = {"boot": "auto", "equiv": "0", "gyroctl": "auto"}
 STEP_DPS = 100.0       # hal/stm32f4/qemu/qemu_plant_setup.h QEMU_PLANT_STEP_DPS
 TRACE_LEN = 1000       # QEMU_TRACE_LEN
 TRACE_EVERY = 100      # QEMU_TRACE_EVERY
@@ -134,6 +140,8 @@ def case_equiv(emu, args):
     check(host.returncode == 0, f"host twin ran ({host.stderr.strip()})")
     hv = [float(ln.split(" ")[1]) for ln in host.stdout.splitlines() if not ln.startswith("mode")]
     check(len(hv) == TRACE_LEN, f"host trace has {len(hv)} entries")
+    r = emu.command(f"emu stretch {EQUIV_STRETCH}")
+    check(r.ok, f"emu stretch {EQUIV_STRETCH} ({r.final})")
     t_end = time.monotonic() + 120.0
     while int(emu.emu()["trace_n"]) < TRACE_LEN and time.monotonic() < t_end:
         time.sleep(0.5)
@@ -219,14 +227,14 @@ def main():
     ap.add_argument("--elf", required=True)
     ap.add_argument("--twin")
     ap.add_argument("--gyroctl", default=os.path.join(ROOT, "tools", "gyroctl"))
-    ap.add_argument("--icount", default="auto")
+    ap.add_argument("--icount", default=None, help="QEMU -icount shift (default: per case)")
     args = ap.parse_args()
     if not os.path.isfile(args.elf):
         print(f"SKIP: {args.elf} not built (cmake --workflow --preset target first)")
         return SKIP
     t0 = time.monotonic()
     try:
-        with Emulator(args.qemu, args.elf, icount=args.icount) as emu:
+        with Emulator(args.qemu, args.elf, icount=args.icount or ICOUNT[args.case]) as emu:
             print(f"     booted in {emu.boot_s:.1f} s (plant and loop design on the target)")
             {"boot": case_boot, "equiv": case_equiv, "gyroctl": case_gyroctl}[args.case](emu, args)
     except SystemExit:

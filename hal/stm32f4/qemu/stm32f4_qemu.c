@@ -26,17 +26,21 @@
 #include "stm32f4_core.h"
 #include "stm32f4_dac.h"
 #include "stm32f4_fault.h"
+#include "stm32f4_qemu.h"
 #include "stm32f4_sample.h"
 #include "stm32f4_uart.h"
 #include "stm32f4_uptime.h"
 #ifdef STM32F4_QEMU_PLANT
-#include "stm32f4_qemu.h"
 #include "stm32f4_qemu_plant.h"
 #endif
 
 #ifndef STM32F4_QEMU_TICK_STRETCH
 #define STM32F4_QEMU_TICK_STRETCH 1u
 #endif
+
+/* Turns of the background loop's pause (stm32f4_qemu_idle): a few thousand
+ * instructions between two passes over the UART and watchdog registers. */
+#define STM32F4_QEMU_IDLE_SPINS 2000u
 
 #define QEMU_SYSCLK_HZ 168000000u
 #define QEMU_TIM_HZ 1000000000u /* QEMU's STM32 timer model counts its input at 1 GHz */
@@ -49,8 +53,10 @@ static volatile uint32_t s_wraps;
 static volatile uint32_t s_ticks;
 #ifdef STM32F4_QEMU_PLANT
 static stm32f4_qemu_tick_stats_t s_tick;
-static uint32_t s_t_prev_ns;  /* TIM2 at the previous handler entry */
-static uint64_t s_elapsed_ns; /* from the first handler entry to the latest */
+static uint32_t s_t_prev_ns;    /* TIM2 at the previous handler entry */
+static uint32_t s_cycles_per_sample; /* 168 MHz / rate_hz */
+static uint32_t s_ns_per_sample;     /* 1e9 / rate_hz */
+static uint32_t s_lost_skip;         /* ticks after a stretch change: periods mixed */
 #else
 static hal_dac_frame_t s_dac;
 #endif
@@ -100,7 +106,9 @@ int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
   s_tick = (stm32f4_qemu_tick_stats_t){0};
   s_tick.stretch = STM32F4_QEMU_TICK_STRETCH;
   s_tick.period_ns = 1000000000u / rate_hz * STM32F4_QEMU_TICK_STRETCH;
-  s_elapsed_ns = 0u;
+  s_cycles_per_sample = QEMU_SYSCLK_HZ / rate_hz;
+  s_ns_per_sample = 1000000000u / rate_hz;
+  s_lost_skip = 0u;
 #endif
   SCB->SHPR[SYSTICK_SHPR_INDEX] = (uint8_t)(STM32F4_PRIO_SAMPLE << 4);
   SYSTICK->LOAD = QEMU_SYSCLK_HZ / rate_hz * STM32F4_QEMU_TICK_STRETCH - 1u;
@@ -128,11 +136,15 @@ STM32F4_RAMFUNC void SysTick_Handler(void)
   const uint32_t t2 = TIM2->CNT;
 
   stm32f4_qemu_tick_stats_t *st = &s_tick;
-  if (st->ticks > 0u) s_elapsed_ns += t0 - s_t_prev_ns; /* < 4.3 s between ticks */
+  if (s_lost_skip > 0u) {
+    s_lost_skip--;
+  } else if (st->ticks > 0u) {
+    /* Whole periods since the previous tick (< 4.3 s apart): more than one were lost. */
+    const uint32_t periods = (t0 - s_t_prev_ns + st->period_ns / 2u) / st->period_ns;
+    if (periods > 1u) st->lost += periods - 1u;
+  }
   s_t_prev_ns = t0;
   st->ticks++;
-  const uint64_t periods = (s_elapsed_ns + st->period_ns / 2u) / st->period_ns;
-  st->lost = (uint32_t)(periods + 1u - st->ticks);
   if ((SYSTICK->CTRL & SYSTICK_CTRL_COUNTFLAG) != 0u) st->overruns++;
   st->isr_ns_last = t1 - t0;
   st->plant_ns_last = t2 - t1;
@@ -149,6 +161,22 @@ void stm32f4_qemu_tick_stats(stm32f4_qemu_tick_stats_t *s)
   *s = s_tick;
   hal_critical_exit(pm);
 }
+
+int stm32f4_qemu_set_stretch(uint32_t stretch)
+{
+  if (s_cycles_per_sample == 0u || stretch == 0u ||
+      stretch > 0x1000000u / s_cycles_per_sample) {
+    return -1;
+  }
+  const uint32_t pm = hal_critical_enter();
+  /* Taken at the next reload: the period running now keeps its length. */
+  SYSTICK->LOAD = s_cycles_per_sample * stretch - 1u;
+  s_tick.stretch = stretch;
+  s_tick.period_ns = s_ns_per_sample * stretch;
+  s_lost_skip = 2u;
+  hal_critical_exit(pm);
+  return 0;
+}
 #else
 STM32F4_RAMFUNC void SysTick_Handler(void)
 {
@@ -157,6 +185,13 @@ STM32F4_RAMFUNC void SysTick_Handler(void)
   if (s_isr != 0) s_isr(s_ctx);
 }
 #endif
+
+void stm32f4_qemu_idle(void)
+{
+  for (uint32_t i = 0u; i < STM32F4_QEMU_IDLE_SPINS; ++i) {
+    __asm volatile("" ::: "memory");
+  }
+}
 
 STM32F4_RAMFUNC uint32_t hal_cycles_now(void)
 {

@@ -1,4 +1,4 @@
-/* Figures of the emulator image's sample clock (gyro-fw-qemu: SysTick, stretched by
+/* The emulator board's own controls, and the figures of the emulator image's sample clock (gyro-fw-qemu: SysTick, stretched by
  * STM32F4_QEMU_TICK_STRETCH, with the plant stepped after the application's ISR).
  *
  * Times are emulated nanoseconds from TIM2 counting QEMU's 1 GHz timer input undivided
@@ -34,5 +34,20 @@ typedef struct {
 
 /* A consistent copy (taken with the sample interrupt masked). */
 void stm32f4_qemu_tick_stats(stm32f4_qemu_tick_stats_t *s);
+
+/* Change the stretch while the sample clock runs (from the next period on): 1 .. 4993
+ * (SysTick's 24-bit reload). The firmware and the plant still advance one sample per
+ * tick; only the emulated time between ticks changes. Returns 0, or -1 (out of range,
+ * or the sample clock not started). */
+int stm32f4_qemu_set_stretch(uint32_t stretch);
+
+/* The emulator's background loop pauses here between passes (both QEMU images): under
+ * -icount every access to a peripheral register ends QEMU's translation block and is
+ * executed again on its own, so a loop that polls registers back to back runs more than
+ * ten times slower per instruction than ordinary code, and -icount shift=auto then
+ * stretches every instruction's emulated time to match (measured: 297 ticks/s against
+ * 4016 with the pause, -icount shift=4, stretch 64). A spin of a few thousand register-only
+ * instructions keeps the UART answering within microseconds of emulated time. */
+void stm32f4_qemu_idle(void);
 
 #endif /* STM32F4_QEMU_H */
