@@ -40,13 +40,16 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from fw_qemu import ROOT, SKIP, Emulator  # noqa: E402
 
 FS_HZ = 50000
-RATE_TOL_DPS = 0.5     # bias and noise of a 1 s mean, with margin
+RATE_TOL_DPS = 0.5     # bias and noise of a 0.1 s mean (sd of one reading ~0.06), with margin
 RATE_TOL_REL = 0.005   # scale-factor error of the default calibration, with margin
 SF_TOL = 0.005
 EQUIV_REL = 1e-4
 EQUIV_STRETCH = 3      # x 20000 instructions per tick under -icount shift=0
+AUTO_NS_PER_INSN = 8   # -icount shift=auto settles at shift 3 here (plant_ns / instructions)
+STRETCH_MARGIN = 0.6   # worst tick's share of the period
 ICOUNT = {"boot": "auto", "equiv": "0", "gyroctl": "auto"}
 STEP_DPS = 100.0       # hal/stm32f4/qemu/qemu_plant_setup.h QEMU_PLANT_STEP_DPS
+GYROCTL_RATE_DPS = 80.0
 TRACE_LEN = 1000       # QEMU_TRACE_LEN
 TRACE_EVERY = 100      # QEMU_TRACE_EVERY
 
@@ -101,9 +104,9 @@ def case_boot(emu, args):
     for rate in (60.0, -120.0):
         r = emu.command(f"emu rate {rate:g}")
         check(r.ok, f"emu rate {rate:g} accepted ({r.final})")
-        emu.wait_ticks(FS_HZ // 5)  # 0.2 s: the 100 Hz output filter and the 10 ms ramp
+        emu.wait_ticks(FS_HZ // 20)  # 50 ms: the 10 ms ramp and the 100 Hz output filter
         applied = float(emu.emu()["plant_rate_dps"])
-        m, sd = mean_rate(emu, FS_HZ // 2)
+        m, sd = mean_rate(emu, FS_HZ // 10, reads=5)
         tol = RATE_TOL_DPS + RATE_TOL_REL * abs(rate)
         check(abs(applied - rate) < 1e-6, f"plant applies {applied:g} deg/s")
         check(abs(m - rate) <= tol, f"rate output {m:.4f} deg/s (sd {sd:.4f}) for {rate:g} "
@@ -114,8 +117,12 @@ def case_boot(emu, args):
     check(emu.command("emu rate 1e6").final.startswith("err RANGE"), "emu rate 1e6 refused")
     st, em = print_figures(emu)
     check(st["mode"] == "LOCKED" and st["fault_count"] == "0", "still locked, no fault")
-    check(em["tick_overruns"] == "0" and em["ticks_lost"] == "0" and st["tick_overruns"] == "0",
-          "no tick overrun or lost")
+    # Under -icount shift=auto emulated time follows the host's pace: a loaded host can
+    # delay a tick past the next one. Counted and shown, not judged here (that would make
+    # the test depend on the machine's load); the equiv case checks the stretch's margin
+    # on the deterministic instruction counts.
+    print(f"     note: {em['tick_overruns']} ticks overran, {em['ticks_lost']} periods lost "
+          f"of {em['ticks']} (stretch {em['stretch']}; 0 expected on an unloaded host)")
 
 
 def read_trace(emu):
@@ -140,13 +147,26 @@ def case_equiv(emu, args):
     check(host.returncode == 0, f"host twin ran ({host.stderr.strip()})")
     hv = [float(ln.split(" ")[1]) for ln in host.stdout.splitlines() if not ln.startswith("mode")]
     check(len(hv) == TRACE_LEN, f"host trace has {len(hv)} entries")
+    stretch0 = int(emu.emu()["stretch"])  # the image's default, for shift=auto
     r = emu.command(f"emu stretch {EQUIV_STRETCH}")
     check(r.ok, f"emu stretch {EQUIV_STRETCH} ({r.final})")
     t_end = time.monotonic() + 120.0
     while int(emu.emu()["trace_n"]) < TRACE_LEN and time.monotonic() < t_end:
         time.sleep(0.5)
     ev = read_trace(emu)
-    print_figures(emu)
+    _, em = print_figures(emu)
+    # shift=0: the figures are instructions. The default stretch must leave the worst
+    # tick well inside its period at the pace shift=auto settles to on this class of
+    # host (2^3 ns per instruction measured, hal/stm32f4/README.md): a deterministic
+    # check of the margin, where the boot case can only count late ticks.
+    worst = int(em["isr_ns_max"]) + int(em["plant_ns_max"])
+    period_insn = stretch0 * 20000 // AUTO_NS_PER_INSN
+    print(f"     per tick: ISR without the plant {float(em['isr_ns_mean']):.1f} instructions "
+          f"mean, {em['isr_ns_max']} max; plant {float(em['plant_ns_mean']):.0f} mean, "
+          f"{em['plant_ns_max']} max")
+    check(worst <= STRETCH_MARGIN * period_insn,
+          f"worst tick {worst} instructions <= {STRETCH_MARGIN:g} x the {period_insn} of a "
+          f"stretch-{stretch0} period at {AUTO_NS_PER_INSN} ns per instruction")
     if len(hv) != TRACE_LEN:
         return
     import numpy as np
@@ -178,6 +198,7 @@ def gyroctl(args, port, *cmd, timeout=60):
 def case_gyroctl(emu, args):
     st = wait_locked(emu, 60.0)
     check(st["mode"] == "LOCKED", f"drive locks before the session (mode {st['mode']})")
+    check(emu.command(f"emu rate {GYROCTL_RATE_DPS:g}").ok, f"emu rate {GYROCTL_RATE_DPS:g}")
     emu.link.close()  # gyroctl connects on its own (QEMU serves one client at a time)
     port = emu.url
     p = gyroctl(args, port, "get", "rate.bias_c0_dps")
@@ -204,10 +225,9 @@ def case_gyroctl(emu, args):
         if rows:
             col = next(c for c in rows[0] if c.startswith("rate"))
             m = statistics.fmean(float(r[col]) for r in rows)
-            # the compiled-in step has brought the input to 100 deg/s by now; the bias
-            # of 2.5 is subtracted (rate_channel.c)
-            check(abs(m - (STEP_DPS - 2.5)) < 1.0,
-                  f"streamed rate {m:.3f} deg/s = {STEP_DPS:g} applied - 2.5 bias")
+            # the bias of 2.5 is subtracted (rate_channel.c)
+            check(abs(m - (GYROCTL_RATE_DPS - 2.5)) < 1.0,
+                  f"streamed rate {m:.3f} deg/s = {GYROCTL_RATE_DPS:g} applied - 2.5 bias")
 
     p = gyroctl(args, port, "save")
     check(p.returncode == 1 and "BUSY" in p.stderr, "save refused while the drive runs")
