@@ -45,9 +45,10 @@ int stm32f4_qemu_set_stretch(uint32_t stretch);
  * -icount every access to a peripheral register ends QEMU's translation block and is
  * executed again on its own, so a loop that polls registers back to back runs more than
  * ten times slower per instruction than ordinary code, and -icount shift=auto then
- * stretches every instruction's emulated time to match (measured: 297 ticks/s against
- * 4016 with the pause, -icount shift=4, stretch 64). A spin of a few thousand register-only
- * instructions keeps the UART answering within microseconds of emulated time. */
+ * stretches every instruction's emulated time to match (measured at -icount shift=4,
+ * stretch 64: 297 ticks/s without the pause, 1450-4016 with it, hal/stm32f4/README.md).
+ * A spin of a few thousand register-free instructions keeps the UART answering within
+ * microseconds of emulated time. */
 void stm32f4_qemu_idle(void);
 
 #endif /* STM32F4_QEMU_H */
