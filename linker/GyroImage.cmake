@@ -8,6 +8,9 @@
 # followed by flash / SRAM / CCM used vs available (linker/image_size.cmake).
 # Compiler and linker warnings are errors.
 set(GYRO_DEFAULT_LINKER_SCRIPT ${CMAKE_CURRENT_LIST_DIR}/stm32f405.ld)
+# Images that run in QEMU's netduinoplus2 (no CCM there: stm32f405_qemu.ld).
+set(GYRO_QEMU_LINKER_SCRIPT ${CMAKE_CURRENT_LIST_DIR}/stm32f405_qemu.ld)
+set(GYRO_LINKER_SECTIONS ${CMAKE_CURRENT_LIST_DIR}/stm32f405_sections.ld)
 set(GYRO_IMAGE_SIZE_SCRIPT ${CMAKE_CURRENT_LIST_DIR}/image_size.cmake)
 
 function(gyro_add_image name)
@@ -19,11 +22,13 @@ function(gyro_add_image name)
     set(IMG_LINKER_SCRIPT ${GYRO_DEFAULT_LINKER_SCRIPT})
   endif()
   add_executable(${name} ${IMG_SOURCES})
-  set_target_properties(${name} PROPERTIES SUFFIX ".elf" LINK_DEPENDS ${IMG_LINKER_SCRIPT})
+  set_target_properties(${name} PROPERTIES SUFFIX ".elf"
+    LINK_DEPENDS "${IMG_LINKER_SCRIPT};${GYRO_LINKER_SECTIONS}")
   target_link_libraries(${name} PRIVATE ${IMG_LIBS})
   gyro_strict_warnings(${name})
   target_link_options(${name} PRIVATE
     -T${IMG_LINKER_SCRIPT}
+    -L${CMAKE_CURRENT_FUNCTION_LIST_DIR}
     -Wl,-Map=${CMAKE_CURRENT_BINARY_DIR}/${name}.map,--cref
     -Wl,--print-memory-usage
     -Wl,--fatal-warnings

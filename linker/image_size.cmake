@@ -1,6 +1,7 @@
 # Size report of one image: cmake -DELF=<elf> -DSIZE_TOOL=<arm-none-eabi-size> -DNAME=<n>
 #   -P image_size.cmake
-# Sums the sections of `size -A` by region (address ranges of linker/stm32f405.ld); the
+# Sums the sections of `size -A` by region (address ranges of linker/stm32f405.ld, the
+# CCM sections by name: stm32f405_qemu.ld puts them at the top of QEMU's SRAM); the
 # load images of .data, .ramfunc and .ccm_data count against flash as well.
 execute_process(COMMAND ${SIZE_TOOL} -A -d ${ELF} OUTPUT_VARIABLE out RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
@@ -17,7 +18,9 @@ foreach(line ${lines})
     set(sec ${CMAKE_MATCH_1})
     set(sz ${CMAKE_MATCH_2})
     set(addr ${CMAKE_MATCH_3})
-    if(addr GREATER_EQUAL 134217728 AND addr LESS 134234112)        # 0x08000000 + 16K
+    if(sec STREQUAL ".ccm_data" OR sec STREQUAL ".ccm_bss")          # CCM (QEMU: top of SRAM)
+      math(EXPR ccm "${ccm} + ${sz}")
+    elseif(addr GREATER_EQUAL 134217728 AND addr LESS 134234112)    # 0x08000000 + 16K
       math(EXPR boot "${boot} + ${sz}")
     elseif(addr GREATER_EQUAL 134234112 AND addr LESS 135266304)    # .. 0x08100000
       math(EXPR flash "${flash} + ${sz}")

@@ -1,6 +1,6 @@
 /* Entry point of the product image gyro-fw. Built with STM32F4_QEMU (the QEMU board
  * layer) it also runs in the emulator as gyro-fw-qemu, the plant model in place of the
- * converters: no WFI, the UART drained from the loop, SRAM instead of CCM.
+ * converters: no WFI, the UART drained from the loop.
  *
  *   boot: Reset_Handler (clock tree, .data/.bss/.ccm) -> main: board (pins, converter
  *   resets, DAC sequencer, UART), app_init (parameters from the flash store, or the
@@ -41,14 +41,9 @@
 #define SAMPLE_RATE_HZ 50000u
 #define WATCHDOG_MS 250u
 
-/* QEMU's netduinoplus2 maps no CCM (a write there is a bus fault): ordinary SRAM. */
-#ifdef STM32F4_QEMU
-#define APP_STATE_RAM
-#else
-#define APP_STATE_RAM STM32F4_CCM_BSS
-#endif
-
-static APP_STATE_RAM app_t s_app;
+/* In QEMU's netduinoplus2, which maps no CCM, the emulator images' memory map
+ * (linker/stm32f405_qemu.ld) puts the CCM sections at the top of its SRAM. */
+static STM32F4_CCM_BSS app_t s_app;
 
 static void say(const char *s)
 {

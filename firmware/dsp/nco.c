@@ -73,12 +73,3 @@ int nco_shift_phase(nco_t *nco, float delta_rad)
   shift_raw(nco, sincos_rad_to_phase(delta_rad));
   return 0;
 }
-
-void nco_step(nco_t *nco, nco_out_t *out)
-{
-  const uint32_t phase = nco->half_phase << 1;
-  out->phase = phase;
-  out->half_phase = nco->half_phase;
-  sincos_lut(phase, &out->sin_wc, &out->cos_wc);
-  nco->half_phase += nco->half_step;
-}

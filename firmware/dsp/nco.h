@@ -25,6 +25,8 @@
 
 #include <stdint.h>
 
+#include "dsp/sincos.h"
+
 typedef struct {
   double freq_hz;   /* wc/(2*pi), 0 <= freq_hz < fs_hz/2 */
   double fs_hz;     /* sample rate, > 0 */
@@ -65,6 +67,13 @@ int nco_set_phase(nco_t *nco, float phase_rad);
 int nco_shift_phase(nco_t *nco, float delta_rad);
 
 /* The oscillator at this sample, then advance by one sample. */
-void nco_step(nco_t *nco, nco_out_t *out);
+static inline void nco_step(nco_t *nco, nco_out_t *out)
+{
+  const uint32_t phase = nco->half_phase << 1;
+  out->phase = phase;
+  out->half_phase = nco->half_phase;
+  sincos_lut(phase, &out->sin_wc, &out->cos_wc);
+  nco->half_phase += nco->half_step;
+}
 
 #endif /* NCO_H */

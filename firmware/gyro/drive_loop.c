@@ -16,9 +16,14 @@ int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t 
     return -1;
   }
   /* Loop phase at crossover wc of the first-order open loop K Kp/(tau s) with the demod
-   * lag and 1.5 samples of delay (DAC latency + ZOH): 90 - atan(wc/wd) - 1.5 wc T. */
+   * lag and the delay of one sample (DAC latency) plus the hold of a loop period N T
+   * (N T / 2): 90 - atan(wc/wd) - (1 + N/2) wc T. */
+  if (!(in->loop_decim >= 0.0) || !(in->loop_decim <= 1000.0)) {
+    return -1;
+  }
+  const double n_hold = in->loop_decim > 1.0 ? in->loop_decim : 1.0;
   const double wd = 2.0 * FM_PI * in->demod_bw_hz;
-  const double delay_s = 1.5 / in->fs_hz;
+  const double delay_s = (1.0 + 0.5 * n_hold) / in->fs_hz;
   double wc = 2.0 * FM_PI * in->bw_hz;
   double pm = 0.0;
   for (int i = 0; i < 60; i++) {
@@ -85,18 +90,28 @@ void drive_loop_reset(drive_loop_t *dl)
   dl->p_rad = dl->p_init_rad;
 }
 
-void drive_loop_step(drive_loop_t *dl, float w_s, float w_c)
+void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c)
 {
   dl->amp_v = fm_sqrtf(w_s * w_s + w_c * w_c);
-  dl->phase_rad = fm_atan2f(w_c, w_s);
   dl->amp_err_v = dl->amp_set_v - dl->amp_v;
+  dl->f_cmd_v2 = pi_step(&dl->amp_pi, dl->amp_err_v);
+}
+
+void drive_loop_step_phase(drive_loop_t *dl, float w_s, float w_c)
+{
+  dl->phase_rad = fm_atan2f(w_c, w_s);
+  dl->phase_err_rad = fm_wrap_pi(dl->phase_set_rad - dl->phase_rad);
   /* While the amplitude is still tiny its phase is noise; hold P until there is a
    * vibration to measure (10 % of the setpoint). */
-  dl->phase_err_rad = fm_wrap_pi(dl->phase_set_rad - dl->phase_rad);
-  dl->f_cmd_v2 = pi_step(&dl->amp_pi, dl->amp_err_v);
   if (dl->amp_v > 0.1f * dl->amp_set_v) {
     dl->p_rad = pi_step(&dl->phase_pi, dl->phase_err_rad);
   } else {
     (void)pi_reset(&dl->phase_pi, dl->p_rad, dl->phase_err_rad);
   }
+}
+
+void drive_loop_step(drive_loop_t *dl, float w_s, float w_c)
+{
+  drive_loop_step_amp(dl, w_s, w_c);
+  drive_loop_step_phase(dl, w_s, w_c);
 }

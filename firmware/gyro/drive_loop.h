@@ -1,4 +1,6 @@
-/* Drive-mode amplitude and phase loops (thesis 6.4), one call per tick.
+/* Drive-mode amplitude and phase loops (thesis 6.4), one call per loop period dt_s
+ * (gyro_tick: once per block of RATE_DECIM samples, 5 kHz; the loops close at tens of
+ * Hz, and the LMSD's few hundred Hz of bandwidth leave nothing at 5 kHz to alias).
  *
  * Measurement: the drive pickoff phasor Z = w_s + j w_c from the drive LMSD (see
  * gyro_cfg.h for the phasor convention). Amplitude |Z| by one VSQRT, phase arg(Z) by
@@ -22,8 +24,9 @@
  * Design (drive_loop_design): with the first-order plant K/(tau s + 1), tau = 2Q/wn
  * (6-12, 6-17), the PI zero is put on the plant pole (Ki/Kp = 1/tau), leaving the
  * open loop K Kp / (tau s): a first-order closed loop of bandwidth wc = K Kp / tau, with
- * no overshoot. The demodulator's lag (a first-order lag of bandwidth lmsd_bw) and the
- * one-sample DAC latency cost phase margin; wc is capped so that at least 60 deg remain.
+ * no overshoot. The demodulator's lag (a first-order lag of bandwidth lmsd_bw), the
+ * one-sample DAC latency and the hold of the command between loop updates (half a loop
+ * period on average) cost phase margin; wc is capped so that at least 60 deg remain.
  */
 #ifndef DRIVE_LOOP_H
 #define DRIVE_LOOP_H
@@ -62,7 +65,9 @@ typedef struct {
   double tau_s;        /* 2 Q / wn */
   double bw_hz;        /* wanted closed-loop bandwidth */
   double demod_bw_hz;  /* LMSD bandwidth, (lmsd_bandwidth_hz) */
-  double fs_hz;
+  double fs_hz;        /* sample rate */
+  double loop_decim;   /* samples per loop update (the loop runs at fs / loop_decim and
+                        * its output is held between updates); 0 or 1: every sample */
 } drive_loop_design_in_t;
 
 typedef struct {
@@ -87,5 +92,10 @@ void drive_loop_reset(drive_loop_t *dl);
 
 /* One tick: measurement from the drive LMSD weights, then both PIs. */
 void drive_loop_step(drive_loop_t *dl, float w_s, float w_c);
+/* The two halves of drive_loop_step, for a caller that spreads them over two ticks:
+ * the amplitude loop (|Z|, f_cmd) and the phase loop (arg Z, P; it uses the latest
+ * amplitude to tell whether there is a vibration to measure). */
+void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c);
+void drive_loop_step_phase(drive_loop_t *dl, float w_s, float w_c);
 
 #endif /* DRIVE_LOOP_H */

@@ -3,7 +3,6 @@
 #include <stddef.h>
 
 #include "dsp/fastmath.h"
-#include "dsp/sincos.h"
 
 int drive_synth_init(drive_synth_t *ds, const drive_synth_cfg_t *cfg)
 {
@@ -22,6 +21,8 @@ int drive_synth_init(drive_synth_t *ds, const drive_synth_cfg_t *cfg)
   ds->dc_bias_v = cfg->dc_bias_v;
   ds->u_max_v = cfg->u_max_v;
   ds->inv_4d = (cfg->mode == GYRO_DRIVE_DC_AC) ? 0.25f / cfg->dc_bias_v : 0.0f;
+  ds->a_v = 0.0f;
+  ds->off = 0u;
   return 0;
 }
 
@@ -34,22 +35,20 @@ float drive_synth_f_cmd_max(const drive_synth_t *ds)
   return ds->u_max_v * ds->u_max_v;
 }
 
-void drive_synth_step(const drive_synth_t *ds, float f_cmd_v2, float p_rad, uint32_t phase,
-                      uint32_t half_phase, float *u1_v, float *u2_v)
+void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad)
 {
-  float s, c;
-  const float f = f_cmd_v2 > 0.0f ? f_cmd_v2 : 0.0f;
+  /* A non-finite command (a NaN the supervisor has not caught yet: it looks once per
+   * block) drives nothing rather than a rail voltage; a non-finite P leaves the phase. */
+  if (!fm_isfinite(p_rad) || fm_absf(p_rad) > 7.0f) {
+    p_rad = 0.0f;
+  }
+  const float f = (f_cmd_v2 > 0.0f && fm_isfinite(f_cmd_v2)) ? f_cmd_v2 : 0.0f;
   if (ds->mode == GYRO_DRIVE_DC_AC) {
     /* Force phase P = twice the half-angle phase: exact modulo 2^32. */
-    sincos_lut(phase + 2u * sincos_half_rad_to_phase(p_rad), &s, &c);
-    const float a = f * ds->inv_4d;
-    *u1_v = ds->dc_bias_v + a * c;
-    *u2_v = ds->dc_bias_v - a * c;
+    ds->off = 2u * sincos_half_rad_to_phase(p_rad);
+    ds->a_v = f * ds->inv_4d;
   } else {
-    /* (6-25): the voltage phase is half the force phase. */
-    sincos_lut(half_phase + sincos_half_rad_to_phase(p_rad), &s, &c);
-    const float a = fm_sqrtf(f);
-    *u1_v = a * c;
-    *u2_v = a * s;
+    ds->off = sincos_half_rad_to_phase(p_rad);
+    ds->a_v = fm_sqrtf(f);
   }
 }

@@ -12,11 +12,18 @@
  * Both give the same force for the same (f_cmd, P), so the loops need no retuning when
  * the scheme changes. The half phase comes from the NCO's half-rate accumulator, so the
  * voltage phase stays continuous across the main accumulator's wrap.
+ *
+ * The command changes at the drive loops' rate (fs / GYRO_BLOCK), the waveform every
+ * sample: drive_synth_set() turns (f_cmd, P) into an amplitude and a phase offset (the
+ * square root and the radian-to-phase conversion, once per command), and
+ * drive_synth_step() is one table lookup and two multiplies per sample.
  */
 #ifndef DRIVE_SYNTH_H
 #define DRIVE_SYNTH_H
 
 #include <stdint.h>
+
+#include "dsp/sincos.h"
 
 typedef enum {
   GYRO_DRIVE_HALF_FREQ = 0, /* U1 = A cos(phi/2 + P/2), U2 = A sin(phi/2 + P/2), (6-18) */
@@ -28,6 +35,9 @@ typedef struct {
   float dc_bias_v;   /* D */
   float u_max_v;     /* largest voltage magnitude on either electrode */
   float inv_4d;      /* 1 / (4 D) */
+  /* The current command (drive_synth_set): */
+  float a_v;         /* A, the voltage amplitude */
+  uint32_t off;      /* phase offset added to the NCO phase: P/2 (half-freq) or P (DC+AC) */
 } drive_synth_t;
 
 typedef struct {
@@ -37,14 +47,31 @@ typedef struct {
 } drive_synth_cfg_t;
 
 /* Returns 0, or -1 (nothing changed) for a bad configuration (DC+AC needs
- * 0 < D < u_max). */
+ * 0 < D < u_max). The command starts at zero force. */
 int drive_synth_init(drive_synth_t *ds, const drive_synth_cfg_t *cfg);
 
 /* Largest force command the electrodes can deliver (Ks*V^2). */
 float drive_synth_f_cmd_max(const drive_synth_t *ds);
 
-/* phase: NCO phase at wc of this sample; half_phase: its half-rate companion. */
-void drive_synth_step(const drive_synth_t *ds, float f_cmd_v2, float p_rad, uint32_t phase,
-                      uint32_t half_phase, float *u1_v, float *u2_v);
+/* A new force command (f_cmd in Ks*V^2, negative = 0; P in rad, |P| < 2 pi). */
+void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad);
+
+/* One sample of the electrode voltages for the current command. phase: NCO phase at wc
+ * of this sample; half_phase: its half-rate companion. */
+static inline void drive_synth_step(const drive_synth_t *ds, uint32_t phase, uint32_t half_phase,
+                                    float *u1_v, float *u2_v)
+{
+  float s, c;
+  if (ds->mode == GYRO_DRIVE_DC_AC) {
+    sincos_lut(phase + ds->off, &s, &c);
+    *u1_v = ds->dc_bias_v + ds->a_v * c;
+    *u2_v = ds->dc_bias_v - ds->a_v * c;
+  } else {
+    /* (6-25): the voltage phase is half the force phase. */
+    sincos_lut(half_phase + ds->off, &s, &c);
+    *u1_v = ds->a_v * c;
+    *u2_v = ds->a_v * s;
+  }
+}
 
 #endif /* DRIVE_SYNTH_H */

@@ -39,14 +39,15 @@ int gyro_design(const param_values_t *v, gyro_design_t *d)
   const double tau = 2.0 * (double)v->drive_cal_q / (2.0 * FM_PI * (double)v->drive_cal_f0_hz);
   const double demod_bw = lmsd_bandwidth_hz((double)v->demod_mu_drive, fs);
   if (!(demod_bw > 0.0)) return -3;
+  const double blk = (double)GYRO_BLOCK;
   const drive_loop_design_in_t amp_in = {(double)v->drive_cal_gain_v_per_v2, tau,
-                                         (double)v->drive_amp_bw_hz, demod_bw, fs};
-  const drive_loop_design_in_t ph_in = {1.0, tau, (double)v->drive_phase_bw_hz, demod_bw, fs};
+                                         (double)v->drive_amp_bw_hz, demod_bw, fs, blk};
+  const drive_loop_design_in_t ph_in = {1.0, tau, (double)v->drive_phase_bw_hz, demod_bw, fs, blk};
   if (drive_loop_design(&amp_in, &t.amp_design) != 0 ||
       drive_loop_design(&ph_in, &t.phase_design) != 0) {
     return -4;
   }
-  t.drive.dt_s = 1.0f / fs_f;
+  t.drive.dt_s = (float)GYRO_BLOCK / fs_f; /* the loops run once per block */
   t.drive.amp_set_v = v->drive_amp_set_v;
   t.drive.phase_set_rad = v->drive_phase_set_deg * FM_RAD_PER_DEG_F;
   const int manual_amp = v->drive_amp_kp > 0.0f || v->drive_amp_ki > 0.0f;
@@ -80,12 +81,12 @@ int gyro_design(const param_values_t *v, gyro_design_t *d)
   t.rate.p_lpf_alpha =
       (float)(1.0 - exp(-2.0 * FM_PI * (double)v->rate_p_lpf_hz * RATE_P_DECIM / fs));
   t.rate.lpf = NULL; /* gyro_init/gyro_apply point it at t.rate_lpf where it is used */
-  t.rate.p_mode_k = (float)(1.0 - exp(-1.0 / (fs * tau)));
+  t.rate.p_mode_k = (float)(1.0 - exp(-blk / (fs * tau))); /* per block */
   t.rate.lpf_sections = (uint32_t)n;
   t.rate.min_drive_v = 0.05f * v->drive_amp_set_v;
   t.rate_out_v_per_dps = v->rate_out_v_per_dps;
 
-  t.sup.dt_s = 1.0f / fs_f;
+  t.sup.dt_s = (float)GYRO_BLOCK / fs_f;
   t.sup.lock_tol_rel = v->sup_lock_tol_rel;
   t.sup.lock_phase_tol_rad = v->sup_lock_phase_tol_deg * FM_RAD_PER_DEG_F;
   t.sup.lock_hold_s = v->sup_lock_hold_s;
@@ -100,7 +101,8 @@ int gyro_design(const param_values_t *v, gyro_design_t *d)
     const double th = (double)v->drive_phase_set_deg * FM_PI / 180.0;
     selftest_cfg_t st = {v->selftest_amp_v, v->selftest_expect_dps, v->selftest_tol_rel,
                          (float)cos(th), (float)sin(th), v->rate_scale_dps,
-                         v->sys_fs_hz / 5u, v->sys_fs_hz / 10u, v->sys_fs_hz / 5u};
+                         v->sys_fs_hz / (5u * GYRO_BLOCK), v->sys_fs_hz / (10u * GYRO_BLOCK),
+                         v->sys_fs_hz / (5u * GYRO_BLOCK)}; /* 0.2 s, 0.1 s, 0.2 s */
     t.selftest = st;
   }
   /* Every module must accept its part: a design that gyro_apply could not apply is
@@ -166,6 +168,9 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   /* The drive scheme only changes with the drive off (drive.mode is not live). */
   if (d->synth.mode == g->synth.mode || !supervisor_drive_enabled(&g->sup)) {
     (void)drive_synth_init(&g->synth, &d->synth);
+    if (supervisor_drive_enabled(&g->sup)) {
+      drive_synth_set(&g->synth, g->drive.f_cmd_v2, g->drive.p_rad); /* carry on driving */
+    }
   }
   rate_channel_cfg_t rc = d->rate;
   rc.lpf = d->rate_lpf;
@@ -222,86 +227,57 @@ static void clear_loop_state(gyro_t *g)
   lmsd_reset(&g->lmsd_sense);
   drive_loop_reset(&g->drive);
   rate_channel_reset(&g->rate, g->rate.p_ref_deg);
+  drive_synth_set(&g->synth, 0.0f, g->drive.p_rad);
 }
 
-void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
+/* Block work, one job per tick slot (gyro.h): the drive loops and their command, the
+ * amplitude loop and the phase loop on two consecutive ticks. */
+static void block_drive(gyro_t *g, float d_s, float d_c, int phase)
 {
-  nco_out_t ref;
-  nco_step(&g->nco, &ref);
-
-  const float v_drive = (float)adc->drive * g->adc_v_per_code;
-  const float v_sense = (float)adc->sense * g->adc_v_per_code;
-  lmsd_step(&g->lmsd_drive, v_drive, ref.sin_wc, ref.cos_wc);
-  lmsd_step(&g->lmsd_sense, v_sense, ref.sin_wc, ref.cos_wc);
-  const float d_s = g->lmsd_drive.w_i, d_c = g->lmsd_drive.w_q;
-  const float s_s = g->lmsd_sense.w_i, s_c = g->lmsd_sense.w_q;
-
-  const int drive_on = supervisor_drive_enabled(&g->sup);
-  float u1 = 0.0f, u2 = 0.0f;
-  if (drive_on) {
-    drive_loop_step(&g->drive, d_s, d_c);
-    drive_synth_step(&g->synth, g->drive.f_cmd_v2, g->drive.p_rad, ref.phase, ref.half_phase,
-                     &u1, &u2);
+  if (!supervisor_drive_enabled(&g->sup)) {
+    return;
+  }
+  if (phase) {
+    drive_loop_step_phase(&g->drive, d_s, d_c);
   } else {
+    drive_loop_step_amp(&g->drive, d_s, d_c);
+    if (g->drive.f_cmd_v2 >= g->f_cmd_max_v2) g->flags_acc |= GYRO_FLAG_DRIVE_LIMIT;
+  }
+  drive_synth_set(&g->synth, g->drive.f_cmd_v2, g->drive.p_rad);
+}
+
+/* The supervisor on the block's evidence. Returns nonzero when it cleared the loops. */
+static int block_supervise(gyro_t *g, float d_s, float d_c, float s_s, float s_c)
+{
+  const int drive_on = supervisor_drive_enabled(&g->sup);
+  if (!drive_on) {
     /* Measure only: the amplitude is still watched for the over-amplitude trip. */
     g->drive.amp_v = fm_sqrtf(d_s * d_s + d_c * d_c);
-    if (g->sup.mode == GYRO_MODE_SWEEP) {
-      float f_cmd, p;
-      uint32_t half_step;
-      selfcal_exec_tick(&g->cal, d_s, d_c, &half_step, &f_cmd, &p);
-      drive_synth_step(&g->synth, f_cmd, p, ref.phase, ref.half_phase, &u1, &u2);
-      g->nco.half_step = half_step; /* from the next sample on */
-    }
   }
-  rate_channel_step(&g->rate, d_s, d_c, s_s, s_c, g->drive.p_rad);
-
-  const int at_rail = adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN ||
-                      adc->sense == HAL_ADC_CODE_MAX || adc->sense == HAL_ADC_CODE_MIN;
-  const int at_limit = g->drive.f_cmd_v2 >= g->f_cmd_max_v2;
-  /* Work that needs no per-sample rate runs on one tick in GYRO_SLOW_DECIM, offset from
-   * the rate channel's filter tick so the two never fall on the same tick. */
-  if (++g->slow_count == GYRO_SLOW_DECIM) {
-    g->slow_count = 0u;
-  }
-  const int slow = g->slow_count == GYRO_SLOW_PHASE;
-  g->flags_acc |= (at_rail ? GYRO_FLAG_ADC_RAIL : 0u) | (at_limit ? GYRO_FLAG_DRIVE_LIMIT : 0u);
   supervisor_in_t si;
   si.amp_rel = g->drive.amp_v * g->inv_amp_set;
   si.amp_rel_err = si.amp_rel - 1.0f;
   si.phase_err_rad = g->drive.phase_err_rad;
-  si.drive_at_limit = drive_on && at_limit;
-  si.adc_at_rail = at_rail;
-  /* A NaN anywhere propagates into these within a tick, and is caught within
-   * GYRO_SLOW_DECIM ticks (0.2 ms): long before it could reach the structure. */
-  si.state_finite = !slow || (fm_isfinite(d_s + d_c + s_s + s_c) && fm_isfinite(g->drive.f_cmd_v2) &&
-                              fm_isfinite(g->drive.p_rad) && fm_isfinite(g->rate.rate_dps) &&
-                              fm_isfinite(g->rate.quad_dps));
+  si.drive_at_limit = drive_on && g->drive.f_cmd_v2 >= g->f_cmd_max_v2;
+  si.clip_run = g->clip_run_max;
+  g->clip_run_max = g->clip_run; /* a run still going carries into the next block */
+  /* A NaN anywhere propagates into these within a block, and is caught at the next
+   * supervisor slot (0.2 ms): long before it could reach the structure. */
+  si.state_finite = fm_isfinite(d_s + d_c + s_s + s_c) && fm_isfinite(g->drive.f_cmd_v2) &&
+                    fm_isfinite(g->drive.p_rad) && fm_isfinite(g->rate.rate_dps) &&
+                    fm_isfinite(g->rate.quad_dps);
   if (supervisor_step(&g->sup, &si) != 0) {
     clear_loop_state(g);
-    u1 = 0.0f;
-    u2 = 0.0f;
+    return 1;
   }
-  if (!supervisor_drive_enabled(&g->sup) && g->sup.mode != GYRO_MODE_SWEEP) {
-    u1 = 0.0f;
-    u2 = 0.0f;
-  }
+  return 0;
+}
 
-  dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
-  dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
-  dac->code[HAL_DAC_RATE_OUT] = g->rate_code; /* the rate changes at fs / RATE_DECIM */
-  /* Built-in self-test force on the sense feedback electrodes (selftest.h). */
-  const float u_st = selftest_step(&g->selftest, g->sup.mode == GYRO_MODE_LOCKED,
-                                   g->rate.rate_raw, ref.sin_wc, ref.cos_wc);
-  dac->code[HAL_DAC_SPARE] = gyro_volts_to_dac(u_st);
-  if (selftest_running(&g->selftest)) g->flags_acc |= GYRO_FLAG_SELFTEST;
-
+/* The snapshot for telemetry and status, at fs / GYRO_BLOCK (5 kHz: the telemetry's
+ * highest rate); flags hold what happened over the whole block. */
+static void block_output(gyro_t *g, float u1, float u2, float s_s, float s_c)
+{
   gyro_out_t *o = &g->out;
-  o->tick++;
-  if (!slow) {
-    return;
-  }
-  /* The snapshot for telemetry and status, at fs / GYRO_SLOW_DECIM (5 kHz: the
-   * telemetry's highest rate); flags hold what happened over the whole block. */
   g->rate_code = gyro_volts_to_dac(g->rate.rate_dps * g->rate_out_v_per_dps);
   o->rate_dps = g->rate.rate_dps;
   o->rate_unc_dps = g->rate.rate_unc_dps;
@@ -317,7 +293,72 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
   o->sense_q_v = s_c;
   o->mode = (uint32_t)g->sup.mode;
   o->fault = g->sup.fault;
+  if (selftest_running(&g->selftest)) g->flags_acc |= GYRO_FLAG_SELFTEST;
   o->flags = (g->sup.mode == GYRO_MODE_LOCKED ? GYRO_FLAG_LOCKED : 0u) | g->flags_acc |
              (g->sup.mode == GYRO_MODE_FAULT ? GYRO_FLAG_FAULT : 0u);
   g->flags_acc = 0u;
+}
+
+void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
+{
+  nco_out_t ref;
+  nco_step(&g->nco, &ref);
+
+  const float v_drive = (float)adc->drive * g->adc_v_per_code;
+  const float v_sense = (float)adc->sense * g->adc_v_per_code;
+  lmsd_step(&g->lmsd_drive, v_drive, ref.sin_wc, ref.cos_wc);
+  lmsd_step(&g->lmsd_sense, v_sense, ref.sin_wc, ref.cos_wc);
+  const float d_s = g->lmsd_drive.w_i, d_c = g->lmsd_drive.w_q;
+  const float s_s = g->lmsd_sense.w_i, s_c = g->lmsd_sense.w_q;
+  rate_channel_accumulate(&g->rate, s_s, s_c);
+
+  /* Consecutive rail codes, counted per sample: clipping is judged on the longest run. */
+  if (adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN ||
+      adc->sense == HAL_ADC_CODE_MAX || adc->sense == HAL_ADC_CODE_MIN) {
+    g->flags_acc |= GYRO_FLAG_ADC_RAIL;
+    if (++g->clip_run > g->clip_run_max) g->clip_run_max = g->clip_run;
+  } else {
+    g->clip_run = 0u;
+  }
+
+  /* Everything slower than the carrier runs once per block of GYRO_BLOCK ticks, each
+   * job on its own tick so that no tick carries two of them. */
+  const uint32_t slot = g->slot;
+  g->slot = slot + 1u == GYRO_BLOCK ? 0u : slot + 1u;
+  if (slot == GYRO_SLOT_DRIVE_AMP) {
+    block_drive(g, d_s, d_c, 0);
+  } else if (slot == GYRO_SLOT_DRIVE_PHASE) {
+    block_drive(g, d_s, d_c, 1);
+  } else if (slot == GYRO_SLOT_SUPERVISE) {
+    (void)block_supervise(g, d_s, d_c, s_s, s_c);
+  } else if (slot == GYRO_SLOT_RATE) {
+    rate_channel_update(&g->rate, d_s, d_c, g->drive.p_rad);
+    selftest_update(&g->selftest, g->sup.mode == GYRO_MODE_LOCKED, g->rate.rate_raw);
+  } else if (slot == GYRO_SLOT_QUAD) {
+    rate_channel_update_quad(&g->rate);
+  }
+
+  float u1 = 0.0f, u2 = 0.0f;
+  if (g->sup.mode == GYRO_MODE_SWEEP) {
+    float f_cmd, p;
+    uint32_t half_step;
+    selfcal_exec_tick(&g->cal, d_s, d_c, &half_step, &f_cmd, &p);
+    drive_synth_set(&g->synth, f_cmd, p);
+    drive_synth_step(&g->synth, ref.phase, ref.half_phase, &u1, &u2);
+    g->nco.half_step = half_step; /* from the next sample on */
+  } else if (supervisor_drive_enabled(&g->sup)) {
+    drive_synth_step(&g->synth, ref.phase, ref.half_phase, &u1, &u2);
+  }
+  dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
+  dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
+  dac->code[HAL_DAC_RATE_OUT] = g->rate_code; /* the rate changes once per block */
+  /* Built-in self-test force on the sense feedback electrodes (selftest.h). */
+  dac->code[HAL_DAC_SPARE] = g->selftest.state == SELFTEST_FORCE
+                                 ? gyro_volts_to_dac(selftest_force(&g->selftest, ref.sin_wc, ref.cos_wc))
+                                 : (uint16_t)HAL_DAC_CODE_MID;
+
+  g->out.tick++;
+  if (slot == GYRO_SLOT_OUTPUT) {
+    block_output(g, u1, u2, s_s, s_c);
+  }
 }

@@ -4,6 +4,7 @@
  * target:
  *   NCO -> LMSD(drive), LMSD(sense) -> drive loops -> drive synthesis -> rate channel
  *   -> supervisor -> outputs (DAC frame, telemetry snapshot)
+ * with the loops, rate channel, supervisor and snapshot once per block (GYRO_BLOCK).
  * Deterministic, allocation-free, single precision, no libm.
  *
  * Phase conventions (used throughout firmware/gyro):
@@ -88,19 +89,30 @@ typedef struct {
   selfcal_exec_t cal; /* self-calibration jobs, run while the supervisor is in SWEEP */
   float f_cmd_max_v2;
   float inv_amp_set;     /* 1 / drive amplitude setpoint: no divide per tick */
-  uint32_t slow_count;   /* tick counter modulo GYRO_SLOW_DECIM */
+  uint32_t slot;         /* tick within the block, 0 .. GYRO_BLOCK - 1 */
+  uint32_t clip_run;     /* consecutive ADC rail codes up to this tick */
+  uint32_t clip_run_max; /* longest run reaching into the current supervisor period */
   uint32_t flags_acc;    /* GYRO_FLAG_* seen since the last snapshot */
   uint16_t rate_code;    /* analog rate output DAC code, updated with the snapshot */
   selftest_t selftest;
-  gyro_out_t out;        /* updated every GYRO_SLOW_DECIM ticks (tick: every tick) */
+  gyro_out_t out;        /* updated once per block (tick: every tick) */
 } gyro_t;
 
-/* Work without a per-sample need (output snapshot, analog rate code, the finiteness
- * check of the loop state) runs on one tick in GYRO_SLOW_DECIM, on the tick
- * GYRO_SLOW_PHASE of the block: half a block away from the rate channel's filter tick
- * (rate_channel.h, RATE_DECIM), so the worst-case tick carries only one of them. */
-#define GYRO_SLOW_DECIM 10u
-#define GYRO_SLOW_PHASE 5u
+/* The block: GYRO_BLOCK ticks (the rate channel's RATE_DECIM, 0.2 ms at 50 kHz). Per
+ * tick only what moves with the carrier runs: the NCO, both LMSDs, the sum of the sense
+ * phasor, the drive waveform and the self-test force, the rail count and the DAC frame.
+ * Everything else (the drive loops and their square root and arctangent, the
+ * supervisor and the finiteness check, the rate channel's projection, filters and
+ * compensation, the output snapshot) runs once per block, each job on its own tick of
+ * the block so that the worst tick carries one job: the interrupt's budget is set by
+ * its worst tick (tools/bench/README.md). */
+#define GYRO_BLOCK RATE_DECIM
+#define GYRO_SLOT_DRIVE_AMP 0u
+#define GYRO_SLOT_DRIVE_PHASE 1u
+#define GYRO_SLOT_SUPERVISE 3u
+#define GYRO_SLOT_RATE 5u
+#define GYRO_SLOT_QUAD 7u
+#define GYRO_SLOT_OUTPUT 8u
 
 /* Turn parameter values into module configurations, checking that every module
  * accepts its part. Returns 0, or a negative value (then *d is untouched). */

@@ -88,7 +88,6 @@ void rate_channel_reset(rate_channel_t *rc, float p_deg)
   rc->quad_raw = 0.0f;
   rc->acc_re = 0.0f;
   rc->acc_im = 0.0f;
-  rc->count = 0u;
   rc->rate_unc_dps = 0.0f;
   rc->quad_dps = 0.0f;
   rc->p_acc_deg = 0.0f;
@@ -99,9 +98,16 @@ void rate_channel_reset(rate_channel_t *rc, float p_deg)
   rc->rate_dps = 0.0f;
 }
 
-void rate_channel_step(rate_channel_t *rc, float d_s, float d_c, float s_s, float s_c,
-                       float p_rad)
+/* Blocks of RATE_DECIM ticks per low-pass sample of P. */
+#define RATE_P_BLOCKS (RATE_P_DECIM / RATE_DECIM)
+_Static_assert(RATE_P_DECIM % RATE_DECIM == 0u, "P's average spans whole blocks");
+
+void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad)
 {
+  const float k = 1.0f / (float)RATE_DECIM;
+  const float s_s = rc->acc_re * k, s_c = rc->acc_im * k;
+  rc->acc_re = 0.0f;
+  rc->acc_im = 0.0f;
   /* (6-17): the true drive phase follows P through the mode's lag. Work on P - p_ref
    * (small) so the float low-pass has no dead band. */
   const float p_dev_rad = p_rad - rc->p_ref_deg * FM_RAD_PER_DEG_F;
@@ -119,28 +125,23 @@ void rate_channel_step(rate_channel_t *rc, float d_s, float d_c, float s_s, floa
   rc->quad_raw = im;
 
   rc->p_acc_deg += p_rad * FM_DEG_PER_RAD_F - rc->p_ref_deg;
-  if (++rc->p_count == RATE_P_DECIM) {
-    const float mean = rc->p_acc_deg * (1.0f / (float)RATE_P_DECIM);
+  if (++rc->p_count == RATE_P_BLOCKS) {
+    const float mean = rc->p_acc_deg * (1.0f / (float)RATE_P_BLOCKS);
     rc->p_dev_deg += rc->p_lpf_alpha * (mean - rc->p_dev_deg);
     rc->p_f_deg = rc->p_ref_deg + rc->p_dev_deg;
     rc->p_acc_deg = 0.0f;
     rc->p_count = 0u;
   }
-  rc->acc_re += re;
-  rc->acc_im += im;
-  if (++rc->count < RATE_DECIM) {
-    return;
-  }
-  const float k = 1.0f / (float)RATE_DECIM;
-  rc->rate_unc_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_rate, rc->acc_re * k);
-  rc->quad_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_quad, rc->acc_im * k);
-  rc->acc_re = 0.0f;
-  rc->acc_im = 0.0f;
-  rc->count = 0u;
+  rc->rate_unc_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_rate, re);
 
   const float p = rc->p_f_deg;
   const float *b3 = rc->bias_c_dps, *s3 = rc->sf_c;
   const float bias = b3[0] + p * (b3[1] + p * (b3[2] + p * b3[3]));
   const float sf = 1.0f + p * (s3[1] + p * (s3[2] + p * s3[3]));
   rc->rate_dps = rc->rate_unc_dps * sf - bias;
+}
+
+void rate_channel_update_quad(rate_channel_t *rc)
+{
+  rc->quad_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_quad, rc->quad_raw);
 }

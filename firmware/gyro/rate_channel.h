@@ -29,7 +29,11 @@
 
 #include "dsp/biquad.h"
 
-/* The output low-pass runs on block means of RATE_DECIM ticks (fs / 10 = 5 kHz). A
+/* The channel runs on block means of RATE_DECIM ticks (fs / 10 = 5 kHz): every tick
+ * only adds the sense phasor to a sum (rate_channel_accumulate); once per block
+ * rate_channel_update forms R from the block mean, with the drive-phase correction, and
+ * runs the output filter. R is linear in S and the correction changes far slower than
+ * a block, so projecting the mean equals the mean of per-tick projections. A
  * 100 Hz 4th-order Butterworth run at 50 kHz in float has a level-dependent DC error
  * of about 1e-3 (each sample adds b0 x ~ 4e-5 x to a state the size of the output, and
  * the rounding is amplified by 1/(1 + a1 + a2) ~ 6400, see dsp/biquad.h): that would be
@@ -50,7 +54,7 @@ typedef struct {
   float sf_c[4];
   float p_ref_deg;            /* P around which its low-pass works (the start value) */
   float p_lpf_alpha;          /* first-order low-pass of P at fs / RATE_P_DECIM */
-  float p_mode_k;             /* per-tick factor of the mode's lag: dt / (2Q/wn) */
+  float p_mode_k;             /* per-block factor of the mode's lag: 1 - exp(-T_block / (2Q/wn)) */
   const biquad_coeffs_t *lpf; /* output low-pass sections, designed for fs / RATE_DECIM */
   uint32_t lpf_sections;
   float min_drive_v;          /* below this measured drive amplitude no rate is formed */
@@ -63,19 +67,18 @@ typedef struct {
   float sf_c[4];
   float p_ref_deg;
   float p_lpf_alpha;
-  float p_acc_deg;            /* sum of (P - p_ref) over the current decimation block */
+  float p_acc_deg;            /* sum of (P - p_ref), one sample per block, over RATE_P_DECIM ticks */
   uint32_t p_count;
   float p_dev_deg;            /* low-passed P - p_ref */
   float p_mode_k;
   float p_mode_rad;           /* P - p_ref through the mode's lag, rad */
   float min_drive_v2;
-  float acc_re, acc_im;       /* sums over the current decimation block */
-  uint32_t count;
+  float acc_re, acc_im;       /* sense phasor summed over the current block */
   biquad_cascade_t lpf_rate;
   biquad_cascade_t lpf_quad;
-  /* Outputs of the latest tick. */
-  float rate_raw;             /* Re(R), unfiltered */
-  float quad_raw;             /* Im(R), unfiltered */
+  /* Outputs of the latest block. */
+  float rate_raw;             /* Re(R) of the block mean, before the output filter */
+  float quad_raw;             /* Im(R) of the block mean */
   float rate_unc_dps;         /* filtered, scaled, not compensated */
   float quad_dps;             /* filtered, scaled quadrature */
   float p_f_deg;              /* low-passed P */
@@ -94,10 +97,20 @@ int rate_channel_retune(rate_channel_t *rc, const rate_channel_cfg_t *cfg);
 /* Clear the filters; P_f starts at p_deg. */
 void rate_channel_reset(rate_channel_t *rc, float p_deg);
 
-/* One tick. (d_s, d_c): measured drive phasor (only to tell that the drive runs);
- * (s_s, s_c): sense phasor; p_rad: force phase.
- * The filtered outputs change once per RATE_DECIM ticks. */
-void rate_channel_step(rate_channel_t *rc, float d_s, float d_c, float s_s, float s_c,
-                       float p_rad);
+/* Every tick: add the sense LMSD phasor (s_s, s_c) to the block sum. */
+static inline void rate_channel_accumulate(rate_channel_t *rc, float s_s, float s_c)
+{
+  rc->acc_re += s_s;
+  rc->acc_im += s_c;
+}
+
+/* Once per RATE_DECIM ticks, after the block's last accumulate. (d_s, d_c): measured
+ * drive phasor (only to tell that the drive runs); p_rad: force phase (the phase loop
+ * holds it over the block). */
+void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad);
+
+/* The quadrature's output filter, once per block after rate_channel_update (on another
+ * tick of the block: it only feeds telemetry). */
+void rate_channel_update_quad(rate_channel_t *rc);
 
 #endif /* RATE_CHANNEL_H */

@@ -26,41 +26,36 @@ void selftest_start(selftest_t *st)
   st->acc_base = st->acc_meas = 0.0f;
 }
 
-float selftest_step(selftest_t *st, int locked, float rate_raw, float sin_wc, float cos_wc)
+void selftest_update(selftest_t *st, int locked, float rate_raw)
 {
   if (!selftest_running(st)) {
-    return 0.0f;
+    return;
   }
   if (!locked) {
     st->state = SELFTEST_ABORTED;
-    return 0.0f;
+    return;
   }
   const selftest_cfg_t *c = &st->cfg;
   st->count++;
   if (st->state == SELFTEST_BASE) {
     st->acc_base += rate_raw;
-    if (st->count >= c->base_ticks) {
+    if (st->count >= c->base_blocks) {
       st->state = SELFTEST_FORCE;
       st->count = 0u;
     }
-    return 0.0f;
+    return;
   }
-  /* FORCE: A cos(phi + theta_set), in phase with the drive velocity (gyro.h phasor
-   * convention: the velocity of y = Im{Z e^{j phi}} is Re{Z e^{j phi}}). */
-  const float u = c->amp_v * (c->ref_c * cos_wc - c->ref_s * sin_wc);
-  if (st->count > c->settle_ticks) {
+  if (st->count > c->settle_blocks) {
     st->acc_meas += rate_raw;
   }
-  if (st->count >= c->settle_ticks + c->meas_ticks) {
-    const float base = st->acc_base / (float)c->base_ticks;
-    const float meas = st->acc_meas / (float)c->meas_ticks;
+  if (st->count >= c->settle_blocks + c->meas_blocks) {
+    const float base = st->acc_base / (float)c->base_blocks;
+    const float meas = st->acc_meas / (float)c->meas_blocks;
     st->result_dps = (meas - base) * c->scale_dps;
     const float e = c->expect_dps != 0.0f ? fm_absf(st->result_dps / c->expect_dps - 1.0f) : 1.0f;
     st->state = e <= c->tol_rel ? SELFTEST_PASS : SELFTEST_FAIL;
     st->runs++;
-    return 0.0f;
   }
-  return u;
 }
 
 const char *selftest_state_name(uint32_t state)

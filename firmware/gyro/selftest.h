@@ -6,9 +6,11 @@
  * (2-22) - using the drive phase the loop holds (drive.phase_set_deg), so the response
  * lands on the rate axis of the calibrated demodulation: u = A cos(phi + theta_set),
  * with the differential electrodes' force 4 Ks_fb V_bias u. The test runs only while
- * LOCKED: a baseline of the unfiltered rate over BASE ticks, then the force, SETTLE
- * ticks for the sense mode and the output path, the response over MEAS ticks, and the
- * force off. Pass: |response / expected - 1| <= tolerance. The rate output carries the
+ * LOCKED: a baseline of the unfiltered rate over BASE blocks, then the force, SETTLE
+ * blocks for the sense mode and the output path, the response over MEAS blocks, and the
+ * force off. A block is the rate channel's (RATE_DECIM ticks): the sequence advances
+ * once per block on the block's unfiltered rate (selftest_update), while the force is a
+ * carrier and is formed every tick (selftest_force). Pass: |response / expected - 1| <= tolerance. The rate output carries the
  * test force while it runs (GYRO_FLAG_SELFTEST).
  */
 #ifndef SELFTEST_H
@@ -31,13 +33,13 @@ typedef struct {
   float tol_rel;     /* pass band, relative */
   float ref_c, ref_s; /* cos, sin of the drive phase setpoint */
   float scale_dps;   /* rate channel scale: deg/s per unit of the unfiltered rate */
-  uint32_t base_ticks, settle_ticks, meas_ticks;
+  uint32_t base_blocks, settle_blocks, meas_blocks;
 } selftest_cfg_t;
 
 typedef struct {
   selftest_cfg_t cfg;
   uint32_t state;    /* selftest_state_t */
-  uint32_t count;
+  uint32_t count;     /* blocks in the current state */
   float acc_base, acc_meas; /* sums of the unfiltered rate */
   float result_dps;  /* measured response of the last test */
   uint32_t runs;
@@ -48,13 +50,24 @@ void selftest_init(selftest_t *st, const selftest_cfg_t *cfg);
 void selftest_retune(selftest_t *st, const selftest_cfg_t *cfg);
 /* Start a test (ignored while one runs). */
 void selftest_start(selftest_t *st);
-/* One tick: locked = drive LOCKED, rate_raw = the rate channel's unfiltered rate,
- * (sin_wc, cos_wc) the NCO references. Returns the spare DAC voltage to apply. */
-float selftest_step(selftest_t *st, int locked, float rate_raw, float sin_wc, float cos_wc);
+/* Once per block: locked = drive LOCKED, rate_raw = the rate channel's unfiltered
+ * rate of the block. */
+void selftest_update(selftest_t *st, int locked, float rate_raw);
 
 static inline int selftest_running(const selftest_t *st)
 {
   return st->state == SELFTEST_BASE || st->state == SELFTEST_FORCE;
+}
+
+/* Every tick: the spare DAC voltage, (sin_wc, cos_wc) the NCO references. FORCE:
+ * A cos(phi + theta_set), in phase with the drive velocity (gyro.h phasor convention:
+ * the velocity of y = Im{Z e^{j phi}} is Re{Z e^{j phi}}). */
+static inline float selftest_force(const selftest_t *st, float sin_wc, float cos_wc)
+{
+  if (st->state != SELFTEST_FORCE) {
+    return 0.0f;
+  }
+  return st->cfg.amp_v * (st->cfg.ref_c * cos_wc - st->cfg.ref_s * sin_wc);
 }
 
 const char *selftest_state_name(uint32_t state);

@@ -27,7 +27,7 @@ int supervisor_init(supervisor_t *sv, const supervisor_cfg_t *cfg)
   sv->fault = GYRO_FAULT_NONE;
   sv->fault_count = 0u;
   sv->in_tol_ticks = sv->out_tol_ticks = sv->sat_ticks = 0u;
-  sv->clip_run = sv->fault_ticks = sv->mode_ticks = 0u;
+  sv->fault_ticks = sv->mode_ticks = 0u;
   supervisor_retune(sv, cfg);
   return 0;
 }
@@ -85,7 +85,6 @@ static int trip(supervisor_t *sv, uint32_t reason)
 int supervisor_step(supervisor_t *sv, const supervisor_in_t *in)
 {
   sv->mode_ticks++;
-  sv->clip_run = in->adc_at_rail ? sv->clip_run + 1u : 0u;
 
   if (sv->mode == GYRO_MODE_FAULT) {
     if (++sv->fault_ticks >= sv->retry_ticks) {
@@ -98,7 +97,7 @@ int supervisor_step(supervisor_t *sv, const supervisor_in_t *in)
    * integrators forever; clipping makes the demodulated amplitude meaningless. */
   if (sv->mode != GYRO_MODE_OFF) {
     if (!in->state_finite) return trip(sv, GYRO_FAULT_NAN);
-    if (sv->clip_run >= sv->clip_max_count) return trip(sv, GYRO_FAULT_ADC_CLIP);
+    if (in->clip_run >= sv->clip_max_count) return trip(sv, GYRO_FAULT_ADC_CLIP);
     if (sv->mode != GYRO_MODE_SWEEP && in->amp_rel > sv->amp_trip_rel) {
       return trip(sv, GYRO_FAULT_OVER_AMP);
     }

@@ -11,7 +11,9 @@
  * demodulated drive amplitude carries the residue of the drive-voltage feedthrough at
  * wc/2 (an LMSD of a few hundred Hz bandwidth passes part of a 745 Hz offset) and of
  * the pickoff noise, which would otherwise break the consecutive-tick count.
- * The supervisor only decides; gyro_tick acts on its decisions.
+ * The supervisor only decides; gyro_tick acts on its decisions. It steps once per block
+ * of the gyro (dt_s = RATE_DECIM / fs, 0.2 ms): every threshold is a time, and a fault
+ * is seen within one block.
  */
 #ifndef SUPERVISOR_H
 #define SUPERVISOR_H
@@ -56,7 +58,6 @@ typedef struct {
   uint32_t in_tol_ticks;   /* consecutive ticks inside lock tolerance */
   uint32_t out_tol_ticks;  /* consecutive ticks outside lost tolerance while LOCKED */
   uint32_t sat_ticks;
-  uint32_t clip_run;       /* consecutive rail codes */
   uint32_t fault_ticks;    /* ticks spent in FAULT */
   uint32_t mode_ticks;     /* ticks spent in the current mode */
   float err_lpf_k;         /* first-order low-pass (~100 Hz) of the lock errors */
@@ -70,7 +71,8 @@ typedef struct {
   float amp_rel;       /* A / A_set */
   float phase_err_rad;
   int drive_at_limit;  /* amplitude PI pinned at its maximum */
-  int adc_at_rail;     /* either ADC code at a rail this tick */
+  uint32_t clip_run;   /* longest run of consecutive ADC rail codes (either channel)
+                        * that reached into the period since the last step */
   int state_finite;    /* every loop state value finite */
 } supervisor_in_t;
 

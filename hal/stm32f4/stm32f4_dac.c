@@ -11,12 +11,6 @@ static volatile uint32_t s_overruns;
 static volatile uint32_t s_late;
 static volatile uint32_t s_deadline = 0xFFFFFFFFu;
 
-STM32F4_RAMFUNC uint16_t stm32f4_dac_word(uint32_t channel, uint16_t code)
-{
-  const uint16_t c = code > HAL_DAC_CODE_MAX ? (uint16_t)HAL_DAC_CODE_MAX : code;
-  return (uint16_t)(((channel & 3u) << 14) | c);
-}
-
 void stm32f4_dac_init(void)
 {
   RCC->APB1ENR |= RCC_APB1ENR_SPI2EN;

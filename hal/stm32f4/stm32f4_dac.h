@@ -17,6 +17,8 @@
 
 #include <stdint.h>
 
+#include "hal/hal_dac.h"
+
 #define STM32F4_DAC_SLOT_TICKS 210u     /* 1.25 us at 168 MHz */
 #define STM32F4_DAC_CS_HIGH_TICKS 16u   /* 95 ns CS high between words */
 
@@ -24,7 +26,11 @@
 void stm32f4_dac_init(void);
 
 /* AD5554 input word for one channel: address in bits 15..14, code clamped to 14 bits. */
-uint16_t stm32f4_dac_word(uint32_t channel, uint16_t code);
+static inline uint16_t stm32f4_dac_word(uint32_t channel, uint16_t code)
+{
+  const uint16_t c = code > HAL_DAC_CODE_MAX ? (uint16_t)HAL_DAC_CODE_MAX : code;
+  return (uint16_t)(((channel & 3u) << 14) | c);
+}
 
 /* Frames refused because the previous sequence was still running (ISR overran). */
 uint32_t stm32f4_dac_overruns(void);

@@ -17,6 +17,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "bench_figs.h"
 #include "post.h"
 #include "scenario.h"
 #include "sim.h"
@@ -34,7 +35,9 @@ static void usage(FILE *f)
         "closed loop and prints its figures. --out keeps the analysis plots (PNG) and\n"
         "tool outputs; --set overrides any plant or firmware parameter. --uart-pty runs\n"
         "in real time with the tuning UART on a pseudo-terminal (path printed as\n"
-        "'pty PATH'; optional symlink LINK) for gyroctl; SIGINT/SIGTERM end the run.\n",
+        "'pty PATH'; optional symlink LINK) for gyroctl; SIGINT/SIGTERM end the run.\n"
+        "--isr-figures adds the Cortex-M4F interrupt cost that tools/bench/run-bench\n"
+        "--json measured to the figures (isr_instructions_per_tick, ...).\n",
         f);
 }
 
@@ -105,6 +108,7 @@ int main(int argc, char **argv)
   long long seed = -1;
   int quiet = 0, analysis = 1, uart_pty = 0;
   const char *uart_pty_link = NULL;
+  const char *isr_json = NULL;
   static const struct option lo[] = {
       {"scenario", required_argument, 0, 's'}, {"duration", required_argument, 0, 'd'},
       {"seed", required_argument, 0, 'S'},     {"csv", required_argument, 0, 'c'},
@@ -112,7 +116,7 @@ int main(int argc, char **argv)
       {"out", required_argument, 0, 'o'},      {"set", required_argument, 0, 'x'},
       {"quiet", no_argument, 0, 'q'},          {"no-analysis", no_argument, 0, 'n'},
       {"list-params", no_argument, 0, 'L'},    {"help", no_argument, 0, 'h'},
-      {"uart-pty", optional_argument, 0, 'u'},
+      {"uart-pty", optional_argument, 0, 'u'}, {"isr-figures", required_argument, 0, 'i'},
       {0, 0, 0, 0}};
   static char sets[SIM_MAX_SETS][160];
   int n_sets = 0;
@@ -161,6 +165,7 @@ int main(int argc, char **argv)
       uart_pty_link = optarg;
       break;
     case 'n': analysis = 0; break;
+    case 'i': isr_json = optarg; break;
     case 'L': list_params(); return 0;
     case 'h': usage(stdout); return 0;
     default: usage(stderr); return 2;
@@ -180,6 +185,11 @@ int main(int argc, char **argv)
       fprintf(stderr, "gyro-sim: %s\n", err);
       return 2;
     }
+  }
+  bench_figs_t isr;
+  if (isr_json != NULL && bench_figs_load(isr_json, &isr, err, sizeof err) != 0) {
+    fprintf(stderr, "gyro-sim: %s\n", err);
+    return 2;
   }
   if (duration > 0.0) sc.duration_s = duration;
   if (seed >= 0) sc.seed = (uint64_t)seed;
@@ -250,11 +260,25 @@ int main(int argc, char **argv)
   add_num(params, "seed", (double)sc.seed);
   cJSON *fig = cJSON_AddObjectToObject(root, "figures");
   int failed = 0;
+  if (isr_json != NULL) {
+    add_num(fig, "isr_instructions_per_tick", isr.insns_mean);
+    add_num(fig, "isr_instructions_per_tick_max", isr.insns_max);
+    if (isr.have_cycles) {
+      add_num(fig, "isr_cycles_est_mean", isr.cycles_mean);
+      add_num(fig, "isr_cycles_est_max", isr.cycles_max);
+    }
+  }
 
   if (!quiet) {
     printf("scenario %s: %s\n", sc.name, sc.description);
     printf("  simulated %.1f s in %.2f s wall (%.2f s CPU): %.0fx real time (%.0fx per CPU second)\n",
            res.sim_s, res.wall_s, res.cpu_s, res.realtime_factor, res.realtime_factor_cpu);
+    if (isr_json != NULL) {
+      printf("  Cortex-M4F sample interrupt (%s): %.0f instructions per tick (worst %.0f)",
+             isr_json, isr.insns_mean, isr.insns_max);
+      if (isr.have_cycles) printf(", about %.0f cycles (worst %.0f)", isr.cycles_mean, isr.cycles_max);
+      printf("\n");
+    }
   }
   if (sc.analyses & SIM_AN_STARTUP) {
     const sim_startup_t *s = &res.startup;

@@ -2,6 +2,7 @@
 """Closed-loop acceptance test: run a gyro-sim scenario and check its JSON figures.
 
     check_scenario.py --sim PATH --scenario FILE [--set K=V ...] [--duration S]
+                      [--isr-figures BENCH_JSON]
                       --expect 'lock_time_s<=0.2' --expect 'q~33.33:0.02' ...
 
 Expectations: NAME<=X, NAME>=X, NAME==X, or NAME~X:REL (within REL relative of X), or
@@ -45,6 +46,7 @@ def main():
     p.add_argument("--scenario", required=True)
     p.add_argument("--set", action="append", default=[])
     p.add_argument("--duration", default=None)
+    p.add_argument("--isr-figures", default=None)
     p.add_argument("--expect", action="append", default=[])
     a = p.parse_args()
     with tempfile.TemporaryDirectory() as d:
@@ -54,6 +56,8 @@ def main():
             cmd += ["--set", s]
         if a.duration:
             cmd += ["--duration", a.duration]
+        if a.isr_figures:
+            cmd += ["--isr-figures", a.isr_figures]
         print(" ".join(cmd), flush=True)
         r = subprocess.run(cmd, text=True)
         if r.returncode != 0:

@@ -11,7 +11,7 @@
 static void test_design_formula(void **state)
 {
   (void)state;
-  const drive_loop_design_in_t in = {0.03125, 0.00712, 30.0, 270.0, 50000.0};
+  const drive_loop_design_in_t in = {0.03125, 0.00712, 30.0, 270.0, 50000.0, 1.0};
   drive_loop_design_out_t out;
   assert_int_equal(drive_loop_design(&in, &out), 0);
   const double wc = 2.0 * M_PI * 30.0;
@@ -25,7 +25,7 @@ static void test_design_formula(void **state)
 static void test_design_caps_bandwidth(void **state)
 {
   (void)state;
-  const drive_loop_design_in_t in = {1.0, 0.1, 1000.0, 270.0, 50000.0};
+  const drive_loop_design_in_t in = {1.0, 0.1, 1000.0, 270.0, 50000.0, 1.0};
   drive_loop_design_out_t out;
   assert_int_equal(drive_loop_design(&in, &out), 0);
   assert_true(out.bw_hz < 1000.0);
@@ -33,7 +33,19 @@ static void test_design_caps_bandwidth(void **state)
   const double wc = 2.0 * M_PI * out.bw_hz;
   const double pm = 90.0 - (atan(wc / (2 * M_PI * 270.0)) + wc * 1.5 / 50000.0) * 180.0 / M_PI;
   assert_true(fabs(pm - out.phase_margin_deg) < 1e-9);
+  /* Run once per 10 samples with the command held: 1 + 10/2 samples of delay. */
+  drive_loop_design_in_t held = in;
+  held.loop_decim = 10.0;
+  drive_loop_design_out_t out_h;
+  assert_int_equal(drive_loop_design(&held, &out_h), 0);
+  const double wch = 2.0 * M_PI * out_h.bw_hz;
+  const double pmh = 90.0 - (atan(wch / (2 * M_PI * 270.0)) + wch * 6.0 / 50000.0) * 180.0 / M_PI;
+  assert_true(fabs(pmh - out_h.phase_margin_deg) < 1e-9 && pmh >= 60.0);
+  assert_true(out_h.bw_hz < out.bw_hz);
   drive_loop_design_in_t bad = in;
+  bad.loop_decim = -1.0;
+  assert_int_equal(drive_loop_design(&bad, &out), -1);
+  bad = in;
   bad.tau_s = -1.0;
   assert_int_equal(drive_loop_design(&bad, &out), -1);
   bad = in;
@@ -62,7 +74,7 @@ static void test_closed_loop_first_order(void **state)
 {
   (void)state;
   const double fs = 50000.0, tau = 0.00712, k = 0.03125, bw = 30.0;
-  drive_loop_design_in_t in = {k, tau, bw, 270.0, fs};
+  drive_loop_design_in_t in = {k, tau, bw, 270.0, fs, 1.0};
   drive_loop_design_out_t amp, ph;
   in.plant_gain = k;
   assert_int_equal(drive_loop_design(&in, &amp), 0);
@@ -104,7 +116,7 @@ static void test_startup_no_overshoot(void **state)
 {
   (void)state;
   const double fs = 50000.0, tau = 0.00712, k = 0.03125;
-  drive_loop_design_in_t in = {k, tau, 30.0, 270.0, fs};
+  drive_loop_design_in_t in = {k, tau, 30.0, 270.0, fs, 1.0};
   drive_loop_design_out_t amp, ph;
   assert_int_equal(drive_loop_design(&in, &amp), 0);
   in.plant_gain = 1.0;

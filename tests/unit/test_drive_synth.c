@@ -26,7 +26,8 @@ static void check_force(gyro_drive_mode_t mode)
     nco_step(&nco, &o);
     const float p = -2.0f + 4.0f * (float)n / 200000.0f; /* sweep P through +-2 rad */
     float u1, u2;
-    drive_synth_step(&ds, f, p, o.phase, o.half_phase, &u1, &u2);
+    drive_synth_set(&ds, f, p);
+    drive_synth_step(&ds, o.phase, o.half_phase, &u1, &u2);
     const double phi = 2.0 * M_PI * (double)o.phase / 4294967296.0; /* the NCO's own phase */
     const double force = (double)u1 * u1 - (double)u2 * u2;
     const double err = fabs(force - f * cos(phi + p));
@@ -57,12 +58,42 @@ static void test_limits(void **state)
   assert_int_equal(drive_synth_init(&ds, &c), 0);
   assert_true(fabsf(drive_synth_f_cmd_max(&ds) - 196.0f) < 1e-4f);
   float u1, u2;
-  drive_synth_step(&ds, 196.0f, 0.0f, 0u, 0u, &u1, &u2);
+  drive_synth_set(&ds, 196.0f, 0.0f);
+  drive_synth_step(&ds, 0u, 0u, &u1, &u2);
   assert_true(u1 <= 14.0f + 1e-4f && u2 >= -1e-4f);
   c.dc_bias_v = 14.0f; /* no room for AC */
   assert_int_equal(drive_synth_init(&ds, &c), -1);
   c.mode = (gyro_drive_mode_t)7;
   assert_int_equal(drive_synth_init(&ds, &c), -1);
+}
+
+/* A NaN or infinite command gives zero volts, never a rail: the loop state is checked
+ * once per block, the waveform runs every sample. */
+static void test_non_finite_command(void **state)
+{
+  (void)state;
+  const gyro_drive_mode_t modes[] = {GYRO_DRIVE_HALF_FREQ, GYRO_DRIVE_DC_AC};
+  const float bad[] = {NAN, INFINITY, -INFINITY};
+  for (int m = 0; m < 2; m++) {
+    drive_synth_t ds;
+    drive_synth_cfg_t c = {.mode = modes[m], .dc_bias_v = 7.0f, .u_max_v = 14.0f};
+    assert_int_equal(drive_synth_init(&ds, &c), 0);
+    for (int i = 0; i < 3; i++) {
+      for (int j = 0; j < 3; j++) {
+        drive_synth_set(&ds, bad[i], j == 0 ? 0.3f : bad[j]);
+        for (uint32_t ph = 0u; ph < 0xF0000000u; ph += 0x10000000u) {
+          float u1, u2;
+          drive_synth_step(&ds, ph, ph / 2u, &u1, &u2);
+          const float rest = modes[m] == GYRO_DRIVE_DC_AC ? 7.0f : 0.0f;
+          assert_true(u1 == rest && u2 == rest);
+        }
+        drive_synth_set(&ds, 64.0f, bad[i]); /* finite force, bad phase: bounded */
+        float u1, u2;
+        drive_synth_step(&ds, 123u, 45u, &u1, &u2);
+        assert_true(isfinite(u1) && isfinite(u2) && fabsf(u1) <= 14.0f && fabsf(u2) <= 14.0f);
+      }
+    }
+  }
 }
 
 int main(void)
@@ -71,6 +102,7 @@ int main(void)
       cmocka_unit_test(test_half_frequency_force),
       cmocka_unit_test(test_dc_ac_force),
       cmocka_unit_test(test_limits),
+      cmocka_unit_test(test_non_finite_command),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

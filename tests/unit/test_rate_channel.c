@@ -15,9 +15,17 @@ static rate_channel_cfg_t base_cfg(biquad_coeffs_t *sec, float phi_dm)
   assert_int_equal(n, 2);
   rate_channel_cfg_t c = {.ref_re = cosf(phi_dm), .ref_im = sinf(phi_dm), .scale_dps = 250.0f,
                           .bias_c_dps = {0, 0, 0, 0}, .sf_c = {0, 0, 0, 0},
-                          .p_ref_deg = 0.0f, .p_lpf_alpha = 0.5f, .p_mode_k = 2.8e-3f, .lpf = sec,
+                          .p_ref_deg = 0.0f, .p_lpf_alpha = 0.5f, .p_mode_k = 2.7658e-2f, /* 1 - (1 - 2.8e-3)^10 per block */ .lpf = sec,
                           .lpf_sections = (uint32_t)n, .min_drive_v = 0.1f};
   return c;
+}
+
+/* One block as gyro_tick feeds the channel: the same sense phasor on every tick. */
+static void block(rate_channel_t *rc, float d_s, float d_c, float s_s, float s_c, float p_rad)
+{
+  for (uint32_t i = 0; i < RATE_DECIM; i++) rate_channel_accumulate(rc, s_s, s_c);
+  rate_channel_update(rc, d_s, d_c, p_rad);
+  rate_channel_update_quad(rc);
 }
 
 /* A sense phasor built as (r + j q) A_set e^{j psi} must come out as rate r and
@@ -36,7 +44,7 @@ static void test_phasor_separation(void **state)
     rate_channel_t rc;
     assert_int_equal(rate_channel_init(&rc, &c), 0);
     const double er = amp * (r * cos(psi) - q * sin(psi)), ei = amp * (r * sin(psi) + q * cos(psi));
-    rate_channel_step(&rc, (float)(0.3 * cos(th)), (float)(0.3 * sin(th)), (float)er, (float)ei, 0.0f);
+    block(&rc, (float)(0.3 * cos(th)), (float)(0.3 * sin(th)), (float)er, (float)ei, 0.0f);
     assert_true(fabs((double)rc.rate_raw - r) < 2e-6);
     assert_true(fabs((double)rc.quad_raw - q) < 2e-6);
   }
@@ -50,7 +58,7 @@ static void test_phase_error_leakage(void **state)
   rate_channel_cfg_t c = base_cfg(sec, 0.01f);
   rate_channel_t rc;
   assert_int_equal(rate_channel_init(&rc, &c), 0);
-  rate_channel_step(&rc, 1.0f, 0.0f, 0.0f, 1.0f, 0.0f); /* pure quadrature, phi_dm true = 0 */
+  block(&rc, 1.0f, 0.0f, 0.0f, 1.0f, 0.0f); /* pure quadrature, phi_dm true = 0 */
   assert_true(fabs((double)rc.rate_raw - sin(0.01)) < 1e-6);
 }
 
@@ -69,14 +77,15 @@ static void test_compensation_polynomials(void **state)
   rate_channel_t rc;
   assert_int_equal(rate_channel_init(&rc, &c), 0);
   rate_channel_reset(&rc, -1.5f);
-  const double p_deg = -1.7, r = 0.2;
-  for (int n = 0; n < 50000; n++) {
-    rate_channel_step(&rc, 1.0f, 0.0f, (float)r, 0.0f, (float)(p_deg * M_PI / 180.0));
+  const double p_deg = -1.7, r = 0.2, q = -0.05;
+  for (int n = 0; n < 5000; n++) {
+    block(&rc, 1.0f, 0.0f, (float)r, (float)q, (float)(p_deg * M_PI / 180.0));
   }
   const double sf = 1.0 + 1e-3 * p_deg - 2e-6 * p_deg * p_deg * p_deg;
   const double bias = 58.533 + 34.59 * p_deg + 0.1 * p_deg * p_deg;
   assert_true(fabs((double)rc.p_f_deg - p_deg) < 1e-5);
   assert_true(fabs((double)rc.rate_unc_dps - 250.0 * r) < 250.0 * r * 1e-5);
+  assert_true(fabs((double)rc.quad_dps - 250.0 * q) < 250.0 * fabs(q) * 1e-5); /* not compensated */
   assert_true(fabs((double)rc.rate_dps - (250.0 * r * sf - bias)) < 1e-3);
 }
 
@@ -93,8 +102,8 @@ static void test_p_lowpass_resolution(void **state)
   assert_int_equal(rate_channel_init(&rc, &c), 0);
   rate_channel_reset(&rc, -100.0f);
   const double p_deg = -100.0 + 1e-4;
-  for (int n = 0; n < 500000; n++) {
-    rate_channel_step(&rc, 1.0f, 0.0f, 0.0f, 0.0f, (float)(p_deg * M_PI / 180.0));
+  for (int n = 0; n < 50000; n++) {
+    block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, (float)(p_deg * M_PI / 180.0));
   }
   assert_true(fabs((double)rc.p_f_deg - p_deg) < 2e-5);
 }
@@ -118,7 +127,8 @@ static void test_dc_linearity(void **state)
     for (long n = 0; n < 400000; n++) {
       lcg = lcg * 1664525u + 1013904223u;
       const double noise = 1e-3 * ((double)(lcg >> 8) / 16777216.0 - 0.5);
-      rate_channel_step(&rc, 1.0f, 0.0f, (float)(levels[i] + noise), 0.0f, 0.0f);
+      rate_channel_accumulate(&rc, (float)(levels[i] + noise), 0.0f);
+      if (n % RATE_DECIM == RATE_DECIM - 1) rate_channel_update(&rc, 1.0f, 0.0f, 0.0f);
       if (n >= 50000 && n % RATE_DECIM == RATE_DECIM - 1) {
         sum += rc.rate_unc_dps;
         n_sum++;
@@ -149,7 +159,9 @@ static void test_reference_follows_drive_jitter(void **state)
     const double p = dp;           /* P stepped at n = 0 */
     lag += k * (p - lag);          /* the structure's response (6-17) */
     const double sr = -q * sin(lag), si = q * cos(lag); /* quadrature turned by the true phase */
-    rate_channel_step(&rc, 1.0f, 0.0f, (float)sr, (float)si, (float)p);
+    rate_channel_accumulate(&rc, (float)sr, (float)si);
+    if (n % RATE_DECIM != RATE_DECIM - 1) continue;
+    rate_channel_update(&rc, 1.0f, 0.0f, (float)p);
     if (n > 100 && fabs((double)rc.rate_raw) > worst) worst = fabs((double)rc.rate_raw);
   }
   /* Left: P's 1 Hz low-pass moving over 50 ms (2 pi 1 Hz 0.05 s ~ 0.3 of dp at most). */
@@ -165,7 +177,7 @@ static void test_no_drive(void **state)
   rate_channel_cfg_t c = base_cfg(sec, 0.0f);
   rate_channel_t rc;
   assert_int_equal(rate_channel_init(&rc, &c), 0);
-  rate_channel_step(&rc, 0.0f, 0.0f, 1.0f, 1.0f, 0.0f); /* drive below min_drive_v */
+  block(&rc, 0.0f, 0.0f, 1.0f, 1.0f, 0.0f); /* drive below min_drive_v */
   assert_true(rc.rate_raw == 0.0f && rc.quad_raw == 0.0f);
   assert_true(isfinite(rc.rate_dps));
   c.p_lpf_alpha = 0.0f;

@@ -19,7 +19,7 @@ static supervisor_cfg_t cfg(void)
 static supervisor_in_t good(void)
 {
   supervisor_in_t in = {.amp_rel_err = 0.0f, .amp_rel = 1.0f, .phase_err_rad = 0.0f,
-                        .drive_at_limit = 0, .adc_at_rail = 0, .state_finite = 1};
+                        .drive_at_limit = 0, .clip_run = 0u, .state_finite = 1};
   return in;
 }
 
@@ -121,17 +121,14 @@ static void test_immediate_faults(void **state)
   assert_int_equal(supervisor_step(&sv, &in), 1);
   assert_int_equal(sv.fault, GYRO_FAULT_NAN);
 
-  /* Clipping needs clip_max_count consecutive rail codes. */
+  /* Clipping: a run of clip_max_count consecutive rail codes (gyro_tick counts them). */
   assert_int_equal(supervisor_init(&sv, &c), 0);
   supervisor_start(&sv);
   in = good();
-  in.adc_at_rail = 1;
-  run(&sv, &in, 2);
-  in.adc_at_rail = 0;
-  run(&sv, &in, 1);
-  in.adc_at_rail = 1;
-  run(&sv, &in, 2);
+  in.clip_run = c.clip_max_count - 1u;
+  run(&sv, &in, 5);
   assert_int_equal(sv.mode, GYRO_MODE_ACQUIRE);
+  in.clip_run = c.clip_max_count;
   run(&sv, &in, 1);
   assert_int_equal(sv.mode, GYRO_MODE_FAULT);
   assert_int_equal(sv.fault, GYRO_FAULT_ADC_CLIP);

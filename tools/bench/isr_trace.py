@@ -31,6 +31,9 @@ from collections import Counter, OrderedDict
 HANDLER = "DMA2_Stream0_IRQHandler"
 RETURN_TO = "run_irq"                           # the bench loop that pends the interrupt
 SCAFFOLD = {"bench_cb", "bench_board_clear_tc"}  # not in the product's path
+# Kept although not in the product's path either: __app_sample_isr_veneer, the long
+# branch from bench_cb (flash) to app_sample_isr (SRAM); the product's handler calls it
+# through a pointer. One instruction per interrupt that the -icount counter also sees.
 
 TRACE_RE = re.compile(rb"^Trace \d+: 0x[0-9a-f]+ \[[0-9a-f]+/([0-9a-f]+)/")
 DIS_RE = re.compile(r"^\s*([0-9a-f]+):\t([0-9a-f]{4})(?: ([0-9a-f]{4}))?\s*\t(\S+)\s*(.*)$")
@@ -70,6 +73,17 @@ def symbols(nm, elf):
             funcs.append((int(parts[0], 16) & ~1, int(parts[1], 16), parts[3]))
     funcs.sort()
     return funcs
+
+
+def data_symbol(nm, elf, name):
+    """Address of a data symbol, or None."""
+    out = subprocess.run([nm, "--defined-only", elf], check=True, capture_output=True,
+                         text=True).stdout
+    for line in out.splitlines():
+        parts = line.split()
+        if len(parts) == 3 and parts[2] == name:
+            return int(parts[0], 16)
+    return None
 
 
 class FuncMap:
@@ -136,7 +150,14 @@ class CycleModel:
     prefetch overlaps it with the previous line, stalling max(0, 6 - cycles spent in
     that line). Literal-pool loads go through the data cache (+5 on a miss); loads from
     the sine table in sincos_lut are taken as misses for the first of each k, k+1 pair.
-    Code in SRAM (.ramfunc) and data in SRAM: no wait states (bus contention ignored).
+    Each instruction is priced by where it sits: the image puts the sample path in SRAM
+    (.ramfunc, linker/stm32f405_sections.ld), so "flash" below prices the flash model
+    only for what is still fetched from flash. SRAM code has no wait states, but its
+    fetches share the S-bus with data accesses to SRAM: a stack access (sp-relative
+    load/store, PUSH/POP per register) or a literal-pool load from SRAM code costs one
+    cycle more. The state (app_t) and the sine table live in CCM on the D-bus (no
+    contention); the sine table is priced as flash data only when the image leaves it
+    in flash. "zero wait" ignores all of this (every access one cycle).
     The cache is fully associative LRU here (the ART's organisation is not documented
     in that detail), which flatters the warm case.
     """
@@ -144,6 +165,7 @@ class CycleModel:
     P = 2
     FLASH_LINE = 6
     FLASH_LO, FLASH_HI = 0x08000000, 0x08100000
+    SRAM_LO, SRAM_HI = 0x20000000, 0x20020000
 
     FP1 = {"vadd", "vsub", "vmul", "vnmul", "vneg", "vabs", "vcmp", "vcmpe", "vcvt", "vmrs",
            "vmsr", "vcvtr", "vcvtb", "vcvtt"}
@@ -238,6 +260,12 @@ class CycleModel:
                     a = ((pc + 4) & ~3) + int(lit.group(1))
                     if self.FLASH_LO <= a < self.FLASH_HI:
                         c += self._touch(dcache, a >> 4, 8) * (self.FLASH_LINE - 1)
+            # SRAM code: S-bus shared by the fetch and SRAM data (stack, literal pool)
+            if flash and self.SRAM_LO <= pc < self.SRAM_HI:
+                if root in self.MULTI and ("sp" in ops or root in ("push", "pop", "vpush", "vpop")):
+                    c += self._nregs(ops)
+                elif root in self.LDST1 | {"ldrd", "strd"} and re.search(r"\[(sp|pc)\b", ops):
+                    c += 1
             if flash and root == "vldr" and self._in_sincos(pc):
                 c += 0 if sine_pair_hit else self.FLASH_LINE - 1
                 sine_pair_hit = not sine_pair_hit
@@ -303,8 +331,10 @@ def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm"):
     funcs = symbols(nm, elf)
     fmap = FuncMap(funcs)
     model = CycleModel(insns)
+    table = data_symbol(nm, elf, "sincos_table")
+    table_in_flash = table is not None and CycleModel.FLASH_LO <= table < CycleModel.FLASH_HI
     for start, size, name in funcs:
-        if name == "sincos_lut":
+        if name == "sincos_lut" and table_in_flash:
             model.set_sincos(start, size)
     isrs = list(read_isrs(lines, fmap))
     if not isrs:
@@ -345,6 +375,7 @@ def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm"):
         "insns_min": min(counts),
         "insns_max": max(counts),
         "insns_each": counts,
+        "cycles_each": cold,  # as linked, ART cold: one per interrupt, in order
         "per_function_mean": {k: v / n for k, v in per_func.most_common()},
         "per_function_cycles_mean": {k: {"flash_cold": cyc_cold[k] / n, "zero_wait": cyc_sram[k] / n}
                                      for k, _ in cyc_cold.most_common()},
