@@ -32,6 +32,10 @@ typedef enum {
   APP_REQ_SELFTEST = 5u        /* run the built-in self-test (selftest.h) */
 } app_req_t;
 
+/* Lines an image adds to the status reply (board figures: stack, sample clock), written
+ * with cli_put / cli_emit_data before the final ok line. */
+typedef void (*app_status_fn)(cli_t *cli, void *ctx);
+
 typedef struct {
   params_t params;
   gyro_design_t derived[2];  /* the bank's derived blocks */
@@ -50,6 +54,9 @@ typedef struct {
   uint32_t isr_cycles_last;
   uint32_t isr_cycles_max;
   uint32_t isr_ticks;
+  /* Set by the image's main after app_init (NULL: nothing added, as on the host). */
+  app_status_fn status_board;
+  void *status_board_ctx;
 } app_t;
 
 /* Load the stored parameters (defaults if the store is empty or corrupt), design, init

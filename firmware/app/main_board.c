@@ -1,6 +1,6 @@
 /* Entry point of the product image gyro-fw. Built with STM32F4_QEMU (the QEMU board
- * layer) it also runs in the emulator: no WFI, the UART drained from the loop, SRAM
- * instead of CCM.
+ * layer) it also runs in the emulator as gyro-fw-qemu, the plant model in place of the
+ * converters: no WFI, the UART drained from the loop.
  *
  *   boot: Reset_Handler (clock tree, .data/.bss/.ccm) -> main: board (pins, converter
  *   resets, DAC sequencer, UART), app_init (parameters from the flash store, or the
@@ -14,7 +14,11 @@
  * sample chain. The watchdog starts after app_init, whose init-time design (double
  * precision, libm) is not bounded by the 250 ms timeout; a parameter save reloads it
  * from the flash driver's wait loop (stm32f4_flash.c), and is refused while the drive
- * runs (param_store), so an erase never stalls a running loop. */
+ * runs (param_store), so an erase never stalls a running loop.
+ *
+ * status gains the board's lines (board_status): tick overruns, late DAC frames, and the
+ * main stack's size and high-water marks (since reset, and of the running loop alone).
+ * The emulator image also has the `emu` command (main_board_emu.h). */
 #include <stdint.h>
 
 #include "app/app.h"
@@ -22,26 +26,51 @@
 #include "hal/hal_uart.h"
 #include "stm32f4_board.h"
 #include "stm32f4_core.h"
+#include "stm32f4_dac.h"
 #include "stm32f4_iwdg.h"
+#include "stm32f4_sample.h"
+#include "stm32f4_stack.h"
 #include "stm32f4_uart.h"
+#ifdef STM32F4_QEMU
+#include "stm32f4_qemu.h"
+#endif
+#ifdef STM32F4_QEMU_PLANT
+#include "main_board_emu.h"
+#endif
 
 #define SAMPLE_RATE_HZ 50000u
 #define WATCHDOG_MS 250u
 
-/* QEMU's netduinoplus2 maps no CCM (a write there is a bus fault): ordinary SRAM. */
-#ifdef STM32F4_QEMU
-#define APP_STATE_RAM
-#else
-#define APP_STATE_RAM STM32F4_CCM_BSS
-#endif
-
-static APP_STATE_RAM app_t s_app;
+/* In QEMU's netduinoplus2, which maps no CCM, the emulator images' memory map
+ * (linker/stm32f405_qemu.ld) puts the CCM sections at the top of its SRAM. */
+static STM32F4_CCM_BSS app_t s_app;
 
 static void say(const char *s)
 {
   uint32_t n = 0u;
   while (s[n] != '\0') ++n;
   (void)hal_uart_write((const uint8_t *)s, n);
+}
+
+/* The board's lines of the status reply: sample-clock health and the main stack. */
+static void board_status(cli_t *cli, void *ctx)
+{
+  (void)ctx;
+  stm32f4_sample_stats_t st;
+  stm32f4_sample_stats(&st);
+  const struct {
+    const char *key;
+    uint32_t v;
+  } rows[] = {{"tick_overruns ", st.overruns},
+              {"dac_late ", stm32f4_dac_late()},
+              {"stack_size_bytes ", stm32f4_stack_size_bytes()},
+              {"stack_hwm_bytes ", stm32f4_stack_hwm_bytes()},
+              {"stack_run_bytes ", stm32f4_stack_run_bytes()}};
+  for (uint32_t i = 0u; i < sizeof rows / sizeof rows[0]; ++i) {
+    cli_put(cli, rows[i].key);
+    cli_put_u32(cli, rows[i].v);
+    cli_emit_data(cli);
+  }
 }
 
 int main(void)
@@ -65,6 +94,13 @@ int main(void)
       stm32f4_iwdg_kick();
     }
   }
+  a->status_board = board_status;
+#ifdef STM32F4_QEMU_PLANT
+  if (main_board_emu_init(a) != 0) say("gyro-fw error: emu command not registered\r\n");
+#endif
+  /* The init-time design is done: what the stack holds from here on is the running
+   * loop's (status: stack_run_bytes; stack_hwm_bytes keeps the deepest since reset). */
+  stm32f4_stack_mark();
   say("gyro-fw ready\r\n");
   if (hal_sample_timer_start(SAMPLE_RATE_HZ, app_sample_isr, a) != 0) {
     say("gyro-fw error: sample clock did not start\r\n");
@@ -73,6 +109,7 @@ int main(void)
     app_poll(a);
 #ifdef STM32F4_QEMU
     stm32f4_uart_poll_tx();
+    stm32f4_qemu_idle(); /* fewer register polls per emulated instruction (stm32f4_qemu.h) */
 #endif
     stm32f4_iwdg_kick();
 #ifndef STM32F4_QEMU

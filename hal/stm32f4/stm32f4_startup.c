@@ -2,7 +2,8 @@
  * and 82 interrupts).
  *
  * Reset_Handler, in this order: FPU access on (CPACR CP10/CP11) before any code that
- * may touch a float register; .data, .ramfunc and .ccm_data copied from their load
+ * may touch a float register; the main stack below its own frame painted for the
+ * high-water mark (stm32f4_stack.h); .data, .ramfunc and .ccm_data copied from their load
  * addresses in flash; .bss and .ccm_bss zeroed (.noinit, the fault record, is left
  * alone); the vector table copied to SRAM and VTOR pointed at it, so that interrupts
  * keep being dispatched while a flash erase stalls fetches from flash; then
@@ -13,12 +14,13 @@
 #include "stm32f4_board.h"
 #include "stm32f4_core.h"
 #include "stm32f4_fault.h"
+#include "stm32f4_stack.h"
 #include "stm32f4_regs.h"
 
 #define NUM_VECTORS (16u + STM32F4_NUM_IRQS)
 
 /* Linker-script symbols (linker/stm32f405.ld). */
-extern uint32_t _estack[];
+extern uint32_t _sstack[], _estack[];
 extern uint32_t _sidata[], _sdata[], _edata[];
 extern uint32_t _siramfunc[], _sramfunc[], _eramfunc[];
 extern uint32_t _siccm_data[], _sccm_data[], _eccm_data[];
@@ -88,18 +90,32 @@ static STM32F4_BOOT_TEXT void copy_words(uint32_t *dst, const uint32_t *src, con
   }
 }
 
-static STM32F4_BOOT_TEXT void zero_words(uint32_t *dst, const uint32_t *end)
+static STM32F4_BOOT_TEXT void fill_words(uint32_t *dst, const uint32_t *end, uint32_t v)
 {
   while (dst < end) {
-    *dst++ = 0u;
+    *dst++ = v;
   }
 }
+
+static STM32F4_BOOT_TEXT void zero_words(uint32_t *dst, const uint32_t *end)
+{
+  fill_words(dst, end, 0u);
+}
+
+/* Words of the stack left unpainted below Reset_Handler's stack pointer: its own frame
+ * and that of fill_words. */
+#define PAINT_GUARD_WORDS 16u
 
 STM32F4_BOOT_TEXT void Reset_Handler(void)
 {
   CPACR |= CPACR_CP10_CP11_FULL;
   stm32f4_dsb();
   stm32f4_isb();
+
+  uintptr_t sp;
+  __asm volatile("mov %0, sp" : "=r"(sp));
+  fill_words(_sstack, (const uint32_t *)(sp & ~(uintptr_t)3u) - PAINT_GUARD_WORDS,
+             STM32F4_STACK_PAINT);
 
   copy_words(_sdata, _sidata, _edata);
   copy_words(_sramfunc, _siramfunc, _eramfunc);

@@ -8,17 +8,39 @@
  *                 reads and writes real data
  *   cycles        SysTick periods elapsed x 3360 + SysTick count (no DWT in QEMU)
  *   uptime        TIM2 free running, prescaled to 1 MHz of emulated time
- * Everything else (UART driver, fault capture, start-up, flash driver) is the board's. */
+ * Everything else (UART driver, fault capture, start-up, flash driver) is the board's.
+ *
+ * With STM32F4_QEMU_PLANT (gyro-fw-qemu) the converters are the plant model instead
+ * (stm32f4_qemu_plant.c), stepped after the application's ISR in the SysTick handler,
+ * and the SysTick period is STM32F4_QEMU_TICK_STRETCH times the requested one: the
+ * double-precision plant runs in software on the single-precision FPU and needs far more
+ * than the 3360 cycles of a 20 us tick. The firmware and the plant still advance one
+ * 50 kHz sample per tick; only emulated wall time runs slower. The handler times the
+ * application's ISR and the plant with TIM2 as an emulated-nanosecond counter and counts
+ * overrun and lost ticks (stm32f4_qemu.h). */
 #include "hal/hal_adc.h"
+#include "hal/hal_critical.h"
 #include "hal/hal_dac.h"
 #include "hal/hal_sample_timer.h"
 #include "stm32f4_board.h"
 #include "stm32f4_core.h"
 #include "stm32f4_dac.h"
 #include "stm32f4_fault.h"
+#include "stm32f4_qemu.h"
 #include "stm32f4_sample.h"
 #include "stm32f4_uart.h"
 #include "stm32f4_uptime.h"
+#ifdef STM32F4_QEMU_PLANT
+#include "stm32f4_qemu_plant.h"
+#endif
+
+#ifndef STM32F4_QEMU_TICK_STRETCH
+#define STM32F4_QEMU_TICK_STRETCH 1u
+#endif
+
+/* Turns of the background loop's pause (stm32f4_qemu_idle): a few thousand
+ * instructions between two passes over the UART and watchdog registers. */
+#define STM32F4_QEMU_IDLE_SPINS 2000u
 
 #define QEMU_SYSCLK_HZ 168000000u
 #define QEMU_TIM_HZ 1000000000u /* QEMU's STM32 timer model counts its input at 1 GHz */
@@ -29,7 +51,15 @@ static hal_sample_isr_fn s_isr;
 static void *s_ctx;
 static volatile uint32_t s_wraps;
 static volatile uint32_t s_ticks;
+#ifdef STM32F4_QEMU_PLANT
+static stm32f4_qemu_tick_stats_t s_tick;
+static uint32_t s_t_prev_ns;    /* TIM2 at the previous handler entry */
+static uint32_t s_cycles_per_sample; /* 168 MHz / rate_hz */
+static uint32_t s_ns_per_sample;     /* 1e9 / rate_hz */
+static uint32_t s_lost_skip;         /* ticks after a stretch change: periods mixed */
+#else
 static hal_dac_frame_t s_dac;
+#endif
 
 void stm32f4_system_init(void)
 {
@@ -47,24 +77,41 @@ const stm32f4_board_info_t *stm32f4_board_info(void)
 
 int stm32f4_board_init(void)
 {
+#ifdef STM32F4_QEMU_PLANT
+  if (stm32f4_qemu_plant_init() != 0) return -1;
+  /* TIM2 undivided: QEMU's timer input is 1 GHz of emulated time (stm32f4_qemu.h). */
+  TIM2->CR1 = 0u;
+  TIM2->PSC = 0u;
+  TIM2->ARR = 0xFFFFFFFFu;
+  TIM2->CR1 = TIM_CR1_CEN;
+#else
   for (uint32_t ch = 0u; ch < HAL_DAC_NUM_CHANNELS; ++ch) {
     s_dac.code[ch] = (uint16_t)HAL_DAC_CODE_MID;
   }
+#endif
   return stm32f4_uart_init(s_info.clock.pclk2_hz, STM32F4_UART_BAUD);
 }
 
 int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
 {
   if (isr == 0 || rate_hz == 0u || QEMU_SYSCLK_HZ % rate_hz != 0u ||
-      QEMU_SYSCLK_HZ / rate_hz > 0x1000000u) {
+      QEMU_SYSCLK_HZ / rate_hz > 0x1000000u / STM32F4_QEMU_TICK_STRETCH) {
     return -1;
   }
   hal_sample_timer_stop();
   s_isr = isr;
   s_ctx = ctx;
   s_ticks = 0u;
+#ifdef STM32F4_QEMU_PLANT
+  s_tick = (stm32f4_qemu_tick_stats_t){0};
+  s_tick.stretch = STM32F4_QEMU_TICK_STRETCH;
+  s_tick.period_ns = 1000000000u / rate_hz * STM32F4_QEMU_TICK_STRETCH;
+  s_cycles_per_sample = QEMU_SYSCLK_HZ / rate_hz;
+  s_ns_per_sample = 1000000000u / rate_hz;
+  s_lost_skip = 0u;
+#endif
   SCB->SHPR[SYSTICK_SHPR_INDEX] = (uint8_t)(STM32F4_PRIO_SAMPLE << 4);
-  SYSTICK->LOAD = QEMU_SYSCLK_HZ / rate_hz - 1u;
+  SYSTICK->LOAD = QEMU_SYSCLK_HZ / rate_hz * STM32F4_QEMU_TICK_STRETCH - 1u;
   SYSTICK->VAL = 0u;
   SYSTICK->CTRL = SYSTICK_CTRL_CLKSOURCE | SYSTICK_CTRL_TICKINT | SYSTICK_CTRL_ENABLE;
   return 0;
@@ -76,11 +123,74 @@ void hal_sample_timer_stop(void)
 }
 
 void SysTick_Handler(void);
+#ifdef STM32F4_QEMU_PLANT
+STM32F4_RAMFUNC void SysTick_Handler(void)
+{
+  const uint32_t t0 = TIM2->CNT;
+  (void)SYSTICK->CTRL; /* clears COUNTFLAG, set by the wrap that raised this tick */
+  s_wraps = s_wraps + 1u;
+  s_ticks = s_ticks + 1u;
+  if (s_isr != 0) s_isr(s_ctx);
+  const uint32_t t1 = TIM2->CNT;
+  stm32f4_qemu_plant_tick();
+  const uint32_t t2 = TIM2->CNT;
+
+  stm32f4_qemu_tick_stats_t *st = &s_tick;
+  if (s_lost_skip > 0u) {
+    s_lost_skip--;
+  } else if (st->ticks > 0u) {
+    /* Whole periods since the previous tick (< 4.3 s apart): more than one were lost. */
+    const uint32_t periods = (t0 - s_t_prev_ns + st->period_ns / 2u) / st->period_ns;
+    if (periods > 1u) st->lost += periods - 1u;
+  }
+  s_t_prev_ns = t0;
+  st->ticks++;
+  if ((SYSTICK->CTRL & SYSTICK_CTRL_COUNTFLAG) != 0u) st->overruns++;
+  st->isr_ns_last = t1 - t0;
+  st->plant_ns_last = t2 - t1;
+  st->isr_ns_sum += st->isr_ns_last;
+  st->plant_ns_sum += st->plant_ns_last;
+  if (st->isr_ns_last > st->isr_ns_max) st->isr_ns_max = st->isr_ns_last;
+  if (st->plant_ns_last > st->plant_ns_max) st->plant_ns_max = st->plant_ns_last;
+}
+
+void stm32f4_qemu_tick_stats(stm32f4_qemu_tick_stats_t *s)
+{
+  if (s == 0) return;
+  const uint32_t pm = hal_critical_enter();
+  *s = s_tick;
+  hal_critical_exit(pm);
+}
+
+int stm32f4_qemu_set_stretch(uint32_t stretch)
+{
+  if (s_cycles_per_sample == 0u || stretch == 0u ||
+      stretch > 0x1000000u / s_cycles_per_sample) {
+    return -1;
+  }
+  const uint32_t pm = hal_critical_enter();
+  /* Taken at the next reload: the period running now keeps its length. */
+  SYSTICK->LOAD = s_cycles_per_sample * stretch - 1u;
+  s_tick.stretch = stretch;
+  s_tick.period_ns = s_ns_per_sample * stretch;
+  s_lost_skip = 2u;
+  hal_critical_exit(pm);
+  return 0;
+}
+#else
 STM32F4_RAMFUNC void SysTick_Handler(void)
 {
   s_wraps = s_wraps + 1u;
   s_ticks = s_ticks + 1u;
   if (s_isr != 0) s_isr(s_ctx);
+}
+#endif
+
+void stm32f4_qemu_idle(void)
+{
+  for (uint32_t i = 0u; i < STM32F4_QEMU_IDLE_SPINS; ++i) {
+    __asm volatile("" ::: "memory");
+  }
 }
 
 STM32F4_RAMFUNC uint32_t hal_cycles_now(void)
@@ -95,6 +205,7 @@ STM32F4_RAMFUNC uint32_t hal_cycles_now(void)
   return w1 * (load + 1u) + (load - val);
 }
 
+#ifndef STM32F4_QEMU_PLANT
 static int16_t loopback_code(uint16_t dac_code)
 {
   return (int16_t)(((int32_t)dac_code - (int32_t)HAL_DAC_CODE_MID) * 4);
@@ -110,12 +221,17 @@ STM32F4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame)
 {
   s_dac = *frame;
 }
+#endif
 
 void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
 {
   if (stats == 0) return;
   stats->ticks = s_ticks;
+#ifdef STM32F4_QEMU_PLANT
+  stats->overruns = s_tick.overruns;
+#else
   stats->overruns = 0u;
+#endif
   stats->dma_errors = 0u;
 }
 

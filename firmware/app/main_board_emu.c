@@ -1,0 +1,129 @@
+#include "main_board_emu.h"
+
+#include <string.h>
+
+#include "comm/numparse.h"
+#include "qemu_plant_setup.h"
+#include "stm32f4_qemu.h"
+#include "stm32f4_qemu_plant.h"
+
+#define TRACE_LINES_PER_REPLY 16u /* 16 short lines: well inside the 1 KB UART TX ring */
+
+static void kv_u(cli_t *cli, const char *k, uint32_t v)
+{
+  cli_put(cli, k);
+  cli_put(cli, " ");
+  cli_put_u32(cli, v);
+  cli_emit_data(cli);
+}
+
+static void kv_f(cli_t *cli, const char *k, float v)
+{
+  cli_put(cli, k);
+  cli_put(cli, " ");
+  cli_put_f32(cli, v);
+  cli_emit_data(cli);
+}
+
+static void emu_figures(cli_t *cli)
+{
+  stm32f4_qemu_tick_stats_t st;
+  stm32f4_qemu_tick_stats(&st);
+  kv_u(cli, "stretch", st.stretch);
+  kv_u(cli, "period_ns", st.period_ns);
+  kv_u(cli, "ticks", st.ticks);
+  kv_u(cli, "tick_overruns", st.overruns);
+  kv_u(cli, "ticks_lost", st.lost);
+  const float n = st.ticks > 0u ? (float)st.ticks : 1.0f;
+  kv_u(cli, "isr_ns_last", st.isr_ns_last);
+  kv_u(cli, "isr_ns_max", st.isr_ns_max);
+  kv_f(cli, "isr_ns_mean", (float)st.isr_ns_sum / n);
+  kv_u(cli, "plant_ns_last", st.plant_ns_last);
+  kv_u(cli, "plant_ns_max", st.plant_ns_max);
+  kv_f(cli, "plant_ns_mean", (float)st.plant_ns_sum / n);
+  kv_f(cli, "plant_rate_dps", (float)stm32f4_qemu_plant_rate_dps());
+  kv_u(cli, "trace_n", stm32f4_qemu_trace_count());
+  kv_u(cli, "trace_len", QEMU_TRACE_LEN);
+  kv_u(cli, "trace_every", QEMU_TRACE_EVERY);
+  cli_ok(cli, "emu");
+}
+
+static void emu_rate(cli_t *cli, const char *arg)
+{
+  float v;
+  if (numparse_f32(arg, strlen(arg), &v) != NUMPARSE_OK) {
+    cli_err(cli, "VALUE", "rate: a number in deg/s");
+    return;
+  }
+  const int rc = stm32f4_qemu_plant_set_rate((double)v);
+  if (rc == -1) {
+    cli_err(cli, "RANGE", "rate: |DPS| <= 10000");
+    return;
+  }
+  if (rc != 0) {
+    cli_err(cli, "BUSY", "the previous rate move has not been taken yet");
+    return;
+  }
+  cli_put(cli, "rate ");
+  cli_put_f32(cli, v);
+  cli_emit_ok(cli);
+}
+
+static void emu_stretch(cli_t *cli, const char *arg)
+{
+  uint32_t n;
+  if (numparse_u32(arg, strlen(arg), &n) != NUMPARSE_OK || stm32f4_qemu_set_stretch(n) != 0) {
+    cli_err(cli, "RANGE", "stretch N: 1..4993 sample periods per tick");
+    return;
+  }
+  cli_put(cli, "stretch ");
+  cli_put_u32(cli, n);
+  cli_emit_ok(cli);
+}
+
+static void emu_trace(cli_t *cli, const char *arg)
+{
+  uint32_t from;
+  if (numparse_u32(arg, strlen(arg), &from) != NUMPARSE_OK || from > QEMU_TRACE_LEN) {
+    cli_err(cli, "RANGE", "trace FROM: 0..trace_len");
+    return;
+  }
+  const uint32_t n = stm32f4_qemu_trace_count();
+  for (uint32_t i = from; i < n && i < from + TRACE_LINES_PER_REPLY; ++i) {
+    cli_put_u32(cli, i);
+    cli_put(cli, " ");
+    cli_put_f32(cli, stm32f4_qemu_trace_at(i));
+    cli_emit_data(cli);
+  }
+  cli_put(cli, "trace ");
+  cli_put_u32(cli, n);
+  cli_emit_ok(cli);
+}
+
+static void cmd_emu(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
+{
+  (void)ctx;
+  if (argc == 1u) {
+    emu_figures(cli);
+  } else if (argc == 3u && strcmp(argv[1], "rate") == 0) {
+    emu_rate(cli, argv[2]);
+  } else if (argc == 3u && strcmp(argv[1], "stretch") == 0) {
+    emu_stretch(cli, argv[2]);
+  } else if (argc == 3u && strcmp(argv[1], "trace") == 0) {
+    emu_trace(cli, argv[2]);
+  } else {
+    cli_err(cli, "ARGS", "usage: emu | emu rate DPS | emu stretch N | emu trace FROM");
+  }
+}
+
+static cli_cmd_t s_emu_cmd; /* the CLI keeps rows by pointer */
+
+int main_board_emu_init(app_t *a)
+{
+  const cli_cmd_t row = {"emu", "[rate DPS | stretch N | trace FROM]",
+                         "emulator: tick and plant figures, input rate, rate trace", cmd_emu,
+                         NULL};
+  s_emu_cmd = row;
+  stm32f4_qemu_plant_trace_from(&a->gyro.out.rate_dps);
+  return cli_register(&a->cli, &s_emu_cmd);
+}
