@@ -1,4 +1,5 @@
-# gyro_add_image(<name> SOURCES <src>... LIBS <lib>... [LINKER_SCRIPT <file>])
+# gyro_add_image(<name> SOURCES <src>... LIBS <lib>... [LINKER_SCRIPT <file>]
+#                [STACK_BYTES <n>])
 #
 # One firmware image for the Cortex-M4F board: links SOURCES and LIBS with the board's
 # linker script (default linker/stm32f405.ld) into <name>.elf, writes <name>.map,
@@ -14,7 +15,7 @@ set(GYRO_LINKER_SECTIONS ${CMAKE_CURRENT_LIST_DIR}/stm32f405_sections.ld)
 set(GYRO_IMAGE_SIZE_SCRIPT ${CMAKE_CURRENT_LIST_DIR}/image_size.cmake)
 
 function(gyro_add_image name)
-  cmake_parse_arguments(IMG "" "LINKER_SCRIPT" "SOURCES;LIBS" ${ARGN})
+  cmake_parse_arguments(IMG "" "LINKER_SCRIPT;STACK_BYTES" "SOURCES;LIBS" ${ARGN})
   if(NOT IMG_SOURCES)
     message(FATAL_ERROR "gyro_add_image(${name}): SOURCES is required")
   endif()
@@ -34,6 +35,10 @@ function(gyro_add_image name)
     -Wl,--fatal-warnings
     # .ramfunc makes the SRAM segment writable and executable on purpose.
     -Wl,--no-warn-rwx-segments)
+  if(IMG_STACK_BYTES)
+    # the main stack's size (stm32f405_sections.ld; 8 KB unless given)
+    target_link_options(${name} PRIVATE -Wl,--defsym=__gyro_stack_size=${IMG_STACK_BYTES})
+  endif()
   add_custom_command(TARGET ${name} POST_BUILD
     COMMAND ${CMAKE_OBJCOPY} -O binary --gap-fill 0xff $<TARGET_FILE:${name}> ${name}.bin
     COMMAND ${CMAKE_OBJCOPY} -O ihex $<TARGET_FILE:${name}> ${name}.hex
