@@ -149,6 +149,21 @@ extern stm32f4_host_map_t stm32f4_host_map;
 #define RCC STM32F4_PERIPH(rcc, stm32f4_rcc_t, STM32F4_RCC_BASE)
 #define PWR STM32F4_PERIPH(pwr, stm32f4_pwr_t, STM32F4_PWR_BASE)
 #define FLASH_R STM32F4_PERIPH(flash, stm32f4_flash_t, STM32F4_FLASH_R_BASE)
+#if defined(STM32F4_QEMU_FLASH_MODEL) && !defined(STM32F4_HOST_TEST)
+/* gyro-fw-qemu: QEMU's netduinoplus2 models neither the flash interface nor writable
+ * flash, so the emulator image runs the board's flash driver unchanged against a model
+ * of both in SRAM (qemu/stm32f4_qemu_flash.c), which plays the controller from the
+ * driver's busy-wait hook as the unit test's fake does. */
+#undef FLASH_R
+#undef STM32F4_PARAM_FLASH
+#undef STM32F4_POLL_HOOK
+extern stm32f4_flash_t stm32f4_qemu_flash_regs;
+extern volatile uint8_t stm32f4_qemu_param_flash[];
+void stm32f4_qemu_flash_controller(void);
+#define FLASH_R (&stm32f4_qemu_flash_regs)
+#define STM32F4_PARAM_FLASH (stm32f4_qemu_param_flash)
+#define STM32F4_POLL_HOOK() stm32f4_qemu_flash_controller()
+#endif
 #define GPIOA STM32F4_PERIPH(gpioa, stm32f4_gpio_t, STM32F4_GPIOA_BASE)
 #define GPIOB STM32F4_PERIPH(gpiob, stm32f4_gpio_t, STM32F4_GPIOB_BASE)
 #define GPIOC STM32F4_PERIPH(gpioc, stm32f4_gpio_t, STM32F4_GPIOC_BASE)

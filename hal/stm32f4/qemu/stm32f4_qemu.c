@@ -79,6 +79,11 @@ int stm32f4_board_init(void)
 {
 #ifdef STM32F4_QEMU_PLANT
   if (stm32f4_qemu_plant_init() != 0) return -1;
+#endif
+#ifdef STM32F4_QEMU_FLASH_MODEL
+  stm32f4_qemu_flash_init();
+#endif
+#ifdef STM32F4_QEMU_PLANT
   /* TIM2 undivided: QEMU's timer input is 1 GHz of emulated time (stm32f4_qemu.h). */
   TIM2->CR1 = 0u;
   TIM2->PSC = 0u;

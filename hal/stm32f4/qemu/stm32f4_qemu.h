@@ -51,4 +51,9 @@ int stm32f4_qemu_set_stretch(uint32_t stretch);
  * microseconds of emulated time. */
 void stm32f4_qemu_idle(void);
 
+/* With STM32F4_QEMU_FLASH_MODEL: the parameter sectors modelled in SRAM
+ * (stm32f4_qemu_flash.c) set blank; called by stm32f4_board_init before the store is
+ * read. */
+void stm32f4_qemu_flash_init(void);
+
 #endif /* STM32F4_QEMU_H */
