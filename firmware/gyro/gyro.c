@@ -332,11 +332,11 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
   } else if (slot == GYRO_SLOT_SUPERVISE) {
     (void)block_supervise(g, d_s, d_c, s_s, s_c);
   } else if (slot == GYRO_SLOT_RATE) {
-    rate_channel_hold_p(&g->rate, g->sup.mode != GYRO_MODE_LOCKED);
     rate_channel_update(&g->rate, d_s, d_c, g->drive.p_rad);
     selftest_update(&g->selftest, g->sup.mode == GYRO_MODE_LOCKED, g->rate.rate_raw);
   } else if (slot == GYRO_SLOT_QUAD) {
-    rate_channel_update_quad(&g->rate);
+    rate_channel_hold_p(&g->rate, g->sup.mode != GYRO_MODE_LOCKED);
+    rate_channel_update_quad_p(&g->rate, g->drive.p_rad);
   }
 
   float u1 = 0.0f, u2 = 0.0f;

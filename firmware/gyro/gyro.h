@@ -107,12 +107,12 @@ typedef struct {
  * the block so that the worst tick carries one job: the interrupt's budget is set by
  * its worst tick (tools/bench/README.md). */
 #define GYRO_BLOCK RATE_DECIM
-#define GYRO_SLOT_DRIVE_AMP 0u
-#define GYRO_SLOT_DRIVE_PHASE 1u
-#define GYRO_SLOT_SUPERVISE 3u
-#define GYRO_SLOT_RATE 5u
-#define GYRO_SLOT_QUAD 7u
-#define GYRO_SLOT_OUTPUT 8u
+#define GYRO_SLOT_DRIVE_AMP 0u   /* |Z|, amplitude PI, drive command */
+#define GYRO_SLOT_DRIVE_PHASE 1u /* arg Z, phase PI, drive command */
+#define GYRO_SLOT_SUPERVISE 3u   /* supervisor, finiteness check */
+#define GYRO_SLOT_RATE 5u        /* projection, rate filter, compensation, self-test */
+#define GYRO_SLOT_QUAD 7u        /* quadrature filter, P's low-pass */
+#define GYRO_SLOT_OUTPUT 8u      /* snapshot, analog rate code */
 
 /* Turn parameter values into module configurations, checking that every module
  * accepts its part. Returns 0, or a negative value (then *d is untouched). */

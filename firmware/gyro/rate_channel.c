@@ -131,6 +131,18 @@ void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad)
   rc->rate_raw = re;
   rc->quad_raw = im;
 
+  rc->rate_unc_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_rate, re);
+
+  const float p = rc->p_f_deg;
+  const float *b3 = rc->bias_c_dps, *s3 = rc->sf_c;
+  const float bias = b3[0] + p * (b3[1] + p * (b3[2] + p * b3[3]));
+  const float sf = 1.0f + p * (s3[1] + p * (s3[2] + p * s3[3]));
+  rc->rate_dps = rc->rate_unc_dps * sf - bias;
+}
+
+void rate_channel_update_quad_p(rate_channel_t *rc, float p_rad)
+{
+  rc->quad_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_quad, rc->quad_raw);
   if (rc->p_hold != 0u) {
     rc->p_acc_deg = 0.0f;
     rc->p_count = 0u;
@@ -146,7 +158,11 @@ void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad)
       if (rc->p_n < RATE_P_FAST_MAX) {
         rc->p_n++;
         const float a_mean = 1.0f / (float)(rc->p_n + RATE_P_PRIOR);
-        if (a_mean > a) a = a_mean;
+        if (a_mean > a) {
+          a = a_mean;
+        } else {
+          rc->p_n = RATE_P_FAST_MAX; /* the low-pass from here on */
+        }
       }
       rc->p_dev_deg += a * (mean - rc->p_dev_deg);
       rc->p_f_deg = rc->p_ref_deg + rc->p_dev_deg;
@@ -154,16 +170,4 @@ void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad)
       rc->p_count = 0u;
     }
   }
-  rc->rate_unc_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_rate, re);
-
-  const float p = rc->p_f_deg;
-  const float *b3 = rc->bias_c_dps, *s3 = rc->sf_c;
-  const float bias = b3[0] + p * (b3[1] + p * (b3[2] + p * b3[3]));
-  const float sf = 1.0f + p * (s3[1] + p * (s3[2] + p * s3[3]));
-  rc->rate_dps = rc->rate_unc_dps * sf - bias;
-}
-
-void rate_channel_update_quad(rate_channel_t *rc)
-{
-  rc->quad_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_quad, rc->quad_raw);
 }

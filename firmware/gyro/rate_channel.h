@@ -118,11 +118,13 @@ static inline void rate_channel_hold_p(rate_channel_t *rc, int hold)
 
 /* Once per RATE_DECIM ticks, after the block's last accumulate. (d_s, d_c): measured
  * drive phasor (only to tell that the drive runs); p_rad: force phase (the phase loop
- * holds it over the block). */
+ * holds it over the block), for the reference's correction; the compensation uses P_f
+ * as rate_channel_update_quad_p last left it. */
 void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad);
 
-/* The quadrature's output filter, once per block after rate_channel_update (on another
- * tick of the block: it only feeds telemetry). */
-void rate_channel_update_quad(rate_channel_t *rc);
+/* The quadrature's output filter and P's low-pass (P_f: the temperature signal, which
+ * rate_channel_update compensates with), once per block after rate_channel_update, on
+ * another tick of the block so that no tick carries both. p_rad: the force phase. */
+void rate_channel_update_quad_p(rate_channel_t *rc, float p_rad);
 
 #endif /* RATE_CHANNEL_H */
