@@ -38,22 +38,6 @@ static void put_faults(cli_t *cli, uint32_t f)
   }
 }
 
-static void kv_f(cli_t *cli, const char *k, float v)
-{
-  cli_put(cli, k);
-  cli_put(cli, " ");
-  cli_put_f32(cli, v);
-  cli_emit_data(cli);
-}
-
-static void kv_u(cli_t *cli, const char *k, uint32_t v)
-{
-  cli_put(cli, k);
-  cli_put(cli, " ");
-  cli_put_u32(cli, v);
-  cli_emit_data(cli);
-}
-
 /* Self-calibration progress and result (the figures of the latest sweep). */
 static void put_selfcal(cli_t *cli, const app_t *a)
 {
@@ -68,18 +52,18 @@ static void put_selfcal(cli_t *cli, const app_t *a)
     cli_emit_data(cli);
   }
   const uint32_t t = selfcal_running(s) ? a->isr_ticks - a->selfcal_t0_ticks : a->selfcal_ticks;
-  kv_f(cli, "selfcal_s", (float)t / (float)params_current(&a->params)->sys_fs_hz);
-  if (s->f_coarse_hz > 0.0) kv_f(cli, "selfcal_coarse_hz", (float)s->f_coarse_hz);
+  cli_data_f32(cli, "selfcal_s", (float)t / (float)params_current(&a->params)->sys_fs_hz);
+  if (s->f_coarse_hz > 0.0) cli_data_f32(cli, "selfcal_coarse_hz", (float)s->f_coarse_hz);
   if (s->rd_q > 0.0) {
-    kv_f(cli, "selfcal_ringdown_hz", (float)s->rd_f_hz);
-    kv_f(cli, "selfcal_ringdown_q", (float)s->rd_q);
+    cli_data_f32(cli, "selfcal_ringdown_hz", (float)s->rd_f_hz);
+    cli_data_f32(cli, "selfcal_ringdown_q", (float)s->rd_q);
   }
   if (s->fit.q > 0.0) {
-    kv_f(cli, "selfcal_f0_hz", (float)s->fit.f0_hz);
-    kv_f(cli, "selfcal_q", (float)s->fit.q);
-    kv_f(cli, "selfcal_gain_v_per_v2", (float)s->fit.gain_v_per_v2);
-    kv_f(cli, "selfcal_p_init_deg", (float)(s->hold_p_rad * 57.29577951308232));
-    kv_f(cli, "selfcal_fit_rms_rel", (float)s->fit.rms_rel);
+    cli_data_f32(cli, "selfcal_f0_hz", (float)s->fit.f0_hz);
+    cli_data_f32(cli, "selfcal_q", (float)s->fit.q);
+    cli_data_f32(cli, "selfcal_gain_v_per_v2", (float)s->fit.gain_v_per_v2);
+    cli_data_f32(cli, "selfcal_p_init_deg", (float)(s->hold_p_rad * 57.29577951308232));
+    cli_data_f32(cli, "selfcal_fit_rms_rel", (float)s->fit.rms_rel);
   }
 }
 
@@ -101,17 +85,17 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   cli_put(cli, "fault ");
   put_faults(cli, a->gyro.sup.fault);
   cli_emit_data(cli);
-  kv_u(cli, "fault_count", a->gyro.sup.fault_count);
-  kv_f(cli, "rate_dps", o->rate_dps);
-  kv_f(cli, "quad_dps", o->quad_dps);
-  kv_f(cli, "drive_amp_v", o->drive_amp_v);
-  kv_f(cli, "drive_phase_deg", o->drive_phase_deg);
-  kv_f(cli, "p_deg", o->p_deg);
-  kv_f(cli, "p_f_deg", o->p_f_deg);
-  kv_f(cli, "f_cmd_v2", o->f_cmd_v2);
-  kv_u(cli, "ticks", a->isr_ticks);
-  kv_u(cli, "isr_cycles_last", a->isr_cycles_last);
-  kv_u(cli, "isr_cycles_max", a->isr_cycles_max);
+  cli_data_u32(cli, "fault_count", a->gyro.sup.fault_count);
+  cli_data_f32(cli, "rate_dps", o->rate_dps);
+  cli_data_f32(cli, "quad_dps", o->quad_dps);
+  cli_data_f32(cli, "drive_amp_v", o->drive_amp_v);
+  cli_data_f32(cli, "drive_phase_deg", o->drive_phase_deg);
+  cli_data_f32(cli, "p_deg", o->p_deg);
+  cli_data_f32(cli, "p_f_deg", o->p_f_deg);
+  cli_data_f32(cli, "f_cmd_v2", o->f_cmd_v2);
+  cli_data_u32(cli, "ticks", a->isr_ticks);
+  cli_data_u32(cli, "isr_cycles_last", a->isr_cycles_last);
+  cli_data_u32(cli, "isr_cycles_max", a->isr_cycles_max);
   cli_put(cli, "store ");
   cli_put(cli, param_store_status_str(a->store_status));
   cli_emit_data(cli);
@@ -119,7 +103,7 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   cli_put(cli, "selftest ");
   cli_put(cli, selftest_state_name(a->gyro.selftest.state));
   cli_emit_data(cli);
-  kv_f(cli, "selftest_dps", a->gyro.selftest.result_dps);
+  cli_data_f32(cli, "selftest_dps", a->gyro.selftest.result_dps);
   if (a->status_board != NULL) a->status_board(cli, a->status_board_ctx);
   cli_ok(cli, mode_name((uint32_t)a->gyro.sup.mode));
 }

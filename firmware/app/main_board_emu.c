@@ -9,42 +9,26 @@
 
 #define TRACE_LINES_PER_REPLY 16u /* 16 short lines: well inside the 1 KB UART TX ring */
 
-static void kv_u(cli_t *cli, const char *k, uint32_t v)
-{
-  cli_put(cli, k);
-  cli_put(cli, " ");
-  cli_put_u32(cli, v);
-  cli_emit_data(cli);
-}
-
-static void kv_f(cli_t *cli, const char *k, float v)
-{
-  cli_put(cli, k);
-  cli_put(cli, " ");
-  cli_put_f32(cli, v);
-  cli_emit_data(cli);
-}
-
 static void emu_figures(cli_t *cli)
 {
   stm32f4_qemu_tick_stats_t st;
   stm32f4_qemu_tick_stats(&st);
-  kv_u(cli, "stretch", st.stretch);
-  kv_u(cli, "period_ns", st.period_ns);
-  kv_u(cli, "ticks", st.ticks);
-  kv_u(cli, "tick_overruns", st.overruns);
-  kv_u(cli, "ticks_lost", st.lost);
+  cli_data_u32(cli, "stretch", st.stretch);
+  cli_data_u32(cli, "period_ns", st.period_ns);
+  cli_data_u32(cli, "ticks", st.ticks);
+  cli_data_u32(cli, "tick_overruns", st.overruns);
+  cli_data_u32(cli, "ticks_lost", st.lost);
   const float n = st.ticks > 0u ? (float)st.ticks : 1.0f;
-  kv_u(cli, "isr_ns_last", st.isr_ns_last);
-  kv_u(cli, "isr_ns_max", st.isr_ns_max);
-  kv_f(cli, "isr_ns_mean", (float)st.isr_ns_sum / n);
-  kv_u(cli, "plant_ns_last", st.plant_ns_last);
-  kv_u(cli, "plant_ns_max", st.plant_ns_max);
-  kv_f(cli, "plant_ns_mean", (float)st.plant_ns_sum / n);
-  kv_f(cli, "plant_rate_dps", (float)stm32f4_qemu_plant_rate_dps());
-  kv_u(cli, "trace_n", stm32f4_qemu_trace_count());
-  kv_u(cli, "trace_len", QEMU_TRACE_LEN);
-  kv_u(cli, "trace_every", QEMU_TRACE_EVERY);
+  cli_data_u32(cli, "isr_ns_last", st.isr_ns_last);
+  cli_data_u32(cli, "isr_ns_max", st.isr_ns_max);
+  cli_data_f32(cli, "isr_ns_mean", (float)st.isr_ns_sum / n);
+  cli_data_u32(cli, "plant_ns_last", st.plant_ns_last);
+  cli_data_u32(cli, "plant_ns_max", st.plant_ns_max);
+  cli_data_f32(cli, "plant_ns_mean", (float)st.plant_ns_sum / n);
+  cli_data_f32(cli, "plant_rate_dps", (float)stm32f4_qemu_plant_rate_dps());
+  cli_data_u32(cli, "trace_n", stm32f4_qemu_trace_count());
+  cli_data_u32(cli, "trace_len", QEMU_TRACE_LEN);
+  cli_data_u32(cli, "trace_every", QEMU_TRACE_EVERY);
   cli_ok(cli, "emu");
 }
 

@@ -90,6 +90,22 @@ void cli_put_u32(cli_t *cli, uint32_t x)
   cli_put_n(cli, buf, n);
 }
 
+void cli_data_u32(cli_t *cli, const char *key, uint32_t v)
+{
+  cli_put(cli, key);
+  cli_put(cli, " ");
+  cli_put_u32(cli, v);
+  cli_emit_data(cli);
+}
+
+void cli_data_f32(cli_t *cli, const char *key, float v)
+{
+  cli_put(cli, key);
+  cli_put(cli, " ");
+  cli_put_f32(cli, v);
+  cli_emit_data(cli);
+}
+
 /* Send prefix + the built text + CRLF, then clear the builder. */
 static void emit(cli_t *cli, const char *prefix, bool final)
 {

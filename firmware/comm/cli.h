@@ -119,6 +119,9 @@ void cli_put_n(cli_t *cli, const char *s, size_t n);
 void cli_put_f32(cli_t *cli, float x);
 void cli_put_u32(cli_t *cli, uint32_t x);
 void cli_emit_data(cli_t *cli);                  /* "- " text */
+/* One "- KEY VALUE" data line (status-style key/value reports). */
+void cli_data_u32(cli_t *cli, const char *key, uint32_t v);
+void cli_data_f32(cli_t *cli, const char *key, float v);
 void cli_emit_ok(cli_t *cli);                    /* "ok" [" " text], final */
 void cli_emit_err(cli_t *cli, const char *code); /* "err CODE " text, final */
 void cli_ok(cli_t *cli, const char *msg);        /* msg may be NULL */
