@@ -51,8 +51,6 @@ typedef struct {
   uint32_t selfcal_t0_ticks; /* isr_ticks when the sweep was requested */
   uint32_t selfcal_ticks;    /* its length up to the hand-over */
   /* Self-measurement of the sample ISR (DWT cycles on the board). */
-  uint32_t isr_cycles_last;
-  uint32_t isr_cycles_max;
   uint32_t isr_ticks;
   /* Set by the image's main after app_init (NULL: nothing added, as on the host). */
   app_status_fn status_board;

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "app/app_selfcal.h"
+#include "hal/hal_sample_timer.h"
 
 static const char *mode_name(uint32_t m)
 {
@@ -94,8 +95,10 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   cli_data_f32(cli, "p_f_deg", o->p_f_deg);
   cli_data_f32(cli, "f_cmd_v2", o->f_cmd_v2);
   cli_data_u32(cli, "ticks", a->isr_ticks);
-  cli_data_u32(cli, "isr_cycles_last", a->isr_cycles_last);
-  cli_data_u32(cli, "isr_cycles_max", a->isr_cycles_max);
+  uint32_t cyc_last, cyc_max;
+  hal_sample_isr_cycles(&cyc_last, &cyc_max);
+  cli_data_u32(cli, "isr_cycles_last", cyc_last);
+  cli_data_u32(cli, "isr_cycles_max", cyc_max);
   cli_put(cli, "store ");
   cli_put(cli, param_store_status_str(a->store_status));
   cli_emit_data(cli);

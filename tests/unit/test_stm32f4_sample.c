@@ -80,6 +80,7 @@ typedef struct {
   uint32_t tx_cr_seen;
   int leave_tc_pending;
   hal_adc_frame_t frame;
+  uint32_t cycles;
 } isr_probe_t;
 
 static void probe_isr(void *ctx)
@@ -90,6 +91,7 @@ static void probe_isr(void *ctx)
   p->tx_ndtr_seen = DMA2->S[5].NDTR;
   p->tx_cr_seen = DMA2->S[5].CR;
   hal_adc_read_frame(&p->frame);
+  DWT->CYCCNT += p->cycles; /* the cycles this tick "takes" */
   /* Hardware clears LISR on the LIFCR write; a frame landing meanwhile sets it again. */
   DMA2->LISR = p->leave_tc_pending ? DMA_FLAG_TCIF : 0u;
 }
@@ -216,6 +218,34 @@ static void test_interrupt_rearms_and_calls_isr(void **state)
   assert_int_equal(st.dma_errors, 1);
 }
 
+/* The handler measures itself (DWT CYCCNT at entry and after the tick, across the
+ * counter's wrap): latest and worst, reset by a new start. */
+static void test_interrupt_measures_its_cycles(void **state)
+{
+  (void)state;
+  isr_probe_t probe = {0};
+  assert_int_equal(hal_sample_timer_start(50000u, probe_isr, &probe), 0);
+  uint32_t last = 7u, max = 7u;
+  hal_sample_isr_cycles(&last, &max);
+  assert_int_equal(last, 0u);
+  assert_int_equal(max, 0u);
+  const uint32_t cyc[] = {600u, 900u, 450u};
+  DWT->CYCCNT = 0xFFFFFE00u; /* wraps during the second tick */
+  for (int i = 0; i < 3; i++) {
+    probe.cycles = cyc[i];
+    DMA2->S[5].CR &= ~DMA_SXCR_EN;
+    DMA2->LISR = DMA_FLAG_TCIF;
+    DMA2_Stream0_IRQHandler();
+    hal_sample_isr_cycles(&last, NULL);
+    assert_int_equal(last, cyc[i]);
+  }
+  hal_sample_isr_cycles(NULL, &max);
+  assert_int_equal(max, 900u);
+  assert_int_equal(hal_sample_timer_start(50000u, probe_isr, &probe), 0);
+  hal_sample_isr_cycles(&last, &max);
+  assert_int_equal(max, 0u);
+}
+
 static void test_stop_parks_outputs(void **state)
 {
   (void)state;
@@ -242,6 +272,7 @@ int main(void)
       cmocka_unit_test_setup(test_start_sets_dac_deadline, setup),
       cmocka_unit_test_setup(test_start_rejects, setup),
       cmocka_unit_test_setup(test_interrupt_rearms_and_calls_isr, setup),
+      cmocka_unit_test_setup(test_interrupt_measures_its_cycles, setup),
       cmocka_unit_test_setup(test_stop_parks_outputs, setup),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

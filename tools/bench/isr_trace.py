@@ -319,7 +319,7 @@ EXC_ENTRY, EXC_EXIT, FP_LAZY_SAVE, FP_RESTORE = 12, 10, 17, 17
 #     (test, read-modify-write); writes DMA2 LIFCR, HIFCR, S5.NDTR, S5.CR and SPI1 CR2;
 #   hal_dac_write_frame (stm32f4_dac.c): reads TIM1 CNT, TIM8 CR1, DMA2 S2.CR; writes
 #     DMA2 LIFCR, S2.NDTR, S2.CR and TIM8 CR1;
-#   hal_cycles_now (stm32f4_cycles.c), twice: reads DWT CYCCNT.
+#   DMA2_Stream0_IRQHandler's self-measurement, twice: reads DWT CYCCNT.
 # Reads: DMA2 (AHB1) 5, TIM1/TIM8 (APB2) 2, DWT (PPB) 2; writes: DMA2 7, APB2 2.
 # Assumed extra cycles over an SRAM access: AHB1 read +2, APB2 read +4 (bridge at
 # HCLK/2), PPB read +1, write +1.

@@ -12,7 +12,13 @@ typedef void (*hal_sample_isr_fn)(void *ctx);
 int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx);
 void hal_sample_timer_stop(void);
 
-/* Free-running cycle counter (DWT CYCCNT on the board) for self-measurement of the tick. */
+/* Free-running cycle counter (DWT CYCCNT on the board). */
 uint32_t hal_cycles_now(void);
+
+/* The sample interrupt measured by the HAL itself, from the first instruction of its
+ * handler to the return of isr(ctx): cycles of the latest interrupt and the worst since
+ * hal_sample_timer_start. The board reads DWT CYCCNT inline; the host stub has no cycle
+ * counter and reports 0. Either pointer may be NULL. */
+void hal_sample_isr_cycles(uint32_t *last, uint32_t *max);
 
 #endif /* HAL_SAMPLE_TIMER_H */

@@ -128,6 +128,23 @@ void hal_sample_timer_stop(void)
 }
 
 void SysTick_Handler(void);
+
+/* hal_sample_isr_cycles: the emulator has no DWT; its cycles are SysTick's (emulated
+ * 168 MHz, so under -icount they count instructions, not a real core's cycles). */
+static volatile uint32_t s_isr_cycles_last, s_isr_cycles_max;
+
+static STM32F4_RAMFUNC void note_isr_cycles(uint32_t dc)
+{
+  s_isr_cycles_last = dc;
+  if (dc > s_isr_cycles_max) s_isr_cycles_max = dc;
+}
+
+void hal_sample_isr_cycles(uint32_t *last, uint32_t *max)
+{
+  if (last != 0) *last = s_isr_cycles_last;
+  if (max != 0) *max = s_isr_cycles_max;
+}
+
 #ifdef STM32F4_QEMU_PLANT
 STM32F4_RAMFUNC void SysTick_Handler(void)
 {
@@ -135,7 +152,9 @@ STM32F4_RAMFUNC void SysTick_Handler(void)
   (void)SYSTICK->CTRL; /* clears COUNTFLAG, set by the wrap that raised this tick */
   s_wraps = s_wraps + 1u;
   s_ticks = s_ticks + 1u;
+  const uint32_t c0 = hal_cycles_now();
   if (s_isr != 0) s_isr(s_ctx);
+  note_isr_cycles(hal_cycles_now() - c0);
   const uint32_t t1 = TIM2->CNT;
   stm32f4_qemu_plant_tick();
   const uint32_t t2 = TIM2->CNT;
@@ -187,7 +206,9 @@ STM32F4_RAMFUNC void SysTick_Handler(void)
 {
   s_wraps = s_wraps + 1u;
   s_ticks = s_ticks + 1u;
+  const uint32_t c0 = hal_cycles_now();
   if (s_isr != 0) s_isr(s_ctx);
+  note_isr_cycles(hal_cycles_now() - c0);
 }
 #endif
 
