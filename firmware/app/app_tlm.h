@@ -31,9 +31,11 @@
 
 /* The tuning port's line rate (hal/stm32f4: STM32F4_UART_BAUD, 8N1). */
 #define APP_TLM_BAUD 921600u
-/* TX-ring bytes telemetry leaves free for command replies: a status reply is about
- * 400 bytes. (list, about 4 KB, needs the stream stopped on the board's 1 KB ring.) */
-#define APP_TLM_TX_RESERVE 512u
+/* TX-ring bytes telemetry leaves free for command replies, so that the longest (list,
+ * about 5.0 KB; status with the self-calibration lines about 0.7 KB) comes out whole
+ * while a stream runs (test_app: every reply fits). The rings are 8 KB on the board and
+ * the host, which leaves telemetry 2 KB (22 ms of the line) of backlog. */
+#define APP_TLM_TX_RESERVE 6144u
 
 typedef struct {
   tlm_t stream;

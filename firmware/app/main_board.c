@@ -39,6 +39,8 @@
 #endif
 
 #define SAMPLE_RATE_HZ 50000u
+_Static_assert(STM32F4_UART_TX_BYTES >= APP_TLM_TX_RESERVE + 1024u,
+               "the tuning port's TX ring holds the longest reply and some telemetry");
 #define WATCHDOG_MS 250u
 
 /* In QEMU's netduinoplus2, which maps no CCM, the emulator images' memory map

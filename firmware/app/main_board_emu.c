@@ -7,7 +7,7 @@
 #include "stm32f4_qemu.h"
 #include "stm32f4_qemu_plant.h"
 
-#define TRACE_LINES_PER_REPLY 16u /* 16 short lines: well inside the 1 KB UART TX ring */
+#define TRACE_LINES_PER_REPLY 16u /* 16 short lines: well inside the reply reserve */
 
 static void emu_figures(cli_t *cli)
 {

@@ -45,7 +45,7 @@
  * stop, ...), listed by help.
  *
  * The output callback receives whole lines (CRLF included) and must take all of them:
- * the application queues them (a TX ring sized for the longest reply, about 4 KB for
+ * the application queues them (a TX ring sized for the longest reply, about 5 KB for
  * list) or drains the UART; the CLI keeps no output backlog.
  */
 #ifndef CLI_H

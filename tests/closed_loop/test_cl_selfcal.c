@@ -39,6 +39,7 @@ static void test_default_plant(void **state)
   const char *r = cmd("status\n");
   assert_non_null(strstr(r, "selfcal DONE"));
   assert_non_null(strstr(r, "selfcal_q "));
+  printf("# status with the self-calibration lines: %zu bytes\n", strlen(r));
   check_lock();
 }
 

@@ -215,6 +215,11 @@ def case_gyroctl(emu, args):
     check(p.returncode == 0 and float(p.stdout.split()[0]) == 2.5, "get reads 2.5 back")
     p = gyroctl(args, port, "set", "rate.bias_c0_dps", "nan")
     check(p.returncode == 1 and "err" in p.stderr, "set to nan refused")
+    # the longest reply (about 5 KB) through the board's UART driver and TX ring, whole
+    p = gyroctl(args, port, "list")
+    names = [ln.split()[0] for ln in p.stdout.splitlines() if ln and not ln.endswith("parameters")]
+    check(p.returncode == 0 and "rate.bias_c0_dps" in names and len(names) >= 40,
+          f"list: the whole parameter table ({len(names)} parameters)")
 
     with tempfile.TemporaryDirectory() as d:
         out = os.path.join(d, "log.csv")

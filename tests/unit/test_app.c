@@ -121,6 +121,30 @@ static void test_isr_cycles(void **state)
   hal_sample_isr_cycles(NULL, NULL);
 }
 
+/* Every command's reply fits in what telemetry leaves free (APP_TLM_TX_RESERVE), so it
+ * comes out whole while a stream runs; and the host ring (like the board's) holds it
+ * with room for telemetry. The longest: list. */
+static void test_replies_fit_the_reserve(void **state)
+{
+  (void)state;
+  setup_app();
+  hal_host_run(2u);
+  const char *const lines[] = {"list\n", "help\n", "status\n", "diff\n", "version\n",
+                               "stream\n", "selftest status\n"};
+  size_t longest = 0u;
+  for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++) {
+    const char *r = cmd(lines[i]);
+    const size_t n = strlen(r);
+    /* whole: ends with its final ok/err line */
+    assert_true(n >= 2u && r[n - 2u] == '\r' && r[n - 1u] == '\n');
+    assert_true(strstr(r, "ok") != NULL || strstr(r, "err") != NULL);
+    if (n > longest) longest = n;
+  }
+  printf("# longest reply %zu bytes, reserve %u\n", longest, (unsigned)APP_TLM_TX_RESERVE);
+  assert_true(longest <= APP_TLM_TX_RESERVE);
+  assert_true(longest > 3000u); /* list is the long one: the test looks at it */
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -128,6 +152,7 @@ int main(void)
       cmocka_unit_test(test_drive_and_status),
       cmocka_unit_test(test_save_and_restart),
       cmocka_unit_test(test_isr_cycles),
+      cmocka_unit_test(test_replies_fit_the_reserve),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
