@@ -11,7 +11,7 @@
  *
  * Besides the kernels (tools/bench/common), it counts:
  *   app_sample_isr      called directly, with the board HAL calls (hal_adc_read_frame,
- *                       hal_dac_write_frame, hal_cycles_now)
+ *                       hal_dac_write_frame; the self-measurement is the handler's)
  *   isr_app_cb          the real DMA2_Stream0_IRQHandler pended through the NVIC, its
  *                       callback being bench_cb = app_sample_isr + clearing the fake
  *                       TCIF; baseline: an IRQ whose handler is a lone BX LR
