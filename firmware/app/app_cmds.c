@@ -71,6 +71,26 @@ static void put_selfcal(cli_t *cli, const app_t *a)
 /* status: one data line per figure, then ok MODE. The snapshot is copied field by
  * field while the ISR may update it; each figure is one aligned word, so each line is a
  * consistent value (lines may come from adjacent ticks). */
+/* What the store holds now (the "store" line is what the boot found): the newest valid
+ * image after any save since, read back without applying it. Background only. */
+static void put_store_now(cli_t *cli, app_t *a)
+{
+  if (a->store_status == PARAM_STORE_ERR_CONFIG) {
+    return; /* no usable store: the "store" line says so */
+  }
+  param_values_t scratch = *params_current(&a->params);
+  param_store_report_t rep;
+  const param_store_status_t st = param_store_load(&a->store, &scratch, &rep);
+  cli_put(cli, "store_now ");
+  if (st == PARAM_STORE_OK && rep.slot >= 0) {
+    cli_put(cli, rep.slot == 0 ? "slot A seq " : "slot B seq ");
+    cli_put_u32(cli, rep.seq);
+  } else {
+    cli_put(cli, param_store_status_str(st));
+  }
+  cli_emit_data(cli);
+}
+
 static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
 {
   (void)argv;
@@ -102,6 +122,7 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   cli_put(cli, "store ");
   cli_put(cli, param_store_status_str(a->store_status));
   cli_emit_data(cli);
+  put_store_now(cli, a);
   put_selfcal(cli, a);
   cli_put(cli, "selftest ");
   cli_put(cli, selftest_state_name(a->gyro.selftest.state));

@@ -96,8 +96,13 @@ static void test_save_and_restart(void **state)
   assert_non_null(strstr(cmd("save\n"), "err BUSY"));
   cmd("drive off\n");
   hal_host_run(1u);
+  assert_non_null(strstr(cmd("status\n"), "- store_now no valid parameter image\r\n"));
   const char *saved = cmd("save\n");
   assert_true(strncmp(saved, "ok", 2) == 0);
+  /* status: what the boot found, and what the store holds now */
+  const char *st = cmd("status\n");
+  assert_non_null(strstr(st, "- store no valid parameter image\r\n"));
+  assert_non_null(strstr(st, "- store_now slot A seq 1\r\n"));
   /* Restart: a new instance over the same flash. */
   hal_uart_host_reset();
   assert_int_equal(app_init(&app), 0);
