@@ -13,27 +13,11 @@
 #include <string.h>
 #include <cmocka.h>
 
-#include "app/app.h"
-#include "hal/hal_sample_timer.h"
-#include "hal_flash_host.h"
-#include "hal_host.h"
-#include "hal_uart_host.h"
-#include "plant/plant.h"
+#include "app_plant.h"
 
-static plant_t plant;
-static app_t app;
 
-static void start(const plant_cfg_t *pc)
-{
-  if (plant_init(&plant, pc, 21u) != 0) fail_msg("plant: %s", plant_error(&plant));
-  assert_int_equal(hal_flash_host_configure(NULL), 0);
-  hal_uart_host_reset();
-  hal_host_attach(plant_step_hal, &plant);
-  assert_int_equal(app_init(&app), 0);
-  assert_int_equal(hal_sample_timer_start(50000u, app_sample_isr, &app), 0);
-}
 
-static void run_s(double s) { hal_host_run((uint64_t)(s * 50000.0)); }
+static void start(const plant_cfg_t *pc) { app_plant_start(pc, 21u, NULL); }
 
 static void step_structure(double dk)
 {

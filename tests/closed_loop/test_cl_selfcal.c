@@ -23,11 +23,11 @@ static void test_default_plant(void **state)
   param_values_defaults(&v);
   start(&pc, &v);
   /* The sweep is commanded while the drive runs locked with the stored design. */
-  run_s(0.3);
+  run_polled_s(0.3);
   assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
   /* A second request while the sweep runs is refused. */
   assert_true(strncmp(cmd("sweep\n"), "ok", 2) == 0);
-  run_s(0.01);
+  run_polled_s(0.01);
   assert_int_equal(app.gyro.sup.mode, GYRO_MODE_SWEEP);
   assert_non_null(strstr(cmd("sweep\n"), "BUSY"));
   assert_non_null(strstr(cmd("status\n"), "selfcal QUIET_UP"));

@@ -12,39 +12,16 @@
 #include <string.h>
 #include <cmocka.h>
 
-#include "app/app.h"
-#include "hal/hal_sample_timer.h"
-#include "hal_flash_host.h"
-#include "hal_host.h"
-#include "hal_uart_host.h"
-#include "plant/plant.h"
+#include "app_plant.h"
 
-static plant_t plant;
-static app_t app;
+
 
 static void start(int fb_mode)
 {
   plant_cfg_t pc;
   plant_default_cfg(&pc);
   pc.fb_mode = fb_mode;
-  if (plant_init(&plant, &pc, 31u) != 0) fail_msg("plant: %s", plant_error(&plant));
-  assert_int_equal(hal_flash_host_configure(NULL), 0);
-  hal_uart_host_reset();
-  hal_host_attach(plant_step_hal, &plant);
-  assert_int_equal(app_init(&app), 0);
-  assert_int_equal(hal_sample_timer_start(50000u, app_sample_isr, &app), 0);
-}
-
-static void run_s(double s) { hal_host_run((uint64_t)(s * 50000.0)); }
-
-static const char *cmd(const char *line)
-{
-  static char reply[4096];
-  hal_uart_host_rx_push((const uint8_t *)line, strlen(line));
-  app_poll(&app);
-  const size_t n = hal_uart_host_tx_pop((uint8_t *)reply, sizeof reply - 1u);
-  reply[n] = '\0';
-  return reply;
+  app_plant_start(&pc, 31u, NULL);
 }
 
 static void test_pass_on_healthy_part(void **state)

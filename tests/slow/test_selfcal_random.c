@@ -65,7 +65,7 @@ static void test_too_weak_plant(void **state)
   assert_true(fabs(app.selfcal.fit.f0_hz - f0) <= f0 / 20.0 / 100.0);
   assert_true(fabs(app.selfcal.fit.q / 20.0 - 1.0) <= 0.02);
   assert_true(params_current(&app.params)->drive_freq_hz == v.drive_freq_hz);
-  run_s(0.01);
+  run_polled_s(0.01);
   assert_int_equal(app.gyro.sup.mode, GYRO_MODE_OFF);
   assert_non_null(strstr(cmd("status\n"), "selfcal_why the amplitude set point"));
 }

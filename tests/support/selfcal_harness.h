@@ -8,38 +8,15 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "app/app.h"
-#include "hal/hal_sample_timer.h"
-#include "hal_flash_host.h"
-#include "hal_host.h"
-#include "hal_uart_host.h"
-#include "plant/plant.h"
-
-static plant_t plant;
-static app_t app;
-
-static inline const char *cmd(const char *line)
-{
-  static char reply[4096];
-  hal_uart_host_rx_push((const uint8_t *)line, strlen(line));
-  app_poll(&app);
-  const size_t n = hal_uart_host_tx_pop((uint8_t *)reply, sizeof reply - 1u);
-  reply[n] = '\0';
-  return reply;
-}
+#include "app_plant.h"
 
 static inline void start(const plant_cfg_t *pc, const param_values_t *v)
 {
-  assert_int_equal(plant_init(&plant, pc, 23u), 0);
-  assert_int_equal(hal_flash_host_configure(NULL), 0);
-  hal_uart_host_reset();
-  hal_host_attach(plant_step_hal, &plant);
-  assert_int_equal(app_init_with(&app, v), 0);
-  assert_int_equal(hal_sample_timer_start(50000u, app_sample_isr, &app), 0);
+  app_plant_start(pc, 23u, v);
 }
 
 /* Run with the background loop polled every millisecond. */
-static inline void run_s(double s)
+static inline void run_polled_s(double s)
 {
   const uint64_t n = (uint64_t)(s * 1000.0 + 0.5);
   for (uint64_t i = 0; i < n; i++) {
@@ -68,7 +45,7 @@ static inline double sweep_report(uint64_t t0)
 {
   for (int i = 0; i < 70000 && (app.selfcal.state != SELFCAL_DONE &&
                                 app.selfcal.state != SELFCAL_FAILED); i++) {
-    run_s(0.001);
+    run_polled_s(0.001);
   }
   const double t = (double)(plant_truth(&plant)->sample - t0) / 50000.0;
   printf("# sweep %s in %.2f s (%s): coarse %.2f Hz, ring-down %.3f Hz Q %.1f, fit %.4f Hz "
@@ -119,11 +96,11 @@ static inline double amp_m(void)
 static inline void check_lock(void)
 {
   assert_int_equal(app.selfcal.state, SELFCAL_DONE);
-  run_s(0.2);
+  run_polled_s(0.2);
   const double a02 = amp_m();
   double amin = a02, amax = a02;
   for (int i = 0; i < 40; i++) {
-    run_s(0.02);
+    run_polled_s(0.02);
     const double a = amp_m();
     amin = fmin(amin, a);
     amax = fmax(amax, a);
@@ -150,7 +127,7 @@ static inline void check_resonance_step(const plant_cfg_t *pc, double df_hz)
   thermal_set(&plant.thermal, t);
   double worst = 0.0;
   for (int i = 0; i < 50; i++) {
-    run_s(0.01);
+    run_polled_s(0.01);
     if (i >= 20) worst = fmax(worst, fabs(amp_m() / 10.0e-6 - 1.0));
   }
   printf("# resonance step %+.1f Hz: mode %u faults %u, amplitude within %.3f %% from 0.2 s\n",
@@ -194,7 +171,7 @@ static inline int fixed_design_fails(double f_hz, double q)
   param_values_t v;
   param_values_defaults(&v);
   start(&pc, &v);
-  run_s(1.2);
+  run_polled_s(1.2);
   const double a = amp_m();
   printf("# fixed design on f %.1f Hz Q %.0f: mode %u faults %u amplitude %.3f um\n", f_hz, q,
          (unsigned)app.gyro.sup.mode, (unsigned)app.gyro.sup.fault_count, a * 1e6);

@@ -1,0 +1,45 @@
+/* The application on the host plant through the host HAL, driven over its command line
+ * as gyroctl would drive a board: the harness the closed-loop C tests share.
+ * Header-only (static), one instance per test program. */
+#ifndef APP_PLANT_H
+#define APP_PLANT_H
+
+#include <string.h>
+
+#include "app/app.h"
+#include "hal/hal_sample_timer.h"
+#include "hal_flash_host.h"
+#include "hal_host.h"
+#include "hal_uart_host.h"
+#include "plant/plant.h"
+
+static plant_t plant;
+static app_t app;
+
+/* Plant pc (seed) on the host HAL, an empty flash store, the application with the
+ * values v (NULL: from the store, that is the defaults), the 50 kHz clock running. */
+static inline void app_plant_start(const plant_cfg_t *pc, uint64_t seed, const param_values_t *v)
+{
+  if (plant_init(&plant, pc, seed) != 0) fail_msg("plant: %s", plant_error(&plant));
+  assert_int_equal(hal_flash_host_configure(NULL), 0);
+  hal_uart_host_reset();
+  hal_host_attach(plant_step_hal, &plant);
+  assert_int_equal(v != NULL ? app_init_with(&app, v) : app_init(&app), 0);
+  assert_int_equal(hal_sample_timer_start(50000u, app_sample_isr, &app), 0);
+}
+
+/* One command line in, the whole reply out (the background loop runs once). */
+static inline const char *cmd(const char *line)
+{
+  static char reply[8192];
+  hal_uart_host_rx_push((const uint8_t *)line, strlen(line));
+  app_poll(&app);
+  const size_t n = hal_uart_host_tx_pop((uint8_t *)reply, sizeof reply - 1u);
+  reply[n] = '\0';
+  return reply;
+}
+
+/* s seconds of samples, the background loop not polled. */
+static inline void run_s(double s) { hal_host_run((uint64_t)(s * 50000.0)); }
+
+#endif /* APP_PLANT_H */
