@@ -107,6 +107,20 @@ int plant_param_set(plant_cfg_t *cfg, const char *name, double value, char *errb
 /* Sources of the defaults. Sections are the thesis's; "table" is the system spec's
  * table "thesis linear gyro, air package". Values the thesis does not give are
  * chosen to reproduce a measured relation, and say which. */
+/* The thermal network's figures of a preset into the flat configuration. */
+static void set_thermal(plant_cfg_t *c, const thermal_cfg_t *t)
+{
+  c->tau_struct_s = t->tau_s[THERMAL_STRUCT];
+  c->tau_circuit_s = t->tau_s[THERMAL_CIRCUIT];
+  c->tau_board_s = t->tau_s[THERMAL_BOARD];
+  c->couple_sc_per_s = t->couple_per_s[THERMAL_PAIR_SC];
+  c->couple_sb_per_s = t->couple_per_s[THERMAL_PAIR_SB];
+  c->couple_cb_per_s = t->couple_per_s[THERMAL_PAIR_CB];
+  c->rise_struct_k = t->rise_k[THERMAL_STRUCT];
+  c->rise_circuit_k = t->rise_k[THERMAL_CIRCUIT];
+  c->rise_board_k = t->rise_k[THERMAL_BOARD];
+}
+
 void plant_default_cfg(plant_cfg_t *c)
 {
   memset(c, 0, sizeof *c);
@@ -240,15 +254,7 @@ void plant_default_cfg(plant_cfg_t *c)
   /* thermal network: default preset (thermal.c) */
   thermal_cfg_t th;
   thermal_preset(&th, THERMAL_PRESET_DEFAULT);
-  c->tau_struct_s = th.tau_s[THERMAL_STRUCT];
-  c->tau_circuit_s = th.tau_s[THERMAL_CIRCUIT];
-  c->tau_board_s = th.tau_s[THERMAL_BOARD];
-  c->couple_sc_per_s = th.couple_per_s[THERMAL_PAIR_SC];
-  c->couple_sb_per_s = th.couple_per_s[THERMAL_PAIR_SB];
-  c->couple_cb_per_s = th.couple_per_s[THERMAL_PAIR_CB];
-  c->rise_struct_k = th.rise_k[THERMAL_STRUCT];
-  c->rise_circuit_k = th.rise_k[THERMAL_CIRCUIT];
-  c->rise_board_k = th.rise_k[THERMAL_BOARD];
+  set_thermal(c, &th);
   c->thermal_dt_s = th.dt_s;
 }
 
@@ -262,15 +268,7 @@ int plant_thermal_preset(plant_cfg_t *c, const char *name)
   else return -1;
   thermal_cfg_t th;
   thermal_preset(&th, which);
-  c->tau_struct_s = th.tau_s[THERMAL_STRUCT];
-  c->tau_circuit_s = th.tau_s[THERMAL_CIRCUIT];
-  c->tau_board_s = th.tau_s[THERMAL_BOARD];
-  c->couple_sc_per_s = th.couple_per_s[THERMAL_PAIR_SC];
-  c->couple_sb_per_s = th.couple_per_s[THERMAL_PAIR_SB];
-  c->couple_cb_per_s = th.couple_per_s[THERMAL_PAIR_CB];
-  c->rise_struct_k = th.rise_k[THERMAL_STRUCT];
-  c->rise_circuit_k = th.rise_k[THERMAL_CIRCUIT];
-  c->rise_board_k = th.rise_k[THERMAL_BOARD];
+  set_thermal(c, &th);
   return 0;
 }
 
