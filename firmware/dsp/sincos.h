@@ -52,7 +52,7 @@ static inline void sincos_lut(uint32_t phase, float *sin_out, float *cos_out)
 }
 
 /* Half an angle in radians to a phase (2^32 = 2 pi) of rad / 2: one multiply and one
- * conversion, for the per-tick drive phase. The caller guarantees |rad| < 2 pi (the
+ * conversion, for the drive phase of each new command. The caller guarantees |rad| < 2 pi (the
  * drive loop limits P to +-6.2 rad); sincos_rad_to_phase reduces any angle and is for
  * everything else. */
 static inline uint32_t sincos_half_rad_to_phase(float rad)

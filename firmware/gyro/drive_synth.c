@@ -38,8 +38,9 @@ float drive_synth_f_cmd_max(const drive_synth_t *ds)
 void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad)
 {
   /* A non-finite command (a NaN the supervisor has not caught yet: it looks once per
-   * block) drives nothing rather than a rail voltage; a non-finite P leaves the phase. */
-  if (!fm_isfinite(p_rad) || fm_absf(p_rad) > 7.0f) {
+   * block) drives nothing rather than a rail voltage; a P outside the +-2 pi that the
+   * phase conversion needs (NaN included: the comparison fails) leaves the phase. */
+  if (!(fm_absf(p_rad) < 6.28f)) {
     p_rad = 0.0f;
   }
   const float f = (f_cmd_v2 > 0.0f && fm_isfinite(f_cmd_v2)) ? f_cmd_v2 : 0.0f;
