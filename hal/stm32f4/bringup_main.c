@@ -188,7 +188,6 @@ static void cmd_stat(bringup_t *b, out_t *o)
   out_kv(o, "period_min", b->period_min);
   out_kv(o, "period_max", b->period_max);
   out_kv(o, "overruns", st.overruns);
-  out_kv(o, "dac_overruns", stm32f4_dac_overruns());
   out_kv(o, "dac_late", stm32f4_dac_late());
   out_kv(o, "dma_err", st.dma_errors);
   out_kv(o, "uart_drop", stm32f4_uart_rx_dropped() + stm32f4_uart_rx_overruns());

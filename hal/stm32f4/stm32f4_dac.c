@@ -7,7 +7,6 @@
 #define DAC_STREAM 2u /* DMA2 stream 2 channel 7: TIM8_CH1 (RM0090 table 43) */
 
 static volatile uint16_t s_words[HAL_DAC_NUM_CHANNELS]; /* SRAM: read by DMA */
-static volatile uint32_t s_overruns;
 static volatile uint32_t s_late;
 static volatile uint32_t s_deadline = 0xFFFFFFFFu;
 
@@ -16,8 +15,10 @@ void stm32f4_dac_init(void)
   RCC->APB1ENR |= RCC_APB1ENR_SPI2EN;
   RCC->APB2ENR |= RCC_APB2ENR_TIM8EN;
   RCC->AHB1ENR |= RCC_AHB1ENR_DMA2EN;
-  s_overruns = 0u;
   s_late = 0u;
+  for (uint32_t ch = 0u; ch < HAL_DAC_NUM_CHANNELS; ++ch) {
+    s_words[ch] = stm32f4_dac_word(ch, (uint16_t)HAL_DAC_CODE_MID);
+  }
 
   /* SPI2: transmit-only master (bidirectional mode, output enabled), 16-bit, mode 0,
    * BR = 000: PCLK1 / 2 = 21 MHz. */
@@ -31,9 +32,14 @@ void stm32f4_dac_init(void)
   stm32f4_dma_clear(DMA2, DAC_STREAM, DMA_FLAG_ALL);
   DMA2->S[DAC_STREAM].PAR = (uint32_t)(uintptr_t)&SPI2->DR;
   DMA2->S[DAC_STREAM].M0AR = (uint32_t)(uintptr_t)s_words;
+  DMA2->S[DAC_STREAM].NDTR = HAL_DAC_NUM_CHANNELS;
+  DMA2->S[DAC_STREAM].CR = (7u << DMA_SXCR_CHSEL_POS) | DMA_SXCR_PL_HIGH | DMA_SXCR_MSIZE_16 |
+                           DMA_SXCR_PSIZE_16 | DMA_SXCR_MINC | DMA_SXCR_CIRC | DMA_SXCR_DIR_M2P;
+  DMA2->S[DAC_STREAM].CR |= DMA_SXCR_EN;
 
   /* TIM8: one-pulse, RCR = 3 -> four periods then stop; CH1 PWM2 active low (CS high
-   * while CNT < CCR1), CC1 raises the DMA request, MOE enables the output. */
+   * while CNT < CCR1), CC1 raises the DMA request, MOE enables the output; a rising
+   * edge of TIM4's TRGO (ITR2) sets CEN. */
   TIM8->CR1 = TIM_CR1_OPM;
   TIM8->PSC = 0u;
   TIM8->ARR = STM32F4_DAC_SLOT_TICKS - 1u;
@@ -45,6 +51,7 @@ void stm32f4_dac_init(void)
   TIM8->BDTR = TIM_BDTR_MOE;
   TIM8->EGR = TIM_EGR_UG; /* load RCR and ARR; the counter stays stopped */
   TIM8->SR = 0u;
+  TIM8->SMCR = (TIM_TS_ITR2 << TIM_SMCR_TS_POS) | TIM_SMS_TRIGGER;
 }
 
 STM32F4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame)
@@ -53,23 +60,9 @@ STM32F4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame)
     ++s_late;
     return;
   }
-  if ((TIM8->CR1 & TIM_CR1_CEN) != 0u || (DMA2->S[DAC_STREAM].CR & DMA_SXCR_EN) != 0u) {
-    ++s_overruns;
-    return;
-  }
   for (uint32_t ch = 0u; ch < HAL_DAC_NUM_CHANNELS; ++ch) {
     s_words[ch] = stm32f4_dac_word(ch, frame->code[ch]);
   }
-  stm32f4_dma_clear(DMA2, DAC_STREAM, DMA_FLAG_ALL);
-  DMA2->S[DAC_STREAM].NDTR = HAL_DAC_NUM_CHANNELS;
-  DMA2->S[DAC_STREAM].CR = (7u << DMA_SXCR_CHSEL_POS) | DMA_SXCR_PL_HIGH | DMA_SXCR_MSIZE_16 |
-                           DMA_SXCR_PSIZE_16 | DMA_SXCR_MINC | DMA_SXCR_DIR_M2P | DMA_SXCR_EN;
-  TIM8->CR1 = TIM_CR1_OPM | TIM_CR1_CEN;
-}
-
-uint32_t stm32f4_dac_overruns(void)
-{
-  return s_overruns;
 }
 
 void stm32f4_dac_set_deadline(uint32_t tim1_count)

@@ -1,9 +1,9 @@
 /* STM32F405 register map: only the peripherals and bits this board port uses.
  * Addresses and bit positions from RM0090 (STM32F405/415/407/417 reference manual):
  * memory map §2.3 table 1, RCC §7.3, PWR §5.4, FLASH §3.8, GPIO §8.4, TIM1/TIM8 §17.4,
- * SPI §28.5, DMA §10.5, USART §30.6, IWDG §21.4; core peripherals from the Cortex-M4
- * Devices Generic User Guide (SCB, NVIC, SysTick, CPACR) and the ARMv7-M ARM (DWT,
- * DEMCR).
+ * TIM2-TIM5 §18.4, SPI §28.5, DMA §10.5, USART §30.6, IWDG §21.4; core peripherals from
+ * the Cortex-M4 Devices Generic User Guide (SCB, NVIC, SysTick, CPACR) and the ARMv7-M
+ * ARM (DWT, DEMCR).
  *
  * Host builds (STM32F4_HOST_TEST defined) see every peripheral through a pointer in
  * stm32f4_host_map, which a unit test points at RAM structs: the drivers then run their
@@ -85,6 +85,7 @@ typedef struct {
 
 /* Base addresses (RM0090 table 1; ARMv7-M system address map). */
 #define STM32F4_TIM2_BASE 0x40000000UL
+#define STM32F4_TIM4_BASE 0x40000800UL
 #define STM32F4_PWR_BASE 0x40007000UL
 #define STM32F4_IWDG_BASE 0x40003000UL
 #define STM32F4_SPI2_BASE 0x40003800UL
@@ -117,7 +118,7 @@ typedef struct {
   stm32f4_pwr_t *pwr;
   stm32f4_flash_t *flash;
   stm32f4_gpio_t *gpioa, *gpiob, *gpioc;
-  stm32f4_tim_t *tim1, *tim2, *tim8;
+  stm32f4_tim_t *tim1, *tim2, *tim4, *tim8;
   stm32f4_spi_t *spi1, *spi2;
   stm32f4_dma_t *dma2;
   stm32f4_usart_t *usart1;
@@ -169,6 +170,7 @@ void stm32f4_qemu_flash_controller(void);
 #define GPIOC STM32F4_PERIPH(gpioc, stm32f4_gpio_t, STM32F4_GPIOC_BASE)
 #define TIM1 STM32F4_PERIPH(tim1, stm32f4_tim_t, STM32F4_TIM1_BASE)
 #define TIM2 STM32F4_PERIPH(tim2, stm32f4_tim_t, STM32F4_TIM2_BASE)
+#define TIM4 STM32F4_PERIPH(tim4, stm32f4_tim_t, STM32F4_TIM4_BASE)
 #define TIM8 STM32F4_PERIPH(tim8, stm32f4_tim_t, STM32F4_TIM8_BASE)
 #define SPI1 STM32F4_PERIPH(spi1, stm32f4_spi_t, STM32F4_SPI1_BASE)
 #define SPI2 STM32F4_PERIPH(spi2, stm32f4_spi_t, STM32F4_SPI2_BASE)
@@ -214,6 +216,7 @@ void stm32f4_qemu_flash_controller(void);
 #define RCC_AHB1ENR_CCMDATARAMEN (1u << 20)
 #define RCC_AHB1ENR_DMA2EN (1u << 22)
 #define RCC_APB1ENR_TIM2EN (1u << 0)
+#define RCC_APB1ENR_TIM4EN (1u << 2)
 #define RCC_APB1ENR_SPI2EN (1u << 14)
 #define RCC_APB1ENR_PWREN (1u << 28)
 #define RCC_APB2ENR_TIM1EN (1u << 0)
@@ -266,13 +269,26 @@ void stm32f4_qemu_flash_controller(void);
 #define TIM_CR1_ARPE (1u << 7)
 #define TIM_DIER_CC1DE (1u << 9)
 #define TIM_DIER_CC3DE (1u << 11)
+#define TIM_DIER_CC4DE (1u << 12)
 #define TIM_EGR_UG (1u << 0)
+/* Master/slave (RM0090 §17.4.2-3, §18.4.2-3): CR2.MMS picks what drives TRGO; SMCR.TS
+ * picks the trigger input, SMCR.SMS what the trigger does. */
+#define TIM_CR2_MMS_POS 4u
+#define TIM_MMS_UPDATE 2u /* TRGO = update event */
+#define TIM_MMS_OC1REF 4u /* TRGO = OC1REF */
+#define TIM_SMCR_TS_POS 4u
+#define TIM_TS_ITR0 0u    /* TIM4's ITR0 = TIM1 TRGO (TIM2-TIM5 internal trigger table) */
+#define TIM_TS_ITR2 2u    /* TIM8's ITR2 = TIM4 TRGO (TIM1/TIM8 internal trigger table) */
+#define TIM_SMS_RESET 4u   /* a trigger edge resets the counter */
+#define TIM_SMS_TRIGGER 6u /* a trigger edge sets CEN */
 #define TIM_OCM_PWM1 6u /* active while CNT < CCR */
 #define TIM_OCM_PWM2 7u /* inactive while CNT < CCR */
 #define TIM_CCMR_OC1M_POS 4u
 #define TIM_CCMR_OC1PE (1u << 3)
 #define TIM_CCMR_OC2M_POS 12u
 #define TIM_CCMR_OC2PE (1u << 11)
+#define TIM_CCMR_OC4M_POS 12u /* in CCMR2 */
+#define TIM_CCMR_OC4PE (1u << 11)
 #define TIM_CCER_CC1E (1u << 0)
 #define TIM_CCER_CC1P (1u << 1)
 #define TIM_CCER_CC2E (1u << 4)

@@ -1,5 +1,6 @@
 /* AD5554 DAC path (hal/stm32f4/stm32f4_dac.c): word format, the TIM8 framing that makes
- * exactly four chip-select slots in hardware, and the non-blocking frame write. */
+ * exactly four chip-select slots in hardware when TIM4 starts it, the circular stream
+ * that sends the words every tick, and the frame write that only stores them. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -52,7 +53,8 @@ static void test_init_registers(void **state)
   assert_int_equal(SPI2->CR1, want);
   assert_int_equal(SPI2->CR2, SPI_CR2_TXDMAEN);
   /* TIM8: one-pulse with repetition counter 3 = four slots; CS on CH1 as PWM2 active
-   * low; CC1 drives the DMA request. */
+   * low; CC1 drives the DMA request; stopped until TIM4's TRGO (ITR2) starts it
+   * (trigger mode). */
   assert_true((TIM8->CR1 & TIM_CR1_OPM) != 0u);
   assert_int_equal(TIM8->CR1 & TIM_CR1_CEN, 0);
   assert_int_equal(TIM8->ARR, STM32F4_DAC_SLOT_TICKS - 1u);
@@ -62,12 +64,28 @@ static void test_init_registers(void **state)
   assert_int_equal(TIM8->CCER, TIM_CCER_CC1E | TIM_CCER_CC1P);
   assert_int_equal(TIM8->DIER, TIM_DIER_CC1DE);
   assert_true((TIM8->BDTR & TIM_BDTR_MOE) != 0u);
+  assert_int_equal(TIM8->SMCR & 7u, 6u);         /* trigger mode */
+  assert_int_equal((TIM8->SMCR >> 4) & 7u, 2u);  /* ITR2 = TIM4 */
+  /* DMA2 stream 2, channel 7 (TIM8_CH1): the four words into SPI2_DR, circular, armed
+   * once here and never again. */
   assert_int_equal(DMA2->S[2].PAR, (uint32_t)(uintptr_t)&SPI2->DR);
+  assert_int_equal(DMA2->S[2].NDTR, 4);
+  assert_int_equal(DMA2->S[2].CR >> 25, 7u);
+  const uint32_t on = DMA_SXCR_EN | DMA_SXCR_MINC | DMA_SXCR_CIRC;
+  assert_int_equal(DMA2->S[2].CR & on, on);
+  assert_int_equal((DMA2->S[2].CR >> 6) & 3u, 1u); /* memory -> peripheral */
+  /* Until the first frame the slots send mid-scale (0 V) to each channel. */
+  volatile uint16_t *w = stm32f4_dac_host_words();
+  for (uint32_t ch = 0u; ch < 4u; ch++) {
+    assert_int_equal(w[ch], (ch << 14) | 8192u);
+  }
 }
 
-static void test_write_frame_arms_sequence(void **state)
+static void test_write_frame_only_fills_words(void **state)
 {
   (void)state;
+  const stm32f4_dma_t dma_before = *DMA2;
+  const stm32f4_tim_t tim8_before = *TIM8;
   const hal_dac_frame_t f = {{100u, 8192u, 16383u, 0u}};
   hal_dac_write_frame(&f);
   volatile uint16_t *w = stm32f4_dac_host_words();
@@ -75,40 +93,27 @@ static void test_write_frame_arms_sequence(void **state)
   assert_int_equal(w[1], 0x4000u | 8192u);
   assert_int_equal(w[2], 0x8000u | 16383u);
   assert_int_equal(w[3], 0xC000u);
-  assert_int_equal(DMA2->S[2].NDTR, 4);
-  assert_int_equal(DMA2->S[2].CR >> 25, 7u); /* channel 7: TIM8_CH1 */
-  assert_true((DMA2->S[2].CR & (DMA_SXCR_EN | DMA_SXCR_MINC)) == (DMA_SXCR_EN | DMA_SXCR_MINC));
-  assert_int_equal((DMA2->S[2].CR >> 6) & 3u, 1u); /* memory -> peripheral */
-  assert_int_equal(TIM8->CR1, TIM_CR1_OPM | TIM_CR1_CEN);
-  assert_int_equal(stm32f4_dac_overruns(), 0);
-}
-
-static void test_write_while_busy_is_refused(void **state)
-{
-  (void)state;
-  const hal_dac_frame_t a = {{1u, 2u, 3u, 4u}};
-  const hal_dac_frame_t b = {{9u, 9u, 9u, 9u}};
-  hal_dac_write_frame(&a);
-  hal_dac_write_frame(&b); /* TIM8 still running: the sequence is not disturbed */
-  assert_int_equal(stm32f4_dac_overruns(), 1);
-  assert_int_equal(stm32f4_dac_host_words()[0], 1u);
-  /* Sequence done (TIM8 stopped itself, DMA stream disabled): next frame goes out. */
-  TIM8->CR1 = TIM_CR1_OPM;
-  DMA2->S[2].CR &= ~DMA_SXCR_EN;
-  hal_dac_write_frame(&b);
-  assert_int_equal(stm32f4_dac_host_words()[0], 9u);
+  /* No register is touched: the hardware sends the words at the next slots. */
+  assert_memory_equal((const void *)DMA2, (const void *)&dma_before, sizeof dma_before);
+  assert_memory_equal((const void *)TIM8, (const void *)&tim8_before, sizeof tim8_before);
+  /* The next frame replaces the words whole. */
+  const hal_dac_frame_t g = {{9u, 10u, 11u, 12u}};
+  hal_dac_write_frame(&g);
+  assert_int_equal(w[0], 9u);
+  assert_int_equal(w[3], 0xC000u | 12u);
+  assert_int_equal(stm32f4_dac_late(), 0);
 }
 
 static void test_late_frame_is_dropped(void **state)
 {
   (void)state;
   const hal_dac_frame_t a = {{5u, 6u, 7u, 8u}};
-  stm32f4_dac_set_deadline(2503u);
-  TIM1->CNT = 2504u; /* too late: the sequence would straddle the next LDAC */
+  stm32f4_dac_set_deadline(2485u);
+  TIM1->CNT = 2486u; /* too late: the slots may already be sending */
   hal_dac_write_frame(&a);
   assert_int_equal(stm32f4_dac_late(), 1);
-  assert_int_equal(TIM8->CR1 & TIM_CR1_CEN, 0);
-  TIM1->CNT = 2503u;
+  assert_int_equal(stm32f4_dac_host_words()[3], 0xC000u | 8192u); /* previous words kept */
+  TIM1->CNT = 2485u;
   hal_dac_write_frame(&a);
   assert_int_equal(stm32f4_dac_late(), 1);
   assert_int_equal(stm32f4_dac_host_words()[3], 0xC000u | 8u);
@@ -121,8 +126,7 @@ int main(void)
       cmocka_unit_test(test_word_format),
       cmocka_unit_test(test_slot_timing_fits),
       cmocka_unit_test_setup(test_init_registers, setup),
-      cmocka_unit_test_setup(test_write_frame_arms_sequence, setup),
-      cmocka_unit_test_setup(test_write_while_busy_is_refused, setup),
+      cmocka_unit_test_setup(test_write_frame_only_fills_words, setup),
       cmocka_unit_test_setup(test_late_frame_is_dropped, setup),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -314,16 +314,17 @@ class CycleModel:
 # context the first FP instruction of the handler stacks S0-S15 and FPSCR, 17 words, and
 # the return unstacks them).
 EXC_ENTRY, EXC_EXIT, FP_LAZY_SAVE, FP_RESTORE = 12, 10, 17, 17
-# Peripheral accesses of the handler and the HAL calls per tick, counted in the source:
-#   DMA2_Stream0_IRQHandler (stm32f4_sample.c): reads DMA2 LISR twice and S5.CR twice
-#     (test, read-modify-write); writes DMA2 LIFCR, HIFCR, S5.NDTR, S5.CR and SPI1 CR2;
-#   hal_dac_write_frame (stm32f4_dac.c): reads TIM1 CNT, TIM8 CR1, DMA2 S2.CR; writes
-#     DMA2 LIFCR, S2.NDTR, S2.CR and TIM8 CR1;
+# Peripheral accesses of the handler and the HAL calls per tick, counted in the source
+# (every converter stream is circular and timer-started, so nothing is re-armed):
+#   DMA2_Stream0_IRQHandler (stm32f4_sample.c): reads DMA2 LISR twice (the flags, the
+#     overrun check after the tick); writes DMA2 LIFCR once;
+#   hal_dac_write_frame (stm32f4_dac.c): reads TIM1 CNT (the deadline); its four words
+#     go to SRAM;
 #   DMA2_Stream0_IRQHandler's self-measurement, twice: reads DWT CYCCNT.
-# Reads: DMA2 (AHB1) 5, TIM1/TIM8 (APB2) 2, DWT (PPB) 2; writes: DMA2 7, APB2 2.
+# Reads: DMA2 (AHB1) 2, TIM1 (APB2) 1, DWT (PPB) 2; writes: DMA2 1.
 # Assumed extra cycles over an SRAM access: AHB1 read +2, APB2 read +4 (bridge at
 # HCLK/2), PPB read +1, write +1.
-PERIPH_EXTRA = 5 * 2 + 2 * 4 + 2 * 1 + (7 + 2) * 1
+PERIPH_EXTRA = 2 * 2 + 1 * 4 + 2 * 1 + 1 * 1
 
 
 def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm"):

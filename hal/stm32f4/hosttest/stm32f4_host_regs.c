@@ -6,7 +6,7 @@ static stm32f4_rcc_t s_rcc;
 static stm32f4_pwr_t s_pwr;
 static stm32f4_flash_t s_flash;
 static stm32f4_gpio_t s_gpioa, s_gpiob, s_gpioc;
-static stm32f4_tim_t s_tim1, s_tim2, s_tim8;
+static stm32f4_tim_t s_tim1, s_tim2, s_tim4, s_tim8;
 static stm32f4_spi_t s_spi1, s_spi2;
 static stm32f4_dma_t s_dma2;
 static stm32f4_usart_t s_usart1;
@@ -20,7 +20,7 @@ static uint8_t s_param_flash[STM32F4_PARAM_NUM_SECTORS * STM32F4_PARAM_SECTOR_BY
     __attribute__((aligned(4)));
 
 stm32f4_host_map_t stm32f4_host_map = {
-    &s_rcc, &s_pwr, &s_flash, &s_gpioa, &s_gpiob, &s_gpioc, &s_tim1, &s_tim2, &s_tim8,
+    &s_rcc, &s_pwr, &s_flash, &s_gpioa, &s_gpiob, &s_gpioc, &s_tim1, &s_tim2, &s_tim4, &s_tim8,
     &s_spi1, &s_spi2, &s_dma2, &s_usart1, &s_iwdg, &s_scb, &s_nvic, &s_systick, &s_dwt,
     &s_cpacr, &s_demcr, s_param_flash, 0, 0u};
 
@@ -36,6 +36,7 @@ void stm32f4_host_reset(void)
   ZERO(s_gpioc);
   ZERO(s_tim1);
   ZERO(s_tim2);
+  ZERO(s_tim4);
   ZERO(s_tim8);
   ZERO(s_spi1);
   ZERO(s_spi2);

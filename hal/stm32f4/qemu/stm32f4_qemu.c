@@ -261,11 +261,6 @@ void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
   stats->dma_errors = 0u;
 }
 
-uint32_t stm32f4_dac_overruns(void)
-{
-  return 0u;
-}
-
 uint32_t stm32f4_dac_late(void)
 {
   return 0u;

@@ -19,7 +19,6 @@ void bench_board_set_frame(const hal_adc_frame_t *frame)
 void bench_board_arm(void)
 {
   bench_fake_dma2.LISR = DMA_FLAG_TCIF; /* stream 0: shift 0 */
-  bench_fake_dma2.S[ADC_TX_STREAM].CR &= ~DMA_SXCR_EN;
 }
 
 void bench_board_clear_tc(void) { bench_fake_dma2.LISR = 0u; }

@@ -3,11 +3,10 @@
  * the bench sets as the hardware would leave it at the transfer-complete interrupt.
  *
  * QEMU's netduinoplus2 has no DMA model (reads 0, writes ignored), so the handler would
- * see no transfer-complete flag and return at once. Everything else the handler and the
- * HAL calls touch (TIM1, TIM8, SPI1, the DAC's DMA stream) is left to QEMU: reads of the
- * unmodelled blocks return 0, which is the normal path of hal_dac_write_frame (TIM1
- * before the deadline, TIM8 and the DAC stream idle). Instruction counts are unaffected
- * by where a register lives; bus timing is, and is added in the cycle model. */
+ * see no transfer-complete flag and return at once. The one other register the handler
+ * and the HAL calls touch, TIM1's counter, is left to QEMU: it reads 0 there, which is
+ * the normal path of hal_dac_write_frame (before the deadline). Instruction counts are
+ * unaffected by where a register lives; bus timing is, and is added in the cycle model. */
 #ifndef BENCH_ISR_BOARD_H
 #define BENCH_ISR_BOARD_H
 
@@ -16,7 +15,7 @@
 /* Play the ADC DMA: the frame the next hal_adc_read_frame returns. */
 void bench_board_set_frame(const hal_adc_frame_t *frame);
 
-/* State at the transfer-complete interrupt: stream 0 TCIF set, stream 5 finished. */
+/* State at the transfer-complete interrupt: stream 0 TCIF set. */
 void bench_board_arm(void);
 
 /* The handler's write to LIFCR would clear TCIF on the chip; in RAM it does not, so the
