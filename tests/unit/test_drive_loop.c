@@ -11,7 +11,7 @@
 static void test_design_formula(void **state)
 {
   (void)state;
-  const drive_loop_design_in_t in = {0.03125, 0.00712, 30.0, 270.0, 50000.0, 1.0};
+  const drive_loop_design_in_t in = {0.03125, 0.00712, 30.0, 270.0, 50000.0, 1.0, 0.0};
   drive_loop_design_out_t out;
   assert_int_equal(drive_loop_design(&in, &out), 0);
   const double wc = 2.0 * M_PI * 30.0;
@@ -25,7 +25,7 @@ static void test_design_formula(void **state)
 static void test_design_caps_bandwidth(void **state)
 {
   (void)state;
-  const drive_loop_design_in_t in = {1.0, 0.1, 1000.0, 270.0, 50000.0, 1.0};
+  const drive_loop_design_in_t in = {1.0, 0.1, 1000.0, 270.0, 50000.0, 1.0, 0.0};
   drive_loop_design_out_t out;
   assert_int_equal(drive_loop_design(&in, &out), 0);
   assert_true(out.bw_hz < 1000.0);
@@ -42,8 +42,32 @@ static void test_design_caps_bandwidth(void **state)
   const double pmh = 90.0 - (atan(wch / (2 * M_PI * 270.0)) + wch * 6.0 / 50000.0) * 180.0 / M_PI;
   assert_true(fabs(pmh - out_h.phase_margin_deg) < 1e-9 && pmh >= 60.0);
   assert_true(out_h.bw_hz < out.bw_hz);
+  /* The command reaching the DAC 4 samples after the measured one: 4 + 1 + 10/2. */
+  drive_loop_design_in_t late = held;
+  late.lag_samples = 4.0;
+  drive_loop_design_out_t out_l;
+  assert_int_equal(drive_loop_design(&late, &out_l), 0);
+  const double wcl = 2.0 * M_PI * out_l.bw_hz;
+  const double pml = 90.0 - (atan(wcl / (2 * M_PI * 270.0)) + wcl * 10.0 / 50000.0) * 180.0 / M_PI;
+  assert_true(fabs(pml - out_l.phase_margin_deg) < 1e-9 && pml >= 60.0);
+  assert_true(out_l.bw_hz < out_h.bw_hz);
+  /* Where the cap is not reached the delay changes nothing but the margin. */
+  drive_loop_design_in_t slow = late;
+  slow.bw_hz = 30.0;
+  assert_int_equal(drive_loop_design(&slow, &out_l), 0);
+  assert_true(fabs(out_l.bw_hz - 30.0) < 1e-9);
+  const double wcs = 2.0 * M_PI * 30.0;
+  assert_true(fabs(out_l.phase_margin_deg -
+                   (90.0 - (atan(wcs / (2 * M_PI * 270.0)) + wcs * 10.0 / 50000.0) * 180.0 / M_PI)) <
+              1e-9);
   drive_loop_design_in_t bad = in;
   bad.loop_decim = -1.0;
+  assert_int_equal(drive_loop_design(&bad, &out), -1);
+  bad = in;
+  bad.lag_samples = -1.0;
+  assert_int_equal(drive_loop_design(&bad, &out), -1);
+  bad = in;
+  bad.lag_samples = NAN;
   assert_int_equal(drive_loop_design(&bad, &out), -1);
   bad = in;
   bad.tau_s = -1.0;
@@ -74,7 +98,7 @@ static void test_closed_loop_first_order(void **state)
 {
   (void)state;
   const double fs = 50000.0, tau = 0.00712, k = 0.03125, bw = 30.0;
-  drive_loop_design_in_t in = {k, tau, bw, 270.0, fs, 1.0};
+  drive_loop_design_in_t in = {k, tau, bw, 270.0, fs, 1.0, 0.0};
   drive_loop_design_out_t amp, ph;
   in.plant_gain = k;
   assert_int_equal(drive_loop_design(&in, &amp), 0);
@@ -116,7 +140,7 @@ static void test_startup_no_overshoot(void **state)
 {
   (void)state;
   const double fs = 50000.0, tau = 0.00712, k = 0.03125;
-  drive_loop_design_in_t in = {k, tau, 30.0, 270.0, fs, 1.0};
+  drive_loop_design_in_t in = {k, tau, 30.0, 270.0, fs, 1.0, 0.0};
   drive_loop_design_out_t amp, ph;
   assert_int_equal(drive_loop_design(&in, &amp), 0);
   in.plant_gain = 1.0;
