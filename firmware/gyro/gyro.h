@@ -114,21 +114,24 @@ typedef struct {
  * are tail calls of gyro_tick, gyro_block.h), so what it changes reaches the DAC from
  * the next tick on.
  *
- *   slot  job                                              uses (slot it comes from)
- *   0     arg Z: atan2 (one divide), wrapped phase error   drive LMSD
- *   1     finiteness check of the state;                   LMSDs, loops, rate channel
- *         phase PI -> P (held while |Z| < 10 % of set)     phase error (0), |Z| (2, last block)
- *   2     |Z| (square root), amplitude PI -> f_cmd         drive LMSD
- *   3     drive_synth_set(f_cmd, P): the waveform's        f_cmd (2), P (1)
+ *   slot  job                                             uses (slot it comes from)
+ *   0     arg Z (fm_atan2f: one divide)                   drive LMSD
+ *   1     phase loop: wrapped error, PI -> P (P held      arg Z (0), |Z| (2, last block)
+ *         while |Z| < 10 % of its setpoint)
+ *   2     finiteness check, first half (LMSD weights);    drive LMSD
+ *         |Z| (square root), amplitude PI -> f_cmd
+ *   3     the supervisor's evidence (sup_in);             |Z|, f_cmd (2), phase error (1)
+ *         drive_synth_set(f_cmd, P): the waveform's       f_cmd (2), P (1)
  *         amplitude (square root) and phase offset
- *   4     supervisor                                       |Z|, f_cmd (2), phase error (0),
- *                                                          finiteness (1)
- *   5     rate channel: block mean of S, projection        sense sum, P (1)
- *   6     rate output filter and scale                     projection (5)
- *   7     rate compensation in P_f; P's low-pass           filtered rate (6), P (1)
- *         (its mean every 10th block)
- *   8     quadrature filter and scale; self-test sequence  projection (5)
- *   9     output snapshot, analog rate code                everything
+ *   4     supervisor (its clear request: slot 5)          evidence (3), finiteness (7, last block)
+ *   5     rate channel: block mean of S, projection       sense sum, P (1)
+ *         (or, on request, the loop state cleared)
+ *   6     rate: output filter, scale, compensation        projection (5), P_f (8, last block)
+ *   7     finiteness check, second half (loop and rate    weights' half (2)
+ *         outputs) and verdict; quadrature filter         projection (5)
+ *   8     P's hold and low-pass (its mean every 10th      P (1)
+ *         block); the self-test sequence while it runs    projection (5)
+ *   9     output snapshot, analog rate code               everything
  *
  * The drive command thus reaches the DAC (COMMAND + 1 - slot) ticks after the sample
  * the loop measured: 4 for the phase loop, 2 for the amplitude loop; gyro_design adds
@@ -145,10 +148,10 @@ typedef struct {
 #define GYRO_SLOT_P 8u
 #define GYRO_SLOT_OUTPUT 9u
 _Static_assert(GYRO_SLOT_PHASE_MEAS < GYRO_SLOT_PHASE_PI && GYRO_SLOT_PHASE_PI < GYRO_SLOT_COMMAND &&
-                   GYRO_SLOT_AMP < GYRO_SLOT_COMMAND && GYRO_SLOT_PHASE_PI < GYRO_SLOT_SUPERVISE &&
-                   GYRO_SLOT_AMP < GYRO_SLOT_SUPERVISE && GYRO_SLOT_PROJECT < GYRO_SLOT_RATE &&
+                   GYRO_SLOT_AMP < GYRO_SLOT_COMMAND && GYRO_SLOT_COMMAND < GYRO_SLOT_SUPERVISE &&
+                   GYRO_SLOT_SUPERVISE < GYRO_SLOT_PROJECT && GYRO_SLOT_PROJECT < GYRO_SLOT_RATE &&
                    GYRO_SLOT_PROJECT < GYRO_SLOT_QUAD && GYRO_SLOT_PROJECT < GYRO_SLOT_P &&
-                   GYRO_SLOT_OUTPUT == GYRO_BLOCK - 1u,
+                   GYRO_SLOT_AMP < GYRO_SLOT_QUAD && GYRO_SLOT_OUTPUT == GYRO_BLOCK - 1u,
                "block jobs out of order (gyro.h slot table)");
 
 /* Turn parameter values into module configurations, checking that every module

@@ -4,10 +4,13 @@
  *
  * A job runs at the end of its tick, after the DAC frame is written: gyro_tick ends in
  * gyro_block_run, which ends in one call of a job, compiled as a tail call. The sample
- * path itself then calls nothing, keeps its values in the caller-saved registers and
- * saves no register on entry; a job pays only for its own registers. The jobs that are
- * more than a call into a module are functions of their own here (a separate
- * translation unit, so they stay out of gyro_tick's register allocation).
+ * path itself then calls nothing before its frame, keeps its values in the caller-saved
+ * registers (it saves three core registers on entry, no FP register) and a job pays
+ * only for its own registers. The jobs that are more than a call into a module are
+ * functions of their own here (a separate translation unit, so they stay out of
+ * gyro_tick's register allocation); a job that would need a call before its last one
+ * is split by the switch instead (the self-test in GYRO_SLOT_P), so that the common
+ * path saves nothing.
  */
 #ifndef GYRO_BLOCK_H
 #define GYRO_BLOCK_H
