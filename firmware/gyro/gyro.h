@@ -192,6 +192,11 @@ int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d);
  * is clear: below 1.5 * 2^23 or negative is code 0, above is the largest code
  * (infinity included). IEEE 754 single precision with round-to-nearest, the same on
  * host and target. */
+#if defined(__GNUC__)
+#define GYRO_UNLIKELY(x) __builtin_expect((x) != 0, 0) /* block layout only */
+#else
+#define GYRO_UNLIKELY(x) ((x) != 0)
+#endif
 #define GYRO_DAC_ROUND_F 12582912.0f    /* 1.5 * 2^23 */
 #define GYRO_DAC_ROUND_BITS 0x4B400000u /* its bit pattern */
 static inline uint16_t gyro_volts_to_dac(float v)
@@ -200,7 +205,7 @@ static inline uint16_t gyro_volts_to_dac(float v)
   uint32_t u;
   memcpy(&u, &m, sizeof u);
   uint32_t code = u - GYRO_DAC_ROUND_BITS;
-  if (code > HAL_DAC_CODE_MAX) {
+  if (GYRO_UNLIKELY(code > HAL_DAC_CODE_MAX)) {
     if ((u << 1) > 0xFF000000u) { /* exponent all ones, mantissa not zero: NaN */
       code = HAL_DAC_CODE_MID;
     } else {
