@@ -16,14 +16,16 @@ int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t 
     return -1;
   }
   /* Loop phase at crossover wc of the first-order open loop K Kp/(tau s) with the demod
-   * lag and the delay of one sample (DAC latency) plus the hold of a loop period N T
-   * (N T / 2): 90 - atan(wc/wd) - (1 + N/2) wc T. */
-  if (!(in->loop_decim >= 0.0) || !(in->loop_decim <= 1000.0)) {
+   * lag and the delays: from the measured sample to the first DAC frame of the command
+   * (lag), the DAC's latency of one sample and the hold of a loop period N T (N T / 2):
+   * 90 - atan(wc/wd) - (lag + 1 + N/2) wc T. */
+  if (!(in->loop_decim >= 0.0) || !(in->loop_decim <= 1000.0) || !(in->lag_samples >= 0.0) ||
+      !(in->lag_samples <= 1000.0)) {
     return -1;
   }
   const double n_hold = in->loop_decim > 1.0 ? in->loop_decim : 1.0;
   const double wd = 2.0 * FM_PI * in->demod_bw_hz;
-  const double delay_s = (1.0 + 0.5 * n_hold) / in->fs_hz;
+  const double delay_s = (in->lag_samples + 1.0 + 0.5 * n_hold) / in->fs_hz;
   double wc = 2.0 * FM_PI * in->bw_hz;
   double pm = 0.0;
   for (int i = 0; i < 60; i++) {
@@ -97,9 +99,13 @@ void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c)
   dl->f_cmd_v2 = pi_step(&dl->amp_pi, dl->amp_err_v);
 }
 
-void drive_loop_step_phase(drive_loop_t *dl, float w_s, float w_c)
+void drive_loop_measure_phase(drive_loop_t *dl, float w_s, float w_c)
 {
   dl->phase_rad = fm_atan2f(w_c, w_s);
+}
+
+void drive_loop_update_phase(drive_loop_t *dl)
+{
   dl->phase_err_rad = fm_wrap_pi(dl->phase_set_rad - dl->phase_rad);
   /* While the amplitude is still tiny its phase is noise; hold P until there is a
    * vibration to measure (10 % of the setpoint). */
@@ -108,6 +114,12 @@ void drive_loop_step_phase(drive_loop_t *dl, float w_s, float w_c)
   } else {
     (void)pi_reset(&dl->phase_pi, dl->p_rad, dl->phase_err_rad);
   }
+}
+
+void drive_loop_step_phase(drive_loop_t *dl, float w_s, float w_c)
+{
+  drive_loop_measure_phase(dl, w_s, w_c);
+  drive_loop_update_phase(dl);
 }
 
 void drive_loop_step(drive_loop_t *dl, float w_s, float w_c)

@@ -1,6 +1,9 @@
-/* Drive-mode amplitude and phase loops (thesis 6.4), one call per loop period dt_s
+/* Drive-mode amplitude and phase loops (thesis 6.4), one update per loop period dt_s
  * (gyro_tick: once per block of RATE_DECIM samples, 5 kHz; the loops close at tens of
  * Hz, and the LMSD's few hundred Hz of bandwidth leave nothing at 5 kHz to alias).
+ * The caller may spread one update over several ticks (measurement of arg Z, phase PI,
+ * amplitude loop, each on its own tick of the block, gyro.h) and turn the command into
+ * voltages later still; the designer is told that delay (lag_samples).
  *
  * Measurement: the drive pickoff phasor Z = w_s + j w_c from the drive LMSD (see
  * gyro_cfg.h for the phasor convention). Amplitude |Z| by one VSQRT, phase arg(Z) by
@@ -25,8 +28,11 @@
  * (6-12, 6-17), the PI zero is put on the plant pole (Ki/Kp = 1/tau), leaving the
  * open loop K Kp / (tau s): a first-order closed loop of bandwidth wc = K Kp / tau, with
  * no overshoot. The demodulator's lag (a first-order lag of bandwidth lmsd_bw), the
- * one-sample DAC latency and the hold of the command between loop updates (half a loop
- * period on average) cost phase margin; wc is capped so that at least 60 deg remain.
+ * delay from the measured sample to the first DAC frame carrying the new command
+ * (lag_samples), the one-sample DAC latency and the hold of the command between loop
+ * updates (half a loop period on average) cost phase margin; wc is capped so that at
+ * least 60 deg remain:
+ *     PM = 90 - atan(wc / wd) - (lag + 1 + N/2) wc T   (deg, T = 1/fs, N = loop_decim).
  */
 #ifndef DRIVE_LOOP_H
 #define DRIVE_LOOP_H
@@ -68,6 +74,10 @@ typedef struct {
   double fs_hz;        /* sample rate */
   double loop_decim;   /* samples per loop update (the loop runs at fs / loop_decim and
                         * its output is held between updates); 0 or 1: every sample */
+  double lag_samples;  /* samples from the one whose demodulated phasor the loop measures
+                        * to the first one whose DAC frame carries the resulting command
+                        * (0: the same sample); the DAC's own latency of one sample comes
+                        * on top */
 } drive_loop_design_in_t;
 
 typedef struct {
@@ -90,12 +100,16 @@ void drive_loop_retune(drive_loop_t *dl, const drive_loop_cfg_t *cfg);
 /* Drive off: force command 0, P back to its start value, integrators cleared. */
 void drive_loop_reset(drive_loop_t *dl);
 
-/* One tick: measurement from the drive LMSD weights, then both PIs. */
+/* One update: measurement from the drive LMSD weights, then both PIs. */
 void drive_loop_step(drive_loop_t *dl, float w_s, float w_c);
-/* The two halves of drive_loop_step, for a caller that spreads them over two ticks:
+/* The parts of drive_loop_step, for a caller that spreads them over several ticks:
  * the amplitude loop (|Z|, f_cmd) and the phase loop (arg Z, P; it uses the latest
- * amplitude to tell whether there is a vibration to measure). */
+ * amplitude to tell whether there is a vibration to measure), the latter itself in two
+ * parts: the measurement (arg Z by fm_atan2f and its divide) and the update (the wrapped
+ * error of the phase measured last, the PI). */
 void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c);
 void drive_loop_step_phase(drive_loop_t *dl, float w_s, float w_c);
+void drive_loop_measure_phase(drive_loop_t *dl, float w_s, float w_c);
+void drive_loop_update_phase(drive_loop_t *dl);
 
 #endif /* DRIVE_LOOP_H */

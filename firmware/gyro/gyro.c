@@ -6,6 +6,7 @@
 
 #include "dsp/butter.h"
 #include "dsp/fastmath.h"
+#include "gyro/gyro_block.h"
 
 int gyro_design(const param_values_t *v, gyro_design_t *d)
 {
@@ -40,9 +41,16 @@ int gyro_design(const param_values_t *v, gyro_design_t *d)
   const double demod_bw = lmsd_bandwidth_hz((double)v->demod_mu_drive, fs);
   if (!(demod_bw > 0.0)) return -3;
   const double blk = (double)GYRO_BLOCK;
+  /* The loops run once per block; each measures on its own tick and the command goes
+   * to the synthesis on GYRO_SLOT_COMMAND, reaching the DAC frame one tick later (the
+   * jobs run after their tick's frame). */
+  const double amp_lag = (double)((GYRO_SLOT_COMMAND + GYRO_BLOCK - GYRO_SLOT_AMP) % GYRO_BLOCK + 1u);
+  const double ph_lag =
+      (double)((GYRO_SLOT_COMMAND + GYRO_BLOCK - GYRO_SLOT_PHASE_MEAS) % GYRO_BLOCK + 1u);
   const drive_loop_design_in_t amp_in = {(double)v->drive_cal_gain_v_per_v2, tau,
-                                         (double)v->drive_amp_bw_hz, demod_bw, fs, blk};
-  const drive_loop_design_in_t ph_in = {1.0, tau, (double)v->drive_phase_bw_hz, demod_bw, fs, blk};
+                                         (double)v->drive_amp_bw_hz, demod_bw, fs, blk, amp_lag};
+  const drive_loop_design_in_t ph_in = {1.0, tau, (double)v->drive_phase_bw_hz, demod_bw, fs, blk,
+                                        ph_lag};
   if (drive_loop_design(&amp_in, &t.amp_design) != 0 ||
       drive_loop_design(&ph_in, &t.phase_design) != 0) {
     return -4;
@@ -132,6 +140,8 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   t.inv_amp_set = 1.0f / d->drive.amp_set_v;
   selftest_init(&t.selftest, &d->selftest);
   t.rate_code = (uint16_t)HAL_DAC_CODE_MID;
+  t.sup_in.state_finite = 1;
+  t.weights_finite = 1u;
   t.rate_out_v_per_dps = d->rate_out_v_per_dps;
   t.f_cmd_max_v2 = d->drive.f_cmd_max_v2;
   *g = t;
@@ -212,93 +222,6 @@ int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d)
   return 0;
 }
 
-uint16_t gyro_volts_to_dac(float v)
-{
-  float c = v * (1.0f / HAL_DAC_V_PER_CODE) + (float)HAL_DAC_CODE_MID + 0.5f;
-  c = fm_clampf(c, 0.0f, (float)HAL_DAC_CODE_MAX);
-  return (uint16_t)c;
-}
-
-/* Clear every integrating state: after a fault nothing of the old state (possibly NaN)
- * may survive into the next acquisition. */
-static void clear_loop_state(gyro_t *g)
-{
-  lmsd_reset(&g->lmsd_drive);
-  lmsd_reset(&g->lmsd_sense);
-  drive_loop_reset(&g->drive);
-  rate_channel_reset(&g->rate, g->rate.p_ref_deg);
-  drive_synth_set(&g->synth, 0.0f, g->drive.p_rad);
-}
-
-/* Block work, one job per tick slot (gyro.h): the drive loops and their command, the
- * amplitude loop and the phase loop on two consecutive ticks. */
-static void block_drive(gyro_t *g, float d_s, float d_c, int phase)
-{
-  if (!supervisor_drive_enabled(&g->sup)) {
-    return;
-  }
-  if (phase) {
-    drive_loop_step_phase(&g->drive, d_s, d_c);
-  } else {
-    drive_loop_step_amp(&g->drive, d_s, d_c);
-    if (g->drive.f_cmd_v2 >= g->f_cmd_max_v2) g->flags_acc |= GYRO_FLAG_DRIVE_LIMIT;
-  }
-  drive_synth_set(&g->synth, g->drive.f_cmd_v2, g->drive.p_rad);
-}
-
-/* The supervisor on the block's evidence. Returns nonzero when it cleared the loops. */
-static int block_supervise(gyro_t *g, float d_s, float d_c, float s_s, float s_c)
-{
-  const int drive_on = supervisor_drive_enabled(&g->sup);
-  if (!drive_on) {
-    /* Measure only: the amplitude is still watched for the over-amplitude trip. */
-    g->drive.amp_v = fm_sqrtf(d_s * d_s + d_c * d_c);
-  }
-  supervisor_in_t si;
-  si.amp_rel = g->drive.amp_v * g->inv_amp_set;
-  si.amp_rel_err = si.amp_rel - 1.0f;
-  si.phase_err_rad = g->drive.phase_err_rad;
-  si.drive_at_limit = drive_on && g->drive.f_cmd_v2 >= g->f_cmd_max_v2;
-  si.clip_run = g->clip_run_max;
-  g->clip_run_max = g->clip_run; /* a run still going carries into the next block */
-  /* A NaN anywhere propagates into these within a block, and is caught at the next
-   * supervisor slot (0.2 ms): long before it could reach the structure. */
-  si.state_finite = fm_isfinite(d_s + d_c + s_s + s_c) && fm_isfinite(g->drive.f_cmd_v2) &&
-                    fm_isfinite(g->drive.p_rad) && fm_isfinite(g->rate.rate_dps) &&
-                    fm_isfinite(g->rate.quad_dps);
-  if (supervisor_step(&g->sup, &si) != 0) {
-    clear_loop_state(g);
-    return 1;
-  }
-  return 0;
-}
-
-/* The snapshot for telemetry and status, at fs / GYRO_BLOCK (5 kHz: the telemetry's
- * highest rate); flags hold what happened over the whole block. */
-static void block_output(gyro_t *g, float u1, float u2, float s_s, float s_c)
-{
-  gyro_out_t *o = &g->out;
-  g->rate_code = gyro_volts_to_dac(g->rate.rate_dps * g->rate_out_v_per_dps);
-  o->rate_dps = g->rate.rate_dps;
-  o->rate_unc_dps = g->rate.rate_unc_dps;
-  o->quad_dps = g->rate.quad_dps;
-  o->drive_amp_v = g->drive.amp_v;
-  o->drive_phase_deg = g->drive.phase_rad * FM_DEG_PER_RAD_F;
-  o->p_deg = g->drive.p_rad * FM_DEG_PER_RAD_F;
-  o->p_f_deg = g->rate.p_f_deg;
-  o->f_cmd_v2 = g->drive.f_cmd_v2;
-  o->u1_v = u1;
-  o->u2_v = u2;
-  o->sense_i_v = s_s;
-  o->sense_q_v = s_c;
-  o->mode = (uint32_t)g->sup.mode;
-  o->fault = g->sup.fault;
-  if (selftest_running(&g->selftest)) g->flags_acc |= GYRO_FLAG_SELFTEST;
-  o->flags = (g->sup.mode == GYRO_MODE_LOCKED ? GYRO_FLAG_LOCKED : 0u) | g->flags_acc |
-             (g->sup.mode == GYRO_MODE_FAULT ? GYRO_FLAG_FAULT : 0u);
-  g->flags_acc = 0u;
-}
-
 void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
 {
   nco_out_t ref;
@@ -308,9 +231,7 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
   const float v_sense = (float)adc->sense * g->adc_v_per_code;
   lmsd_step(&g->lmsd_drive, v_drive, ref.sin_wc, ref.cos_wc);
   lmsd_step(&g->lmsd_sense, v_sense, ref.sin_wc, ref.cos_wc);
-  const float d_s = g->lmsd_drive.w_i, d_c = g->lmsd_drive.w_q;
-  const float s_s = g->lmsd_sense.w_i, s_c = g->lmsd_sense.w_q;
-  rate_channel_accumulate(&g->rate, s_s, s_c);
+  rate_channel_accumulate(&g->rate, g->lmsd_sense.w_i, g->lmsd_sense.w_q);
 
   /* Consecutive rail codes, counted per sample: clipping is judged on the longest run. */
   if (adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN ||
@@ -321,33 +242,11 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
     g->clip_run = 0u;
   }
 
-  /* Everything slower than the carrier runs once per block of GYRO_BLOCK ticks, each
-   * job on its own tick so that no tick carries two of them. */
-  const uint32_t slot = g->slot;
-  g->slot = slot + 1u == GYRO_BLOCK ? 0u : slot + 1u;
-  if (slot == GYRO_SLOT_DRIVE_AMP) {
-    block_drive(g, d_s, d_c, 0);
-  } else if (slot == GYRO_SLOT_DRIVE_PHASE) {
-    block_drive(g, d_s, d_c, 1);
-  } else if (slot == GYRO_SLOT_SUPERVISE) {
-    (void)block_supervise(g, d_s, d_c, s_s, s_c);
-  } else if (slot == GYRO_SLOT_RATE) {
-    rate_channel_update(&g->rate, d_s, d_c, g->drive.p_rad);
-    selftest_update(&g->selftest, g->sup.mode == GYRO_MODE_LOCKED, g->rate.rate_raw);
-  } else if (slot == GYRO_SLOT_QUAD) {
-    rate_channel_hold_p(&g->rate, g->sup.mode != GYRO_MODE_LOCKED);
-    rate_channel_update_quad_p(&g->rate, g->drive.p_rad);
-  }
-
+  /* The waveform of the command last set: by the loops (ACQUIRE, LOCKED, once per
+   * block) or by the self-calibration job (SWEEP, every tick). */
+  const gyro_mode_t mode = g->sup.mode;
   float u1 = 0.0f, u2 = 0.0f;
-  if (g->sup.mode == GYRO_MODE_SWEEP) {
-    float f_cmd, p;
-    uint32_t half_step;
-    selfcal_exec_tick(&g->cal, d_s, d_c, &half_step, &f_cmd, &p);
-    drive_synth_set(&g->synth, f_cmd, p);
-    drive_synth_step(&g->synth, ref.phase, ref.half_phase, &u1, &u2);
-    g->nco.half_step = half_step; /* from the next sample on */
-  } else if (supervisor_drive_enabled(&g->sup)) {
+  if (mode == GYRO_MODE_SWEEP || mode == GYRO_MODE_ACQUIRE || mode == GYRO_MODE_LOCKED) {
     drive_synth_step(&g->synth, ref.phase, ref.half_phase, &u1, &u2);
   }
   dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
@@ -357,9 +256,15 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
   dac->code[HAL_DAC_SPARE] = g->selftest.state == SELFTEST_FORCE
                                  ? gyro_volts_to_dac(selftest_force(&g->selftest, ref.sin_wc, ref.cos_wc))
                                  : (uint16_t)HAL_DAC_CODE_MID;
-
   g->out.tick++;
-  if (slot == GYRO_SLOT_OUTPUT) {
-    block_output(g, u1, u2, s_s, s_c);
+
+  /* Everything slower than the carrier: this tick's job of the block (gyro_block.h),
+   * last, as a tail call. */
+  const uint32_t slot = g->slot;
+  g->slot = slot + 1u == GYRO_BLOCK ? 0u : slot + 1u;
+  if (mode == GYRO_MODE_SWEEP) {
+    gyro_block_sweep(g, slot, u1, u2);
+  } else {
+    gyro_block_run(g, slot, u1, u2);
   }
 }

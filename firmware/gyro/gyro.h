@@ -4,7 +4,8 @@
  * target:
  *   NCO -> LMSD(drive), LMSD(sense) -> drive loops -> drive synthesis -> rate channel
  *   -> supervisor -> outputs (DAC frame, telemetry snapshot)
- * with the loops, rate channel, supervisor and snapshot once per block (GYRO_BLOCK).
+ * with the loops, rate channel, supervisor and snapshot once per block (GYRO_BLOCK),
+ * spread over the ticks of the block.
  * Deterministic, allocation-free, single precision, no libm.
  *
  * Phase conventions (used throughout firmware/gyro):
@@ -21,6 +22,7 @@
 #define GYRO_H
 
 #include <stdint.h>
+#include <string.h>
 
 #include "dsp/biquad.h"
 #include "dsp/lmsd.h"
@@ -86,33 +88,71 @@ typedef struct {
   drive_synth_t synth;
   rate_channel_t rate;
   supervisor_t sup;
-  selfcal_exec_t cal; /* self-calibration jobs, run while the supervisor is in SWEEP */
   float f_cmd_max_v2;
   float inv_amp_set;     /* 1 / drive amplitude setpoint: no divide per tick */
   uint32_t slot;         /* tick within the block, 0 .. GYRO_BLOCK - 1 */
   uint32_t clip_run;     /* consecutive ADC rail codes up to this tick */
   uint32_t clip_run_max; /* longest run reaching into the current supervisor period */
   uint32_t flags_acc;    /* GYRO_FLAG_* seen since the last snapshot */
+  supervisor_in_t sup_in; /* the supervisor's evidence, gathered by the jobs before
+                           * GYRO_SLOT_SUPERVISE (slot table above) */
+  uint32_t weights_finite; /* first half of the finiteness check (GYRO_SLOT_AMP) */
   uint16_t rate_code;    /* analog rate output DAC code, updated with the snapshot */
   selftest_t selftest;
   gyro_out_t out;        /* updated once per block (tick: every tick) */
+  /* Last, so that what the sample path reads every block stays within the reach of
+   * one load's immediate offset. */
+  selfcal_exec_t cal; /* self-calibration jobs, run while the supervisor is in SWEEP */
 } gyro_t;
 
 /* The block: GYRO_BLOCK ticks (the rate channel's RATE_DECIM, 0.2 ms at 50 kHz). Per
  * tick only what moves with the carrier runs: the NCO, both LMSDs, the sum of the sense
  * phasor, the drive waveform and the self-test force, the rail count and the DAC frame.
- * Everything else (the drive loops and their square root and arctangent, the
- * supervisor and the finiteness check, the rate channel's projection, filters and
- * compensation, the output snapshot) runs once per block, each job on its own tick of
- * the block so that the worst tick carries one job: the interrupt's budget is set by
- * its worst tick (tools/bench/README.md). */
+ * Everything else runs once per block, cut into jobs of about the same cost, one job
+ * on each tick of the block: the interrupt's budget is set by its worst tick
+ * (tools/bench/README.md). A job runs after its tick's DAC frame is written (the jobs
+ * are tail calls of gyro_tick, gyro_block.h), so what it changes reaches the DAC from
+ * the next tick on.
+ *
+ *   slot  job                                             uses (slot it comes from)
+ *   0     arg Z (fm_atan2f: one divide)                   drive LMSD
+ *   1     phase loop: wrapped error, PI -> P (P held      arg Z (0), |Z| (2, last block)
+ *         while |Z| < 10 % of its setpoint)
+ *   2     finiteness check, first half (LMSD weights);    drive LMSD
+ *         |Z| (square root), amplitude PI -> f_cmd
+ *   3     the supervisor's evidence (sup_in);             |Z|, f_cmd (2), phase error (1)
+ *         drive_synth_set(f_cmd, P): the waveform's       f_cmd (2), P (1)
+ *         amplitude (square root) and phase offset
+ *   4     supervisor (its clear request: slot 5)          evidence (3), finiteness (7, last block)
+ *   5     rate channel: block mean of S, projection       sense sum, P (1)
+ *         (or, on request, the loop state cleared)
+ *   6     rate: output filter, scale, compensation        projection (5), P_f (8, last block)
+ *   7     finiteness check, second half (loop and rate    weights' half (2)
+ *         outputs) and verdict; quadrature filter         projection (5)
+ *   8     P's hold and low-pass (its mean every 10th      P (1)
+ *         block); the self-test sequence while it runs    projection (5)
+ *   9     output snapshot, analog rate code               everything
+ *
+ * The drive command thus reaches the DAC (COMMAND + 1 - slot) ticks after the sample
+ * the loop measured: 4 for the phase loop, 2 for the amplitude loop; gyro_design adds
+ * that to the loops' delay budget (drive_loop_design). */
 #define GYRO_BLOCK RATE_DECIM
-#define GYRO_SLOT_DRIVE_AMP 0u   /* |Z|, amplitude PI, drive command */
-#define GYRO_SLOT_DRIVE_PHASE 1u /* arg Z, phase PI, drive command */
-#define GYRO_SLOT_SUPERVISE 3u   /* supervisor, finiteness check */
-#define GYRO_SLOT_RATE 5u        /* projection, rate filter, compensation, self-test */
-#define GYRO_SLOT_QUAD 7u        /* quadrature filter, P's low-pass */
-#define GYRO_SLOT_OUTPUT 8u      /* snapshot, analog rate code */
+#define GYRO_SLOT_PHASE_MEAS 0u
+#define GYRO_SLOT_PHASE_PI 1u
+#define GYRO_SLOT_AMP 2u
+#define GYRO_SLOT_COMMAND 3u
+#define GYRO_SLOT_SUPERVISE 4u
+#define GYRO_SLOT_PROJECT 5u
+#define GYRO_SLOT_RATE 6u
+#define GYRO_SLOT_QUAD 7u
+#define GYRO_SLOT_P 8u
+#define GYRO_SLOT_OUTPUT 9u
+_Static_assert(GYRO_SLOT_PHASE_MEAS < GYRO_SLOT_PHASE_PI && GYRO_SLOT_PHASE_PI < GYRO_SLOT_COMMAND &&
+                   GYRO_SLOT_AMP < GYRO_SLOT_COMMAND && GYRO_SLOT_COMMAND < GYRO_SLOT_SUPERVISE &&
+                   GYRO_SLOT_SUPERVISE < GYRO_SLOT_PROJECT && GYRO_SLOT_PROJECT < GYRO_SLOT_RATE &&
+                   GYRO_SLOT_PROJECT < GYRO_SLOT_QUAD && GYRO_SLOT_PROJECT < GYRO_SLOT_P &&
+                   GYRO_SLOT_AMP < GYRO_SLOT_QUAD && GYRO_SLOT_OUTPUT == GYRO_BLOCK - 1u,
+               "block jobs out of order (gyro.h slot table)");
 
 /* Turn parameter values into module configurations, checking that every module
  * accepts its part. Returns 0, or a negative value (then *d is untouched). */
@@ -141,7 +181,38 @@ void gyro_sweep_begin(gyro_t *g);
  * or -1 (nothing changed) when not in SWEEP. */
 int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d);
 
-/* Volts to an offset-binary DAC code, clamped to the converter's range. */
-uint16_t gyro_volts_to_dac(float v);
+/* Volts to an offset-binary DAC code, rounded to the nearest code (ties to even) and
+ * clamped to the converter's range; NaN gives the mid code (0 V).
+ * Per sample, for three channels, so without float compares (each a VCMP, a VMRS and a
+ * branch on the FPv4-SP, which has no VMIN/VMAX): adding 1.5 * 2^23 to the code makes
+ * the float adder round it to an integer (the sum's unit in the last place is 1 for
+ * sums in [2^23, 2^24)) and leaves it in the low mantissa bits: in range, the code is
+ * the sum's bit pattern less that of 1.5 * 2^23, and one unsigned compare tells that it
+ * is in range. Outside, the bit pattern of a float grows with its value while the sign
+ * is clear: below 1.5 * 2^23 or negative is code 0, above is the largest code
+ * (infinity included). IEEE 754 single precision with round-to-nearest, the same on
+ * host and target. */
+#if defined(__GNUC__)
+#define GYRO_UNLIKELY(x) __builtin_expect((x) != 0, 0) /* block layout only */
+#else
+#define GYRO_UNLIKELY(x) ((x) != 0)
+#endif
+#define GYRO_DAC_ROUND_F 12582912.0f    /* 1.5 * 2^23 */
+#define GYRO_DAC_ROUND_BITS 0x4B400000u /* its bit pattern */
+static inline uint16_t gyro_volts_to_dac(float v)
+{
+  const float m = v * (1.0f / HAL_DAC_V_PER_CODE) + ((float)HAL_DAC_CODE_MID + GYRO_DAC_ROUND_F);
+  uint32_t u;
+  memcpy(&u, &m, sizeof u);
+  uint32_t code = u - GYRO_DAC_ROUND_BITS;
+  if (GYRO_UNLIKELY(code > HAL_DAC_CODE_MAX)) {
+    if ((u << 1) > 0xFF000000u) { /* exponent all ones, mantissa not zero: NaN */
+      code = HAL_DAC_CODE_MID;
+    } else {
+      code = (u & 0x80000000u) != 0u || u < GYRO_DAC_ROUND_BITS ? 0u : HAL_DAC_CODE_MAX;
+    }
+  }
+  return (uint16_t)code;
+}
 
 #endif /* GYRO_H */

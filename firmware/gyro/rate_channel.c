@@ -54,6 +54,7 @@ int rate_channel_init(rate_channel_t *rc, const rate_channel_cfg_t *cfg)
   rc->p_ref_deg = cfg->p_ref_deg;
   rc->p_hold = 0u;
   rc->p_n = RATE_P_FAST_MAX; /* no fast start without a hold */
+  rc->p_a_mean = 0.0f;        /* set before its use (rate_channel_update_p) */
   rate_channel_reset(rc, cfg->p_ref_deg);
   return 0;
 }
@@ -107,9 +108,10 @@ void rate_channel_reset(rate_channel_t *rc, float p_deg)
 
 /* Blocks of RATE_DECIM ticks per low-pass sample of P. */
 #define RATE_P_BLOCKS (RATE_P_DECIM / RATE_DECIM)
-_Static_assert(RATE_P_DECIM % RATE_DECIM == 0u, "P's average spans whole blocks");
+_Static_assert(RATE_P_DECIM % RATE_DECIM == 0u && RATE_P_BLOCKS >= 2u,
+               "P's average spans whole blocks, at least two");
 
-void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad)
+void rate_channel_project(rate_channel_t *rc, float d_s, float d_c, float p_rad)
 {
   const float k = 1.0f / (float)RATE_DECIM;
   const float s_s = rc->acc_re * k, s_c = rc->acc_im * k;
@@ -130,9 +132,12 @@ void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad)
   }
   rc->rate_raw = re;
   rc->quad_raw = im;
+}
 
-  rc->rate_unc_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_rate, re);
-
+void rate_channel_filter_rate(rate_channel_t *rc)
+{
+  rc->rate_unc_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_rate, rc->rate_raw);
+  /* Temperature compensation in P_f (the thesis fits the bias linear in P, 7.3.2). */
   const float p = rc->p_f_deg;
   const float *b3 = rc->bias_c_dps, *s3 = rc->sf_c;
   const float bias = b3[0] + p * (b3[1] + p * (b3[2] + p * b3[3]));
@@ -140,16 +145,33 @@ void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad)
   rc->rate_dps = rc->rate_unc_dps * sf - bias;
 }
 
-void rate_channel_update_quad_p(rate_channel_t *rc, float p_rad)
+void rate_channel_filter_quad(rate_channel_t *rc)
 {
   rc->quad_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_quad, rc->quad_raw);
+}
+
+void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad)
+{
+  rate_channel_project(rc, d_s, d_c, p_rad);
+  rate_channel_filter_rate(rc);
+  rate_channel_filter_quad(rc);
+}
+
+void rate_channel_update_p(rate_channel_t *rc, float p_rad)
+{
   if (rc->p_hold != 0u) {
     rc->p_acc_deg = 0.0f;
     rc->p_count = 0u;
     rc->p_n = 0u;
   } else {
     rc->p_acc_deg += p_rad * FM_DEG_PER_RAD_F - rc->p_ref_deg;
-    if (++rc->p_count == RATE_P_BLOCKS) {
+    if (++rc->p_count == 1u && rc->p_n < RATE_P_FAST_MAX) {
+      /* The fast start's weight of the coming mean, divided here (on the first block of
+       * the RATE_P_BLOCKS) rather than with the low-pass (on the last): each block of the
+       * sample interrupt carries at most one divide. */
+      rc->p_a_mean = 1.0f / (float)(rc->p_n + 1u + RATE_P_PRIOR);
+    }
+    if (rc->p_count == RATE_P_BLOCKS) {
       const float mean = rc->p_acc_deg * (1.0f / (float)RATE_P_BLOCKS);
       /* Fast start after a hold: the running mean of the means seen since the release
        * (the held value weighing as RATE_P_PRIOR of them) until its weight falls to the
@@ -157,7 +179,7 @@ void rate_channel_update_quad_p(rate_channel_t *rc, float p_rad)
       float a = rc->p_lpf_alpha;
       if (rc->p_n < RATE_P_FAST_MAX) {
         rc->p_n++;
-        const float a_mean = 1.0f / (float)(rc->p_n + RATE_P_PRIOR);
+        const float a_mean = rc->p_a_mean; /* 1 / (p_n + RATE_P_PRIOR) */
         if (a_mean > a) {
           a = a_mean;
         } else {
@@ -171,3 +193,4 @@ void rate_channel_update_quad_p(rate_channel_t *rc, float p_rad)
     }
   }
 }
+

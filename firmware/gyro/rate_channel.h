@@ -75,6 +75,7 @@ typedef struct {
   float min_drive_v2;
   uint32_t p_hold;            /* nonzero: P is not the temperature yet, P_f holds */
   uint32_t p_n;               /* P means since the last hold (fast start) */
+  float p_a_mean;             /* 1 / (p_n + 1 + prior): the fast start's next weight */
   float acc_re, acc_im;       /* sense phasor summed over the current block */
   biquad_cascade_t lpf_rate;
   biquad_cascade_t lpf_quad;
@@ -119,12 +120,22 @@ static inline void rate_channel_hold_p(rate_channel_t *rc, int hold)
 /* Once per RATE_DECIM ticks, after the block's last accumulate. (d_s, d_c): measured
  * drive phasor (only to tell that the drive runs); p_rad: force phase (the phase loop
  * holds it over the block), for the reference's correction; the compensation uses P_f
- * as rate_channel_update_quad_p last left it. */
+ * as rate_channel_update_p last left it. Rate and quadrature outputs. The same as
+ * rate_channel_project, rate_channel_filter_rate and rate_channel_filter_quad in a row. */
 void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad);
 
-/* The quadrature's output filter and P's low-pass (P_f: the temperature signal, which
- * rate_channel_update compensates with), once per block after rate_channel_update, on
- * another tick of the block so that no tick carries both. p_rad: the force phase. */
-void rate_channel_update_quad_p(rate_channel_t *rc, float p_rad);
+/* The parts of the block update, for a caller that spreads them over the ticks of the
+ * block (gyro.h), each once per block:
+ *   rate_channel_project      block mean of S, reference correction -> rate_raw, quad_raw
+ *                             (clears the sum: the next block starts here)
+ *   rate_channel_filter_rate  after project: output low-pass and scale of rate_raw,
+ *                             compensation in P_f -> rate_unc_dps, rate_dps
+ *   rate_channel_filter_quad  after project: the same for quad_raw -> quad_dps
+ *   rate_channel_update_p     any time: P's block sum, its low-pass every RATE_P_DECIM
+ *                             ticks -> P_f (the compensation's from then on) */
+void rate_channel_project(rate_channel_t *rc, float d_s, float d_c, float p_rad);
+void rate_channel_filter_rate(rate_channel_t *rc);
+void rate_channel_filter_quad(rate_channel_t *rc);
+void rate_channel_update_p(rate_channel_t *rc, float p_rad);
 
 #endif /* RATE_CHANNEL_H */

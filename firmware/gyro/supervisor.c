@@ -23,6 +23,7 @@ int supervisor_init(supervisor_t *sv, const supervisor_cfg_t *cfg)
   }
   sv->mode = GYRO_MODE_OFF;
   sv->primed = 0u;
+  sv->clear_req = 0u;
   sv->amp_err_f = sv->phase_err_f = 0.0f;
   sv->fault = GYRO_FAULT_NONE;
   sv->fault_count = 0u;
@@ -79,58 +80,79 @@ static int trip(supervisor_t *sv, uint32_t reason)
   sv->fault_count++;
   sv->fault_ticks = 0u;
   set_mode(sv, GYRO_MODE_FAULT);
+  sv->clear_req = 1u;
   return 1;
 }
 
-int supervisor_step(supervisor_t *sv, const supervisor_in_t *in)
+/* Which of the faults that act in every mode but OFF the evidence shows, in order of
+ * precedence: NaN, clipping, over-amplitude (not in SWEEP); 0 for none. A NaN anywhere
+ * would otherwise stay in the integrators forever; clipping makes the demodulated
+ * amplitude meaningless. */
+static uint32_t fault_seen(const supervisor_t *sv, const supervisor_in_t *in, gyro_mode_t mode)
 {
-  sv->mode_ticks++;
+  if (!in->state_finite) return GYRO_FAULT_NAN;
+  if (in->clip_run >= sv->clip_max_count) return GYRO_FAULT_ADC_CLIP;
+  if (mode != GYRO_MODE_SWEEP && in->amp_rel > sv->amp_trip_rel) return GYRO_FAULT_OVER_AMP;
+  return GYRO_FAULT_NONE;
+}
 
-  if (sv->mode == GYRO_MODE_FAULT) {
-    if (++sv->fault_ticks >= sv->retry_ticks) {
-      set_mode(sv, GYRO_MODE_ACQUIRE);
-      return 1;
-    }
-    return 0;
+/* ACQUIRE and LOCKED: the fault checks, the low-pass of the lock errors and the lock
+ * decisions. The common path of the sample interrupt, kept straight. */
+static int step_driving(supervisor_t *sv, const supervisor_in_t *in, gyro_mode_t mode)
+{
+  const uint32_t f = fault_seen(sv, in, mode);
+  if (f != GYRO_FAULT_NONE) {
+    return trip(sv, f);
   }
-  /* Faults that act in every mode but OFF. A NaN anywhere would otherwise stay in the
-   * integrators forever; clipping makes the demodulated amplitude meaningless. */
-  if (sv->mode != GYRO_MODE_OFF) {
-    if (!in->state_finite) return trip(sv, GYRO_FAULT_NAN);
-    if (in->clip_run >= sv->clip_max_count) return trip(sv, GYRO_FAULT_ADC_CLIP);
-    if (sv->mode != GYRO_MODE_SWEEP && in->amp_rel > sv->amp_trip_rel) {
-      return trip(sv, GYRO_FAULT_OVER_AMP);
-    }
+  /* The low-pass starts from the first error of a mode (whatever it held before, a NaN
+   * included, is dropped). */
+  float ea = in->amp_rel_err, ep = in->phase_err_rad;
+  if (sv->primed != 0u) {
+    ea = sv->amp_err_f + sv->err_lpf_k * (ea - sv->amp_err_f);
+    ep = sv->phase_err_f + sv->err_lpf_k * (ep - sv->phase_err_f);
   }
-
-  if (sv->primed == 0u) {
-    sv->amp_err_f = in->amp_rel_err;
-    sv->phase_err_f = in->phase_err_rad;
-    sv->primed = 1u;
+  sv->primed = 1u;
+  sv->amp_err_f = ea;
+  sv->phase_err_f = ep;
+  const float ae = fm_absf(ea);
+  if (mode == GYRO_MODE_LOCKED) {
+    sv->out_tol_ticks = (ae > sv->lost_tol_rel) ? sv->out_tol_ticks + 1u : 0u;
+    sv->sat_ticks = in->drive_at_limit ? sv->sat_ticks + 1u : 0u;
+    if (sv->out_tol_ticks >= sv->lost_ticks_needed) return trip(sv, GYRO_FAULT_LOST_LOCK);
+    if (sv->sat_ticks >= sv->sat_ticks_needed) return trip(sv, GYRO_FAULT_DRIVE_SAT);
   } else {
-    sv->amp_err_f += sv->err_lpf_k * (in->amp_rel_err - sv->amp_err_f);
-    sv->phase_err_f += sv->err_lpf_k * (in->phase_err_rad - sv->phase_err_f);
-  }
-  const float ae = fm_absf(sv->amp_err_f);
-  const float pe = fm_absf(sv->phase_err_f);
-  switch (sv->mode) {
-  case GYRO_MODE_ACQUIRE:
+    const float pe = fm_absf(ep);
     sv->in_tol_ticks = (ae <= sv->lock_tol_rel && pe <= sv->lock_phase_tol_rad)
                            ? sv->in_tol_ticks + 1u : 0u;
     if (sv->in_tol_ticks >= sv->lock_ticks_needed) {
       set_mode(sv, GYRO_MODE_LOCKED);
     }
-    break;
-  case GYRO_MODE_LOCKED:
-    sv->out_tol_ticks = (ae > sv->lost_tol_rel) ? sv->out_tol_ticks + 1u : 0u;
-    sv->sat_ticks = in->drive_at_limit ? sv->sat_ticks + 1u : 0u;
-    if (sv->out_tol_ticks >= sv->lost_ticks_needed) return trip(sv, GYRO_FAULT_LOST_LOCK);
-    if (sv->sat_ticks >= sv->sat_ticks_needed) return trip(sv, GYRO_FAULT_DRIVE_SAT);
-    break;
-  case GYRO_MODE_OFF:
-  case GYRO_MODE_SWEEP:
-  case GYRO_MODE_FAULT:
-    break;
   }
   return 0;
+}
+
+int supervisor_step(supervisor_t *sv, const supervisor_in_t *in)
+{
+  const gyro_mode_t mode = sv->mode;
+  sv->mode_ticks++;
+  if (mode == GYRO_MODE_ACQUIRE || mode == GYRO_MODE_LOCKED) {
+    return step_driving(sv, in, mode);
+  }
+  if (mode == GYRO_MODE_FAULT) {
+    if (++sv->fault_ticks >= sv->retry_ticks) {
+      set_mode(sv, GYRO_MODE_ACQUIRE);
+      sv->clear_req = 1u;
+      return 1;
+    }
+    return 0;
+  }
+  if (mode == GYRO_MODE_SWEEP) {
+    /* No lock errors to judge (the loops are off; the low-pass restarts with the next
+     * mode): only the faults. */
+    const uint32_t f = fault_seen(sv, in, mode);
+    if (f != GYRO_FAULT_NONE) {
+      return trip(sv, f);
+    }
+  }
+  return 0; /* OFF */
 }

@@ -63,6 +63,8 @@ typedef struct {
   float err_lpf_k;         /* first-order low-pass (~100 Hz) of the lock errors */
   float amp_err_f, phase_err_f;
   uint32_t primed;         /* the low-pass starts from the first error seen in a mode */
+  uint32_t clear_req;      /* set whenever supervisor_step returns 1, for a caller that
+                            * acts on it later; the caller clears it */
 } supervisor_t;
 
 /* What one tick saw, for the supervisor to judge. */
@@ -91,7 +93,7 @@ void supervisor_enter_sweep(supervisor_t *sv);
 void supervisor_reacquire(supervisor_t *sv);
 
 /* One tick. Returns 1 when the loop state must be cleared (entering FAULT or leaving it
- * to re-acquire), else 0. */
+ * to re-acquire), else 0; a 1 is also latched in clear_req. */
 int supervisor_step(supervisor_t *sv, const supervisor_in_t *in);
 
 static inline int supervisor_drive_enabled(const supervisor_t *sv)

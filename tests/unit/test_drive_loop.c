@@ -11,7 +11,7 @@
 static void test_design_formula(void **state)
 {
   (void)state;
-  const drive_loop_design_in_t in = {0.03125, 0.00712, 30.0, 270.0, 50000.0, 1.0};
+  const drive_loop_design_in_t in = {0.03125, 0.00712, 30.0, 270.0, 50000.0, 1.0, 0.0};
   drive_loop_design_out_t out;
   assert_int_equal(drive_loop_design(&in, &out), 0);
   const double wc = 2.0 * M_PI * 30.0;
@@ -25,7 +25,7 @@ static void test_design_formula(void **state)
 static void test_design_caps_bandwidth(void **state)
 {
   (void)state;
-  const drive_loop_design_in_t in = {1.0, 0.1, 1000.0, 270.0, 50000.0, 1.0};
+  const drive_loop_design_in_t in = {1.0, 0.1, 1000.0, 270.0, 50000.0, 1.0, 0.0};
   drive_loop_design_out_t out;
   assert_int_equal(drive_loop_design(&in, &out), 0);
   assert_true(out.bw_hz < 1000.0);
@@ -42,8 +42,32 @@ static void test_design_caps_bandwidth(void **state)
   const double pmh = 90.0 - (atan(wch / (2 * M_PI * 270.0)) + wch * 6.0 / 50000.0) * 180.0 / M_PI;
   assert_true(fabs(pmh - out_h.phase_margin_deg) < 1e-9 && pmh >= 60.0);
   assert_true(out_h.bw_hz < out.bw_hz);
+  /* The command reaching the DAC 4 samples after the measured one: 4 + 1 + 10/2. */
+  drive_loop_design_in_t late = held;
+  late.lag_samples = 4.0;
+  drive_loop_design_out_t out_l;
+  assert_int_equal(drive_loop_design(&late, &out_l), 0);
+  const double wcl = 2.0 * M_PI * out_l.bw_hz;
+  const double pml = 90.0 - (atan(wcl / (2 * M_PI * 270.0)) + wcl * 10.0 / 50000.0) * 180.0 / M_PI;
+  assert_true(fabs(pml - out_l.phase_margin_deg) < 1e-9 && pml >= 60.0);
+  assert_true(out_l.bw_hz < out_h.bw_hz);
+  /* Where the cap is not reached the delay changes nothing but the margin. */
+  drive_loop_design_in_t slow = late;
+  slow.bw_hz = 30.0;
+  assert_int_equal(drive_loop_design(&slow, &out_l), 0);
+  assert_true(fabs(out_l.bw_hz - 30.0) < 1e-9);
+  const double wcs = 2.0 * M_PI * 30.0;
+  assert_true(fabs(out_l.phase_margin_deg -
+                   (90.0 - (atan(wcs / (2 * M_PI * 270.0)) + wcs * 10.0 / 50000.0) * 180.0 / M_PI)) <
+              1e-9);
   drive_loop_design_in_t bad = in;
   bad.loop_decim = -1.0;
+  assert_int_equal(drive_loop_design(&bad, &out), -1);
+  bad = in;
+  bad.lag_samples = -1.0;
+  assert_int_equal(drive_loop_design(&bad, &out), -1);
+  bad = in;
+  bad.lag_samples = NAN;
   assert_int_equal(drive_loop_design(&bad, &out), -1);
   bad = in;
   bad.tau_s = -1.0;
@@ -74,7 +98,7 @@ static void test_closed_loop_first_order(void **state)
 {
   (void)state;
   const double fs = 50000.0, tau = 0.00712, k = 0.03125, bw = 30.0;
-  drive_loop_design_in_t in = {k, tau, bw, 270.0, fs, 1.0};
+  drive_loop_design_in_t in = {k, tau, bw, 270.0, fs, 1.0, 0.0};
   drive_loop_design_out_t amp, ph;
   in.plant_gain = k;
   assert_int_equal(drive_loop_design(&in, &amp), 0);
@@ -116,7 +140,7 @@ static void test_startup_no_overshoot(void **state)
 {
   (void)state;
   const double fs = 50000.0, tau = 0.00712, k = 0.03125;
-  drive_loop_design_in_t in = {k, tau, 30.0, 270.0, fs, 1.0};
+  drive_loop_design_in_t in = {k, tau, 30.0, 270.0, fs, 1.0, 0.0};
   drive_loop_design_out_t amp, ph;
   assert_int_equal(drive_loop_design(&in, &amp), 0);
   in.plant_gain = 1.0;
@@ -145,6 +169,66 @@ static void test_startup_no_overshoot(void **state)
   assert_true(max_amp < 2.0 * 1.01);
 }
 
+/* The loops as gyro_tick runs them (gyro.h slot table): one update per block of 10
+ * samples, spread over the block - arg Z measured on tick 0, the phase PI on tick 1,
+ * the amplitude loop on tick 2, the command to the synthesis on tick 3, on the DAC's
+ * frame from tick 4 and at the electrodes one sample later, held for the block -
+ * designed with those lags (4 and 2 samples). Small steps settle as the designed
+ * first-order loop delayed by the loop's delay (lag + 1 + N/2 samples), without
+ * overshoot. */
+static void test_block_schedule(void **state)
+{
+  (void)state;
+  const double fs = 50000.0, tau = 0.00712, k = 0.03125, bw = 30.0;
+  const int n_blk = 10;
+  drive_loop_design_in_t in = {k, tau, bw, 270.0, fs, (double)n_blk, 2.0};
+  drive_loop_design_out_t amp, ph;
+  assert_int_equal(drive_loop_design(&in, &amp), 0);
+  in.plant_gain = 1.0;
+  in.lag_samples = 4.0;
+  assert_int_equal(drive_loop_design(&in, &ph), 0);
+  assert_true(amp.phase_margin_deg > 60.0 && ph.phase_margin_deg > 60.0);
+  drive_loop_cfg_t c = {.dt_s = (float)(n_blk / fs), .amp_set_v = 2.0f, .phase_set_rad = 0.3f,
+                        .amp_kp = (float)amp.kp, .amp_ki = (float)amp.ki,
+                        .phase_kp = (float)ph.kp, .phase_ki = (float)ph.ki,
+                        .f_cmd_max_v2 = 196.0f, .p_init_rad = 0.3f};
+  drive_loop_t dl;
+  assert_int_equal(drive_loop_init(&dl, &c), 0);
+  env_plant_t p = {1.9 * cos(0.3), 1.9 * sin(0.3), exp(-1.0 / (fs * tau)), k};
+  dl.amp_pi.u = (float)(1.9 / k);
+  dl.f_cmd_v2 = dl.amp_pi.u;
+  dl.amp_v = 1.9f;
+  dl.phase_set_rad = 0.35f;
+  double f_set = dl.f_cmd_v2, p_set = dl.p_rad; /* command of the synthesis */
+  double f_out = f_set, p_out = p_set;          /* at the electrodes */
+  const double wc = 2.0 * M_PI * bw, t_d = (3.0 + 1.0 + n_blk / 2.0) / fs;
+  double max_amp = 0.0;
+  for (int n = 0; n < 10000; n++) {
+    const int slot = n % n_blk;
+    const float zs = (float)p.zr, zc = (float)p.zi;
+    double f_dac = f_set, p_dac = p_set; /* this tick's DAC frame */
+    if (slot == 0) drive_loop_measure_phase(&dl, zs, zc);
+    if (slot == 1) drive_loop_update_phase(&dl);
+    if (slot == 2) drive_loop_step_amp(&dl, zs, zc);
+    if (slot == 3) { /* after the frame: from the next tick's on */
+      f_set = dl.f_cmd_v2;
+      p_set = dl.p_rad;
+    }
+    env_step(&p, f_out, p_out); /* the electrodes hold the last frame for this sample */
+    f_out = f_dac;
+    p_out = p_dac;
+    const double t = (n + 1) / fs;
+    const double a = hypot(p.zr, p.zi), ph_now = atan2(p.zi, p.zr);
+    if (a > max_amp) max_amp = a;
+    if ((n + 1) % 500 == 0) {
+      const double e = t > t_d ? exp(-wc * (t - t_d)) : 1.0;
+      assert_true(fabs(a - (2.0 - 0.1 * e)) < 0.003);
+      assert_true(fabs(ph_now - (0.35 - 0.05 * e)) < 0.0015);
+    }
+  }
+  assert_true(max_amp < 2.0 * 1.002);
+}
+
 static void test_bad_cfg(void **state)
 {
   (void)state;
@@ -164,6 +248,7 @@ int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_design_formula),        cmocka_unit_test(test_design_caps_bandwidth),
+      cmocka_unit_test(test_block_schedule),
       cmocka_unit_test(test_closed_loop_first_order), cmocka_unit_test(test_startup_no_overshoot),
       cmocka_unit_test(test_bad_cfg),
   };

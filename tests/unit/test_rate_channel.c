@@ -25,7 +25,7 @@ static void block(rate_channel_t *rc, float d_s, float d_c, float s_s, float s_c
 {
   for (uint32_t i = 0; i < RATE_DECIM; i++) rate_channel_accumulate(rc, s_s, s_c);
   rate_channel_update(rc, d_s, d_c, p_rad);
-  rate_channel_update_quad_p(rc, p_rad);
+  rate_channel_update_p(rc, p_rad);
 }
 
 /* A sense phasor built as (r + j q) A_set e^{j psi} must come out as rate r and
@@ -130,7 +130,7 @@ static void test_dc_linearity(void **state)
       rate_channel_accumulate(&rc, (float)(levels[i] + noise), 0.0f);
       if (n % RATE_DECIM == RATE_DECIM - 1) {
         rate_channel_update(&rc, 1.0f, 0.0f, 0.0f);
-        rate_channel_update_quad_p(&rc, 0.0f);
+        rate_channel_update_p(&rc, 0.0f);
       }
       if (n >= 50000 && n % RATE_DECIM == RATE_DECIM - 1) {
         sum += rc.rate_unc_dps;
@@ -165,7 +165,7 @@ static void test_reference_follows_drive_jitter(void **state)
     rate_channel_accumulate(&rc, (float)sr, (float)si);
     if (n % RATE_DECIM != RATE_DECIM - 1) continue;
     rate_channel_update(&rc, 1.0f, 0.0f, (float)p);
-    rate_channel_update_quad_p(&rc, (float)p);
+    rate_channel_update_p(&rc, (float)p);
     if (n > 100 && fabs((double)rc.rate_raw) > worst) worst = fabs((double)rc.rate_raw);
   }
   /* Left: P's 1 Hz low-pass moving over 50 ms (2 pi 1 Hz 0.05 s ~ 0.3 of dp at most). */

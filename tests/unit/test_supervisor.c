@@ -175,12 +175,74 @@ static void test_ripple_filtered(void **state)
   assert_int_equal(sv.mode, GYRO_MODE_ACQUIRE);
 }
 
+/* Every 1 that supervisor_step returns is latched in clear_req until the caller takes
+ * it, and nothing else sets it: the gyro acts on it one tick after the supervisor. */
+static void test_clear_request_latched(void **state)
+{
+  (void)state;
+  supervisor_t sv;
+  supervisor_cfg_t c = cfg();
+  assert_int_equal(supervisor_init(&sv, &c), 0);
+  assert_int_equal(sv.clear_req, 0u);
+  supervisor_start(&sv);
+  supervisor_in_t in = good();
+  int requests = 0;
+  for (int k = 0; k < 400; k++) {
+    /* lock, lose it (fault), retry, lock again, a NaN (fault), retry */
+    in.amp_rel_err = (k >= 20 && k < 40) ? -0.2f : 0.0f;
+    in.amp_rel = 1.0f + in.amp_rel_err;
+    in.state_finite = k != 250;
+    const int r = supervisor_step(&sv, &in);
+    assert_int_equal(sv.clear_req, (uint32_t)r);
+    requests += r;
+    sv.clear_req = 0u; /* taken */
+  }
+  assert_int_equal(requests, 4); /* two faults, two retries */
+  assert_int_equal(sv.fault_count, 2u);
+  assert_int_equal(sv.mode, GYRO_MODE_LOCKED);
+}
+
+/* OFF judges nothing; SWEEP trips on a NaN and on clipping but not on the amplitude
+ * (the sweep drives the mode through resonance on purpose). */
+static void test_off_and_sweep_faults(void **state)
+{
+  (void)state;
+  supervisor_t sv;
+  supervisor_cfg_t c = cfg();
+  supervisor_in_t in = good();
+  assert_int_equal(supervisor_init(&sv, &c), 0);
+  in.state_finite = 0;
+  in.clip_run = 100u;
+  in.amp_rel = 9.0f;
+  run(&sv, &in, 10);
+  assert_int_equal(sv.mode, GYRO_MODE_OFF);
+  assert_int_equal(sv.fault_count, 0u);
+
+  supervisor_enter_sweep(&sv);
+  in = good();
+  in.amp_rel = 9.0f;
+  in.amp_rel_err = 8.0f;
+  run(&sv, &in, 10);
+  assert_int_equal(sv.mode, GYRO_MODE_SWEEP);
+  in.clip_run = c.clip_max_count;
+  assert_int_equal(supervisor_step(&sv, &in), 1);
+  assert_int_equal(sv.fault, GYRO_FAULT_ADC_CLIP);
+
+  supervisor_enter_sweep(&sv);
+  in = good();
+  in.state_finite = 0;
+  in.clip_run = c.clip_max_count; /* both: the NaN is reported */
+  assert_int_equal(supervisor_step(&sv, &in), 1);
+  assert_int_equal(sv.fault, GYRO_FAULT_NAN);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_bad_cfg_rejected),   cmocka_unit_test(test_lock_sequence),
       cmocka_unit_test(test_lost_lock_and_retry), cmocka_unit_test(test_immediate_faults),
       cmocka_unit_test(test_drive_saturation),   cmocka_unit_test(test_ripple_filtered),
+      cmocka_unit_test(test_clear_request_latched), cmocka_unit_test(test_off_and_sweep_faults),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,95 @@
+/* The once-per-block jobs of gyro_tick, one per tick of the block (gyro.h: the block,
+ * its slot table and the order the jobs depend on). Internal to the gyro: only
+ * gyro_tick runs them.
+ *
+ * A job runs at the end of its tick, after the DAC frame is written: gyro_tick ends in
+ * gyro_block_run, which ends in one call of a job, compiled as a tail call. The sample
+ * path itself then calls nothing before its frame, keeps its values in the caller-saved
+ * registers (it saves three core registers on entry, no FP register) and a job pays
+ * only for its own registers. The jobs that are more than a call into a module are
+ * functions of their own here (a separate translation unit, so they stay out of
+ * gyro_tick's register allocation); a job that would need a call before its last one
+ * is split by the switch instead (the self-test in GYRO_SLOT_P), so that the common
+ * path saves nothing.
+ */
+#ifndef GYRO_BLOCK_H
+#define GYRO_BLOCK_H
+
+#include <stdint.h>
+
+#include "gyro/gyro.h"
+
+/* GYRO_SLOT_AMP: the first half of the finiteness check (the LMSD weights), then |Z|
+ * and, while the drive runs, the amplitude PI (with the drive off |Z| only, for the
+ * over-amplitude trip). */
+void gyro_block_amp(gyro_t *g);
+/* GYRO_SLOT_COMMAND: the rest of the supervisor's evidence (sup_in), and the block's
+ * drive command into the synthesis (once, after both loops). */
+void gyro_block_command(gyro_t *g);
+/* GYRO_SLOT_PROJECT when the supervisor asked for it: clear every integrating state, so
+ * that nothing of the old state (possibly NaN) survives into the next acquisition. */
+void gyro_block_clear(gyro_t *g);
+/* GYRO_SLOT_QUAD: the second half of the finiteness check (loop outputs, rate channel
+ * outputs) and its verdict for the supervisor (sup_in: the next block's supervisor acts
+ * on it), then the quadrature's output filter. */
+void gyro_block_quad(gyro_t *g);
+/* GYRO_SLOT_P while a self-test runs: its sequence on the block's projection, then P's
+ * hold and low-pass. */
+void gyro_block_p_selftest(gyro_t *g);
+/* GYRO_SLOT_OUTPUT: the snapshot for telemetry and status, the analog rate code.
+ * (u1_v, u2_v): the drive voltages of this tick. */
+void gyro_block_output(gyro_t *g, float u1_v, float u2_v);
+/* Every tick in SWEEP, instead of gyro_block_run: the self-calibration job's
+ * excitation (from the next tick on) and NCO step, then the slot's job. */
+void gyro_block_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v);
+
+/* The job of tick `slot` of the block. Every branch ends in one call (a tail call). */
+static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
+{
+  const int drive_on = supervisor_drive_enabled(&g->sup);
+  switch (slot) {
+  case GYRO_SLOT_PHASE_MEAS:
+    if (drive_on) drive_loop_measure_phase(&g->drive, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
+    break;
+  case GYRO_SLOT_PHASE_PI:
+    if (drive_on) drive_loop_update_phase(&g->drive);
+    break;
+  case GYRO_SLOT_AMP:
+    gyro_block_amp(g);
+    break;
+  case GYRO_SLOT_COMMAND:
+    gyro_block_command(g);
+    break;
+  case GYRO_SLOT_SUPERVISE:
+    /* Its request to clear the loop state (sup.clear_req) is acted on next tick. */
+    (void)supervisor_step(&g->sup, &g->sup_in);
+    break;
+  case GYRO_SLOT_PROJECT:
+    /* The clear resets the rate channel, whose projection waits for the next block. */
+    if (g->sup.clear_req != 0u) {
+      gyro_block_clear(g);
+    } else {
+      rate_channel_project(&g->rate, g->lmsd_drive.w_i, g->lmsd_drive.w_q, g->drive.p_rad);
+    }
+    break;
+  case GYRO_SLOT_RATE:
+    rate_channel_filter_rate(&g->rate);
+    break;
+  case GYRO_SLOT_QUAD:
+    gyro_block_quad(g);
+    break;
+  case GYRO_SLOT_P:
+    if (selftest_running(&g->selftest)) {
+      gyro_block_p_selftest(g);
+    } else {
+      rate_channel_hold_p(&g->rate, g->sup.mode != GYRO_MODE_LOCKED);
+      rate_channel_update_p(&g->rate, g->drive.p_rad);
+    }
+    break;
+  default: /* GYRO_SLOT_OUTPUT */
+    gyro_block_output(g, u1_v, u2_v);
+    break;
+  }
+}
+
+#endif /* GYRO_BLOCK_H */
