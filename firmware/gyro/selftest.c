@@ -4,9 +4,17 @@
 
 #include "dsp/fastmath.h"
 
-void selftest_init(selftest_t *st, const selftest_cfg_t *cfg)
+static void set_cfg(selftest_t *st, const selftest_cfg_t *cfg)
 {
   st->cfg = *cfg;
+  st->inv_base = cfg->base_blocks != 0u ? 1.0f / (float)cfg->base_blocks : 0.0f;
+  st->inv_meas = cfg->meas_blocks != 0u ? 1.0f / (float)cfg->meas_blocks : 0.0f;
+  st->inv_expect = cfg->expect_dps != 0.0f ? 1.0f / cfg->expect_dps : 0.0f;
+}
+
+void selftest_init(selftest_t *st, const selftest_cfg_t *cfg)
+{
+  set_cfg(st, cfg);
   st->state = SELFTEST_IDLE;
   st->count = 0u;
   st->acc_base = st->acc_meas = 0.0f;
@@ -14,7 +22,7 @@ void selftest_init(selftest_t *st, const selftest_cfg_t *cfg)
   st->runs = 0u;
 }
 
-void selftest_retune(selftest_t *st, const selftest_cfg_t *cfg) { st->cfg = *cfg; }
+void selftest_retune(selftest_t *st, const selftest_cfg_t *cfg) { set_cfg(st, cfg); }
 
 void selftest_start(selftest_t *st)
 {
@@ -49,10 +57,10 @@ void selftest_update(selftest_t *st, int locked, float rate_raw)
     st->acc_meas += rate_raw;
   }
   if (st->count >= c->settle_blocks + c->meas_blocks) {
-    const float base = st->acc_base / (float)c->base_blocks;
-    const float meas = st->acc_meas / (float)c->meas_blocks;
+    const float base = st->acc_base * st->inv_base;
+    const float meas = st->acc_meas * st->inv_meas;
     st->result_dps = (meas - base) * c->scale_dps;
-    const float e = c->expect_dps != 0.0f ? fm_absf(st->result_dps / c->expect_dps - 1.0f) : 1.0f;
+    const float e = c->expect_dps != 0.0f ? fm_absf(st->result_dps * st->inv_expect - 1.0f) : 1.0f;
     st->state = e <= c->tol_rel ? SELFTEST_PASS : SELFTEST_FAIL;
     st->runs++;
   }

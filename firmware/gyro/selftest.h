@@ -43,6 +43,9 @@ typedef struct {
   float acc_base, acc_meas; /* sums of the unfiltered rate */
   float result_dps;  /* measured response of the last test */
   uint32_t runs;
+  /* 1 / base_blocks, 1 / meas_blocks, 1 / expect_dps (0 where the divisor is 0), set with
+   * the configuration: the verdict block divides nothing (its tick's budget). */
+  float inv_base, inv_meas, inv_expect;
 } selftest_t;
 
 void selftest_init(selftest_t *st, const selftest_cfg_t *cfg);
