@@ -1,5 +1,6 @@
 #include "gyro/drive_synth.h"
 
+#include <math.h> /* NAN (a constant, no call) */
 #include <stddef.h>
 
 #include "dsp/fastmath.h"
@@ -23,6 +24,7 @@ int drive_synth_init(drive_synth_t *ds, const drive_synth_cfg_t *cfg)
   ds->inv_4d = (cfg->mode == GYRO_DRIVE_DC_AC) ? 0.25f / cfg->dc_bias_v : 0.0f;
   ds->a_v = 0.0f;
   ds->off = 0u;
+  ds->f_set_v2 = ds->p_set_rad = NAN;
   return 0;
 }
 
@@ -37,6 +39,8 @@ float drive_synth_f_cmd_max(const drive_synth_t *ds)
 
 void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad)
 {
+  ds->f_set_v2 = f_cmd_v2;
+  ds->p_set_rad = p_rad;
   /* A non-finite command (a NaN the supervisor has not caught yet: it looks once per
    * block) drives nothing rather than a rail voltage; a P outside the +-2 pi that the
    * phase conversion needs (NaN included: the comparison fails) leaves the phase. */

@@ -38,6 +38,7 @@ typedef struct {
   /* The current command (drive_synth_set): */
   float a_v;         /* A, the voltage amplitude */
   uint32_t off;      /* phase offset added to the NCO phase: P/2 (half-freq) or P (DC+AC) */
+  float f_set_v2, p_set_rad; /* the command as last passed to drive_synth_set (NaN: none) */
 } drive_synth_t;
 
 typedef struct {
@@ -55,6 +56,17 @@ float drive_synth_f_cmd_max(const drive_synth_t *ds);
 
 /* A new force command (f_cmd in Ks*V^2, negative = 0; P in rad, |P| < 2 pi). */
 void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad);
+
+/* drive_synth_set, skipped when the command is the one last set (a NaN never is, and
+ * drive_synth_init forgets it). For a caller that passes a command every tick though it
+ * changes rarely: the self-calibration sweep, which would otherwise pay the square root
+ * and the phase conversion on every sample. */
+static inline void drive_synth_follow(drive_synth_t *ds, float f_cmd_v2, float p_rad)
+{
+  if (f_cmd_v2 != ds->f_set_v2 || p_rad != ds->p_set_rad) {
+    drive_synth_set(ds, f_cmd_v2, p_rad);
+  }
+}
 
 /* One sample of the electrode voltages for the current command. phase: NCO phase at wc
  * of this sample; half_phase: its half-rate companion. */

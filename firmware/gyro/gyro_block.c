@@ -95,7 +95,7 @@ void gyro_block_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
   float f_cmd, p;
   uint32_t half_step;
   selfcal_exec_tick(&g->cal, g->lmsd_drive.w_i, g->lmsd_drive.w_q, &half_step, &f_cmd, &p);
-  drive_synth_set(&g->synth, f_cmd, p);
+  drive_synth_follow(&g->synth, f_cmd, p);
   g->nco.half_step = half_step; /* from the next sample on, as the excitation */
   gyro_block_run(g, slot, u1_v, u2_v);
 }
