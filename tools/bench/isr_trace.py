@@ -327,6 +327,12 @@ EXC_ENTRY, EXC_EXIT, FP_LAZY_SAVE, FP_RESTORE = 12, 10, 17, 17
 PERIPH_EXTRA = 2 * 2 + 1 * 4 + 2 * 1 + 1 * 1
 
 
+def job_functions(isrs, fmap):
+    sets = [sorted({fmap.name(pc) for pc in pcs}) for pcs in isrs]
+    common = set(sets[0]).intersection(*sets[1:]) if sets else set()
+    return [[f for f in s if f not in common] for s in sets]
+
+
 def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm"):
     insns = disassemble(objdump, elf)
     funcs = symbols(nm, elf)
@@ -377,6 +383,8 @@ def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm"):
         "insns_max": max(counts),
         "insns_each": counts,
         "cycles_each": cold,  # as linked, ART cold: one per interrupt, in order
+        # the functions each interrupt ran beyond those every interrupt runs (its job)
+        "job_functions_each": job_functions(isrs, fmap),
         "per_function_mean": {k: v / n for k, v in per_func.most_common()},
         "per_function_cycles_mean": {k: {"flash_cold": cyc_cold[k] / n, "zero_wait": cyc_sram[k] / n}
                                      for k, _ in cyc_cold.most_common()},
