@@ -22,44 +22,44 @@ static void test_design_formula(void **state)
 }
 
 /* Asking for more bandwidth than the demodulator allows is capped at 60 deg margin. */
+/* Reference phase margin of the first-order plant (corner f_p) under an integral
+ * controller with a pure delay of delay_samples at fs: 90 deg - atan(wc/wp) - wc*T_d. */
+static double ref_margin_deg(double bw_hz, double f_p_hz, double delay_samples, double fs_hz)
+{
+  const double wc = 2.0 * M_PI * bw_hz;
+  return 90.0 - (atan(wc / (2 * M_PI * f_p_hz)) + wc * delay_samples / fs_hz) * 180.0 / M_PI;
+}
+
 static void test_design_caps_bandwidth(void **state)
 {
   (void)state;
   const drive_loop_design_in_t in = {1.0, 0.1, 1000.0, 270.0, 50000.0, 1.0, 0.0};
   drive_loop_design_out_t out;
-  assert_int_equal(drive_loop_design(&in, &out), 0);
-  assert_true(out.bw_hz < 1000.0);
-  assert_true(out.phase_margin_deg >= 60.0);
-  const double wc = 2.0 * M_PI * out.bw_hz;
-  const double pm = 90.0 - (atan(wc / (2 * M_PI * 270.0)) + wc * 1.5 / 50000.0) * 180.0 / M_PI;
-  assert_true(fabs(pm - out.phase_margin_deg) < 1e-9);
-  /* Run once per 10 samples with the command held: 1 + 10/2 samples of delay. */
-  drive_loop_design_in_t held = in;
-  held.loop_decim = 10.0;
-  drive_loop_design_out_t out_h;
-  assert_int_equal(drive_loop_design(&held, &out_h), 0);
-  const double wch = 2.0 * M_PI * out_h.bw_hz;
-  const double pmh = 90.0 - (atan(wch / (2 * M_PI * 270.0)) + wch * 6.0 / 50000.0) * 180.0 / M_PI;
-  assert_true(fabs(pmh - out_h.phase_margin_deg) < 1e-9 && pmh >= 60.0);
-  assert_true(out_h.bw_hz < out.bw_hz);
-  /* The command reaching the DAC 4 samples after the measured one: 4 + 1 + 10/2. */
-  drive_loop_design_in_t late = held;
-  late.lag_samples = 4.0;
+  /* Each sample of delay costs margin, so the capped bandwidth falls: every sample
+   * (1 + 1/2 for the hold), once per 10 samples with the command held (1 + 10/2), and
+   * with the command reaching the DAC 4 samples after the measured one (4 + 1 + 10/2). */
+  const struct {
+    double loop_decim, lag_samples, delay_samples;
+  } cases[] = {{1.0, 0.0, 1.5}, {10.0, 0.0, 6.0}, {10.0, 4.0, 10.0}};
+  double bw_prev = 1000.0;
+  drive_loop_design_in_t late = in;
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    late = in;
+    late.loop_decim = cases[i].loop_decim;
+    late.lag_samples = cases[i].lag_samples;
+    assert_int_equal(drive_loop_design(&late, &out), 0);
+    const double pm = ref_margin_deg(out.bw_hz, 270.0, cases[i].delay_samples, 50000.0);
+    assert_true(fabs(pm - out.phase_margin_deg) < 1e-9 && pm >= 60.0);
+    assert_true(out.bw_hz < bw_prev);
+    bw_prev = out.bw_hz;
+  }
   drive_loop_design_out_t out_l;
-  assert_int_equal(drive_loop_design(&late, &out_l), 0);
-  const double wcl = 2.0 * M_PI * out_l.bw_hz;
-  const double pml = 90.0 - (atan(wcl / (2 * M_PI * 270.0)) + wcl * 10.0 / 50000.0) * 180.0 / M_PI;
-  assert_true(fabs(pml - out_l.phase_margin_deg) < 1e-9 && pml >= 60.0);
-  assert_true(out_l.bw_hz < out_h.bw_hz);
   /* Where the cap is not reached the delay changes nothing but the margin. */
   drive_loop_design_in_t slow = late;
   slow.bw_hz = 30.0;
   assert_int_equal(drive_loop_design(&slow, &out_l), 0);
   assert_true(fabs(out_l.bw_hz - 30.0) < 1e-9);
-  const double wcs = 2.0 * M_PI * 30.0;
-  assert_true(fabs(out_l.phase_margin_deg -
-                   (90.0 - (atan(wcs / (2 * M_PI * 270.0)) + wcs * 10.0 / 50000.0) * 180.0 / M_PI)) <
-              1e-9);
+  assert_true(fabs(out_l.phase_margin_deg - ref_margin_deg(30.0, 270.0, 10.0, 50000.0)) < 1e-9);
   drive_loop_design_in_t bad = in;
   bad.loop_decim = -1.0;
   assert_int_equal(drive_loop_design(&bad, &out), -1);
@@ -94,6 +94,26 @@ static void env_step(env_plant_t *p, double f, double p_rad)
 /* Small steps (no saturation): amplitude and phase errors decay as the designed
  * first-order closed loop, e^{-wc t}, to a few per cent of the step (the LMSD lag is
  * not in this model, so the response is the ideal one). */
+/* Loops from the amplitude and phase designs, run every dt_s, starting in equilibrium
+ * with the envelope plant (1.9 V at phase 0.3 rad, force matching) and then asked for
+ * 2.0 V and 0.35 rad. */
+static void loop_at_equilibrium(drive_loop_t *dl, env_plant_t *p,
+                                const drive_loop_design_out_t *amp,
+                                const drive_loop_design_out_t *ph, double dt_s, double fs,
+                                double tau, double k)
+{
+  drive_loop_cfg_t c = {.dt_s = (float)dt_s, .amp_set_v = 2.0f, .phase_set_rad = 0.3f,
+                        .amp_kp = (float)amp->kp, .amp_ki = (float)amp->ki,
+                        .phase_kp = (float)ph->kp, .phase_ki = (float)ph->ki,
+                        .f_cmd_max_v2 = 196.0f, .p_init_rad = 0.3f};
+  assert_int_equal(drive_loop_init(dl, &c), 0);
+  const env_plant_t p0 = {1.9 * cos(0.3), 1.9 * sin(0.3), exp(-1.0 / (fs * tau)), k};
+  *p = p0;
+  dl->amp_pi.u = (float)(1.9 / k);
+  dl->f_cmd_v2 = dl->amp_pi.u;
+  dl->phase_set_rad = 0.35f;
+}
+
 static void test_closed_loop_first_order(void **state)
 {
   (void)state;
@@ -105,17 +125,9 @@ static void test_closed_loop_first_order(void **state)
   in.plant_gain = 1.0;
   assert_int_equal(drive_loop_design(&in, &ph), 0);
 
-  drive_loop_cfg_t c = {.dt_s = (float)(1.0 / fs), .amp_set_v = 2.0f, .phase_set_rad = 0.3f,
-                        .amp_kp = (float)amp.kp, .amp_ki = (float)amp.ki,
-                        .phase_kp = (float)ph.kp, .phase_ki = (float)ph.ki,
-                        .f_cmd_max_v2 = 196.0f, .p_init_rad = 0.3f};
   drive_loop_t dl;
-  assert_int_equal(drive_loop_init(&dl, &c), 0);
-  /* Start in equilibrium at 1.9 V and phase 0.3, force matching. */
-  env_plant_t p = {1.9 * cos(0.3), 1.9 * sin(0.3), exp(-1.0 / (fs * tau)), k};
-  dl.amp_pi.u = (float)(1.9 / k);
-  dl.f_cmd_v2 = dl.amp_pi.u;
-  dl.phase_set_rad = 0.35f; /* 0.05 rad phase step together with the 0.1 V amplitude step */
+  env_plant_t p;
+  loop_at_equilibrium(&dl, &p, &amp, &ph, 1.0 / fs, fs, tau, k);
   const double wc = 2.0 * M_PI * bw;
   double max_amp = 0.0;
   for (int n = 1; n <= 10000; n++) {
@@ -188,17 +200,10 @@ static void test_block_schedule(void **state)
   in.lag_samples = 4.0;
   assert_int_equal(drive_loop_design(&in, &ph), 0);
   assert_true(amp.phase_margin_deg > 60.0 && ph.phase_margin_deg > 60.0);
-  drive_loop_cfg_t c = {.dt_s = (float)(n_blk / fs), .amp_set_v = 2.0f, .phase_set_rad = 0.3f,
-                        .amp_kp = (float)amp.kp, .amp_ki = (float)amp.ki,
-                        .phase_kp = (float)ph.kp, .phase_ki = (float)ph.ki,
-                        .f_cmd_max_v2 = 196.0f, .p_init_rad = 0.3f};
   drive_loop_t dl;
-  assert_int_equal(drive_loop_init(&dl, &c), 0);
-  env_plant_t p = {1.9 * cos(0.3), 1.9 * sin(0.3), exp(-1.0 / (fs * tau)), k};
-  dl.amp_pi.u = (float)(1.9 / k);
-  dl.f_cmd_v2 = dl.amp_pi.u;
+  env_plant_t p;
+  loop_at_equilibrium(&dl, &p, &amp, &ph, n_blk / fs, fs, tau, k);
   dl.amp_v = 1.9f;
-  dl.phase_set_rad = 0.35f;
   double f_set = dl.f_cmd_v2, p_set = dl.p_rad; /* command of the synthesis */
   double f_out = f_set, p_out = p_set;          /* at the electrodes */
   const double wc = 2.0 * M_PI * bw, t_d = (3.0 + 1.0 + n_blk / 2.0) / fs;
