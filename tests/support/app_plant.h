@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "app/app.h"
+#include "app_cmd.h"
 #include "hal/hal_sample_timer.h"
 #include "hal_flash_host.h"
 #include "hal_host.h"
@@ -29,15 +30,7 @@ static inline void app_plant_start(const plant_cfg_t *pc, uint64_t seed, const p
 }
 
 /* One command line in, the whole reply out (the background loop runs once). */
-static inline const char *cmd(const char *line)
-{
-  static char reply[8192];
-  hal_uart_host_rx_push((const uint8_t *)line, strlen(line));
-  app_poll(&app);
-  const size_t n = hal_uart_host_tx_pop((uint8_t *)reply, sizeof reply - 1u);
-  reply[n] = '\0';
-  return reply;
-}
+static inline const char *cmd(const char *line) { return app_cmd_line(&app, line); }
 
 /* s seconds of samples, the background loop not polled. */
 static inline void run_s(double s) { hal_host_run((uint64_t)(s * 50000.0)); }

@@ -8,6 +8,7 @@
 #include <cmocka.h>
 
 #include "app/app.h"
+#include "app_cmd.h"
 #include "hal/hal_sample_timer.h"
 #include "hal_flash_host.h"
 #include "hal_host.h"
@@ -35,15 +36,7 @@ static void setup_app(void)
 }
 
 /* Send one line through the UART stub, run the background loop, return the reply. */
-static const char *cmd(const char *line)
-{
-  static char reply[8192];
-  hal_uart_host_rx_push((const uint8_t *)line, strlen(line));
-  app_poll(&app);
-  const size_t n = hal_uart_host_tx_pop((uint8_t *)reply, sizeof reply - 1u);
-  reply[n] = '\0';
-  return reply;
-}
+static const char *cmd(const char *line) { return app_cmd_line(&app, line); }
 
 /* A set of a live parameter reaches the running gyro at the next tick, through the
  * bank's derived block; nothing of it is visible before that tick. */
