@@ -74,6 +74,11 @@ param_value_t param_get(const param_values_t *v, param_idx_t i)
 void param_put(param_values_t *v, param_idx_t i, param_value_t val)
 {
   if ((unsigned)i < (unsigned)PARAM_COUNT) {
+    /* -0 and 0 are one value: stored as +0, so diff, the flash image and the
+     * unchanged-save check see one bit pattern for it. */
+    if (k_param_table[i].type == (uint8_t)PARAM_T_F32 && val.f == 0.0f) {
+      val.u = 0u;
+    }
     memcpy((uint8_t *)v + k_param_table[i].offset, &val, sizeof val);
   }
 }
@@ -88,6 +93,11 @@ param_status_t param_check(param_idx_t i, param_value_t val)
   case PARAM_T_F32:
     if (!isfinite(val.f)) {
       return PARAM_ERR_NOT_FINITE;
+    }
+    /* A subnormal means nothing to any parameter, and the FPU in flush-to-zero mode
+     * would run a 0 where the bank holds something else. */
+    if (fpclassify(val.f) == FP_SUBNORMAL) {
+      return PARAM_ERR_RANGE;
     }
     return (val.f >= pi->min.f && val.f <= pi->max.f) ? PARAM_OK : PARAM_ERR_RANGE;
   case PARAM_T_ENUM:
@@ -172,6 +182,9 @@ param_status_t params_init(params_t *p, const params_cfg_t *cfg, const param_val
   param_status_t st = check_all(&p->block[0], err);
   if (st != PARAM_OK) {
     return st;
+  }
+  for (unsigned i = 0; i < (unsigned)PARAM_COUNT; i++) {
+    param_put(&p->block[0], (param_idx_t)i, param_get(&p->block[0], (param_idx_t)i)); /* -0 */
   }
   if (p->cfg.derive != NULL) {
     const char *why = NULL;

@@ -100,12 +100,14 @@ param_idx_t param_lookup(const char *name, size_t len);
 /* Index by flash record id; PARAM_COUNT if none. */
 param_idx_t param_lookup_id(uint16_t id);
 param_value_t param_get(const param_values_t *v, param_idx_t i);
-/* Type, finiteness, range and choice check (read-only-ness is the bank's business). */
+/* Type, finiteness, range and choice check; a subnormal float is out of range
+ * (read-only-ness is the bank's business). */
 param_status_t param_check(param_idx_t i, param_value_t val);
-/* Bitwise equality of two values of parameter i (so -0 differs from 0, as in flash). */
+/* Bitwise equality of two values of parameter i (param_put never stores a -0). */
 bool param_value_equal(param_idx_t i, param_value_t a, param_value_t b);
 void param_values_defaults(param_values_t *v);
-/* Unchecked write of one member (callers have run param_check). */
+/* Unchecked write of one member (callers have run param_check); a float -0 is written as
+ * +0, so every way into a value set (command line, flash record, simulator) normalises. */
 void param_put(param_values_t *v, param_idx_t i, param_value_t val);
 const char *param_status_str(param_status_t st);
 
