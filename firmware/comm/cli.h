@@ -20,8 +20,8 @@
  *   final   = "ok" [ SP text ] CRLF
  *           | "err" SP CODE SP message CRLF
  *   CODE    = ARGS | UNKNOWN | NAME | RO | VALUE | RANGE | BUSY | PENDING | REJECTED |
- *             NOSTORE | FLASH | TOOLONG | BADCHAR | INTERNAL   (application handlers may
- *             add their own upper-case codes)
+ *             NOSTORE | FLASH | FORMAT | TOOLONG | BADCHAR | INTERNAL
+ *             (application handlers may add their own upper-case codes)
  *   text never contains CR or LF; a host reads lines until one starts with "ok" or "err".
  *
  * Built-in commands and their final lines
@@ -36,7 +36,9 @@
  *                           ok NAME VALUE [NAME VALUE ...]   (values as now held)
  *       all pairs are validated, staged and published together at one tick boundary,
  *       or nothing changes; a bad value is answered with the allowed range.
- *   save                    ok saved slot A|B seq N  |  ok unchanged slot A|B seq N
+ *   save [force]            ok saved slot A|B seq N  |  ok unchanged slot A|B seq N
+ *       refused (err FORMAT) while the store holds an image of a newer format, which
+ *       this firmware cannot read; "save force" overwrites it.
  *   load                    ok loaded slot A|B seq N dropped D rejected R defaulted M
  *   defaults                ok defaults applied (not saved)
  *   diff                    - NAME VALUE default DEFAULT ...  ok N differ

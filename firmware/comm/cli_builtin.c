@@ -71,8 +71,11 @@ static param_idx_t lookup_arg(cli_t *cli, const char *name)
 static void cmd_help(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
 {
   (void)ctx;
-  (void)argc;
   (void)argv;
+  if (argc != 1u) {
+    cli_err(cli, "ARGS", "usage: help");
+    return;
+  }
   uint32_t n = 0u;
   for (uint32_t pass = 0; pass < 2u; pass++) {
     const uint32_t count = (pass == 0u) ? cli_builtin_count() : cli_app_count(cli);
@@ -287,9 +290,9 @@ static void put_slot(cli_t *cli, const param_store_report_t *rep)
 static void cmd_save(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
 {
   (void)ctx;
-  (void)argv;
-  if (argc != 1u) {
-    cli_err(cli, "ARGS", "usage: save");
+  const bool force = argc == 2u && strcmp(argv[1], "force") == 0;
+  if (argc != 1u && !force) {
+    cli_err(cli, "ARGS", "usage: save [force]");
     return;
   }
   if (cli->cfg.store == NULL) {
@@ -298,7 +301,9 @@ static void cmd_save(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
   }
   params_t *p = cli->cfg.params;
   param_store_report_t rep;
-  const param_store_status_t st = param_store_save(cli->cfg.store, params_current(p), params_loop_safe(p), &rep);
+  const uint32_t how = (params_loop_safe(p) ? (uint32_t)PARAM_SAVE_LOOP_SAFE : 0u) |
+                       (force ? (uint32_t)PARAM_SAVE_FORCE : 0u);
+  const param_store_status_t st = param_store_save(cli->cfg.store, params_current(p), how, &rep);
   switch (st) {
   case PARAM_STORE_OK:
   case PARAM_STORE_UNCHANGED:
@@ -309,7 +314,12 @@ static void cmd_save(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
   case PARAM_STORE_ERR_BUSY:
     cli_err(cli, "BUSY", "drive running: stop the drive first");
     break;
+  case PARAM_STORE_ERR_NEWER:
+    cli_err(cli, "FORMAT", "the store holds an image of a newer firmware format; "
+                           "save force overwrites it");
+    break;
   case PARAM_STORE_NONE:
+  case PARAM_STORE_NEWER:
   case PARAM_STORE_ERR_FLASH:
   case PARAM_STORE_ERR_VERIFY:
   case PARAM_STORE_ERR_CONFIG:
@@ -323,7 +333,13 @@ static void cmd_save(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
 
 static const char *slot_state_str(uint8_t s)
 {
-  return (s == (uint8_t)PARAM_SLOT_EMPTY) ? "empty" : (s == (uint8_t)PARAM_SLOT_VALID) ? "valid" : "corrupt";
+  switch ((param_slot_state_t)s) {
+  case PARAM_SLOT_EMPTY: return "empty";
+  case PARAM_SLOT_VALID: return "valid";
+  case PARAM_SLOT_NEWER: return "newer format";
+  case PARAM_SLOT_CORRUPT:
+  default: return "corrupt";
+  }
 }
 
 static void apply_all(cli_t *cli, const param_values_t *v, param_status_t *st_out)
@@ -432,8 +448,11 @@ static void cmd_diff(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
 static void cmd_version(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
 {
   (void)ctx;
-  (void)argc;
   (void)argv;
+  if (argc != 1u) {
+    cli_err(cli, "ARGS", "usage: version");
+    return;
+  }
   cli_put(cli, "fw ");
   cli_put(cli, fw_version_string());
   cli_put(cli, " layout ");
@@ -450,7 +469,8 @@ static const cli_cmd_t k_builtin[] = {
     {"list", "[PREFIX]", "parameters with value, unit, range, default, flags and help", cmd_list, NULL},
     {"get", "NAME", "value of one parameter", cmd_get, NULL},
     {"set", "NAME VALUE [NAME VALUE ...]", "change parameters together (all or nothing)", cmd_set, NULL},
-    {"save", "", "write the persistent parameters to flash (drive stopped)", cmd_save, NULL},
+    {"save", "[force]", "write the persistent parameters to flash (drive stopped; force: "
+                        "over an image of a newer format)", cmd_save, NULL},
     {"load", "", "apply the parameters stored in flash", cmd_load, NULL},
     {"defaults", "", "apply the default parameters (not saved)", cmd_defaults, NULL},
     {"diff", "", "parameters that differ from their defaults", cmd_diff, NULL},

@@ -76,7 +76,13 @@ static param_slot_state_t slot_check(const param_store_t *st, unsigned slot, slo
     return PARAM_SLOT_EMPTY;
   }
   const uint32_t count = get_u32(&hdr[16]);
-  if (get_u32(&hdr[0]) != PARAM_STORE_MAGIC || get_u16(&hdr[4]) != PARAM_STORE_FORMAT ||
+  /* A newer writer's image: its layout is not ours to check. A format with the high byte
+   * set is an erased or torn field (0xFFFF, 0xFF01 after a cut), not a newer writer. */
+  const uint16_t format = get_u16(&hdr[4]);
+  if (get_u32(&hdr[0]) == PARAM_STORE_MAGIC && format > PARAM_STORE_FORMAT && format <= 0xFFu) {
+    return PARAM_SLOT_NEWER;
+  }
+  if (get_u32(&hdr[0]) != PARAM_STORE_MAGIC || format != PARAM_STORE_FORMAT ||
       count > PARAM_STORE_MAX_RECORDS ||
       PARAM_STORE_HDR_BYTES + PARAM_STORE_REC_BYTES * count + 8u > st->sector_size) {
     return PARAM_SLOT_CORRUPT;
@@ -121,6 +127,11 @@ static int newest_slot(const param_store_t *st, param_store_report_t *rep, slot_
   return best;
 }
 
+static bool holds_newer(const param_store_report_t *rep)
+{
+  return rep->slot_state[0] == (uint8_t)PARAM_SLOT_NEWER || rep->slot_state[1] == (uint8_t)PARAM_SLOT_NEWER;
+}
+
 static bool type_compatible(uint8_t rec_type, uint8_t table_type)
 {
   const bool rec_float = (rec_type == (uint8_t)PARAM_T_F32);
@@ -139,10 +150,10 @@ param_store_status_t param_store_load(param_store_t *st, param_values_t *v, para
   slot_hdr_t hdr[2];
   const int s = newest_slot(st, rep, hdr);
   if (s < 0) {
-    return PARAM_STORE_NONE;
+    return holds_newer(rep) ? PARAM_STORE_NEWER : PARAM_STORE_NONE;
   }
   param_values_t out = *v;
-  /* per parameter: 0 not in the image, 1 loaded, 2 only rejected records */
+  /* per parameter: 0 not in the image, 1 loaded, 2 one rejected record, 3 duplicated */
   uint8_t got[PARAM_COUNT];
   memset(got, 0, sizeof got);
   uint8_t chunk[CHUNK_RECORDS * PARAM_STORE_REC_BYTES];
@@ -165,11 +176,15 @@ param_store_status_t param_store_load(param_store_t *st, param_values_t *v, para
       continue;
     }
     const param_value_t val = {.u = get_u32(&rec[4])};
-    if (got[idx] == 1u || !type_compatible(rec[2], pi->type) || param_check(idx, val) != PARAM_OK) {
+    if (got[idx] != 0u) {
+      /* the first one was taken as loaded: both count */
+      rep->rejected = (uint16_t)(rep->rejected + ((got[idx] == 1u) ? 2u : 1u));
+      got[idx] = 3u;
+      continue;
+    }
+    if (!type_compatible(rec[2], pi->type) || param_check(idx, val) != PARAM_OK) {
       rep->rejected++;
-      if (got[idx] == 0u) {
-        got[idx] = 2u;
-      }
+      got[idx] = 2u;
       continue;
     }
     got[idx] = 1u;
@@ -241,7 +256,7 @@ static bool records_equal(const param_store_t *st, unsigned s, uint32_t count, u
   return true;
 }
 
-param_store_status_t param_store_save(param_store_t *st, const param_values_t *v, bool loop_safe,
+param_store_status_t param_store_save(param_store_t *st, const param_values_t *v, uint32_t how,
                                       param_store_report_t *rep)
 {
   param_store_report_t local;
@@ -252,7 +267,7 @@ param_store_status_t param_store_save(param_store_t *st, const param_values_t *v
   if (st->sector_size == 0u) {
     return PARAM_STORE_ERR_CONFIG;
   }
-  if (!loop_safe) {
+  if ((how & PARAM_SAVE_LOOP_SAFE) == 0u) {
     return PARAM_STORE_ERR_BUSY;
   }
   slot_hdr_t hdr[2];
@@ -268,8 +283,13 @@ param_store_status_t param_store_save(param_store_t *st, const param_values_t *v
     rep->seq = hdr[newest].seq;
     return PARAM_STORE_UNCHANGED;
   }
-  /* never touch the newest valid image: write the other slot (A if neither is valid) */
-  const unsigned target = (newest == 0) ? 1u : 0u;
+  /* never touch the newest valid image: write the other slot (with neither valid, A
+   * unless A holds a newer-format image) */
+  const unsigned target = (newest == 0 || (newest < 0 && rep->slot_state[0] == (uint8_t)PARAM_SLOT_NEWER)) ? 1u : 0u;
+  /* refused while either slot holds one: the save after this one would take the other */
+  if (holds_newer(rep) && (how & PARAM_SAVE_FORCE) == 0u) {
+    return PARAM_STORE_ERR_NEWER;
+  }
   const uint32_t sec = st->sector[target];
   hal_flash_status_t fs = hal_flash_erase(sec);
   if (fs == HAL_FLASH_OK) {
@@ -304,6 +324,8 @@ const char *param_store_status_str(param_store_status_t s)
   case PARAM_STORE_ERR_FLASH: return "flash erase/program failed";
   case PARAM_STORE_ERR_VERIFY: return "written image did not verify";
   case PARAM_STORE_ERR_CONFIG: return "bad store configuration";
+  case PARAM_STORE_NEWER: return "newer format image (not loaded)";
+  case PARAM_STORE_ERR_NEWER: return "the save would erase an image of a newer format";
   default: return "?";
   }
 }

@@ -26,11 +26,20 @@
  * Load: an image is valid when magic, format, count (fits in the sector), commit word
  * and CRC all check. The valid image with the higher seq wins; a corrupt newest image
  * falls back to the other slot. Records are migrated field by field against the running
- * table: unknown (or no longer persistent) ids are dropped and counted; a wrong type, a
- * duplicate or a value failing param_check is rejected and counted, and that parameter
- * keeps its default; persistent parameters missing from the image take their defaults.
- * With no valid image, nothing is loaded and the caller keeps its values (defaults at
- * boot), with the slot states in the report.
+ * table: unknown (or no longer persistent) ids are dropped and counted; a wrong type or
+ * a value failing param_check is rejected and counted, and that parameter keeps its
+ * default; an id that appears more than once is a duplicate: all its records are
+ * rejected (which one was meant cannot be told) and it keeps its default as well;
+ * persistent parameters missing from the image take their defaults. A float -0 loads as
+ * +0 (param_put). With no valid image, nothing is loaded and the caller keeps its
+ * values (defaults at boot), with the slot states in the report.
+ *
+ * An image of a newer format (magic right, format above PARAM_STORE_FORMAT and below
+ * 0x100: a set high byte is an erased or torn field) is not read,
+ * and not overwritten either: a save that would erase it is refused
+ * (PARAM_STORE_ERR_NEWER) while either slot holds one (the next save would take the
+ * other slot), unless the caller forces it (PARAM_SAVE_FORCE); a forced save still
+ * writes the slot without it when it can.
  *
  * Why save needs the loop safe: on a single-bank STM32F4 a 16 KB sector erase stalls
  * every instruction fetch from flash for 250 ms typical (500 ms max), and the drive
@@ -66,13 +75,22 @@ typedef enum {
   PARAM_STORE_ERR_BUSY,    /* save refused: the loop is not in a safe mode */
   PARAM_STORE_ERR_FLASH,   /* erase/program failed (including a power cut) */
   PARAM_STORE_ERR_VERIFY,  /* the written image did not read back valid */
-  PARAM_STORE_ERR_CONFIG   /* bad sectors or a sector too small for an image */
+  PARAM_STORE_ERR_CONFIG,  /* bad sectors or a sector too small for an image */
+  PARAM_STORE_NEWER,       /* load: no valid image, but one of a newer format */
+  PARAM_STORE_ERR_NEWER    /* save refused: it would erase a newer-format image */
 } param_store_status_t;
+
+/* How a save may go (bits). */
+enum {
+  PARAM_SAVE_LOOP_SAFE = 1u << 0, /* the caller's word that the loop is in a safe mode */
+  PARAM_SAVE_FORCE = 1u << 1      /* overwrite a newer-format image if need be */
+};
 
 typedef enum {
   PARAM_SLOT_EMPTY = 0,  /* header erased (all 0xFF) */
   PARAM_SLOT_VALID,
-  PARAM_SLOT_CORRUPT     /* something there, but it does not check */
+  PARAM_SLOT_CORRUPT,    /* something there, but it does not check */
+  PARAM_SLOT_NEWER       /* an image of a newer format: not read, not overwritten */
 } param_slot_state_t;
 
 typedef struct {
@@ -102,13 +120,15 @@ param_store_status_t param_store_init(param_store_t *st, const param_store_cfg_t
 
 /* Load the newest valid image into *v: every persistent parameter is overwritten (from
  * the image or its default); other members are left as the caller set them. Returns
- * PARAM_STORE_OK, or PARAM_STORE_NONE with *v untouched. Never writes flash. */
+ * PARAM_STORE_OK, or PARAM_STORE_NONE / PARAM_STORE_NEWER with *v untouched. Never
+ * writes flash. */
 param_store_status_t param_store_load(param_store_t *st, param_values_t *v, param_store_report_t *rep);
 
-/* Save the persistent parameters of *v (all must pass param_check). loop_safe: the
- * caller's word that the loop is in a safe mode; false -> PARAM_STORE_ERR_BUSY without
+/* Save the persistent parameters of *v (all must pass param_check). how: PARAM_SAVE_*
+ * bits; without PARAM_SAVE_LOOP_SAFE -> PARAM_STORE_ERR_BUSY, and a save that would erase
+ * a newer-format image without PARAM_SAVE_FORCE -> PARAM_STORE_ERR_NEWER, both without
  * touching flash. */
-param_store_status_t param_store_save(param_store_t *st, const param_values_t *v, bool loop_safe,
+param_store_status_t param_store_save(param_store_t *st, const param_values_t *v, uint32_t how,
                                       param_store_report_t *rep);
 
 const char *param_store_status_str(param_store_status_t s);

@@ -39,6 +39,7 @@ static void start_on_flash(void)
 
 
 
+static float param_f(param_idx_t i) { return param_get(params_current(&app.params), i).f; }
 
 /* ---- flash images written by hand ---- */
 
@@ -53,7 +54,12 @@ static void put32(uint8_t *p, uint32_t v)
   for (int i = 0; i < 4; i++) p[i] = (uint8_t)(v >> (8 * i));
 }
 
-
+static uint32_t bits_of(float f)
+{
+  uint32_t u;
+  memcpy(&u, &f, sizeof u);
+  return u;
+}
 
 /* A committed image in sector 0 (slot A) in the layout of param_store.h. */
 static void write_image(uint16_t format, const rec_t *r, uint32_t n)
@@ -132,12 +138,72 @@ static void test_minus_zero_normalised(void **state)
   assert_true(param_get(&v, PARAM_drive_amp_kp).u == 0u);
 }
 
+/* Duplicate record ids: as param_store.h says, the parameter keeps its default (which of
+ * two records was meant cannot be told) and both records count as rejected. */
+static void test_duplicate_record_ids_take_default(void **state)
+{
+  (void)state;
+  const rec_t r[] = {
+      {id_of(PARAM_rate_bias_c0_dps), PARAM_T_F32, bits_of(1.5f)},
+      {id_of(PARAM_rate_scale_dps), PARAM_T_F32, bits_of(1.0f)},
+      {id_of(PARAM_rate_bias_c0_dps), PARAM_T_F32, bits_of(2.5f)},
+      {id_of(PARAM_rate_bias_c0_dps), PARAM_T_F32, bits_of(3.5f)},
+  };
+  write_image(PARAM_STORE_FORMAT, r, 4u);
+  start_on_flash();
+  assert_int_equal(app.store_status, PARAM_STORE_OK);
+  assert_true(param_f(PARAM_rate_bias_c0_dps) == 0.0f);
+  assert_true(param_f(PARAM_rate_scale_dps) == 1.0f);
+  assert_non_null(strstr(cmd("load\n"), " rejected 3 "));
+}
+
+/* An image of a newer format is not ours to overwrite: save refused with a clear error,
+ * `save force` writes the other slot and keeps it. */
+static void test_newer_format_image_not_overwritten(void **state)
+{
+  (void)state;
+  const rec_t r[] = {{id_of(PARAM_rate_bias_c0_dps), PARAM_T_F32, bits_of(1.5f)}};
+  write_image(PARAM_STORE_FORMAT + 1u, r, 1u);
+  uint8_t before[64];
+  assert_int_equal(hal_flash_read(0u, 0u, before, sizeof before), HAL_FLASH_OK);
+  start_on_flash();
+  assert_non_null(strstr(cmd("status\n"), "- store newer format image (not loaded)\r\n"));
+  assert_string_equal(cmd("drive off\n"), "ok drive off\r\n");
+  run_s(0.001);
+  const char *e = cmd("save\n");
+  assert_non_null(strstr(e, "err FORMAT "));
+  assert_non_null(strstr(e, "save force"));
+  assert_non_null(strstr(cmd("save forc\n"), "err ARGS"));
+  uint8_t after[64];
+  assert_int_equal(hal_flash_read(0u, 0u, after, sizeof after), HAL_FLASH_OK);
+  assert_memory_equal(before, after, sizeof before);
+  assert_string_equal(cmd("save force\n"), "ok saved slot B seq 1\r\n");
+  assert_int_equal(hal_flash_read(0u, 0u, after, sizeof after), HAL_FLASH_OK);
+  assert_memory_equal(before, after, sizeof before);
+}
+
+/* Extra words are refused by every built-in, help and version included. */
+static void test_extra_words_refused(void **state)
+{
+  (void)state;
+  start();
+  const char *const lines[] = {"help x\n", "version x\n", "save x\n", "load x\n",
+                               "defaults x\n", "diff x\n", "list a b\n", "get a b\n"};
+  for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++) {
+    assert_non_null(strstr(cmd(lines[i]), "err ARGS "));
+  }
+}
+
+
 
 int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_subnormal_refused_everywhere),
       cmocka_unit_test(test_minus_zero_normalised),
+      cmocka_unit_test(test_duplicate_record_ids_take_default),
+      cmocka_unit_test(test_newer_format_image_not_overwritten),
+      cmocka_unit_test(test_extra_words_refused),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,7 +1,8 @@
 /* The parameter-store loader fed arbitrary flash content in both slots. Byte 0 picks
  * options: bit 0 repairs the CRC and commit word of each slot (so the fuzzer reaches
  * the record decoder), bit 1 swaps the slot order. Whatever is loaded must be a valid
- * parameter set, and a save over that content must load back exactly. */
+ * parameter set, a save over a newer-format image needs forcing, and a save over that
+ * content must load back exactly. */
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -63,7 +64,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
   param_values_defaults(&v);
   param_store_report_t rep;
   const param_store_status_t ls = param_store_load(&st, &v, &rep);
-  FUZZ_CHECK(ls == PARAM_STORE_OK || ls == PARAM_STORE_NONE);
+  FUZZ_CHECK(ls == PARAM_STORE_OK || ls == PARAM_STORE_NONE || ls == PARAM_STORE_NEWER);
   for (int i = 0; i < PARAM_COUNT; i++) {
     FUZZ_CHECK(param_check((param_idx_t)i, param_get(&v, (param_idx_t)i)) == PARAM_OK);
   }
@@ -76,7 +77,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
   }
   /* a save never destroys the newest valid image and reads back exactly */
   v.drive_freq_hz = 1234.5f;
-  const param_store_status_t ss = param_store_save(&st, &v, true, &rep);
+  const bool newer = rep.slot_state[0] == PARAM_SLOT_NEWER || rep.slot_state[1] == PARAM_SLOT_NEWER;
+  FUZZ_CHECK((ls == PARAM_STORE_NEWER) == (newer && ls != PARAM_STORE_OK));
+  param_store_status_t ss = param_store_save(&st, &v, PARAM_SAVE_LOOP_SAFE, &rep);
+  /* a newer-format image is only overwritten by a forced save */
+  if (newer) {
+    FUZZ_CHECK(ss == PARAM_STORE_ERR_NEWER);
+    ss = param_store_save(&st, &v, PARAM_SAVE_LOOP_SAFE | PARAM_SAVE_FORCE, &rep);
+  }
   FUZZ_CHECK(ss == PARAM_STORE_OK);
   param_values_t back;
   param_values_defaults(&back);

@@ -110,16 +110,16 @@ static void test_roundtrip_and_alternation(void **state)
   values_a(&a);
   values_b(&b);
   param_store_report_t rep;
-  assert_int_equal(param_store_save(&g_store, &a, true, &rep), PARAM_STORE_OK);
+  assert_int_equal(param_store_save(&g_store, &a, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
   assert_int_equal(rep.slot, 0);
   assert_int_equal(rep.seq, 1u);
   check_slot_bytes(0u, 1u, &a);
-  assert_int_equal(param_store_save(&g_store, &b, true, &rep), PARAM_STORE_OK);
+  assert_int_equal(param_store_save(&g_store, &b, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
   assert_int_equal(rep.slot, 1);
   assert_int_equal(rep.seq, 2u);
   check_slot_bytes(1u, 2u, &b);
   check_slot_bytes(0u, 1u, &a); /* the older image is untouched */
-  assert_int_equal(param_store_save(&g_store, &a, true, &rep), PARAM_STORE_OK);
+  assert_int_equal(param_store_save(&g_store, &a, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
   assert_int_equal(rep.slot, 0);
   assert_int_equal(rep.seq, 3u);
   param_values_defaults(&got);
@@ -137,17 +137,17 @@ static void test_unchanged_save_writes_nothing(void **state)
   param_values_t a;
   values_a(&a);
   param_store_report_t rep;
-  assert_int_equal(param_store_save(&g_store, &a, true, &rep), PARAM_STORE_OK);
+  assert_int_equal(param_store_save(&g_store, &a, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
   hal_flash_host_stats_t s0, s1;
   hal_flash_host_stats(&s0);
-  assert_int_equal(param_store_save(&g_store, &a, true, &rep), PARAM_STORE_UNCHANGED);
+  assert_int_equal(param_store_save(&g_store, &a, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_UNCHANGED);
   assert_int_equal(rep.slot, 0);
   hal_flash_host_stats(&s1);
   assert_int_equal(s1.erases, s0.erases);
   assert_int_equal(s1.programmed_bytes, s0.programmed_bytes);
   /* a non-persistent member does not count as a change */
   a.sys_fs_hz = 50000u;
-  assert_int_equal(param_store_save(&g_store, &a, true, &rep), PARAM_STORE_UNCHANGED);
+  assert_int_equal(param_store_save(&g_store, &a, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_UNCHANGED);
 }
 
 /* Why a save needs the loop stopped, measured on the stub's simulated clock. */
@@ -158,7 +158,7 @@ static void test_save_refused_while_running(void **state)
   values_a(&a);
   hal_flash_host_stats_clear();
   param_store_report_t rep;
-  assert_int_equal(param_store_save(&g_store, &a, false, &rep), PARAM_STORE_ERR_BUSY);
+  assert_int_equal(param_store_save(&g_store, &a, 0u, &rep), PARAM_STORE_ERR_BUSY);
   hal_flash_host_stats_t st;
   hal_flash_host_stats(&st);
   assert_int_equal(st.busy_us, 0u); /* flash never touched: no stall */
@@ -167,7 +167,7 @@ static void test_save_refused_while_running(void **state)
   param_values_defaults(&v);
   assert_int_equal(param_store_load(&g_store, &v, &rep), PARAM_STORE_NONE);
 
-  assert_int_equal(param_store_save(&g_store, &a, true, &rep), PARAM_STORE_OK);
+  assert_int_equal(param_store_save(&g_store, &a, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
   hal_flash_host_stats(&st);
   /* the drive amplitude decays with tau = 2 Q1 / wn1 (6-12); Q1 = 33.33 (7.2.2) */
   const double tau_s = 2.0 * 33.33 / (2.0 * 3.14159265358979 * (double)a.drive_freq_hz);
@@ -190,16 +190,16 @@ static int save_with_cut(uint32_t cut, bool erase_cut, bool two_old)
   if (two_old) {
     param_values_t older = old;
     older.tlm_rate_hz = 7u;
-    assert_int_equal(param_store_save(&g_store, &older, true, &rep), PARAM_STORE_OK);
+    assert_int_equal(param_store_save(&g_store, &older, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
   }
-  assert_int_equal(param_store_save(&g_store, &old, true, &rep), PARAM_STORE_OK);
+  assert_int_equal(param_store_save(&g_store, &old, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
   const int old_slot = rep.slot;
   if (erase_cut) {
     hal_flash_host_power_cut_in_erase(cut);
   } else {
     hal_flash_host_power_cut_after(cut);
   }
-  const param_store_status_t st = param_store_save(&g_store, &nw, true, &rep);
+  const param_store_status_t st = param_store_save(&g_store, &nw, PARAM_SAVE_LOOP_SAFE, &rep);
   hal_flash_host_power_restore(); /* reboot */
   /* protocol: a complete commit word implies a complete image before it */
   const uint8_t *tgt = hal_flash_host_data() + (uint32_t)(1 - old_slot) * SECTOR_SIZE;
@@ -221,7 +221,7 @@ static int save_with_cut(uint32_t cut, bool erase_cut, bool two_old)
   /* and the store keeps working after the reboot */
   param_values_t again = nw;
   again.drive_freq_hz = 1600.0f;
-  assert_int_equal(param_store_save(&g_store, &again, true, &rep), PARAM_STORE_OK);
+  assert_int_equal(param_store_save(&g_store, &again, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
   param_values_defaults(&got);
   assert_int_equal(param_store_load(&g_store, &got, &rep), PARAM_STORE_OK);
   assert_memory_equal(&got, &again, sizeof got);
@@ -260,8 +260,8 @@ static void test_bit_flips_fall_back(void **state)
   values_a(&a);
   values_b(&b);
   param_store_report_t rep;
-  assert_int_equal(param_store_save(&g_store, &a, true, &rep), PARAM_STORE_OK); /* A, seq 1 */
-  assert_int_equal(param_store_save(&g_store, &b, true, &rep), PARAM_STORE_OK); /* B, seq 2 */
+  assert_int_equal(param_store_save(&g_store, &a, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK); /* A, seq 1 */
+  assert_int_equal(param_store_save(&g_store, &b, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK); /* B, seq 2 */
   const uint32_t len = 20u + 8u * persistent_count() + 8u;
   for (uint32_t slot = 0; slot < 2u; slot++) {
     for (uint32_t off = 0; off < len; off++) {
@@ -269,7 +269,8 @@ static void test_bit_flips_fall_back(void **state)
       assert_int_equal(hal_flash_host_flip_bit(slot, off, bit), 0);
       param_values_defaults(&got);
       assert_int_equal(param_store_load(&g_store, &got, &rep), PARAM_STORE_OK);
-      assert_int_equal(rep.slot_state[slot], PARAM_SLOT_CORRUPT);
+      /* format 1 -> 17: a newer writer's image for all it shows (not read either) */
+      assert_int_equal(rep.slot_state[slot], off == 4u ? PARAM_SLOT_NEWER : PARAM_SLOT_CORRUPT);
       assert_int_equal(rep.slot, slot == 1u ? 0 : 1); /* the other slot is used */
       assert_memory_equal(&got, slot == 1u ? &a : &b, sizeof got);
       assert_int_equal(hal_flash_host_flip_bit(slot, off, bit), 0);
@@ -289,7 +290,7 @@ static void test_bit_flips_fall_back(void **state)
   assert_int_equal(rep.slot_state[0], PARAM_SLOT_CORRUPT);
   assert_int_equal(rep.slot_state[1], PARAM_SLOT_CORRUPT);
   /* a save over two corrupt slots works and starts again */
-  assert_int_equal(param_store_save(&g_store, &b, true, &rep), PARAM_STORE_OK);
+  assert_int_equal(param_store_save(&g_store, &b, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
   assert_int_equal(param_store_load(&g_store, &got, &rep), PARAM_STORE_OK);
   assert_memory_equal(&got, &b, sizeof got);
 }
@@ -355,7 +356,7 @@ static void test_migration_field_by_field(void **state)
       {0x0105, 1, 3u},              /* drive.amp_kp as an integer: wrong type, rejected */
       {0x0303, 2, 5u},              /* rate.lpf_order 5: not a choice, rejected */
       {0x0501, 1, 500u},            /* tlm.rate_hz: loaded */
-      {0x0501, 1, 600u},            /* duplicate: rejected, the first stays */
+      {0x0501, 1, 600u},            /* duplicate: both rejected, the default stays */
       {0x0302, 0, fbits(50.0f)},    /* rate.lpf_cutoff_hz: loaded */
       {0x0102, 1, 1u},              /* drive.mode as U32 into an ENUM: integer, loaded */
   };
@@ -372,12 +373,12 @@ static void test_migration_field_by_field(void **state)
   assert_int_equal(rep.layout, 7u);
   assert_int_equal(rep.fw_version, 0x900u);
   assert_int_equal(rep.dropped, 2);
-  assert_int_equal(rep.rejected, 5);
-  /* persistent parameters with no record at all: 8 known persistent ids appear (4
-   * loaded, 4 only rejected), the rest are missing */
+  assert_int_equal(rep.rejected, 6);
+  /* persistent parameters with no record at all: 8 known persistent ids appear (3
+   * loaded, 5 only rejected), the rest are missing */
   assert_int_equal(rep.defaulted, persistent_count() - 8u);
   assert_true(v.drive_freq_hz == 1600.0f);
-  assert_int_equal(v.tlm_rate_hz, 500u);
+  assert_int_equal(v.tlm_rate_hz, def.tlm_rate_hz);
   assert_true(v.rate_lpf_cutoff_hz == 50.0f);
   assert_int_equal(v.drive_mode, 1u);
   assert_true(v.drive_amp_set_v == def.drive_amp_set_v);
@@ -386,7 +387,7 @@ static void test_migration_field_by_field(void **state)
   assert_int_equal(v.rate_lpf_order, def.rate_lpf_order);
   assert_int_equal(v.sys_fs_hz, 50000u);
   /* the next save writes the migrated set in the current layout, into slot B */
-  assert_int_equal(param_store_save(&g_store, &v, true, &rep), PARAM_STORE_OK);
+  assert_int_equal(param_store_save(&g_store, &v, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
   assert_int_equal(rep.slot, 1);
   assert_int_equal(rep.seq, 11u);
   check_slot_bytes(1u, 11u, &v);
@@ -398,11 +399,21 @@ static void test_bad_headers_are_corrupt(void **state)
   const rec_t r[] = {{0x0101, 0, fbits(1600.0f)}};
   param_values_t v;
   param_store_report_t rep;
-  /* a newer image format this firmware cannot read */
+  /* a newer image format this firmware cannot read: not read, and a save that would
+   * erase it is refused unless forced */
   write_image(0u, 2u, 1u, 5u, r, 1u, 1u);
   param_values_defaults(&v);
-  assert_int_equal(param_store_load(&g_store, &v, &rep), PARAM_STORE_NONE);
+  assert_int_equal(param_store_load(&g_store, &v, &rep), PARAM_STORE_NEWER);
+  assert_int_equal(rep.slot_state[0], PARAM_SLOT_NEWER);
+  assert_int_equal(param_store_save(&g_store, &v, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_ERR_NEWER);
+  assert_int_equal(param_store_save(&g_store, &v, PARAM_SAVE_LOOP_SAFE | PARAM_SAVE_FORCE, &rep),
+                   PARAM_STORE_OK);
+  assert_int_equal(rep.slot, 1); /* the newer image is kept while there is room */
+  /* a torn format field (high byte still erased) is corrupt, not newer */
+  write_image(0u, 0xFF01u, 1u, 5u, r, 1u, 1u);
+  assert_int_equal(param_store_load(&g_store, &v, &rep), PARAM_STORE_OK);
   assert_int_equal(rep.slot_state[0], PARAM_SLOT_CORRUPT);
+  assert_int_equal(hal_flash_erase(1u), HAL_FLASH_OK);
   /* a count that runs past the sector */
   write_image(0u, 1u, 1u, 5u, r, 1u, 4000u);
   assert_int_equal(param_store_load(&g_store, &v, &rep), PARAM_STORE_NONE);
@@ -431,7 +442,7 @@ static void test_sequence_wrap(void **state)
   assert_true(v.drive_freq_hz == 2000.0f);
   /* and the next save goes over the older slot A with seq 4 */
   v.drive_freq_hz = 3000.0f;
-  assert_int_equal(param_store_save(&g_store, &v, true, &rep), PARAM_STORE_OK);
+  assert_int_equal(param_store_save(&g_store, &v, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
   assert_int_equal(rep.slot, 0);
   assert_int_equal(rep.seq, 4u);
 }
@@ -450,7 +461,7 @@ static void test_config_errors(void **state)
   assert_int_equal(param_store_init(&st, &ok), PARAM_STORE_ERR_CONFIG);
   param_values_t v;
   param_values_defaults(&v);
-  assert_int_equal(param_store_save(&st, &v, true, NULL), PARAM_STORE_ERR_CONFIG);
+  assert_int_equal(param_store_save(&st, &v, PARAM_SAVE_LOOP_SAFE, NULL), PARAM_STORE_ERR_CONFIG);
 }
 
 /* A file-backed store survives a "reboot" (close, re-open). */
@@ -468,7 +479,7 @@ static void test_file_backed_reboot(void **state)
   assert_int_equal(param_store_init(&st, &sc), PARAM_STORE_OK);
   param_values_t a, got;
   values_b(&a);
-  assert_int_equal(param_store_save(&st, &a, true, NULL), PARAM_STORE_OK);
+  assert_int_equal(param_store_save(&st, &a, PARAM_SAVE_LOOP_SAFE, NULL), PARAM_STORE_OK);
   hal_flash_host_close();
   assert_int_equal(hal_flash_host_configure(&cfg), 0);
   param_values_defaults(&got);
