@@ -209,6 +209,8 @@ static void end_of_line(cli_t *cli)
     cli_emit_err(cli, "TOOLONG");
   } else if (cli->discard == (uint8_t)CLI_DISCARD_BADCHAR) {
     cli_err(cli, "BADCHAR", "line with a non-printable byte discarded");
+  } else if (cli->discard == (uint8_t)CLI_DISCARD_OVERFLOW) {
+    cli_err(cli, "OVERFLOW", "input lost (receive buffer full): line discarded, send it again");
   } else if (cli->len > 0u) {
     execute(cli);
   }
@@ -216,13 +218,28 @@ static void end_of_line(cli_t *cli)
   cli->discard = (uint8_t)CLI_DISCARD_NONE;
 }
 
+void cli_rx_lost(cli_t *cli)
+{
+  cli->discard = (uint8_t)CLI_DISCARD_OVERFLOW; /* also a line lost from its start */
+  cli->rx_overflows++;
+}
+
 void cli_feed(cli_t *cli, const uint8_t *data, size_t len)
+{
+  while (len > 0u) {
+    const size_t n = cli_feed_line(cli, data, len);
+    data += n;
+    len -= n;
+  }
+}
+
+size_t cli_feed_line(cli_t *cli, const uint8_t *data, size_t len)
 {
   for (size_t i = 0; i < len; i++) {
     const uint8_t ch = data[i];
     if (ch == '\r' || ch == '\n') {
       end_of_line(cli);
-      continue;
+      return i + 1u;
     }
     if (cli->discard != (uint8_t)CLI_DISCARD_NONE) {
       continue;
@@ -235,4 +252,5 @@ void cli_feed(cli_t *cli, const uint8_t *data, size_t len)
       cli->line[cli->len++] = (char)ch;
     }
   }
+  return len;
 }

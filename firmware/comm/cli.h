@@ -12,6 +12,9 @@
  *     answered "err TOOLONG ..." when its EOL arrives;
  *   - any other byte (NUL, control characters, DEL, bytes >= 0x80) discards the whole
  *     line, answered "err BADCHAR ..." at its EOL;
+ *   - received bytes lost (cli_rx_lost: the UART's RX ring overflowed) discard the line
+ *     in progress, answered "err OVERFLOW ..." at the next EOL: a line missing bytes is
+ *     never executed; the losses are counted (rx_overflows);
  *   - no echo, no prompt, no line editing; names are case-sensitive.
  *
  * Reply grammar: every non-blank line gets exactly one reply,
@@ -20,7 +23,7 @@
  *   final   = "ok" [ SP text ] CRLF
  *           | "err" SP CODE SP message CRLF
  *   CODE    = ARGS | UNKNOWN | NAME | RO | VALUE | RANGE | BUSY | PENDING | REJECTED |
- *             NOSTORE | FLASH | FORMAT | TOOLONG | BADCHAR | INTERNAL
+ *             NOSTORE | FLASH | FORMAT | TOOLONG | BADCHAR | OVERFLOW | INTERNAL
  *             (application handlers may add their own upper-case codes)
  *   text never contains CR or LF; a host reads lines until one starts with "ok" or "err".
  *
@@ -48,7 +51,9 @@
  *
  * The output callback receives whole lines (CRLF included) and must take all of them:
  * the application queues them (a TX ring sized for the longest reply, about 5 KB for
- * list) or drains the UART; the CLI keeps no output backlog.
+ * list) or drains the UART; the CLI keeps no output backlog. An application that feeds
+ * one line at a time (cli_feed_line) can wait in the background for room in its TX ring
+ * before the next line, so no reply is ever cut.
  */
 #ifndef CLI_H
 #define CLI_H
@@ -88,7 +93,12 @@ typedef struct {
   void *write_ctx;
 } cli_cfg_t;
 
-typedef enum { CLI_DISCARD_NONE = 0, CLI_DISCARD_TOOLONG, CLI_DISCARD_BADCHAR } cli_discard_t;
+typedef enum {
+  CLI_DISCARD_NONE = 0,
+  CLI_DISCARD_TOOLONG,
+  CLI_DISCARD_BADCHAR,
+  CLI_DISCARD_OVERFLOW
+} cli_discard_t;
 
 struct cli {
   cli_cfg_t cfg;
@@ -101,6 +111,7 @@ struct cli {
   char out[CLI_OUT_MAX];
   uint32_t out_len;
   uint32_t truncated; /* reply lines cut at CLI_OUT_MAX (should stay 0) */
+  uint32_t rx_overflows; /* input losses reported by cli_rx_lost */
 };
 
 /* Returns 0, or -1 for a missing params/write. */
@@ -113,6 +124,12 @@ uint32_t cli_app_count(const cli_t *cli);
 const cli_cmd_t *cli_app_cmd(const cli_t *cli, uint32_t i);
 /* Feed received bytes; complete lines are executed and answered before it returns. */
 void cli_feed(cli_t *cli, const uint8_t *data, size_t len);
+/* Feed bytes up to and including the first EOL (executed and answered); returns the
+ * number taken (len if there is no EOL). */
+size_t cli_feed_line(cli_t *cli, const uint8_t *data, size_t len);
+/* Bytes were lost after the last byte fed: discard the line in progress (err OVERFLOW
+ * at its EOL) and count the loss. */
+void cli_rx_lost(cli_t *cli);
 
 /* Reply building for handlers: append to the pending line, then emit it. Characters
  * outside %x20-7E are replaced by '?', so a reply is always one line. */

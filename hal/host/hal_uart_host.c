@@ -8,6 +8,7 @@ static struct {
   uint8_t tx[HAL_UART_HOST_TX_SIZE];
   size_t rx_head, rx_tail, tx_head, tx_tail; /* head: write index, tail: read index */
   uint32_t rx_dropped, tx_dropped;
+  bool rx_gap; /* bytes lost: nothing stored until the reader reaches the gap */
 } uart;
 
 static size_t used(size_t head, size_t tail, size_t size) { return (head + size - tail) % size; }
@@ -16,8 +17,10 @@ size_t hal_uart_host_rx_push(const uint8_t *data, size_t len)
 {
   size_t n = 0;
   for (; n < len; n++) {
-    if (used(uart.rx_head, uart.rx_tail, HAL_UART_HOST_RX_SIZE) == HAL_UART_HOST_RX_SIZE - 1u) {
+    if (uart.rx_gap ||
+        used(uart.rx_head, uart.rx_tail, HAL_UART_HOST_RX_SIZE) == HAL_UART_HOST_RX_SIZE - 1u) {
       uart.rx_dropped += (uint32_t)(len - n);
+      uart.rx_gap = true;
       break;
     }
     uart.rx[uart.rx_head] = data[n];
@@ -43,6 +46,14 @@ void hal_uart_host_reset(void)
 {
   uart.rx_head = uart.rx_tail = uart.tx_head = uart.tx_tail = 0u;
   uart.rx_dropped = uart.tx_dropped = 0u;
+  uart.rx_gap = false;
+}
+
+bool hal_uart_rx_lost(void)
+{
+  if (!uart.rx_gap || uart.rx_tail != uart.rx_head) return false;
+  uart.rx_gap = false;
+  return true;
 }
 
 size_t hal_uart_read(uint8_t *buf, size_t max)

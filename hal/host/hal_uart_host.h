@@ -10,7 +10,8 @@
 #define HAL_UART_HOST_TX_SIZE 8192u
 
 /* Bytes "received on the wire": queued for hal_uart_read. Returns the number accepted
- * (the rest is dropped and counted, as the board's RX interrupt does). */
+ * (the rest is dropped and counted, as the board's RX interrupt does; after a drop
+ * nothing is accepted until the reader has seen the loss, hal_uart_rx_lost). */
 size_t hal_uart_host_rx_push(const uint8_t *data, size_t len);
 /* Bytes "sent on the wire": taken from the TX ring. Returns the number moved. */
 size_t hal_uart_host_tx_pop(uint8_t *buf, size_t max);

@@ -11,6 +11,7 @@ static stm32f4_ring_t s_rx;
 static stm32f4_ring_t s_tx;
 static volatile uint32_t s_rx_dropped;
 static volatile uint32_t s_rx_overruns;
+static volatile uint32_t s_rx_gap; /* set by the ISR on a loss, cleared by the reader */
 
 uint32_t stm32f4_usart_brr(uint32_t pclk_hz, uint32_t baud)
 {
@@ -29,6 +30,7 @@ int stm32f4_uart_init(uint32_t pclk_hz, uint32_t baud)
   (void)stm32f4_ring_init(&s_tx, &tx_cfg);
   s_rx_dropped = 0u;
   s_rx_overruns = 0u;
+  s_rx_gap = 0u;
 
   RCC->APB2ENR |= RCC_APB2ENR_USART1EN;
   USART1->CR1 = 0u;
@@ -49,8 +51,16 @@ STM32F4_RAMFUNC void USART1_IRQHandler(void)
   if ((sr & (USART_SR_RXNE | USART_SR_ORE)) != 0u) {
     /* Reading DR after SR clears RXNE and ORE. */
     const uint8_t byte = (uint8_t)(USART1->DR & 0xFFu);
-    if ((sr & USART_SR_ORE) != 0u) ++s_rx_overruns;
-    if (!stm32f4_ring_put(&s_rx, byte)) ++s_rx_dropped;
+    /* An overrun lost the byte before this one: a gap like a full ring. From a gap on
+     * nothing is stored until the reader has reached it (hal_uart_rx_lost). */
+    if ((sr & USART_SR_ORE) != 0u) {
+      ++s_rx_overruns;
+      s_rx_gap = 1u;
+    }
+    if (s_rx_gap != 0u || !stm32f4_ring_put(&s_rx, byte)) {
+      s_rx_gap = 1u;
+      ++s_rx_dropped;
+    }
   }
   if ((USART1->CR1 & USART_CR1_TXEIE) != 0u && (sr & USART_SR_TXE) != 0u) {
     uint8_t byte;
@@ -81,6 +91,13 @@ size_t hal_uart_read(uint8_t *buf, size_t max)
 {
   if (buf == 0) return 0u;
   return stm32f4_ring_read(&s_rx, buf, max);
+}
+
+bool hal_uart_rx_lost(void)
+{
+  if (s_rx_gap == 0u || stm32f4_ring_used(&s_rx) != 0u) return false;
+  s_rx_gap = 0u; /* a byte the ISR drops meanwhile belongs to the same gap */
+  return true;
 }
 
 size_t hal_uart_write(const uint8_t *data, size_t len)

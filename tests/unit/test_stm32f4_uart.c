@@ -69,9 +69,15 @@ static void test_rx_ring_overflow_and_wrap(void **state)
   (void)state;
   for (uint32_t i = 0; i < STM32F4_UART_RX_BYTES + 44u; ++i) receive((uint8_t)i, 0u);
   assert_int_equal(stm32f4_uart_rx_dropped(), 44); /* the ring kept the oldest 256 */
+  assert_false(hal_uart_rx_lost()); /* bytes before the gap still waiting */
   uint8_t buf[STM32F4_UART_RX_BYTES + 8u];
-  assert_int_equal(hal_uart_read(buf, sizeof(buf)), STM32F4_UART_RX_BYTES);
+  assert_int_equal(hal_uart_read(buf, 8u), 8);
+  receive(0xEE, 0u); /* room again, but the gap is not yet reached: dropped */
+  assert_int_equal(stm32f4_uart_rx_dropped(), 45);
+  assert_int_equal(hal_uart_read(&buf[8], sizeof(buf) - 8u), STM32F4_UART_RX_BYTES - 8u);
   for (uint32_t i = 0; i < STM32F4_UART_RX_BYTES; ++i) assert_int_equal(buf[i], (uint8_t)i);
+  assert_true(hal_uart_rx_lost()); /* once per loss */
+  assert_false(hal_uart_rx_lost());
   /* The indices now wrap across the end of the storage; order is kept. */
   for (uint32_t i = 0; i < 100u; ++i) receive((uint8_t)(200u + i), 0u);
   assert_int_equal(hal_uart_read(buf, 60u), 60);
@@ -82,14 +88,21 @@ static void test_rx_ring_overflow_and_wrap(void **state)
   assert_int_equal(hal_uart_read(NULL, 4u), 0);
 }
 
-static void test_rx_overrun_counted_byte_kept(void **state)
+/* An overrun lost the byte before the one in DR: a gap, reported like a full ring. */
+static void test_rx_overrun_is_a_gap(void **state)
 {
   (void)state;
+  receive(0x41, 0u);
   receive(0x42, USART_SR_ORE);
   assert_int_equal(stm32f4_uart_rx_overruns(), 1);
   uint8_t b = 0;
+  assert_false(hal_uart_rx_lost());
   assert_int_equal(hal_uart_read(&b, 1u), 1);
-  assert_int_equal(b, 0x42);
+  assert_int_equal(b, 0x41);
+  assert_true(hal_uart_rx_lost());
+  receive(0x43, 0u);
+  assert_int_equal(hal_uart_read(&b, 1u), 1);
+  assert_int_equal(b, 0x43);
 }
 
 static void test_tx_interrupt_drains_ring(void **state)
@@ -134,7 +147,7 @@ int main(void)
       cmocka_unit_test(test_brr_values),
       cmocka_unit_test_setup(test_init_registers, setup),
       cmocka_unit_test_setup(test_rx_ring_overflow_and_wrap, setup),
-      cmocka_unit_test_setup(test_rx_overrun_counted_byte_kept, setup),
+      cmocka_unit_test_setup(test_rx_overrun_is_a_gap, setup),
       cmocka_unit_test_setup(test_tx_interrupt_drains_ring, setup),
       cmocka_unit_test_setup(test_tx_full_ring_accepts_what_fits, setup),
   };
