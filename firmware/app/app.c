@@ -1,5 +1,6 @@
 #include "app/app.h"
 
+#include <stdatomic.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -26,20 +27,20 @@ static int derive(void *ctx, const param_values_t *v, void *derived, const char 
 }
 
 /* Non-live parameters and flash saves need the drive off: an erase stalls every flash
- * fetch for hundreds of ms while the drive decays in a few (param_store.h). */
+ * fetch for hundreds of ms while the drive decays in a few (param_store.h). A sweep
+ * excites the drive as well, and a queued drive on is as good as done. */
 static bool loop_safe(void *ctx)
 {
   const app_t *a = ctx;
-  return !supervisor_drive_enabled(&a->gyro.sup);
+  const gyro_mode_t m = app_mode_after_queue(a);
+  return (m == GYRO_MODE_OFF || m == GYRO_MODE_FAULT) && !selfcal_running(&a->selfcal);
 }
 
 static void cli_write(void *ctx, const char *data, size_t len)
 {
   (void)ctx;
-  const uint8_t *p = (const uint8_t *)data;
-  /* The TX ring is sized for the longest reply; what does not fit is lost rather than
-   * blocking the background loop. */
-  (void)hal_uart_write(p, len);
+  /* A line is only executed with room for its whole reply (feed_lines): all fits. */
+  (void)hal_uart_write((const uint8_t *)data, len);
 }
 
 int app_init_with(app_t *a, const param_values_t *values)
@@ -94,6 +95,67 @@ int app_init_with(app_t *a, const param_values_t *values)
 
 int app_init(app_t *a) { return app_init_with(a, NULL); }
 
+/* ISR: one request at the tick boundary. */
+static void take_request(app_t *a, uint32_t req)
+{
+  switch ((app_req_t)req) {
+  case APP_REQ_DRIVE_ON:
+    /* from a sweep or a fault's wait as well: the command takes the drive over now */
+    if (!supervisor_drive_enabled(&a->gyro.sup)) gyro_stop(&a->gyro);
+    gyro_start(&a->gyro);
+    supervisor_clear_fault(&a->gyro.sup);
+    break;
+  case APP_REQ_SWEEP: gyro_sweep_begin(&a->gyro); break;
+  case APP_REQ_SWEEP_HANDOVER:
+    /* The design committed with the identified model was applied above. */
+    (void)gyro_sweep_handover(&a->gyro, a->applied);
+    break;
+  case APP_REQ_SELFTEST: selftest_start(&a->gyro.selftest); break;
+  case APP_REQ_CLEAR: supervisor_clear_fault(&a->gyro.sup); break;
+  case APP_REQ_DRIVE_OFF: gyro_stop(&a->gyro); break;
+  case APP_REQ_NONE:
+  default: break;
+  }
+}
+
+int app_request(app_t *a, app_req_t r)
+{
+  const uint32_t head = a->req_head;
+  if (head - a->req_tail >= APP_REQ_QUEUE) return -1;
+  a->req_word[head % APP_REQ_QUEUE] = (uint32_t)r;
+  atomic_signal_fence(memory_order_release); /* the word before the head that shows it */
+  a->req_head = head + 1u;
+  return 0;
+}
+
+bool app_requests_pending(const app_t *a) { return a->req_head != a->req_tail; }
+
+static gyro_mode_t mode_after(gyro_mode_t m, uint32_t req)
+{
+  switch ((app_req_t)req) {
+  case APP_REQ_DRIVE_ON:
+    return (m == GYRO_MODE_ACQUIRE || m == GYRO_MODE_LOCKED) ? m : GYRO_MODE_ACQUIRE;
+  case APP_REQ_DRIVE_OFF: return GYRO_MODE_OFF;
+  case APP_REQ_SWEEP: return GYRO_MODE_SWEEP;
+  case APP_REQ_SWEEP_HANDOVER: return GYRO_MODE_ACQUIRE;
+  case APP_REQ_SELFTEST:
+  case APP_REQ_CLEAR:
+  case APP_REQ_NONE:
+  default: return m;
+  }
+}
+
+/* A request the ISR takes during the walk is applied twice: each one is idempotent. */
+gyro_mode_t app_mode_after_queue(const app_t *a)
+{
+  gyro_mode_t m = a->gyro.sup.mode;
+  const uint32_t head = a->req_head;
+  for (uint32_t i = a->req_tail; i != head; i++) {
+    m = mode_after(m, a->req_word[i % APP_REQ_QUEUE]);
+  }
+  return m;
+}
+
 void app_sample_isr(void *ctx)
 {
   app_t *a = ctx;
@@ -103,21 +165,11 @@ void app_sample_isr(void *ctx)
     gyro_apply(&a->gyro, view.derived);
     a->applied = view.derived;
   }
-  const uint32_t req = a->request;
-  if (req != APP_REQ_NONE) {
-    if (req == APP_REQ_DRIVE_ON) {
-      gyro_start(&a->gyro);
-    } else if (req == APP_REQ_SWEEP) {
-      gyro_sweep_begin(&a->gyro);
-    } else if (req == APP_REQ_SWEEP_HANDOVER) {
-      /* The design committed with the identified model was applied above. */
-      (void)gyro_sweep_handover(&a->gyro, a->applied);
-    } else if (req == APP_REQ_SELFTEST) {
-      selftest_start(&a->gyro.selftest);
-    } else {
-      gyro_stop(&a->gyro);
-    }
-    a->request = APP_REQ_NONE;
+  const uint32_t tail = a->req_tail;
+  if (tail != a->req_head) {
+    atomic_signal_fence(memory_order_acquire); /* the word was written before the head */
+    take_request(a, a->req_word[tail % APP_REQ_QUEUE]);
+    a->req_tail = tail + 1u;
   }
 
   hal_adc_frame_t adc;
@@ -132,13 +184,28 @@ void app_sample_isr(void *ctx)
 
 void app_cli_feed(app_t *a, const uint8_t *data, size_t len) { cli_feed(&a->cli, data, len); }
 
+/* UART -> command line, one line at a time while the TX ring has room for the longest
+ * reply; bytes not yet fed wait in rx_buf for the next pass. */
+static void feed_lines(app_t *a)
+{
+  for (;;) {
+    if (a->rx_pos == a->rx_len) {
+      a->rx_pos = 0u;
+      a->rx_len = (uint32_t)hal_uart_read(a->rx_buf, sizeof a->rx_buf);
+      if (a->rx_len == 0u) {
+        /* everything before a loss has been fed: the line in progress lost bytes */
+        if (hal_uart_rx_lost()) cli_rx_lost(&a->cli);
+        return;
+      }
+    }
+    if (hal_uart_tx_free() < APP_TLM_TX_RESERVE) return;
+    a->rx_pos += (uint32_t)cli_feed_line(&a->cli, &a->rx_buf[a->rx_pos], a->rx_len - a->rx_pos);
+  }
+}
+
 void app_poll(app_t *a)
 {
-  uint8_t buf[64];
-  size_t n;
-  while ((n = hal_uart_read(buf, sizeof buf)) > 0u) {
-    cli_feed(&a->cli, buf, n);
-  }
+  feed_lines(a);
   app_tlm_poll(&a->tlm);
   app_selfcal_poll(a);
 }

@@ -4,9 +4,17 @@
  *   app_sample_isr (50 kHz, highest priority): take this tick's parameter view (apply a
  *     newly published design at the tick boundary), read the ADC frame, gyro_tick, write
  *     the DAC frame, measure its own cycles.
- *   app_poll (background loop): UART bytes -> command line -> parameter bank / store.
- * Requests from the background to the loop (drive on/off) are single-word flags the ISR
- * takes at its next tick, so the ISR never sees a half-made change.
+ *   app_poll (background loop): UART bytes -> command line -> parameter bank / store. A
+ *     line is only executed when the TX ring has room for the longest reply
+ *     (APP_TLM_TX_RESERVE, which telemetry leaves free): otherwise the loop waits for the
+ *     UART to drain, so replies are never cut or interleaved. Bytes lost on reception
+ *     discard the line they belong to (err OVERFLOW, counted in status).
+ * Requests from the background to the loop (drive on/off, sweep, self-test, clear) go
+ * through a queue of single words: every acknowledged request is taken by the ISR, in
+ * order, one per tick at the tick boundary, so the ISR never sees a half-made change and
+ * no request replaces another. Commands judge the drive as it will be once the queue is
+ * taken (app_mode_after_queue), so "drive off" then "selftest" in one write refuses the
+ * self-test.
  */
 #ifndef APP_H
 #define APP_H
@@ -22,6 +30,9 @@
 #include "params/params.h"
 
 #define APP_MAX_CMDS 8u
+/* Requests waiting for the ISR (a power of two); it takes one per tick, so a full queue
+ * drains in 160 us: a command finding it full is refused (err BUSY), never dropped. */
+#define APP_REQ_QUEUE 8u
 
 typedef enum {
   APP_REQ_NONE = 0u,
@@ -29,7 +40,8 @@ typedef enum {
   APP_REQ_DRIVE_OFF = 2u,
   APP_REQ_SWEEP = 3u,         /* enter SWEEP: self-calibration (app_selfcal.h) */
   APP_REQ_SWEEP_HANDOVER = 4u, /* SWEEP -> ACQUIRE with the newly applied design */
-  APP_REQ_SELFTEST = 5u        /* run the built-in self-test (selftest.h) */
+  APP_REQ_SELFTEST = 5u,       /* run the built-in self-test (selftest.h) */
+  APP_REQ_CLEAR = 6u           /* clear the shown fault; its record stays (last_fault) */
 } app_req_t;
 
 /* Lines an image adds to the status reply (board figures: stack, sample clock), written
@@ -45,7 +57,14 @@ typedef struct {
   param_store_status_t store_status; /* result of the boot-time load */
   cli_t cli;
   cli_cmd_t cmds[APP_MAX_CMDS]; /* the application's command rows (app_cmds.c) */
-  volatile uint32_t request; /* app_req_t, written by the background, taken by the ISR */
+  /* Bytes read from the UART, fed to the command line a line at a time (app_poll). */
+  uint8_t rx_buf[64];
+  uint32_t rx_len, rx_pos;
+  /* Request queue: words written by the background before it advances req_head; the
+   * ISR takes req_word[req_tail % APP_REQ_QUEUE] and advances req_tail. */
+  volatile uint32_t req_word[APP_REQ_QUEUE];
+  volatile uint32_t req_head, req_tail;
+  bool sweep_owns_drive;     /* the sequencer, not a command, decides the drive's next mode */
   app_tlm_t tlm;             /* telemetry stream and its commands (app_tlm.c) */
   selfcal_t selfcal;         /* self-calibration sequencer (background, app_selfcal.c) */
   uint32_t selfcal_t0_ticks; /* isr_ticks when the sweep was requested */
@@ -73,5 +92,12 @@ void app_poll(app_t *a);
 
 /* Feed command-line bytes directly (host programs and tests; the board uses the UART). */
 void app_cli_feed(app_t *a, const uint8_t *data, size_t len);
+
+/* Background: queue a request for the ISR. Returns 0, or -1 (nothing queued) when full. */
+int app_request(app_t *a, app_req_t r);
+/* Background: requests queued and not yet taken. */
+bool app_requests_pending(const app_t *a);
+/* Background: the drive's mode once the queued requests are taken. */
+gyro_mode_t app_mode_after_queue(const app_t *a);
 
 #endif /* APP_H */

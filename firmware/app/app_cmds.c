@@ -68,6 +68,19 @@ static void put_selfcal(cli_t *cli, const app_t *a)
   }
 }
 
+/* The fault history: the latest fault, cleared or not, and when (seconds since start,
+ * from the supervisor's step count; it steps once per block). */
+static void put_last_fault(cli_t *cli, const app_t *a)
+{
+  const supervisor_t *sv = &a->gyro.sup;
+  cli_put(cli, "last_fault ");
+  put_faults(cli, sv->last_fault);
+  cli_emit_data(cli);
+  if (sv->last_fault == GYRO_FAULT_NONE) return;
+  const float step_s = (float)GYRO_BLOCK / (float)params_current(&a->params)->sys_fs_hz;
+  cli_data_f32(cli, "last_fault_s", (float)sv->last_fault_step * step_s);
+}
+
 /* status: one data line per figure, then ok MODE. The snapshot is copied field by
  * field while the ISR may update it; each figure is one aligned word, so each line is a
  * consistent value (lines may come from adjacent ticks). */
@@ -107,6 +120,7 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   put_faults(cli, a->gyro.sup.fault);
   cli_emit_data(cli);
   cli_data_u32(cli, "fault_count", a->gyro.sup.fault_count);
+  put_last_fault(cli, a);
   cli_data_f32(cli, "rate_dps", o->rate_dps);
   cli_data_f32(cli, "quad_dps", o->quad_dps);
   cli_data_f32(cli, "drive_amp_v", o->drive_amp_v);
@@ -119,6 +133,7 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   hal_sample_isr_cycles(&cyc_last, &cyc_max);
   cli_data_u32(cli, "isr_cycles_last", cyc_last);
   cli_data_u32(cli, "isr_cycles_max", cyc_max);
+  cli_data_u32(cli, "rx_overflows", a->cli.rx_overflows);
   cli_put(cli, "store ");
   cli_put(cli, param_store_status_str(a->store_status));
   cli_emit_data(cli);
@@ -132,6 +147,16 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   cli_ok(cli, mode_name((uint32_t)a->gyro.sup.mode));
 }
 
+/* Queue r; a full queue is answered err BUSY (false). */
+static bool queue_or_refuse(cli_t *cli, app_t *a, app_req_t r)
+{
+  if (app_request(a, r) != 0) {
+    cli_err(cli, "BUSY", "request queue full: retry");
+    return false;
+  }
+  return true;
+}
+
 /* selftest: the built-in self-test runs in the ISR (0.5 s); status shows the result. */
 static void cmd_selftest(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
 {
@@ -141,15 +166,21 @@ static void cmd_selftest(cli_t *cli, void *ctx, uint32_t argc, const char *const
     cli_err(cli, "ARGS", "usage: selftest");
     return;
   }
-  if (a->gyro.sup.mode != GYRO_MODE_LOCKED) {
+  const gyro_mode_t m = app_mode_after_queue(a);
+  if (m == GYRO_MODE_OFF) {
+    cli_err(cli, "STATE", "the drive is off: drive on first");
+    return;
+  }
+  if (m != GYRO_MODE_LOCKED) {
     cli_err(cli, "BUSY", "the self-test needs the drive LOCKED");
     return;
   }
-  a->request = APP_REQ_SELFTEST;
+  if (!queue_or_refuse(cli, a, APP_REQ_SELFTEST)) return;
   cli_ok(cli, "selftest started: see status in 0.5 s");
 }
 
-/* drive on|off: the request is taken by the ISR at its next tick. */
+/* drive on|off: queued for the ISR. A command takes the drive over from a running
+ * sweep, which is aborted; drive on also clears the shown fault. */
 static void cmd_drive(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
 {
   app_t *a = ctx;
@@ -158,8 +189,23 @@ static void cmd_drive(cli_t *cli, void *ctx, uint32_t argc, const char *const *a
     return;
   }
   const int on = strcmp(argv[1], "on") == 0;
-  a->request = on ? APP_REQ_DRIVE_ON : APP_REQ_DRIVE_OFF;
+  if (!queue_or_refuse(cli, a, on ? APP_REQ_DRIVE_ON : APP_REQ_DRIVE_OFF)) return;
+  selfcal_abort(&a->selfcal, "sweep aborted by a drive command");
+  a->sweep_owns_drive = false;
   cli_ok(cli, on ? "drive on" : "drive off");
+}
+
+/* clear: the shown fault goes; last_fault keeps it. */
+static void cmd_clear(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
+{
+  (void)argv;
+  app_t *a = ctx;
+  if (argc != 1u) {
+    cli_err(cli, "ARGS", "usage: clear");
+    return;
+  }
+  if (!queue_or_refuse(cli, a, APP_REQ_CLEAR)) return;
+  cli_ok(cli, "fault cleared");
 }
 
 /* sweep: self-calibration; the drive goes SWEEP -> ACQUIRE with the identified model. */
@@ -172,7 +218,7 @@ static void cmd_sweep(cli_t *cli, void *ctx, uint32_t argc, const char *const *a
     return;
   }
   if (app_selfcal_start(a) != 0) {
-    cli_err(cli, "BUSY", "a sweep or a drive request is in progress");
+    cli_err(cli, "BUSY", "a sweep is in progress, or the request queue is full");
     return;
   }
   cli_ok(cli, "sweep started");
@@ -192,9 +238,12 @@ int app_cmds_register(app_t *a)
   cmds[1] = drive;
   const cli_cmd_t selftest = {"selftest", "", "built-in self-test: a known force on the sense "
                                "mode, checked on the rate output", cmd_selftest, a};
+  const cli_cmd_t clear = {"clear", "", "clear the shown fault (status keeps it as last_fault)",
+                            cmd_clear, a};
   cmds[2] = sweep;
   cmds[3] = selftest;
-  for (size_t i = 0; i < 4u; i++) {
+  cmds[4] = clear;
+  for (size_t i = 0; i < 5u; i++) {
     if (cli_register(&a->cli, &cmds[i]) != 0) {
       return -1;
     }

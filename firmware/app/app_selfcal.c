@@ -1,6 +1,5 @@
 #include "app/app_selfcal.h"
 
-#include <stdatomic.h>
 #include <stddef.h>
 
 #include "dsp/fastmath.h"
@@ -20,7 +19,7 @@
 
 int app_selfcal_start(app_t *a)
 {
-  if (selfcal_running(&a->selfcal) || a->request != APP_REQ_NONE) return -1;
+  if (selfcal_running(&a->selfcal) || a->req_head - a->req_tail >= APP_REQ_QUEUE) return -1;
   const param_values_t *v = params_current(&a->params);
   selfcal_cfg_t c;
   c.fs_hz = (double)v->sys_fs_hz;
@@ -37,9 +36,10 @@ int app_selfcal_start(app_t *a)
   /* One sample of DAC latency plus half a sample of zero-order hold. */
   c.delay_s = 1.5 / c.fs_hz;
   if (selfcal_start(&a->selfcal, &c) != 0) return -1;
+  (void)app_request(a, APP_REQ_SWEEP); /* room checked above */
   a->selfcal_t0_ticks = a->isr_ticks;
   a->selfcal_ticks = 0u;
-  a->request = APP_REQ_SWEEP;
+  a->sweep_owns_drive = true;
   return 0;
 }
 
@@ -50,18 +50,10 @@ static param_status_t stage_f(app_t *a, param_idx_t i, double v)
   return params_stage(&a->params, i, pv);
 }
 
-void app_selfcal_poll(app_t *a)
+/* READY: stage and commit the identified model, then hand the drive to the loops. */
+static void hand_over(app_t *a)
 {
   selfcal_t *s = &a->selfcal;
-  if (!selfcal_running(s)) return;
-  const int sweeping = a->gyro.sup.mode == GYRO_MODE_SWEEP && a->request == APP_REQ_NONE;
-  const selfcal_state_t st0 = selfcal_background(s, sweeping);
-  if (st0 == SELFCAL_FAILED && sweeping) {
-    /* A failed sweep leaves the electrodes off (safe mode); status says why. */
-    a->request = APP_REQ_DRIVE_OFF;
-    return;
-  }
-  if (st0 != SELFCAL_READY || a->request != APP_REQ_NONE) return;
   param_status_t st = stage_f(a, PARAM_drive_freq_hz, (double)s->f0_hz_f);
   if (st == PARAM_OK) st = stage_f(a, PARAM_drive_cal_f0_hz, (double)s->f0_hz_f);
   if (st == PARAM_OK) st = stage_f(a, PARAM_drive_cal_q, s->fit.q);
@@ -70,7 +62,6 @@ void app_selfcal_poll(app_t *a)
   if (st != PARAM_OK) {
     params_discard(&a->params);
     selfcal_finish(s, 0, param_status_str(st));
-    a->request = APP_REQ_DRIVE_OFF;
     return;
   }
   params_err_t err;
@@ -78,13 +69,30 @@ void app_selfcal_poll(app_t *a)
   if (st == PARAM_ERR_PENDING) return; /* the ISR has not taken the last change: retry */
   if (st != PARAM_OK) {
     selfcal_finish(s, 0, err.why != NULL ? err.why : param_status_str(st));
-    a->request = APP_REQ_DRIVE_OFF;
     return;
   }
   selfcal_finish(s, 1, NULL);
   a->selfcal_ticks = a->isr_ticks - a->selfcal_t0_ticks;
-  /* The ISR must see the published design no later than the request: it applies the
-   * new block at the start of the tick, then takes the request (app_sample_isr). */
-  atomic_signal_fence(memory_order_release);
-  a->request = APP_REQ_SWEEP_HANDOVER;
+  /* The design is published before the request (app_request's fence), and the ISR
+   * applies a new block at the start of a tick before it takes a request. */
+  a->sweep_owns_drive = false;
+  (void)app_request(a, APP_REQ_SWEEP_HANDOVER); /* the queue is empty (app_selfcal_poll) */
+}
+
+void app_selfcal_poll(app_t *a)
+{
+  selfcal_t *s = &a->selfcal;
+  selfcal_watch(s, a->isr_ticks);
+  /* The drive is judged once the ISR has taken every request, the sweep's own included;
+   * then the queue is empty and the sequencer's request always fits. */
+  if (app_requests_pending(a)) return;
+  if (selfcal_running(s)) {
+    const int sweeping = a->gyro.sup.mode == GYRO_MODE_SWEEP;
+    if (selfcal_background(s, sweeping) == SELFCAL_READY) hand_over(a);
+  }
+  if (!selfcal_running(s) && a->sweep_owns_drive) {
+    /* A failed sweep leaves the electrodes off (safe mode); status says why. */
+    a->sweep_owns_drive = false;
+    (void)app_request(a, APP_REQ_DRIVE_OFF);
+  }
 }

@@ -7,12 +7,13 @@
 #include "app/app.h"
 
 /* Request SWEEP and start the sequencer. Returns 0, or -1 (nothing changed) when a
- * sweep is running, a request is pending or the configuration is refused. */
+ * sweep is running, the request queue is full or the configuration is refused. */
 int app_selfcal_start(app_t *a);
 
-/* Background pass (from app_poll): sequencer step; on READY stage and commit
+/* Background pass (from app_poll): timeouts (selfcal_watch); once the ISR has taken
+ * every queued request, the sequencer step; on READY stage and commit
  * drive.freq_hz, drive.cal_f0_hz, drive.cal_q, drive.cal_gain_v_per_v2,
- * drive.p_init_deg, then request the hand-over. */
+ * drive.p_init_deg, then request the hand-over; a failed sweep requests drive off. */
 void app_selfcal_poll(app_t *a);
 
 #endif /* APP_SELFCAL_H */

@@ -71,6 +71,7 @@ int selfcal_start(selfcal_t *s, const selfcal_cfg_t *c)
   s->cfg = *c;
   s->f_cmd_v2 = c->f_cmd_start_v2;
   s->state = SELFCAL_WAIT_SWEEP;
+  s->watch_state = SELFCAL_IDLE; /* the first watch starts the clock of WAIT_SWEEP */
   return 0;
 }
 
@@ -88,12 +89,23 @@ static void base_job(const selfcal_t *s, selfcal_job_t *j, selfcal_job_kind_t ki
   j->f_cmd_v2 = (float)s->f_cmd_v2;
 }
 
+/* The longest a job can run, samples: every phase it may have, each at its longest (a
+ * ring-down is an excitation and a decay of avg_ticks each). */
+static uint32_t job_bound_ticks(const selfcal_job_t *j)
+{
+  const uint64_t per_pt = (uint64_t)j->step_settle_ticks + j->avg_ticks;
+  const uint64_t n = (uint64_t)j->chirp_ticks + j->settle_ticks + ((uint64_t)j->n_pts + 2u) * per_pt;
+  return n > 1000000000u ? 1000000000u : (uint32_t)n;
+}
+
 static void post(selfcal_t *s, const selfcal_job_t *j, selfcal_state_t next)
 {
   if (selfcal_exec_post(s->x, j) != 0) {
     fail(s, "measurement job refused");
     return;
   }
+  s->job_bound_ticks = job_bound_ticks(j);
+  s->watch_state = SELFCAL_IDLE; /* a new job: selfcal_watch restarts its clock */
   s->state = next;
 }
 
@@ -319,5 +331,30 @@ void selfcal_finish(selfcal_t *s, int ok, const char *why)
     s->state = SELFCAL_DONE;
   } else {
     fail(s, why != NULL ? why : "parameters refused");
+  }
+}
+
+void selfcal_abort(selfcal_t *s, const char *why)
+{
+  if (s != NULL && selfcal_running(s)) fail(s, why);
+}
+
+void selfcal_watch(selfcal_t *s, uint32_t now_ticks)
+{
+  if (s == NULL || !selfcal_running(s)) return;
+  if (s->state != s->watch_state) {
+    s->watch_state = s->state;
+    s->watch_t0 = now_ticks;
+    return;
+  }
+  const double fs = s->cfg.fs_hz;
+  double limit_s = 1.0;
+  if (s->state == SELFCAL_WAIT_SWEEP) {
+    limit_s = 0.1;
+  } else if (s->state != SELFCAL_READY) {
+    limit_s = 2.0 * (double)s->job_bound_ticks / fs + 1.0;
+  }
+  if ((double)(uint32_t)(now_ticks - s->watch_t0) > limit_s * fs) {
+    fail(s, s->state == SELFCAL_WAIT_SWEEP ? "the drive never entered SWEEP" : "sweep step timed out");
   }
 }

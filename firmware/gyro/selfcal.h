@@ -77,6 +77,10 @@ typedef struct {
   uint32_t ticks;                 /* sweep length so far, samples */
   uint32_t retries, refits;
   const char *why;                /* reason of FAILED */
+  /* selfcal_watch: the state last seen, since when (caller's ticks), and how long the
+   * posted job may take (samples). */
+  selfcal_state_t watch_state;
+  uint32_t watch_t0, job_bound_ticks;
 } selfcal_t;
 
 /* Bind to the ISR half. Returns 0, or -1 for NULL. State IDLE. */
@@ -89,6 +93,13 @@ int selfcal_start(selfcal_t *s, const selfcal_cfg_t *cfg);
 selfcal_state_t selfcal_background(selfcal_t *s, int sweeping);
 /* The application's verdict on READY: ok -> DONE, else FAILED with why. */
 void selfcal_finish(selfcal_t *s, int ok, const char *why);
+/* Stop a running sweep (a drive command took the drive): FAILED with why. */
+void selfcal_abort(selfcal_t *s, const char *why);
+/* Timeouts, from the background with a sample counter: a sweep that stays in one state
+ * longer than that state can take fails (the request never taken: 0.1 s; a job that never
+ * reports: twice its planned length plus 1 s; READY never committed: 1 s), so a sweep
+ * can never hold the sequencer busy. */
+void selfcal_watch(selfcal_t *s, uint32_t now_ticks);
 int selfcal_running(const selfcal_t *s);
 const char *selfcal_state_name(selfcal_state_t st);
 

@@ -27,6 +27,8 @@ int supervisor_init(supervisor_t *sv, const supervisor_cfg_t *cfg)
   sv->amp_err_f = sv->phase_err_f = 0.0f;
   sv->fault = GYRO_FAULT_NONE;
   sv->fault_count = 0u;
+  sv->last_fault = GYRO_FAULT_NONE;
+  sv->last_fault_step = sv->steps = 0u;
   sv->in_tol_ticks = sv->out_tol_ticks = sv->sat_ticks = 0u;
   sv->fault_ticks = sv->mode_ticks = 0u;
   supervisor_retune(sv, cfg);
@@ -74,9 +76,13 @@ void supervisor_reacquire(supervisor_t *sv)
   }
 }
 
+void supervisor_clear_fault(supervisor_t *sv) { sv->fault = GYRO_FAULT_NONE; }
+
 static int trip(supervisor_t *sv, uint32_t reason)
 {
   sv->fault = reason;
+  sv->last_fault = reason;
+  sv->last_fault_step = sv->steps;
   sv->fault_count++;
   sv->fault_ticks = 0u;
   set_mode(sv, GYRO_MODE_FAULT);
@@ -135,6 +141,7 @@ int supervisor_step(supervisor_t *sv, const supervisor_in_t *in)
 {
   const gyro_mode_t mode = sv->mode;
   sv->mode_ticks++;
+  sv->steps++;
   if (mode == GYRO_MODE_ACQUIRE || mode == GYRO_MODE_LOCKED) {
     return step_driving(sv, in, mode);
   }

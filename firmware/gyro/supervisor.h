@@ -50,8 +50,12 @@ typedef struct {
 
 typedef struct {
   gyro_mode_t mode;
-  uint32_t fault;          /* reason of the current/last fault (gyro_fault_t bits) */
+  uint32_t fault;          /* reason of the current/last fault (gyro_fault_t bits), shown
+                            * until cleared (supervisor_clear_fault) */
   uint32_t fault_count;    /* faults since power-on */
+  uint32_t last_fault;     /* history: reason of the latest fault, kept by a clear */
+  uint32_t last_fault_step; /* steps count when it tripped */
+  uint32_t steps;          /* supervisor_step calls since init (wraps after 9.9 days) */
   uint32_t lock_ticks_needed, lost_ticks_needed, sat_ticks_needed, retry_ticks;
   uint32_t clip_max_count;
   float lock_tol_rel, lock_phase_tol_rad, lost_tol_rel, amp_trip_rel;
@@ -91,6 +95,9 @@ void supervisor_stop(supervisor_t *sv);
 void supervisor_enter_sweep(supervisor_t *sv);
 /* LOCKED -> ACQUIRE (e.g. a new setpoint): lock is declared again once inside tolerance. */
 void supervisor_reacquire(supervisor_t *sv);
+/* The operator has seen the fault: no longer shown as active (fault = none); the mode is
+ * untouched and last_fault / last_fault_step keep the record. */
+void supervisor_clear_fault(supervisor_t *sv);
 
 /* One tick. Returns 1 when the loop state must be cleared (entering FAULT or leaving it
  * to re-acquire), else 0; a 1 is also latched in clear_req. */

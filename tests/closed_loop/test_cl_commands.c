@@ -35,9 +35,25 @@ static void start_on_flash(void)
 
 /* The background loop runs n times with the clock going on between: what a batch of
  * commands sees on the board. Returns everything sent meanwhile. */
+static const char *drain(int n)
+{
+  static char out[65536];
+  size_t len = 0u;
+  for (int i = 0; i < n; i++) {
+    app_poll(&app);
+    len += hal_uart_host_tx_pop((uint8_t *)&out[len], sizeof out - 1u - len);
+    run_s(0.001);
+  }
+  out[len] = '\0';
+  return out;
+}
 
-
-
+static size_t count_of(const char *hay, const char *needle)
+{
+  size_t n = 0u;
+  for (const char *p = strstr(hay, needle); p != NULL; p = strstr(p + 1, needle)) n++;
+  return n;
+}
 
 static float param_f(param_idx_t i) { return param_get(params_current(&app.params), i).f; }
 
@@ -91,7 +107,181 @@ static void write_image(uint16_t format, const rec_t *r, uint32_t n)
 
 static uint16_t id_of(param_idx_t i) { return param_info(i)->id; }
 
-/* ---- the cases ---- *//* Subnormal values: refused from a flash record and from gyro-sim --set as they are
+/* ---- the cases ---- */
+
+/* `drive off` and `selftest` in one write: both used to share one request word, so the
+ * self-test replaced the drive off and the drive kept running. Now the drive off is
+ * queued, and the self-test, judged against the drive as it will be, is refused. */
+static void test_drive_off_then_selftest_in_one_write(void **state)
+{
+  (void)state;
+  start();
+  run_s(0.3);
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
+  const char *r = cmd("drive off\nselftest\n");
+  assert_non_null(strstr(r, "ok drive off\r\n"));
+  assert_non_null(strstr(r, "err STATE "));
+  run_s(0.01);
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_OFF);
+  assert_int_equal(app.gyro.selftest.state, SELFTEST_IDLE);
+}
+
+/* `sweep` and `drive off` (or `drive on`) in one write: the sweep was never entered and
+ * the sequencer waited for it forever, refusing every later sweep. Now the drive command
+ * aborts the sweep, both take effect in order, and a new sweep is accepted. */
+static void check_sweep_then_drive(const char *drive, gyro_mode_t after)
+{
+  start();
+  run_s(0.05);
+  char line[64];
+  snprintf(line, sizeof line, "sweep\n%s\n", drive);
+  const char *r = cmd(line);
+  assert_non_null(strstr(r, "ok sweep started\r\n"));
+  assert_int_equal(count_of(r, "ok "), 2u);
+  (void)drain(10);
+  assert_int_equal(app.gyro.sup.mode, after);
+  assert_int_equal(app.selfcal.state, SELFCAL_FAILED);
+  assert_non_null(strstr(cmd("status\n"), "- selfcal_why sweep aborted by a drive command"));
+  assert_string_equal(cmd("sweep\n"), "ok sweep started\r\n");
+  (void)drain(5);
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_SWEEP);
+}
+
+static void test_sweep_then_drive_off_in_one_write(void **state)
+{
+  (void)state;
+  check_sweep_then_drive("drive off", GYRO_MODE_OFF);
+}
+
+static void test_sweep_then_drive_on_in_one_write(void **state)
+{
+  (void)state;
+  check_sweep_then_drive("drive on", GYRO_MODE_ACQUIRE);
+}
+
+/* A sweep whose request the ISR never takes (the clock stopped) cannot hold the
+ * sequencer: WAIT_SWEEP times out after 0.1 s of the caller's ticks. */
+static void test_sweep_request_never_taken_times_out(void **state)
+{
+  (void)state;
+  start();
+  /* no tick runs: the background's first look starts the clock at isr_ticks = 0 */
+  assert_string_equal(cmd("sweep\n"), "ok sweep started\r\n");
+  assert_int_equal(app.isr_ticks, 0u);
+  selfcal_watch(&app.selfcal, 4900u);
+  assert_int_equal(app.selfcal.state, SELFCAL_WAIT_SWEEP);
+  selfcal_watch(&app.selfcal, 5100u);
+  assert_int_equal(app.selfcal.state, SELFCAL_FAILED);
+  assert_string_equal(app.selfcal.why, "the drive never entered SWEEP");
+  (void)drain(3); /* the failed sweep takes the drive off */
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_OFF);
+  assert_string_equal(cmd("sweep\n"), "ok sweep started\r\n");
+}
+
+/* RX overflow in a batch (the loop stalled by a flash save): the ring held
+ * "set rate.bias_c0_dps 10" when the "0" was lost; the line must be discarded with
+ * err OVERFLOW, never executed as 10, and the loss counted in status. */
+static void test_rx_overflow_discards_the_line(void **state)
+{
+  (void)state;
+  start();
+  run_s(0.01);
+  static const char head[] = "set rate.bias_c0_dps 10";
+  uint8_t fill[HAL_UART_HOST_RX_SIZE];
+  const size_t room = HAL_UART_HOST_RX_SIZE - 1u; /* one slot of the ring stays free */
+  const size_t pad = room - (sizeof head - 1u);
+  memset(fill, '\n', pad); /* blank lines: no reply */
+  memcpy(&fill[pad], head, sizeof head - 1u);
+  assert_int_equal(hal_uart_host_rx_push(fill, room), room);
+  assert_int_equal(hal_uart_host_rx_push((const uint8_t *)"0", 1u), 0u); /* lost */
+  (void)cmd("");
+  const char *r = cmd("\n");
+  assert_non_null(strstr(r, "err OVERFLOW "));
+  assert_null(strstr(r, "ok"));
+  assert_true(param_f(PARAM_rate_bias_c0_dps) == 0.0f);
+  assert_non_null(strstr(cmd("status\n"), "- rx_overflows 1\r\n"));
+  /* the line discipline recovers: the next line is executed */
+  assert_string_equal(cmd("get rate.bias_c0_dps\n"), "ok rate.bias_c0_dps 0 deg/s\r\n");
+}
+
+/* Two `list` pipelined: the second reply used to be cut where the TX ring was full and
+ * the next reply glued on. Every reply now comes out whole, in order. */
+static void test_pipelined_lists_come_out_whole(void **state)
+{
+  (void)state;
+  start();
+  run_s(0.01);
+  const char *batch = "list\nlist\nversion\n";
+  assert_int_equal(hal_uart_host_rx_push((const uint8_t *)batch, strlen(batch)), strlen(batch));
+  const char *out = drain(20);
+  assert_int_equal(hal_uart_host_tx_dropped(), 0u);
+  assert_int_equal(count_of(out, " parameters\r\n"), 2u);
+  const char *second = strstr(strstr(out, " parameters\r\n") + 1, "- drive.freq_hz ");
+  assert_non_null(second);
+  assert_non_null(strstr(out, "\r\nok fw "));
+  /* every line is a data line or a final line: nothing cut or glued */
+  for (const char *p = out; *p != '\0';) {
+    assert_true(strncmp(p, "- ", 2) == 0 || strncmp(p, "ok", 2) == 0);
+    const char *e = strstr(p, "\r\n");
+    assert_non_null(e);
+    assert_null(memchr(p, '\n', (size_t)(e - p)));
+    p = e + 2;
+  }
+}
+
+/* A fault stays shown until cleared (`clear`, or `drive on`); it stays readable as
+ * history (last_fault with its time). */
+static void test_fault_clear_and_history(void **state)
+{
+  (void)state;
+  start();
+  run_s(0.3);
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
+  app.gyro.drive.amp_pi.u = NAN; /* a broken loop state */
+  run_s(1.0);
+  assert_int_equal(app.gyro.sup.fault_count, 1u);
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
+  const char *s = cmd("status\n");
+  assert_non_null(strstr(s, "- fault NAN\r\n"));
+  assert_non_null(strstr(s, "- last_fault NAN\r\n"));
+  assert_non_null(strstr(s, "- last_fault_s 0.3"));
+  assert_string_equal(cmd("clear\n"), "ok fault cleared\r\n");
+  assert_non_null(strstr(cmd("clear x\n"), "err ARGS"));
+  run_s(0.001);
+  s = cmd("status\n");
+  assert_non_null(strstr(s, "- fault none\r\n"));
+  assert_non_null(strstr(s, "- last_fault NAN\r\n"));
+  assert_non_null(strstr(s, "- fault_count 1\r\n"));
+  /* drive on after a fault clears it too */
+  app.gyro.drive.amp_pi.u = NAN;
+  run_s(1.0);
+  assert_non_null(strstr(cmd("status\n"), "- fault NAN\r\n"));
+  assert_string_equal(cmd("drive on\n"), "ok drive on\r\n");
+  run_s(0.001);
+  assert_non_null(strstr(cmd("status\n"), "- fault none\r\n"));
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
+}
+
+/* `save` and a non-live `set` during a sweep: the sweep excites the drive, which a
+ * flash stall would leave running uncontrolled. Both refused. */
+static void test_save_and_nonlive_set_refused_during_sweep(void **state)
+{
+  (void)state;
+  start();
+  run_s(0.01);
+  assert_string_equal(cmd("sweep\n"), "ok sweep started\r\n");
+  (void)drain(3);
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_SWEEP);
+  assert_non_null(strstr(cmd("save\n"), "err BUSY "));
+  assert_non_null(strstr(cmd("set drive.mode 1\n"), "err BUSY "));
+  assert_int_equal(params_current(&app.params)->drive_mode, 0u);
+  /* a queued drive on makes the loop unsafe at once */
+  assert_string_equal(cmd("drive off\n"), "ok drive off\r\n");
+  run_s(0.001);
+  assert_non_null(strstr(cmd("drive on\nsave\n"), "err BUSY "));
+}
+
+/* Subnormal values: refused from a flash record and from gyro-sim --set as they are
  * by the command line. */
 static void test_subnormal_refused_everywhere(void **state)
 {
@@ -199,6 +389,14 @@ static void test_extra_words_refused(void **state)
 int main(void)
 {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_drive_off_then_selftest_in_one_write),
+      cmocka_unit_test(test_sweep_then_drive_off_in_one_write),
+      cmocka_unit_test(test_sweep_then_drive_on_in_one_write),
+      cmocka_unit_test(test_sweep_request_never_taken_times_out),
+      cmocka_unit_test(test_rx_overflow_discards_the_line),
+      cmocka_unit_test(test_pipelined_lists_come_out_whole),
+      cmocka_unit_test(test_fault_clear_and_history),
+      cmocka_unit_test(test_save_and_nonlive_set_refused_during_sweep),
       cmocka_unit_test(test_subnormal_refused_everywhere),
       cmocka_unit_test(test_minus_zero_normalised),
       cmocka_unit_test(test_duplicate_record_ids_take_default),
