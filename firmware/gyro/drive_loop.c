@@ -40,6 +40,14 @@ int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t 
   return 0;
 }
 
+static void set_targets(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
+{
+  dl->amp_target_v = cfg->amp_set_v;
+  dl->inv_amp_target = 1.0f / cfg->amp_set_v;
+  dl->phase_target_rad = cfg->phase_set_rad;
+  dl->p_init_rad = cfg->p_init_rad;
+}
+
 static int cfg_ok(const drive_loop_cfg_t *c)
 {
   return c != NULL && c->dt_s > 0.0f && c->amp_set_v > 0.0f && c->f_cmd_max_v2 > 0.0f &&
@@ -63,9 +71,10 @@ int drive_loop_init(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
   }
   dl->amp_pi = amp_pi;
   dl->phase_pi = phase_pi;
-  dl->amp_set_v = cfg->amp_set_v;
-  dl->phase_set_rad = cfg->phase_set_rad;
-  dl->p_init_rad = cfg->p_init_rad;
+  dl->amp_slew_up = 1.0f + DRIVE_AMP_SLEW_PER_S * cfg->dt_s;
+  dl->amp_slew_down = 1.0f / dl->amp_slew_up;
+  dl->phase_slew_rad = DRIVE_PHASE_SLEW_RAD_PER_S * cfg->dt_s;
+  set_targets(dl, cfg);
   drive_loop_reset(dl);
   return 0;
 }
@@ -75,13 +84,38 @@ void drive_loop_retune(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
   (void)pi_set_gains(&dl->amp_pi, cfg->amp_kp, cfg->amp_ki);
   (void)pi_set_gains(&dl->phase_pi, cfg->phase_kp, cfg->phase_ki);
   (void)pi_set_limits(&dl->amp_pi, 0.0f, cfg->f_cmd_max_v2);
-  dl->amp_set_v = cfg->amp_set_v;
-  dl->phase_set_rad = cfg->phase_set_rad;
-  dl->p_init_rad = cfg->p_init_rad;
+  set_targets(dl, cfg);
+}
+
+/* Geometric in amplitude (a constant relative rate, the loop's relative lag constant),
+ * the reciprocal moved by the inverse factor; both land exactly on the target. */
+static void slew_amp(drive_loop_t *dl)
+{
+  const int up = dl->amp_set_v < dl->amp_target_v;
+  dl->amp_set_v *= up ? dl->amp_slew_up : dl->amp_slew_down;
+  dl->inv_amp_set *= up ? dl->amp_slew_down : dl->amp_slew_up;
+  if (up ? dl->amp_set_v >= dl->amp_target_v : dl->amp_set_v <= dl->amp_target_v) {
+    dl->amp_set_v = dl->amp_target_v;
+    dl->inv_amp_set = dl->inv_amp_target;
+  }
+}
+
+/* The short way round: the phase error is wrapped, so is the setpoint. */
+static void slew_phase(drive_loop_t *dl)
+{
+  const float d = fm_wrap_pi(dl->phase_target_rad - dl->phase_set_rad);
+  if (fm_absf(d) <= dl->phase_slew_rad) {
+    dl->phase_set_rad = dl->phase_target_rad;
+  } else {
+    dl->phase_set_rad = fm_wrap_pi(dl->phase_set_rad + (d > 0.0f ? dl->phase_slew_rad : -dl->phase_slew_rad));
+  }
 }
 
 void drive_loop_reset(drive_loop_t *dl)
 {
+  dl->amp_set_v = dl->amp_target_v;
+  dl->inv_amp_set = dl->inv_amp_target;
+  dl->phase_set_rad = dl->phase_target_rad;
   (void)pi_reset(&dl->amp_pi, 0.0f, 0.0f);
   (void)pi_reset(&dl->phase_pi, dl->p_init_rad, 0.0f);
   dl->amp_v = 0.0f;
@@ -94,6 +128,7 @@ void drive_loop_reset(drive_loop_t *dl)
 
 void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c)
 {
+  if (dl->amp_set_v != dl->amp_target_v) slew_amp(dl);
   dl->amp_v = fm_sqrtf(w_s * w_s + w_c * w_c);
   dl->amp_err_v = dl->amp_set_v - dl->amp_v;
   dl->f_cmd_v2 = pi_step(&dl->amp_pi, dl->amp_err_v);
@@ -106,6 +141,7 @@ void drive_loop_measure_phase(drive_loop_t *dl, float w_s, float w_c)
 
 void drive_loop_update_phase(drive_loop_t *dl)
 {
+  if (dl->phase_set_rad != dl->phase_target_rad) slew_phase(dl);
   dl->phase_err_rad = fm_wrap_pi(dl->phase_set_rad - dl->phase_rad);
   /* While the amplitude is still tiny its phase is noise; hold P until there is a
    * vibration to measure (10 % of the setpoint). */

@@ -24,6 +24,16 @@
  * not wrapped (its half drives the half-frequency voltage phase, (6-25), and wrapping P
  * would flip both voltages); its range is limited to +-2 pi.
  *
+ * Setpoint changes slew (drive_loop_retune sets the targets; each update moves the
+ * setpoints towards them): the amplitude by at most DRIVE_AMP_SLEW_PER_S relative per
+ * second, the phase by DRIVE_PHASE_SLEW_RAD_PER_S. A step would leave the vibration at
+ * the old amplitude while the over-amplitude trip (a multiple of the setpoint) and the
+ * lock judgement already use the new one: 0.349 V -> 0.2 V tripped at 1.5 x 0.2 V. A
+ * first-order loop of bandwidth wc follows a ramp of relative rate r with a relative lag
+ * of r / wc: 2 /s against the default 30 Hz (188 rad/s) is 1 %, inside the lock
+ * tolerance, and the phase ramp lags by 0.5 deg. The trip and the lock judgement use
+ * the slewed setpoint (inv_amp_set), kept with it without a divide per update.
+ *
  * Design (drive_loop_design): with the first-order plant K/(tau s + 1), tau = 2Q/wn
  * (6-12, 6-17), the PI zero is put on the plant pole (Ki/Kp = 1/tau), leaving the
  * open loop K Kp / (tau s): a first-order closed loop of bandwidth wc = K Kp / tau, with
@@ -51,11 +61,21 @@ typedef struct {
   float p_init_rad;
 } drive_loop_cfg_t;
 
+#define DRIVE_AMP_SLEW_PER_S 2.0f
+#define DRIVE_PHASE_SLEW_RAD_PER_S 1.5707964f /* 90 deg/s */
+
 typedef struct {
   pi_t amp_pi;
   pi_t phase_pi;
-  float amp_set_v;
+  float amp_set_v;       /* setpoints the loops use now, slewing towards the targets */
   float phase_set_rad;
+  float inv_amp_set;     /* 1 / amp_set_v: the supervisor's reference */
+  float amp_target_v;    /* setpoints as configured */
+  float phase_target_rad;
+  float inv_amp_target;
+  float amp_slew_up;     /* per update: amp_set_v x this while below the target ... */
+  float amp_slew_down;   /* ... x this (1 / amp_slew_up) while above */
+  float phase_slew_rad;  /* per update */
   float p_init_rad;
   /* Latest measurement and outputs. */
   float amp_v;
@@ -93,11 +113,13 @@ int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t 
 /* Returns 0, or -1 (nothing changed) for a bad configuration. */
 int drive_loop_init(drive_loop_t *dl, const drive_loop_cfg_t *cfg);
 
-/* New gains, setpoints and limits with the loop state kept (bumpless). The cfg must have
- * passed drive_loop_init once (the designer checks it); dt_s must not change. */
+/* New gains, setpoint targets and limits with the loop state kept (bumpless); the
+ * setpoints slew to the targets. The cfg must have passed drive_loop_init once (the
+ * designer checks it); dt_s must not change. */
 void drive_loop_retune(drive_loop_t *dl, const drive_loop_cfg_t *cfg);
 
-/* Drive off: force command 0, P back to its start value, integrators cleared. */
+/* Drive off: force command 0, P back to its start value, integrators cleared, setpoints
+ * at their targets (a start from rest needs no slew). */
 void drive_loop_reset(drive_loop_t *dl);
 
 /* One update: measurement from the drive LMSD weights, then both PIs. */

@@ -137,7 +137,6 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
     return -2;
   }
   t.adc_v_per_code = HAL_ADC_V_PER_CODE;
-  t.inv_amp_set = 1.0f / d->drive.amp_set_v;
   selftest_init(&t.selftest, &d->selftest);
   t.rate_code = (uint16_t)HAL_DAC_CODE_MID;
   t.sup_in.state_finite = 1;
@@ -173,7 +172,6 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   (void)lmsd_set_mu(&g->lmsd_drive, d->lmsd_drive.mu);
   (void)lmsd_set_mu(&g->lmsd_sense, d->lmsd_sense.mu);
   drive_loop_retune(&g->drive, &d->drive);
-  g->inv_amp_set = 1.0f / d->drive.amp_set_v;
   selftest_retune(&g->selftest, &d->selftest);
   /* The drive scheme only changes with the drive off (drive.mode is not live). */
   if (d->synth.mode == g->synth.mode || !supervisor_drive_enabled(&g->sup)) {

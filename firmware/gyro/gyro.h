@@ -89,7 +89,6 @@ typedef struct {
   rate_channel_t rate;
   supervisor_t sup;
   float f_cmd_max_v2;
-  float inv_amp_set;     /* 1 / drive amplitude setpoint: no divide per tick */
   uint32_t slot;         /* tick within the block, 0 .. GYRO_BLOCK - 1 */
   uint32_t clip_run;     /* consecutive ADC rail codes up to this tick */
   uint32_t clip_run_max; /* longest run reaching into the current supervisor period */

@@ -26,7 +26,7 @@ void gyro_block_command(gyro_t *g)
   /* The supervisor's evidence of the block, now that both loops have measured. */
   supervisor_in_t *si = &g->sup_in;
   const int drive_on = supervisor_drive_enabled(&g->sup);
-  si->amp_rel = g->drive.amp_v * g->inv_amp_set;
+  si->amp_rel = g->drive.amp_v * g->drive.inv_amp_set; /* the slewed setpoint's */
   si->amp_rel_err = si->amp_rel - 1.0f;
   si->phase_err_rad = g->drive.phase_err_rad;
   si->drive_at_limit = drive_on && g->drive.f_cmd_v2 >= g->f_cmd_max_v2;

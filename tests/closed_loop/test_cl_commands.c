@@ -229,6 +229,27 @@ static void test_pipelined_lists_come_out_whole(void **state)
   }
 }
 
+/* The README's own tuning step: from 0.349 V to 0.2 V the over-amplitude trip (1.5 x the
+ * new setpoint, 0.3 V) used to fire on the vibration still at 0.349 V. The setpoint now
+ * slews and the trip follows it. */
+static void test_amp_setpoint_step_down_no_fault(void **state)
+{
+  (void)state;
+  start();
+  run_s(0.3);
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
+  assert_true(strncmp(cmd("set drive.amp_set_v 0.2\n"), "ok", 2) == 0);
+  run_s(1.0);
+  assert_int_equal(app.gyro.sup.fault_count, 0u);
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
+  assert_true(fabsf(app.gyro.drive.amp_v / 0.2f - 1.0f) < 0.02f);
+  /* and back up, and a phase setpoint across most of its range */
+  assert_true(strncmp(cmd("set drive.amp_set_v 0.349 drive.phase_set_deg 170\n"), "ok", 2) == 0);
+  run_s(2.5);
+  assert_int_equal(app.gyro.sup.fault_count, 0u);
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
+}
+
 /* A fault stays shown until cleared (`clear`, or `drive on`); it stays readable as
  * history (last_fault with its time). */
 static void test_fault_clear_and_history(void **state)
@@ -395,6 +416,7 @@ int main(void)
       cmocka_unit_test(test_sweep_request_never_taken_times_out),
       cmocka_unit_test(test_rx_overflow_discards_the_line),
       cmocka_unit_test(test_pipelined_lists_come_out_whole),
+      cmocka_unit_test(test_amp_setpoint_step_down_no_fault),
       cmocka_unit_test(test_fault_clear_and_history),
       cmocka_unit_test(test_save_and_nonlive_set_refused_during_sweep),
       cmocka_unit_test(test_subnormal_refused_everywhere),

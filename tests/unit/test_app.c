@@ -45,11 +45,11 @@ static void test_set_applies_at_tick(void **state)
   (void)state;
   setup_app();
   hal_host_run(10u);
-  const float before = app.gyro.drive.amp_set_v;
+  const float before = app.gyro.drive.amp_target_v;
   assert_true(strncmp(cmd("set drive.amp_set_v 2.5\n"), "ok", 2) == 0);
-  assert_true(app.gyro.drive.amp_set_v == before);
+  assert_true(app.gyro.drive.amp_target_v == before);
   hal_host_run(1u);
-  assert_true(app.gyro.drive.amp_set_v == 2.5f);
+  assert_true(app.gyro.drive.amp_target_v == 2.5f); /* the loop's setpoint slews to it */
   assert_int_equal(app.gyro.sup.fault_count, 0u);
   /* Designed gains follow a new model: doubling the identified gain halves Kp. */
   const float kp = app.gyro.drive.amp_pi.kp;
