@@ -43,6 +43,52 @@ static void cli_write(void *ctx, const char *data, size_t len)
   (void)hal_uart_write((const uint8_t *)data, len);
 }
 
+static bool designable(app_t *a, const param_values_t *v, const char **why)
+{
+  return derive(a, v, &a->derived[0], why) == 0; /* derived[0]: scratch before params_init */
+}
+
+static void mark_dropped(app_t *a, unsigned i, bool on)
+{
+  const uint32_t bit = 1u << (i % 32u);
+  a->store_dropped[i / 32u] = on ? (a->store_dropped[i / 32u] | bit) : (a->store_dropped[i / 32u] & ~bit);
+}
+
+/* A stored set whose values pass one by one but cannot be designed together: set stored
+ * values back to their defaults, in table order, until the set designs; then take back
+ * every one of them that designs with the rest. What stays dropped is in store_dropped. */
+bool app_store_dropped(const app_t *a, param_idx_t i)
+{
+  const unsigned k = (unsigned)i;
+  return k < (unsigned)PARAM_COUNT && (a->store_dropped[k / 32u] & (1u << (k % 32u))) != 0u;
+}
+
+static void keep_designable(app_t *a, param_values_t *v)
+{
+  if (designable(a, v, &a->store_dropped_why)) return;
+  const param_values_t stored = *v;
+  unsigned end = 0u; /* one past the last value set back */
+  for (unsigned i = 0; i < (unsigned)PARAM_COUNT; i++) {
+    const param_info_t *pi = param_info((param_idx_t)i);
+    if ((pi->flags & PF_PERSIST) == 0u || param_value_equal((param_idx_t)i, param_get(v, (param_idx_t)i), pi->def)) {
+      continue;
+    }
+    param_put(v, (param_idx_t)i, pi->def);
+    mark_dropped(a, i, true);
+    end = i + 1u;
+    if (designable(a, v, NULL)) break;
+  }
+  for (unsigned i = 0; i < end; i++) {
+    if (!app_store_dropped(a, (param_idx_t)i)) continue;
+    param_values_t t = *v;
+    param_put(&t, (param_idx_t)i, param_get(&stored, (param_idx_t)i));
+    if (designable(a, &t, NULL)) {
+      *v = t;
+      mark_dropped(a, i, false);
+    }
+  }
+}
+
 int app_init_with(app_t *a, const param_values_t *values)
 {
   memset(a, 0, sizeof *a);
@@ -61,6 +107,7 @@ int app_init_with(app_t *a, const param_values_t *values)
       param_store_report_t rep;
       a->store_status = param_store_load(&a->store, &loaded, &rep);
       if (a->store_status == PARAM_STORE_OK) {
+        keep_designable(a, &loaded);
         initial = loaded;
       }
     }
@@ -72,8 +119,8 @@ int app_init_with(app_t *a, const param_values_t *values)
   const params_cfg_t pc = {derive, {&a->derived[0], &a->derived[1]}, loop_safe, a};
   params_err_t err;
   if (params_init(&a->params, &pc, &initial, &err) != PARAM_OK) {
-    /* Values that load but cannot be designed: fall back to the defaults, unless the
-     * caller insisted on its own. */
+    /* Values that cannot be designed even with the stored ones dropped: fall back to the
+     * defaults, unless the caller insisted on its own. */
     if (values != NULL || params_init(&a->params, &pc, NULL, &err) != PARAM_OK) {
       return -1;
     }

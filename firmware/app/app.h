@@ -55,6 +55,10 @@ typedef struct {
   gyro_t gyro;
   param_store_t store;
   param_store_status_t store_status; /* result of the boot-time load */
+  /* Stored values the boot could not design with the rest, set back to their defaults
+   * (bit i: parameter i), and why the stored set as a whole was refused. */
+  uint32_t store_dropped[(PARAM_COUNT + 31u) / 32u];
+  const char *store_dropped_why;
   cli_t cli;
   cli_cmd_t cmds[APP_MAX_CMDS]; /* the application's command rows (app_cmds.c) */
   /* Bytes read from the UART, fed to the command line a line at a time (app_poll). */
@@ -89,6 +93,10 @@ void app_sample_isr(void *ctx);
 
 /* One pass of the background loop: never blocks. */
 void app_poll(app_t *a);
+
+/* Boot: stored value i set back to its default because the stored set could not be
+ * designed with it (status lists them). */
+bool app_store_dropped(const app_t *a, param_idx_t i);
 
 /* Feed command-line bytes directly (host programs and tests; the board uses the UART). */
 void app_cli_feed(app_t *a, const uint8_t *data, size_t len);

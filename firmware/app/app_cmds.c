@@ -68,6 +68,20 @@ static void put_selfcal(cli_t *cli, const app_t *a)
   }
 }
 
+/* Stored values the boot set back to their defaults, each with the reason. */
+static void put_store_dropped(cli_t *cli, const app_t *a)
+{
+  for (unsigned i = 0; i < (unsigned)PARAM_COUNT; i++) {
+    if (!app_store_dropped(a, (param_idx_t)i)) continue;
+    cli_put(cli, "store_dropped ");
+    cli_put(cli, param_info((param_idx_t)i)->name);
+    cli_put(cli, ": cannot be designed with the other stored values (");
+    cli_put(cli, a->store_dropped_why);
+    cli_put(cli, ")");
+    cli_emit_data(cli);
+  }
+}
+
 /* The fault history: the latest fault, cleared or not, and when (seconds since start,
  * from the supervisor's step count; it steps once per block). */
 static void put_last_fault(cli_t *cli, const app_t *a)
@@ -137,6 +151,7 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   cli_put(cli, "store ");
   cli_put(cli, param_store_status_str(a->store_status));
   cli_emit_data(cli);
+  put_store_dropped(cli, a);
   put_store_now(cli, a);
   put_selfcal(cli, a);
   cli_put(cli, "selftest ");

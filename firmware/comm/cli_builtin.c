@@ -245,6 +245,19 @@ static void commit_error(cli_t *cli, param_status_t st, const params_err_t *err)
   }
 }
 
+/* A set the application cannot design: which parameters, and its reason. */
+static void rejected_set(cli_t *cli, uint32_t argc, const char *const *argv, const params_err_t *err)
+{
+  for (uint32_t k = 1; k + 1u < argc; k += 2u) {
+    cli_put(cli, argv[k]);
+    cli_put(cli, " ");
+    cli_put(cli, argv[k + 1u]);
+    cli_put(cli, (k + 3u < argc) ? ", " : ": ");
+  }
+  cli_put(cli, (err->why != NULL) ? err->why : param_status_str(PARAM_ERR_REJECTED));
+  cli_emit_err(cli, "REJECTED");
+}
+
 static void cmd_set(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
 {
   (void)ctx;
@@ -262,6 +275,10 @@ static void cmd_set(cli_t *cli, void *ctx, uint32_t argc, const char *const *arg
   }
   params_err_t err;
   const param_status_t st = params_commit(p, &err);
+  if (st == PARAM_ERR_REJECTED) {
+    rejected_set(cli, argc, argv, &err);
+    return;
+  }
   if (st != PARAM_OK) {
     commit_error(cli, st, &err);
     return;

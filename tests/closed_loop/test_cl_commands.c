@@ -302,6 +302,30 @@ static void test_save_and_nonlive_set_refused_during_sweep(void **state)
   assert_non_null(strstr(cmd("drive on\nsave\n"), "err BUSY "));
 }
 
+/* A stored set whose values are each in range but cannot be designed together: keep
+ * every parameter that can be kept, drop the rest, say which and why. */
+static void test_undesignable_stored_set_keeps_the_rest(void **state)
+{
+  (void)state;
+  const rec_t r[] = {
+      {id_of(PARAM_drive_p_init_deg), PARAM_T_F32, bits_of(356.0f)},
+      {id_of(PARAM_rate_bias_c0_dps), PARAM_T_F32, bits_of(1.5f)},
+      {id_of(PARAM_drive_cal_q), PARAM_T_F32, bits_of(40.0f)},
+  };
+  write_image(PARAM_STORE_FORMAT, r, 3u);
+  start_on_flash();
+  assert_true(param_f(PARAM_rate_bias_c0_dps) == 1.5f);
+  assert_true(param_f(PARAM_drive_cal_q) == 40.0f);
+  assert_true(param_f(PARAM_drive_p_init_deg) == param_info(PARAM_drive_p_init_deg)->def.f);
+  const char *s = cmd("status\n");
+  assert_non_null(strstr(s, "- store ok\r\n"));
+  assert_non_null(strstr(s, "- store_dropped drive.p_init_deg: "));
+  /* the same value at `set` time is refused with the reason */
+  const char *e = cmd("set drive.p_init_deg 356\n");
+  assert_non_null(strstr(e, "err REJECTED "));
+  assert_non_null(strstr(e, "drive.p_init_deg"));
+}
+
 /* Subnormal values: refused from a flash record and from gyro-sim --set as they are
  * by the command line. */
 static void test_subnormal_refused_everywhere(void **state)
@@ -405,8 +429,6 @@ static void test_extra_words_refused(void **state)
   }
 }
 
-
-
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -419,6 +441,7 @@ int main(void)
       cmocka_unit_test(test_amp_setpoint_step_down_no_fault),
       cmocka_unit_test(test_fault_clear_and_history),
       cmocka_unit_test(test_save_and_nonlive_set_refused_during_sweep),
+      cmocka_unit_test(test_undesignable_stored_set_keeps_the_rest),
       cmocka_unit_test(test_subnormal_refused_everywhere),
       cmocka_unit_test(test_minus_zero_normalised),
       cmocka_unit_test(test_duplicate_record_ids_take_default),

@@ -176,7 +176,7 @@ static void test_loop_running_refusals(void **state)
   g.safe = true;
   expect("set drive.mode 1\n", "ok drive.mode 1\r\n");
   /* the application's derive() can refuse a combination */
-  expect("set drive.dc_bias_v 13 drive.u_max_v 12\n", "err REJECTED drive.dc_bias_v must stay below drive.u_max_v\r\n");
+  expect("set drive.dc_bias_v 13 drive.u_max_v 12\n", "err REJECTED drive.dc_bias_v 13, drive.u_max_v 12: drive.dc_bias_v must stay below drive.u_max_v\r\n");
   assert_true(cur()->drive_u_max_v == 12.75f);
 }
 
