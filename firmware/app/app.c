@@ -54,15 +54,15 @@ static void mark_dropped(app_t *a, unsigned i, bool on)
   a->store_dropped[i / 32u] = on ? (a->store_dropped[i / 32u] | bit) : (a->store_dropped[i / 32u] & ~bit);
 }
 
-/* A stored set whose values pass one by one but cannot be designed together: set stored
- * values back to their defaults, in table order, until the set designs; then take back
- * every one of them that designs with the rest. What stays dropped is in store_dropped. */
 bool app_store_dropped(const app_t *a, param_idx_t i)
 {
   const unsigned k = (unsigned)i;
   return k < (unsigned)PARAM_COUNT && (a->store_dropped[k / 32u] & (1u << (k % 32u))) != 0u;
 }
 
+/* A stored set whose values pass one by one but cannot be designed together: set stored
+ * values back to their defaults, in table order, until the set designs; then take back
+ * every one of them that designs with the rest. What stays dropped is in store_dropped. */
 static void keep_designable(app_t *a, param_values_t *v)
 {
   if (designable(a, v, &a->store_dropped_why)) return;

@@ -1,7 +1,8 @@
 /* The command line fed arbitrary bytes. Byte 0 picks options: bit 0 the loop is safe
- * (save, non-live sets allowed), bits 4-7 the chunk size the bytes arrive in, with an
- * ISR tick between chunks. Invariants: every reply line is well formed, the held
- * parameters always pass their checks, no staged edit is left behind. */
+ * (save, non-live sets allowed), bit 1 received bytes are lost after every chunk
+ * (cli_rx_lost), bits 4-7 the chunk size the bytes arrive in, with an ISR tick between
+ * chunks. Invariants: every reply line is well formed, the held parameters always pass
+ * their checks and hold no -0, no staged edit is left behind, every loss is counted. */
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -71,18 +72,27 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     return 0;
   }
   g.safe = (data[0] & 1u) != 0;
+  const bool lossy = (data[0] & 2u) != 0;
+  uint32_t losses = 0u;
   const size_t chunk = 1u + (size_t)(data[0] >> 4) * 4u;
   for (size_t off = 1; off < size; off += chunk) {
     const size_t n = (size - off < chunk) ? size - off : chunk;
     cli_feed(&g.cli, data + off, n);
+    if (lossy) {
+      cli_rx_lost(&g.cli);
+      losses++;
+    }
     (void)params_isr_acquire(&g.bank);
     const param_values_t *cur = params_current(&g.bank);
     for (int i = 0; i < PARAM_COUNT; i++) {
       FUZZ_CHECK(param_check((param_idx_t)i, param_get(cur, (param_idx_t)i)) == PARAM_OK);
+      FUZZ_CHECK(param_info((param_idx_t)i)->type != PARAM_T_F32 ||
+                 param_get(cur, (param_idx_t)i).u != 0x80000000u);
     }
     FUZZ_CHECK(memcmp(params_staged(&g.bank), cur, sizeof *cur) == 0);
     FUZZ_CHECK(cur->sys_fs_hz == 50000u);
   }
   FUZZ_CHECK(g.cli.truncated == 0u);
+  FUZZ_CHECK(g.cli.rx_overflows == losses);
   return 0;
 }
