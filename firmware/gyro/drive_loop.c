@@ -55,8 +55,11 @@ int drive_loop_init(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
     return -1;
   }
   const pi_cfg_t amp = {cfg->amp_kp, cfg->amp_ki, cfg->dt_s, 0.0f, cfg->f_cmd_max_v2, 0.0f};
-  const pi_cfg_t ph = {cfg->phase_kp, cfg->phase_ki, cfg->dt_s, -DRIVE_P_LIMIT_RAD,
-                       DRIVE_P_LIMIT_RAD, cfg->p_init_rad};
+  /* P is kept within +-pi of p_init by whole turns (drive_loop_update_phase): limits a
+   * turn beyond that are never reached. */
+  const pi_cfg_t ph = {cfg->phase_kp, cfg->phase_ki, cfg->dt_s,
+                       cfg->p_init_rad - 2.0f * FM_TWO_PI_F, cfg->p_init_rad + 2.0f * FM_TWO_PI_F,
+                       cfg->p_init_rad};
   pi_t amp_pi, phase_pi;
   if (pi_init(&amp_pi, &amp) != 0 || pi_init(&phase_pi, &ph) != 0) {
     return -1;
@@ -75,6 +78,8 @@ void drive_loop_retune(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
   (void)pi_set_gains(&dl->amp_pi, cfg->amp_kp, cfg->amp_ki);
   (void)pi_set_gains(&dl->phase_pi, cfg->phase_kp, cfg->phase_ki);
   (void)pi_set_limits(&dl->amp_pi, 0.0f, cfg->f_cmd_max_v2);
+  (void)pi_set_limits(&dl->phase_pi, cfg->p_init_rad - 2.0f * FM_TWO_PI_F,
+                      cfg->p_init_rad + 2.0f * FM_TWO_PI_F);
   dl->amp_set_v = cfg->amp_set_v;
   dl->phase_set_rad = cfg->phase_set_rad;
   dl->p_init_rad = cfg->p_init_rad;
@@ -90,6 +95,7 @@ void drive_loop_reset(drive_loop_t *dl)
   dl->phase_err_rad = 0.0f;
   dl->f_cmd_v2 = 0.0f;
   dl->p_rad = dl->p_init_rad;
+  dl->p_turn_rad = 0.0f;
 }
 
 void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c)
@@ -110,7 +116,15 @@ void drive_loop_update_phase(drive_loop_t *dl)
   /* While the amplitude is still tiny its phase is noise; hold P until there is a
    * vibration to measure (10 % of the setpoint). */
   if (dl->amp_v > 0.1f * dl->amp_set_v) {
-    dl->p_rad = pi_step(&dl->phase_pi, dl->phase_err_rad);
+    float p = pi_step(&dl->phase_pi, dl->phase_err_rad);
+    const float dev = p - dl->p_init_rad;
+    if (dev > FM_PI_F || dev < -FM_PI_F) {
+      const float turn = dev > 0.0f ? FM_TWO_PI_F : -FM_TWO_PI_F;
+      p -= turn;
+      dl->phase_pi.u = p;
+      dl->p_turn_rad -= turn;
+    }
+    dl->p_rad = p;
   } else {
     (void)pi_reset(&dl->phase_pi, dl->p_rad, dl->phase_err_rad);
   }

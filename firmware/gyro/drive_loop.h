@@ -20,9 +20,13 @@
  * limit during start-up. Together these remove the start-up overshoot.
  *
  * Phase loop: e_P = wrap(phase_set - arg Z) (rad); the PI output is the force phase P
- * (rad), whose effect on arg Z is one-to-one with the first-order lag of (6-17). P is
- * not wrapped (its half drives the half-frequency voltage phase, (6-25), and wrapping P
- * would flip both voltages); its range is limited to +-2 pi.
+ * (rad), whose effect on arg Z is one-to-one with the first-order lag of (6-17). The
+ * wrapped error takes the shorter way to a new setpoint, so two setpoint changes can
+ * walk P by more than a turn; a force phase is only defined modulo 2 pi, so P (the PI's
+ * state with it) is kept within +-pi of its start value p_init by whole turns, and the
+ * turn is reported (p_turn_rad) for the thermometer, which must not see it. The loop
+ * thus never pins at a limit; drive synthesis takes the turns off its own phase
+ * conversion with hysteresis (drive_synth.h).
  *
  * Design (drive_loop_design): with the first-order plant K/(tau s + 1), tau = 2Q/wn
  * (6-12, 6-17), the PI zero is put on the plant pole (Ki/Kp = 1/tau), leaving the
@@ -64,6 +68,8 @@ typedef struct {
   float phase_err_rad;
   float f_cmd_v2;  /* force amplitude command, Ks*V^2 */
   float p_rad;     /* force phase P */
+  float p_turn_rad; /* whole turn taken off P at the latest update (0: none), for the
+                     * caller to act on and clear */
 } drive_loop_t;
 
 typedef struct {
