@@ -17,24 +17,89 @@ static const char *mode_name(uint32_t m)
   return "?";
 }
 
+static const struct {
+  uint32_t bit;
+  const char *name;
+} k_fault_names[] = {{GYRO_FAULT_ADC_CLIP, "ADC_CLIP"},   {GYRO_FAULT_NAN, "NAN"},
+               {GYRO_FAULT_LOST_LOCK, "LOST_LOCK"}, {GYRO_FAULT_DRIVE_SAT, "DRIVE_SAT"},
+               {GYRO_FAULT_OVER_AMP, "OVER_AMP"},   {GYRO_FAULT_PHASE_LOST, "PHASE_LOST"},
+               {GYRO_FAULT_ACQ_TIMEOUT, "ACQ_TIMEOUT"}, {GYRO_FAULT_LOST_SAMPLE, "LOST_SAMPLE"}};
+#define FAULT_NAMES (sizeof k_fault_names / sizeof k_fault_names[0])
+_Static_assert(FAULT_NAMES == GYRO_FAULT_KINDS, "a name for every fault kind");
+
+static const char *fault_name(uint32_t bit)
+{
+  for (size_t i = 0; i < FAULT_NAMES; i++) {
+    if (k_fault_names[i].bit == bit) return k_fault_names[i].name;
+  }
+  return "?";
+}
+
 static void put_faults(cli_t *cli, uint32_t f)
 {
-  static const struct {
-    uint32_t bit;
-    const char *name;
-  } names[] = {{GYRO_FAULT_ADC_CLIP, "ADC_CLIP"},   {GYRO_FAULT_NAN, "NAN"},
-               {GYRO_FAULT_LOST_LOCK, "LOST_LOCK"}, {GYRO_FAULT_DRIVE_SAT, "DRIVE_SAT"},
-               {GYRO_FAULT_OVER_AMP, "OVER_AMP"}};
   if (f == 0u) {
     cli_put(cli, "none");
     return;
   }
   int first = 1;
-  for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
-    if ((f & names[i].bit) != 0u) {
+  for (size_t i = 0; i < FAULT_NAMES; i++) {
+    if ((f & k_fault_names[i].bit) != 0u) {
       if (!first) cli_put(cli, ",");
-      cli_put(cli, names[i].name);
+      cli_put(cli, k_fault_names[i].name);
       first = 0;
+    }
+  }
+}
+
+/* Output integrity (rate_valid.h, supervisor.h): the verdict with its reasons, then one
+ * line per monitor that has ever fired, `NAME count N last_s T` (T: seconds since
+ * power-on of its latest onset). */
+static void put_reasons(cli_t *cli, uint32_t r)
+{
+  if (r == 0u) {
+    cli_put(cli, "none");
+    return;
+  }
+  int first = 1;
+  for (uint32_t i = 0; i < RATE_INVALID_KINDS; i++) {
+    if ((r & (1u << i)) != 0u) {
+      if (!first) cli_put(cli, ",");
+      cli_put(cli, rate_valid_reason_name(i));
+      first = 0;
+    }
+  }
+}
+
+static void put_monitor(cli_t *cli, const char *kind, const char *name, uint32_t count, float t_s)
+{
+  cli_put(cli, kind);
+  cli_put(cli, name);
+  cli_put(cli, " count ");
+  cli_put_u32(cli, count);
+  cli_put(cli, " last_s ");
+  cli_put_f32(cli, t_s);
+  cli_emit_data(cli);
+}
+
+static void put_integrity(cli_t *cli, const app_t *a)
+{
+  const gyro_t *g = &a->gyro;
+  const float block_s = (float)GYRO_BLOCK / (float)params_current(&a->params)->sys_fs_hz;
+  cli_data_u32(cli, "rate_valid", g->out.rate_valid);
+  cli_put(cli, "rate_invalid ");
+  put_reasons(cli, g->out.rate_invalid);
+  cli_emit_data(cli);
+  cli_data_f32(cli, "rate_out_v", g->out.rate_out_v);
+  for (uint32_t i = 0; i < RATE_INVALID_KINDS; i++) {
+    if (g->valid.count[i] != 0u) {
+      put_monitor(cli, "invalid_", rate_valid_reason_name(i), g->valid.count[i],
+                  (float)g->valid.last_block[i] * block_s);
+    }
+  }
+  for (uint32_t i = 0; i < GYRO_FAULT_KINDS; i++) {
+    if (g->sup.kind_count[i] != 0u) {
+      put_monitor(cli, "fault_", fault_name(1u << i), g->sup.kind_count[i],
+                  (float)g->sup.kind_last_step[i] * block_s);
     }
   }
 }
@@ -136,6 +201,7 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   cli_data_u32(cli, "fault_count", a->gyro.sup.fault_count);
   put_last_fault(cli, a);
   cli_data_f32(cli, "rate_dps", o->rate_dps);
+  put_integrity(cli, a);
   cli_data_f32(cli, "quad_dps", o->quad_dps);
   cli_data_f32(cli, "drive_amp_v", o->drive_amp_v);
   cli_data_f32(cli, "drive_phase_deg", o->drive_phase_deg);

@@ -42,9 +42,15 @@ int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t 
 
 static void set_targets(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
 {
+  float rate_per_s = DRIVE_AMP_SLEW_MAX_PER_S;
+  if (cfg->amp_ki > 0.0f && cfg->amp_kp > 0.0f && DRIVE_AMP_SLEW_TAU * cfg->amp_ki < rate_per_s * cfg->amp_kp) {
+    rate_per_s = DRIVE_AMP_SLEW_TAU * cfg->amp_ki / cfg->amp_kp; /* DRIVE_AMP_SLEW_TAU / tau */
+  }
+  dl->amp_slew_up = 1.0f + rate_per_s * cfg->dt_s;
+  dl->amp_slew_down = 1.0f / dl->amp_slew_up;
   dl->amp_target_v = cfg->amp_set_v;
   dl->inv_amp_target = 1.0f / cfg->amp_set_v;
-  dl->phase_target_rad = cfg->phase_set_rad;
+  dl->phase_set_rad = cfg->phase_set_rad;
   dl->p_init_rad = cfg->p_init_rad;
 }
 
@@ -63,17 +69,17 @@ int drive_loop_init(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
     return -1;
   }
   const pi_cfg_t amp = {cfg->amp_kp, cfg->amp_ki, cfg->dt_s, 0.0f, cfg->f_cmd_max_v2, 0.0f};
-  const pi_cfg_t ph = {cfg->phase_kp, cfg->phase_ki, cfg->dt_s, -DRIVE_P_LIMIT_RAD,
-                       DRIVE_P_LIMIT_RAD, cfg->p_init_rad};
+  /* P is kept within +-pi of p_init by whole turns (drive_loop_update_phase): limits a
+   * turn beyond that are never reached. */
+  const pi_cfg_t ph = {cfg->phase_kp, cfg->phase_ki, cfg->dt_s,
+                       cfg->p_init_rad - 2.0f * FM_TWO_PI_F, cfg->p_init_rad + 2.0f * FM_TWO_PI_F,
+                       cfg->p_init_rad};
   pi_t amp_pi, phase_pi;
   if (pi_init(&amp_pi, &amp) != 0 || pi_init(&phase_pi, &ph) != 0) {
     return -1;
   }
   dl->amp_pi = amp_pi;
   dl->phase_pi = phase_pi;
-  dl->amp_slew_up = 1.0f + DRIVE_AMP_SLEW_PER_S * cfg->dt_s;
-  dl->amp_slew_down = 1.0f / dl->amp_slew_up;
-  dl->phase_slew_rad = DRIVE_PHASE_SLEW_RAD_PER_S * cfg->dt_s;
   set_targets(dl, cfg);
   drive_loop_reset(dl);
   return 0;
@@ -84,11 +90,13 @@ void drive_loop_retune(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
   (void)pi_set_gains(&dl->amp_pi, cfg->amp_kp, cfg->amp_ki);
   (void)pi_set_gains(&dl->phase_pi, cfg->phase_kp, cfg->phase_ki);
   (void)pi_set_limits(&dl->amp_pi, 0.0f, cfg->f_cmd_max_v2);
+  (void)pi_set_limits(&dl->phase_pi, cfg->p_init_rad - 2.0f * FM_TWO_PI_F,
+                      cfg->p_init_rad + 2.0f * FM_TWO_PI_F);
   set_targets(dl, cfg);
 }
 
-/* Geometric in amplitude (a constant relative rate, the loop's relative lag constant),
- * the reciprocal moved by the inverse factor; both land exactly on the target. */
+/* Geometric (a constant relative rate: a constant relative lag), the reciprocal moved by
+ * the inverse factor; both land exactly on the target. */
 static void slew_amp(drive_loop_t *dl)
 {
   const int up = dl->amp_set_v < dl->amp_target_v;
@@ -100,22 +108,10 @@ static void slew_amp(drive_loop_t *dl)
   }
 }
 
-/* The short way round: the phase error is wrapped, so is the setpoint. */
-static void slew_phase(drive_loop_t *dl)
-{
-  const float d = fm_wrap_pi(dl->phase_target_rad - dl->phase_set_rad);
-  if (fm_absf(d) <= dl->phase_slew_rad) {
-    dl->phase_set_rad = dl->phase_target_rad;
-  } else {
-    dl->phase_set_rad = fm_wrap_pi(dl->phase_set_rad + (d > 0.0f ? dl->phase_slew_rad : -dl->phase_slew_rad));
-  }
-}
-
 void drive_loop_reset(drive_loop_t *dl)
 {
   dl->amp_set_v = dl->amp_target_v;
   dl->inv_amp_set = dl->inv_amp_target;
-  dl->phase_set_rad = dl->phase_target_rad;
   (void)pi_reset(&dl->amp_pi, 0.0f, 0.0f);
   (void)pi_reset(&dl->phase_pi, dl->p_init_rad, 0.0f);
   dl->amp_v = 0.0f;
@@ -124,11 +120,12 @@ void drive_loop_reset(drive_loop_t *dl)
   dl->phase_err_rad = 0.0f;
   dl->f_cmd_v2 = 0.0f;
   dl->p_rad = dl->p_init_rad;
+  dl->p_turn_rad = 0.0f;
 }
 
 void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c)
 {
-  if (dl->amp_set_v != dl->amp_target_v) slew_amp(dl);
+  if (drive_loop_slewing(dl)) slew_amp(dl);
   dl->amp_v = fm_sqrtf(w_s * w_s + w_c * w_c);
   dl->amp_err_v = dl->amp_set_v - dl->amp_v;
   dl->f_cmd_v2 = pi_step(&dl->amp_pi, dl->amp_err_v);
@@ -141,12 +138,19 @@ void drive_loop_measure_phase(drive_loop_t *dl, float w_s, float w_c)
 
 void drive_loop_update_phase(drive_loop_t *dl)
 {
-  if (dl->phase_set_rad != dl->phase_target_rad) slew_phase(dl);
   dl->phase_err_rad = fm_wrap_pi(dl->phase_set_rad - dl->phase_rad);
   /* While the amplitude is still tiny its phase is noise; hold P until there is a
    * vibration to measure (10 % of the setpoint). */
   if (dl->amp_v > 0.1f * dl->amp_set_v) {
-    dl->p_rad = pi_step(&dl->phase_pi, dl->phase_err_rad);
+    float p = pi_step(&dl->phase_pi, dl->phase_err_rad);
+    const float dev = p - dl->p_init_rad;
+    if (dev > FM_PI_F || dev < -FM_PI_F) {
+      const float turn = dev > 0.0f ? FM_TWO_PI_F : -FM_TWO_PI_F;
+      p -= turn;
+      dl->phase_pi.u = p;
+      dl->p_turn_rad -= turn;
+    }
+    dl->p_rad = p;
   } else {
     (void)pi_reset(&dl->phase_pi, dl->p_rad, dl->phase_err_rad);
   }

@@ -20,19 +20,26 @@
  * limit during start-up. Together these remove the start-up overshoot.
  *
  * Phase loop: e_P = wrap(phase_set - arg Z) (rad); the PI output is the force phase P
- * (rad), whose effect on arg Z is one-to-one with the first-order lag of (6-17). P is
- * not wrapped (its half drives the half-frequency voltage phase, (6-25), and wrapping P
- * would flip both voltages); its range is limited to +-2 pi.
+ * (rad), whose effect on arg Z is one-to-one with the first-order lag of (6-17). The
+ * wrapped error takes the shorter way to a new setpoint, so two setpoint changes can
+ * walk P by more than a turn; a force phase is only defined modulo 2 pi, so P (the PI's
+ * state with it) is kept within +-pi of its start value p_init by whole turns, and the
+ * turn is reported (p_turn_rad) for the thermometer, which must not see it. The loop
+ * thus never pins at a limit; drive synthesis takes the turns off its own phase
+ * conversion with hysteresis (drive_synth.h).
  *
- * Setpoint changes slew (drive_loop_retune sets the targets; each update moves the
- * setpoints towards them): the amplitude by at most DRIVE_AMP_SLEW_PER_S relative per
- * second, the phase by DRIVE_PHASE_SLEW_RAD_PER_S. A step would leave the vibration at
- * the old amplitude while the over-amplitude trip (a multiple of the setpoint) and the
- * lock judgement already use the new one: 0.349 V -> 0.2 V tripped at 1.5 x 0.2 V. A
- * first-order loop of bandwidth wc follows a ramp of relative rate r with a relative lag
- * of r / wc: 2 /s against the default 30 Hz (188 rad/s) is 1 %, inside the lock
- * tolerance, and the phase ramp lags by 0.5 deg. The trip and the lock judgement use
- * the slewed setpoint (inv_amp_set), kept with it without a divide per update.
+ * Amplitude setpoint changes slew (drive_loop_retune sets the target; each update moves
+ * the setpoint towards it by a constant factor). A step would leave the vibration at the
+ * old amplitude while the over-amplitude trip (a multiple of the setpoint) already used
+ * the new one: 0.349 V -> 0.2 V tripped at 1.5 x 0.2 V. The vibration cannot fall faster
+ * than its free decay, rate 1/tau with tau = 2Q/wn (the force command stops at 0), so
+ * the setpoint moves at DRIVE_AMP_SLEW_TAU / tau relative per second: a ramp that slow
+ * is followed with a relative lag of at most DRIVE_AMP_SLEW_TAU, below the lowest trip
+ * (sup.amp_trip_rel >= 1.2). tau is the amplitude PI's kp / ki (the designer puts the
+ * zero on the plant pole); without an integral gain the rate is DRIVE_AMP_SLEW_MAX_PER_S.
+ * The trip and the lock judgement use the slewed setpoint (inv_amp_set, kept with it
+ * without a divide per update). The phase setpoint steps: P follows it within the phase
+ * loop's bandwidth and no trip depends on it.
  *
  * Design (drive_loop_design): with the first-order plant K/(tau s + 1), tau = 2Q/wn
  * (6-12, 6-17), the PI zero is put on the plant pole (Ki/Kp = 1/tau), leaving the
@@ -61,21 +68,19 @@ typedef struct {
   float p_init_rad;
 } drive_loop_cfg_t;
 
-#define DRIVE_AMP_SLEW_PER_S 2.0f
-#define DRIVE_PHASE_SLEW_RAD_PER_S 1.5707964f /* 90 deg/s */
+#define DRIVE_AMP_SLEW_TAU 0.15f
+#define DRIVE_AMP_SLEW_MAX_PER_S 20.0f
 
 typedef struct {
   pi_t amp_pi;
   pi_t phase_pi;
-  float amp_set_v;       /* setpoints the loops use now, slewing towards the targets */
+  float amp_set_v;       /* setpoint the loop uses now, slewing towards amp_target_v */
   float phase_set_rad;
   float inv_amp_set;     /* 1 / amp_set_v: the supervisor's reference */
-  float amp_target_v;    /* setpoints as configured */
-  float phase_target_rad;
+  float amp_target_v;    /* setpoint as configured */
   float inv_amp_target;
   float amp_slew_up;     /* per update: amp_set_v x this while below the target ... */
   float amp_slew_down;   /* ... x this (1 / amp_slew_up) while above */
-  float phase_slew_rad;  /* per update */
   float p_init_rad;
   /* Latest measurement and outputs. */
   float amp_v;
@@ -84,6 +89,8 @@ typedef struct {
   float phase_err_rad;
   float f_cmd_v2;  /* force amplitude command, Ks*V^2 */
   float p_rad;     /* force phase P */
+  float p_turn_rad; /* whole turn taken off P at the latest update (0: none), for the
+                     * caller to act on and clear */
 } drive_loop_t;
 
 typedef struct {
@@ -113,13 +120,13 @@ int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t 
 /* Returns 0, or -1 (nothing changed) for a bad configuration. */
 int drive_loop_init(drive_loop_t *dl, const drive_loop_cfg_t *cfg);
 
-/* New gains, setpoint targets and limits with the loop state kept (bumpless); the
- * setpoints slew to the targets. The cfg must have passed drive_loop_init once (the
+/* New gains, setpoints and limits with the loop state kept (bumpless); the amplitude
+ * setpoint slews to its new value. The cfg must have passed drive_loop_init once (the
  * designer checks it); dt_s must not change. */
 void drive_loop_retune(drive_loop_t *dl, const drive_loop_cfg_t *cfg);
 
-/* Drive off: force command 0, P back to its start value, integrators cleared, setpoints
- * at their targets (a start from rest needs no slew). */
+/* Drive off: force command 0, P back to its start value, integrators cleared, the
+ * amplitude setpoint at its target (a start from rest needs no slew). */
 void drive_loop_reset(drive_loop_t *dl);
 
 /* One update: measurement from the drive LMSD weights, then both PIs. */
@@ -132,6 +139,8 @@ void drive_loop_step(drive_loop_t *dl, float w_s, float w_c);
 void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c);
 void drive_loop_step_phase(drive_loop_t *dl, float w_s, float w_c);
 void drive_loop_measure_phase(drive_loop_t *dl, float w_s, float w_c);
+/* The amplitude setpoint is still moving to its target. */
+static inline int drive_loop_slewing(const drive_loop_t *dl) { return dl->amp_set_v != dl->amp_target_v; }
 void drive_loop_update_phase(drive_loop_t *dl);
 
 #endif /* DRIVE_LOOP_H */

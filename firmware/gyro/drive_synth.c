@@ -25,6 +25,7 @@ int drive_synth_init(drive_synth_t *ds, const drive_synth_cfg_t *cfg)
   ds->a_v = 0.0f;
   ds->off = 0u;
   ds->f_set_v2 = ds->p_set_rad = NAN;
+  ds->p_turn_rad = 0.0f;
   return 0;
 }
 
@@ -41,11 +42,21 @@ void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad)
 {
   ds->f_set_v2 = f_cmd_v2;
   ds->p_set_rad = p_rad;
+  p_rad -= ds->p_turn_rad;
+  if (p_rad > 1.5f * FM_PI_F) {
+    ds->p_turn_rad += FM_TWO_PI_F;
+    p_rad -= FM_TWO_PI_F;
+  } else if (p_rad < -1.5f * FM_PI_F) {
+    ds->p_turn_rad -= FM_TWO_PI_F;
+    p_rad += FM_TWO_PI_F;
+  }
   /* A non-finite command (a NaN the supervisor has not caught yet: it looks once per
-   * block) drives nothing rather than a rail voltage; a P outside the +-2 pi that the
-   * phase conversion needs (NaN included: the comparison fails) leaves the phase. */
+   * block) drives nothing rather than a rail voltage; a P still outside the +-2 pi that
+   * the phase conversion needs (NaN included: the comparison fails) is replaced by 0
+   * and the turns are forgotten. */
   if (!(fm_absf(p_rad) < 6.28f)) {
     p_rad = 0.0f;
+    ds->p_turn_rad = 0.0f;
   }
   const float f = (f_cmd_v2 > 0.0f && fm_isfinite(f_cmd_v2)) ? f_cmd_v2 : 0.0f;
   if (ds->mode == GYRO_DRIVE_DC_AC) {

@@ -39,6 +39,7 @@ typedef struct {
   float a_v;         /* A, the voltage amplitude */
   uint32_t off;      /* phase offset added to the NCO phase: P/2 (half-freq) or P (DC+AC) */
   float f_set_v2, p_set_rad; /* the command as last passed to drive_synth_set (NaN: none) */
+  float p_turn_rad;  /* whole turns taken off P before the conversion (hysteresis) */
 } drive_synth_t;
 
 typedef struct {
@@ -54,7 +55,10 @@ int drive_synth_init(drive_synth_t *ds, const drive_synth_cfg_t *cfg);
 /* Largest force command the electrodes can deliver (Ks*V^2). */
 float drive_synth_f_cmd_max(const drive_synth_t *ds);
 
-/* A new force command (f_cmd in Ks*V^2, negative = 0; P in rad, |P| < 2 pi). */
+/* A new force command (f_cmd in Ks*V^2, negative = 0; P in rad). The conversion needs
+ * |P| < 2 pi: a P that moves continuously beyond +-1.5 pi is taken modulo 2 pi, with
+ * hysteresis, so that the voltages' sign flip of a whole turn of P (the force is
+ * unchanged, (6-25)) happens once, not on every noise crossing. */
 void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad);
 
 /* drive_synth_set, skipped when the command is the one last set (a NaN never is, and

@@ -8,6 +8,67 @@
 #include "dsp/fastmath.h"
 #include "gyro/gyro_block.h"
 
+/* The absolute over-amplitude trip, as a fraction of the ADC's range: the highest
+ * drive-pickoff amplitude the ADC still measures with headroom for the carrier's noise. */
+#define GYRO_AMP_MAX_FRAC 0.95f
+
+/* How long acquisition may take before it is a fault (ACQ_TIMEOUT): the drive mode
+ * rings up within a few time constants 2Q/wn at full force (10 of them here), the
+ * slower loop settles within three of its time constants after that, lock needs its
+ * hold time, and 0.1 s covers the demodulator and the noise. The loops' bandwidths are
+ * those of the gains in use (manual gains included): K kp / (2 pi tau) for the
+ * first-order loops of drive_loop.h. */
+static double acq_timeout_s(const param_values_t *v, double tau_s, const gyro_design_t *t)
+{
+  const double bw_amp = (double)v->drive_cal_gain_v_per_v2 * (double)t->drive.amp_kp /
+                        (2.0 * FM_PI * tau_s);
+  const double bw_ph = (double)t->drive.phase_kp / (2.0 * FM_PI * tau_s);
+  double bw = bw_amp < bw_ph ? bw_amp : bw_ph;
+  if (!(bw > 1e-3)) bw = 1e-3; /* a loop of no gain: the hour below */
+  const double t_s = 0.1 + 10.0 * tau_s + 3.0 / (2.0 * FM_PI * bw) + (double)v->sup_lock_hold_s;
+  return t_s < 3600.0 ? t_s : 3600.0; /* an hour: beyond it the part is not acquiring */
+}
+
+/* Largest |dB/dP| of the bias polynomial (absolute P, rate_channel.h) over the
+ * thermometer's range around p_ref, from nine points: how far a lag of P_f moves the
+ * compensation. */
+static double bias_slope_max(const param_values_t *v)
+{
+  const double c1 = v->rate_bias_c1_dps_per_deg, c2 = v->rate_bias_c2_dps_per_deg2;
+  const double c3 = v->rate_bias_c3_dps_per_deg3;
+  double m = 0.0;
+  for (int i = -4; i <= 4; i++) {
+    const double p = (double)v->drive_p_init_deg + 0.25 * i * (double)v->rate_p_range_deg;
+    const double d = fabs(c1 + 2.0 * c2 * p + 3.0 * c3 * p * p);
+    if (d > m) m = d;
+  }
+  return m;
+}
+
+/* The rate-valid monitors (rate_valid.h) and the analog fault level. The fault level
+ * must lie outside the span full scale x out_v_per_dps (with 10 % for the output
+ * stage's gain and offset), or a failed gyro could read as a rate. */
+static int design_validity(const param_values_t *v, gyro_design_t *t)
+{
+  const float span_v = v->rate_full_scale_dps * fm_absf(v->rate_out_v_per_dps);
+  if (!(fm_absf(v->rate_fault_out_v) > 1.1f * span_v)) return -1;
+  const double slope = bias_slope_max(v);
+  if (!isfinite(slope) || slope > 1e30) return -1;
+  const float sense_max_v = RATE_VALID_SENSE_FRAC * HAL_ADC_FULL_SCALE_V;
+  const float window_s = (float)(RATE_VALID_SLEW_UPDATES * RATE_P_DECIM) / (float)v->sys_fs_hz;
+  const rate_valid_cfg_t c = {v->rate_valid_tol_dps,
+                              v->rate_full_scale_dps,
+                              v->rate_p_range_deg,
+                              v->rate_p_slew_max_deg_s * window_s,
+                              (float)(1.0 / (2.0 * FM_PI * (double)v->rate_p_lpf_hz)) / window_s,
+                              sense_max_v * sense_max_v,
+                              v->sup_lock_phase_tol_deg * FM_RAD_PER_DEG_F,
+                              (float)slope};
+  t->valid = c;
+  t->rate_fault_out_v = v->rate_fault_out_v;
+  return 0;
+}
+
 int gyro_design(const param_values_t *v, gyro_design_t *d)
 {
   if (v == NULL || d == NULL) {
@@ -104,6 +165,13 @@ int gyro_design(const param_values_t *v, gyro_design_t *d)
   t.sup.sat_hold_s = v->sup_sat_hold_s;
   t.sup.retry_s = v->sup_retry_s;
   t.sup.clip_max_count = v->sup_clip_count;
+  t.sup.lost_phase_tol_rad = (v->sup_lost_phase_tol_deg > v->sup_lock_phase_tol_deg
+                                  ? v->sup_lost_phase_tol_deg
+                                  : v->sup_lock_phase_tol_deg) * FM_RAD_PER_DEG_F;
+  t.sup.amp_set_v = v->drive_amp_set_v;
+  t.sup.amp_max_v = GYRO_AMP_MAX_FRAC * HAL_ADC_FULL_SCALE_V;
+  t.sup.acq_timeout_s = (float)acq_timeout_s(v, tau, &t);
+  if (design_validity(v, &t) != 0) return -7;
   t.autostart = v->sys_autostart;
   {
     const double th = (double)v->drive_phase_set_deg * FM_PI / 180.0;
@@ -133,12 +201,16 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   if (nco_init(&t.nco, &d->nco) != 0 || lmsd_init(&t.lmsd_drive, &d->lmsd_drive) != 0 ||
       lmsd_init(&t.lmsd_sense, &d->lmsd_sense) != 0 || drive_loop_init(&t.drive, &d->drive) != 0 ||
       drive_synth_init(&t.synth, &d->synth) != 0 || rate_channel_init(&t.rate, &rc) != 0 ||
-      supervisor_init(&t.sup, &d->sup) != 0) {
+      supervisor_init(&t.sup, &d->sup) != 0 || rate_valid_init(&t.valid, &d->valid) != 0) {
     return -2;
   }
+  t.rate_fault_out_v = d->rate_fault_out_v;
+  t.rate_fault_code = gyro_volts_to_dac(d->rate_fault_out_v);
   t.adc_v_per_code = HAL_ADC_V_PER_CODE;
   selftest_init(&t.selftest, &d->selftest);
-  t.rate_code = (uint16_t)HAL_DAC_CODE_MID;
+  t.rate_code = t.rate_fault_code; /* not valid until the first verdict says so */
+  t.out.rate_out_v = t.rate_fault_out_v;
+  t.out.rate_invalid = RATE_INVALID_MODE;
   t.sup_in.state_finite = 1;
   t.weights_finite = 1u;
   t.rate_out_v_per_dps = d->rate_out_v_per_dps;
@@ -159,6 +231,19 @@ int gyro_init(gyro_t *g, const param_values_t *v)
   return gyro_init_from_design(g, &d);
 }
 
+/* Whether a new rate-channel configuration changes what the output means (reference,
+ * scale, compensation, output filter): then the output is not valid until the filters
+ * have settled again. */
+static int rate_path_same(const rate_channel_t *r, const rate_channel_cfg_t *c)
+{
+  int same = r->ref_re == c->ref_re && r->ref_im == c->ref_im && r->scale_dps == c->scale_dps &&
+             r->p_ref_deg == c->p_ref_deg && r->lpf_rate.num_sections == c->lpf_sections;
+  for (int i = 0; i < 4; i++) {
+    same = same && r->bias_c_dps[i] == c->bias_c_dps[i] && r->sf_c[i] == c->sf_c[i];
+  }
+  return same && memcmp(r->lpf_rate.coeffs, c->lpf, c->lpf_sections * sizeof c->lpf[0]) == 0;
+}
+
 void gyro_apply(gyro_t *g, const gyro_design_t *d)
 {
   /* Coefficients only: the loop state carries on (bumpless). The design was validated
@@ -167,6 +252,13 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
    * instead of letting the lost-lock detector trip on the step. */
   if (fm_absf(d->drive.amp_set_v - g->drive.amp_set_v) > g->sup.lock_tol_rel * g->drive.amp_set_v) {
     supervisor_reacquire(&g->sup);
+  }
+  /* A new phase setpoint moves P by the same angle (arg Z = P - the mode's phase): that
+   * is no change of temperature, so the thermometer moves with it at once rather than
+   * gliding through its low-pass (which would read as a slew). */
+  const float dphase_rad = d->drive.phase_set_rad - g->drive.phase_set_rad;
+  if (dphase_rad != 0.0f && supervisor_drive_enabled(&g->sup)) {
+    rate_channel_shift_p(&g->rate, dphase_rad * FM_DEG_PER_RAD_F);
   }
   g->nco.half_step = d->nco_half_step;
   (void)lmsd_set_mu(&g->lmsd_drive, d->lmsd_drive.mu);
@@ -182,8 +274,14 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   }
   rate_channel_cfg_t rc = d->rate;
   rc.lpf = d->rate_lpf;
+  if (!rate_path_same(&g->rate, &rc)) {
+    rate_valid_disturb(&g->valid); /* the output filters settle again */
+  }
   (void)rate_channel_retune(&g->rate, &rc);
   supervisor_retune(&g->sup, &d->sup);
+  rate_valid_retune(&g->valid, &d->valid);
+  g->rate_fault_out_v = d->rate_fault_out_v;
+  g->rate_fault_code = gyro_volts_to_dac(d->rate_fault_out_v);
   g->rate_out_v_per_dps = d->rate_out_v_per_dps;
   g->f_cmd_max_v2 = d->drive.f_cmd_max_v2;
 }
@@ -231,13 +329,13 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
   lmsd_step(&g->lmsd_sense, v_sense, ref.sin_wc, ref.cos_wc);
   rate_channel_accumulate(&g->rate, g->lmsd_sense.w_i, g->lmsd_sense.w_q);
 
-  /* Consecutive rail codes, counted per sample: clipping is judged on the longest run. */
-  if (adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN ||
-      adc->sense == HAL_ADC_CODE_MAX || adc->sense == HAL_ADC_CODE_MIN) {
+  /* Rail codes, counted per block: a waveform clipped only at its peaks has a few per
+   * carrier cycle and never a long run, yet its demodulated phasor is wrong. */
+  if (GYRO_UNLIKELY(adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN ||
+                    adc->sense == HAL_ADC_CODE_MAX || adc->sense == HAL_ADC_CODE_MIN)) {
     g->flags_acc |= GYRO_FLAG_ADC_RAIL;
-    if (++g->clip_run > g->clip_run_max) g->clip_run_max = g->clip_run;
-  } else {
-    g->clip_run = 0u;
+    g->clip_count++;
+    if (adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN) g->clip_drive_count++;
   }
 
   /* The waveform of the command last set: by the loops (ACQUIRE, LOCKED, once per

@@ -30,6 +30,7 @@
 #include "gyro/drive_loop.h"
 #include "gyro/drive_synth.h"
 #include "gyro/rate_channel.h"
+#include "gyro/rate_valid.h"
 #include "gyro/selfcal_exec.h"
 #include "gyro/selftest.h"
 #include "gyro/supervisor.h"
@@ -49,6 +50,8 @@ typedef struct {
   rate_channel_cfg_t rate;
   biquad_coeffs_t rate_lpf[BIQUAD_MAX_SECTIONS];
   supervisor_cfg_t sup;
+  rate_valid_cfg_t valid;
+  float rate_fault_out_v;  /* analog rate output while the rate is not valid */
   drive_loop_design_out_t amp_design, phase_design; /* what the designer achieved */
   float rate_out_v_per_dps;
   uint32_t autostart;
@@ -71,6 +74,9 @@ typedef struct {
   uint32_t mode;         /* gyro_mode_t */
   uint32_t fault;        /* gyro_fault_t bits of the last fault */
   uint32_t flags;        /* GYRO_FLAG_* */
+  uint32_t rate_invalid; /* RATE_INVALID_* reasons of this block (0: valid) */
+  float rate_out_v;      /* voltage commanded on the analog rate output this block */
+  uint32_t rate_valid; /* 1 when the rate output can be trusted (output integrity), else 0 */
 } gyro_out_t;
 
 #define GYRO_FLAG_LOCKED (1u << 0)
@@ -78,6 +84,9 @@ typedef struct {
 #define GYRO_FLAG_DRIVE_LIMIT (1u << 2)
 #define GYRO_FLAG_FAULT (1u << 3)
 #define GYRO_FLAG_SELFTEST (1u << 4) /* the self-test force is on: rate output not valid */
+#define GYRO_FLAG_RATE_VALID (1u << 5) /* the rate output can be trusted (rate_valid.h) */
+#define GYRO_FLAG_OVER_RANGE (1u << 6) /* |rate| above rate.full_scale_dps */
+#define GYRO_FLAG_SENSE_RANGE (1u << 7) /* sense pickoff near the ADC's range (warning) */
 
 typedef struct {
   float adc_v_per_code;
@@ -90,13 +99,18 @@ typedef struct {
   supervisor_t sup;
   float f_cmd_max_v2;
   uint32_t slot;         /* tick within the block, 0 .. GYRO_BLOCK - 1 */
-  uint32_t clip_run;     /* consecutive ADC rail codes up to this tick */
-  uint32_t clip_run_max; /* longest run reaching into the current supervisor period */
+  uint32_t clip_count;   /* ADC rail codes since the block's projection (slot 5) */
+  uint32_t clip_block;   /* rail codes over the ticks of the latest projected block */
+  uint32_t clip_drive_count, clip_drive_block; /* the same, drive channel only */
+  uint32_t sample_lost;  /* set by the application when the HAL reports a lost sample */
   uint32_t flags_acc;    /* GYRO_FLAG_* seen since the last snapshot */
   supervisor_in_t sup_in; /* the supervisor's evidence, gathered by the jobs before
                            * GYRO_SLOT_SUPERVISE (slot table above) */
   uint32_t weights_finite; /* first half of the finiteness check (GYRO_SLOT_AMP) */
   uint16_t rate_code;    /* analog rate output DAC code, updated with the snapshot */
+  uint16_t rate_fault_code; /* its code at the fault level */
+  float rate_fault_out_v;
+  rate_valid_t valid;    /* the rate-valid verdict and its monitors */
   selftest_t selftest;
   gyro_out_t out;        /* updated once per block (tick: every tick) */
   /* Last, so that what the sample path reads every block stays within the reach of
@@ -127,10 +141,13 @@ typedef struct {
  *         (or, on request, the loop state cleared)
  *   6     rate: output filter, scale, compensation        projection (5), P_f (8, last block)
  *   7     finiteness check, second half (loop and rate    weights' half (2)
- *         outputs) and verdict; quadrature filter         projection (5)
+ *         outputs) and verdict; quadrature filter;        projection (5)
+ *         the filters' settling (rate_valid.h)            rate filter (6)
  *   8     P's hold and low-pass (its mean every 10th      P (1)
- *         block); the self-test sequence while it runs    projection (5)
- *   9     output snapshot, analog rate code               everything
+ *         block); the self-test sequence while it runs;   projection (5)
+ *         the thermometer checks at each new P_f          P_f (8)
+ *   9     rate-valid verdict, output snapshot, analog     everything
+ *         rate code (the fault level when not valid)
  *
  * The drive command thus reaches the DAC (COMMAND + 1 - slot) ticks after the sample
  * the loop measured: 4 for the phase loop, 2 for the amplitude loop; gyro_design adds

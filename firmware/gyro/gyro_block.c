@@ -28,11 +28,16 @@ void gyro_block_command(gyro_t *g)
   const int drive_on = supervisor_drive_enabled(&g->sup);
   si->amp_rel = g->drive.amp_v * g->drive.inv_amp_set; /* the slewed setpoint's */
   si->amp_rel_err = si->amp_rel - 1.0f;
+  si->setpoint_moving = drive_loop_slewing(&g->drive);
   si->phase_err_rad = g->drive.phase_err_rad;
   si->drive_at_limit = drive_on && g->drive.f_cmd_v2 >= g->f_cmd_max_v2;
   if (si->drive_at_limit) g->flags_acc |= GYRO_FLAG_DRIVE_LIMIT;
-  si->clip_run = g->clip_run_max;
-  g->clip_run_max = g->clip_run; /* a run still going carries into the next block */
+  /* The drive loops' fault is a clipped drive channel. A clipped sense channel (too much
+   * quadrature, rate or vibration for its gain) leaves the drive sound: the rate is not
+   * valid then (rate_valid.h, CLIP), but the drive keeps running. */
+  si->clip_count = g->clip_drive_block;
+  si->sample_lost = (int)g->sample_lost;
+  g->sample_lost = 0u;
   /* Once per block, after both loops: the square root and the phase conversion. */
   if (drive_on) {
     drive_synth_set(&g->synth, g->drive.f_cmd_v2, g->drive.p_rad);
@@ -49,19 +54,44 @@ void gyro_block_clear(gyro_t *g)
   drive_synth_set(&g->synth, 0.0f, g->drive.p_rad);
 }
 
+void gyro_block_phase(gyro_t *g)
+{
+  drive_loop_update_phase(&g->drive);
+  if (GYRO_UNLIKELY(g->drive.p_turn_rad != 0.0f)) {
+    /* A whole turn of P is no change of temperature: the thermometer moves with it,
+     * and the filters settle again after the jump of the rate reference's correction. */
+    rate_channel_shift_p(&g->rate, g->drive.p_turn_rad * FM_DEG_PER_RAD_F);
+    g->drive.p_turn_rad = 0.0f;
+    rate_valid_disturb(&g->valid);
+  }
+}
+
 void gyro_block_quad(gyro_t *g)
 {
   const float sum = g->drive.f_cmd_v2 + g->drive.p_rad + g->rate.rate_dps + g->rate.quad_dps;
   g->sup_in.state_finite = g->weights_finite != 0u && fm_isfinite(sum);
-  rate_channel_filter_quad(&g->rate);
+  rate_channel_t *rc = &g->rate;
+  rate_channel_filter_quad(rc);
+  rate_valid_settling(&g->valid, rc->rate_raw, rc->quad_raw, rc->rate_unc_dps, rc->quad_dps,
+                      rc->scale_dps);
+}
+
+void gyro_block_p(gyro_t *g, int hold)
+{
+  rate_channel_t *rc = &g->rate;
+  rate_channel_hold_p(rc, hold);
+  if (rate_channel_update_p(rc, g->drive.p_rad) != 0) {
+    rate_valid_thermo(&g->valid, rc->p_dev_deg, rc->p_held_dev_deg, rc->p_held_w, rc->quad_dps);
+  }
 }
 
 void gyro_block_p_selftest(gyro_t *g)
 {
   const int locked = g->sup.mode == GYRO_MODE_LOCKED;
   selftest_update(&g->selftest, locked, g->rate.rate_raw);
-  rate_channel_hold_p(&g->rate, !locked);
-  rate_channel_update_p(&g->rate, g->drive.p_rad);
+  /* The test force disturbs the rate output: its filters settle again afterwards. */
+  rate_valid_disturb(&g->valid);
+  gyro_block_p(g, !locked);
 }
 
 /* The snapshot for telemetry and status, at fs / GYRO_BLOCK (5 kHz: the telemetry's
@@ -69,7 +99,27 @@ void gyro_block_p_selftest(gyro_t *g)
 void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
 {
   gyro_out_t *o = &g->out;
-  g->rate_code = gyro_volts_to_dac(g->rate.rate_dps * g->rate_out_v_per_dps);
+  const rate_valid_in_t vin = {g->sup.mode == GYRO_MODE_LOCKED,
+                               selftest_running(&g->selftest),
+                               g->clip_block,
+                               g->lmsd_sense.w_i * g->lmsd_sense.w_i +
+                                   g->lmsd_sense.w_q * g->lmsd_sense.w_q,
+                               g->rate.rate_dps,
+                               g->rate.quad_dps,
+                               g->sup.phase_err_f};
+  const uint32_t invalid = rate_valid_verdict(&g->valid, &vin);
+  /* Never a valid-looking wrong rate: the analog output goes to the fault level in the
+   * same sample as the verdict, without a slew. */
+  float out_v = g->rate_fault_out_v;
+  uint16_t code = g->rate_fault_code;
+  if (invalid == 0u) {
+    out_v = g->rate.rate_dps * g->rate_out_v_per_dps;
+    code = gyro_volts_to_dac(out_v);
+  }
+  g->rate_code = code;
+  o->rate_out_v = out_v;
+  o->rate_invalid = invalid;
+  o->rate_valid = invalid == 0u ? 1u : 0u;
   o->rate_dps = g->rate.rate_dps;
   o->rate_unc_dps = g->rate.rate_unc_dps;
   o->quad_dps = g->rate.quad_dps;
@@ -86,7 +136,10 @@ void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
   o->fault = g->sup.fault;
   if (selftest_running(&g->selftest)) g->flags_acc |= GYRO_FLAG_SELFTEST;
   o->flags = (g->sup.mode == GYRO_MODE_LOCKED ? GYRO_FLAG_LOCKED : 0u) | g->flags_acc |
-             (g->sup.mode == GYRO_MODE_FAULT ? GYRO_FLAG_FAULT : 0u);
+             (g->sup.mode == GYRO_MODE_FAULT ? GYRO_FLAG_FAULT : 0u) |
+             (invalid == 0u ? GYRO_FLAG_RATE_VALID : 0u) |
+             ((invalid & RATE_INVALID_OVER_RANGE) != 0u ? GYRO_FLAG_OVER_RANGE : 0u) |
+             ((invalid & RATE_INVALID_SENSE_RANGE) != 0u ? GYRO_FLAG_SENSE_RANGE : 0u);
   g->flags_acc = 0u;
 }
 

@@ -33,6 +33,11 @@ void gyro_block_clear(gyro_t *g);
  * outputs) and its verdict for the supervisor (sup_in: the next block's supervisor acts
  * on it), then the quadrature's output filter. */
 void gyro_block_quad(gyro_t *g);
+/* GYRO_SLOT_PHASE_PI: the phase loop's update; a whole turn of P it took is passed on to
+ * the thermometer (rate_channel_shift_p). */
+void gyro_block_phase(gyro_t *g);
+/* GYRO_SLOT_P: P's hold and low-pass, the thermometer checks at each new P_f. */
+void gyro_block_p(gyro_t *g, int hold);
 /* GYRO_SLOT_P while a self-test runs: its sequence on the block's projection, then P's
  * hold and low-pass. */
 void gyro_block_p_selftest(gyro_t *g);
@@ -52,7 +57,7 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
     if (drive_on) drive_loop_measure_phase(&g->drive, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
     break;
   case GYRO_SLOT_PHASE_PI:
-    if (drive_on) drive_loop_update_phase(&g->drive);
+    if (drive_on) gyro_block_phase(g);
     break;
   case GYRO_SLOT_AMP:
     gyro_block_amp(g);
@@ -66,6 +71,11 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
     break;
   case GYRO_SLOT_PROJECT:
     /* The clear resets the rate channel, whose projection waits for the next block. */
+    /* The rail codes of the ticks whose sense sum is projected now. */
+    g->clip_block = g->clip_count;
+    g->clip_count = 0u;
+    g->clip_drive_block = g->clip_drive_count;
+    g->clip_drive_count = 0u;
     if (g->sup.clear_req != 0u) {
       gyro_block_clear(g);
     } else {
@@ -82,8 +92,7 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
     if (selftest_running(&g->selftest)) {
       gyro_block_p_selftest(g);
     } else {
-      rate_channel_hold_p(&g->rate, g->sup.mode != GYRO_MODE_LOCKED);
-      rate_channel_update_p(&g->rate, g->drive.p_rad);
+      gyro_block_p(g, g->sup.mode != GYRO_MODE_LOCKED);
     }
     break;
   default: /* GYRO_SLOT_OUTPUT */

@@ -101,6 +101,9 @@ void rate_channel_reset(rate_channel_t *rc, float p_deg)
   rc->p_acc_deg = 0.0f;
   rc->p_count = 0u;
   rc->p_dev_deg = p_deg - rc->p_ref_deg;
+  rc->p_mean_dev_deg = rc->p_dev_deg;
+  rc->p_held_dev_deg = rc->p_dev_deg;
+  rc->p_held_w = 0.0f;
   rc->p_mode_rad = rc->p_dev_deg * FM_RAD_PER_DEG_F;
   rc->p_f_deg = p_deg;
   rc->rate_dps = 0.0f;
@@ -157,12 +160,24 @@ void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad)
   rate_channel_filter_quad(rc);
 }
 
-void rate_channel_update_p(rate_channel_t *rc, float p_rad)
+void rate_channel_shift_p(rate_channel_t *rc, float shift_deg)
+{
+  rc->p_dev_deg += shift_deg;
+  rc->p_f_deg += shift_deg;
+  rc->p_mean_dev_deg += shift_deg;
+  rc->p_held_dev_deg += shift_deg;
+  rc->p_acc_deg += shift_deg * (float)rc->p_count;
+  rc->p_mode_rad += shift_deg * FM_RAD_PER_DEG_F;
+}
+
+int rate_channel_update_p(rate_channel_t *rc, float p_rad)
 {
   if (rc->p_hold != 0u) {
     rc->p_acc_deg = 0.0f;
     rc->p_count = 0u;
     rc->p_n = 0u;
+    rc->p_held_dev_deg = rc->p_dev_deg;
+    rc->p_held_w = 1.0f;
   } else {
     rc->p_acc_deg += p_rad * FM_DEG_PER_RAD_F - rc->p_ref_deg;
     if (++rc->p_count == 1u && rc->p_n < RATE_P_FAST_MAX) {
@@ -186,11 +201,17 @@ void rate_channel_update_p(rate_channel_t *rc, float p_rad)
           rc->p_n = RATE_P_FAST_MAX; /* the low-pass from here on */
         }
       }
+      /* Both the running mean and the low-pass scale what the held value still weighs
+       * by (1 - a): it tells how far P_f may still be from P (rate_valid_thermo). */
+      rc->p_held_w *= 1.0f - a;
       rc->p_dev_deg += a * (mean - rc->p_dev_deg);
+      rc->p_mean_dev_deg = mean;
       rc->p_f_deg = rc->p_ref_deg + rc->p_dev_deg;
       rc->p_acc_deg = 0.0f;
       rc->p_count = 0u;
+      return 1;
     }
   }
+  return 0;
 }
 

@@ -70,6 +70,9 @@ typedef struct {
   float p_acc_deg;            /* sum of (P - p_ref), one sample per block, over RATE_P_DECIM ticks */
   uint32_t p_count;
   float p_dev_deg;            /* low-passed P - p_ref */
+  float p_mean_dev_deg;       /* the latest mean of P - p_ref the low-pass took */
+  float p_held_dev_deg;       /* P_f - p_ref while held: where the fast start began */
+  float p_held_w;             /* weight the held value still has in P_f (1 while held) */
   float p_mode_k;
   float p_mode_rad;           /* P - p_ref through the mode's lag, rad */
   float min_drive_v2;
@@ -136,6 +139,10 @@ void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad);
 void rate_channel_project(rate_channel_t *rc, float d_s, float d_c, float p_rad);
 void rate_channel_filter_rate(rate_channel_t *rc);
 void rate_channel_filter_quad(rate_channel_t *rc);
-void rate_channel_update_p(rate_channel_t *rc, float p_rad);
+/* Returns 1 when it made a new P_f (every RATE_P_DECIM ticks while not held), else 0. */
+int rate_channel_update_p(rate_channel_t *rc, float p_rad);
+/* P jumped by shift_deg without a change of temperature (the phase loop wrapped its
+ * state by a whole turn, drive_loop.h): P_f and its average move with it. */
+void rate_channel_shift_p(rate_channel_t *rc, float shift_deg);
 
 #endif /* RATE_CHANNEL_H */

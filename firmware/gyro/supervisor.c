@@ -14,7 +14,11 @@ int supervisor_init(supervisor_t *sv, const supervisor_cfg_t *cfg)
 {
   if (sv == NULL || cfg == NULL || !(cfg->dt_s > 0.0f) || !(cfg->lock_tol_rel > 0.0f) ||
       !(cfg->lost_tol_rel >= cfg->lock_tol_rel) || !(cfg->lock_phase_tol_rad > 0.0f) ||
+      !(cfg->lost_phase_tol_rad >= cfg->lock_phase_tol_rad) ||
       !(cfg->amp_trip_rel > 1.0f + cfg->lost_tol_rel) || !(cfg->lock_hold_s >= 0.0f) ||
+      !(cfg->amp_set_v > 0.0f) ||
+      !(cfg->amp_max_v > cfg->amp_set_v) ||
+      !(cfg->acq_timeout_s > cfg->lock_hold_s) || !(cfg->acq_timeout_s < 1e4f) ||
       !(cfg->lost_hold_s >= 0.0f) || !(cfg->sat_hold_s >= 0.0f) || !(cfg->retry_s >= 0.0f) ||
       !(cfg->lock_hold_s < 1e4f && cfg->lost_hold_s < 1e4f && cfg->sat_hold_s < 1e4f &&
         cfg->retry_s < 1e4f) ||
@@ -28,9 +32,13 @@ int supervisor_init(supervisor_t *sv, const supervisor_cfg_t *cfg)
   sv->fault = GYRO_FAULT_NONE;
   sv->fault_count = 0u;
   sv->last_fault = GYRO_FAULT_NONE;
-  sv->last_fault_step = sv->steps = 0u;
-  sv->in_tol_ticks = sv->out_tol_ticks = sv->sat_ticks = 0u;
+  sv->last_fault_step = 0u;
+  sv->in_tol_ticks = sv->out_tol_ticks = sv->out_phase_ticks = sv->sat_ticks = 0u;
   sv->fault_ticks = sv->mode_ticks = 0u;
+  sv->clip_sum = sv->clip_pos = 0u;
+  sv->steps = 0u;
+  for (uint32_t i = 0; i < GYRO_CLIP_WINDOW; i++) sv->clip_window[i] = 0u;
+  for (uint32_t i = 0; i < GYRO_FAULT_KINDS; i++) sv->kind_count[i] = sv->kind_last_step[i] = 0u;
   supervisor_retune(sv, cfg);
   return 0;
 }
@@ -43,11 +51,15 @@ void supervisor_retune(supervisor_t *sv, const supervisor_cfg_t *cfg)
   sv->lost_ticks_needed = ticks_of(cfg->lost_hold_s, cfg->dt_s);
   sv->sat_ticks_needed = ticks_of(cfg->sat_hold_s, cfg->dt_s);
   sv->retry_ticks = ticks_of(cfg->retry_s, cfg->dt_s);
+  sv->acq_ticks_max = ticks_of(cfg->acq_timeout_s, cfg->dt_s);
   sv->clip_max_count = cfg->clip_max_count;
   sv->lock_tol_rel = cfg->lock_tol_rel;
   sv->lock_phase_tol_rad = cfg->lock_phase_tol_rad;
   sv->lost_tol_rel = cfg->lost_tol_rel;
-  sv->amp_trip_rel = cfg->amp_trip_rel;
+  sv->lost_phase_tol_rad = cfg->lost_phase_tol_rad;
+  /* One relative trip for the sample path: the lower of the two limits. */
+  const float abs_rel = cfg->amp_max_v / cfg->amp_set_v;
+  sv->amp_trip_rel = cfg->amp_trip_rel < abs_rel ? cfg->amp_trip_rel : abs_rel;
 }
 
 static void set_mode(supervisor_t *sv, gyro_mode_t m)
@@ -55,7 +67,7 @@ static void set_mode(supervisor_t *sv, gyro_mode_t m)
   sv->primed = 0u;
   sv->mode = m;
   sv->mode_ticks = 0u;
-  sv->in_tol_ticks = sv->out_tol_ticks = sv->sat_ticks = 0u;
+  sv->in_tol_ticks = sv->out_tol_ticks = sv->out_phase_ticks = sv->sat_ticks = 0u;
 }
 
 void supervisor_start(supervisor_t *sv)
@@ -84,20 +96,39 @@ static int trip(supervisor_t *sv, uint32_t reason)
   sv->last_fault = reason;
   sv->last_fault_step = sv->steps;
   sv->fault_count++;
+  for (uint32_t i = 0; i < GYRO_FAULT_KINDS; i++) {
+    if ((reason & (1u << i)) != 0u) {
+      sv->kind_count[i]++;
+      sv->kind_last_step[i] = sv->steps;
+    }
+  }
   sv->fault_ticks = 0u;
   set_mode(sv, GYRO_MODE_FAULT);
   sv->clear_req = 1u;
   return 1;
 }
 
-/* Which of the faults that act in every mode but OFF the evidence shows, in order of
- * precedence: NaN, clipping, over-amplitude (not in SWEEP); 0 for none. A NaN anywhere
- * would otherwise stay in the integrators forever; clipping makes the demodulated
- * amplitude meaningless. */
-static uint32_t fault_seen(const supervisor_t *sv, const supervisor_in_t *in, gyro_mode_t mode)
+/* Rail codes over the last GYRO_CLIP_WINDOW steps (a running sum over a ring). */
+static uint32_t clip_window_sum(supervisor_t *sv, uint32_t count)
 {
+  const uint32_t pos = sv->clip_pos;
+  sv->clip_sum += count - sv->clip_window[pos];
+  sv->clip_window[pos] = count;
+  sv->clip_pos = pos + 1u == GYRO_CLIP_WINDOW ? 0u : pos + 1u;
+  return sv->clip_sum;
+}
+
+/* Which of the faults that act in every mode but OFF the evidence shows, in order of
+ * precedence: NaN, lost sample, clipping, over-amplitude (not in SWEEP); 0 for none. A
+ * NaN anywhere would otherwise stay in the integrators forever; a lost sample shifts
+ * the NCO against the converters (one sample is 10.7 deg of carrier at 1490 Hz);
+ * clipping makes the demodulated amplitude meaningless. */
+static uint32_t fault_seen(supervisor_t *sv, const supervisor_in_t *in, gyro_mode_t mode)
+{
+  const uint32_t clips = clip_window_sum(sv, in->clip_count);
   if (!in->state_finite) return GYRO_FAULT_NAN;
-  if (in->clip_run >= sv->clip_max_count) return GYRO_FAULT_ADC_CLIP;
+  if (in->sample_lost) return GYRO_FAULT_LOST_SAMPLE;
+  if (clips >= sv->clip_max_count) return GYRO_FAULT_ADC_CLIP;
   if (mode != GYRO_MODE_SWEEP && in->amp_rel > sv->amp_trip_rel) return GYRO_FAULT_OVER_AMP;
   return GYRO_FAULT_NONE;
 }
@@ -121,17 +152,27 @@ static int step_driving(supervisor_t *sv, const supervisor_in_t *in, gyro_mode_t
   sv->amp_err_f = ea;
   sv->phase_err_f = ep;
   const float ae = fm_absf(ea);
+  const float pe = fm_absf(ep);
   if (mode == GYRO_MODE_LOCKED) {
+    /* Amplitude and phase each have their own count: a drive that holds its amplitude
+     * while its phase has run off (a phase loop at a dead end) is not locked either. */
     sv->out_tol_ticks = (ae > sv->lost_tol_rel) ? sv->out_tol_ticks + 1u : 0u;
+    sv->out_phase_ticks = (pe > sv->lost_phase_tol_rad) ? sv->out_phase_ticks + 1u : 0u;
     sv->sat_ticks = in->drive_at_limit ? sv->sat_ticks + 1u : 0u;
     if (sv->out_tol_ticks >= sv->lost_ticks_needed) return trip(sv, GYRO_FAULT_LOST_LOCK);
+    if (sv->out_phase_ticks >= sv->lost_ticks_needed) return trip(sv, GYRO_FAULT_PHASE_LOST);
     if (sv->sat_ticks >= sv->sat_ticks_needed) return trip(sv, GYRO_FAULT_DRIVE_SAT);
   } else {
-    const float pe = fm_absf(ep);
     sv->in_tol_ticks = (ae <= sv->lock_tol_rel && pe <= sv->lock_phase_tol_rad)
                            ? sv->in_tol_ticks + 1u : 0u;
     if (sv->in_tol_ticks >= sv->lock_ticks_needed) {
       set_mode(sv, GYRO_MODE_LOCKED);
+    } else if (in->setpoint_moving) {
+      sv->mode_ticks = 0u;
+    } else if (sv->mode_ticks >= sv->acq_ticks_max) {
+      /* Whatever held it back (the drive pinned at its limit included), acquisition
+       * has taken longer than the loops' design allows. */
+      return trip(sv, in->drive_at_limit ? GYRO_FAULT_DRIVE_SAT : GYRO_FAULT_ACQ_TIMEOUT);
     }
   }
   return 0;

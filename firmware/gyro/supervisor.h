@@ -1,10 +1,18 @@
 /* Supervisor: operating modes and faults of the gyro.
  *
  *   OFF -> (start) -> ACQUIRE -> (amplitude and phase inside tolerance for lock_hold_s)
- *   -> LOCKED -> (outside lost tolerance for lost_hold_s, or the amplitude loop pinned
- *   at the drive limit for sat_hold_s) -> FAULT
- *   any mode -> FAULT at once on: over-amplitude (structure protection), ADC clipping
- *   (clip_max_count consecutive rail codes), a non-finite value in the loop state.
+ *   -> LOCKED -> (amplitude outside lost tolerance for lost_hold_s: LOST_LOCK; phase
+ *   error beyond lost_phase_tol for lost_hold_s: PHASE_LOST; the amplitude loop pinned
+ *   at the drive limit for sat_hold_s: DRIVE_SAT) -> FAULT
+ *   ACQUIRE -> FAULT (ACQ_TIMEOUT) when lock is not reached within acq_timeout_s, a time
+ *   the designer derives from the mode's time constant and the loop bandwidths: a part
+ *   the loops cannot hold (resonance out of reach, drive pinned at its limit, a
+ *   setpoint the drive cannot reach) faults instead of acquiring for ever.
+ *   any mode -> FAULT at once on: over-amplitude (above amp_trip_rel times the setpoint,
+ *   or above amp_max_v, an absolute level the ADC can still measure: structure
+ *   protection whatever the setpoint), drive ADC clipping (clip_max_count rail codes
+ *   within a window of GYRO_CLIP_WINDOW supervisor steps), a non-finite value in the loop state,
+ *   a lost sample (the NCO's phase then no longer matches the converters').
  *   FAULT: drive off for retry_s (the drive mode rings down with tau = 2Q/wn), loop state
  *   cleared, then ACQUIRE again by itself. SWEEP belongs to self-calibration.
  * Lock is judged on the amplitude and phase errors low-passed at about 100 Hz: the
@@ -35,14 +43,27 @@ typedef enum {
   GYRO_FAULT_NAN = 1u << 1,
   GYRO_FAULT_LOST_LOCK = 1u << 2,
   GYRO_FAULT_DRIVE_SAT = 1u << 3,
-  GYRO_FAULT_OVER_AMP = 1u << 4
+  GYRO_FAULT_OVER_AMP = 1u << 4,
+  GYRO_FAULT_PHASE_LOST = 1u << 5,
+  GYRO_FAULT_ACQ_TIMEOUT = 1u << 6,
+  GYRO_FAULT_LOST_SAMPLE = 1u << 7
 } gyro_fault_t;
+#define GYRO_FAULT_KINDS 8u
+
+/* Supervisor steps (blocks) over which rail codes are counted against clip_max_count:
+ * 2 ms, about three carrier cycles, so that a waveform clipped only at its peaks (a
+ * few codes per cycle, never a long run) is seen as well as a rail held. */
+#define GYRO_CLIP_WINDOW 10u
 
 typedef struct {
   float dt_s;
   float lock_tol_rel, lock_phase_tol_rad, lock_hold_s;
   float lost_tol_rel, lost_hold_s;
+  float lost_phase_tol_rad;
   float amp_trip_rel;
+  float amp_max_v;     /* absolute over-amplitude trip, V of drive pickoff */
+  float amp_set_v;     /* the setpoint amp_trip_rel multiplies */
+  float acq_timeout_s;
   float sat_hold_s;
   float retry_s;
   uint32_t clip_max_count;
@@ -55,12 +76,19 @@ typedef struct {
   uint32_t fault_count;    /* faults since power-on */
   uint32_t last_fault;     /* history: reason of the latest fault, kept by a clear */
   uint32_t last_fault_step; /* steps count when it tripped */
-  uint32_t steps;          /* supervisor_step calls since init (wraps after 9.9 days) */
   uint32_t lock_ticks_needed, lost_ticks_needed, sat_ticks_needed, retry_ticks;
+  uint32_t acq_ticks_max;
   uint32_t clip_max_count;
-  float lock_tol_rel, lock_phase_tol_rad, lost_tol_rel, amp_trip_rel;
+  float lock_tol_rel, lock_phase_tol_rad, lost_tol_rel, lost_phase_tol_rad;
+  float amp_trip_rel;      /* relative to the setpoint: min(amp_trip_rel A_set, amp_max_v) / A_set */
+  uint32_t clip_window[GYRO_CLIP_WINDOW]; /* rail codes of the last steps */
+  uint32_t clip_sum, clip_pos;
+  uint32_t steps;          /* supervisor steps since power-on (the fault history's clock) */
+  uint32_t kind_count[GYRO_FAULT_KINDS];     /* faults of each kind (bit n of gyro_fault_t) */
+  uint32_t kind_last_step[GYRO_FAULT_KINDS]; /* step of each kind's latest fault */
   uint32_t in_tol_ticks;   /* consecutive ticks inside lock tolerance */
   uint32_t out_tol_ticks;  /* consecutive ticks outside lost tolerance while LOCKED */
+  uint32_t out_phase_ticks; /* consecutive ticks beyond the lost phase tolerance */
   uint32_t sat_ticks;
   uint32_t fault_ticks;    /* ticks spent in FAULT */
   uint32_t mode_ticks;     /* ticks spent in the current mode */
@@ -77,9 +105,11 @@ typedef struct {
   float amp_rel;       /* A / A_set */
   float phase_err_rad;
   int drive_at_limit;  /* amplitude PI pinned at its maximum */
-  uint32_t clip_run;   /* longest run of consecutive ADC rail codes (either channel)
-                        * that reached into the period since the last step */
+  uint32_t clip_count;  /* drive-channel ADC rail codes since the last step */
   int state_finite;    /* every loop state value finite */
+  int sample_lost;     /* a sample was lost since the last step */
+  int setpoint_moving; /* the amplitude setpoint is slewing to a new value (drive_loop.h):
+                        * acquisition is timed from the end of the move */
 } supervisor_in_t;
 
 /* Returns 0, or -1 (nothing changed) for a bad configuration. */

@@ -31,7 +31,7 @@
 #ifndef PARAM_LIST_H
 #define PARAM_LIST_H
 
-#define PARAM_LAYOUT_VERSION 3u
+#define PARAM_LAYOUT_VERSION 4u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -131,6 +131,23 @@
   /* 7.2.4: 7.25 mV/(deg/s) at the analog output */ \
   X(rate_out_v_per_dps, 0x030Du, "rate.out_v_per_dps", F32, "V/(deg/s)", -1.0f, 1.0f, 0.00725f, 0u, \
     PF_PERSIST | PF_LIVE, "analog rate output scale on the DAC") \
+  /* outside the valid span (full scale x out_v_per_dps: 2.2 V), inside the DAC's 15 V:
+   * a failed gyro never reads as one at rest (0 V), as automotive rate sensors do */ \
+  X(rate_fault_out_v, 0x030Eu, "rate.fault_out_v", F32, "V", -14.0f, 14.0f, -10.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "analog rate output whenever the rate is not valid") \
+  /* the thesis's +-300 deg/s range (its rate table stops at 160) */ \
+  X(rate_full_scale_dps, 0x030Fu, "rate.full_scale_dps", F32, "deg/s", 1.0f, 10000.0f, 300.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "full scale: above it the rate is flagged over range and not valid") \
+  /* a quarter of the 1 deg/s the output-integrity battery allows, each source alone */ \
+  X(rate_valid_tol_dps, 0x0311u, "rate.valid_tol_dps", F32, "deg/s", 0.01f, 100.0f, 0.25f, 0u, \
+    PF_PERSIST | PF_LIVE, "largest rate error a monitored source (phase, thermometer, settling) may leave while valid") \
+  /* 8 deg of P is about +-100 K on the air part (0.0765 deg/K): the default covers its
+   * whole -40..85 degC; a calibration narrows it to the range it was fitted over */ \
+  X(rate_p_range_deg, 0x0312u, "rate.p_range_deg", F32, "deg", 0.01f, 180.0f, 8.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "thermometer range: largest |P_f - drive.p_init_deg| the compensation holds for") \
+  /* 0.05 deg/s of P: 0.65 K/s on the air part, far above any thermal ramp it was run on */ \
+  X(rate_p_slew_max_deg_s, 0x0313u, "rate.p_slew_max_deg_s", F32, "deg/s", 0.001f, 100.0f, 0.05f, 0u, \
+    PF_PERSIST | PF_LIVE, "thermometer slew: P_f moving faster than this makes the rate not valid") \
   /* 50 % over the setpoint: beyond any PI overshoot, short of the stops */ \
   X(sup_amp_trip_rel, 0x0401u, "sup.amp_trip_rel", F32, "-", 1.2f, 5.0f, 1.5f, 0u, \
     PF_PERSIST | PF_LIVE, "over-amplitude trip, as a multiple of drive.amp_set_v") \
@@ -155,9 +172,13 @@
   /* 0.3 s: 40 ring-down time constants at Q = 33, 2.3 at Q = 600 */ \
   X(sup_retry_s, 0x0408u, "sup.retry_s", F32, "s", 0.0f, 60.0f, 0.3f, 0u, \
     PF_PERSIST | PF_LIVE, "drive-off time after a fault before re-acquiring") \
-  /* 1 ms of consecutive rail codes */ \
+  /* half the samples of the 2 ms window on a rail: a clipped waveform, not a spike */ \
   X(sup_clip_count, 0x0409u, "sup.clip_count", U32, "-", 1u, 1000000u, 50u, 0u, \
-    PF_PERSIST | PF_LIVE, "consecutive ADC rail codes that make an ADC_CLIP fault") \
+    PF_PERSIST | PF_LIVE, "ADC rail codes within 2 ms (100 samples) that make an ADC_CLIP fault") \
+  /* 5 deg: beyond the 1 deg lock tolerance, short of the 30 deg where a dead-ended phase
+   * loop was seen LOCKED with a rate wrong by 800 deg/s */ \
+  X(sup_lost_phase_tol_deg, 0x040Au, "sup.lost_phase_tol_deg", F32, "deg", 0.1f, 90.0f, 5.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "phase lock is lost (PHASE_LOST) when the phase error stays beyond this for sup.lost_hold_s") \
   /* 0.1 V on the differential sense electrodes (5 V bias): about 5.5 deg/s equivalent */ \
   X(selftest_amp_v, 0x0701u, "selftest.amp_v", F32, "V", 0.0f, 5.0f, 0.1f, 0u, \
     PF_PERSIST | PF_LIVE, "self-test force: voltage amplitude on the sense feedback electrodes") \

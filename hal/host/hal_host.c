@@ -84,6 +84,13 @@ uint32_t hal_cycles_now(void)
   return (uint32_t)(host.ticks * per_tick);
 }
 
+/* The host loses no sample unless a test says so (hal_host_lose_sample). */
+static uint32_t s_lost;
+
+uint32_t hal_sample_lost(void) { return s_lost; }
+
+void hal_host_lose_sample(void) { s_lost++; }
+
 /* The host has no cycle counter for its own interrupt (it would measure the host). */
 void hal_sample_isr_cycles(uint32_t *last, uint32_t *max)
 {

@@ -37,6 +37,9 @@ uint32_t hal_host_rate_hz(void);
 
 /* The frame the firmware wrote at the latest tick (for traces). */
 const hal_dac_frame_t *hal_host_last_dac(void);
+
+/* Count one lost sample, as the board's converters report an overrun (hal_sample_lost). */
+void hal_host_lose_sample(void);
 /* The ADC frame the firmware will read at the next tick. */
 const hal_adc_frame_t *hal_host_next_adc(void);
 

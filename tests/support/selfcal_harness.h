@@ -106,9 +106,9 @@ static inline void check_lock(void)
     amax = fmax(amax, a);
   }
   const double a_end = amp_m();
-  printf("# after hand-over: amplitude %.4f um at 0.2 s, %.4f..%.4f um to 1 s, mode %u faults %u\n",
+  printf("# after hand-over: amplitude %.4f um at 0.2 s, %.4f..%.4f um to 1 s, mode %u faults %u (last 0x%x)\n",
          a02 * 1e6, amin * 1e6, amax * 1e6, (unsigned)app.gyro.sup.mode,
-         (unsigned)app.gyro.sup.fault_count);
+         (unsigned)app.gyro.sup.fault_count, (unsigned)app.gyro.sup.fault);
   assert_true(fabs(amin / a_end - 1.0) < 0.01 && fabs(amax / a_end - 1.0) < 0.01);
   assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
   assert_int_equal(app.gyro.sup.fault_count, 0u);

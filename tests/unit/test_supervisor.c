@@ -12,14 +12,16 @@ static supervisor_cfg_t cfg(void)
   supervisor_cfg_t c = {
       .dt_s = 1e-3f, .lock_tol_rel = 0.01f, .lock_phase_tol_rad = 0.02f, .lock_hold_s = 0.01f,
       .lost_tol_rel = 0.1f, .lost_hold_s = 0.005f, .amp_trip_rel = 1.5f, .sat_hold_s = 0.02f,
-      .retry_s = 0.1f, .clip_max_count = 3u};
+      .retry_s = 0.1f, .clip_max_count = 3u, .lost_phase_tol_rad = 0.05f, .amp_max_v = 4.75f,
+      .amp_set_v = 0.35f, .acq_timeout_s = 0.5f};
   return c;
 }
 
 static supervisor_in_t good(void)
 {
   supervisor_in_t in = {.amp_rel_err = 0.0f, .amp_rel = 1.0f, .phase_err_rad = 0.0f,
-                        .drive_at_limit = 0, .clip_run = 0u, .state_finite = 1};
+                        .drive_at_limit = 0, .clip_count = 0u, .state_finite = 1,
+                        .sample_lost = 0};
   return in;
 }
 
@@ -121,14 +123,19 @@ static void test_immediate_faults(void **state)
   assert_int_equal(supervisor_step(&sv, &in), 1);
   assert_int_equal(sv.fault, GYRO_FAULT_NAN);
 
-  /* Clipping: a run of clip_max_count consecutive rail codes (gyro_tick counts them). */
+  /* Clipping: clip_max_count rail codes within GYRO_CLIP_WINDOW steps (gyro_tick counts
+   * them per block), sparse or in a run. */
   assert_int_equal(supervisor_init(&sv, &c), 0);
   supervisor_start(&sv);
   in = good();
-  in.clip_run = c.clip_max_count - 1u;
-  run(&sv, &in, 5);
-  assert_int_equal(sv.mode, GYRO_MODE_ACQUIRE);
-  in.clip_run = c.clip_max_count;
+  in.clip_count = c.clip_max_count - 1u;
+  run(&sv, &in, 1);
+  in.clip_count = 0u;
+  run(&sv, &in, GYRO_CLIP_WINDOW);
+  assert_int_not_equal(sv.mode, GYRO_MODE_FAULT);
+  in.clip_count = 1u; /* one code per step: the window's sum reaches the count */
+  run(&sv, &in, (int)c.clip_max_count - 1);
+  assert_int_not_equal(sv.mode, GYRO_MODE_FAULT);
   run(&sv, &in, 1);
   assert_int_equal(sv.mode, GYRO_MODE_FAULT);
   assert_int_equal(sv.fault, GYRO_FAULT_ADC_CLIP);
@@ -212,7 +219,7 @@ static void test_off_and_sweep_faults(void **state)
   supervisor_in_t in = good();
   assert_int_equal(supervisor_init(&sv, &c), 0);
   in.state_finite = 0;
-  in.clip_run = 100u;
+  in.clip_count = 100u;
   in.amp_rel = 9.0f;
   run(&sv, &in, 10);
   assert_int_equal(sv.mode, GYRO_MODE_OFF);
@@ -224,21 +231,110 @@ static void test_off_and_sweep_faults(void **state)
   in.amp_rel_err = 8.0f;
   run(&sv, &in, 10);
   assert_int_equal(sv.mode, GYRO_MODE_SWEEP);
-  in.clip_run = c.clip_max_count;
+  in.clip_count = c.clip_max_count;
   assert_int_equal(supervisor_step(&sv, &in), 1);
   assert_int_equal(sv.fault, GYRO_FAULT_ADC_CLIP);
 
   supervisor_enter_sweep(&sv);
   in = good();
   in.state_finite = 0;
-  in.clip_run = c.clip_max_count; /* both: the NaN is reported */
+  in.clip_count = c.clip_max_count; /* both: the NaN is reported */
   assert_int_equal(supervisor_step(&sv, &in), 1);
   assert_int_equal(sv.fault, GYRO_FAULT_NAN);
+}
+
+static void lock(supervisor_t *sv, const supervisor_cfg_t *c)
+{
+  assert_int_equal(supervisor_init(sv, c), 0);
+  supervisor_start(sv);
+  const supervisor_in_t in = good();
+  run(sv, &in, 20);
+  assert_int_equal(sv->mode, GYRO_MODE_LOCKED);
+}
+
+/* LOCKED with the amplitude held but the phase run off (a phase loop at a dead end):
+ * PHASE_LOST after lost_hold_s, not before. */
+static void test_phase_lost(void **state)
+{
+  (void)state;
+  supervisor_t sv;
+  const supervisor_cfg_t c = cfg();
+  lock(&sv, &c);
+  supervisor_in_t in = good();
+  in.phase_err_rad = 0.5f;
+  run(&sv, &in, 3);
+  assert_int_equal(sv.mode, GYRO_MODE_LOCKED);
+  run(&sv, &in, 20);
+  assert_int_equal(sv.mode, GYRO_MODE_FAULT);
+  assert_int_equal(sv.fault, GYRO_FAULT_PHASE_LOST);
+  assert_int_equal(sv.kind_count[5], 1u);
+}
+
+/* ACQUIRE that never locks faults at acq_timeout_s: ACQ_TIMEOUT, or DRIVE_SAT when the
+ * drive sits at its limit. */
+static void test_acquisition_timeout(void **state)
+{
+  (void)state;
+  supervisor_t sv;
+  const supervisor_cfg_t c = cfg();
+  assert_int_equal(supervisor_init(&sv, &c), 0);
+  supervisor_start(&sv);
+  supervisor_in_t in = good();
+  in.amp_rel_err = -0.5f;
+  in.amp_rel = 0.5f;
+  run(&sv, &in, 490);
+  assert_int_equal(sv.mode, GYRO_MODE_ACQUIRE);
+  run(&sv, &in, 20);
+  assert_int_equal(sv.mode, GYRO_MODE_FAULT);
+  assert_int_equal(sv.fault, GYRO_FAULT_ACQ_TIMEOUT);
+  run(&sv, &in, 200); /* retry */
+  assert_int_equal(sv.mode, GYRO_MODE_ACQUIRE);
+  in.drive_at_limit = 1;
+  run(&sv, &in, 600);
+  assert_int_equal(sv.fault, GYRO_FAULT_DRIVE_SAT);
+  assert_int_equal(sv.kind_count[6], 1u);
+  assert_int_equal(sv.kind_count[3], 1u);
+}
+
+/* Over-amplitude is absolute too: with a setpoint near the ADC's range, the relative
+ * trip would lie beyond what the ADC can measure; amp_max_v trips first. */
+static void test_absolute_over_amplitude(void **state)
+{
+  (void)state;
+  supervisor_t sv;
+  supervisor_cfg_t c = cfg();
+  c.amp_set_v = 4.0f;
+  lock(&sv, &c);
+  supervisor_in_t in = good();
+  in.amp_rel = 4.8f / 4.0f; /* 1.2 < amp_trip_rel 1.5, above 4.75 V */
+  in.amp_rel_err = in.amp_rel - 1.0f;
+  assert_int_equal(supervisor_step(&sv, &in), 1);
+  assert_int_equal(sv.fault, GYRO_FAULT_OVER_AMP);
+  c.amp_max_v = 3.9f; /* below the setpoint: refused */
+  assert_int_equal(supervisor_init(&sv, &c), -1);
+}
+
+static void test_lost_sample(void **state)
+{
+  (void)state;
+  supervisor_t sv;
+  const supervisor_cfg_t c = cfg();
+  lock(&sv, &c);
+  supervisor_in_t in = good();
+  in.sample_lost = 1;
+  assert_int_equal(supervisor_step(&sv, &in), 1);
+  assert_int_equal(sv.fault, GYRO_FAULT_LOST_SAMPLE);
+  assert_int_equal(sv.kind_count[7], 1u);
+  assert_true(sv.kind_last_step[7] > 0u);
 }
 
 int main(void)
 {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_phase_lost),
+      cmocka_unit_test(test_acquisition_timeout),
+      cmocka_unit_test(test_absolute_over_amplitude),
+      cmocka_unit_test(test_lost_sample),
       cmocka_unit_test(test_bad_cfg_rejected),   cmocka_unit_test(test_lock_sequence),
       cmocka_unit_test(test_lost_lock_and_retry), cmocka_unit_test(test_immediate_faults),
       cmocka_unit_test(test_drive_saturation),   cmocka_unit_test(test_ripple_filtered),

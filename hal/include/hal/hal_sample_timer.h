@@ -21,4 +21,9 @@ uint32_t hal_cycles_now(void);
  * counter and reports 0. Either pointer may be NULL. */
 void hal_sample_isr_cycles(uint32_t *last, uint32_t *max);
 
+/* Samples lost since hal_sample_timer_start: a new frame converted before the ISR had
+ * taken the previous one (the NCO then runs a sample behind the converters). Read by
+ * the ISR on every tick: a load, no side effect. */
+uint32_t hal_sample_lost(void);
+
 #endif /* HAL_SAMPLE_TIMER_H */

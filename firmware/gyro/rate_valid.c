@@ -1,0 +1,136 @@
+#include "gyro/rate_valid.h"
+
+#include <stddef.h>
+
+#include "dsp/fastmath.h"
+
+static int cfg_ok(const rate_valid_cfg_t *c)
+{
+  return c != NULL && c->tol_dps > 0.0f && fm_isfinite(c->tol_dps) && c->full_scale_dps > 0.0f &&
+         fm_isfinite(c->full_scale_dps) && c->p_range_deg > 0.0f && fm_isfinite(c->p_range_deg) &&
+         c->p_window_max_deg > 0.0f && fm_isfinite(c->p_window_max_deg) &&
+         c->p_lag_per_deg > 0.0f && fm_isfinite(c->p_lag_per_deg) && c->sense_max_v2 > 0.0f &&
+         fm_isfinite(c->sense_max_v2) && c->phase_tol_rad > 0.0f && fm_isfinite(c->phase_tol_rad) &&
+         c->bias_slope_dps_per_deg >= 0.0f && fm_isfinite(c->bias_slope_dps_per_deg);
+}
+
+int rate_valid_init(rate_valid_t *rv, const rate_valid_cfg_t *cfg)
+{
+  if (rv == NULL || !cfg_ok(cfg)) {
+    return -1;
+  }
+  rv->cfg = *cfg;
+  rv->reasons = RATE_INVALID_MODE;
+  rv->thermo = 0u;
+  rv->was_locked = 0u;
+  rv->x_rate = rv->x_quad = 0.0f;
+  rv->p_dev_window_deg = 0.0f;
+  rv->p_updates = 0u;
+  rv->slew = 0u;
+  rv->phase_err_lp_rad = 0.0f;
+  rv->blocks = 0u;
+  for (uint32_t i = 0; i < RATE_INVALID_KINDS; i++) rv->count[i] = rv->last_block[i] = 0u;
+  rate_valid_disturb(rv);
+  return 0;
+}
+
+void rate_valid_retune(rate_valid_t *rv, const rate_valid_cfg_t *cfg) { rv->cfg = *cfg; }
+
+void rate_valid_settling(rate_valid_t *rv, float rate_raw, float quad_raw, float rate_unc_dps,
+                         float quad_dps, float scale_dps)
+{
+  rv->x_rate += RATE_VALID_INPUT_K * (rate_raw - rv->x_rate);
+  rv->x_quad += RATE_VALID_INPUT_K * (quad_raw - rv->x_quad);
+  if (rv->settled != 0u) return;
+  const float tol = rv->cfg.tol_dps;
+  const int inside = fm_absf(rate_unc_dps - scale_dps * rv->x_rate) <= tol &&
+                     fm_absf(quad_dps - scale_dps * rv->x_quad) <= tol;
+  rv->settle_run = inside ? rv->settle_run + 1u : 0u;
+  if (rv->settle_run >= RATE_VALID_SETTLE_BLOCKS) rv->settled = 1u;
+}
+
+/* The rate error a lag of P_f of lag_deg makes: the quadrature rotated by the lag and
+ * the bias polynomial moved along its slope. */
+static float lag_error_dps(const rate_valid_cfg_t *c, float lag_deg, float quad_dps)
+{
+  return lag_deg * (fm_absf(quad_dps) * FM_RAD_PER_DEG_F + c->bias_slope_dps_per_deg);
+}
+
+void rate_valid_thermo(rate_valid_t *rv, float p_dev_deg, float p_held_dev_deg, float p_held_w,
+                       float quad_dps)
+{
+  const rate_valid_cfg_t *c = &rv->cfg;
+  uint32_t r = rv->slew;
+  if (!(fm_absf(p_dev_deg) <= c->p_range_deg)) r |= RATE_INVALID_THERMO_RANGE;
+  if (p_held_w > RATE_VALID_SLEW_W_MAX) {
+    /* P_f still converging from a hold (THERMO_SETTLE bounds that): no slew of the
+     * temperature can be told from it, the window starts later. */
+    rv->p_dev_window_deg = p_dev_deg;
+    rv->p_updates = 0u;
+  } else if (++rv->p_updates >= RATE_VALID_SLEW_UPDATES) {
+    const float change = fm_absf(p_dev_deg - rv->p_dev_window_deg);
+    const int slewing = !(change <= c->p_window_max_deg) ||
+                        !(lag_error_dps(c, change * c->p_lag_per_deg, quad_dps) <= c->tol_dps);
+    rv->slew = slewing ? RATE_INVALID_THERMO_SLEW : 0u;
+    r = (r & ~RATE_INVALID_THERMO_SLEW) | rv->slew;
+    rv->p_dev_window_deg = p_dev_deg;
+    rv->p_updates = 0u;
+  }
+  /* |P_f - P| <= w / (1 - w) |P_held - P_f|, compared without the divide. */
+  const float gap = lag_error_dps(c, p_held_w * fm_absf(p_held_dev_deg - p_dev_deg), quad_dps);
+  if (!(gap <= c->tol_dps * (1.0f - p_held_w))) r |= RATE_INVALID_THERMO_SETTLE;
+  rv->thermo = r;
+}
+
+/* Onsets of each reason, counted with the block they happened in (rare: only when the
+ * set of reasons grows). */
+static void count_onsets(rate_valid_t *rv, uint32_t onsets)
+{
+  for (uint32_t i = 0; i < RATE_INVALID_KINDS; i++) {
+    if ((onsets & (1u << i)) != 0u) {
+      rv->count[i]++;
+      rv->last_block[i] = rv->blocks;
+    }
+  }
+}
+
+uint32_t rate_valid_verdict(rate_valid_t *rv, const rate_valid_in_t *in)
+{
+  const rate_valid_cfg_t *c = &rv->cfg;
+  rv->blocks++;
+  if (in->locked && rv->was_locked == 0u) {
+    /* The lasting error's low-pass starts from zero, not from what acquisition left in
+     * it nor from the 100 Hz error's noise: at lock the phase PI's integrator removes
+     * a lasting error within its own time constant, unless the loop is at a dead end,
+     * which builds up here (and in PHASE_LOST) within tens of milliseconds. */
+    rate_valid_disturb(rv);
+    rv->phase_err_lp_rad = 0.0f;
+  }
+  rv->was_locked = in->locked ? 1u : 0u;
+  if (in->rail_codes != 0u) rate_valid_disturb(rv);
+  uint32_t r = rv->thermo;
+  if (!in->locked) r |= RATE_INVALID_MODE;
+  if (in->selftest) r |= RATE_INVALID_SELFTEST;
+  if (rv->settled == 0u) r |= RATE_INVALID_SETTLING;
+  if (in->rail_codes != 0u) r |= RATE_INVALID_CLIP;
+  if (!(in->sense_v2 <= c->sense_max_v2)) r |= RATE_INVALID_SENSE_RANGE;
+  if (!(fm_absf(in->rate_dps) <= c->full_scale_dps)) r |= RATE_INVALID_OVER_RANGE;
+  /* The lock tolerance on the 100 Hz error; the quadrature it rotates into the rate on
+   * its lasting part. */
+  rv->phase_err_lp_rad += RATE_VALID_PHASE_K * (in->phase_err_rad - rv->phase_err_lp_rad);
+  const float pe = fm_absf(in->phase_err_rad);
+  const float leak_dps = fm_absf(rv->phase_err_lp_rad) * fm_absf(in->quad_dps);
+  if (!(pe <= c->phase_tol_rad && leak_dps <= c->tol_dps)) r |= RATE_INVALID_PHASE;
+  const uint32_t onsets = r & ~rv->reasons;
+  if (onsets != 0u) count_onsets(rv, onsets);
+  rv->reasons = r;
+  return r;
+}
+
+const char *rate_valid_reason_name(uint32_t kind)
+{
+  static const char *const names[RATE_INVALID_KINDS] = {
+      "MODE",        "SELFTEST", "SETTLING",     "CLIP",         "SENSE_RANGE",
+      "OVER_RANGE",  "PHASE",    "THERMO_RANGE", "THERMO_SLEW",  "THERMO_SETTLE"};
+  return kind < RATE_INVALID_KINDS ? names[kind] : "?";
+}

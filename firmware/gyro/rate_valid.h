@@ -1,0 +1,137 @@
+/* Rate validity: whether the rate output can be trusted, block by block.
+ *
+ * The rate is always computed; this verdict says whether to use it. It is valid only
+ * when none of these reasons holds (each a bit of rate_valid_t.reasons, counted with the
+ * step of its latest onset for `status`):
+ *   MODE          the drive is not LOCKED (acquiring, sweeping, off, in a fault)
+ *   SELFTEST      the self-test force is on the sense mode
+ *   SETTLING      the output filters have not settled since the last disturbance
+ *                 (entering LOCKED, a change of the rate path's coefficients, the end
+ *                 of a self-test, a rail code, a wrap of P): settled is measured, both
+ *                 the rate and the quadrature filter outputs within tol_dps of a fast
+ *                 low-pass of their inputs for RATE_VALID_SETTLE_BLOCKS blocks in a row
+ *   CLIP          an ADC rail code in the latest block (the demodulated phasors are
+ *                 then wrong by an unknown amount)
+ *   SENSE_RANGE   the sense pickoff amplitude above RATE_VALID_SENSE_FRAC of the ADC
+ *                 range: a little more rate, quadrature or vibration clips it
+ *   OVER_RANGE    |rate| above the full scale
+ *   PHASE         the drive phase error, turned into rate through the quadrature it
+ *                 rotates (Q sin(e), system.md 2.4.2 B), above tol_dps, or the phase
+ *                 error beyond the lock tolerance
+ *   THERMO_RANGE  the thermometer P_f outside the range its compensation holds for
+ *   THERMO_SLEW   the thermometer moving faster than it was validated for
+ *                 (p_slew_max), or so fast that P_f's low-pass lags it by more than
+ *                 tol_dps of rate: a lag of P_f rotates the quadrature into the rate
+ *                 (the reference's correction, rate_channel.h: Q x lag) and shifts the
+ *                 bias polynomial (slope x lag)
+ *   THERMO_SETTLE P_f not yet at P after a hold (acquisition, a fault): how far it may
+ *                 still be is known without noise from the weight w the held value
+ *                 keeps in P_f, |P_f - P| = w / (1 - w) |P_held - P_f|, and the rate
+ *                 error that makes as above
+ * Each check is a few multiplies and compares per block; no divide, no libm. */
+#ifndef RATE_VALID_H
+#define RATE_VALID_H
+
+#include <stdint.h>
+
+#define RATE_INVALID_MODE (1u << 0)
+#define RATE_INVALID_SELFTEST (1u << 1)
+#define RATE_INVALID_SETTLING (1u << 2)
+#define RATE_INVALID_CLIP (1u << 3)
+#define RATE_INVALID_SENSE_RANGE (1u << 4)
+#define RATE_INVALID_OVER_RANGE (1u << 5)
+#define RATE_INVALID_PHASE (1u << 6)
+#define RATE_INVALID_THERMO_RANGE (1u << 7)
+#define RATE_INVALID_THERMO_SLEW (1u << 8)
+#define RATE_INVALID_THERMO_SETTLE (1u << 9)
+#define RATE_INVALID_KINDS 10u
+
+/* Blocks in a row inside the settling tolerance (2 ms): longer than the noise's
+ * correlation time at the filters' 100 Hz, far shorter than their settling. */
+#define RATE_VALID_SETTLE_BLOCKS 10u
+/* P_f updates over which its slew is judged (0.1 s at 500 Hz): a slew of the
+ * temperature, not the noise of P_f. */
+#define RATE_VALID_SLEW_UPDATES 50u
+/* The slew is judged once the held value weighs less than this in P_f. */
+#define RATE_VALID_SLEW_W_MAX 0.05f
+/* Low-pass of the drive phase error for the PHASE check, per block: about 1 Hz, so
+ * that the pickoff's noise on the measured phase (0.03 deg rms at 100 Hz on the
+ * default part, which does not reach the rate: the rate channel references the
+ * setpoint, not the measurement) is not taken for a lasting error of the true phase. */
+#define RATE_VALID_PHASE_K 0.00126f
+/* Low-pass of the filters' inputs the settling is judged against: per block, a time
+ * constant of 5 blocks (1 ms, a corner of about 160 Hz), faster than the 100 Hz
+ * output filter it checks. */
+#define RATE_VALID_INPUT_K 0.2f
+/* Fraction of the ADC range the sense amplitude may use. */
+#define RATE_VALID_SENSE_FRAC 0.8f
+
+typedef struct {
+  float tol_dps;            /* the largest rate error each source may leave */
+  float full_scale_dps;
+  float p_range_deg;        /* |P_f - p_ref| the compensation holds for */
+  float p_window_max_deg;   /* largest change of P_f over RATE_VALID_SLEW_UPDATES updates */
+  float p_lag_per_deg;      /* P_f's lag per degree of change over that window:
+                             * its time constant / the window's length */
+  float sense_max_v2;       /* (RATE_VALID_SENSE_FRAC x ADC full scale)^2 */
+  float phase_tol_rad;      /* the lock tolerance of the drive phase */
+  float bias_slope_dps_per_deg; /* |dB/dP| of the compensation near p_ref */
+} rate_valid_cfg_t;
+
+typedef struct {
+  rate_valid_cfg_t cfg;
+  uint32_t reasons;         /* RATE_INVALID_* of the latest verdict */
+  uint32_t thermo;          /* RATE_INVALID_THERMO_* of the latest P update */
+  uint32_t settled;         /* nonzero once settled since the last disturbance */
+  uint32_t settle_run;      /* blocks in a row inside the settling tolerance */
+  uint32_t was_locked;      /* LOCKED at the previous verdict (entering it disturbs) */
+  float x_rate, x_quad;     /* fast low-passes of the filters' inputs (raw units) */
+  float p_dev_window_deg;   /* P_f - p_ref at the start of the slew window */
+  uint32_t p_updates;       /* P_f updates into the slew window */
+  uint32_t slew;            /* RATE_INVALID_THERMO_SLEW of the latest window */
+  float phase_err_lp_rad;   /* the drive phase error through RATE_VALID_PHASE_K */
+  uint32_t count[RATE_INVALID_KINDS];     /* onsets of each reason */
+  uint32_t last_block[RATE_INVALID_KINDS]; /* block count of each reason's latest onset */
+  uint32_t blocks;          /* verdicts since power-on */
+} rate_valid_t;
+
+/* Returns 0, or -1 (nothing changed) for a bad configuration. */
+int rate_valid_init(rate_valid_t *rv, const rate_valid_cfg_t *cfg);
+/* New configuration; the running state is kept. */
+void rate_valid_retune(rate_valid_t *rv, const rate_valid_cfg_t *cfg);
+
+/* The filters must settle again before the rate is valid. */
+static inline void rate_valid_disturb(rate_valid_t *rv)
+{
+  rv->settled = 0u;
+  rv->settle_run = 0u;
+}
+
+/* Once per block, after both output filters ran: (rate_raw, quad_raw) their inputs,
+ * (rate_unc_dps, quad_dps) their outputs, scale_dps the scale between the two. */
+void rate_valid_settling(rate_valid_t *rv, float rate_raw, float quad_raw, float rate_unc_dps,
+                         float quad_dps, float scale_dps);
+
+/* At each new P_f (rate_channel_update_p): p_dev_deg = P_f - p_ref; p_held_dev_deg and
+ * p_held_w where P_f's fast start began and the weight that value still has in P_f;
+ * quad_dps the quadrature output. */
+void rate_valid_thermo(rate_valid_t *rv, float p_dev_deg, float p_held_dev_deg, float p_held_w,
+                       float quad_dps);
+
+/* What the block saw, for the verdict. */
+typedef struct {
+  int locked;
+  int selftest;
+  uint32_t rail_codes;      /* ADC rail codes in the block */
+  float sense_v2;           /* squared sense pickoff amplitude */
+  float rate_dps;
+  float quad_dps;
+  float phase_err_rad;      /* low-passed drive phase error (supervisor) */
+} rate_valid_in_t;
+
+/* Once per block: the verdict (0: valid, else RATE_INVALID_* bits). */
+uint32_t rate_valid_verdict(rate_valid_t *rv, const rate_valid_in_t *in);
+
+const char *rate_valid_reason_name(uint32_t kind);
+
+#endif /* RATE_VALID_H */

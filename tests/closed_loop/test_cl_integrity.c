@@ -1,0 +1,331 @@
+/* Output integrity on the plant: the fault battery. Every case is a part, a setting or a
+ * command sequence on which the gyro could put out a wrong rate; on each, the whole
+ * application runs on the host plant and every block's output is judged:
+ *   - once the rate has first been valid, no block has rate_valid = 1 with
+ *     |rate - true rate| > max(1 deg/s, 1 % of the input);
+ *   - whenever the rate is not valid, the analog rate output is commanded to the fault
+ *     level rate.fault_out_v in the same block (never the 0 V of "no rotation").
+ * The healthy default part, as the positive control, is valid >= 95 % of the time after
+ * 0.3 s and first valid within 0.25 s of power-on. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "selfcal_harness.h"
+
+typedef struct {
+  uint32_t blocks, valid_blocks, valid_after_0p3, blocks_after_0p3;
+  uint32_t wrong_valid;       /* valid blocks with a wrong rate, once first valid */
+  uint32_t not_at_fault;      /* invalid blocks whose analog output is not the fault level */
+  double first_valid_s;
+  double worst_err_dps, worst_err_t_s;
+  double t0_s;                /* power-on of this run */
+} judge_t;
+
+static int rate_valid_now(void) { return (app.gyro.out.flags & GYRO_FLAG_RATE_VALID) != 0u; }
+
+static double analog_out_v(void)
+{
+  return ((double)app.gyro.rate_code - (double)HAL_DAC_CODE_MID) * (double)HAL_DAC_V_PER_CODE;
+}
+
+/* The fault level as the DAC can command it (one code of the 14-bit converter). */
+static int at_fault_level(void)
+{
+  const double fault_v = (double)params_current(&app.params)->rate_fault_out_v;
+  return fabs(analog_out_v() - fault_v) <= (double)HAL_DAC_V_PER_CODE;
+}
+
+static void judge_reset(judge_t *j)
+{
+  memset(j, 0, sizeof *j);
+  j->first_valid_s = -1.0;
+  j->t0_s = (double)plant_truth(&plant)->sample / 50000.0;
+}
+
+/* Run s seconds block by block (the snapshot and the analog code change together on the
+ * block's last tick), the background loop polled every millisecond. */
+static void judge_run(judge_t *j, double s)
+{
+  const uint64_t n = (uint64_t)(s * 5000.0 + 0.5);
+  for (uint64_t i = 0; i < n; i++) {
+    hal_host_run(GYRO_BLOCK);
+    if (i % 5u == 4u) app_poll(&app);
+    const double t = (double)plant_truth(&plant)->sample / 50000.0 - j->t0_s;
+    const int valid = rate_valid_now();
+    j->blocks++;
+    if (t >= 0.3) {
+      j->blocks_after_0p3++;
+      if (valid) j->valid_after_0p3++;
+    }
+    if (!valid) {
+      if (!at_fault_level()) j->not_at_fault++;
+      continue;
+    }
+    j->valid_blocks++;
+    if (j->first_valid_s < 0.0) j->first_valid_s = t;
+    const double truth = plant_truth(&plant)->rate_dps;
+    const double err = fabs((double)app.gyro.out.rate_dps - truth);
+    if (err > fmax(1.0, 0.01 * fabs(truth))) j->wrong_valid++;
+    if (err > j->worst_err_dps) {
+      j->worst_err_dps = err;
+      j->worst_err_t_s = t;
+    }
+  }
+}
+
+static void judge_print(const char *name, const judge_t *j)
+{
+  printf("# %-28s valid %5.1f %% (first at %.3f s), wrong-but-valid blocks %u (worst "
+         "valid error %.3g deg/s at %.3f s), invalid blocks off the fault level %u, mode %u "
+         "fault 0x%x\n",
+         name, 100.0 * j->valid_blocks / (j->blocks ? j->blocks : 1u), j->first_valid_s,
+         j->wrong_valid, j->worst_err_dps, j->worst_err_t_s, j->not_at_fault,
+         (unsigned)app.gyro.sup.mode, (unsigned)app.gyro.sup.fault);
+}
+
+static void judge_assert(const judge_t *j)
+{
+  assert_int_equal(j->wrong_valid, 0u);
+  assert_int_equal(j->not_at_fault, 0u);
+}
+
+static void start_part(const plant_cfg_t *pc, const param_values_t *v)
+{
+  app_plant_start(pc, 31u, v);
+}
+
+/* One case: part pc, firmware values v (NULL: the defaults), s seconds from power-on. */
+static void run_case(const char *name, const plant_cfg_t *pc, const param_values_t *v, double s)
+{
+  judge_t j;
+  start_part(pc, v);
+  judge_reset(&j);
+  judge_run(&j, s);
+  judge_print(name, &j);
+  judge_assert(&j);
+}
+
+static void default_part(plant_cfg_t *pc) { plant_default_cfg(pc); }
+
+static void test_healthy_default_part(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  default_part(&pc);
+  judge_t j;
+  start_part(&pc, NULL);
+  judge_reset(&j);
+  judge_run(&j, 1.5);
+  judge_print("healthy default part", &j);
+  judge_assert(&j);
+  assert_true(j.first_valid_s >= 0.0 && j.first_valid_s <= 0.25);
+  assert_true(j.valid_after_0p3 >= 0.95 * j.blocks_after_0p3);
+}
+
+static void test_resonance_60hz_off(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  default_part(&pc);
+  pc.f_drive_hz = 1550.0;
+  run_case("f_drive 1550 Hz", &pc, NULL, 2.0);
+}
+
+static void test_resonance_40hz_off(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  default_part(&pc);
+  pc.f_drive_hz = 1530.0;
+  run_case("f_drive 1530 Hz", &pc, NULL, 2.0);
+}
+
+/* Two in-range phase setpoints over the command line: the loop must not pin P. */
+static void test_phase_setpoint_walk(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  default_part(&pc);
+  judge_t j;
+  start_part(&pc, NULL);
+  judge_reset(&j);
+  judge_run(&j, 0.4);
+  assert_true(strncmp(cmd("set drive.phase_set_deg -179\n"), "ok", 2) == 0);
+  judge_run(&j, 1.0);
+  assert_true(strncmp(cmd("set drive.phase_set_deg 2\n"), "ok", 2) == 0);
+  judge_run(&j, 2.0);
+  judge_print("phase set -179 then 2", &j);
+  judge_assert(&j);
+  /* Not a dead end: the drive is locked again on the new setpoint, the rate valid. */
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
+  assert_true(rate_valid_now());
+}
+
+/* A self-calibrated high-Q part, then the structure 22.5 K warmer than at its sweep:
+ * beyond the fixed-frequency drive's reach (the drive phase slips towards 90 deg). */
+static void test_q5000_selfcal_warm(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  default_part(&pc);
+  pc.q_drive = 5000.0;
+  param_values_t v;
+  param_values_defaults(&v);
+  start(&pc, &v);
+  run_polled_s(0.05);
+  sweep();
+  assert_int_equal(app.selfcal.state, SELFCAL_DONE);
+  const param_values_t cal = *params_current(&app.params);
+  pc.temp_k += 22.5;
+  run_case("Q 5000 self-calibrated, +22.5 K", &pc, &cal, 3.0);
+}
+
+static void test_q10000_defaults(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  default_part(&pc);
+  pc.q_drive = 10000.0;
+  run_case("Q 10000, defaults", &pc, NULL, 3.0);
+}
+
+static void test_quadrature_clips_sense_adc(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  default_part(&pc);
+  pc.quad_dps = 4000.0;
+  pc.rate_dps = 100.0;
+  run_case("quad 4000, rate 100", &pc, NULL, 1.5);
+}
+
+static void test_rate_beyond_range(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  default_part(&pc);
+  pc.rate_dps = 3000.0;
+  run_case("rate 3000", &pc, NULL, 1.5);
+}
+
+static void test_sense_vibration_10g(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  default_part(&pc);
+  judge_t j;
+  start_part(&pc, NULL);
+  plant_profiles_t prof;
+  memset(&prof, 0, sizeof prof);
+  profile_const(&prof.rate_dps, 0.0);
+  profile_const(&prof.ambient_k, pc.temp_k);
+  prof.accel_g.amp_g[ACCEL_AXIS_SENSE] = 10.0;
+  prof.accel_g.freq_hz[ACCEL_AXIS_SENSE] = 100.0;
+  assert_int_equal(plant_set_profiles(&plant, &prof), 0);
+  judge_reset(&j);
+  judge_run(&j, 1.5);
+  judge_print("10 g at 100 Hz, sense axis", &j);
+  judge_assert(&j);
+}
+
+static void set_value(param_values_t *v, const char *name, float x)
+{
+  const param_idx_t i = param_lookup(name, strlen(name));
+  assert_true(i < PARAM_COUNT);
+  memcpy((char *)v + param_info(i)->offset, &x, sizeof x);
+}
+
+static void test_amplitude_setpoint_at_limit(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  default_part(&pc);
+  param_values_t v;
+  param_values_defaults(&v);
+  set_value(&v, "drive.amp_set_v", 4.5f);
+  run_case("drive.amp_set_v 4.5", &pc, &v, 2.0);
+}
+
+static void test_drive_frequency_5000(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  default_part(&pc);
+  param_values_t v;
+  param_values_defaults(&v);
+  set_value(&v, "drive.freq_hz", 5000.0f);
+  run_case("drive.freq_hz 5000", &pc, &v, 2.0);
+}
+
+/* A subnormal gain: either refused before it reaches the gyro, or the rate is never
+ * valid with it. */
+static void test_subnormal_gain(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  default_part(&pc);
+  param_values_t v;
+  param_values_defaults(&v);
+  set_value(&v, "drive.amp_kp", 1e-45f);
+  assert_int_equal(plant_init(&plant, &pc, 31u), 0);
+  assert_int_equal(hal_flash_host_configure(NULL), 0);
+  hal_uart_host_reset();
+  hal_host_attach(plant_step_hal, &plant);
+  if (app_init_with(&app, &v) != 0) {
+    printf("# subnormal drive.amp_kp refused at design\n");
+    return;
+  }
+  assert_int_equal(hal_sample_timer_start(50000u, app_sample_isr, &app), 0);
+  judge_t j;
+  judge_reset(&j);
+  judge_run(&j, 1.0);
+  judge_print("drive.amp_kp 1e-45", &j);
+  judge_assert(&j);
+}
+
+/* The self-calibration excites the drive off its operating point: the rate is not valid
+ * during the sweep, and `status` says so. */
+static void test_status_during_sweep(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  default_part(&pc);
+  judge_t j;
+  start_part(&pc, NULL);
+  judge_reset(&j);
+  judge_run(&j, 0.3);
+  assert_true(strncmp(cmd("sweep\n"), "ok", 2) == 0);
+  judge_run(&j, 1.0);
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_SWEEP);
+  const char *status = cmd("status\n");
+  assert_non_null(strstr(status, "- rate_valid 0"));
+  assert_null(strstr(status, "- rate_valid 1"));
+  judge_print("status during sweep", &j);
+  judge_assert(&j);
+}
+
+int main(void)
+{
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_healthy_default_part),
+      cmocka_unit_test(test_resonance_60hz_off),
+      cmocka_unit_test(test_resonance_40hz_off),
+      cmocka_unit_test(test_phase_setpoint_walk),
+      cmocka_unit_test(test_q5000_selfcal_warm),
+      cmocka_unit_test(test_q10000_defaults),
+      cmocka_unit_test(test_quadrature_clips_sense_adc),
+      cmocka_unit_test(test_rate_beyond_range),
+      cmocka_unit_test(test_sense_vibration_10g),
+      cmocka_unit_test(test_amplitude_setpoint_at_limit),
+      cmocka_unit_test(test_drive_frequency_5000),
+      cmocka_unit_test(test_subnormal_gain),
+      cmocka_unit_test(test_status_during_sweep),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
