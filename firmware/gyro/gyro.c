@@ -189,6 +189,15 @@ int gyro_design(const param_values_t *v, gyro_design_t *d)
   return 0;
 }
 
+/* No counter of lost samples attached (gyro_attach_lost_counter): none are lost. */
+static const volatile uint32_t k_no_loss = 0u;
+
+void gyro_attach_lost_counter(gyro_t *g, const volatile uint32_t *count)
+{
+  g->lost_count = count != NULL ? count : &k_no_loss;
+  g->lost_seen = *g->lost_count;
+}
+
 int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
 {
   if (g == NULL || d == NULL) {
@@ -206,6 +215,7 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   }
   t.rate_fault_out_v = d->rate_fault_out_v;
   t.rate_fault_code = gyro_volts_to_dac(d->rate_fault_out_v);
+  gyro_attach_lost_counter(&t, NULL);
   t.adc_v_per_code = HAL_ADC_V_PER_CODE;
   t.inv_amp_set = 1.0f / d->drive.amp_set_v;
   selftest_init(&t.selftest, &d->selftest);

@@ -19,6 +19,10 @@ void gyro_block_amp(gyro_t *g)
     /* Measure only: the amplitude is still watched for the over-amplitude trip. */
     g->drive.amp_v = fm_sqrtf(w_s * w_s + w_c * w_c);
   }
+  /* The drive-phase and sense-range checks of the rate's validity, on evidence of the
+   * last block (phase error: supervisor; quadrature: its filter). */
+  const float s_i = g->lmsd_sense.w_i, s_q = g->lmsd_sense.w_q;
+  rate_valid_drive(&g->valid, g->sup.phase_err_f, g->rate.quad_dps, s_i * s_i + s_q * s_q);
 }
 
 void gyro_block_command(gyro_t *g)
@@ -35,8 +39,9 @@ void gyro_block_command(gyro_t *g)
    * quadrature, rate or vibration for its gain) leaves the drive sound: the rate is not
    * valid then (rate_valid.h, CLIP), but the drive keeps running. */
   si->clip_count = g->clip_drive_block;
-  si->sample_lost = (int)g->sample_lost;
-  g->sample_lost = 0u;
+  const uint32_t lost = *g->lost_count;
+  si->sample_lost = lost != g->lost_seen;
+  g->lost_seen = lost;
   /* Once per block, after both loops: the square root and the phase conversion. */
   if (drive_on) {
     drive_synth_set(&g->synth, g->drive.f_cmd_v2, g->drive.p_rad);
@@ -75,13 +80,24 @@ void gyro_block_quad(gyro_t *g)
                       rc->scale_dps);
 }
 
+void gyro_block_rate(gyro_t *g)
+{
+  rate_channel_t *rc = &g->rate;
+  rate_channel_filter_rate(rc);
+  rate_valid_range(&g->valid, rc->rate_dps);
+}
+
 void gyro_block_p(gyro_t *g, int hold)
 {
   rate_channel_t *rc = &g->rate;
-  rate_channel_hold_p(rc, hold);
-  if (rate_channel_update_p(rc, g->drive.p_rad) != 0) {
+  if (g->thermo_due != 0u) {
+    /* The thermometer checks of the P_f the last block made: P's low-pass runs on one
+     * block in RATE_P_BLOCKS, the checks on the next, so that no tick carries both. */
+    g->thermo_due = 0u;
     rate_valid_thermo(&g->valid, rc->p_dev_deg, rc->p_held_dev_deg, rc->p_held_w, rc->quad_dps);
   }
+  rate_channel_hold_p(rc, hold);
+  if (rate_channel_update_p(rc, g->drive.p_rad) != 0) g->thermo_due = 1u;
 }
 
 void gyro_block_p_selftest(gyro_t *g)
@@ -98,15 +114,10 @@ void gyro_block_p_selftest(gyro_t *g)
 void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
 {
   gyro_out_t *o = &g->out;
-  const rate_valid_in_t vin = {g->sup.mode == GYRO_MODE_LOCKED,
-                               selftest_running(&g->selftest),
-                               g->clip_block,
-                               g->lmsd_sense.w_i * g->lmsd_sense.w_i +
-                                   g->lmsd_sense.w_q * g->lmsd_sense.w_q,
-                               g->rate.rate_dps,
-                               g->rate.quad_dps,
-                               g->sup.phase_err_f};
-  const uint32_t invalid = rate_valid_verdict(&g->valid, &vin);
+  const uint32_t block_bits = (g->sup.mode == GYRO_MODE_LOCKED ? 0u : RATE_INVALID_MODE) |
+                              (selftest_running(&g->selftest) ? RATE_INVALID_SELFTEST : 0u) |
+                              (g->clip_block != 0u ? RATE_INVALID_CLIP : 0u);
+  const uint32_t invalid = rate_valid_verdict(&g->valid, &g->valid_history, block_bits);
   /* Never a valid-looking wrong rate: the analog output goes to the fault level in the
    * same sample as the verdict, without a slew. */
   float out_v = g->rate_fault_out_v;

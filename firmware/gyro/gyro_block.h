@@ -21,7 +21,7 @@
 
 /* GYRO_SLOT_AMP: the first half of the finiteness check (the LMSD weights), then |Z|
  * and, while the drive runs, the amplitude PI (with the drive off |Z| only, for the
- * over-amplitude trip). */
+ * over-amplitude trip); the rate-valid drive-phase and sense-range checks. */
 void gyro_block_amp(gyro_t *g);
 /* GYRO_SLOT_COMMAND: the rest of the supervisor's evidence (sup_in), and the block's
  * drive command into the synthesis (once, after both loops). */
@@ -36,7 +36,10 @@ void gyro_block_quad(gyro_t *g);
 /* GYRO_SLOT_PHASE_PI: the phase loop's update; a whole turn of P it took is passed on to
  * the thermometer (rate_channel_shift_p). */
 void gyro_block_phase(gyro_t *g);
-/* GYRO_SLOT_P: P's hold and low-pass, the thermometer checks at each new P_f. */
+/* GYRO_SLOT_RATE: the rate's output filter, scale and compensation; its range check. */
+void gyro_block_rate(gyro_t *g);
+/* GYRO_SLOT_P: P's hold and low-pass (hold: not LOCKED); the thermometer checks of the
+ * P_f the last block made. */
 void gyro_block_p(gyro_t *g, int hold);
 /* GYRO_SLOT_P while a self-test runs: its sequence on the block's projection, then P's
  * hold and low-pass. */
@@ -83,7 +86,7 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
     }
     break;
   case GYRO_SLOT_RATE:
-    rate_channel_filter_rate(&g->rate);
+    gyro_block_rate(g);
     break;
   case GYRO_SLOT_QUAD:
     gyro_block_quad(g);
