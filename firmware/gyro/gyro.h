@@ -106,6 +106,7 @@ typedef struct {
   const volatile uint32_t *lost_count; /* the HAL's count of lost samples */
   uint32_t lost_seen;    /* its value at the last block */
   uint32_t thermo_due;   /* a new P_f awaits the thermometer checks (next GYRO_SLOT_P) */
+  uint32_t cont_fail;    /* the continuous self-test's verdict (GYRO_SLOT_P) */
   uint32_t flags_acc;    /* GYRO_FLAG_* seen since the last snapshot */
   supervisor_in_t sup_in; /* the supervisor's evidence, gathered by the jobs before
                            * GYRO_SLOT_SUPERVISE (slot table above) */
@@ -145,7 +146,8 @@ typedef struct {
  *   4     supervisor (its clear request: slot 5)          evidence (3), finiteness (7, last block)
  *   5     rate channel: block mean of S, projection       sense sum, P (1)
  *         (or, on request, the loop state cleared);
- *         the block's rail codes
+ *         the block's rail codes; the continuous
+ *         self-test's tone measured and taken out
  *   6     rate: output filter, scale, compensation;       projection (5), P_f (8, last block)
  *         its range check
  *   7     finiteness check, second half (loop and rate    weights' half (2)
@@ -154,7 +156,8 @@ typedef struct {
  *   8     P's hold and low-pass (its mean every 10th      P (1)
  *         block), the thermometer checks of the P_f       P_f (8, last block)
  *         made the block before; the self-test sequence   projection (5)
- *         while it runs
+ *         while it runs; the continuous self-test's
+ *         verdict
  *   9     rate-valid verdict, output snapshot, analog     checks (2, 6, 7), rails (5),
  *         rate code (the fault level when not valid)      everything
  *

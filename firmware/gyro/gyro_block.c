@@ -80,6 +80,13 @@ void gyro_block_quad(gyro_t *g)
                       rc->scale_dps);
 }
 
+void gyro_block_project(gyro_t *g)
+{
+  rate_channel_t *rc = &g->rate;
+  rate_channel_project(rc, g->lmsd_drive.w_i, g->lmsd_drive.w_q, g->drive.p_rad);
+  selftest_cont_notch(&g->selftest, &rc->rate_raw, &rc->quad_raw);
+}
+
 void gyro_block_rate(gyro_t *g)
 {
   rate_channel_t *rc = &g->rate;
@@ -90,6 +97,7 @@ void gyro_block_rate(gyro_t *g)
 void gyro_block_p(gyro_t *g, int hold)
 {
   rate_channel_t *rc = &g->rate;
+  g->cont_fail = selftest_cont_judge(&g->selftest, !hold);
   if (g->thermo_due != 0u) {
     /* The thermometer checks of the P_f the last block made: P's low-pass runs on one
      * block in RATE_P_BLOCKS, the checks on the next, so that no tick carries both. */
@@ -116,7 +124,8 @@ void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
   gyro_out_t *o = &g->out;
   const uint32_t block_bits = (g->sup.mode == GYRO_MODE_LOCKED ? 0u : RATE_INVALID_MODE) |
                               (selftest_running(&g->selftest) ? RATE_INVALID_SELFTEST : 0u) |
-                              (g->clip_block != 0u ? RATE_INVALID_CLIP : 0u);
+                              (g->clip_block != 0u ? RATE_INVALID_CLIP : 0u) |
+                              (g->cont_fail != 0u ? RATE_INVALID_CONT_SELFTEST : 0u);
   const uint32_t invalid = rate_valid_verdict(&g->valid, &g->valid_history, block_bits);
   /* Never a valid-looking wrong rate: the analog output goes to the fault level in the
    * same sample as the verdict, without a slew. */

@@ -36,6 +36,8 @@ void gyro_block_quad(gyro_t *g);
 /* GYRO_SLOT_PHASE_PI: the phase loop's update; a whole turn of P it took is passed on to
  * the thermometer (rate_channel_shift_p). */
 void gyro_block_phase(gyro_t *g);
+/* GYRO_SLOT_PROJECT: the block's projection, the continuous self-test's tone taken out. */
+void gyro_block_project(gyro_t *g);
 /* GYRO_SLOT_RATE: the rate's output filter, scale and compensation; its range check. */
 void gyro_block_rate(gyro_t *g);
 /* GYRO_SLOT_P: P's hold and low-pass (hold: not LOCKED); the thermometer checks of the
@@ -82,7 +84,7 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
     if (g->sup.clear_req != 0u) {
       gyro_block_clear(g);
     } else {
-      rate_channel_project(&g->rate, g->lmsd_drive.w_i, g->lmsd_drive.w_q, g->drive.p_rad);
+      gyro_block_project(g);
     }
     break;
   case GYRO_SLOT_RATE:

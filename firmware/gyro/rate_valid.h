@@ -28,6 +28,8 @@
  *                 still be is known without noise from the weight w the held value
  *                 keeps in P_f, |P_f - P| = w / (1 - w) |P_held - P_f|, and the rate
  *                 error that makes as above
+ *   CONT_SELFTEST the continuous self-test's response missing or out of its band
+ *                 (selftest.h)
  * Each check is a few multiplies and compares per block; no divide, no libm. */
 #ifndef RATE_VALID_H
 #define RATE_VALID_H
@@ -44,7 +46,8 @@
 #define RATE_INVALID_THERMO_RANGE (1u << 7)
 #define RATE_INVALID_THERMO_SLEW (1u << 8)
 #define RATE_INVALID_THERMO_SETTLE (1u << 9)
-#define RATE_INVALID_KINDS 10u
+#define RATE_INVALID_CONT_SELFTEST (1u << 10)
+#define RATE_INVALID_KINDS 11u
 
 /* Blocks in a row inside the settling tolerance (2 ms): longer than the noise's
  * correlation time at the filters' 100 Hz, far shorter than their settling. */
