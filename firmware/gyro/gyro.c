@@ -103,6 +103,7 @@ static int design_selftest(const param_values_t *v, gyro_design_t *t)
   }
   st.cont_step = (uint32_t)(f_m / block_hz * 4294967296.0 + 0.5);
   st.cont_mu = (float)(2.0 / (GYRO_CONT_TAU_S * block_hz));
+  st.cont_gain = 1.0f - 0.5f * st.cont_mu;
   st.cont_settle_blocks = (uint32_t)(5.0 * GYRO_CONT_TAU_S * block_hz);
   const double scale = fabs((double)v->rate_scale_dps);
   const double e = scale > 0.0 ? (double)v->selftest_cont_expect_dps * amp_k / scale : 0.0;

@@ -33,6 +33,10 @@
 
 #include <stdint.h>
 
+/* Low-pass of the continuous test's weights before they are judged, per block: about
+ * 2 Hz at the 5 kHz block rate. */
+#define SELFTEST_CONT_AVG_K 0.0025f
+
 typedef enum {
   SELFTEST_IDLE = 0,
   SELFTEST_BASE = 1,
@@ -48,6 +52,7 @@ typedef struct {
   float cont_amp_v;  /* its force amplitude A_c */
   uint32_t cont_step; /* its modulation's phase step per block (2^32 per turn) */
   float cont_mu;     /* its LMS step size per block */
+  float cont_gain;   /* 1 - mu / 2: the notch's pass-band gain undone */
   float cont_lo2, cont_hi2; /* bounds of the response's squared magnitude (raw rate units) */
   uint32_t cont_settle_blocks; /* blocks LOCKED before the response is judged */
   float expect_dps;  /* response expected on the rate axis (calibrated on the part) */
@@ -74,6 +79,7 @@ typedef struct {
   uint32_t cont_phase;   /* modulation phase */
   float cont_c, cont_s;  /* cos, sin of the modulation of the current block */
   float w[4];            /* LMS weights: rate (cos, sin), quadrature (cos, sin) */
+  float w_avg[2];        /* the rate axis's weights through SELFTEST_CONT_AVG_K */
   uint32_t cont_blocks;  /* blocks LOCKED since the LMS started */
   uint32_t cont_fail;    /* the response is judged and out of its band */
 } selftest_t;

@@ -104,6 +104,31 @@ static void test_continuous_healthy(void **state)
   assert_true(fabs(m_on - m_off) < 0.05);
 }
 
+/* The notch takes the tone out and nothing else: with the test on, the output at a
+ * constant 100 deg/s is the same (an LMS notch's pass band is 1 / (1 - mu/2), 0.2 %,
+ * unless undone), and the judged response does not move with the rate. */
+static void test_continuous_keeps_scale(void **state)
+{
+  (void)state;
+  double m[2], resp[2];
+  for (int on = 0; on < 2; on++) {
+    plant_cfg_t pc;
+    plant_default_cfg(&pc);
+    pc.rate_dps = 100.0;
+    app_plant_start(&pc, 31u, NULL);
+    if (on) assert_true(strncmp(cmd("set selftest.continuous 1\n"), "ok", 2) == 0);
+    run_s(1.0);
+    (void)rate_rms(2.0, &m[on]);
+    resp[on] = hypot((double)app.gyro.selftest.w_avg[0], (double)app.gyro.selftest.w_avg[1]) *
+               fabs((double)app.gyro.rate.scale_dps);
+  }
+  printf("# at 100 deg/s: output %.5f off / %.5f on, judged response %.4f deg/s\n", m[0], m[1],
+         resp[1]);
+  assert_true(fabs(m[1] / m[0] - 1.0) < 1e-4);
+  assert_true(fabs(resp[1] / 4.24 - 1.0) < 0.02);
+  assert_int_equal(app.gyro.cont_fail, 0u);
+}
+
 static void test_continuous_dead_electrode(void **state)
 {
   (void)state;
@@ -123,6 +148,7 @@ int main(void)
       cmocka_unit_test(test_pass_on_healthy_part),
       cmocka_unit_test(test_fail_on_dead_electrode),
       cmocka_unit_test(test_continuous_healthy),
+      cmocka_unit_test(test_continuous_keeps_scale),
       cmocka_unit_test(test_continuous_dead_electrode),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
