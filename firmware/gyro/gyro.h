@@ -107,6 +107,7 @@ typedef struct {
   uint32_t lost_seen;    /* its value at the last block */
   uint32_t thermo_due;   /* a new P_f awaits the thermometer checks (next GYRO_SLOT_P) */
   uint32_t cont_fail;    /* the continuous self-test's verdict (GYRO_SLOT_P) */
+  uint32_t rate_clear_due; /* the loop-state clear's rate-channel half is due (GYRO_SLOT_RATE) */
   uint32_t flags_acc;    /* GYRO_FLAG_* seen since the last snapshot */
   supervisor_in_t sup_in; /* the supervisor's evidence, gathered by the jobs before
                            * GYRO_SLOT_SUPERVISE (slot table above) */
@@ -133,10 +134,12 @@ typedef struct {
  * the next tick on.
  *
  *   slot  job                                             uses (slot it comes from)
- *   0     arg Z (fm_atan2f: one divide)                   drive LMSD
+ *   0     arg Z (fm_atan2f: one divide); the drive half   drive LMSD
+ *         of the output snapshot                          drive loop (1, 2, last block)
  *   1     phase loop: wrapped error, PI -> P (P held      arg Z (0), |Z| (2, last block)
  *         while |Z| < 10 % of its setpoint; a whole
- *         turn of P passed on to the thermometer)
+ *         turn of P passed on to the thermometer); the
+ *         continuous self-test's verdict                  its LMS (6, 7, last block)
  *   2     finiteness check, first half (LMSD weights);    drive LMSD
  *         |Z| (square root), amplitude PI -> f_cmd;
  *         rate-valid drive-phase and sense-range checks   phase error (4), quad (7), sense LMSD
@@ -147,19 +150,22 @@ typedef struct {
  *   5     rate channel: block mean of S, projection       sense sum, P (1)
  *         (or, on request, the loop state cleared);
  *         the block's rail codes; the continuous
- *         self-test's tone measured and taken out
- *   6     rate: output filter, scale, compensation;       projection (5), P_f (8, last block)
- *         its range check
+ *         self-test's modulation
+ *   6     the continuous self-test's notch (rate axis);   projection (5), modulation (5)
+ *         rate: output filter, scale, compensation;       P_f (8, last block)
+ *         its range check (or, after a clear, the rate
+ *         channel's reset)
  *   7     finiteness check, second half (loop and rate    weights' half (2)
- *         outputs) and verdict; quadrature filter;        projection (5)
- *         the filters' settling (rate_valid.h)            rate filter (6)
+ *         outputs) and verdict; the continuous            projection (5)
+ *         self-test's notch (quadrature axis),
+ *         quadrature filter; the filters' settling        rate filter (6)
  *   8     P's hold and low-pass (its mean every 10th      P (1)
  *         block), the thermometer checks of the P_f       P_f (8, last block)
  *         made the block before; the self-test sequence   projection (5)
- *         while it runs; the continuous self-test's
- *         verdict
- *   9     rate-valid verdict, output snapshot, analog     checks (2, 6, 7), rails (5),
- *         rate code (the fault level when not valid)      everything
+ *         while it runs
+ *   9     rate-valid verdict, rate half of the output     checks (2, 6, 7), rails (5),
+ *         snapshot, analog rate code (the fault level     everything
+ *         when not valid)
  *
  * The drive command thus reaches the DAC (COMMAND + 1 - slot) ticks after the sample
  * the loop measured: 4 for the phase loop, 2 for the amplitude loop; gyro_design adds

@@ -54,8 +54,8 @@ void gyro_block_clear(gyro_t *g)
   lmsd_reset(&g->lmsd_drive);
   lmsd_reset(&g->lmsd_sense);
   drive_loop_reset(&g->drive);
-  rate_channel_reset(&g->rate, g->rate.p_ref_deg);
   drive_synth_set(&g->synth, 0.0f, g->drive.p_rad);
+  g->rate_clear_due = 1u; /* the rate channel's half, on the next tick (its budget) */
 }
 
 void gyro_block_phase(gyro_t *g)
@@ -75,6 +75,7 @@ void gyro_block_quad(gyro_t *g)
   const float sum = g->drive.f_cmd_v2 + g->drive.p_rad + g->rate.rate_dps + g->rate.quad_dps;
   g->sup_in.state_finite = g->weights_finite != 0u && fm_isfinite(sum);
   rate_channel_t *rc = &g->rate;
+  selftest_cont_notch(&g->selftest, 1u, &rc->quad_raw);
   rate_channel_filter_quad(rc);
   rate_valid_settling(&g->valid, rc->rate_raw, rc->quad_raw, rc->rate_unc_dps, rc->quad_dps,
                       rc->scale_dps);
@@ -82,14 +83,41 @@ void gyro_block_quad(gyro_t *g)
 
 void gyro_block_project(gyro_t *g)
 {
-  rate_channel_t *rc = &g->rate;
-  rate_channel_project(rc, g->lmsd_drive.w_i, g->lmsd_drive.w_q, g->drive.p_rad);
-  selftest_cont_notch(&g->selftest, &rc->rate_raw, &rc->quad_raw);
+  rate_channel_project(&g->rate, g->lmsd_drive.w_i, g->lmsd_drive.w_q, g->drive.p_rad);
+  /* The continuous self-test's modulation, for the ticks from here on and for its notch
+   * on this projection (GYRO_SLOT_RATE, GYRO_SLOT_QUAD): the force runs a fixed block
+   * ahead of the reference, which the LMS's two weights absorb as a phase. */
+  selftest_cont_advance(&g->selftest);
+}
+
+void gyro_block_measure(gyro_t *g, int drive_on)
+{
+  if (drive_on) drive_loop_measure_phase(&g->drive, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
+  /* The drive half of the snapshot (gyro_block_output the rest): on this lighter tick. */
+  gyro_out_t *o = &g->out;
+  o->drive_amp_v = g->drive.amp_v;
+  o->drive_phase_deg = g->drive.phase_rad * FM_DEG_PER_RAD_F;
+  o->p_deg = g->drive.p_rad * FM_DEG_PER_RAD_F;
+  o->f_cmd_v2 = g->drive.f_cmd_v2;
+  o->sense_i_v = g->lmsd_sense.w_i;
+  o->sense_q_v = g->lmsd_sense.w_q;
+}
+
+void gyro_block_phase_judge(gyro_t *g, int drive_on)
+{
+  if (drive_on) gyro_block_phase(g);
+  g->cont_fail = selftest_cont_judge(&g->selftest, g->sup.mode == GYRO_MODE_LOCKED);
 }
 
 void gyro_block_rate(gyro_t *g)
 {
   rate_channel_t *rc = &g->rate;
+  if (GYRO_UNLIKELY(g->rate_clear_due != 0u)) {
+    g->rate_clear_due = 0u;
+    rate_channel_reset(rc, rc->p_ref_deg);
+    return;
+  }
+  selftest_cont_notch(&g->selftest, 0u, &rc->rate_raw);
   rate_channel_filter_rate(rc);
   rate_valid_range(&g->valid, rc->rate_dps);
 }
@@ -97,7 +125,6 @@ void gyro_block_rate(gyro_t *g)
 void gyro_block_p(gyro_t *g, int hold)
 {
   rate_channel_t *rc = &g->rate;
-  g->cont_fail = selftest_cont_judge(&g->selftest, !hold);
   if (g->thermo_due != 0u) {
     /* The thermometer checks of the P_f the last block made: P's low-pass runs on one
      * block in RATE_P_BLOCKS, the checks on the next, so that no tick carries both. */
@@ -142,15 +169,9 @@ void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
   o->rate_dps = g->rate.rate_dps;
   o->rate_unc_dps = g->rate.rate_unc_dps;
   o->quad_dps = g->rate.quad_dps;
-  o->drive_amp_v = g->drive.amp_v;
-  o->drive_phase_deg = g->drive.phase_rad * FM_DEG_PER_RAD_F;
-  o->p_deg = g->drive.p_rad * FM_DEG_PER_RAD_F;
   o->p_f_deg = g->rate.p_f_deg;
-  o->f_cmd_v2 = g->drive.f_cmd_v2;
   o->u1_v = u1_v;
   o->u2_v = u2_v;
-  o->sense_i_v = g->lmsd_sense.w_i;
-  o->sense_q_v = g->lmsd_sense.w_q;
   o->mode = (uint32_t)g->sup.mode;
   o->fault = g->sup.fault;
   if (selftest_running(&g->selftest)) g->flags_acc |= GYRO_FLAG_SELFTEST;

@@ -100,26 +100,10 @@ void selftest_update(selftest_t *st, int locked, float rate_raw)
   }
 }
 
-void selftest_cont_notch(selftest_t *st, float *rate_raw, float *quad_raw)
+void selftest_cont_advance(selftest_t *st)
 {
-  const selftest_cfg_t *c = &st->cfg;
-  if (c->cont_on == 0u) return;
-  /* (5-5) at f_m: the weights' phasor is the tone; the error is the notched signal. */
-  const float mc = st->cont_c, ms = st->cont_s, mu = c->cont_mu;
-  float *w = st->w;
-  const float er = *rate_raw - (w[0] * mc + w[1] * ms);
-  const float eq = *quad_raw - (w[2] * mc + w[3] * ms);
-  w[0] += mu * er * mc;
-  w[1] += mu * er * ms;
-  w[2] += mu * eq * mc;
-  w[3] += mu * eq * ms;
-  /* The LMS with a sinusoidal reference is the notch (Widrow 1975)
-   *   H(z) = (z^2 - 2 cos(w0) z + 1) / (z^2 - 2 (1 - C) cos(w0) z + 1 - 2 C),  C = mu / 2,
-   * whose gain away from w0 (at DC and at the Nyquist frequency alike) is 1 / (1 - C):
-   * 0.2 % of scale factor at mu = 0.004, undone here. */
-  *rate_raw = er * c->cont_gain;
-  *quad_raw = eq * c->cont_gain;
-  st->cont_phase += c->cont_step;
+  if (st->cfg.cont_on == 0u) return;
+  st->cont_phase += st->cfg.cont_step;
   sincos_lut(st->cont_phase, &st->cont_s, &st->cont_c);
   set_force(st);
 }

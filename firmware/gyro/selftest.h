@@ -107,10 +107,27 @@ static inline float selftest_force(const selftest_t *st, float sin_wc, float cos
   return st->a_c * cos_wc - st->a_s * sin_wc;
 }
 
-/* Once per block, on the block's projection (rate_raw, quad_raw, in place): the
- * continuous test's LMS measures its tone and takes it out; then the next block's
- * modulation. Does nothing unless cont_on. */
-void selftest_cont_notch(selftest_t *st, float *rate_raw, float *quad_raw);
+/* Once per block and axis (0 rate, 1 quadrature), on the block's projection (x, in
+ * place) before its output filter: the continuous test's LMS measures its tone and takes
+ * it out. Does nothing unless cont_on. Inline: it runs on ticks near their budget. */
+static inline void selftest_cont_notch(selftest_t *st, uint32_t axis, float *x)
+{
+  const selftest_cfg_t *c = &st->cfg;
+  if (c->cont_on == 0u) return;
+  /* (5-5) at f_m: the weights' phasor is the tone; the error is the notched signal. */
+  const float mc = st->cont_c, ms = st->cont_s, mu = c->cont_mu;
+  float *w = &st->w[2u * axis];
+  const float e = *x - (w[0] * mc + w[1] * ms);
+  w[0] += mu * e * mc;
+  w[1] += mu * e * ms;
+  /* The LMS with a sinusoidal reference is the notch (Widrow 1975)
+   *   H(z) = (z^2 - 2 cos(w0) z + 1) / (z^2 - 2 (1 - C) cos(w0) z + 1 - 2 C),  C = mu / 2,
+   * whose gain away from w0 (at DC and at the Nyquist frequency alike) is 1 / (1 - C):
+   * 0.2 % of scale factor at mu = 0.004, undone here. */
+  *x = e * c->cont_gain;
+}
+/* Once per block, after both axes' notch: the next block's modulation and force. */
+void selftest_cont_advance(selftest_t *st);
 /* Once per block: judge the continuous test's response (locked: drive LOCKED; the
  * judgement restarts with the LMS when not). Returns cont_fail. */
 uint32_t selftest_cont_judge(selftest_t *st, int locked);
