@@ -54,7 +54,7 @@ void gyro_block_clear(gyro_t *g)
   lmsd_reset(&g->lmsd_drive);
   lmsd_reset(&g->lmsd_sense);
   drive_loop_reset(&g->drive);
-  drive_synth_set(&g->synth, 0.0f, g->drive.p_rad);
+  drive_synth_silence(&g->synth);
   g->rate_clear_due = 1u; /* the rate channel's half, on the next tick (its budget) */
 }
 
