@@ -92,7 +92,6 @@ static void keep_designable(app_t *a, param_values_t *v)
 int app_init_with(app_t *a, const param_values_t *values)
 {
   memset(a, 0, sizeof *a);
-  a->lost_seen = hal_sample_lost(); /* losses before this start are not this run's */
   param_values_t initial;
   param_values_defaults(&initial);
 
@@ -130,6 +129,7 @@ int app_init_with(app_t *a, const param_values_t *values)
   if (gyro_init_from_design(&a->gyro, view.derived) != 0) {
     return -2;
   }
+  gyro_attach_lost_counter(&a->gyro, hal_sample_lost_counter());
   a->applied = view.derived;
 
   const cli_cfg_t cc = {&a->params, &a->store, cli_write, a};
@@ -220,11 +220,6 @@ void app_sample_isr(void *ctx)
     a->req_tail = tail + 1u;
   }
 
-  const uint32_t lost = hal_sample_lost();
-  if (lost != a->lost_seen) {
-    a->lost_seen = lost;
-    a->gyro.sample_lost = 1u; /* the supervisor faults at its next step */
-  }
   hal_adc_frame_t adc;
   hal_dac_frame_t dac;
   hal_adc_read_frame(&adc);

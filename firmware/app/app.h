@@ -75,7 +75,6 @@ typedef struct {
   uint32_t selfcal_ticks;    /* its length up to the hand-over */
   /* Self-measurement of the sample ISR (DWT cycles on the board). */
   uint32_t isr_ticks;
-  uint32_t lost_seen;        /* hal_sample_lost() as the ISR last saw it */
   /* Set by the image's main after app_init (NULL: nothing added, as on the host). */
   app_status_fn status_board;
   void *status_board_ctx;

@@ -91,9 +91,9 @@ static void put_integrity(cli_t *cli, const app_t *a)
   cli_emit_data(cli);
   cli_data_f32(cli, "rate_out_v", g->out.rate_out_v);
   for (uint32_t i = 0; i < RATE_INVALID_KINDS; i++) {
-    if (g->valid.count[i] != 0u) {
-      put_monitor(cli, "invalid_", rate_valid_reason_name(i), g->valid.count[i],
-                  (float)g->valid.last_block[i] * block_s);
+    if (g->valid_history.count[i] != 0u) {
+      put_monitor(cli, "invalid_", rate_valid_reason_name(i), g->valid_history.count[i],
+                  (float)g->valid_history.last_block[i] * block_s);
     }
   }
   for (uint32_t i = 0; i < GYRO_FAULT_KINDS; i++) {

@@ -32,10 +32,11 @@
 /* The tuning port's line rate (hal/stm32f4: STM32F4_UART_BAUD, 8N1). */
 #define APP_TLM_BAUD 921600u
 /* TX-ring bytes telemetry leaves free for command replies, so that the longest (list,
- * about 5.0 KB; status with the self-calibration lines about 0.7 KB) comes out whole
- * while a stream runs (test_app: every reply fits). The rings are 8 KB on the board and
- * the host, which leaves telemetry 2 KB (22 ms of the line) of backlog. */
-#define APP_TLM_TX_RESERVE 6144u
+ * about 6.5 KB; status with the self-calibration and output-integrity lines about
+ * 1.5 KB) comes out whole while a stream runs (test_app: every reply fits). The rings
+ * are 8 KB on the board and the host, which leaves telemetry 1 KB (11 ms of the line)
+ * of backlog. */
+#define APP_TLM_TX_RESERVE 7168u
 
 typedef struct {
   tlm_t stream;

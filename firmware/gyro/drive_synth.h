@@ -21,6 +21,7 @@
 #ifndef DRIVE_SYNTH_H
 #define DRIVE_SYNTH_H
 
+#include <math.h> /* NAN (a constant, no call) */
 #include <stdint.h>
 
 #include "dsp/sincos.h"
@@ -60,6 +61,15 @@ float drive_synth_f_cmd_max(const drive_synth_t *ds);
  * hysteresis, so that the voltages' sign flip of a whole turn of P (the force is
  * unchanged, (6-25)) happens once, not on every noise crossing. */
 void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad);
+
+/* No force from the next sample on (amplitude 0; in DC+AC the bias alone), without the
+ * square root and phase conversion of drive_synth_set: a fault's clear, on a tick near
+ * its budget. The next drive_synth_set or _follow sets a command again. */
+static inline void drive_synth_silence(drive_synth_t *ds)
+{
+  ds->a_v = 0.0f;
+  ds->f_set_v2 = ds->p_set_rad = NAN;
+}
 
 /* drive_synth_set, skipped when the command is the one last set (a NaN never is, and
  * drive_synth_init forgets it). For a caller that passes a command every tick though it

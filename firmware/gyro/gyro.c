@@ -69,6 +69,52 @@ static int design_validity(const param_values_t *v, gyro_design_t *t)
   return 0;
 }
 
+/* Continuous self-test's LMS: a convergence time constant of 0.1 s, 2 / mu blocks for
+ * two weights on a reference of power 1/2 each (a notch about 3 Hz wide); its response
+ * is judged after five of them. */
+#define GYRO_CONT_TAU_S 0.1
+
+/* Both self-tests (selftest.h). Their expectations were measured at the setpoint
+ * selftest.ref_amp_v; the rate channel divides by the setpoint, so a response in deg/s
+ * scales as ref_amp_v / amp_set_v. The continuous test's tone must lie above the rate's
+ * output band (the notch would otherwise take rate out of it) and below a quarter of
+ * the block rate. */
+static int design_selftest(const param_values_t *v, gyro_design_t *t)
+{
+  const double th = (double)v->drive_phase_set_deg * FM_PI / 180.0;
+  const double amp_k = (double)v->selftest_ref_amp_v / (double)v->drive_amp_set_v;
+  const double block_hz = (double)v->sys_fs_hz / GYRO_BLOCK;
+  selftest_cfg_t st;
+  memset(&st, 0, sizeof st);
+  st.amp_v = v->selftest_amp_v;
+  st.expect_dps = (float)((double)v->selftest_expect_dps * amp_k);
+  st.tol_rel = v->selftest_tol_rel;
+  st.ref_c = (float)cos(th);
+  st.ref_s = (float)sin(th);
+  st.scale_dps = v->rate_scale_dps;
+  st.base_blocks = v->sys_fs_hz / (5u * GYRO_BLOCK); /* 0.2 s */
+  st.settle_blocks = v->sys_fs_hz / (10u * GYRO_BLOCK); /* 0.1 s */
+  st.meas_blocks = v->sys_fs_hz / (5u * GYRO_BLOCK);    /* 0.2 s */
+  st.cont_on = v->selftest_continuous;
+  st.cont_amp_v = v->selftest_cont_amp_v;
+  const double f_m = (double)v->selftest_cont_freq_hz;
+  if (st.cont_on != 0u && !(f_m >= 1.5 * (double)v->rate_lpf_cutoff_hz && f_m <= block_hz / 4.0)) {
+    return -1;
+  }
+  st.cont_step = (uint32_t)(f_m / block_hz * 4294967296.0 + 0.5);
+  st.cont_mu = (float)(2.0 / (GYRO_CONT_TAU_S * block_hz));
+  st.cont_gain = 1.0f - 0.5f * st.cont_mu;
+  st.cont_settle_blocks = (uint32_t)(5.0 * GYRO_CONT_TAU_S * block_hz);
+  const double scale = fabs((double)v->rate_scale_dps);
+  const double e = scale > 0.0 ? (double)v->selftest_cont_expect_dps * amp_k / scale : 0.0;
+  const double tol = (double)v->selftest_tol_rel;
+  if (st.cont_on != 0u && !(e > 0.0 && tol < 1.0)) return -1;
+  st.cont_lo2 = (float)(e * e * (1.0 - tol) * (1.0 - tol));
+  st.cont_hi2 = (float)(e * e * (1.0 + tol) * (1.0 + tol));
+  t->selftest = st;
+  return 0;
+}
+
 int gyro_design(const param_values_t *v, gyro_design_t *d)
 {
   if (v == NULL || d == NULL) {
@@ -173,20 +219,22 @@ int gyro_design(const param_values_t *v, gyro_design_t *d)
   t.sup.acq_timeout_s = (float)acq_timeout_s(v, tau, &t);
   if (design_validity(v, &t) != 0) return -7;
   t.autostart = v->sys_autostart;
-  {
-    const double th = (double)v->drive_phase_set_deg * FM_PI / 180.0;
-    selftest_cfg_t st = {v->selftest_amp_v, v->selftest_expect_dps, v->selftest_tol_rel,
-                         (float)cos(th), (float)sin(th), v->rate_scale_dps,
-                         v->sys_fs_hz / (5u * GYRO_BLOCK), v->sys_fs_hz / (10u * GYRO_BLOCK),
-                         v->sys_fs_hz / (5u * GYRO_BLOCK)}; /* 0.2 s, 0.1 s, 0.2 s */
-    t.selftest = st;
-  }
+  if (design_selftest(v, &t) != 0) return -8;
   /* Every module must accept its part: a design that gyro_apply could not apply is
    * rejected here, in the background, where the error can be reported. */
   gyro_t scratch;
   if (gyro_init_from_design(&scratch, &t) != 0) return -6;
   *d = t;
   return 0;
+}
+
+/* No counter of lost samples attached (gyro_attach_lost_counter): none are lost. */
+static const volatile uint32_t k_no_loss = 0u;
+
+void gyro_attach_lost_counter(gyro_t *g, const volatile uint32_t *count)
+{
+  g->lost_count = count != NULL ? count : &k_no_loss;
+  g->lost_seen = *g->lost_count;
 }
 
 int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
@@ -206,6 +254,7 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   }
   t.rate_fault_out_v = d->rate_fault_out_v;
   t.rate_fault_code = gyro_volts_to_dac(d->rate_fault_out_v);
+  gyro_attach_lost_counter(&t, NULL);
   t.adc_v_per_code = HAL_ADC_V_PER_CODE;
   selftest_init(&t.selftest, &d->selftest);
   t.rate_code = t.rate_fault_code; /* not valid until the first verdict says so */
@@ -349,7 +398,7 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
   dac->code[HAL_DAC_RATE_OUT] = g->rate_code; /* the rate changes once per block */
   /* Built-in self-test force on the sense feedback electrodes (selftest.h). */
-  dac->code[HAL_DAC_SPARE] = g->selftest.state == SELFTEST_FORCE
+  dac->code[HAL_DAC_SPARE] = g->selftest.force_on != 0u
                                  ? gyro_volts_to_dac(selftest_force(&g->selftest, ref.sin_wc, ref.cos_wc))
                                  : (uint16_t)HAL_DAC_CODE_MID;
   g->out.tick++;

@@ -102,7 +102,11 @@ typedef struct {
   uint32_t clip_count;   /* ADC rail codes since the block's projection (slot 5) */
   uint32_t clip_block;   /* rail codes over the ticks of the latest projected block */
   uint32_t clip_drive_count, clip_drive_block; /* the same, drive channel only */
-  uint32_t sample_lost;  /* set by the application when the HAL reports a lost sample */
+  const volatile uint32_t *lost_count; /* the HAL's count of lost samples */
+  uint32_t lost_seen;    /* its value at the last block */
+  uint32_t thermo_due;   /* a new P_f awaits the thermometer checks (next GYRO_SLOT_P) */
+  uint32_t cont_fail;    /* the continuous self-test's verdict (GYRO_SLOT_P) */
+  uint32_t rate_clear_due; /* the loop-state clear's rate-channel half is due (GYRO_SLOT_RATE) */
   uint32_t flags_acc;    /* GYRO_FLAG_* seen since the last snapshot */
   supervisor_in_t sup_in; /* the supervisor's evidence, gathered by the jobs before
                            * GYRO_SLOT_SUPERVISE (slot table above) */
@@ -110,12 +114,13 @@ typedef struct {
   uint16_t rate_code;    /* analog rate output DAC code, updated with the snapshot */
   uint16_t rate_fault_code; /* its code at the fault level */
   float rate_fault_out_v;
-  rate_valid_t valid;    /* the rate-valid verdict and its monitors */
   selftest_t selftest;
   gyro_out_t out;        /* updated once per block (tick: every tick) */
   /* Last, so that what the sample path reads every block stays within the reach of
    * one load's immediate offset. */
+  rate_valid_t valid;    /* the rate-valid verdict and its monitors (once per block) */
   selfcal_exec_t cal; /* self-calibration jobs, run while the supervisor is in SWEEP */
+  rate_valid_history_t valid_history; /* onsets of the reasons, for `status` */
 } gyro_t;
 
 /* The block: GYRO_BLOCK ticks (the rate channel's RATE_DECIM, 0.2 ms at 50 kHz). Per
@@ -128,26 +133,38 @@ typedef struct {
  * the next tick on.
  *
  *   slot  job                                             uses (slot it comes from)
- *   0     arg Z (fm_atan2f: one divide)                   drive LMSD
+ *   0     arg Z (fm_atan2f: one divide); the drive half   drive LMSD
+ *         of the output snapshot                          drive loop (1, 2, last block)
  *   1     phase loop: wrapped error, PI -> P (P held      arg Z (0), |Z| (2, last block)
- *         while |Z| < 10 % of its setpoint)
+ *         while |Z| < 10 % of its setpoint; a whole
+ *         turn of P passed on to the thermometer); the
+ *         continuous self-test's verdict                  its LMS (6, 7, last block)
  *   2     finiteness check, first half (LMSD weights);    drive LMSD
- *         |Z| (square root), amplitude PI -> f_cmd
+ *         |Z| (square root), amplitude PI -> f_cmd;
+ *         rate-valid drive-phase and sense-range checks   phase error (4), quad (7), sense LMSD
  *   3     the supervisor's evidence (sup_in);             |Z|, f_cmd (2), phase error (1)
  *         drive_synth_set(f_cmd, P): the waveform's       f_cmd (2), P (1)
  *         amplitude (square root) and phase offset
  *   4     supervisor (its clear request: slot 5)          evidence (3), finiteness (7, last block)
  *   5     rate channel: block mean of S, projection       sense sum, P (1)
- *         (or, on request, the loop state cleared)
- *   6     rate: output filter, scale, compensation        projection (5), P_f (8, last block)
+ *         (or, on request, the loop state cleared);
+ *         the block's rail codes; the continuous
+ *         self-test's modulation
+ *   6     the continuous self-test's notch (rate axis);   projection (5), modulation (5)
+ *         rate: output filter, scale, compensation;       P_f (8, last block)
+ *         its range check (or, after a clear, the rate
+ *         channel's reset)
  *   7     finiteness check, second half (loop and rate    weights' half (2)
- *         outputs) and verdict; quadrature filter;        projection (5)
- *         the filters' settling (rate_valid.h)            rate filter (6)
+ *         outputs) and verdict; the continuous            projection (5)
+ *         self-test's notch (quadrature axis),
+ *         quadrature filter; the filters' settling        rate filter (6)
  *   8     P's hold and low-pass (its mean every 10th      P (1)
- *         block); the self-test sequence while it runs;   projection (5)
- *         the thermometer checks at each new P_f          P_f (8)
- *   9     rate-valid verdict, output snapshot, analog     everything
- *         rate code (the fault level when not valid)
+ *         block), the thermometer checks of the P_f       P_f (8, last block)
+ *         made the block before; the self-test sequence   projection (5)
+ *         while it runs
+ *   9     rate-valid verdict, rate half of the output     checks (2, 6, 7), rails (5),
+ *         snapshot, analog rate code (the fault level     everything
+ *         when not valid)
  *
  * The drive command thus reaches the DAC (COMMAND + 1 - slot) ticks after the sample
  * the loop measured: 4 for the phase loop, 2 for the amplitude loop; gyro_design adds
@@ -185,6 +202,10 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d);
 
 /* One sample: ADC frame in, DAC frame out (latched by the HAL at the next tick). */
 void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac);
+
+/* The HAL's count of lost samples (hal_sample_lost_counter), read once per block: a
+ * change is a LOST_SAMPLE fault. NULL: none. */
+void gyro_attach_lost_counter(gyro_t *g, const volatile uint32_t *count);
 
 void gyro_start(gyro_t *g);
 void gyro_stop(gyro_t *g);

@@ -19,6 +19,10 @@ void gyro_block_amp(gyro_t *g)
     /* Measure only: the amplitude is still watched for the over-amplitude trip. */
     g->drive.amp_v = fm_sqrtf(w_s * w_s + w_c * w_c);
   }
+  /* The drive-phase and sense-range checks of the rate's validity, on evidence of the
+   * last block (phase error: supervisor; quadrature: its filter). */
+  const float s_i = g->lmsd_sense.w_i, s_q = g->lmsd_sense.w_q;
+  rate_valid_drive(&g->valid, g->sup.phase_err_f, g->rate.quad_dps, s_i * s_i + s_q * s_q);
 }
 
 void gyro_block_command(gyro_t *g)
@@ -36,8 +40,9 @@ void gyro_block_command(gyro_t *g)
    * quadrature, rate or vibration for its gain) leaves the drive sound: the rate is not
    * valid then (rate_valid.h, CLIP), but the drive keeps running. */
   si->clip_count = g->clip_drive_block;
-  si->sample_lost = (int)g->sample_lost;
-  g->sample_lost = 0u;
+  const uint32_t lost = *g->lost_count;
+  si->sample_lost = lost != g->lost_seen;
+  g->lost_seen = lost;
   /* Once per block, after both loops: the square root and the phase conversion. */
   if (drive_on) {
     drive_synth_set(&g->synth, g->drive.f_cmd_v2, g->drive.p_rad);
@@ -50,8 +55,8 @@ void gyro_block_clear(gyro_t *g)
   lmsd_reset(&g->lmsd_drive);
   lmsd_reset(&g->lmsd_sense);
   drive_loop_reset(&g->drive);
-  rate_channel_reset(&g->rate, g->rate.p_ref_deg);
-  drive_synth_set(&g->synth, 0.0f, g->drive.p_rad);
+  drive_synth_silence(&g->synth);
+  g->rate_clear_due = 1u; /* the rate channel's half, on the next tick (its budget) */
 }
 
 void gyro_block_phase(gyro_t *g)
@@ -71,18 +76,64 @@ void gyro_block_quad(gyro_t *g)
   const float sum = g->drive.f_cmd_v2 + g->drive.p_rad + g->rate.rate_dps + g->rate.quad_dps;
   g->sup_in.state_finite = g->weights_finite != 0u && fm_isfinite(sum);
   rate_channel_t *rc = &g->rate;
+  selftest_cont_notch(&g->selftest, 1u, &rc->quad_raw);
   rate_channel_filter_quad(rc);
   rate_valid_settling(&g->valid, rc->rate_raw, rc->quad_raw, rc->rate_unc_dps, rc->quad_dps,
                       rc->scale_dps);
 }
 
+void gyro_block_project(gyro_t *g)
+{
+  rate_channel_project(&g->rate, g->lmsd_drive.w_i, g->lmsd_drive.w_q, g->drive.p_rad);
+  /* The continuous self-test's modulation, for the ticks from here on and for its notch
+   * on this projection (GYRO_SLOT_RATE, GYRO_SLOT_QUAD): the force runs a fixed block
+   * ahead of the reference, which the LMS's two weights absorb as a phase. */
+  selftest_cont_advance(&g->selftest);
+}
+
+void gyro_block_measure(gyro_t *g, int drive_on)
+{
+  if (drive_on) drive_loop_measure_phase(&g->drive, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
+  /* The drive half of the snapshot (gyro_block_output the rest): on this lighter tick. */
+  gyro_out_t *o = &g->out;
+  o->drive_amp_v = g->drive.amp_v;
+  o->drive_phase_deg = g->drive.phase_rad * FM_DEG_PER_RAD_F;
+  o->p_deg = g->drive.p_rad * FM_DEG_PER_RAD_F;
+  o->f_cmd_v2 = g->drive.f_cmd_v2;
+  o->sense_i_v = g->lmsd_sense.w_i;
+  o->sense_q_v = g->lmsd_sense.w_q;
+}
+
+void gyro_block_phase_judge(gyro_t *g, int drive_on)
+{
+  if (drive_on) gyro_block_phase(g);
+  g->cont_fail = selftest_cont_judge(&g->selftest, g->sup.mode == GYRO_MODE_LOCKED);
+}
+
+void gyro_block_rate(gyro_t *g)
+{
+  rate_channel_t *rc = &g->rate;
+  if (GYRO_UNLIKELY(g->rate_clear_due != 0u)) {
+    g->rate_clear_due = 0u;
+    rate_channel_reset(rc, rc->p_ref_deg);
+    return;
+  }
+  selftest_cont_notch(&g->selftest, 0u, &rc->rate_raw);
+  rate_channel_filter_rate(rc);
+  rate_valid_range(&g->valid, rc->rate_dps);
+}
+
 void gyro_block_p(gyro_t *g, int hold)
 {
   rate_channel_t *rc = &g->rate;
-  rate_channel_hold_p(rc, hold);
-  if (rate_channel_update_p(rc, g->drive.p_rad) != 0) {
+  if (g->thermo_due != 0u) {
+    /* The thermometer checks of the P_f the last block made: P's low-pass runs on one
+     * block in RATE_P_BLOCKS, the checks on the next, so that no tick carries both. */
+    g->thermo_due = 0u;
     rate_valid_thermo(&g->valid, rc->p_dev_deg, rc->p_held_dev_deg, rc->p_held_w, rc->quad_dps);
   }
+  rate_channel_hold_p(rc, hold);
+  if (rate_channel_update_p(rc, g->drive.p_rad) != 0) g->thermo_due = 1u;
 }
 
 void gyro_block_p_selftest(gyro_t *g)
@@ -99,15 +150,11 @@ void gyro_block_p_selftest(gyro_t *g)
 void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
 {
   gyro_out_t *o = &g->out;
-  const rate_valid_in_t vin = {g->sup.mode == GYRO_MODE_LOCKED,
-                               selftest_running(&g->selftest),
-                               g->clip_block,
-                               g->lmsd_sense.w_i * g->lmsd_sense.w_i +
-                                   g->lmsd_sense.w_q * g->lmsd_sense.w_q,
-                               g->rate.rate_dps,
-                               g->rate.quad_dps,
-                               g->sup.phase_err_f};
-  const uint32_t invalid = rate_valid_verdict(&g->valid, &vin);
+  const uint32_t block_bits = (g->sup.mode == GYRO_MODE_LOCKED ? 0u : RATE_INVALID_MODE) |
+                              (selftest_running(&g->selftest) ? RATE_INVALID_SELFTEST : 0u) |
+                              (g->clip_block != 0u ? RATE_INVALID_CLIP : 0u) |
+                              (g->cont_fail != 0u ? RATE_INVALID_CONT_SELFTEST : 0u);
+  const uint32_t invalid = rate_valid_verdict(&g->valid, &g->valid_history, block_bits);
   /* Never a valid-looking wrong rate: the analog output goes to the fault level in the
    * same sample as the verdict, without a slew. */
   float out_v = g->rate_fault_out_v;
@@ -123,15 +170,9 @@ void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
   o->rate_dps = g->rate.rate_dps;
   o->rate_unc_dps = g->rate.rate_unc_dps;
   o->quad_dps = g->rate.quad_dps;
-  o->drive_amp_v = g->drive.amp_v;
-  o->drive_phase_deg = g->drive.phase_rad * FM_DEG_PER_RAD_F;
-  o->p_deg = g->drive.p_rad * FM_DEG_PER_RAD_F;
   o->p_f_deg = g->rate.p_f_deg;
-  o->f_cmd_v2 = g->drive.f_cmd_v2;
   o->u1_v = u1_v;
   o->u2_v = u2_v;
-  o->sense_i_v = g->lmsd_sense.w_i;
-  o->sense_q_v = g->lmsd_sense.w_q;
   o->mode = (uint32_t)g->sup.mode;
   o->fault = g->sup.fault;
   if (selftest_running(&g->selftest)) g->flags_acc |= GYRO_FLAG_SELFTEST;

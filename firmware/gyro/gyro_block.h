@@ -21,13 +21,14 @@
 
 /* GYRO_SLOT_AMP: the first half of the finiteness check (the LMSD weights), then |Z|
  * and, while the drive runs, the amplitude PI (with the drive off |Z| only, for the
- * over-amplitude trip). */
+ * over-amplitude trip); the rate-valid drive-phase and sense-range checks. */
 void gyro_block_amp(gyro_t *g);
 /* GYRO_SLOT_COMMAND: the rest of the supervisor's evidence (sup_in), and the block's
  * drive command into the synthesis (once, after both loops). */
 void gyro_block_command(gyro_t *g);
 /* GYRO_SLOT_PROJECT when the supervisor asked for it: clear every integrating state, so
- * that nothing of the old state (possibly NaN) survives into the next acquisition. */
+ * that nothing of the old state (possibly NaN) survives into the next acquisition; the
+ * rate channel's on the next tick (GYRO_SLOT_RATE), each half within a tick's budget. */
 void gyro_block_clear(gyro_t *g);
 /* GYRO_SLOT_QUAD: the second half of the finiteness check (loop outputs, rate channel
  * outputs) and its verdict for the supervisor (sup_in: the next block's supervisor acts
@@ -36,7 +37,18 @@ void gyro_block_quad(gyro_t *g);
 /* GYRO_SLOT_PHASE_PI: the phase loop's update; a whole turn of P it took is passed on to
  * the thermometer (rate_channel_shift_p). */
 void gyro_block_phase(gyro_t *g);
-/* GYRO_SLOT_P: P's hold and low-pass, the thermometer checks at each new P_f. */
+/* GYRO_SLOT_PHASE_MEAS: arg Z (drive on), the drive half of the output snapshot. */
+void gyro_block_measure(gyro_t *g, int drive_on);
+/* GYRO_SLOT_PROJECT: the block's projection and the continuous self-test's modulation. */
+void gyro_block_project(gyro_t *g);
+/* GYRO_SLOT_PHASE_PI: the phase loop (drive on, gyro_block_phase) and the continuous
+ * self-test's verdict. */
+void gyro_block_phase_judge(gyro_t *g, int drive_on);
+/* GYRO_SLOT_RATE: the continuous self-test's notch on the rate axis, the rate's output
+ * filter, scale and compensation, its range check. */
+void gyro_block_rate(gyro_t *g);
+/* GYRO_SLOT_P: P's hold and low-pass (hold: not LOCKED); the thermometer checks of the
+ * P_f the last block made. */
 void gyro_block_p(gyro_t *g, int hold);
 /* GYRO_SLOT_P while a self-test runs: its sequence on the block's projection, then P's
  * hold and low-pass. */
@@ -54,10 +66,10 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
   const int drive_on = supervisor_drive_enabled(&g->sup);
   switch (slot) {
   case GYRO_SLOT_PHASE_MEAS:
-    if (drive_on) drive_loop_measure_phase(&g->drive, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
+    gyro_block_measure(g, drive_on);
     break;
   case GYRO_SLOT_PHASE_PI:
-    if (drive_on) gyro_block_phase(g);
+    gyro_block_phase_judge(g, drive_on);
     break;
   case GYRO_SLOT_AMP:
     gyro_block_amp(g);
@@ -79,11 +91,11 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
     if (g->sup.clear_req != 0u) {
       gyro_block_clear(g);
     } else {
-      rate_channel_project(&g->rate, g->lmsd_drive.w_i, g->lmsd_drive.w_q, g->drive.p_rad);
+      gyro_block_project(g);
     }
     break;
   case GYRO_SLOT_RATE:
-    rate_channel_filter_rate(&g->rate);
+    gyro_block_rate(g);
     break;
   case GYRO_SLOT_QUAD:
     gyro_block_quad(g);

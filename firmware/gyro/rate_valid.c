@@ -21,7 +21,7 @@ int rate_valid_init(rate_valid_t *rv, const rate_valid_cfg_t *cfg)
   }
   rv->cfg = *cfg;
   rv->reasons = RATE_INVALID_MODE;
-  rv->thermo = 0u;
+  rv->thermo = rv->drive = rv->range = 0u;
   rv->was_locked = 0u;
   rv->x_rate = rv->x_quad = 0.0f;
   rv->p_dev_window_deg = 0.0f;
@@ -29,10 +29,11 @@ int rate_valid_init(rate_valid_t *rv, const rate_valid_cfg_t *cfg)
   rv->slew = 0u;
   rv->phase_err_lp_rad = 0.0f;
   rv->blocks = 0u;
-  for (uint32_t i = 0; i < RATE_INVALID_KINDS; i++) rv->count[i] = rv->last_block[i] = 0u;
   rate_valid_disturb(rv);
   return 0;
 }
+
+
 
 void rate_valid_retune(rate_valid_t *rv, const rate_valid_cfg_t *cfg) { rv->cfg = *cfg; }
 
@@ -82,55 +83,35 @@ void rate_valid_thermo(rate_valid_t *rv, float p_dev_deg, float p_held_dev_deg, 
   rv->thermo = r;
 }
 
-/* Onsets of each reason, counted with the block they happened in (rare: only when the
- * set of reasons grows). */
-static void count_onsets(rate_valid_t *rv, uint32_t onsets)
+void rate_valid_count_onsets(rate_valid_t *rv, rate_valid_history_t *h, uint32_t onsets)
 {
   for (uint32_t i = 0; i < RATE_INVALID_KINDS; i++) {
     if ((onsets & (1u << i)) != 0u) {
-      rv->count[i]++;
-      rv->last_block[i] = rv->blocks;
+      h->count[i]++;
+      h->last_block[i] = rv->blocks;
     }
   }
 }
 
-uint32_t rate_valid_verdict(rate_valid_t *rv, const rate_valid_in_t *in)
+void rate_valid_drive(rate_valid_t *rv, float phase_err_rad, float quad_dps, float sense_v2)
 {
   const rate_valid_cfg_t *c = &rv->cfg;
-  rv->blocks++;
-  if (in->locked && rv->was_locked == 0u) {
-    /* The lasting error's low-pass starts from zero, not from what acquisition left in
-     * it nor from the 100 Hz error's noise: at lock the phase PI's integrator removes
-     * a lasting error within its own time constant, unless the loop is at a dead end,
-     * which builds up here (and in PHASE_LOST) within tens of milliseconds. */
-    rate_valid_disturb(rv);
-    rv->phase_err_lp_rad = 0.0f;
-  }
-  rv->was_locked = in->locked ? 1u : 0u;
-  if (in->rail_codes != 0u) rate_valid_disturb(rv);
-  uint32_t r = rv->thermo;
-  if (!in->locked) r |= RATE_INVALID_MODE;
-  if (in->selftest) r |= RATE_INVALID_SELFTEST;
-  if (rv->settled == 0u) r |= RATE_INVALID_SETTLING;
-  if (in->rail_codes != 0u) r |= RATE_INVALID_CLIP;
-  if (!(in->sense_v2 <= c->sense_max_v2)) r |= RATE_INVALID_SENSE_RANGE;
-  if (!(fm_absf(in->rate_dps) <= c->full_scale_dps)) r |= RATE_INVALID_OVER_RANGE;
   /* The lock tolerance on the 100 Hz error; the quadrature it rotates into the rate on
    * its lasting part. */
-  rv->phase_err_lp_rad += RATE_VALID_PHASE_K * (in->phase_err_rad - rv->phase_err_lp_rad);
-  const float pe = fm_absf(in->phase_err_rad);
-  const float leak_dps = fm_absf(rv->phase_err_lp_rad) * fm_absf(in->quad_dps);
+  rv->phase_err_lp_rad += RATE_VALID_PHASE_K * (phase_err_rad - rv->phase_err_lp_rad);
+  const float pe = fm_absf(phase_err_rad);
+  const float leak_dps = fm_absf(rv->phase_err_lp_rad) * fm_absf(quad_dps);
+  uint32_t r = 0u;
   if (!(pe <= c->phase_tol_rad && leak_dps <= c->tol_dps)) r |= RATE_INVALID_PHASE;
-  const uint32_t onsets = r & ~rv->reasons;
-  if (onsets != 0u) count_onsets(rv, onsets);
-  rv->reasons = r;
-  return r;
+  if (!(sense_v2 <= c->sense_max_v2)) r |= RATE_INVALID_SENSE_RANGE;
+  rv->drive = r;
 }
 
 const char *rate_valid_reason_name(uint32_t kind)
 {
   static const char *const names[RATE_INVALID_KINDS] = {
       "MODE",        "SELFTEST", "SETTLING",     "CLIP",         "SENSE_RANGE",
-      "OVER_RANGE",  "PHASE",    "THERMO_RANGE", "THERMO_SLEW",  "THERMO_SETTLE"};
+      "OVER_RANGE",  "PHASE",    "THERMO_RANGE", "THERMO_SLEW",  "THERMO_SETTLE",
+      "CONT_SELFTEST"};
   return kind < RATE_INVALID_KINDS ? names[kind] : "?";
 }

@@ -28,6 +28,8 @@
  *                 still be is known without noise from the weight w the held value
  *                 keeps in P_f, |P_f - P| = w / (1 - w) |P_held - P_f|, and the rate
  *                 error that makes as above
+ *   CONT_SELFTEST the continuous self-test's response missing or out of its band
+ *                 (selftest.h)
  * Each check is a few multiplies and compares per block; no divide, no libm. */
 #ifndef RATE_VALID_H
 #define RATE_VALID_H
@@ -44,7 +46,8 @@
 #define RATE_INVALID_THERMO_RANGE (1u << 7)
 #define RATE_INVALID_THERMO_SLEW (1u << 8)
 #define RATE_INVALID_THERMO_SETTLE (1u << 9)
-#define RATE_INVALID_KINDS 10u
+#define RATE_INVALID_CONT_SELFTEST (1u << 10)
+#define RATE_INVALID_KINDS 11u
 
 /* Blocks in a row inside the settling tolerance (2 ms): longer than the noise's
  * correlation time at the filters' 100 Hz, far shorter than their settling. */
@@ -82,6 +85,8 @@ typedef struct {
   rate_valid_cfg_t cfg;
   uint32_t reasons;         /* RATE_INVALID_* of the latest verdict */
   uint32_t thermo;          /* RATE_INVALID_THERMO_* of the latest P update */
+  uint32_t drive;           /* RATE_INVALID_PHASE, _SENSE_RANGE of the latest block */
+  uint32_t range;           /* RATE_INVALID_OVER_RANGE of the latest block */
   uint32_t settled;         /* nonzero once settled since the last disturbance */
   uint32_t settle_run;      /* blocks in a row inside the settling tolerance */
   uint32_t was_locked;      /* LOCKED at the previous verdict (entering it disturbs) */
@@ -90,10 +95,15 @@ typedef struct {
   uint32_t p_updates;       /* P_f updates into the slew window */
   uint32_t slew;            /* RATE_INVALID_THERMO_SLEW of the latest window */
   float phase_err_lp_rad;   /* the drive phase error through RATE_VALID_PHASE_K */
-  uint32_t count[RATE_INVALID_KINDS];     /* onsets of each reason */
-  uint32_t last_block[RATE_INVALID_KINDS]; /* block count of each reason's latest onset */
   uint32_t blocks;          /* verdicts since power-on */
 } rate_valid_t;
+
+/* The history of the reasons for `status`: written only when a reason sets in, so it
+ * lives apart from the state the sample path reads every block (gyro_t keeps it last). */
+typedef struct {
+  uint32_t count[RATE_INVALID_KINDS];      /* onsets of each reason */
+  uint32_t last_block[RATE_INVALID_KINDS]; /* block count of each reason's latest onset */
+} rate_valid_history_t;
 
 /* Returns 0, or -1 (nothing changed) for a bad configuration. */
 int rate_valid_init(rate_valid_t *rv, const rate_valid_cfg_t *cfg);
@@ -118,19 +128,48 @@ void rate_valid_settling(rate_valid_t *rv, float rate_raw, float quad_raw, float
 void rate_valid_thermo(rate_valid_t *rv, float p_dev_deg, float p_held_dev_deg, float p_held_w,
                        float quad_dps);
 
-/* What the block saw, for the verdict. */
-typedef struct {
-  int locked;
-  int selftest;
-  uint32_t rail_codes;      /* ADC rail codes in the block */
-  float sense_v2;           /* squared sense pickoff amplitude */
-  float rate_dps;
-  float quad_dps;
-  float phase_err_rad;      /* low-passed drive phase error (supervisor) */
-} rate_valid_in_t;
+/* Once per block, after the quadrature filter: the drive phase error as the supervisor
+ * low-passed it, the quadrature output and the squared sense pickoff amplitude ->
+ * PHASE, SENSE_RANGE. */
+void rate_valid_drive(rate_valid_t *rv, float phase_err_rad, float quad_dps, float sense_v2);
 
-/* Once per block: the verdict (0: valid, else RATE_INVALID_* bits). */
-uint32_t rate_valid_verdict(rate_valid_t *rv, const rate_valid_in_t *in);
+/* Once per block, after the rate's output filter: OVER_RANGE. */
+static inline void rate_valid_range(rate_valid_t *rv, float rate_dps)
+{
+  rv->range = (rate_dps <= rv->cfg.full_scale_dps && rate_dps >= -rv->cfg.full_scale_dps)
+                  ? 0u : RATE_INVALID_OVER_RANGE;
+}
+
+/* The onsets of reasons into the history (rare: only when the set of reasons grows). */
+void rate_valid_count_onsets(rate_valid_t *rv, rate_valid_history_t *h, uint32_t onsets);
+
+/* Once per block, last: the verdict (0: valid, else RATE_INVALID_* bits) from the
+ * block's own evidence, block_bits (MODE, SELFTEST, CLIP, found by the caller), and what
+ * rate_valid_drive, rate_valid_thermo, rate_valid_range and rate_valid_settling found.
+ * Entering LOCKED and a rail code are disturbances. Integer work only: it runs on the
+ * snapshot's tick. */
+static inline uint32_t rate_valid_verdict(rate_valid_t *rv, rate_valid_history_t *h,
+                                          uint32_t block_bits)
+{
+  rv->blocks++;
+  const uint32_t locked = (block_bits & RATE_INVALID_MODE) == 0u;
+  if (locked > rv->was_locked || (block_bits & RATE_INVALID_CLIP) != 0u) {
+    /* Entering LOCKED: the lasting phase error's low-pass starts from zero, not from
+     * what acquisition left in it nor from the 100 Hz error's noise (at lock the phase
+     * PI's integrator removes a lasting error within its own time constant, unless the
+     * loop is at a dead end, which builds up here and in PHASE_LOST within tens of
+     * milliseconds). */
+    if (locked > rv->was_locked) rv->phase_err_lp_rad = 0.0f;
+    rate_valid_disturb(rv);
+  }
+  rv->was_locked = locked;
+  const uint32_t r = block_bits | rv->thermo | rv->drive | rv->range |
+                     (rv->settled != 0u ? 0u : RATE_INVALID_SETTLING);
+  const uint32_t onsets = r & ~rv->reasons;
+  if (onsets != 0u) rate_valid_count_onsets(rv, h, onsets);
+  rv->reasons = r;
+  return r;
+}
 
 const char *rate_valid_reason_name(uint32_t kind);
 

@@ -10,13 +10,32 @@
  * blocks for the sense mode and the output path, the response over MEAS blocks, and the
  * force off. A block is the rate channel's (RATE_DECIM ticks): the sequence advances
  * once per block on the block's unfiltered rate (selftest_update), while the force is a
- * carrier and is formed every tick (selftest_force). Pass: |response / expected - 1| <= tolerance. The rate output carries the
- * test force while it runs (GYRO_FLAG_SELFTEST).
+ * carrier and is formed every tick (selftest_force). Pass: |response / expected - 1| <=
+ * tolerance. The rate output carries the test force while it runs (GYRO_FLAG_SELFTEST).
+ *
+ * Continuous self-test (cont_on), as current digital gyros run while operating: the same
+ * carrier force, amplitude-modulated at cont_freq, well above the rate's output band:
+ *     u = A_c cos(2 pi f_m t) cos(phi + theta_set)
+ * Demodulated, its response is a tone at f_m on the block's rate and quadrature (the
+ * sense mode answers the two sidebands wc +- 2 pi f_m a little differently, hence some
+ * on both axes). A two-weight LMS per axis at f_m (the LMS demodulator of (5-5), at the
+ * block rate) measures the tone and subtracts it before the output filters: an adaptive
+ * notch, so that no tone is left in the output (the 100 Hz Butterworth alone leaves
+ * -32 dB of it at 250 Hz). The response's magnitude is the test: outside
+ * (1 +- tol_rel) of the expected after the LMS has converged, the rate is not valid
+ * (rate_valid.h, CONT_SELFTEST). Expected responses are calibration values measured at
+ * the drive amplitude setpoint ref_amp_v: the rate channel normalises by the setpoint,
+ * so a response in deg/s scales as ref_amp_v / amp_set_v (the designer applies it to
+ * both tests).
  */
 #ifndef SELFTEST_H
 #define SELFTEST_H
 
 #include <stdint.h>
+
+/* Low-pass of the continuous test's weights before they are judged, per block: about
+ * 2 Hz at the 5 kHz block rate. */
+#define SELFTEST_CONT_AVG_K 0.0025f
 
 typedef enum {
   SELFTEST_IDLE = 0,
@@ -29,6 +48,13 @@ typedef enum {
 
 typedef struct {
   float amp_v;       /* force voltage amplitude A on the spare DAC channel */
+  uint32_t cont_on;  /* continuous self-test */
+  float cont_amp_v;  /* its force amplitude A_c */
+  uint32_t cont_step; /* its modulation's phase step per block (2^32 per turn) */
+  float cont_mu;     /* its LMS step size per block */
+  float cont_gain;   /* 1 - mu / 2: the notch's pass-band gain undone */
+  float cont_lo2, cont_hi2; /* bounds of the response's squared magnitude (raw rate units) */
+  uint32_t cont_settle_blocks; /* blocks LOCKED before the response is judged */
   float expect_dps;  /* response expected on the rate axis (calibrated on the part) */
   float tol_rel;     /* pass band, relative */
   float ref_c, ref_s; /* cos, sin of the drive phase setpoint */
@@ -46,6 +72,16 @@ typedef struct {
   /* 1 / base_blocks, 1 / meas_blocks, 1 / expect_dps (0 where the divisor is 0), set with
    * the configuration: the verdict block divides nothing (its tick's budget). */
   float inv_base, inv_meas, inv_expect;
+  /* The force formed every tick: a_c cos(phi) - a_s sin(phi), set once per block. */
+  uint32_t force_on;
+  float a_c, a_s;
+  /* Continuous self-test. */
+  uint32_t cont_phase;   /* modulation phase */
+  float cont_c, cont_s;  /* cos, sin of the modulation of the current block */
+  float w[4];            /* LMS weights: rate (cos, sin), quadrature (cos, sin) */
+  float w_avg[2];        /* the rate axis's weights through SELFTEST_CONT_AVG_K */
+  uint32_t cont_blocks;  /* blocks LOCKED since the LMS started */
+  uint32_t cont_fail;    /* the response is judged and out of its band */
 } selftest_t;
 
 void selftest_init(selftest_t *st, const selftest_cfg_t *cfg);
@@ -62,16 +98,39 @@ static inline int selftest_running(const selftest_t *st)
   return st->state == SELFTEST_BASE || st->state == SELFTEST_FORCE;
 }
 
-/* Every tick: the spare DAC voltage, (sin_wc, cos_wc) the NCO references. FORCE:
+/* Every tick while force_on: the spare DAC voltage, (sin_wc, cos_wc) the NCO references:
  * A cos(phi + theta_set), in phase with the drive velocity (gyro.h phasor convention:
- * the velocity of y = Im{Z e^{j phi}} is Re{Z e^{j phi}}). */
+ * the velocity of y = Im{Z e^{j phi}} is Re{Z e^{j phi}}), A the on-demand test's
+ * amplitude while it forces plus the continuous test's modulated one. */
 static inline float selftest_force(const selftest_t *st, float sin_wc, float cos_wc)
 {
-  if (st->state != SELFTEST_FORCE) {
-    return 0.0f;
-  }
-  return st->cfg.amp_v * (st->cfg.ref_c * cos_wc - st->cfg.ref_s * sin_wc);
+  return st->a_c * cos_wc - st->a_s * sin_wc;
 }
+
+/* Once per block and axis (0 rate, 1 quadrature), on the block's projection (x, in
+ * place) before its output filter: the continuous test's LMS measures its tone and takes
+ * it out. Does nothing unless cont_on. Inline: it runs on ticks near their budget. */
+static inline void selftest_cont_notch(selftest_t *st, uint32_t axis, float *x)
+{
+  const selftest_cfg_t *c = &st->cfg;
+  if (c->cont_on == 0u) return;
+  /* (5-5) at f_m: the weights' phasor is the tone; the error is the notched signal. */
+  const float mc = st->cont_c, ms = st->cont_s, mu = c->cont_mu;
+  float *w = &st->w[2u * axis];
+  const float e = *x - (w[0] * mc + w[1] * ms);
+  w[0] += mu * e * mc;
+  w[1] += mu * e * ms;
+  /* The LMS with a sinusoidal reference is the notch (Widrow 1975)
+   *   H(z) = (z^2 - 2 cos(w0) z + 1) / (z^2 - 2 (1 - C) cos(w0) z + 1 - 2 C),  C = mu / 2,
+   * whose gain away from w0 (at DC and at the Nyquist frequency alike) is 1 / (1 - C):
+   * 0.2 % of scale factor at mu = 0.004, undone here. */
+  *x = e * c->cont_gain;
+}
+/* Once per block, after both axes' notch: the next block's modulation and force. */
+void selftest_cont_advance(selftest_t *st);
+/* Once per block: judge the continuous test's response (locked: drive LOCKED; the
+ * judgement restarts with the LMS when not). Returns cont_fail. */
+uint32_t selftest_cont_judge(selftest_t *st, int locked);
 
 const char *selftest_state_name(uint32_t state);
 

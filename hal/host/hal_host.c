@@ -39,6 +39,9 @@ void hal_host_attach(hal_host_plant_step_fn step, void *plant)
   }
 }
 
+/* The host loses no sample unless a test says so (hal_host_lose_sample). */
+static volatile uint32_t s_lost;
+
 int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
 {
   if (rate_hz == 0u || isr == NULL) {
@@ -74,6 +77,8 @@ const hal_adc_frame_t *hal_host_next_adc(void) { return &host.adc; }
 
 void hal_adc_read_frame(hal_adc_frame_t *frame) { *frame = host.adc; }
 
+const volatile uint32_t *hal_sample_lost_counter(void) { return &s_lost; }
+
 void hal_dac_write_frame(const hal_dac_frame_t *frame) { host.pending = *frame; }
 
 /* Simulated cycles of a 168 MHz core (the board's DWT counter), so that code measuring
@@ -83,11 +88,6 @@ uint32_t hal_cycles_now(void)
   const uint64_t per_tick = host.rate_hz ? 168000000u / host.rate_hz : 0u;
   return (uint32_t)(host.ticks * per_tick);
 }
-
-/* The host loses no sample unless a test says so (hal_host_lose_sample). */
-static uint32_t s_lost;
-
-uint32_t hal_sample_lost(void) { return s_lost; }
 
 void hal_host_lose_sample(void) { s_lost++; }
 

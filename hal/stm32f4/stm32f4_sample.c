@@ -218,7 +218,7 @@ STM32F4_RAMFUNC void hal_adc_read_frame(hal_adc_frame_t *frame)
   frame->sense = s_adc_rx[1];
 }
 
-STM32F4_RAMFUNC uint32_t hal_sample_lost(void) { return s_chain.overruns; }
+const volatile uint32_t *hal_sample_lost_counter(void) { return &s_chain.overruns; }
 
 void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
 {

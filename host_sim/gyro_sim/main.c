@@ -302,6 +302,12 @@ int main(int argc, char **argv)
   if (sc.mode == SIM_CLOSED_LOOP) {
     add_num(fig, "faults", res.faults);
     add_num(fig, "final_mode", res.final_mode);
+    add_num(fig, "rate_valid_fraction", res.rate_valid_fraction);
+    add_num(fig, "rate_first_valid_s", res.rate_first_valid_s);
+    if (!quiet) {
+      printf("  rate output valid from %.3f s, %.1f %% of the run (faults %u)\n",
+             res.rate_first_valid_s, 100.0 * res.rate_valid_fraction, (unsigned)res.faults);
+    }
     add_num(fig, "mean_drive_freq_hz", res.mean_drive_freq_hz);
     add_num(fig, "mean_drive_amp_m", res.mean_drive_amp_m);
     add_num(fig, "mean_struct_temp_k", res.mean_struct_k);

@@ -55,6 +55,8 @@ typedef struct {
   double adc_fraction[2];   /* worst-case budget from plant_adc_fraction */
   uint64_t adc_clips[2];
   uint32_t faults;
+  double rate_valid_fraction; /* of the run's ticks with the rate output valid */
+  double rate_first_valid_s;  /* first tick with the rate valid; -1: never */
   uint32_t final_mode;
   double mean_struct_k;
   double mean_drive_freq_hz;

@@ -200,7 +200,8 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
     fflush(stdout);
   }
   const double t_wall0 = wall_now(), t_cpu0 = cpu_now();
-  double fw_lock = -1.0, sum_tk = 0.0, sum_f = 0.0, sum_a = 0.0;
+  double fw_lock = -1.0, first_valid = -1.0, sum_tk = 0.0, sum_f = 0.0, sum_a = 0.0;
+  uint64_t valid_ticks = 0;
   uint64_t n_mean = 0;
   size_t it = 0;
   double ph_prev = 0.0, ph_unwrap = 0.0;
@@ -209,6 +210,10 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
     hal_host_run(1u);
     const plant_truth_t *tr = plant_truth(plant);
     if (fw_lock < 0.0 && app->gyro.sup.mode == GYRO_MODE_LOCKED) fw_lock = (double)(k + 1u) / fs;
+    if (app->gyro.out.rate_valid != 0u) {
+      valid_ticks++;
+      if (first_valid < 0.0) first_valid = (double)(k + 1u) / fs;
+    }
     if (want_startup && (k + 1u) % tdec == 0u && it < n_truth) {
       /* The true drive phasor in the firmware's NCO frame: y = Im{Z e^{j phi}}, so
        * Z = (y'/w + j y) e^{-j phi} with phi the NCO phase of the next tick. */
@@ -274,6 +279,8 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
   }
   (void)plant_adc_fraction(&pc, res->adc_fraction);
   res->faults = app->gyro.sup.fault_count;
+  res->rate_valid_fraction = n_ticks > 0u ? (double)valid_ticks / (double)n_ticks : 0.0;
+  res->rate_first_valid_s = first_valid;
   res->final_mode = (uint32_t)app->gyro.sup.mode;
   res->mean_struct_k = n_mean ? sum_tk / (double)n_mean : NAN;
   res->mean_drive_freq_hz = n_mean ? sum_f / (double)n_mean : NAN;

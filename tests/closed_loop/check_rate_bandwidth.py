@@ -6,7 +6,8 @@ fit at f of the firmware's rate output against the true rate gives gain and phas
 -3 dB frequency is interpolated on the gain; the group delay is the phase slope at low
 frequency. Prints the table; exits 1 if the bandwidth is outside 80..120 Hz (the output
 Butterworth is 100 Hz, the sense demodulator's 282 Hz adds a little lag) or the DC gain
-is off by more than 1 %."""
+is off by more than 1 %. Arguments after the gyro-sim path go to every gyro-sim run (for
+instance --set firmware.selftest.continuous=1)."""
 import json
 import os
 import subprocess
@@ -24,6 +25,7 @@ def fit(t, y, f):
 
 def main():
     exe = sys.argv[1]
+    extra = sys.argv[2:]
     freqs = [2.0, 5.0, 20.0, 50.0, 80.0, 100.0, 120.0, 150.0]
     rows = []
     with tempfile.TemporaryDirectory() as d:
@@ -34,8 +36,8 @@ def main():
                        "rate_dps": {"kind": "sine", "value": 0, "amp": 10, "freq_hz": f}},
                       open(scen, "w"))
             csv = os.path.join(d, "t.csv")
-            subprocess.run([exe, "--scenario", scen, "--quiet", "--no-analysis", "--csv", csv],
-                           check=True)
+            subprocess.run([exe, "--scenario", scen, "--quiet", "--no-analysis", "--csv", csv]
+                           + extra, check=True)
             t = np.genfromtxt(csv, delimiter=",", names=True)
             m = t["t_s"] >= 0.5
             h = fit(t["t_s"][m], t["rate_dps"][m], f) / fit(t["t_s"][m], t["rate_true_dps"][m], f)

@@ -16,100 +16,7 @@
 #include <string.h>
 #include <cmocka.h>
 
-#include "selfcal_harness.h"
-
-typedef struct {
-  uint32_t blocks, valid_blocks, valid_after_0p3, blocks_after_0p3;
-  uint32_t wrong_valid;       /* valid blocks with a wrong rate, once first valid */
-  uint32_t not_at_fault;      /* invalid blocks whose analog output is not the fault level */
-  double first_valid_s;
-  double worst_err_dps, worst_err_t_s;
-  double t0_s;                /* power-on of this run */
-} judge_t;
-
-static int rate_valid_now(void) { return (app.gyro.out.flags & GYRO_FLAG_RATE_VALID) != 0u; }
-
-static double analog_out_v(void)
-{
-  return ((double)app.gyro.rate_code - (double)HAL_DAC_CODE_MID) * (double)HAL_DAC_V_PER_CODE;
-}
-
-/* The fault level as the DAC can command it (one code of the 14-bit converter). */
-static int at_fault_level(void)
-{
-  const double fault_v = (double)params_current(&app.params)->rate_fault_out_v;
-  return fabs(analog_out_v() - fault_v) <= (double)HAL_DAC_V_PER_CODE;
-}
-
-static void judge_reset(judge_t *j)
-{
-  memset(j, 0, sizeof *j);
-  j->first_valid_s = -1.0;
-  j->t0_s = (double)plant_truth(&plant)->sample / 50000.0;
-}
-
-/* Run s seconds block by block (the snapshot and the analog code change together on the
- * block's last tick), the background loop polled every millisecond. */
-static void judge_run(judge_t *j, double s)
-{
-  const uint64_t n = (uint64_t)(s * 5000.0 + 0.5);
-  for (uint64_t i = 0; i < n; i++) {
-    hal_host_run(GYRO_BLOCK);
-    if (i % 5u == 4u) app_poll(&app);
-    const double t = (double)plant_truth(&plant)->sample / 50000.0 - j->t0_s;
-    const int valid = rate_valid_now();
-    j->blocks++;
-    if (t >= 0.3) {
-      j->blocks_after_0p3++;
-      if (valid) j->valid_after_0p3++;
-    }
-    if (!valid) {
-      if (!at_fault_level()) j->not_at_fault++;
-      continue;
-    }
-    j->valid_blocks++;
-    if (j->first_valid_s < 0.0) j->first_valid_s = t;
-    const double truth = plant_truth(&plant)->rate_dps;
-    const double err = fabs((double)app.gyro.out.rate_dps - truth);
-    if (err > fmax(1.0, 0.01 * fabs(truth))) j->wrong_valid++;
-    if (err > j->worst_err_dps) {
-      j->worst_err_dps = err;
-      j->worst_err_t_s = t;
-    }
-  }
-}
-
-static void judge_print(const char *name, const judge_t *j)
-{
-  printf("# %-28s valid %5.1f %% (first at %.3f s), wrong-but-valid blocks %u (worst "
-         "valid error %.3g deg/s at %.3f s), invalid blocks off the fault level %u, mode %u "
-         "fault 0x%x\n",
-         name, 100.0 * j->valid_blocks / (j->blocks ? j->blocks : 1u), j->first_valid_s,
-         j->wrong_valid, j->worst_err_dps, j->worst_err_t_s, j->not_at_fault,
-         (unsigned)app.gyro.sup.mode, (unsigned)app.gyro.sup.fault);
-}
-
-static void judge_assert(const judge_t *j)
-{
-  assert_int_equal(j->wrong_valid, 0u);
-  assert_int_equal(j->not_at_fault, 0u);
-}
-
-static void start_part(const plant_cfg_t *pc, const param_values_t *v)
-{
-  app_plant_start(pc, 31u, v);
-}
-
-/* One case: part pc, firmware values v (NULL: the defaults), s seconds from power-on. */
-static void run_case(const char *name, const plant_cfg_t *pc, const param_values_t *v, double s)
-{
-  judge_t j;
-  start_part(pc, v);
-  judge_reset(&j);
-  judge_run(&j, s);
-  judge_print(name, &j);
-  judge_assert(&j);
-}
+#include "integrity_judge.h"
 
 static void default_part(plant_cfg_t *pc) { plant_default_cfg(pc); }
 
@@ -167,9 +74,11 @@ static void test_phase_setpoint_walk(void **state)
   assert_true(rate_valid_now());
 }
 
-/* A self-calibrated high-Q part, then the structure 22.5 K warmer than at its sweep:
- * beyond the fixed-frequency drive's reach (the drive phase slips towards 90 deg). */
-static void test_q5000_selfcal_warm(void **state)
+/* A high-Q part with the calibration its own sweep identifies (tests/slow/
+ * test_integrity_selfcal.c runs that sweep, 69 s of simulated time: f0 1489.8613 Hz,
+ * Q 4999, gain 0.81279 V/V^2, P 25.66 deg), then the structure 22.5 K warmer than at its
+ * sweep: beyond the fixed-frequency drive's reach (the drive phase slips towards 90 deg). */
+static void test_q5000_calibrated_warm(void **state)
 {
   (void)state;
   plant_cfg_t pc;
@@ -177,13 +86,13 @@ static void test_q5000_selfcal_warm(void **state)
   pc.q_drive = 5000.0;
   param_values_t v;
   param_values_defaults(&v);
-  start(&pc, &v);
-  run_polled_s(0.05);
-  sweep();
-  assert_int_equal(app.selfcal.state, SELFCAL_DONE);
-  const param_values_t cal = *params_current(&app.params);
+  v.drive_cal_f0_hz = 1489.8613f;
+  v.drive_freq_hz = 1489.8613f;
+  v.drive_cal_q = 4999.0f;
+  v.drive_cal_gain_v_per_v2 = 0.81279f;
+  v.drive_p_init_deg = 25.66f;
   pc.temp_k += 22.5;
-  run_case("Q 5000 self-calibrated, +22.5 K", &pc, &cal, 3.0);
+  run_case("Q 5000 calibrated, +22.5 K", &pc, &v, 3.0);
 }
 
 static void test_q10000_defaults(void **state)
@@ -310,6 +219,30 @@ static void test_status_during_sweep(void **state)
   judge_assert(&j);
 }
 
+/* A sample lost between the converters and the interrupt (an overrun the HAL counts):
+ * the NCO runs a sample behind from then on, so the drive faults and re-acquires, and
+ * the rate is invalid from the block that saw it. */
+static void test_lost_sample(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  default_part(&pc);
+  judge_t j;
+  start_part(&pc, NULL);
+  judge_reset(&j);
+  judge_run(&j, 0.5);
+  assert_true(rate_valid_now());
+  hal_host_lose_sample();
+  hal_host_run(2u * GYRO_BLOCK);
+  assert_false(rate_valid_now());
+  assert_int_equal(app.gyro.sup.fault, GYRO_FAULT_LOST_SAMPLE);
+  judge_run(&j, 1.0);
+  judge_print("lost sample", &j);
+  judge_assert(&j);
+  assert_true(rate_valid_now()); /* re-acquired */
+  assert_non_null(strstr(cmd("status\n"), "fault_LOST_SAMPLE count 1"));
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -317,7 +250,7 @@ int main(void)
       cmocka_unit_test(test_resonance_60hz_off),
       cmocka_unit_test(test_resonance_40hz_off),
       cmocka_unit_test(test_phase_setpoint_walk),
-      cmocka_unit_test(test_q5000_selfcal_warm),
+      cmocka_unit_test(test_q5000_calibrated_warm),
       cmocka_unit_test(test_q10000_defaults),
       cmocka_unit_test(test_quadrature_clips_sense_adc),
       cmocka_unit_test(test_rate_beyond_range),
@@ -326,6 +259,7 @@ int main(void)
       cmocka_unit_test(test_drive_frequency_5000),
       cmocka_unit_test(test_subnormal_gain),
       cmocka_unit_test(test_status_during_sweep),
+      cmocka_unit_test(test_lost_sample),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

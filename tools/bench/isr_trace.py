@@ -333,7 +333,10 @@ def job_functions(isrs, fmap):
     return [[f for f in s if f not in common] for s in sets]
 
 
-def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm"):
+def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm", summary_n=None):
+    """The trace's interrupts: per-interrupt counts and cycles (insns_each, cycles_each,
+    job_functions_each) for every one, the means, mixes and memory models over the first
+    summary_n (all if None: a trace of several modes summarises its first)."""
     insns = disassemble(objdump, elf)
     funcs = symbols(nm, elf)
     fmap = FuncMap(funcs)
@@ -343,9 +346,11 @@ def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm"):
     for start, size, name in funcs:
         if name == "sincos_lut" and table_in_flash:
             model.set_sincos(start, size)
-    isrs = list(read_isrs(lines, fmap))
-    if not isrs:
+    all_isrs = list(read_isrs(lines, fmap))
+    if not all_isrs:
         raise RuntimeError("no interrupt found in the trace")
+    all_counts = [len(p) for p in all_isrs]
+    isrs = all_isrs[:summary_n] if summary_n else all_isrs
     counts = [len(p) for p in isrs]
     per_func = Counter()
     mix = Counter()
@@ -365,6 +370,7 @@ def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm"):
         warm.append(cyc)
     cyc_cold, cyc_sram = Counter(), Counter()
     cold = [model.cost(p, flash=True, cold=True, attrib=(cyc_cold, fmap))[0] for p in isrs]
+    cold_all = cold + [model.cost(p, flash=True, cold=True)[0] for p in all_isrs[len(isrs):]]
     sram = [model.cost(p, flash=False, attrib=(cyc_sram, fmap))[0] for p in isrs]
     lines_touched = len({pc >> 4 for pc in isrs[worst] if CycleModel.FLASH_LO <= pc < CycleModel.FLASH_HI})
     overhead_best = EXC_ENTRY + EXC_EXIT
@@ -381,10 +387,10 @@ def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm"):
         "insns_mean": sum(counts) / n,
         "insns_min": min(counts),
         "insns_max": max(counts),
-        "insns_each": counts,
-        "cycles_each": cold,  # as linked, ART cold: one per interrupt, in order
+        "insns_each": all_counts,
+        "cycles_each": cold_all,  # as linked, ART cold: one per interrupt, in order
         # the functions each interrupt ran beyond those every interrupt runs (its job)
-        "job_functions_each": job_functions(isrs, fmap),
+        "job_functions_each": job_functions(all_isrs, fmap),
         "per_function_mean": {k: v / n for k, v in per_func.most_common()},
         "per_function_cycles_mean": {k: {"flash_cold": cyc_cold[k] / n, "zero_wait": cyc_sram[k] / n}
                                      for k, _ in cyc_cold.most_common()},

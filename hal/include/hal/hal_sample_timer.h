@@ -21,9 +21,10 @@ uint32_t hal_cycles_now(void);
  * counter and reports 0. Either pointer may be NULL. */
 void hal_sample_isr_cycles(uint32_t *last, uint32_t *max);
 
-/* Samples lost since hal_sample_timer_start: a new frame converted before the ISR had
- * taken the previous one (the NCO then runs a sample behind the converters). Read by
- * the ISR on every tick: a load, no side effect. */
-uint32_t hal_sample_lost(void);
+/* The count of samples lost since hal_sample_timer_start (a frame converted before the
+ * ISR had taken the previous one: the NCO then runs a sample behind the converters), as
+ * the address of the word the HAL counts them in. The firmware reads it once per block,
+ * which costs the sample path nothing per tick. Never NULL. */
+const volatile uint32_t *hal_sample_lost_counter(void);
 
 #endif /* HAL_SAMPLE_TIMER_H */

@@ -18,10 +18,20 @@
  *   isr_empty_cb        the same with bench_cb_empty (handler alone + wrapper)
  *   cb_wrap             bench_cb_empty against bench_empty, called directly: the cost of
  *                       the wrapper, subtracted by run-bench
- * The semihosting command line (-append) selects the mode: "quick" runs fewer
- * iterations; "trace" runs only the locked-up application and BENCH_N_TRACE pended
- * sample interrupts, for an instruction trace (QEMU -singlestep -d exec,nochain) that
- * tools/bench/isr_trace.py turns into a per-function breakdown and a cycle estimate. */
+ * The application runs with every loop on: the continuous self-test is switched on
+ * before the counts. The semihosting command line (-append) selects the mode: "quick"
+ * runs fewer iterations; "trace" runs only the application's pended sample interrupts,
+ * for an instruction trace (QEMU -singlestep -d exec,nochain) that
+ * tools/bench/isr_trace.py turns into a per-function breakdown and a cycle estimate, in
+ * this order (each an irq case, its interrupts in a row):
+ *   isr_app_cb          LOCKED, BENCH_N_TRACE interrupts (the steady state)
+ *   isr_fault           a NaN planted in the drive demodulator: the fault's tick, the
+ *                       loop state's clear and the ticks after it
+ *   isr_sweep_chirp     SWEEP: the self-calibration executive (selfcal_exec.h) on a
+ *   isr_sweep_ringdown  chirp, a ring-down and a stepped-sine job, each posted here as
+ *   isr_sweep_steps     the background sequencer would post it
+ * and "state" lines with the mode and the rate's validity before each. */
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
@@ -44,6 +54,7 @@
 #define BENCH_WARMUP_MAX 400000u
 #define BENCH_SETTLE 5000u
 #define BENCH_N_TRACE 100u      /* traced ISRs: ten rate-filter ticks, one P-filter tick */
+#define BENCH_N_TRACE_MODE 40u  /* traced ISRs of each other mode: four blocks */
 #define BENCH_SETTLE_TRACE 500u
 
 #define SYS_WRITE0 0x04u
@@ -252,6 +263,16 @@ __attribute__((noipa)) static uint32_t run_irq(uint32_t irq, uint32_t n, bk_stat
   return locked;
 }
 
+static void put_state(const char *name)
+{
+  line_t l = {{0}, 0u};
+  put_str(&l, "state ");
+  put_str(&l, name);
+  put_kv(&l, "mode", (uint32_t)s_app.gyro.sup.mode);
+  put_kv(&l, "rate_invalid", s_app.gyro.out.rate_invalid);
+  emit(&l);
+}
+
 static void start_chain(isr_fn cb)
 {
   const int rc = hal_sample_timer_start(BENCH_FS_HZ, cb, &s_app);
@@ -269,17 +290,74 @@ static void direct_case(const char *name, isr_fn fn)
   report(name, &r);
 }
 
-static void irq_case(const char *name, isr_fn cb)
+static void irq_case_n(const char *name, isr_fn cb, uint32_t n)
 {
   bk_result_t r;
   start_chain(cb);
   bk_stat_reset(&r.kern);
   bk_stat_reset(&r.base);
-  r.locked = run_irq(STM32F4_IRQ_DMA2_STREAM0, s_n, &r.kern);
-  (void)run_irq(BENCH_SPARE_IRQ, s_n, &r.base);
+  r.locked = run_irq(STM32F4_IRQ_DMA2_STREAM0, n, &r.kern);
+  (void)run_irq(BENCH_SPARE_IRQ, n, &r.base);
   if (cb != bench_cb) r.locked = 0u;
   report(name, &r);
   hal_sample_timer_stop();
+}
+
+static void irq_case(const char *name, isr_fn cb) { irq_case_n(name, cb, s_n); }
+
+/* Every loop on: the continuous self-test too (it is off by default). */
+static void continuous_selftest_on(void)
+{
+  const char *name = "selftest.continuous";
+  const param_idx_t i = param_lookup(name, strlen(name));
+  param_value_t on;
+  on.u = 1u;
+  params_err_t err;
+  if (i >= PARAM_COUNT || params_set(&s_app.params, i, on, &err) != PARAM_OK) {
+    fail("selftest.continuous", -1);
+  }
+}
+
+/* A job for the self-calibration executive, posted as the background sequencer posts
+ * one (selfcal_exec.h: job, then job_seq + 1). */
+static void post_job(uint32_t kind)
+{
+  selfcal_exec_t *x = &s_app.gyro.cal;
+  selfcal_job_t j;
+  memset(&j, 0, sizeof j);
+  j.kind = kind;
+  j.n_pts = 3u;
+  for (uint32_t k = 0u; k < 3u; k++) j.half_step[k] = s_app.gyro.nco.half_step + 2000u * k;
+  j.chirp_delta = 1;
+  j.chirp_ticks = 100000u;
+  j.settle_ticks = j.step_settle_ticks = 5u;
+  j.avg_ticks = 100000u;
+  j.f_cmd_v2 = 50.0f;
+  j.p_rad = 0.4f;
+  j.amp_max_v = 4.0f;
+  j.amp_target_v = 4.0f;
+  x->job = j;
+  atomic_store(&x->job_seq, atomic_load(&x->job_seq) + 1u);
+}
+
+/* The rarer ticks (trace mode): a fault and its clear, then SWEEP's jobs. */
+static void trace_other_modes(void)
+{
+  s_app.gyro.lmsd_drive.w_i = __builtin_nanf("");
+  put_state("isr_fault");
+  irq_case_n("isr_fault", bench_cb, BENCH_N_TRACE_MODE);
+  gyro_sweep_begin(&s_app.gyro);
+  static const struct {
+    uint32_t kind;
+    const char *name;
+  } jobs[] = {{SELFCAL_JOB_CHIRP, "isr_sweep_chirp"},
+              {SELFCAL_JOB_RINGDOWN, "isr_sweep_ringdown"},
+              {SELFCAL_JOB_STEPS, "isr_sweep_steps"}};
+  for (size_t k = 0u; k < sizeof jobs / sizeof jobs[0]; k++) {
+    post_job(jobs[k].kind);
+    put_state(jobs[k].name);
+    irq_case_n(jobs[k].name, bench_cb, BENCH_N_TRACE_MODE);
+  }
 }
 
 /* The application at lock, then: app_sample_isr called directly; the wrapper cost;
@@ -295,6 +373,7 @@ static void bench_app(uint32_t settle, int trace)
   if (bench_plant_init(&s_plant, (const gyro_design_t *)s_app.applied, &v) != 0) {
     fail("plant_init", -1);
   }
+  continuous_selftest_on();
   gyro_start(&s_app.gyro);
   uint32_t settled = 0u;
   for (uint32_t i = 0u; i < BENCH_WARMUP_MAX && settled < settle; i++) {
@@ -312,7 +391,9 @@ static void bench_app(uint32_t settle, int trace)
 
   if (trace) {
     s_each = 1;
+    put_state("isr_app_cb");
     irq_case("isr_app_cb", bench_cb);
+    trace_other_modes();
     s_each = 0;
     direct_case("cb_wrap", bench_cb_empty);
     return;

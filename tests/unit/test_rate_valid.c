@@ -1,0 +1,170 @@
+/* The rate-valid verdict (gyro/rate_valid.h) on constructed evidence: each reason sets
+ * on its own evidence and clears when it goes, the settling is measured, the
+ * thermometer's bounds follow the quadrature and the bias slope, onsets are counted. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <math.h>
+#include <cmocka.h>
+
+#include "gyro/rate_valid.h"
+
+static rate_valid_cfg_t cfg(void)
+{
+  const rate_valid_cfg_t c = {
+      .tol_dps = 0.25f,
+      .full_scale_dps = 300.0f,
+      .p_range_deg = 8.0f,
+      .p_window_max_deg = 0.005f,       /* 0.05 deg/s over 0.1 s */
+      .p_lag_per_deg = 0.159f / 0.1f,   /* 1 Hz low-pass, 0.1 s window */
+      .sense_max_v2 = 16.0f,
+      .phase_tol_rad = 0.01745f,
+      .bias_slope_dps_per_deg = 0.0f};
+  return c;
+}
+
+static rate_valid_t rv;
+static rate_valid_history_t hist;
+
+/* LOCKED and settled on quiet evidence; returns the verdict. */
+static uint32_t settle(void)
+{
+  const rate_valid_cfg_t c = cfg();
+  assert_int_equal(rate_valid_init(&rv, &c), 0);
+  hist = (rate_valid_history_t){{0u}, {0u}};
+  uint32_t r = 0u;
+  /* The inputs' low-pass (0.2 per block) reaches 1500 deg/s within 0.25 after about 40
+   * blocks; then RATE_VALID_SETTLE_BLOCKS inside. */
+  for (int i = 0; i < 80; i++) {
+    rate_valid_settling(&rv, 0.0f, 10.0f, 0.0f, 1500.0f, 150.0f);
+    rate_valid_drive(&rv, 0.0f, 1500.0f, 1.0f);
+    rate_valid_range(&rv, 0.0f);
+    r = rate_valid_verdict(&rv, &hist, 0u);
+  }
+  return r;
+}
+
+static void test_bad_cfg(void **state)
+{
+  (void)state;
+  rate_valid_cfg_t c = cfg();
+  c.tol_dps = 0.0f;
+  assert_int_equal(rate_valid_init(&rv, &c), -1);
+  c = cfg();
+  c.full_scale_dps = NAN;
+  assert_int_equal(rate_valid_init(&rv, &c), -1);
+}
+
+/* The output filters' settling is measured: outputs far from their inputs' low-pass keep
+ * the rate invalid; RATE_VALID_SETTLE_BLOCKS in a row inside make it valid. */
+static void test_settling_measured(void **state)
+{
+  (void)state;
+  const rate_valid_cfg_t c = cfg();
+  assert_int_equal(rate_valid_init(&rv, &c), 0);
+  for (int i = 0; i < 100; i++) {
+    rate_valid_settling(&rv, 0.0f, 10.0f, 0.0f, 700.0f, 150.0f); /* quad output lags */
+    assert_int_not_equal(rate_valid_verdict(&rv, &hist, 0u) & RATE_INVALID_SETTLING, 0u);
+  }
+  assert_int_equal(settle(), 0u);
+  /* A rail code is a disturbance: settling starts again. */
+  assert_int_not_equal(rate_valid_verdict(&rv, &hist, RATE_INVALID_CLIP) & RATE_INVALID_SETTLING, 0u);
+}
+
+static void test_over_range_and_sense(void **state)
+{
+  (void)state;
+  assert_int_equal(settle(), 0u);
+  rate_valid_range(&rv, -300.5f);
+  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), RATE_INVALID_OVER_RANGE);
+  rate_valid_range(&rv, 299.0f);
+  rate_valid_drive(&rv, 0.0f, 1500.0f, 16.5f);
+  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), RATE_INVALID_SENSE_RANGE);
+  rate_valid_range(&rv, NAN);
+  assert_int_not_equal(rate_valid_verdict(&rv, &hist, 0u) & RATE_INVALID_OVER_RANGE, 0u);
+}
+
+/* A lasting phase error of e rad rotates Q sin(e) of quadrature into the rate: 0.01 deg
+ * at 1500 deg/s is 0.26 deg/s, just over the 0.25 tolerance; 0.008 deg is not. */
+static void test_phase_leak(void **state)
+{
+  (void)state;
+  assert_int_equal(settle(), 0u);
+  for (int i = 0; i < 20000; i++) rate_valid_drive(&rv, 0.008f * 0.0174533f, 1500.0f, 1.0f);
+  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), 0u);
+  for (int i = 0; i < 20000; i++) rate_valid_drive(&rv, 0.0105f * 0.0174533f, 1500.0f, 1.0f);
+  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), RATE_INVALID_PHASE);
+  /* Without quadrature the same error leaks nothing. */
+  for (int i = 0; i < 10; i++) rate_valid_drive(&rv, 0.0105f * 0.0174533f, 0.0f, 1.0f);
+  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), 0u);
+  /* Beyond the lock tolerance, at once. */
+  rate_valid_drive(&rv, 0.02f, 0.0f, 1.0f);
+  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), RATE_INVALID_PHASE);
+}
+
+/* After a hold, P_f may still be w / (1 - w) |P_held - P_f| from P: with 1500 deg/s of
+ * quadrature (26 deg/s per degree) a gap of 1 deg needs w below about 1 %. */
+static void test_thermo_settle_bound(void **state)
+{
+  (void)state;
+  assert_int_equal(settle(), 0u);
+  rate_valid_thermo(&rv, 1.0f, 0.0f, 0.02f, 1500.0f);
+  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), RATE_INVALID_THERMO_SETTLE);
+  rate_valid_thermo(&rv, 1.0f, 0.0f, 0.005f, 1500.0f);
+  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), 0u);
+  rate_valid_thermo(&rv, 9.0f, 9.0f, 0.0f, 1500.0f); /* out of the calibrated range */
+  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), RATE_INVALID_THERMO_RANGE);
+}
+
+/* A slew of P_f is judged over RATE_VALID_SLEW_UPDATES updates, against the cap and the
+ * lag it leaves in P_f's low-pass. */
+static void test_thermo_slew(void **state)
+{
+  (void)state;
+  assert_int_equal(settle(), 0u);
+  float p = 0.0f;
+  for (uint32_t i = 0; i < 3u * RATE_VALID_SLEW_UPDATES; i++) {
+    p += 0.004f / (float)RATE_VALID_SLEW_UPDATES; /* 0.04 deg/s, under the cap */
+    rate_valid_thermo(&rv, p, 0.0f, 0.0f, 0.0f);
+  }
+  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), 0u);
+  for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
+    p += 0.004f / (float)RATE_VALID_SLEW_UPDATES;
+    /* 0.004 deg per 0.1 s leaves P_f 0.0064 deg behind: 0.33 deg/s of 3000 deg/s of
+     * quadrature rotated into the rate, beyond the tolerance though under the cap. */
+    rate_valid_thermo(&rv, p, 0.0f, 0.0f, 3000.0f);
+  }
+  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), RATE_INVALID_THERMO_SLEW);
+}
+
+static void test_onsets_counted(void **state)
+{
+  (void)state;
+  assert_int_equal(settle(), 0u);
+  for (int i = 0; i < 3; i++) {
+    rate_valid_range(&rv, 400.0f);
+    (void)rate_valid_verdict(&rv, &hist, 0u);
+    (void)rate_valid_verdict(&rv, &hist, 0u);
+    rate_valid_range(&rv, 0.0f);
+    (void)rate_valid_verdict(&rv, &hist, 0u);
+  }
+  assert_int_equal(hist.count[5], 3u); /* OVER_RANGE: three onsets, not six blocks */
+  assert_true(hist.last_block[5] > 80u);
+  assert_string_equal(rate_valid_reason_name(5), "OVER_RANGE");
+  assert_string_equal(rate_valid_reason_name(RATE_INVALID_KINDS), "?");
+}
+
+int main(void)
+{
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_bad_cfg),
+      cmocka_unit_test(test_settling_measured),
+      cmocka_unit_test(test_over_range_and_sense),
+      cmocka_unit_test(test_phase_leak),
+      cmocka_unit_test(test_thermo_settle_bound),
+      cmocka_unit_test(test_thermo_slew),
+      cmocka_unit_test(test_onsets_counted),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
