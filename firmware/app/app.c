@@ -27,13 +27,13 @@ static int derive(void *ctx, const param_values_t *v, void *derived, const char 
 }
 
 /* Non-live parameters and flash saves need the drive off: an erase stalls every flash
- * fetch for hundreds of ms while the drive decays in a few (param_store.h). A sweep
- * excites the drive as well, and a queued drive on is as good as done. */
+ * fetch for hundreds of ms while the drive decays in a few (param_store.h). Off means
+ * commanded off: a sweep excites the drive, a fault's wait ends in a restart by itself,
+ * and a queued drive on is as good as done. */
 static bool loop_safe(void *ctx)
 {
   const app_t *a = ctx;
-  const gyro_mode_t m = app_mode_after_queue(a);
-  return (m == GYRO_MODE_OFF || m == GYRO_MODE_FAULT) && !selfcal_running(&a->selfcal);
+  return app_mode_after_queue(a) == GYRO_MODE_OFF && !selfcal_running(&a->selfcal);
 }
 
 static void cli_write(void *ctx, const char *data, size_t len)
