@@ -445,6 +445,95 @@ static void test_idle_isr_does_nothing(void **state)
   assert_int_equal(link_.len, 0u);
 }
 
+/* ---- selection handoff (tlm.h: configuration handoff) ---- */
+
+/* The ISR's next n records, straight from the ring: each must hold exactly the fields of
+ * mask for ticks k0, k0 + decim, ...: a record with one selection's mask and another's
+ * decim (a torn selection) fails either the length or the tick spacing. */
+static void expect_records(uint32_t mask, uint32_t decim, uint32_t k0, uint32_t n)
+{
+  uint32_t nf = 0u;
+  for (uint32_t m = mask; m != 0u; m &= m - 1u) {
+    nf++;
+  }
+  assert_int_equal(tlm_ring_used(&tx.ring), n * (1u + nf));
+  for (uint32_t r = 0; r < n; r++) {
+    uint32_t rec[1u + TLM_FIELDS_MAX];
+    assert_true(tlm_ring_peek(&tx.ring, rec, 1u + nf));
+    uint32_t j = 1u;
+    for (uint32_t i = 0; i < (uint32_t)TLM_FIELD_COUNT; i++) {
+      if ((mask >> i) & 1u) {
+        uint32_t want;
+        (void)truth(tlm_field(i)->name, k0 + r * decim, &want);
+        assert_int_equal(rec[j++], want);
+      }
+    }
+    tlm_ring_consume(&tx.ring, 1u + nf);
+  }
+}
+
+static uint32_t named_slot(void) { return atomic_load(&tx.isr_gen) & 1u; }
+
+/* The background prepares a new selection while a stream runs, and the ISR ticks between
+ * every step: until the publication every record is whole and of the old selection,
+ * from the first tick after it whole and of the new one. */
+static void test_selection_never_torn(void **state)
+{
+  (void)state;
+  setup_all();
+  tick_now = 0u;
+  const uint32_t a = mask_of(four, 4) | (1u << TLM_FIELD_tick);
+  const uint32_t b = (1u << TLM_FIELD_flags) | (1u << TLM_FIELD_tick);
+  start(a, 1000.0f); /* decim 50 */
+  run(100u, 0u);
+  expect_records(a, 50u, 0u, 2u);
+  const tlm_isr_sel_t live = tx.isr_sel[named_slot()];
+  /* steps 1-2: the slot written is not the one the ISR reads, which stays as it was */
+  const uint32_t g = tlm_sel_write(&tx, b, 7u);
+  assert_int_not_equal(g & 1u, named_slot());
+  assert_memory_equal(&tx.isr_sel[named_slot()], &live, sizeof live);
+  run(100u, 0u);
+  expect_records(a, 50u, 100u, 2u);
+  /* the background interrupted half way through rewriting that slot (mask stored, decim
+   * not yet): the ISR still reads only the slot it is given */
+  tx.isr_sel[g & 1u].mask = 1u << TLM_FIELD_mode;
+  run(100u, 0u);
+  expect_records(a, 50u, 200u, 2u);
+  /* written again before a publication: the same unnamed slot, whole again */
+  assert_int_equal(tlm_sel_write(&tx, b, 7u), g);
+  run(100u, 0u);
+  expect_records(a, 50u, 300u, 2u);
+  /* step 3: the next tick takes the new selection's first record at once */
+  tlm_sel_publish(&tx, g);
+  run(70u, 0u);
+  expect_records(b, 7u, 400u, 10u);
+}
+
+/* Two publications between ticks reuse the first slot; the generation, not the slot,
+ * tells the ISR that a new stream began, also across the generation counter's wrap. */
+static void test_selection_slot_reuse(void **state)
+{
+  (void)state;
+  setup_all();
+  tick_now = 0u;
+  tx.sel_gen = 0xFFFFFFFDu;
+  const uint32_t a = mask_of(four, 4);
+  start(a, 1000.0f); /* generation 0xFFFFFFFE */
+  run(60u, 0u);
+  expect_records(a, 50u, 0u, 2u);
+  const uint32_t slot_a = named_slot();
+  const uint32_t gb = tlm_sel_write(&tx, 1u << TLM_FIELD_tick, 3u);
+  tlm_sel_publish(&tx, gb);
+  assert_int_equal(gb, 0xFFFFFFFFu);
+  /* the same selection as before, in the same slot, as a new generation (2: 0 is off) */
+  const uint32_t gc = tlm_sel_write(&tx, a, 50u);
+  assert_int_equal(gc, 2u);
+  assert_int_equal(gc & 1u, slot_a);
+  tlm_sel_publish(&tx, gc);
+  run(100u, 0u); /* a new stream: its first record at once, not at tick 100 */
+  expect_records(a, 50u, 60u, 2u);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -457,6 +546,8 @@ int main(void)
       cmocka_unit_test(test_stop_drops_what_does_not_fit),
       cmocka_unit_test(test_restart),
       cmocka_unit_test(test_idle_isr_does_nothing),
+      cmocka_unit_test(test_selection_never_torn),
+      cmocka_unit_test(test_selection_slot_reuse),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
