@@ -55,8 +55,8 @@
  *   4 f32 at 1 kHz    N = 15, raw 253, wire 256, 66.7 frames/s  -> 17.1 kB/s = 19 %
  *   8 f32 at 1 kHz    N = 7,  raw 237, wire 240, 142.9 frames/s -> 34.4 kB/s = 37 %
  *   12 f32 at 1 kHz   N = 5,  raw 253, wire 256, 200 frames/s -> 51.4 kB/s = 56 %
- *   all 16 at 1 kHz   N = 3,  raw 205, wire 208, 333 frames/s -> 69.5 kB/s = 75 %: refused
- *   all 16 at 500 Hz  N = 3                                  -> 34.8 kB/s = 38 %
+ *   all 17 at 1 kHz   N = 3,  raw 217, wire 220, 333 frames/s -> 73.5 kB/s = 80 %: refused
+ *   all 17 at 500 Hz  N = 3                                  -> 36.9 kB/s = 40 %
  * A stream may use at most TLM_LINK_MAX_PCT = 70 % of the link: command replies share
  * it, and the UART's byte timing and the background loop's latency need slack.
  */

@@ -39,7 +39,8 @@
   X(mode,            U32, "-") \
   X(fault,           U32, "-") \
   X(flags,           U32, "-") \
-  X(tick,            U32, "-")
+  X(tick,            U32, "-") \
+  X(rate_valid,      U32, "-")
 /* clang-format on */
 
 typedef enum { TLM_T_F32 = 0, TLM_T_U32 = 1 } tlm_type_t;

@@ -71,6 +71,7 @@ typedef struct {
   uint32_t mode;         /* gyro_mode_t */
   uint32_t fault;        /* gyro_fault_t bits of the last fault */
   uint32_t flags;        /* GYRO_FLAG_* */
+  uint32_t rate_valid;   /* 1 when the rate output can be trusted (output integrity), else 0 */
 } gyro_out_t;
 
 #define GYRO_FLAG_LOCKED (1u << 0)
