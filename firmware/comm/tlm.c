@@ -249,10 +249,8 @@ static void pump(tlm_t *t, bool flush)
  * before a publication rewrites the same unnamed slot, never the named one. */
 uint32_t tlm_sel_write(tlm_t *t, uint32_t mask, uint32_t decim)
 {
-  uint32_t gen = t->sel_gen + 1u;
-  if (gen == 0u) {
-    gen = 2u; /* 0 means off; 2 keeps the slots alternating after 0xFFFFFFFF */
-  }
+  /* 0 means off: after 0xFFFFFFFF (slot 1) comes 2 (slot 0), the slots still alternate */
+  const uint32_t gen = (t->sel_gen == 0xFFFFFFFFu) ? 2u : t->sel_gen + 1u;
   t->isr_sel[gen & 1u].mask = mask;
   t->isr_sel[gen & 1u].decim = decim;
   return gen;
