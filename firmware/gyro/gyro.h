@@ -76,7 +76,7 @@ typedef struct {
   uint32_t flags;        /* GYRO_FLAG_* */
   uint32_t rate_invalid; /* RATE_INVALID_* reasons of this block (0: valid) */
   float rate_out_v;      /* voltage commanded on the analog rate output this block */
-  uint32_t rate_valid; /* 1 when the rate output can be trusted (output integrity), else 0 */
+  uint32_t rate_valid;   /* 1 when the rate output can be trusted (output integrity), else 0 */
 } gyro_out_t;
 
 #define GYRO_FLAG_LOCKED (1u << 0)
