@@ -110,8 +110,9 @@ class Link:
                 if msg is not None:
                     raise LinkError(msg) from None
                 if time.monotonic() > deadline:
-                    raise LinkError(f"cannot open {self.port}: not there after "
-                                    f"{self.timeout_s:g} s ({e})") from None
+                    what = "nothing listens" if "Connection refused" in str(e) else "no such port"
+                    raise LinkError(f"cannot open {self.port}: {what}, not there after "
+                                    f"{self.timeout_s:g} s of waiting") from None
             time.sleep(0.1)
 
     # ---- receiving ----

@@ -27,7 +27,7 @@ def run_name(csv_path):
     """The run's name for a title: the folder for report-style trace.csv files, else
     the file's name without .csv (a title 'trace.csv' says nothing)."""
     base = os.path.splitext(os.path.basename(str(csv_path)))[0]
-    if base in ("trace", "log", "run"):
+    if base == "trace":  # report runs: the folder names the scenario
         parent = os.path.basename(os.path.dirname(os.path.abspath(str(csv_path))))
         return parent or base
     return base
