@@ -42,7 +42,9 @@ def _parser():
                                         "3 no port or no answer, 4 log/plot failure.")
     ap.add_argument("--port", default=os.environ.get("GYROCTL_PORT"),
                     help="device, pty path or pyserial URL (default $GYROCTL_PORT)")
-    ap.add_argument("--timeout", type=float, default=3.0, help="seconds to wait for a reply")
+    ap.add_argument("--timeout", type=float, default=3.0, metavar="S",
+                    help="seconds to wait for the port and each reply, and the silence "
+                         "`log` allows (default 3; scaled by the emulator's stretch in log)")
     sub = ap.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
     sub.add_parser("shell", help="interactive command line")
     p = sub.add_parser("get", help="print a parameter's value")
