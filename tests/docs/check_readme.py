@@ -8,6 +8,11 @@ allowed) by one mark, an HTML comment that a rendered README does not show:
     <!-- readme-test: run-short: COMMANDS        run COMMANDS instead (a shortened form of
          why: REASON -->                         the block; may span several lines), and
                                                  REASON says what was shortened
+                                                 COMMANDS may instead be lines
+                                                 `replace: OLD => NEW`: the block as
+                                                 written with each OLD (which must
+                                                 occur) replaced, so the block stays the
+                                                 one source of the commands
     <!-- readme-test: skip: REASON -->           not run, and the reason says why
                                                  (hardware, minutes of CPU, QEMU ...)
 
@@ -126,8 +131,33 @@ def tree_state(root):
     return set(r.stdout.splitlines())
 
 
+REPLACE = re.compile(r"^\s*replace:\s*(.*?)\s*=>\s?(.*)$")
+
+
+def script_of(b: Block) -> str:
+    """The commands to run: the block, its replacement, or the block with the
+    `replace:` substitutions applied (ValueError when an OLD no longer occurs)."""
+    if b.kind != "run-short":
+        return b.text
+    lines = [ln for ln in b.arg.splitlines() if ln.strip()]
+    subs = [REPLACE.match(ln) for ln in lines]
+    if not lines or not all(subs):
+        return b.arg
+    text = b.text
+    for m in subs:
+        old, new = m.group(1), m.group(2).rstrip()
+        if old not in text:
+            raise ValueError(f"replace: '{old}' is not in the block any more")
+        text = text.replace(old, new)
+    return text
+
+
 def run_block(b: Block, root: str, pty: str) -> bool:
-    script = b.arg if b.kind == "run-short" else b.text
+    try:
+        script = script_of(b)
+    except ValueError as e:
+        print(f"--- README.md:{b.line}: {e}", flush=True)
+        return False
     script = script.replace("/tmp/gyro.pty", pty)
     # Background jobs of the block (a simulator on a pty) end with it.
     wrapped = "trap 'kill $(jobs -p) 2>/dev/null || true; wait 2>/dev/null || true' EXIT\n" + script

@@ -56,3 +56,12 @@ def test_write_into_tree_is_caught(tmp_path, capsys):
     assert _run(tmp_path, text, git=True) == 1
     err = capsys.readouterr().err
     assert "b.csv" in err and "out/a" not in err
+
+
+def test_replace_lines_edit_the_block(tmp_path, capsys):
+    text = ("<!-- readme-test: run-short: replace: exit 3 => exit 0\n"
+            "     why: shorter -->\n```sh\ntrue\nexit 3\n```\n")
+    assert _run(tmp_path, text) == 0
+    stale = text.replace("replace: exit 3", "replace: exit 4")
+    assert _run(tmp_path, stale) == 1
+    assert "'exit 4' is not in the block any more" in capsys.readouterr().out
