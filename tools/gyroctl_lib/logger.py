@@ -13,7 +13,8 @@ tick) are decimal, as in gyro-sim's logs.
 0 .. round(duration * rate) - 1, however fast the link or the gyro runs. On the emulator
 the gyro runs `stretch` times slower than real time (`emu`), so the wait for each record
 is scaled by it: the log gives up only when no record has come for --timeout seconds
-plus two record periods of wall time.
+plus four frame periods of wall time (a frame carries `per_frame` records, as the
+stream's reply says; four, because a loaded host slows the emulator below its stretch).
 """
 
 from __future__ import annotations
@@ -183,9 +184,15 @@ def log(link, fields, rate_hz, duration_s, out_path, progress=None, timeout_s=No
         for handler, item in pending:
             handler(item)
         pending.clear()
-        # Give up only on silence: --timeout plus two record periods of wall time (the
+        # Give up only on silence: --timeout plus four frame periods of wall time (the
         # emulator's gyro time runs `stretch` times slower).
-        stall_s += 2.0 * stretch / max(res.rate_hz, 1e-3)
+        per_frame = 1
+        if "per_frame" in words[:-1]:
+            try:
+                per_frame = max(1, int(words[words.index("per_frame") + 1]))
+            except ValueError:
+                per_frame = 1
+        stall_s += 4.0 * per_frame * stretch / max(res.rate_hz, 1e-3)
         last, seen = time.monotonic(), -2
         while st["wanted"] is None or st["max_index"] < st["wanted"] - 1:
             if st["max_index"] != seen:

@@ -157,7 +157,7 @@ class StreamPort(TimedPort):
         if line == "emu":
             r = (b"- stretch %d\r\nok emu\r\n" % self.stretch) if self.stretch else b"err UNKNOWN emu\r\n"
         elif line.startswith("stream "):
-            r = b"ok stream 7 100 Hz\r\n" + _header(7, [self.field])
+            r = b"ok stream 7 100 Hz decim 500 fields 1 per_frame 2 link 60 B/s 0%\r\n" + _header(7, [self.field])
             for seq, first in enumerate(range(0, self.records, 10), start=1):
                 r += _data(7, first, min(10, self.records - first), seq)
         elif line == "stop":
@@ -168,14 +168,15 @@ class StreamPort(TimedPort):
 
 
 def test_log_waits_by_the_emulator_stretch_and_timeout(tmp_path):
-    link = Link("fake", timeout_s=1.0, serial_obj=StreamPort(stretch=128, records=5))
+    link = Link("fake", timeout_s=1.0, serial_obj=StreamPort(stretch=32, records=5))
     t0 = time.monotonic()
     with pytest.raises(logger.LogError) as e:
         logger.log(link, ["drive_amp_v"], 100, 1.0, tmp_path / "a.csv", timeout_s=0.2)
     waited = time.monotonic() - t0
-    # silence allowed: --timeout 0.2 s + 2 records of 10 ms gyro time at stretch 128
+    # silence allowed: --timeout 0.2 s + 4 frames (of 2 records, per the reply) of 10 ms
+    # gyro time each at stretch 32 = 0.2 + 2.56 s
     assert 2.7 < waited < 4.5, waited
-    assert "5 of 100 records" in str(e.value) and "stretch 128" in str(e.value)
+    assert "5 of 100 records" in str(e.value) and "stretch 32" in str(e.value)
 
 
 def test_log_header_keeps_the_names_asked_for(tmp_path):
