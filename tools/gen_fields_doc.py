@@ -30,12 +30,18 @@ BIT_MEANING = {
     "GYRO_FLAG_ADC_RAIL": "a drive or sense ADC sample sat at a rail code since the last snapshot",
     "GYRO_FLAG_DRIVE_LIMIT": "the drive command sat at its voltage limit since the last snapshot",
     "GYRO_FLAG_FAULT": "the supervisor holds a fault (mode FAULT)",
-    "GYRO_FAULT_ADC_CLIP": "a run of consecutive ADC rail codes (drive or sense) reached its limit",
+    "GYRO_FAULT_ADC_CLIP": "sup.clip_count drive-channel ADC rail codes within 2 ms",
     "GYRO_FAULT_NAN": "a non-finite value in the loop state (checked first)",
     "GYRO_FAULT_LOST_LOCK": "while LOCKED, the low-passed amplitude error stayed beyond the "
                             "lost-lock tolerance for its hold time",
-    "GYRO_FAULT_DRIVE_SAT": "while LOCKED, the drive stayed at its voltage limit for its hold time",
-    "GYRO_FAULT_OVER_AMP": "drive amplitude above the trip level (not checked in SWEEP)",
+    "GYRO_FAULT_DRIVE_SAT": "while LOCKED, the drive stayed at its voltage limit for its hold "
+                            "time; or ACQUIRE at the limit when the acquisition time ran out",
+    "GYRO_FAULT_OVER_AMP": "drive amplitude above the relative trip or the absolute level the "
+                           "ADC can measure (not checked in SWEEP)",
+    "GYRO_FAULT_PHASE_LOST": "while LOCKED, the low-passed phase error stayed beyond "
+                             "sup.lost_phase_tol_deg for its hold time",
+    "GYRO_FAULT_ACQ_TIMEOUT": "ACQUIRE took longer than the loops' design allows",
+    "GYRO_FAULT_LOST_SAMPLE": "the HAL counted a lost sample (a converter frame overrun)",
 }
 # Telemetry fields whose gyro_out_t comment names a type rather than saying what it is.
 TLM_MEANING = {
@@ -48,7 +54,7 @@ MODE_MEANING = {
     "OFF": "drive off, no excitation",
     "SWEEP": "self-calibration sweep of the drive resonance (open loop)",
     "ACQUIRE": "drive loops closing, amplitude and phase not yet within tolerance",
-    "LOCKED": "drive locked; the rate output is valid",
+    "LOCKED": "drive locked; the rate output is valid when flag RATE_VALID says so",
     "FAULT": "a fault stopped the drive; `status` names it",
 }
 

@@ -85,7 +85,7 @@ typedef struct {
 #define GYRO_FLAG_FAULT (1u << 3)
 #define GYRO_FLAG_SELFTEST (1u << 4) /* the self-test force is on: rate output not valid */
 #define GYRO_FLAG_RATE_VALID (1u << 5) /* the rate output can be trusted (rate_valid.h) */
-#define GYRO_FLAG_OVER_RANGE (1u << 6) /* |rate| above rate.full_scale_dps */
+#define GYRO_FLAG_OVER_RANGE (1u << 6) /* rate magnitude above rate.full_scale_dps */
 #define GYRO_FLAG_SENSE_RANGE (1u << 7) /* sense pickoff near the ADC's range (warning) */
 
 typedef struct {

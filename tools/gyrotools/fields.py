@@ -14,7 +14,8 @@ from __future__ import annotations
 ALIASES = {"drive_amp": "drive_amp_v", "drive_amp_v": "drive_amp"}
 
 # Units that the suffix rule cannot give.
-UNIT_BY_NAME = {"drive_amp": "V", "flags": "-", "mode": "-", "fault": "-", "tick": "-"}
+UNIT_BY_NAME = {"drive_amp": "V", "flags": "-", "mode": "-", "fault": "-", "tick": "-",
+                "rate_valid": "-", "rate_invalid": "-"}
 SUFFIX_UNITS = (("_dps", "deg/s"), ("_v2", "V^2"), ("_deg", "deg"), ("_v", "V"),
                 ("_c", "degC"), ("_m", "m"), ("_s", "s"), ("_hz", "Hz"))
 
@@ -42,6 +43,9 @@ CSV_MEANING = {
     "p_f_deg": "P low-passed, what the compensation uses (firmware)",
     "drive_amp_true_m": "true drive displacement amplitude (truth)",
     "f_cmd_v2": "drive force command (firmware)",
+    "rate_valid": "1 when the rate output can be trusted, 0 when not (firmware, output integrity)",
+    "rate_out_v": "voltage commanded on the analog rate output in the same tick: the rate "
+                  "times rate.out_v_per_dps when valid, rate.fault_out_v when not (firmware)",
 }
 
 
