@@ -2,11 +2,11 @@
 
 #include <string.h>
 
-static uint32_t popcount16(uint32_t m)
+static uint32_t popcount32(uint32_t m)
 {
   uint32_t n = 0u;
-  for (uint32_t i = 0; i < 16u; i++) {
-    n += (m >> i) & 1u;
+  for (; m != 0u; m &= m - 1u) {
+    n++;
   }
   return n;
 }
@@ -19,7 +19,7 @@ int tlm_init(tlm_t *t, const tlm_cfg_t *cfg)
   }
   t->cfg = *cfg;
   tlm_ring_init(&t->ring);
-  atomic_store_explicit(&t->isr_cfg, 0u, memory_order_relaxed);
+  atomic_store_explicit(&t->isr_gen, 0u, memory_order_relaxed);
   atomic_store_explicit(&t->isr_rec, 0u, memory_order_relaxed);
   return 0;
 }
@@ -50,7 +50,7 @@ static uint32_t header_payload_len(uint32_t mask)
 
 uint32_t tlm_plan_bytes_per_s(uint32_t fs_hz, uint32_t mask, uint32_t decim, uint32_t rec_per_frame_)
 {
-  const uint32_t f = popcount16(mask);
+  const uint32_t f = popcount32(mask);
   const uint32_t data_wire = tlm_wire_len_max(TLM_FRAME_OVERHEAD + TLM_DATA_FIXED + 4u * rec_per_frame_ * f);
   const uint32_t hdr_wire = tlm_wire_len_max(TLM_FRAME_OVERHEAD + header_payload_len(mask));
   /* frames/s = fs / (decim N), rounded up */
@@ -78,7 +78,7 @@ tlm_status_t tlm_plan(uint32_t fs_hz, uint32_t baud, uint32_t mask, float rate_h
   }
   tlm_plan_t p;
   p.mask = mask;
-  p.n_fields = popcount16(mask);
+  p.n_fields = popcount32(mask);
   p.decim = decim;
   p.rate_hz = (float)fs_hz / (float)decim;
   p.rec_per_frame = rec_per_frame(fs_hz, decim, p.n_fields);
@@ -93,27 +93,31 @@ tlm_status_t tlm_plan(uint32_t fs_hz, uint32_t baud, uint32_t mask, float rate_h
 
 /* ---- ISR ---- */
 
-void tlm_isr_record(tlm_t *t, const gyro_out_t *out, uint32_t cfg)
+void tlm_isr_record(tlm_t *t, const gyro_out_t *out, uint32_t gen)
 {
-  if (cfg != t->isr_seen) {
-    t->isr_seen = cfg; /* a new stream takes its first record at once */
+  if (gen != t->isr_seen) {
+    t->isr_seen = gen; /* a new stream takes its first record at once */
     t->isr_count = 0u;
   }
   if (t->isr_count != 0u) {
     t->isr_count--;
     return;
   }
-  t->isr_count = (cfg >> 16) - 1u;
+  /* the slot gen names, read after gen and in this activation (tlm.h: handoff) */
+  atomic_signal_fence(memory_order_acquire);
+  const tlm_isr_sel_t *sel = &t->isr_sel[gen & 1u];
+  t->isr_count = sel->decim - 1u;
+  const uint32_t mask = sel->mask;
   const uint32_t k = atomic_load_explicit(&t->isr_rec, memory_order_relaxed);
   atomic_store_explicit(&t->isr_rec, k + 1u, memory_order_relaxed);
   uint32_t rec[1u + TLM_FIELDS_MAX];
   uint32_t n = 0u;
   rec[n++] = k;
   const uint8_t *base = (const uint8_t *)out;
-  for (uint32_t m = cfg & 0xFFFFu, i = 0u; m != 0u; m >>= 1, i++) {
-    if ((m & 1u) != 0u) {
-      memcpy(&rec[n++], base + tlm_field(i)->offset, 4u);
-    }
+  /* set bits only, lowest first (table order): the cost follows the number of fields,
+   * not the index of the highest one (count trailing zeros: RBIT + CLZ on the M4) */
+  for (uint32_t m = mask; m != 0u; m &= m - 1u) {
+    memcpy(&rec[n++], base + tlm_field((uint32_t)__builtin_ctz(m))->offset, 4u);
   }
   (void)tlm_ring_push(&t->ring, rec, n);
 }
@@ -239,10 +243,30 @@ static void pump(tlm_t *t, bool flush)
   }
 }
 
+/* ---- background: selection handoff (tlm.h) ---- */
+
+/* Counted from the last generation published, not the last written: writing twice
+ * before a publication rewrites the same unnamed slot, never the named one. */
+uint32_t tlm_sel_write(tlm_t *t, uint32_t mask, uint32_t decim)
+{
+  /* 0 means off: after 0xFFFFFFFF (slot 1) comes 2 (slot 0), the slots still alternate */
+  const uint32_t gen = (t->sel_gen == 0xFFFFFFFFu) ? 2u : t->sel_gen + 1u;
+  t->isr_sel[gen & 1u].mask = mask;
+  t->isr_sel[gen & 1u].decim = decim;
+  return gen;
+}
+
+void tlm_sel_publish(tlm_t *t, uint32_t gen)
+{
+  atomic_signal_fence(memory_order_release); /* the slot's stores before the name */
+  atomic_store_explicit(&t->isr_gen, gen, memory_order_relaxed);
+  t->sel_gen = gen;
+}
+
 void tlm_start(tlm_t *t, const tlm_plan_t *plan)
 {
   tlm_stop(t);
-  /* cfg is 0: the ISR takes no record, so the ring, the record counter and the overrun
+  /* isr_gen is 0: the ISR takes no record, so the ring, the record counter and the overrun
    * counter hold still while the new stream's bases are taken */
   tlm_ring_discard(&t->ring);
   t->plan = *plan;
@@ -260,13 +284,12 @@ void tlm_start(tlm_t *t, const tlm_plan_t *plan)
   t->records = t->frames = t->dropped = 0u;
   t->pending_len = 0u;
   t->streaming = true;
-  atomic_signal_fence(memory_order_release);
-  atomic_store_explicit(&t->isr_cfg, (plan->decim << 16) | (plan->mask & 0xFFFFu), memory_order_relaxed);
+  tlm_sel_publish(t, tlm_sel_write(t, plan->mask, plan->decim));
 }
 
 void tlm_stop(tlm_t *t)
 {
-  atomic_store_explicit(&t->isr_cfg, 0u, memory_order_relaxed);
+  atomic_store_explicit(&t->isr_gen, 0u, memory_order_relaxed);
   atomic_signal_fence(memory_order_seq_cst);
   if (t->streaming) {
     pump(t, true);

@@ -3,7 +3,8 @@
  * line (frame format and the text/frame rule: tlm_frame.h; fields: tlm_fields.h).
  *
  *   ISR (50 kHz)   tlm_isr_push(): one 32-bit load and a compare while not streaming;
- *                  otherwise a decimation counter, and every decim-th tick one record
+ *                  otherwise a decimation counter, and every decim-th tick (two more
+ *                  loads: the selection, see below) one record
  *                  {record index, selected words} into the SPSC ring (tlm_ring.h). A full
  *                  ring drops the record and counts it; the ISR never waits.
  *   background     tlm_poll(): records -> data frames of rec_per_frame records, a header
@@ -11,11 +12,35 @@
  *                  link only when the link takes all of it; otherwise it waits in
  *                  `pending` and the ring absorbs the delay.
  *
- * Configuration handoff: the ISR reads one 32-bit word, cfg = decim << 16 | mask
- * (0 = off), written by the background only. A stream starts with cfg = 0 already in
- * place (stop), the ring emptied and the ISR's record counter noted as the stream's base
- * while nothing produces, then one store of the new cfg: every record the background
- * reads afterwards belongs to the new stream, with no lock.
+ * Configuration handoff. A selection is two words, {mask, decim} (tlm_isr_sel_t): with
+ * up to 32 fields the mask alone fills a word, so the ISR cannot read a selection with
+ * one load. The background, the only writer, keeps two slots isr_sel[2] and names the
+ * current one with a single 32-bit word, the generation isr_gen: 0 = off, otherwise g,
+ * whose selection is isr_sel[g & 1]. To publish a selection the background
+ *   1. takes g = the last generation it published + 1 (skipping 0), so g's slot is not
+ *      the one isr_gen names (or isr_gen is 0 and names none);
+ *   2. writes mask and decim into isr_sel[g & 1];
+ *   3. a release signal fence, then one store isr_gen = g.
+ * The ISR loads isr_gen once per tick and, on a tick that takes a record, an acquire
+ * signal fence and then the slot g names, in that same activation.
+ * Why the ISR never pairs the mask of one selection with the decim of another: on the
+ * single core the background never runs while an ISR activation does (the ISR preempts
+ * it, never the reverse), so an activation reads the generation and its slot at one
+ * point between the background's steps. Before step 3 it reads the old generation,
+ * whose slot was complete when that generation was published and is not the slot being
+ * written; after step 3 it reads the new slot, complete because the fence keeps step
+ * 2's stores before step 3's store. The slot a generation names is written again only
+ * after a later publication has moved the ISR to the other slot; as the ISR holds no
+ * slot from one tick to the next (it re-reads isr_gen every tick), that publication is
+ * its acknowledgement, and the background never waits. (A reader on another core, or
+ * one the writer could preempt, would have to report the generation it moved to before
+ * its old slot could be reused.) The ISR compares the generation, not the slot index,
+ * with the one it acted on last: two publications between two ticks reuse one slot,
+ * and the new number still tells it that a new stream began.
+ * A stream starts with isr_gen = 0 already in place (stop), the ring emptied and the
+ * ISR's record counter noted as the stream's base while nothing produces, then the
+ * publication of its selection: every record the background reads afterwards belongs
+ * to the new stream, with no lock.
  *
  * Link budget (the command's bandwidth check, tlm_plan). 8N1 at 921600 baud carries
  * 92160 bytes/s. A data frame of N records of F fields is raw = 13 + 4 N F bytes
@@ -30,8 +55,8 @@
  *   4 f32 at 1 kHz    N = 15, raw 253, wire 256, 66.7 frames/s  -> 17.1 kB/s = 19 %
  *   8 f32 at 1 kHz    N = 7,  raw 237, wire 240, 142.9 frames/s -> 34.4 kB/s = 37 %
  *   12 f32 at 1 kHz   N = 5,  raw 253, wire 256, 200 frames/s -> 51.4 kB/s = 56 %
- *   all 16 at 1 kHz   N = 3,  raw 205, wire 208, 333 frames/s -> 69.5 kB/s = 75 %: refused
- *   all 16 at 500 Hz  N = 3                                  -> 34.8 kB/s = 38 %
+ *   all 17 at 1 kHz   N = 3,  raw 217, wire 220, 333 frames/s -> 73.5 kB/s = 80 %: refused
+ *   all 17 at 500 Hz  N = 3                                  -> 36.9 kB/s = 40 %
  * A stream may use at most TLM_LINK_MAX_PCT = 70 % of the link: command replies share
  * it, and the UART's byte timing and the background loop's latency need slack.
  */
@@ -50,7 +75,9 @@
 
 #define TLM_LINK_MAX_PCT 70u
 #define TLM_FRAMES_PER_S 50u
-#define TLM_DECIM_MAX 65535u /* 16 bits of the cfg word */
+/* Slowest stream fs / 65535 (0.76 Hz at 50 kHz): the range the `stream` command offers
+ * (app_tlm.h); the selection slot itself holds 32 bits. */
+#define TLM_DECIM_MAX 65535u
 
 /* Bytes the link takes now without blocking (0: try again later). */
 typedef size_t (*tlm_room_fn)(void *ctx);
@@ -92,11 +119,18 @@ typedef struct {
   uint32_t dropped;  /* frames of this stream the link could not take (at stop) */
 } tlm_stats_t;
 
+/* A selection as the ISR reads it (configuration handoff above). */
+typedef struct {
+  uint32_t mask;  /* bit i: tlm_field(i) */
+  uint32_t decim; /* ticks per record, >= 1 */
+} tlm_isr_sel_t;
+
 typedef struct {
   tlm_ring_t ring;
   /* ISR side */
-  _Atomic uint32_t isr_cfg; /* decim << 16 | mask, 0 = off: written by the background */
-  uint32_t isr_seen;        /* last cfg the ISR acted on */
+  tlm_isr_sel_t isr_sel[2]; /* written by the background, never the slot isr_gen names */
+  _Atomic uint32_t isr_gen; /* 0 = off, else g: selection isr_sel[g & 1]; background */
+  uint32_t isr_seen;        /* last isr_gen the ISR acted on */
   uint32_t isr_count;       /* ticks to wait before the next record */
   _Atomic uint32_t isr_rec; /* records taken (pushed or lost), written by the ISR */
   /* background side */
@@ -105,6 +139,7 @@ typedef struct {
   bool streaming;
   bool header_due;
   uint32_t stream_id;
+  uint32_t sel_gen;        /* the last non-zero generation published */
   uint32_t rec_base;       /* isr_rec when the stream started */
   uint32_t lost_base;      /* ring overruns when the stream started */
   uint32_t next_header;    /* record index that triggers the next periodic header */
@@ -137,14 +172,23 @@ void tlm_stop(tlm_t *t);
 void tlm_poll(tlm_t *t);
 void tlm_stats(const tlm_t *t, tlm_stats_t *st);
 
-void tlm_isr_record(tlm_t *t, const gyro_out_t *out, uint32_t cfg);
+/* The selection handoff's steps (configuration handoff above), background only;
+ * tlm_start runs them back to back, tests run the ISR between them.
+ * Steps 1-2: write {mask, decim} into the slot of the generation after the last one
+ * published (the slot isr_gen does not name) and return that generation.
+ * Step 3: publish gen, the value tlm_sel_write returned. */
+uint32_t tlm_sel_write(tlm_t *t, uint32_t mask, uint32_t decim);
+void tlm_sel_publish(tlm_t *t, uint32_t gen);
+
+/* ISR, streaming: gen is the isr_gen this tick loaded (non-zero). */
+void tlm_isr_record(tlm_t *t, const gyro_out_t *out, uint32_t gen);
 
 /* ISR: call once per tick after gyro_tick, with the tick's snapshot. */
 static inline void tlm_isr_push(tlm_t *t, const gyro_out_t *out)
 {
-  const uint32_t cfg = atomic_load_explicit(&t->isr_cfg, memory_order_relaxed);
-  if (cfg != 0u) {
-    tlm_isr_record(t, out, cfg);
+  const uint32_t gen = atomic_load_explicit(&t->isr_gen, memory_order_relaxed);
+  if (gen != 0u) {
+    tlm_isr_record(t, out, gen);
   }
 }
 

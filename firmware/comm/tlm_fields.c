@@ -2,6 +2,7 @@
 
 #include <string.h>
 
+#include "comm/tlm_frame.h"
 #include "gyro/gyro.h"
 
 #define TLM_X_ROW(member, type, unit) \
@@ -18,8 +19,10 @@ static const tlm_field_t k_fields[TLM_FIELD_COUNT] = {TLM_FIELD_LIST(TLM_X_ROW)}
                      == TLM_T_##type, #member " has another type");
 TLM_FIELD_LIST(TLM_X_CHECK)
 #undef TLM_X_CHECK
-/* The selection is a 16-bit mask in the ISR's configuration word (tlm.h). */
-_Static_assert(TLM_FIELD_COUNT <= 16, "the selection mask has 16 bits");
+/* The selection is one 32-bit mask (tlm.h: tlm_isr_sel_t), and a header frame lists at
+ * most TLM_FIELDS_MAX fields (tlm_frame.h). */
+_Static_assert(TLM_FIELD_COUNT >= 1 && TLM_FIELD_COUNT <= 32, "the selection mask has 32 bits");
+_Static_assert(TLM_FIELD_COUNT <= TLM_FIELDS_MAX, "a header lists every field");
 
 const tlm_field_t *tlm_field(uint32_t i) { return (i < (uint32_t)TLM_FIELD_COUNT) ? &k_fields[i] : NULL; }
 

@@ -12,7 +12,9 @@
  *   TYPE    F32 (IEEE-754 binary32) or U32
  *   unit    printed by `stream` with no arguments; "-" for dimensionless
  * A record holds the selected fields in table order (bit i of the selection mask is row
- * i), whatever order the command named them in.
+ * i), whatever order the command named them in. The table holds at most 32 rows (the
+ * mask is one 32-bit word); append new rows at the end so that existing bit positions
+ * keep their meaning.
  */
 #ifndef TLM_FIELDS_H
 #define TLM_FIELDS_H
@@ -37,7 +39,8 @@
   X(mode,            U32, "-") \
   X(fault,           U32, "-") \
   X(flags,           U32, "-") \
-  X(tick,            U32, "-")
+  X(tick,            U32, "-") \
+  X(rate_valid,      U32, "-")
 /* clang-format on */
 
 typedef enum { TLM_T_F32 = 0, TLM_T_U32 = 1 } tlm_type_t;
@@ -60,7 +63,7 @@ typedef struct {
 const tlm_field_t *tlm_field(uint32_t i);
 /* Index by name (exact, len bytes, need not be NUL-terminated); TLM_FIELD_COUNT if none. */
 uint32_t tlm_field_lookup(const char *name, size_t len);
-/* Mask of every field. */
-#define TLM_FIELD_MASK_ALL ((uint32_t)((1u << TLM_FIELD_COUNT) - 1u))
+/* Mask of every field (a shift by 32, UB, when the table holds 32 fields is avoided). */
+#define TLM_FIELD_MASK_ALL ((uint32_t)(0xFFFFFFFFu >> (32u - (uint32_t)TLM_FIELD_COUNT)))
 
 #endif /* TLM_FIELDS_H */

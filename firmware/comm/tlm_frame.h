@@ -33,7 +33,10 @@
  *   13  2  rec_per_frame: records in a full data frame
  *   15  4  lost: records of this stream lost to ring overruns so far (the ISR side)
  *   19  4  dropped: frames of this stream the UART could not take so far
- *   23  1  n_fields, 1 .. 16
+ *   23  1  n_fields, 1 .. 32 (1 .. 16 before the field table grew past 16 rows: such
+ *          a receiver rejects a wider header as malformed or oversize and reads none of
+ *          that stream's data, it never misreads it; the layout itself is unchanged, so
+ *          the version stays 1)
  *   24  .. n_fields times: type (0 = f32, 1 = u32), name length L (1 .. 31), then L
  *          name bytes from [A-Za-z0-9_.]; names are unique
  * Data payload ('D'):
@@ -82,8 +85,8 @@
 #define TLM_FRAME_HEAD_BYTES 4u /* marker, type, seq */
 #define TLM_FRAME_CRC_BYTES 2u
 #define TLM_FRAME_OVERHEAD (TLM_FRAME_HEAD_BYTES + TLM_FRAME_CRC_BYTES)
-/* Largest raw frame either side handles (a header of 16 fields with 31-byte names). */
-#define TLM_FRAME_MAX 560u
+/* Largest raw frame either side handles (a header of 32 fields with 31-byte names). */
+#define TLM_FRAME_MAX 1086u
 #define TLM_COBS_MAX(n) ((n) + 1u + (n) / 254u)
 /* Largest frame on the wire, both delimiters included. */
 #define TLM_WIRE_MAX (TLM_COBS_MAX(TLM_FRAME_MAX) + 2u)
@@ -91,7 +94,7 @@
 #define TLM_HEADER_VERSION 1u
 #define TLM_HEADER_FIXED 24u /* header payload before the field list */
 #define TLM_DATA_FIXED 7u    /* data payload before the records */
-#define TLM_FIELDS_MAX 16u
+#define TLM_FIELDS_MAX 32u
 #define TLM_NAME_MAX 31u
 /* Record bytes in one data frame: with the fixed part the raw frame stays <= 253 bytes,
  * so COBS adds 2 bytes (the marker's block and one more). */

@@ -367,8 +367,47 @@ int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d)
   return 0;
 }
 
+/* Rail codes, counted per block: a waveform clipped only at its peaks has a few per
+ * carrier cycle and never a long run, yet its demodulated phasor is wrong. */
+static inline void count_rails(gyro_t *g, const hal_adc_frame_t *adc)
+{
+  if (GYRO_UNLIKELY(adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN ||
+                    adc->sense == HAL_ADC_CODE_MAX || adc->sense == HAL_ADC_CODE_MIN)) {
+    g->flags_acc |= GYRO_FLAG_ADC_RAIL;
+    g->clip_count++;
+    if (adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN) g->clip_drive_count++;
+  }
+}
+
+/* A SWEEP tick: the self-calibration executive measures the drive LMSD's phasor and
+ * sets the excitation and the NCO's next step on every tick (selfcal_exec.h). The sense
+ * channel and the self-test forces rest (the rate is not valid in SWEEP and the sweep
+ * does not use it), so that the executive's step fits the tick's budget. */
+static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
+{
+  nco_out_t ref;
+  nco_step(&g->nco, &ref);
+  lmsd_step(&g->lmsd_drive, (float)adc->drive * g->adc_v_per_code, ref.sin_wc, ref.cos_wc);
+  count_rails(g, adc);
+  float u1, u2;
+  drive_synth_step(&g->synth, ref.phase, ref.half_phase, &u1, &u2);
+  dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
+  dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
+  dac->code[HAL_DAC_RATE_OUT] = g->rate_code;
+  dac->code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID;
+  g->out.tick++;
+  const uint32_t slot = g->slot;
+  g->slot = slot + 1u == GYRO_BLOCK ? 0u : slot + 1u;
+  gyro_block_sweep(g, slot, u1, u2);
+}
+
 void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
 {
+  const gyro_mode_t mode = g->sup.mode;
+  if (GYRO_UNLIKELY(mode == GYRO_MODE_SWEEP)) {
+    gyro_tick_sweep(g, adc, dac);
+    return;
+  }
   nco_out_t ref;
   nco_step(&g->nco, &ref);
 
@@ -377,21 +416,11 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
   lmsd_step(&g->lmsd_drive, v_drive, ref.sin_wc, ref.cos_wc);
   lmsd_step(&g->lmsd_sense, v_sense, ref.sin_wc, ref.cos_wc);
   rate_channel_accumulate(&g->rate, g->lmsd_sense.w_i, g->lmsd_sense.w_q);
+  count_rails(g, adc);
 
-  /* Rail codes, counted per block: a waveform clipped only at its peaks has a few per
-   * carrier cycle and never a long run, yet its demodulated phasor is wrong. */
-  if (GYRO_UNLIKELY(adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN ||
-                    adc->sense == HAL_ADC_CODE_MAX || adc->sense == HAL_ADC_CODE_MIN)) {
-    g->flags_acc |= GYRO_FLAG_ADC_RAIL;
-    g->clip_count++;
-    if (adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN) g->clip_drive_count++;
-  }
-
-  /* The waveform of the command last set: by the loops (ACQUIRE, LOCKED, once per
-   * block) or by the self-calibration job (SWEEP, every tick). */
-  const gyro_mode_t mode = g->sup.mode;
+  /* The waveform of the command the loops last set (ACQUIRE, LOCKED, once per block). */
   float u1 = 0.0f, u2 = 0.0f;
-  if (mode == GYRO_MODE_SWEEP || mode == GYRO_MODE_ACQUIRE || mode == GYRO_MODE_LOCKED) {
+  if (mode == GYRO_MODE_ACQUIRE || mode == GYRO_MODE_LOCKED) {
     drive_synth_step(&g->synth, ref.phase, ref.half_phase, &u1, &u2);
   }
   dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
@@ -407,9 +436,5 @@ void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
    * last, as a tail call. */
   const uint32_t slot = g->slot;
   g->slot = slot + 1u == GYRO_BLOCK ? 0u : slot + 1u;
-  if (mode == GYRO_MODE_SWEEP) {
-    gyro_block_sweep(g, slot, u1, u2);
-  } else {
-    gyro_block_run(g, slot, u1, u2);
-  }
+  gyro_block_run(g, slot, u1, u2);
 }

@@ -76,7 +76,7 @@ typedef struct {
   uint32_t flags;        /* GYRO_FLAG_* */
   uint32_t rate_invalid; /* RATE_INVALID_* reasons of this block (0: valid) */
   float rate_out_v;      /* voltage commanded on the analog rate output this block */
-  uint32_t rate_valid; /* 1 when the rate output can be trusted (output integrity), else 0 */
+  uint32_t rate_valid;   /* 1 when the rate output can be trusted (output integrity), else 0 */
 } gyro_out_t;
 
 #define GYRO_FLAG_LOCKED (1u << 0)
@@ -85,7 +85,7 @@ typedef struct {
 #define GYRO_FLAG_FAULT (1u << 3)
 #define GYRO_FLAG_SELFTEST (1u << 4) /* the self-test force is on: rate output not valid */
 #define GYRO_FLAG_RATE_VALID (1u << 5) /* the rate output can be trusted (rate_valid.h) */
-#define GYRO_FLAG_OVER_RANGE (1u << 6) /* |rate| above rate.full_scale_dps */
+#define GYRO_FLAG_OVER_RANGE (1u << 6) /* rate magnitude above rate.full_scale_dps */
 #define GYRO_FLAG_SENSE_RANGE (1u << 7) /* sense pickoff near the ADC's range (warning) */
 
 typedef struct {

@@ -9,7 +9,7 @@
  * overflowing to infinity would need terms near 1e38: broken state as well). The check
  * comes in two halves on two ticks (GYRO_SLOT_AMP, GYRO_SLOT_QUAD). */
 
-void gyro_block_amp(gyro_t *g)
+void gyro_block_amp_measure(gyro_t *g)
 {
   const float w_s = g->lmsd_drive.w_i, w_c = g->lmsd_drive.w_q;
   g->weights_finite = fm_isfinite(w_s + w_c + g->lmsd_sense.w_i + g->lmsd_sense.w_q) ? 1u : 0u;
@@ -19,6 +19,11 @@ void gyro_block_amp(gyro_t *g)
     /* Measure only: the amplitude is still watched for the over-amplitude trip. */
     g->drive.amp_v = fm_sqrtf(w_s * w_s + w_c * w_c);
   }
+}
+
+void gyro_block_amp(gyro_t *g)
+{
+  gyro_block_amp_measure(g);
   /* The drive-phase and sense-range checks of the rate's validity, on evidence of the
    * last block (phase error: supervisor; quadrature: its filter). */
   const float s_i = g->lmsd_sense.w_i, s_q = g->lmsd_sense.w_q;
@@ -73,8 +78,7 @@ void gyro_block_phase(gyro_t *g)
 
 void gyro_block_quad(gyro_t *g)
 {
-  const float sum = g->drive.f_cmd_v2 + g->drive.p_rad + g->rate.rate_dps + g->rate.quad_dps;
-  g->sup_in.state_finite = g->weights_finite != 0u && fm_isfinite(sum);
+  gyro_block_finite(g);
   rate_channel_t *rc = &g->rate;
   selftest_cont_notch(&g->selftest, 1u, &rc->quad_raw);
   rate_channel_filter_quad(rc);
@@ -184,12 +188,37 @@ void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
   g->flags_acc = 0u;
 }
 
+void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v)
+{
+  /* The rate channel rests in SWEEP (its outputs keep their last values): the verdict
+   * (not valid: MODE) and what does change. */
+  gyro_out_t *o = &g->out;
+  const uint32_t block_bits = RATE_INVALID_MODE | (g->clip_block != 0u ? RATE_INVALID_CLIP : 0u);
+  o->rate_invalid = rate_valid_verdict(&g->valid, &g->valid_history, block_bits);
+  o->rate_valid = 0u;
+  o->rate_out_v = g->rate_fault_out_v;
+  g->rate_code = g->rate_fault_code;
+  o->u1_v = u1_v;
+  o->u2_v = u2_v;
+  o->mode = (uint32_t)g->sup.mode;
+  o->fault = g->sup.fault;
+  o->flags = g->flags_acc | (o->rate_invalid & RATE_INVALID_SENSE_RANGE ? GYRO_FLAG_SENSE_RANGE : 0u);
+  g->flags_acc = 0u;
+}
+
 void gyro_block_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
 {
-  float f_cmd, p;
-  uint32_t half_step;
-  selfcal_exec_tick(&g->cal, g->lmsd_drive.w_i, g->lmsd_drive.w_q, &half_step, &f_cmd, &p);
-  drive_synth_follow(&g->synth, f_cmd, p);
-  g->nco.half_step = half_step; /* from the next sample on, as the excitation */
-  gyro_block_run(g, slot, u1_v, u2_v);
+  selfcal_exec_t *x = &g->cal;
+  selfcal_exec_tick(x, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
+  g->nco.half_step = x->half_step; /* from the next sample on, as the excitation */
+  /* A new force command (a job's start, a back-off) goes to the synthesis, and a newly
+   * posted job starts, on the block's next tick without a job of its own in SWEEP, at
+   * most four ticks (80 us) late: neither would fit beside the supervisor's or the
+   * snapshot's job, and every job settles for far longer than that. */
+  if (GYRO_SWEEP_IDLE_SLOT(slot)) {
+    drive_synth_follow(&g->synth, x->f_cmd_v2, x->p_rad);
+    selfcal_exec_take(x); /* a new job starts on a tick without a job of its own */
+    return;
+  }
+  gyro_block_run_sweep(g, slot, u1_v, u2_v);
 }

@@ -17,11 +17,14 @@
 
 #include <stdint.h>
 
+#include "dsp/fastmath.h"
 #include "gyro/gyro.h"
 
 /* GYRO_SLOT_AMP: the first half of the finiteness check (the LMSD weights), then |Z|
  * and, while the drive runs, the amplitude PI (with the drive off |Z| only, for the
- * over-amplitude trip); the rate-valid drive-phase and sense-range checks. */
+ * over-amplitude trip) (gyro_block_amp_measure); the rate-valid drive-phase and
+ * sense-range checks. */
+void gyro_block_amp_measure(gyro_t *g);
 void gyro_block_amp(gyro_t *g);
 /* GYRO_SLOT_COMMAND: the rest of the supervisor's evidence (sup_in), and the block's
  * drive command into the synthesis (once, after both loops). */
@@ -109,6 +112,60 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
     break;
   default: /* GYRO_SLOT_OUTPUT */
     gyro_block_output(g, u1_v, u2_v);
+    break;
+  }
+}
+
+/* GYRO_SLOT_OUTPUT in SWEEP: the verdict and the snapshot of what SWEEP changes. */
+void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v);
+
+/* The finiteness check's second half (loop and rate outputs) and its verdict for the
+ * supervisor (GYRO_SLOT_QUAD, in every mode). */
+static inline void gyro_block_finite(gyro_t *g)
+{
+  const float sum = g->drive.f_cmd_v2 + g->drive.p_rad + g->rate.rate_dps + g->rate.quad_dps;
+  g->sup_in.state_finite = g->weights_finite != 0u && fm_isfinite(sum);
+}
+
+/* The ticks of the block without a job in SWEEP (gyro_block_run_sweep): the drive loops'
+ * and the rate channel's. */
+#define GYRO_SWEEP_IDLE_SLOT(slot) \
+  ((slot) == GYRO_SLOT_PHASE_PI || (slot) == GYRO_SLOT_RATE || (slot) == GYRO_SLOT_P)
+
+/* The jobs of a SWEEP tick, on top of the self-calibration executive's step: the rate
+ * is not valid in SWEEP (rate_valid.h, MODE), so the rate channel's jobs (projection,
+ * filters, P, the continuous self-test) wait for the loops to be back; the supervisor
+ * with its evidence, the finiteness check, the rail counts and the output snapshot run
+ * as in the other modes. */
+static inline void gyro_block_run_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
+{
+  switch (slot) {
+  case GYRO_SLOT_PHASE_MEAS:
+    gyro_block_measure(g, 0);
+    break;
+  case GYRO_SLOT_AMP:
+    gyro_block_amp_measure(g);
+    break;
+  case GYRO_SLOT_COMMAND:
+    gyro_block_command(g);
+    break;
+  case GYRO_SLOT_SUPERVISE:
+    (void)supervisor_step(&g->sup, &g->sup_in);
+    break;
+  case GYRO_SLOT_PROJECT:
+    g->clip_block = g->clip_count;
+    g->clip_count = 0u;
+    g->clip_drive_block = g->clip_drive_count;
+    g->clip_drive_count = 0u;
+    if (g->sup.clear_req != 0u) gyro_block_clear(g);
+    break;
+  case GYRO_SLOT_QUAD:
+    gyro_block_finite(g);
+    break;
+  case GYRO_SLOT_OUTPUT:
+    gyro_block_output_sweep(g, u1_v, u2_v);
+    break;
+  default: /* the drive loops' and the rate channel's jobs */
     break;
   }
 }

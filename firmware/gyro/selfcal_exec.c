@@ -46,9 +46,7 @@ static void begin_point(selfcal_exec_t *x)
 static void start_job(selfcal_exec_t *x)
 {
   const selfcal_job_t *j = &x->job;
-  /* Word by word rather than memset: the library's runs from flash, on the tick. */
-  uint32_t *r = (uint32_t *)(void *)&x->res;
-  for (size_t i = 0; i < sizeof x->res / sizeof *r; i++) r[i] = 0u;
+  /* res was cleared by selfcal_exec_post, in the background: not on the tick. */
   x->active = 1u;
   x->idx = 0u;
   x->ticks = 0u;
@@ -182,8 +180,7 @@ static void tick_chirp(selfcal_exec_t *x, float amp2)
   }
 }
 
-void selfcal_exec_tick(selfcal_exec_t *x, float w_s, float w_c, uint32_t *half_step,
-                       float *f_cmd_v2, float *p_rad)
+void selfcal_exec_take(selfcal_exec_t *x)
 {
   const uint32_t seq = atomic_load_explicit(&x->job_seq, memory_order_relaxed);
   atomic_signal_fence(memory_order_acquire);
@@ -191,6 +188,10 @@ void selfcal_exec_tick(selfcal_exec_t *x, float w_s, float w_c, uint32_t *half_s
     x->running_seq = seq;
     start_job(x);
   }
+}
+
+void selfcal_exec_tick(selfcal_exec_t *x, float w_s, float w_c)
+{
   /* The measurement of this tick belongs to the excitation of the previous ones. */
   if (x->active != 0u) {
     x->ticks++;
@@ -207,9 +208,6 @@ void selfcal_exec_tick(selfcal_exec_t *x, float w_s, float w_c, uint32_t *half_s
     default: finish(x); break;
     }
   }
-  *half_step = x->half_step;
-  *f_cmd_v2 = x->f_cmd_v2;
-  *p_rad = x->p_rad;
 }
 
 static int job_ok(const selfcal_job_t *j)
@@ -236,6 +234,9 @@ int selfcal_exec_post(selfcal_exec_t *x, const selfcal_job_t *job)
   if (x == NULL || job == NULL || !job_ok(job)) return -1;
   const uint32_t seq = atomic_load_explicit(&x->job_seq, memory_order_relaxed);
   if (atomic_load_explicit(&x->done_seq, memory_order_relaxed) != seq) return -1;
+  /* Between jobs the background owns res (done_seq == job_seq): the new job's result
+   * starts from zero here rather than on the interrupt's first tick of the job. */
+  memset(&x->res, 0, sizeof x->res);
   x->job = *job;
   atomic_signal_fence(memory_order_release);
   atomic_store_explicit(&x->job_seq, seq + 1u, memory_order_relaxed);

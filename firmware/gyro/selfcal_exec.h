@@ -29,7 +29,7 @@
  * After a job completes the last excitation is held until the next job.
  *
  * Hand-off: the background writes job, then job_seq + 1 (one writer); the ISR takes it
- * at its next tick, runs it, fills res and then stores done_seq = job_seq. The
+ * at a tick it calls selfcal_exec_take on, runs it, fills res and then stores done_seq = job_seq. The
  * background reads res only when done_seq == job_seq (signal fences order the stores,
  * the same scheme as params.h).
  */
@@ -99,10 +99,14 @@ typedef struct {
 /* ISR: entering SWEEP. Drops any running job, excitation off, at half_step. */
 void selfcal_exec_reset(selfcal_exec_t *x, uint32_t half_step);
 
-/* ISR: one tick in SWEEP with this tick's drive LMSD weights. Outputs the excitation
- * of this tick and the NCO half-step of the next. */
-void selfcal_exec_tick(selfcal_exec_t *x, float w_s, float w_c, uint32_t *half_step,
-                       float *f_cmd_v2, float *p_rad);
+/* ISR: take a newly posted job, if any, and start it. Called on some ticks only (the
+ * caller's lighter ones): a job waits for it at most a few ticks. */
+void selfcal_exec_take(selfcal_exec_t *x);
+
+/* ISR: one tick in SWEEP with this tick's drive LMSD weights. The excitation of this
+ * tick and the NCO half-step of the next are then x->f_cmd_v2, x->p_rad, x->half_step
+ * (read in place: no outputs through memory on the tick). */
+void selfcal_exec_tick(selfcal_exec_t *x, float w_s, float w_c);
 
 /* Background: publish a job. Returns 0, or -1 (nothing posted) when the previous job
  * has not completed or the job is malformed. */

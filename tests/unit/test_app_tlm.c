@@ -31,6 +31,7 @@ typedef struct {
   uint32_t lines;
   char line[64][TLM_DECODE_LINE_MAX + 1u];
   uint32_t headers, records, bad_ticks;
+  uint32_t bad_valid; /* rate_valid words other than 0 or 1 */
   uint32_t last_tick;
   tlm_layout_t layout;
 } sink_t;
@@ -54,11 +55,13 @@ static void on_header(void *ctx, const tlm_layout_t *l)
 static void on_data(void *ctx, const tlm_data_t *d)
 {
   sink_t *g = ctx;
-  uint32_t f_tick = 99u;
+  uint32_t f_tick = 99u, f_valid = 99u;
   for (uint32_t f = 0; f < d->layout->n_fields; f++) {
     if (strcmp(d->layout->name[f], "tick") == 0) f_tick = f;
+    if (strcmp(d->layout->name[f], "rate_valid") == 0) f_valid = f;
   }
   for (uint32_t r = 0; r < d->n_rec; r++) {
+    if (f_valid != 99u && tlm_data_u32(d, r, f_valid) > 1u) g->bad_valid++;
     if (f_tick != 99u) {
       const uint32_t t = tlm_data_u32(d, r, f_tick);
       if (g->records > 0u && t != g->last_tick + d->layout->decim) g->bad_ticks++;
@@ -116,11 +119,12 @@ static void test_list_fields(void **state)
 {
   (void)state;
   const uint32_t before = got.lines;
-  assert_string_equal(cmd("stream\n"), "ok 16 fields; usage: stream FIELD...|all [@RATE_HZ]");
-  assert_int_equal(got.lines - before, 17u);
+  assert_string_equal(cmd("stream\n"), "ok 17 fields; usage: stream FIELD...|all [@RATE_HZ]");
+  assert_int_equal(got.lines - before, 18u);
   assert_string_equal(got.line[before], "- rate_dps f32 deg/s");
   assert_string_equal(got.line[before + 12u], "- mode u32 -");
   assert_string_equal(got.line[before + 15u], "- tick u32 -");
+  assert_string_equal(got.line[before + 16u], "- rate_valid u32 -");
 }
 
 /* Every bad request is refused with a clear err and starts nothing. */
@@ -142,7 +146,7 @@ static void test_errors_change_nothing(void **state)
       {"stream rate_dps @-5\n", "err RANGE"},
       {"stream rate_dps @50001\n", "err RANGE"},
       {"stream rate_dps @0.5\n", "err RANGE"},
-      {"stream all @1000\n", "err BANDWIDTH 16 fields at 1000 Hz need 69517 B/s, over 70% of the link (64512 of 92160 B/s)"},
+      {"stream all @1000\n", "err BANDWIDTH 17 fields at 1000 Hz need 73529 B/s, over 70% of the link (64512 of 92160 B/s)"},
       {"stream tick @50000\n", "err BANDWIDTH"},
       {"stop now\n", "err ARGS"},
   };
@@ -206,11 +210,33 @@ static void test_rate_rounding_and_default(void **state)
   assert_null(strstr(r, "rounded"));
   assert_true(strncmp(cmd("set tlm.rate_hz 250\n"), "ok", 2u) == 0);
   r = cmd("stream all\n");
-  assert_true(strncmp(r, "ok stream 3 250 Hz decim 200 fields 16 ", 39u) == 0);
+  assert_true(strncmp(r, "ok stream 3 250 Hz decim 200 fields 17 ", 39u) == 0);
   run_ms(100u);
   assert_string_equal(got.layout.name[15], "tick");
+  assert_string_equal(got.layout.name[16], "rate_valid");
   assert_true(strncmp(cmd("stop\n"), "ok stop 3 records ", 18u) == 0);
   assert_int_equal(got.bad_ticks, 0u);
+}
+
+/* A field past the 16th (rate_valid, row 16) selected with a low one: the command takes
+ * it, and the host receives both in table order, each in its place (the gyro's tick
+ * counter advances by decim; rate_valid is 0 or 1). */
+static void test_stream_field_past_16(void **state)
+{
+  (void)state;
+  assert_int_equal(tlm_field_lookup("rate_valid", 10u), 16u);
+  const char *want = "ok stream 1 1000 Hz decim 50 fields 2 ";
+  assert_true(strncmp(cmd("stream rate_valid tick @1000\n"), want, strlen(want)) == 0);
+  run_ms(200u);
+  assert_true(strncmp(cmd("stop\n"), "ok stop 1 records ", 18u) == 0);
+  assert_int_equal(got.layout.n_fields, 2u);
+  assert_string_equal(got.layout.name[0], "tick");
+  assert_string_equal(got.layout.name[1], "rate_valid");
+  assert_int_equal(got.layout.type[1], (uint8_t)TLM_T_U32);
+  assert_true(got.records >= 200u);
+  assert_int_equal(got.bad_ticks + got.bad_valid, 0u);
+  assert_int_equal(rx.st.corrupt + rx.st.bad_format + rx.st.no_layout, 0u);
+  assert_int_equal(rx.st.seq_missing + rx.st.rec_missing, 0u);
 }
 
 int main(void)
@@ -220,6 +246,7 @@ int main(void)
       cmocka_unit_test_setup(test_errors_change_nothing, setup),
       cmocka_unit_test_setup(test_stream_and_stop, setup),
       cmocka_unit_test_setup(test_rate_rounding_and_default, setup),
+      cmocka_unit_test_setup(test_stream_field_past_16, setup),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -125,9 +125,8 @@ static void test_exec_refuses_bad_jobs(void **state)
   selfcal_result_t r;
   assert_int_equal(selfcal_exec_poll(&x, &r), 0);
   /* run it: constant phasor 0.5 + 0.25j -> mean per point, excitation 1 */
-  uint32_t hs;
-  float f, p;
-  for (int k = 0; k < 2 * (256 + 10) + 4; k++) selfcal_exec_tick(&x, 0.5f, 0.25f, &hs, &f, &p);
+  selfcal_exec_take(&x);
+  for (int k = 0; k < 2 * (256 + 10) + 4; k++) selfcal_exec_tick(&x, 0.5f, 0.25f);
   assert_int_equal(selfcal_exec_poll(&x, &r), 1);
   assert_true(fabsf(r.z_re[1] - 0.5f) < 1e-6f && fabsf(r.z_im[1] - 0.25f) < 1e-6f);
   assert_true(r.f_cmd_v2[0] == 1.0f && r.backoffs == 0u);

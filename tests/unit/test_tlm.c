@@ -46,6 +46,7 @@ static void snap(gyro_out_t *o, uint32_t k)
   o->mode = k % 5u;
   o->fault = k * 3u;
   o->flags = k ^ 0xA5u;
+  o->rate_valid = (k / 3u) & 1u;
 }
 
 static uint32_t f2w(float f)
@@ -73,7 +74,7 @@ static int truth(const char *name, uint32_t k, uint32_t *w)
       {"u2_v", offsetof(gyro_out_t, u2_v), 0},           {"sense_i_v", offsetof(gyro_out_t, sense_i_v), 0},
       {"sense_q_v", offsetof(gyro_out_t, sense_q_v), 0}, {"mode", offsetof(gyro_out_t, mode), 1},
       {"fault", offsetof(gyro_out_t, fault), 1},         {"flags", offsetof(gyro_out_t, flags), 1},
-      {"tick", offsetof(gyro_out_t, tick), 1}};
+      {"tick", offsetof(gyro_out_t, tick), 1},           {"rate_valid", offsetof(gyro_out_t, rate_valid), 1}};
   for (size_t i = 0; i < sizeof m / sizeof m[0]; i++) {
     if (strcmp(m[i].name, name) == 0) {
       const uint8_t *b = (const uint8_t *)&o;
@@ -205,7 +206,9 @@ static void test_plan_rate_rounding(void **state)
     assert_int_equal(tlm_plan(FS, BAUD, m, bad[i], &p), TLM_ERR_RATE);
   }
   assert_int_equal(tlm_plan(FS, BAUD, 0u, 100.0f, &p), TLM_ERR_FIELDS);
-  assert_int_equal(tlm_plan(FS, BAUD, 1u << 16, 100.0f, &p), TLM_ERR_FIELDS);
+  assert_int_equal(tlm_plan(FS, BAUD, (uint32_t)((uint64_t)1u << TLM_FIELD_COUNT), 100.0f, &p), TLM_ERR_FIELDS);
+  assert_int_equal(tlm_plan(FS, BAUD, 1u << 31, 100.0f, &p), TLM_ERR_FIELDS);
+  assert_int_equal(tlm_plan(FS, BAUD, 1u << TLM_FIELD_rate_valid, 100.0f, &p), TLM_OK);
   /* one u32 at the full tick rate is far beyond the link */
   assert_int_equal(tlm_plan(FS, BAUD, 1u, 50000.0f, &p), TLM_ERR_BANDWIDTH);
 }
@@ -227,14 +230,15 @@ static void test_link_budget_by_hand(void **state)
   assert_int_equal(p.rec_per_frame, 4u);
   assert_int_equal(p.bytes_per_s, 50u * 80u + 73u);
   assert_int_equal(p.link_bytes_per_s, 92160u);
-  /* all 16 at 1 kHz: N = 3, 1000/3 frames of 208 B = 69333.3 -> 69334; header
-   * names 118 bytes + 32 + 30 = 180 -> 183 B: 69517 B/s > 70 % of 92160 = 64512 */
+  /* all 17 at 1 kHz: N = min(20, 240/68) = 3, raw 13 + 12 * 17 = 217, wire 220,
+   * 1000/3 frames = 73333.3 -> 73334; header names 128 bytes + 34 + 30 = 192 -> 195 B:
+   * 73529 B/s > 70 % of 92160 = 64512 */
   assert_int_equal(tlm_plan(FS, BAUD, TLM_FIELD_MASK_ALL, 1000.0f, &p), TLM_ERR_BANDWIDTH);
   assert_int_equal(p.rec_per_frame, 3u);
-  assert_int_equal(p.bytes_per_s, 69334u + 183u);
-  /* all 16 at 500 Hz: 34666.7 -> 34667 + 183 */
+  assert_int_equal(p.bytes_per_s, 73334u + 195u);
+  /* all 17 at 500 Hz: 36666.7 -> 36667 + 195 */
   assert_int_equal(tlm_plan(FS, BAUD, TLM_FIELD_MASK_ALL, 500.0f, &p), TLM_OK);
-  assert_int_equal(p.bytes_per_s, 34667u + 183u);
+  assert_int_equal(p.bytes_per_s, 36667u + 195u);
   /* 12 f32 (the twelve floats) at 1 kHz: N = 5, raw 253, wire 256, 200 frames/s */
   assert_int_equal(tlm_plan(FS, BAUD, 0x0FFFu, 1000.0f, &p), TLM_OK);
   assert_int_equal(p.rec_per_frame, 5u);
@@ -253,7 +257,8 @@ static void test_link_budget_matches_encoder(void **state)
     uint32_t mask;
     float rate;
   } cases[] = {{0x000Fu, 1000.0f}, {0x00FFu, 1000.0f}, {0x0FFFu, 1000.0f},
-               {TLM_FIELD_MASK_ALL, 500.0f}, {0x8001u, 100.0f}, {0x0001u, 10000.0f}};
+               {TLM_FIELD_MASK_ALL, 500.0f}, {0x8001u, 100.0f}, {0x0001u, 10000.0f},
+               {(1u << TLM_FIELD_rate_valid) | 0x8001u, 1000.0f}};
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     setup_all();
     tlm_plan_t p;
@@ -281,9 +286,11 @@ static void start(uint32_t mask, float rate)
 static void test_round_trip(void **state)
 {
   (void)state;
-  const uint32_t masks[] = {mask_of(four, 4), TLM_FIELD_MASK_ALL, 0x8000u, 0x7001u};
-  const float rates[] = {1000.0f, 250.0f, 5000.0f, 3000.0f};
-  for (size_t c = 0; c < 4u; c++) {
+  /* the last two select the field past the 16th (rate_valid), alone and between others */
+  const uint32_t masks[] = {mask_of(four, 4), TLM_FIELD_MASK_ALL, 0x8000u, 0x7001u,
+                            1u << TLM_FIELD_rate_valid, (1u << TLM_FIELD_rate_valid) | 0x9001u};
+  const float rates[] = {1000.0f, 250.0f, 5000.0f, 3000.0f, 2000.0f, 1000.0f};
+  for (size_t c = 0; c < sizeof masks / sizeof masks[0]; c++) {
     setup_all();
     tick_now = 1000u * (uint32_t)c;
     start(masks[c], rates[c]);
@@ -445,6 +452,95 @@ static void test_idle_isr_does_nothing(void **state)
   assert_int_equal(link_.len, 0u);
 }
 
+/* ---- selection handoff (tlm.h: configuration handoff) ---- */
+
+/* The ISR's next n records, straight from the ring: each must hold exactly the fields of
+ * mask for ticks k0, k0 + decim, ...: a record with one selection's mask and another's
+ * decim (a torn selection) fails either the length or the tick spacing. */
+static void expect_records(uint32_t mask, uint32_t decim, uint32_t k0, uint32_t n)
+{
+  uint32_t nf = 0u;
+  for (uint32_t m = mask; m != 0u; m &= m - 1u) {
+    nf++;
+  }
+  assert_int_equal(tlm_ring_used(&tx.ring), n * (1u + nf));
+  for (uint32_t r = 0; r < n; r++) {
+    uint32_t rec[1u + TLM_FIELDS_MAX];
+    assert_true(tlm_ring_peek(&tx.ring, rec, 1u + nf));
+    uint32_t j = 1u;
+    for (uint32_t i = 0; i < (uint32_t)TLM_FIELD_COUNT; i++) {
+      if ((mask >> i) & 1u) {
+        uint32_t want;
+        (void)truth(tlm_field(i)->name, k0 + r * decim, &want);
+        assert_int_equal(rec[j++], want);
+      }
+    }
+    tlm_ring_consume(&tx.ring, 1u + nf);
+  }
+}
+
+static uint32_t named_slot(void) { return atomic_load(&tx.isr_gen) & 1u; }
+
+/* The background prepares a new selection while a stream runs, and the ISR ticks between
+ * every step: until the publication every record is whole and of the old selection,
+ * from the first tick after it whole and of the new one. */
+static void test_selection_never_torn(void **state)
+{
+  (void)state;
+  setup_all();
+  tick_now = 0u;
+  const uint32_t a = mask_of(four, 4) | (1u << TLM_FIELD_tick);
+  const uint32_t b = (1u << TLM_FIELD_flags) | (1u << TLM_FIELD_tick) | (1u << TLM_FIELD_rate_valid);
+  start(a, 1000.0f); /* decim 50 */
+  run(100u, 0u);
+  expect_records(a, 50u, 0u, 2u);
+  const tlm_isr_sel_t live = tx.isr_sel[named_slot()];
+  /* steps 1-2: the slot written is not the one the ISR reads, which stays as it was */
+  const uint32_t g = tlm_sel_write(&tx, b, 7u);
+  assert_int_not_equal(g & 1u, named_slot());
+  assert_memory_equal(&tx.isr_sel[named_slot()], &live, sizeof live);
+  run(100u, 0u);
+  expect_records(a, 50u, 100u, 2u);
+  /* the background interrupted half way through rewriting that slot (mask stored, decim
+   * not yet): the ISR still reads only the slot it is given */
+  tx.isr_sel[g & 1u].mask = 1u << TLM_FIELD_mode;
+  run(100u, 0u);
+  expect_records(a, 50u, 200u, 2u);
+  /* written again before a publication: the same unnamed slot, whole again */
+  assert_int_equal(tlm_sel_write(&tx, b, 7u), g);
+  run(100u, 0u);
+  expect_records(a, 50u, 300u, 2u);
+  /* step 3: the next tick takes the new selection's first record at once */
+  tlm_sel_publish(&tx, g);
+  run(70u, 0u);
+  expect_records(b, 7u, 400u, 10u);
+}
+
+/* Two publications between ticks reuse the first slot; the generation, not the slot,
+ * tells the ISR that a new stream began, also across the generation counter's wrap. */
+static void test_selection_slot_reuse(void **state)
+{
+  (void)state;
+  setup_all();
+  tick_now = 0u;
+  tx.sel_gen = 0xFFFFFFFDu;
+  const uint32_t a = mask_of(four, 4);
+  start(a, 1000.0f); /* generation 0xFFFFFFFE */
+  run(60u, 0u);
+  expect_records(a, 50u, 0u, 2u);
+  const uint32_t slot_a = named_slot();
+  const uint32_t gb = tlm_sel_write(&tx, 1u << TLM_FIELD_tick, 3u);
+  tlm_sel_publish(&tx, gb);
+  assert_int_equal(gb, 0xFFFFFFFFu);
+  /* the same selection as before, in the same slot, as a new generation (2: 0 is off) */
+  const uint32_t gc = tlm_sel_write(&tx, a, 50u);
+  assert_int_equal(gc, 2u);
+  assert_int_equal(gc & 1u, slot_a);
+  tlm_sel_publish(&tx, gc);
+  run(100u, 0u); /* a new stream: its first record at once, not at tick 100 */
+  expect_records(a, 50u, 60u, 2u);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -457,6 +553,8 @@ int main(void)
       cmocka_unit_test(test_stop_drops_what_does_not_fit),
       cmocka_unit_test(test_restart),
       cmocka_unit_test(test_idle_isr_does_nothing),
+      cmocka_unit_test(test_selection_never_torn),
+      cmocka_unit_test(test_selection_slot_reuse),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

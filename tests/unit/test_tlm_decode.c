@@ -23,6 +23,7 @@ typedef struct {
   char line[16][TLM_DECODE_LINE_MAX + 1u];
   uint32_t headers, data, records, mismatches;
   tlm_layout_t last;
+  uint32_t first_words[TLM_FIELDS_MAX]; /* record 0 of the last data frame */
 } sink_t;
 static sink_t got;
 
@@ -53,6 +54,9 @@ static void on_data(void *ctx, const tlm_data_t *d)
 {
   sink_t *g = ctx;
   g->data++;
+  for (uint32_t f = 0; f < d->layout->n_fields; f++) {
+    g->first_words[f] = tlm_data_u32(d, 0u, f);
+  }
   for (uint32_t r = 0; r < d->n_rec; r++) {
     const uint32_t tick = t0 + (d->first_rec + r) * d->layout->decim;
     for (uint32_t f = 0; f < d->layout->n_fields; f++) {
@@ -363,7 +367,7 @@ static void test_header_rejections(void **state)
       {9u, 0u},                  /* decim = 0 */
       {13u, 0u},                 /* rec_per_frame = 0 */
       {23u, 0u},                 /* n_fields = 0 */
-      {23u, 17u},                /* n_fields > 16 */
+      {23u, 33u},                /* n_fields > 32 */
       {23u, 4u},                 /* more fields than given */
       {23u, 2u},                 /* fewer fields than given: trailing bytes */
       {24u, 2u},                 /* type 2 */
@@ -446,6 +450,56 @@ static void test_data_needs_its_header(void **state)
   assert_int_equal(rx.st.rec_missing, 9u);
 }
 
+/* The widest header the format allows, 32 fields with 31-byte names (a raw frame of
+ * exactly TLM_FRAME_MAX bytes), and a record of 32 words: fields past the 16th decode in
+ * place. 33 fields are refused. */
+static void test_header_32_fields(void **state)
+{
+  (void)state;
+  reset_rx();
+  seq = 0u;
+  buf_t h = good_header();
+  h.n = TLM_HEADER_FIXED;
+  h.b[23] = (uint8_t)TLM_FIELDS_MAX;
+  char name[TLM_NAME_MAX + 1u];
+  memset(name, 'x', TLM_NAME_MAX);
+  name[TLM_NAME_MAX] = '\0';
+  for (uint32_t i = 0; i < TLM_FIELDS_MAX; i++) {
+    name[0] = (char)('a' + i / 10u);
+    name[1] = (char)('0' + i % 10u);
+    putname(&h, (uint8_t)(i & 1u), name);
+  }
+  assert_int_equal(TLM_FRAME_OVERHEAD + h.n, TLM_FRAME_MAX);
+  send_frame((uint8_t)TLM_FRAME_HEADER, h.b, h.n);
+  assert_int_equal(got.headers, 1u);
+  assert_int_equal(got.last.n_fields, TLM_FIELDS_MAX);
+  assert_int_equal(got.last.type[31], 1u);
+  assert_string_equal(got.last.name[31], "d1xxxxxxxxxxxxxxxxxxxxxxxxxxxxx");
+  buf_t d = {{0}, 0u};
+  put16(&d, 7u);
+  put32(&d, 0u);
+  put8(&d, 1u);
+  for (uint32_t i = 0; i < TLM_FIELDS_MAX; i++) {
+    put32(&d, 0xA5000000u | i);
+  }
+  send_frame((uint8_t)TLM_FRAME_DATA, d.b, d.n);
+  assert_int_equal(got.data, 1u);
+  for (uint32_t i = 0; i < TLM_FIELDS_MAX; i++) {
+    assert_int_equal(got.first_words[i], 0xA5000000u | i);
+  }
+  /* one field more than the format allows */
+  reset_rx();
+  h.n = TLM_HEADER_FIXED;
+  h.b[23] = (uint8_t)(TLM_FIELDS_MAX + 1u);
+  for (uint32_t i = 0; i <= TLM_FIELDS_MAX; i++) {
+    const char n2[3] = {(char)('a' + i / 10u), (char)('0' + i % 10u), '\0'};
+    putname(&h, 0u, n2);
+  }
+  send_frame((uint8_t)TLM_FRAME_HEADER, h.b, h.n);
+  assert_int_equal(got.headers, 0u);
+  assert_int_equal(rx.st.bad_format, 1u);
+}
+
 /* A frame longer than any valid one, then a good one. */
 static void test_oversize_then_good(void **state)
 {
@@ -474,6 +528,7 @@ int main(void)
       cmocka_unit_test(test_header_rejections),
       cmocka_unit_test(test_data_needs_its_header),
       cmocka_unit_test(test_oversize_then_good),
+      cmocka_unit_test(test_header_32_fields),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

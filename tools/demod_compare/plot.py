@@ -50,14 +50,20 @@ def main(argv):
                           color=COLOURS[d], linestyle="--", linewidth=0.6, alpha=0.6)
             ax[1][j].plot(t_ms, [y / amp for y in cols["am_%s_%s" % (s, d)]],
                           color=COLOURS[d], label=d)
-        ax[0][j].axhspan(1 - proto["settle_band"], 1 + proto["settle_band"], color="0.9")
+        ax[0][j].axhspan(1 - proto["settle_band"], 1 + proto["settle_band"], color="0.9",
+                         label="settling band +-%.0f %%" % (100 * proto["settle_band"]))
+        # One legend entry for every dashed trace (each demodulator's own colour).
+        ax[0][j].plot([], [], color="0.4", linestyle="--", linewidth=0.6,
+                      label="dashed: before the output filter")
         ax[0][j].set_title("%s: mean step / A (dashed: before output filter)" % s, fontsize=10)
         ax[0][j].set_xlabel("t [ms]")
+        ax[0][j].set_ylabel("output / step amplitude A [1]")
         ax[0][j].set_xlim(0, 0.5e3 * proto["mse_window_start_s"])
         ax[0][j].set_ylim(-0.1, 1.4)
         ax[0][j].legend(fontsize=7)
         ax[1][j].set_title("%s: mean AM (%.0f Hz) response / A" % (s, proto["am_hz"]))
         ax[1][j].set_xlabel("t [ms]")
+        ax[1][j].set_ylabel("output / A [1]")
         ax[1][j].legend(fontsize=7)
         ax[0][j].grid(True)
         ax[1][j].grid(True)
@@ -81,6 +87,7 @@ def main(argv):
         ax[2][j].set_xticks([i + 0.2 for i in x])
         ax[2][j].set_xticklabels(DEMODS)
         ax[2][j].set_title(title)
+        ax[2][j].set_ylabel("MSE [dB]" if key == "mse_db" else "-3 dB bandwidth [Hz]")
         ax[2][j].legend(fontsize=7, loc="lower right")
         ax[2][j].grid(True, axis="y")
 

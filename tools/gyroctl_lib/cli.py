@@ -6,8 +6,13 @@
     gyroctl --port PORT save | load | defaults | diff | status | version | help | stop
     gyroctl --port PORT list [PREFIX]
     gyroctl --port PORT drive on|off
+    gyroctl --port PORT fields                   the telemetry fields: name, type, unit
     gyroctl --port PORT log FIELD... [--rate HZ] --duration S --out FILE.csv
-    gyroctl plot FILE.csv [--out FILE.png]
+    gyroctl plot FILE.csv [--columns A,B] [--t-start S] [--t-end S] [--out FILE.png]
+
+--timeout S is how long every command waits for its reply, and how long `log` waits
+without a record (plus two record periods, scaled by the emulator's stretch). The first
+command of each call is resent until the gyro answers (a booting emulator drops it).
 
 PORT: a serial device, a pty (gyro-sim, fw_pty_host) or a pyserial URL
 (socket://127.0.0.1:PORT); default $GYROCTL_PORT.
@@ -37,7 +42,9 @@ def _parser():
                                         "3 no port or no answer, 4 log/plot failure.")
     ap.add_argument("--port", default=os.environ.get("GYROCTL_PORT"),
                     help="device, pty path or pyserial URL (default $GYROCTL_PORT)")
-    ap.add_argument("--timeout", type=float, default=3.0, help="seconds to wait for a reply")
+    ap.add_argument("--timeout", type=float, default=3.0, metavar="S",
+                    help="seconds to wait for the port and each reply, and the silence "
+                         "`log` allows (default 3; scaled by the emulator's stretch in log)")
     sub = ap.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
     sub.add_parser("shell", help="interactive command line")
     p = sub.add_parser("get", help="print a parameter's value")
@@ -50,16 +57,32 @@ def _parser():
     p.add_argument("prefix", nargs="?")
     p = sub.add_parser("drive", help="start or stop the drive")
     p.add_argument("state", choices=("on", "off"))
+    sub.add_parser("fields", help="the telemetry fields `log` can record, with type and unit")
     p = sub.add_parser("log", help="record a telemetry stream to CSV")
     p.add_argument("fields", nargs="+", metavar="FIELD")
     p.add_argument("--rate", type=float, default=None, help="Hz (default: the gyro's tlm.rate_hz)")
-    p.add_argument("--duration", type=float, required=True, help="seconds of stream time")
+    p.add_argument("--duration", type=float, required=True,
+                   help="seconds of gyro time (the stream's clock, not the wall clock)")
     p.add_argument("--out", required=True, help="CSV file")
     p.add_argument("--strict", action="store_true", help="exit 4 if any record or frame was lost")
     p = sub.add_parser("plot", help="draw a CSV log to PNG")
     p.add_argument("csv")
     p.add_argument("--out", default=None, help="PNG file (default: the CSV's name with .png)")
+    p.add_argument("--columns", default=None, metavar="A,B,...",
+                   help="columns to draw, comma separated (default: every column, at most "
+                        f"{plot_mod.MAX_DEFAULT_PANELS})")
+    p.add_argument("--t-start", type=float, default=None, metavar="S", help="from this time (s)")
+    p.add_argument("--t-end", type=float, default=None, metavar="S", help="up to this time (s)")
     return ap
+
+
+# The firmware's hint names its own command line; through gyroctl the list is `fields`.
+FIRMWARE_HINT = "`stream` alone lists them"
+GYROCTL_HINT = "`gyroctl fields` lists them"
+
+
+def _print_err(reply):
+    print(reply.final.replace(FIRMWARE_HINT, GYROCTL_HINT), file=sys.stderr)
 
 
 def _print_reply(r):
@@ -74,7 +97,9 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.cmd == "plot":
         try:
-            out = plot_mod.plot(args.csv, args.out)
+            cols = None if args.columns is None else [c for c in args.columns.split(",") if c]
+            out = plot_mod.plot(args.csv, args.out, columns=cols, t_start=args.t_start,
+                                t_end=args.t_end)
         except plot_mod.PlotError as e:
             print(f"gyroctl: {e}", file=sys.stderr)
             return 4
@@ -84,12 +109,14 @@ def main(argv=None) -> int:
         ap.error("--port is required (or set GYROCTL_PORT)")
     if args.cmd == "set" and (len(args.pairs) == 0 or len(args.pairs) % 2 != 0):
         ap.error("set takes NAME VALUE pairs")
+    if not args.timeout > 0:
+        ap.error("--timeout must be > 0")
     try:
         with Link(args.port, timeout_s=args.timeout) as link:
             link.sync()
             return _run(args, link)
     except CommandError as e:
-        print(e.reply.final, file=sys.stderr)
+        _print_err(e.reply)
         return 1
     except LinkError as e:
         print(f"gyroctl: {e}", file=sys.stderr)
@@ -105,9 +132,13 @@ def _run(args, link) -> int:
         return shell.run(link)
     if args.cmd == "log":
         res = logger.log(link, args.fields, args.rate, args.duration, args.out,
-                         progress=logger.progress_for(sys.stderr))
+                         progress=logger.progress_for(sys.stderr), timeout_s=args.timeout)
         print(f"gyroctl: log: {res.summary()}", file=sys.stderr)
         return 4 if (args.strict and not res.clean) else 0
+    if args.cmd == "fields":
+        for name, ftype, unit in client.fields():
+            print(f"{name:16s} {ftype:4s} {unit}")
+        return 0
     if args.cmd == "get":
         print(client.get(args.name))
         return 0

@@ -15,12 +15,33 @@ from __future__ import annotations
 
 import collections
 import dataclasses
+import errno
 import time
 
 from . import frames
 
 BAUD = 921600
 LINE_MAX = 120  # firmware/comm/cli.h CLI_LINE_MAX
+SYNC_LINE = "version"      # harmless, answered in every mode
+SYNC_REPLY = "ok fw "      # how its reply starts (firmware/comm/cli_builtin.c)
+RESEND_S = 1.0             # resend the sync line after this long without a reply
+GONE = ("the gyro went away (port closed: the simulator or emulator ended, the cable was "
+        "unplugged, or the board reset)")
+
+
+def _open_error(port, e):
+    """Why a port cannot be opened, in words a user can act on; None: try again (the
+    port is not there yet, e.g. a simulator or emulator still starting)."""
+    text = str(e)
+    code = getattr(e, "errno", None)
+    if "exclusively lock" in text or code in (errno.EBUSY, errno.EAGAIN):
+        return (f"{port} is in use by another program (a terminal such as picocom, or "
+                "another gyroctl): close it first")
+    if code == errno.ENOENT or "No such file" in text or "Connection refused" in text:
+        return None
+    if code == errno.EACCES or "Permission denied" in text:
+        return f"cannot open {port}: permission denied (is the user in group dialout?)"
+    return f"cannot open {port}: {text}"
 
 
 class LinkError(Exception):
@@ -65,17 +86,34 @@ class Link:
         self.on_header, self.on_data = on_header, on_data
         self._lines = collections.deque()
         self.decoder = frames.Decoder(self._text, self._header, self._data)
-        if serial_obj is not None:
-            self.ser = serial_obj
-        else:
+        self._stale_sync = 0  # sync lines resent whose late replies are still due
+        self.ser = serial_obj if serial_obj is not None else self._open()
+
+    def _open(self):
+        """Open the port, waiting up to timeout_s for it to appear (a pty or TCP port of
+        a simulator or emulator that is still starting). A local device is opened
+        exclusively, so a second client gets a clear refusal instead of stolen replies."""
+        try:
+            import serial  # pyserial
+        except ImportError as e:  # pragma: no cover - setup.sh installs it
+            raise LinkError("pyserial is not installed (tools/setup.sh)") from e
+        local = "://" not in self.port
+        deadline = time.monotonic() + self.timeout_s
+        while True:
             try:
-                import serial  # pyserial
-            except ImportError as e:  # pragma: no cover - setup.sh installs it
-                raise LinkError("pyserial is not installed (tools/setup.sh)") from e
-            try:
-                self.ser = serial.serial_for_url(port, baudrate=BAUD, timeout=0.02)
+                if local:
+                    return serial.serial_for_url(self.port, baudrate=BAUD, timeout=0.02,
+                                                 exclusive=True)
+                return serial.serial_for_url(self.port, baudrate=BAUD, timeout=0.02)
             except (serial.SerialException, ValueError, OSError) as e:
-                raise LinkError(f"cannot open {port}: {e}") from None
+                msg = _open_error(self.port, e)
+                if msg is not None:
+                    raise LinkError(msg) from None
+                if time.monotonic() > deadline:
+                    what = "nothing listens" if "Connection refused" in str(e) else "no such port"
+                    raise LinkError(f"cannot open {self.port}: {what}, not there after "
+                                    f"{self.timeout_s:g} s of waiting") from None
+            time.sleep(0.1)
 
     # ---- receiving ----
     def _text(self, line):
@@ -100,10 +138,8 @@ class Link:
                     data += self.ser.read(self.ser.in_waiting)
             else:
                 data = self.ser.read(n)
-        except OSError as e:
-            raise LinkError(f"{self.port}: {e}") from None
-        except Exception as e:  # serial.SerialException and friends
-            raise LinkError(f"{self.port}: {e}") from None
+        except Exception:  # OSError (EIO: pty closed), serial.SerialException (socket closed)
+            raise LinkError(f"{self.port}: {GONE}") from None
         if data:
             self.decoder.feed(data)
         return len(data)
@@ -125,10 +161,40 @@ class Link:
         self._lines.clear()
 
     def sync(self):
-        """Start clean: an empty line ends whatever partial line the gyro holds (its reply,
-        if any, is dropped with anything else pending)."""
+        """Start clean, and make sure the gyro listens: an empty line ends whatever partial
+        line it holds, then a harmless command is sent, and resent every RESEND_S, until
+        the first reply (a booting emulator drops what arrives before its UART is up)
+        or timeout_s. Late replies to the resent lines are dropped by read_reply."""
         self.write(b"\n")
+        deadline = time.monotonic() + self.timeout_s
+        sends = 0
+        while True:
+            self._lines.clear()
+            self.write(SYNC_LINE.encode() + b"\n")
+            sends += 1
+            t_resend = min(deadline, time.monotonic() + RESEND_S)
+            if self._wait_final(t_resend):
+                break
+            if time.monotonic() >= deadline:
+                raise LinkError(self._no_reply_message(f"'{SYNC_LINE}'"))
+        self._stale_sync = sends - 1
         self.drain()
+
+    def _wait_final(self, t_end) -> bool:
+        while time.monotonic() < t_end:
+            self.poll()
+            if any(is_final(ln) for ln in self._lines):
+                return True
+        return False
+
+    def _no_reply_message(self, what) -> str:
+        msg = f"no reply to {what} from {self.port} within {self.timeout_s:g} s"
+        if "://" in self.port:
+            # QEMU's TCP serial port serves one client; a second one connects but hears nothing.
+            msg += " (is another client connected? the emulator serves one at a time)"
+        else:
+            msg += " (is the gyro powered and running, at 921600 8N1?)"
+        return msg
 
     # ---- sending ----
     def write(self, data: bytes):
@@ -158,10 +224,14 @@ class Link:
                 if line.startswith("- "):
                     data.append(line[2:])
                 elif is_final(line):
+                    if self._stale_sync and line.startswith(SYNC_REPLY) and what != SYNC_LINE:
+                        self._stale_sync -= 1  # a late answer to a resent sync line
+                        data = []
+                        continue
                     return Reply(line, data)
                 # anything else is not part of the reply grammar: ignored
             if time.monotonic() > t_end:
-                raise LinkError(f"no reply to '{what}' from {self.port}")
+                raise LinkError(self._no_reply_message(f"'{what}'"))
             self.poll()
 
     def close(self):

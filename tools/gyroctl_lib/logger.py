@@ -4,12 +4,17 @@ CSV (the format tools/gyrotools/csvlog.py reads): '#' comment lines with the str
 description, one header row `t_s,<columns>`, one row per record, and '#' comment lines
 with the loss accounting at the end. t_s is the stream's own clock, record index *
 decim / fs_hz from the stream's first record, so rows are exactly 1/rate apart and a
-lost record shows as a gap. Columns are the firmware's field names, except where the
-analysis tools know the quantity by another name (drive_amp_v -> drive_amp); integers
-(flags, mode, fault, tick) are decimal, as in gyro-sim's logs.
+lost record shows as a gap. Columns carry the names the user asked for (drive_amp_v
+stays drive_amp_v; gyro-sim's name drive_amp is accepted too and kept as typed), and the
+analysis tools read either (tools/gyrotools/csvlog.py); integers (flags, mode, fault,
+tick) are decimal, as in gyro-sim's logs.
 
---duration is stream time, not wall time: the file holds the records with index
-0 .. round(duration * rate) - 1, however fast the link or the simulator runs.
+--duration is gyro time, not wall time: the file holds the records with index
+0 .. round(duration * rate) - 1, however fast the link or the gyro runs. On the emulator
+the gyro runs `stretch` times slower than real time (`emu`), so the wait for each record
+is scaled by it: the log gives up only when no record has come for --timeout seconds
+plus four frame periods of wall time (a frame carries `per_frame` records, as the
+stream's reply says; four, because a loaded host slows the emulator below its stretch).
 """
 
 from __future__ import annotations
@@ -77,12 +82,45 @@ def _progress_bar(done, total, width=40):
     sys.stderr.flush()
 
 
+class _ProgressLines:
+    """Progress for a log or a pipe: one line at each quarter, so a long recording
+    is not silent and the output stays readable."""
+
+    def __init__(self, stream):
+        self.stream, self.next_q = stream, 1
+
+    def __call__(self, done, total):
+        while total and self.next_q <= 4 and done * 4 >= total * self.next_q:
+            self.stream.write(f"gyroctl: log: {25 * self.next_q}% ({done} of {total} records)\n")
+            self.stream.flush()
+            self.next_q += 1
+
+
+def emu_stretch(link) -> int:
+    """The emulator's tick stretch (gyro time runs this many times slower than real
+    time); 1 on a board or the simulator, which have no `emu` command."""
+    r = link.command("emu")
+    if not r.ok:
+        return 1
+    for d in r.data:
+        w = d.split()
+        if len(w) == 2 and w[0] == "stretch":
+            try:
+                return max(1, int(w[1]))
+            except ValueError:
+                return 1
+    return 1
+
+
 def log(link, fields, rate_hz, duration_s, out_path, progress=None, timeout_s=None) -> LogResult:
     """Stream `fields` at rate_hz (None: the gyro's tlm.rate_hz) for duration_s seconds of
     stream time into out_path. progress(done, total) is called as rows come in."""
-    if duration_s <= 0:
+    if not duration_s > 0:
         raise LogError("--duration must be > 0")
     names = [field_name(f) for f in fields]
+    asked = {field_name(f): f for f in fields}  # header: the names as the user typed them
+    stretch = emu_stretch(link)
+    stall_s = (3.0 if timeout_s is None else timeout_s)
     res = LogResult(path=str(out_path))
     st = {"layout": None, "max_index": -1, "rows": 0, "wanted": None, "fh": None}
     stats0 = dataclasses.replace(link.decoder.stats)
@@ -103,7 +141,7 @@ def log(link, fields, rate_hz, duration_s, out_path, progress=None, timeout_s=No
                      f"{datetime.datetime.now().isoformat(timespec='seconds')}\n")
             fh.write(f"# fs_hz {lay.fs_hz}, decim {lay.decim}, rate_hz {lay.rate_hz:.9g}, "
                      f"fields {' '.join(lay.names)}\n")
-            fh.write(",".join(["t_s"] + [column_name(n) for n in lay.names]) + "\n")
+            fh.write(",".join(["t_s"] + [asked.get(n, n) for n in lay.names]) + "\n")
 
     def on_data(fr):
         if res.stream_id == 0:
@@ -146,9 +184,20 @@ def log(link, fields, rate_hz, duration_s, out_path, progress=None, timeout_s=No
         for handler, item in pending:
             handler(item)
         pending.clear()
-        deadline = time.monotonic() + (timeout_s if timeout_s is not None else 3.0 * duration_s + 5.0)
+        # Give up only on silence: --timeout plus four frame periods of wall time (the
+        # emulator's gyro time runs `stretch` times slower).
+        per_frame = 1
+        if "per_frame" in words[:-1]:
+            try:
+                per_frame = max(1, int(words[words.index("per_frame") + 1]))
+            except ValueError:
+                per_frame = 1
+        stall_s += 4.0 * per_frame * stretch / max(res.rate_hz, 1e-3)
+        last, seen = time.monotonic(), -2
         while st["wanted"] is None or st["max_index"] < st["wanted"] - 1:
-            if time.monotonic() > deadline:
+            if st["max_index"] != seen:
+                last, seen = time.monotonic(), st["max_index"]
+            elif time.monotonic() - last > stall_s:
                 break
             link.poll()
         stop = link.command("stop")
@@ -156,7 +205,7 @@ def log(link, fields, rate_hz, duration_s, out_path, progress=None, timeout_s=No
         timed_out = st["wanted"] is None or st["max_index"] < st["wanted"] - 1
     finally:
         link.on_header = link.on_data = None
-        if progress and st["wanted"]:
+        if progress is _progress_bar and st["wanted"]:
             sys.stderr.write("\n")
     s = link.decoder.stats
     res.wanted = st["wanted"] or 0
@@ -170,14 +219,15 @@ def log(link, fields, rate_hz, duration_s, out_path, progress=None, timeout_s=No
     fh.write(f"# {res.summary()}\n# stop reply: {res.stop_reply}\n")
     fh.close()
     if timed_out:
-        raise LogError(f"stream stalled: {res.rows} of {res.wanted or '?'} records arrived "
-                       f"(timeout); partial log in {out_path}")
+        raise LogError(f"stream stalled: {res.rows} of {res.wanted or '?'} records arrived, "
+                       f"then none for {stall_s:.1f} s (--timeout, emulator stretch "
+                       f"{stretch}); partial log in {out_path}")
     return res
 
 
 def progress_for(stream) -> callable:
-    """A progress bar on stream (stderr) if it is a terminal, else None."""
-    return _progress_bar if stream.isatty() else None
+    """A progress bar on stream (stderr) if it is a terminal, else a line per quarter."""
+    return _progress_bar if stream.isatty() else _ProgressLines(stream)
 
 
 __all__ = ["log", "LogResult", "LogError", "column_name", "field_name", "progress_for", "LinkError"]

@@ -335,8 +335,42 @@ def summary(res):
     }
 
 
+def fit_agreement(res, z=1.96):
+    """Boolean per tau: the fitted sum lies inside the point's interval widened from
+    68 % to about 95 % (log width scaled by z; a 68 % test would fail a third of the
+    points of a perfect fit by chance). A fit that misses the data must not be drawn or
+    read as if it described it."""
+    ad = res.curve.adev_dph
+    lo = ad * (res.ci_lo_dph / ad) ** z
+    hi = ad * (res.ci_hi_dph / ad) ** z
+    model = model_adev(res.curve.tau_s, res.model)
+    return (model >= lo) & (model <= hi)
+
+
+def b_supported(res):
+    """(True, '') when B can be read off the fitted sum: it follows the data at its
+    minimum and over at least 2/3 of the fitted taus; else (False, why)."""
+    ok = fit_agreement(res)
+    j = int(np.argmin(np.abs(np.log(res.curve.tau_s / res.tau_at_min_s))))
+    n_in, n_fit = int(np.count_nonzero(ok & res.fit_mask)), int(np.count_nonzero(res.fit_mask))
+    if ok[j] and 3 * n_in >= 2 * n_fit:
+        return True, ""
+    return False, (f"the fitted sum misses the data (follows it at {n_in} of {n_fit} taus"
+                   + ("" if ok[j] else ", not at its minimum") + ")")
+
+
+def _span(grid, rng, pad=2.0):
+    """Grid points within a fit's tau range (widened by pad either side)."""
+    lo, hi = rng
+    if lo is None:
+        return np.zeros(grid.shape, dtype=bool)
+    return (grid >= lo / pad) & (grid <= hi * pad)
+
+
 def plot(res, out_dir, name="allan.png", title=""):
-    """Log-log ADEV with 68 % CIs, the fitted sum and its asymptotes (fig. 7-1, 7-11)."""
+    """Log-log ADEV with 68 % CIs, the fitted sum and its asymptotes (fig. 7-1, 7-11),
+    each drawn only where it describes the data: the fitted sum where it lies inside
+    the points' 68 % intervals, each asymptote over the taus its read-off came from."""
     from . import plotting
 
     tau, ad = res.curve.tau_s, res.curve.adev_dph
@@ -345,28 +379,122 @@ def plot(res, out_dir, name="allan.png", title=""):
                     label="68 % confidence interval")
     ax.loglog(tau, ad, "o", ms=3, color="C0", label="overlapping ADEV")
     grid = np.logspace(math.log10(tau[0]), math.log10(tau[-1]), 300)
-    ax.loglog(grid, model_adev(grid, res.model), "-", color="k", lw=1,
-              label="fitted sum (7-11)")
-    top = ad.max() * 3
-    bottom = ad.min() / 3
+    ok = fit_agreement(res)
+    ok_grid = np.interp(np.log(grid), np.log(tau), ok.astype(float)) > 0.5
+    ok_grid &= grid >= res.tau_min_fit_s * (1 - 1e-9)
+    fitted = np.where(ok_grid, model_adev(grid, res.model), np.nan)
+    n_fit = int(np.count_nonzero(res.fit_mask))
+    n_in = int(np.count_nonzero(ok & res.fit_mask))
+    ax.loglog(grid, fitted, "-", color="k", lw=1,
+              label=f"fitted sum (7-11), drawn where it fits: {n_in} of {n_fit} taus")
     if res.arw_dph_rthz is not None:
-        ax.loglog(grid, res.arw_dph_rthz / np.sqrt(grid), "--", color="C1",
+        g = grid[_span(grid, res.arw_tau_range_s)]
+        ax.loglog(g, res.arw_dph_rthz / np.sqrt(g), "--", color="C1",
                   label=f"N = {res.arw_dph_rthz:.3g} deg/h/rtHz  (slope -1/2)")
-    b = res.bias_instability_dph
-    ax.axhline(FLICKER_FLOOR * b, ls="--", color="C2",
-               label=("B < " if res.bias_instability_upper_bound else "B = ")
-               + f"{b:.3g} deg/h  (0.664 B)")
+    _plot_floor(ax, res, grid)
     if res.rate_ramp_dph_per_s is not None:
         r = res.rate_ramp_dph_per_s
-        ax.loglog(grid, r * grid / math.sqrt(2.0), "--", color="C3",
+        g = grid[_span(grid, res.ramp_tau_range_s)]
+        ax.loglog(g, r * g / math.sqrt(2.0), "--", color="C3",
                   label=f"R = {r * 3600:.3g} deg/h/h  (slope +1)")
     if res.model["K_dph_rts"] > 0:
         k = res.model["K_dph_rts"]
-        ax.loglog(grid, k * np.sqrt(grid / 3.0), ":", color="C4",
+        g = grid[grid >= res.tau_min_fit_s]
+        ax.loglog(g, k * np.sqrt(g / 3.0), ":", color="C4",
                   label=f"K = {k * 60:.3g} deg/h/rth  (slope +1/2)")
-    ax.plot([res.tau_at_min_s], [res.adev_min_model_dph], "v", color="C2")
-    ax.axvspan(tau[0], res.tau_min_fit_s, color="0.85", alpha=0.5, lw=0)
-    ax.set_ylim(bottom, top)
+    if res.tau_min_fit_s > tau[0]:
+        ax.axvspan(tau[0], res.tau_min_fit_s, color="0.85", alpha=0.5, lw=0,
+                   label="not fitted (smoothed by the output low-pass)")
+    ax.set_ylim(ad.min() / 3, ad.max() * 3)
     plotting.finish(ax, title=title or "Allan deviation of the rate output",
-                    xlabel="averaging time tau (s)", ylabel="Allan deviation (deg/h)")
+                    xlabel="averaging time tau [s]", ylabel="Allan deviation [deg/h]")
     return plotting.save(fig, out_dir, name)
+
+
+def _plot_floor(ax, res, grid):
+    """The bias-instability floor 0.664 B around the fitted minimum, only where the
+    fitted sum describes the data; otherwise a legend line says why not."""
+    b = res.bias_instability_dph
+    near = (grid >= res.tau_at_min_s / 4) & (grid <= res.tau_at_min_s * 4)
+    if b_supported(res)[0]:
+        ax.loglog(grid[near], np.full(np.count_nonzero(near), FLICKER_FLOOR * b), "--",
+                  color="C2", label=("B < " if res.bias_instability_upper_bound else "B = ")
+                  + f"{b:.3g} deg/h  (0.664 B)")
+        ax.plot([res.tau_at_min_s], [res.adev_min_model_dph], "v", color="C2",
+                label="minimum of the fitted sum")
+    else:
+        ax.plot([], [], " ", label="B not read: the fitted sum misses the data "
+                                   "(the measured curve is the guide)")
+
+
+def _quantization(res):
+    """IEEE 952 quantization noise Q (deg): sigma = sqrt(3) Q / tau where the curve
+    falls with slope -1 (local log slope below -0.8 over an octave); None when no tau
+    shows that slope (a filtered rate output usually hides it)."""
+    tau, ad = res.curve.tau_s, res.curve.adev_dph
+    if tau.size < 3:
+        return None
+    slope = np.gradient(np.log(ad), np.log(tau))
+    steep = slope < -0.8
+    if np.count_nonzero(steep) < 2:
+        return None
+    q_deg = ad[steep] / DPH_PER_DPS * tau[steep] / math.sqrt(3.0)
+    return float(np.median(q_deg))
+
+
+def ieee952(res):
+    """The five coefficients of IEEE Std 952-1997 annex C, each with its unit and how it
+    was obtained (None with the reason when the record does not show it)."""
+    q = _quantization(res)
+    arw = res.arw_dph_rthz
+    k = res.model["K_dph_rts"]
+    ramp = res.rate_ramp_dph_per_s
+    b_ok, b_why = b_supported(res)
+
+    def entry(value, unit, source):
+        return {"value": value, "unit": unit, "source": source}
+
+    return {
+        "Q": entry(q, "deg", "slope -1 region, sigma = sqrt(3) Q / tau" if q is not None
+                   else "not observable: no slope -1 region (the output low-pass hides it)"),
+        "N": entry(None if arw is None else arw / 60.0, "deg/sqrt(h)", res.arw_source),
+        "B": entry(res.bias_instability_dph if b_ok else None, "deg/h",
+                   ("upper bound: the curve still falls at the longest tau"
+                    if res.bias_instability_upper_bound else "flat minimum of the fitted sum / 0.664")
+                   if b_ok else f"not observable: {b_why}"),
+        "K": entry(k * 60.0 if k > 0 else None, "deg/h/sqrt(h)",
+                   "fitted +1/2 term (--rrw)" if k > 0 else
+                   "not observable: no +1/2 slope in the record (fit with --rrw to try)"),
+        "R": entry(None if ramp is None else ramp * 3600.0, "deg/h/h", res.ramp_source),
+    }
+
+
+def kalibr_yaml(res, ieee, fs_hz, source):
+    """Text of a Kalibr IMU file (imu.yaml): the gyroscope's white-noise density and
+    random walk in SI units, the accelerometer entries marked as not measured."""
+    d2r = math.pi / 180.0
+    n = res.arw_dph_rthz if res.arw_dph_rthz is not None else res.model["N_dph_rthz"]
+    n_note = "from N" if res.arw_dph_rthz is not None else "from the fitted white term (N not resolved)"
+    noise = n / DPH_PER_DPS * d2r  # deg/h/rtHz -> rad/s/rtHz
+    if ieee["K"]["value"] is not None:
+        k_dps = res.model["K_dph_rts"] / DPH_PER_DPS  # deg/s per sqrt(s)
+        walk, k_note = k_dps * d2r, "from K (IEEE 952 rate random walk)"
+    else:
+        # K is not in the record: the deviation at the longest tau bounds it from above
+        # (K sqrt(tau/3) cannot exceed what was measured there), which is what a filter
+        # needs - a conservative value, said to be one.
+        t_max, a_max = res.curve.tau_s[-1], res.curve.adev_dph[-1]
+        walk = a_max / DPH_PER_DPS * math.sqrt(3.0 / t_max) * d2r
+        k_note = (f"UPPER BOUND: K not observable in this {res.curve.n_samples / fs_hz:.0f} s "
+                  f"record; sigma({t_max:.4g} s) * sqrt(3 / {t_max:.4g} s) bounds it")
+    return (
+        f"# IMU noise model for Kalibr / VIO (continuous-time densities), from {source}\n"
+        "# by gyro-allan (IEEE Std 952 two-sided Allan deviation, allantools.oadev).\n"
+        "# This device is a single-axis gyroscope: the accelerometer entries are not\n"
+        "# measured; replace the .nan values with your accelerometer's figures.\n"
+        "accelerometer_noise_density: .nan   # [ m / s^2 / sqrt(Hz) ]  not measured\n"
+        "accelerometer_random_walk: .nan     # [ m / s^3 / sqrt(Hz) ]  not measured\n"
+        f"gyroscope_noise_density: {noise:.6e}   # [ rad / s / sqrt(Hz) ]  {n_note}\n"
+        f"gyroscope_random_walk: {walk:.6e}     # [ rad / s^2 / sqrt(Hz) ]  {k_note}\n"
+        "rostopic: /imu0\n"
+        f"update_rate: {fs_hz:.6g}   # [ Hz ]  sample rate of the log\n")

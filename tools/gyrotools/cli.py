@@ -78,6 +78,19 @@ def write_json(directory, name, obj):
     return path
 
 
+def write_text(path, text):
+    """Write a text output file; a missing folder is created."""
+    d = os.path.dirname(path)
+    if d:
+        out_dir(d)
+    try:
+        with open(path, "w", encoding="utf-8") as fh:
+            fh.write(text)
+    except OSError as e:
+        raise InputError(f"{path}: cannot write ({e.strerror})") from None
+    return path
+
+
 def fmt(x, digits=4):
     """Number for the printed summary; None prints as 'n/a'."""
     if x is None:

@@ -7,7 +7,9 @@ comma separated (spaces around fields are allowed; lines starting with '#' are c
     t_s, rate_true_dps, rate_dps, quad_dps, drive_amp, drive_phase_deg, p_deg,
     t_ambient_c, t_struct_c, t_board_c, u1_v, u2_v, adc_drive_v, adc_sense_v, flags
 
-More columns may follow. A `gyroctl` log of real hardware has no truth columns
+More columns may follow. A column may be asked for by its gyro-sim name or its
+telemetry name (drive_amp / drive_amp_v, fields.ALIASES): the one the file has is read
+and returned under the name asked for. A `gyroctl` log of real hardware has no truth columns
 (rate_true_dps, t_ambient_c, t_struct_c). Every tool asks only for the columns it uses,
 and a missing one is reported by name, so a gyroctl log works wherever the truth is not
 needed.
@@ -28,6 +30,7 @@ import warnings
 import numpy as np
 
 from .errors import InputError
+from .fields import ALIASES
 
 TIME_COLUMN = "t_s"
 TRUTH_COLUMNS = ("rate_true_dps", "t_ambient_c", "t_struct_c")
@@ -131,11 +134,14 @@ def read_log(path, need=(), want=(), time_column=TIME_COLUMN, min_rows=2, purpos
             raise InputError(f"{path}:{header_line}: header has empty or repeated names")
         if all(re.fullmatch(r"[-+0-9.eE]+|nan|inf", h) for h in header):
             raise InputError(f"{path}:{header_line}: first row is numbers, not a header")
+        def present(n):
+            return n if n in header else (ALIASES.get(n) if ALIASES.get(n) in header else None)
+
         for name in need:
-            if name not in header:
+            if present(name) is None:
                 raise InputError(_missing_message(path, name, purpose, header))
-        names = need + [w for w in want if w in header and w not in need]
-        cols = [header.index(n) for n in names]
+        names = need + [w for w in want if present(w) is not None and w not in need]
+        cols = [header.index(present(n)) for n in names]
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", UserWarning)  # "no data": checked below

@@ -261,11 +261,13 @@ def plot(res, out_dir, name="freqresp.png", title=""):
     a1.plot(ff, 20 * np.log10(np.abs(hm)), "-", lw=1,
             label=f"fit: f0 {res.f0_hz:.6g} Hz, Q {res.q:.4g}, "
                   f"peak {20 * math.log10(res.peak_gain):.4g} dB")
-    for fx in (res.f_3db_lo_hz, res.f_3db_hi_hz):
-        if math.isfinite(fx):
-            a1.axvline(fx, ls=":", color="C2", lw=0.8)
+    edges = [fx for fx in (res.f_3db_lo_hz, res.f_3db_hi_hz) if math.isfinite(fx)]
+    for k, fx in enumerate(edges):
+        a1.axvline(fx, ls=":", color="C2", lw=0.8,
+                   label="-3 dB frequencies " + ", ".join(f"{e:.6g}" for e in edges) + " Hz"
+                   if k == 0 else None)
     a1.axhline(20 * math.log10(res.peak_gain) - 10 * math.log10(2), ls=":", color="C2",
-               lw=0.8, label="-3 dB")
+               lw=0.8, label="-3 dB level")
     plotting.finish(a1, title=title or "Frequency response", ylabel="amplitude (dB)")
     meas = np.degrees(np.unwrap(np.deg2rad(res.phase_deg)))
     fit_ph = np.degrees(np.unwrap(np.angle(hm)))
@@ -275,6 +277,6 @@ def plot(res, out_dir, name="freqresp.png", title=""):
     a2.plot(f, meas, ".", ms=3, label="sweep")
     a2.plot(ff, fit_ph, "-", lw=1,
             label=f"fit: {res.phase_at_f0_deg:.4g} deg at f0")
-    a2.axvline(res.f0_hz, ls=":", color="k", lw=0.8)
+    a2.axvline(res.f0_hz, ls=":", color="k", lw=0.8, label=f"f0 {res.f0_hz:.6g} Hz")
     plotting.finish(a2, xlabel="frequency (Hz)", ylabel="phase (deg)")
     return plotting.save(fig, out_dir, name)

@@ -227,10 +227,11 @@ def plot(res, out_dir, name="scalefactor.png", title="", out_unit="deg/s"):
     order = np.argsort(x, kind="stable")
     ax2.plot(x[order], res.residual_in_dps[order], "o-", ms=4, lw=0.8)
     ax2.axhline(0, color="k", lw=0.6)
+    ax2.lines[-2].set_label("residual per segment")
     for s in (-1, 1):
-        ax2.axhline(s * res.rms_residual_dps, ls="--", color="C1", lw=0.8)
+        ax2.axhline(s * res.rms_residual_dps, ls="--", color="C1", lw=0.8,
+                    label="+-RMS residual" if s > 0 else None)
     plotting.finish(ax2, title=f"nonlinearity {100 * res.nonlinearity:.3g} % of FS "
                     f"{res.full_scale_dps:g} deg/s (RMS {res.rms_residual_dps:.3g} deg/s)",
-                    xlabel="table rate (deg/s)", ylabel="residual (deg/s, input)",
-                    legend=False)
+                    xlabel="table rate (deg/s)", ylabel="residual (deg/s, input)")
     return plotting.save(fig, out_dir, name)

@@ -252,7 +252,7 @@ def sf_summary(sf):
     }
 
 
-def _scatter_fit(ax, x, y, fit, xlabel):
+def _scatter_fit(ax, x, y, fit, xlabel, name=""):
     from . import plotting
 
     xx = np.linspace(x.min(), x.max(), 200)
@@ -263,23 +263,23 @@ def _scatter_fit(ax, x, y, fit, xlabel):
                      for i, c in enumerate(fit.coeffs))
     ax.plot(xx, poly_eval(fit.coeffs, xx), "-", color="k", lw=1,
             label=f"order {fit.order}: {terms}")
-    plotting.finish(ax, title=f"bias against {fit.variable}: residual std "
-                    f"{fit.residual_std:.3g} deg/s, p-p {fit.residual_p2p:.3g} deg/s",
+    plotting.finish(ax, title=(f"{name} bias against {fit.variable}: residual std "
+                               f"{fit.residual_std:.3g} deg/s, p-p {fit.residual_p2p:.3g} deg/s").lstrip(),
                     xlabel=xlabel, ylabel="bias (deg/s)")
 
 
-def plots(binned, y_col, p_fit, t_fit, out_dir, sf=None, sf_segments=None):
+def plots(binned, y_col, p_fit, t_fit, out_dir, sf=None, sf_segments=None, name=""):
     """Bias vs P, bias vs T, residual vs time (fig. 7-13..7-17); SF vs P if fitted."""
     from . import plotting
 
     paths = []
     fig, ax = plotting.figure()
-    _scatter_fit(ax, binned[p_fit.variable], binned[y_col], p_fit, "drive phase P (deg)")
+    _scatter_fit(ax, binned[p_fit.variable], binned[y_col], p_fit, "drive phase P (deg)", name)
     paths.append(plotting.save(fig, out_dir, "tempcomp_bias_vs_p.png"))
     if t_fit is not None:
         fig, ax = plotting.figure()
         _scatter_fit(ax, binned[t_fit.variable], binned[y_col], t_fit,
-                     f"{t_fit.variable} (degC)")
+                     f"{t_fit.variable} (degC)", name)
         paths.append(plotting.save(fig, out_dir, "tempcomp_bias_vs_t.png"))
     fig, (a1, a2) = plotting.figure(2, 1, height_in=3.2, sharex=True)
     t = binned["t_s"]
@@ -287,7 +287,8 @@ def plots(binned, y_col, p_fit, t_fit, out_dir, sf=None, sf_segments=None):
     a1b = a1.twinx()
     a1b.plot(t, binned[p_fit.variable], "-", lw=0.8, color="C1")
     a1b.set_ylabel("P (deg)", color="C1")
-    plotting.finish(a1, title="bias and drive phase during the log",
+    a1.plot([], [], "-", lw=0.8, color="C1", label="drive phase P (right axis)")
+    plotting.finish(a1, title=f"bias and drive phase during the log {name}".rstrip(),
                     ylabel="bias (deg/s)")
     a2.plot(t[p_fit.kept], p_fit.residual, "-", lw=0.8,
             label=f"compensated with P: std {p_fit.residual_std:.3g} deg/s")

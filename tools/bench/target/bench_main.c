@@ -336,6 +336,7 @@ static void post_job(uint32_t kind)
   j.p_rad = 0.4f;
   j.amp_max_v = 4.0f;
   j.amp_target_v = 4.0f;
+  memset(&x->res, 0, sizeof x->res); /* as selfcal_exec_post does */
   x->job = j;
   atomic_store(&x->job_seq, atomic_load(&x->job_seq) + 1u);
 }

@@ -15,6 +15,8 @@ import io
 import subprocess
 import sys
 
+import time
+
 import pytest
 
 from gyroctl_lib import cli
@@ -115,7 +117,8 @@ def test_tuning_session(host, gyroctl, fw_pty_host, tmp_path, capsys, monkeypatc
         assert link.command(f"get {c0}").final == f"ok {c0} 12.5 deg/s"
     assert g("diff")[1] == diff_before
 
-    # a stream logged to CSV: columns as the analysis tools name them, nothing lost
+    # a stream logged to CSV: columns named as asked (the analysis tools read these
+    # names and gyro-sim's alike), nothing lost
     out = tmp_path / "log.csv"
     rc, _, err = g("log", "rate_dps", "quad_dps", "drive_amp_v", "p_deg", "flags", "--rate", "1000",
                    "--duration", "0.5", "--out", str(out), "--strict")
@@ -123,7 +126,7 @@ def test_tuning_session(host, gyroctl, fw_pty_host, tmp_path, capsys, monkeypatc
     assert "missing records 0, frames missing 0, corrupt frames 0, lost at source 0" in err
     rows = [row for row in csv.reader(line for line in out.read_text().splitlines()
                                       if line and not line.startswith("#"))]
-    assert rows[0] == ["t_s", "rate_dps", "quad_dps", "drive_amp", "p_deg", "flags"]
+    assert rows[0] == ["t_s", "rate_dps", "quad_dps", "drive_amp_v", "p_deg", "flags"]
     data = rows[1:]
     assert len(data) == 500
     assert [float(x[0]) for x in data] == pytest.approx([k / 1000.0 for k in range(500)], abs=1e-12)
@@ -143,7 +146,15 @@ def test_tuning_session(host, gyroctl, fw_pty_host, tmp_path, capsys, monkeypatc
     assert "- mode " in out and "err UNKNOWN" in out
     assert rc == 1  # one command answered err
 
-    # save needs the drive off (sys.autostart started it)
+    # save needs the drive off (sys.autostart started it). The trivial plant never
+    # answers, so the drive would time out of ACQUIRE and rest in FAULT (drive off) for
+    # sup.retry_s, then try again: a mode of Q = 10^5 makes the acquisition time (from
+    # the mode's time constant, minutes) outlast the test, so the drive keeps running.
+    assert g("set", "drive.cal_q", "100000")[0] == 0
+    for _ in range(50):  # at most a retry (sup.retry_s, 0.3 s) to be driving again
+        if "- mode ACQUIRE" in g("status")[1]:
+            break
+        time.sleep(0.05)
     rc, _, err = g("save")
     assert rc == 1 and err.startswith("err BUSY")
     assert g("drive", "off")[1] == "drive off\n"

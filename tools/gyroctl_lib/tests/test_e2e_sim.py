@@ -7,6 +7,8 @@ import csv
 import math
 import os
 import subprocess
+import sys
+import threading
 import time
 
 import pytest
@@ -71,15 +73,45 @@ def test_setpoint_moves_the_loop(sim, gyroctl, tmp_path):
     assert s["fault_count"] == "0"
     # The telemetry shows the drive at the new amplitude.
     out = tmp_path / "log.csv"
-    r = ctl(gyroctl, sim, "log", "drive_amp_v", "rate_dps", "--rate", "200", "--duration", "1",
+    r = ctl(gyroctl, sim, "log", "drive_amp_v", "rate_dps", "--rate", "200", "--duration", "1.5",
             "--out", str(out))
     assert r.returncode == 0, r.stderr
     rows = [row for row in csv.reader(l for l in open(out) if not l.startswith("#"))]
-    # Fields come in the firmware's table order (rate before drive amplitude).
-    assert rows[0] == ["t_s", "rate_dps", "drive_amp"]
+    # Fields come in the firmware's table order (rate before drive amplitude), under
+    # the names asked for.
+    assert rows[0] == ["t_s", "rate_dps", "drive_amp_v"]
     amps = [float(r_[2]) for r_ in rows[1:]]
-    assert len(amps) == 200
+    assert len(amps) == 300
     assert abs(sum(amps) / len(amps) / 0.25 - 1.0) < 0.01
+    # The analysis tools take the telemetry name and gyro-sim's name for it alike.
+    psd = [sys.executable, os.path.join(os.path.dirname(gyroctl[1]), "gyro-psd")]
+    for name in ("drive_amp_v", "drive_amp"):
+        r = subprocess.run(psd + [str(out), "--column", name, "--band", "1", "50",
+                                  "--out", str(tmp_path / name)], capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+
+
+def test_fields_lists_the_telemetry(sim, gyroctl):
+    r = ctl(gyroctl, sim, "fields")
+    assert r.returncode == 0, r.stderr
+    rows = {ln.split()[0]: ln.split()[1:] for ln in r.stdout.splitlines()}
+    assert rows["rate_dps"] == ["f32", "deg/s"] and rows["flags"] == ["u32", "-"]
+    assert "drive_amp_v" in rows
+
+
+def test_log_reports_the_gyro_going_away(gyro_sim, tmp_path, gyroctl):
+    """A simulator that ends during a log: a sentence and exit 3, no traceback."""
+    scen = os.path.join(os.environ.get("GYRO_SCENARIOS", ""), "startup.json")
+    link = str(tmp_path / "gyro.pty")
+    proc = subprocess.Popen([gyro_sim, "--scenario", scen, "--duration", "60", "--quiet",
+                             f"--uart-pty={link}"], stdout=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().startswith("pty ")
+    threading.Timer(1.5, proc.terminate).start()
+    r = ctl(gyroctl, link, "log", "rate_dps", "--rate", "100", "--duration", "30",
+            "--out", str(tmp_path / "gone.csv"))
+    proc.wait(timeout=10)
+    assert r.returncode == 3, (r.returncode, r.stderr)
+    assert "went away" in r.stderr and "Traceback" not in r.stderr
 
 
 def test_gain_changes_the_loop(sim, gyroctl):

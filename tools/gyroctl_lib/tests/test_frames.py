@@ -72,6 +72,27 @@ def test_header_built_by_hand():
     assert len(got) == 1 and d.stats.bad_format == 1
 
 
+def test_header_32_fields():
+    """The widest header (32 fields with 31-byte names: a raw frame of FRAME_MAX bytes)
+    and a record whose fields past the 16th decode in place; 33 fields are refused."""
+    def header(names):
+        fixed = struct.pack("<BIIIHIIB", 1, 7, 50000, 50, 1, 0, 0, len(names))
+        return fixed + b"".join(bytes([i & 1, len(n)]) + n for i, n in enumerate(names))
+    names = [(b"%c%d" % (97 + i // 10, i % 10)).ljust(frames.NAME_MAX, b"x") for i in range(frames.FIELDS_MAX)]
+    raw = frames.seal(frames.TYPE_HEADER, 0, header(names))
+    assert len(raw) == frames.FRAME_MAX
+    heads, data = [], []
+    d = frames.Decoder(on_header=heads.append, on_data=data.append)
+    d.feed(frames.to_wire(raw))
+    assert len(heads) == 1 and len(heads[0].fields) == 32
+    assert heads[0].fields[31] == ("d1" + "x" * 29, frames.T_U32)
+    words = [0xA5000000 | i for i in range(32)]
+    d.feed(frames.to_wire(frames.seal(frames.TYPE_DATA, 1, struct.pack("<HIB", 7, 0, 1) + struct.pack("<32I", *words))))
+    assert len(data) == 1 and list(data[0].words[0]) == words
+    d.feed(frames.to_wire(frames.seal(frames.TYPE_HEADER, 2, header([b"a%d" % i for i in range(33)]))))
+    assert len(heads) == 1 and d.stats.bad_format == 1
+
+
 # ---- against the firmware's encoder ----
 
 @pytest.fixture(scope="module")

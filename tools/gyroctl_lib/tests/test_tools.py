@@ -72,7 +72,7 @@ def test_logger_with_scripted_port(tmp_path):
     link = Link("fake", serial_obj=port)
     out = tmp_path / "x.csv"
     res = logger.log(link, ["rate_dps", "flags"], 1000, 0.1, out, timeout_s=5)
-    assert port.sent == ["stream rate_dps flags @1000", "stop"]
+    assert port.sent == ["emu", "stream rate_dps flags @1000", "stop"]  # emu: no stretch here
     rows = [l for l in out.read_text().splitlines() if l and not l.startswith("#")]
     assert rows[0] == "t_s,rate_dps,flags"
     body = [r.split(",") for r in rows[1:]]

@@ -65,6 +65,7 @@ static void snap(gyro_out_t *o, uint32_t k)
   o->mode = k % 5u;
   o->fault = k * 3u;
   o->flags = k & 0xFu;
+  o->rate_valid = (k >> 4) & 1u;
 }
 
 static tlm_t tx;

@@ -1,0 +1,67 @@
+"""Names and units of the logged quantities, shared by the tools' axes and the field
+dictionary docs/fields.md (tools/gen-fields-doc).
+
+Two producers name the same quantities (tools/gyrotools/csvlog.py): gyro-sim's CSV and
+`gyroctl log`, whose columns are the firmware's telemetry field names
+(firmware/comm/tlm_fields.h). They differ in one name only, the drive amplitude
+(gyro-sim `drive_amp`, telemetry `drive_amp_v`); ALIASES lets every tool accept both.
+Units follow the name's suffix, which the firmware's table keeps by rule
+(_dps, _v, _deg, _v2); the simulator's truth columns add _c, _m, _s.
+"""
+
+from __future__ import annotations
+
+ALIASES = {"drive_amp": "drive_amp_v", "drive_amp_v": "drive_amp"}
+
+# Units that the suffix rule cannot give.
+UNIT_BY_NAME = {"drive_amp": "V", "flags": "-", "mode": "-", "fault": "-", "tick": "-",
+                "rate_valid": "-", "rate_invalid": "-"}
+SUFFIX_UNITS = (("_dps", "deg/s"), ("_v2", "V^2"), ("_deg", "deg"), ("_v", "V"),
+                ("_c", "degC"), ("_m", "m"), ("_s", "s"), ("_hz", "Hz"))
+
+# Meaning of gyro-sim's CSV columns (host_sim/gyro_sim/sim_out.c writes the header);
+# the columns that are firmware outputs carry the firmware's meaning.
+CSV_MEANING = {
+    "t_s": "simulated time since power-on",
+    "rate_true_dps": "input rate applied to the plant (truth)",
+    "rate_dps": "rate output, compensated and filtered (firmware)",
+    "quad_dps": "quadrature, as an equivalent rate (firmware)",
+    "drive_amp": "demodulated drive pickoff amplitude (firmware; telemetry drive_amp_v)",
+    "drive_phase_deg": "phase of the drive pickoff phasor (firmware)",
+    "p_deg": "force phase P, the temperature signal (firmware)",
+    "t_ambient_c": "ambient temperature (truth)",
+    "t_struct_c": "sensor structure temperature (truth)",
+    "t_board_c": "board temperature sensor (truth)",
+    "u1_v": "drive electrode 1 voltage written this tick (firmware)",
+    "u2_v": "drive electrode 2 voltage written this tick (firmware)",
+    "adc_drive_v": "drive pickoff at the ADC input (truth)",
+    "adc_sense_v": "sense pickoff at the ADC input (truth)",
+    "flags": "GYRO_FLAG_* bits of the tick (firmware), below",
+    "mode": "supervisor mode code (firmware), below",
+    "t_circuit_c": "pickoff circuit temperature (truth)",
+    "rate_unc_dps": "rate before temperature compensation (firmware)",
+    "p_f_deg": "P low-passed, what the compensation uses (firmware)",
+    "drive_amp_true_m": "true drive displacement amplitude (truth)",
+    "f_cmd_v2": "drive force command (firmware)",
+    "rate_valid": "1 when the rate output can be trusted, 0 when not (firmware, output integrity)",
+    "rate_out_v": "voltage commanded on the analog rate output in the same tick: the rate "
+                  "times rate.out_v_per_dps when valid, rate.fault_out_v when not (firmware)",
+}
+
+
+def unit_of(name: str) -> str:
+    """Unit of a column or field name ('' when unknown)."""
+    if name in UNIT_BY_NAME:
+        return UNIT_BY_NAME[name]
+    for suffix, unit in SUFFIX_UNITS:
+        if name.endswith(suffix):
+            return unit
+    return ""
+
+
+def axis_label(name: str, scale: float = 1.0) -> str:
+    """'name [unit]' for an axis; dimensionless counts and codes get no unit."""
+    unit = unit_of(name)
+    if unit == "m" and scale == 1e6:
+        unit = "um"
+    return f"{name} [{unit}]" if unit and unit != "-" else name
