@@ -91,7 +91,8 @@ typedef struct {
   uint32_t out_phase_ticks; /* consecutive ticks beyond the lost phase tolerance */
   uint32_t sat_ticks;
   uint32_t fault_ticks;    /* ticks spent in FAULT */
-  uint32_t mode_ticks;     /* ticks spent in the current mode */
+  uint32_t mode_ticks;     /* ticks spent in the current mode (ACQUIRE: since the end of
+                            * a setpoint move, the acquisition timeout's clock) */
   float err_lpf_k;         /* first-order low-pass (~100 Hz) of the lock errors */
   float amp_err_f, phase_err_f;
   uint32_t primed;         /* the low-pass starts from the first error seen in a mode */
