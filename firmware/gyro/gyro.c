@@ -34,8 +34,9 @@ static double acq_timeout_s(const param_values_t *v, double tau_s, const gyro_de
  * compensation. */
 static double bias_slope_max(const param_values_t *v)
 {
-  const double c1 = v->rate_bias_c1_dps_per_deg, c2 = v->rate_bias_c2_dps_per_deg2;
-  const double c3 = v->rate_bias_c3_dps_per_deg3;
+  const double c1 = (double)v->rate_bias_c1_dps_per_deg;
+  const double c2 = (double)v->rate_bias_c2_dps_per_deg2;
+  const double c3 = (double)v->rate_bias_c3_dps_per_deg3;
   double m = 0.0;
   for (int i = -4; i <= 4; i++) {
     const double p = (double)v->drive_p_init_deg + 0.25 * i * (double)v->rate_p_range_deg;

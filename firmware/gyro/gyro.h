@@ -160,8 +160,9 @@ typedef struct {
  *         quadrature filter; the filters' settling        rate filter (6)
  *   8     P's hold and low-pass (its mean every 10th      P (1)
  *         block), the thermometer checks of the P_f       P_f (8, last block)
- *         made the block before; the self-test sequence   projection (5)
- *         while it runs
+ *         made the block before, the slew of a window     P_f (8, last blocks)
+ *         that ended the block before that; the self-
+ *         test sequence while it runs                     projection (5)
  *   9     rate-valid verdict, rate half of the output     checks (2, 6, 7), rails (5),
  *         snapshot, analog rate code (the fault level     everything
  *         when not valid)

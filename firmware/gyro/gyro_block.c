@@ -98,6 +98,10 @@ void gyro_block_project(gyro_t *g)
 void gyro_block_measure(gyro_t *g, int drive_on)
 {
   if (drive_on) drive_loop_measure_phase(&g->drive, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
+  /* The last verdict's onsets into the history, on this lighter tick. */
+  if (GYRO_UNLIKELY(g->valid.onsets_pending != 0u)) {
+    rate_valid_count_onsets(&g->valid, &g->valid_history);
+  }
   /* The drive half of the snapshot (gyro_block_output the rest): on this lighter tick. */
   gyro_out_t *o = &g->out;
   o->drive_amp_v = g->drive.amp_v;
@@ -135,6 +139,8 @@ void gyro_block_p(gyro_t *g, int hold)
      * block in RATE_P_BLOCKS, the checks on the next, so that no tick carries both. */
     g->thermo_due = 0u;
     rate_valid_thermo(&g->valid, rc->p_dev_deg, rc->p_held_dev_deg, rc->p_held_w, rc->quad_dps);
+  } else if (g->valid.slew_due != 0u) {
+    rate_valid_slew(&g->valid, rc->quad_dps);
   }
   rate_channel_hold_p(rc, hold);
   if (rate_channel_update_p(rc, g->drive.p_rad) != 0) g->thermo_due = 1u;
@@ -158,7 +164,7 @@ void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
                               (selftest_running(&g->selftest) ? RATE_INVALID_SELFTEST : 0u) |
                               (g->clip_block != 0u ? RATE_INVALID_CLIP : 0u) |
                               (g->cont_fail != 0u ? RATE_INVALID_CONT_SELFTEST : 0u);
-  const uint32_t invalid = rate_valid_verdict(&g->valid, &g->valid_history, block_bits);
+  const uint32_t invalid = rate_valid_verdict(&g->valid, block_bits);
   /* Never a valid-looking wrong rate: the analog output goes to the fault level in the
    * same sample as the verdict, without a slew. */
   float out_v = g->rate_fault_out_v;
@@ -194,7 +200,7 @@ void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v)
    * (not valid: MODE) and what does change. */
   gyro_out_t *o = &g->out;
   const uint32_t block_bits = RATE_INVALID_MODE | (g->clip_block != 0u ? RATE_INVALID_CLIP : 0u);
-  o->rate_invalid = rate_valid_verdict(&g->valid, &g->valid_history, block_bits);
+  o->rate_invalid = rate_valid_verdict(&g->valid, block_bits);
   o->rate_valid = 0u;
   o->rate_out_v = g->rate_fault_out_v;
   g->rate_code = g->rate_fault_code;
@@ -202,7 +208,8 @@ void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v)
   o->u2_v = u2_v;
   o->mode = (uint32_t)g->sup.mode;
   o->fault = g->sup.fault;
-  o->flags = g->flags_acc | (o->rate_invalid & RATE_INVALID_SENSE_RANGE ? GYRO_FLAG_SENSE_RANGE : 0u);
+  o->flags = g->flags_acc |
+             ((o->rate_invalid & RATE_INVALID_SENSE_RANGE) != 0u ? GYRO_FLAG_SENSE_RANGE : 0u);
   g->flags_acc = 0u;
 }
 

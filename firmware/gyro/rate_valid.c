@@ -26,9 +26,11 @@ int rate_valid_init(rate_valid_t *rv, const rate_valid_cfg_t *cfg)
   rv->x_rate = rv->x_quad = 0.0f;
   rv->p_dev_window_deg = 0.0f;
   rv->p_updates = 0u;
-  rv->slew = 0u;
+  rv->slew = rv->slew_due = 0u;
+  rv->p_window_change_deg = 0.0f;
   rv->phase_err_lp_rad = 0.0f;
   rv->blocks = 0u;
+  rv->onsets_pending = rv->onset_block = 0u;
   rate_valid_disturb(rv);
   return 0;
 }
@@ -69,11 +71,9 @@ void rate_valid_thermo(rate_valid_t *rv, float p_dev_deg, float p_held_dev_deg, 
     rv->p_dev_window_deg = p_dev_deg;
     rv->p_updates = 0u;
   } else if (++rv->p_updates >= RATE_VALID_SLEW_UPDATES) {
-    const float change = fm_absf(p_dev_deg - rv->p_dev_window_deg);
-    const int slewing = !(change <= c->p_window_max_deg) ||
-                        !(lag_error_dps(c, change * c->p_lag_per_deg, quad_dps) <= c->tol_dps);
-    rv->slew = slewing ? RATE_INVALID_THERMO_SLEW : 0u;
-    r = (r & ~RATE_INVALID_THERMO_SLEW) | rv->slew;
+    /* The window's change, judged by rate_valid_slew on a later tick. */
+    rv->p_window_change_deg = fm_absf(p_dev_deg - rv->p_dev_window_deg);
+    rv->slew_due = 1u;
     rv->p_dev_window_deg = p_dev_deg;
     rv->p_updates = 0u;
   }
@@ -83,13 +83,27 @@ void rate_valid_thermo(rate_valid_t *rv, float p_dev_deg, float p_held_dev_deg, 
   rv->thermo = r;
 }
 
-void rate_valid_count_onsets(rate_valid_t *rv, rate_valid_history_t *h, uint32_t onsets)
+void rate_valid_slew(rate_valid_t *rv, float quad_dps)
 {
-  for (uint32_t i = 0; i < RATE_INVALID_KINDS; i++) {
-    if ((onsets & (1u << i)) != 0u) {
-      h->count[i]++;
-      h->last_block[i] = rv->blocks;
-    }
+  const rate_valid_cfg_t *c = &rv->cfg;
+  const float change = rv->p_window_change_deg;
+  const int slewing = !(change <= c->p_window_max_deg) ||
+                      !(lag_error_dps(c, change * c->p_lag_per_deg, quad_dps) <= c->tol_dps);
+  rv->slew = slewing ? RATE_INVALID_THERMO_SLEW : 0u;
+  rv->thermo = (rv->thermo & ~RATE_INVALID_THERMO_SLEW) | rv->slew;
+  rv->slew_due = 0u;
+}
+
+void rate_valid_count_onsets(rate_valid_t *rv, rate_valid_history_t *h)
+{
+  /* Only the bits that are set (usually one). */
+  uint32_t onsets = rv->onsets_pending;
+  rv->onsets_pending = 0u;
+  while (onsets != 0u) {
+    const uint32_t i = (uint32_t)__builtin_ctz(onsets);
+    h->count[i]++;
+    h->last_block[i] = rv->onset_block;
+    onsets &= onsets - 1u;
   }
 }
 

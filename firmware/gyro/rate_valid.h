@@ -94,8 +94,12 @@ typedef struct {
   float p_dev_window_deg;   /* P_f - p_ref at the start of the slew window */
   uint32_t p_updates;       /* P_f updates into the slew window */
   uint32_t slew;            /* RATE_INVALID_THERMO_SLEW of the latest window */
+  uint32_t slew_due;        /* a window ended: rate_valid_slew judges it */
+  float p_window_change_deg; /* |change of P_f| over the window that ended */
   float phase_err_lp_rad;   /* the drive phase error through RATE_VALID_PHASE_K */
   uint32_t blocks;          /* verdicts since power-on */
+  uint32_t onsets_pending;  /* reasons that set in, not yet in the history */
+  uint32_t onset_block;     /* the verdict that saw the latest of them */
 } rate_valid_t;
 
 /* The history of the reasons for `status`: written only when a reason sets in, so it
@@ -127,6 +131,9 @@ void rate_valid_settling(rate_valid_t *rv, float rate_raw, float quad_raw, float
  * quad_dps the quadrature output. */
 void rate_valid_thermo(rate_valid_t *rv, float p_dev_deg, float p_held_dev_deg, float p_held_w,
                        float quad_dps);
+/* On a tick after rate_valid_thermo ended a slew window (slew_due): THERMO_SLEW from the
+ * window's change of P_f (apart, so that no tick carries both). */
+void rate_valid_slew(rate_valid_t *rv, float quad_dps);
 
 /* Once per block, after the quadrature filter: the drive phase error as the supervisor
  * low-passed it, the quadrature output and the squared sense pickoff amplitude ->
@@ -140,16 +147,17 @@ static inline void rate_valid_range(rate_valid_t *rv, float rate_dps)
                   ? 0u : RATE_INVALID_OVER_RANGE;
 }
 
-/* The onsets of reasons into the history (rare: only when the set of reasons grows). */
-void rate_valid_count_onsets(rate_valid_t *rv, rate_valid_history_t *h, uint32_t onsets);
+/* The onsets the verdict noted (onsets_pending) into the history, on a later, lighter
+ * tick than the verdict's (rare: only when the set of reasons grew). */
+void rate_valid_count_onsets(rate_valid_t *rv, rate_valid_history_t *h);
 
 /* Once per block, last: the verdict (0: valid, else RATE_INVALID_* bits) from the
  * block's own evidence, block_bits (MODE, SELFTEST, CLIP, found by the caller), and what
  * rate_valid_drive, rate_valid_thermo, rate_valid_range and rate_valid_settling found.
  * Entering LOCKED and a rail code are disturbances. Integer work only: it runs on the
- * snapshot's tick. */
-static inline uint32_t rate_valid_verdict(rate_valid_t *rv, rate_valid_history_t *h,
-                                          uint32_t block_bits)
+ * snapshot's tick. Onsets of reasons wait in onsets_pending for
+ * rate_valid_count_onsets. */
+static inline uint32_t rate_valid_verdict(rate_valid_t *rv, uint32_t block_bits)
 {
   rv->blocks++;
   const uint32_t locked = (block_bits & RATE_INVALID_MODE) == 0u;
@@ -166,7 +174,10 @@ static inline uint32_t rate_valid_verdict(rate_valid_t *rv, rate_valid_history_t
   const uint32_t r = block_bits | rv->thermo | rv->drive | rv->range |
                      (rv->settled != 0u ? 0u : RATE_INVALID_SETTLING);
   const uint32_t onsets = r & ~rv->reasons;
-  if (onsets != 0u) rate_valid_count_onsets(rv, h, onsets);
+  if (onsets != 0u) {
+    rv->onsets_pending |= onsets;
+    rv->onset_block = rv->blocks;
+  }
   rv->reasons = r;
   return r;
 }

@@ -40,7 +40,7 @@ static uint32_t settle(void)
     rate_valid_settling(&rv, 0.0f, 10.0f, 0.0f, 1500.0f, 150.0f);
     rate_valid_drive(&rv, 0.0f, 1500.0f, 1.0f);
     rate_valid_range(&rv, 0.0f);
-    r = rate_valid_verdict(&rv, &hist, 0u);
+    r = rate_valid_verdict(&rv, 0u);
   }
   return r;
 }
@@ -65,11 +65,11 @@ static void test_settling_measured(void **state)
   assert_int_equal(rate_valid_init(&rv, &c), 0);
   for (int i = 0; i < 100; i++) {
     rate_valid_settling(&rv, 0.0f, 10.0f, 0.0f, 700.0f, 150.0f); /* quad output lags */
-    assert_int_not_equal(rate_valid_verdict(&rv, &hist, 0u) & RATE_INVALID_SETTLING, 0u);
+    assert_int_not_equal(rate_valid_verdict(&rv, 0u) & RATE_INVALID_SETTLING, 0u);
   }
   assert_int_equal(settle(), 0u);
   /* A rail code is a disturbance: settling starts again. */
-  assert_int_not_equal(rate_valid_verdict(&rv, &hist, RATE_INVALID_CLIP) & RATE_INVALID_SETTLING, 0u);
+  assert_int_not_equal(rate_valid_verdict(&rv, RATE_INVALID_CLIP) & RATE_INVALID_SETTLING, 0u);
 }
 
 static void test_over_range_and_sense(void **state)
@@ -77,12 +77,12 @@ static void test_over_range_and_sense(void **state)
   (void)state;
   assert_int_equal(settle(), 0u);
   rate_valid_range(&rv, -300.5f);
-  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), RATE_INVALID_OVER_RANGE);
+  assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_OVER_RANGE);
   rate_valid_range(&rv, 299.0f);
   rate_valid_drive(&rv, 0.0f, 1500.0f, 16.5f);
-  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), RATE_INVALID_SENSE_RANGE);
+  assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_SENSE_RANGE);
   rate_valid_range(&rv, NAN);
-  assert_int_not_equal(rate_valid_verdict(&rv, &hist, 0u) & RATE_INVALID_OVER_RANGE, 0u);
+  assert_int_not_equal(rate_valid_verdict(&rv, 0u) & RATE_INVALID_OVER_RANGE, 0u);
 }
 
 /* A lasting phase error of e rad rotates Q sin(e) of quadrature into the rate: 0.01 deg
@@ -92,15 +92,15 @@ static void test_phase_leak(void **state)
   (void)state;
   assert_int_equal(settle(), 0u);
   for (int i = 0; i < 20000; i++) rate_valid_drive(&rv, 0.008f * 0.0174533f, 1500.0f, 1.0f);
-  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), 0u);
+  assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   for (int i = 0; i < 20000; i++) rate_valid_drive(&rv, 0.0105f * 0.0174533f, 1500.0f, 1.0f);
-  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), RATE_INVALID_PHASE);
+  assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_PHASE);
   /* Without quadrature the same error leaks nothing. */
   for (int i = 0; i < 10; i++) rate_valid_drive(&rv, 0.0105f * 0.0174533f, 0.0f, 1.0f);
-  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), 0u);
+  assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   /* Beyond the lock tolerance, at once. */
   rate_valid_drive(&rv, 0.02f, 0.0f, 1.0f);
-  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), RATE_INVALID_PHASE);
+  assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_PHASE);
 }
 
 /* After a hold, P_f may still be w / (1 - w) |P_held - P_f| from P: with 1500 deg/s of
@@ -110,11 +110,11 @@ static void test_thermo_settle_bound(void **state)
   (void)state;
   assert_int_equal(settle(), 0u);
   rate_valid_thermo(&rv, 1.0f, 0.0f, 0.02f, 1500.0f);
-  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), RATE_INVALID_THERMO_SETTLE);
+  assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SETTLE);
   rate_valid_thermo(&rv, 1.0f, 0.0f, 0.005f, 1500.0f);
-  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), 0u);
+  assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   rate_valid_thermo(&rv, 9.0f, 9.0f, 0.0f, 1500.0f); /* out of the calibrated range */
-  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), RATE_INVALID_THERMO_RANGE);
+  assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_RANGE);
 }
 
 /* A slew of P_f is judged over RATE_VALID_SLEW_UPDATES updates, against the cap and the
@@ -127,15 +127,17 @@ static void test_thermo_slew(void **state)
   for (uint32_t i = 0; i < 3u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.004f / (float)RATE_VALID_SLEW_UPDATES; /* 0.04 deg/s, under the cap */
     rate_valid_thermo(&rv, p, 0.0f, 0.0f, 0.0f);
+    if (rv.slew_due) rate_valid_slew(&rv, 0.0f);
   }
-  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), 0u);
+  assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.004f / (float)RATE_VALID_SLEW_UPDATES;
     /* 0.004 deg per 0.1 s leaves P_f 0.0064 deg behind: 0.33 deg/s of 3000 deg/s of
      * quadrature rotated into the rate, beyond the tolerance though under the cap. */
     rate_valid_thermo(&rv, p, 0.0f, 0.0f, 3000.0f);
+    if (rv.slew_due) rate_valid_slew(&rv, 3000.0f);
   }
-  assert_int_equal(rate_valid_verdict(&rv, &hist, 0u), RATE_INVALID_THERMO_SLEW);
+  assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
 }
 
 static void test_onsets_counted(void **state)
@@ -144,10 +146,12 @@ static void test_onsets_counted(void **state)
   assert_int_equal(settle(), 0u);
   for (int i = 0; i < 3; i++) {
     rate_valid_range(&rv, 400.0f);
-    (void)rate_valid_verdict(&rv, &hist, 0u);
-    (void)rate_valid_verdict(&rv, &hist, 0u);
+    (void)rate_valid_verdict(&rv, 0u);
+    rate_valid_count_onsets(&rv, &hist);
+    (void)rate_valid_verdict(&rv, 0u);
     rate_valid_range(&rv, 0.0f);
-    (void)rate_valid_verdict(&rv, &hist, 0u);
+    (void)rate_valid_verdict(&rv, 0u);
+    rate_valid_count_onsets(&rv, &hist);
   }
   assert_int_equal(hist.count[5], 3u); /* OVER_RANGE: three onsets, not six blocks */
   assert_true(hist.last_block[5] > 80u);
