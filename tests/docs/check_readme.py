@@ -36,6 +36,7 @@ import argparse
 import dataclasses
 import os
 import re
+import signal
 import subprocess
 import sys
 import tempfile
@@ -152,6 +153,26 @@ def script_of(b: Block) -> str:
     return text
 
 
+def stop_group(p: subprocess.Popen) -> None:
+    """SIGTERM to the block's process group, SIGKILL to what is left after 2 s."""
+    for sig, grace in ((signal.SIGTERM, 2.0), (signal.SIGKILL, 0.0)):
+        try:
+            os.killpg(p.pid, sig)
+        except ProcessLookupError:
+            return
+        deadline = time.monotonic() + grace
+        while time.monotonic() < deadline:
+            try:
+                os.killpg(p.pid, 0)
+            except ProcessLookupError:
+                return
+            time.sleep(0.05)
+    try:
+        p.wait(timeout=5)
+    except subprocess.TimeoutExpired:
+        pass
+
+
 def run_block(b: Block, root: str, pty: str) -> bool:
     try:
         script = script_of(b)
@@ -163,12 +184,16 @@ def run_block(b: Block, root: str, pty: str) -> bool:
     wrapped = "trap 'kill $(jobs -p) 2>/dev/null || true; wait 2>/dev/null || true' EXIT\n" + script
     print(f"--- README.md:{b.line} ({b.kind})\n{script}", flush=True)
     t0 = time.monotonic()
+    # Its own process group: whatever the block leaves running (a job the trap did not
+    # see, a process of a subshell) is stopped with the group, and cannot hold the
+    # caller's output open after the block ended.
+    p = subprocess.Popen(["bash", "-euo", "pipefail", "-c", wrapped], cwd=root,
+                         stdin=subprocess.DEVNULL, start_new_session=True)
     try:
-        r = subprocess.run(["bash", "-euo", "pipefail", "-c", wrapped], cwd=root,
-                           stdin=subprocess.DEVNULL, timeout=BLOCK_TIMEOUT_S)
-        rc = r.returncode
+        rc = p.wait(timeout=BLOCK_TIMEOUT_S)
     except subprocess.TimeoutExpired:
         rc = "timeout"
+    stop_group(p)
     dt = time.monotonic() - t0
     print(f"--- README.md:{b.line}: exit {rc} after {dt:.1f} s", flush=True)
     return rc == 0
