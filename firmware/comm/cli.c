@@ -256,7 +256,9 @@ static void recall_last(cli_t *cli)
   memcpy(cli->line, cli->last, cli->last_len);
   drop_line(cli);
   cli->len = cli->last_len;
-  write_raw(cli, cli->line, cli->len);
+  if (cli->len > 0u) { /* Up before any line was run: nothing to bring back */
+    write_raw(cli, cli->line, cli->len);
+  }
 }
 
 /* An escape sequence in progress takes ch; false: ch ended it without being part of it

@@ -413,6 +413,8 @@ static void test_console_editing(void **state)
 {
   (void)state;
   cexpect("console on\n", "ok console on\r\ngyro> ");
+  /* Up before any line was run: nothing to bring back, nothing written */
+  cexpect("\x1b[A", "");
   /* Backspace (DEL) and Ctrl-H */
   cexpect("get tlm.rate_hx\x7fz\r", "get tlm.rate_hx\b \bz\r\nok tlm.rate_hz 100 Hz\r\ngyro> ");
   cexpect("get tlm.ratx\be_hz\r", "get tlm.ratx\b \be_hz\r\nok tlm.rate_hz 100 Hz\r\ngyro> ");
