@@ -150,7 +150,8 @@ const cli_cmd_t *cli_app_cmd(const cli_t *cli, uint32_t i);
 /* Feed received bytes; complete lines are executed and answered before it returns. */
 void cli_feed(cli_t *cli, const uint8_t *data, size_t len);
 /* Feed bytes up to and including the first EOL (executed and answered); returns the
- * number taken (len if there is no EOL). */
+ * number taken (len if there is no EOL). In console mode it takes one byte (its echo
+ * written) per call. */
 size_t cli_feed_line(cli_t *cli, const uint8_t *data, size_t len);
 /* Bytes were lost after the last byte fed: discard the line in progress (err OVERFLOW
  * at its EOL) and count the loss. */
