@@ -25,6 +25,11 @@ CLI = {
                b"set sys.fs_hz 1\nset demod.mu_sense nan\nload\n",
     "bytewise": b"\x01\tget   tlm.rate_hz \r\nset tlm.rate_hz 250\rset drive.dc_bias_v 13 drive.u_max_v 12\r\n",
     "garbage": b"\x31" + bytes(range(256)) + b"\nget sys.fs_hz\n" + b"x" * 130 + b"\nlist rate\n",
+    # console mode (byte 0 bit 2): editing keys, escape sequences, Up, switching back
+    "console": b"\x05get tlm.rate_hx\x7fz\r\n\x1b[A\r\x08\x08\x1b[1;5Dset tlm.rate_hz 250\x15"
+               b"list drive.\x03\x1bOA\r\x1b[3~\x1bx" + b"y" * 130 + b"\r \t \rconsole off\r\nversion\n",
+    "console-switch": b"\x01console on\r\nhelp\r\x1b[Cdiff\x1b[\rconsole\rconsole bad\r"
+                      b"get sys.fs_hz\x00\xff\r\nconsole off\rget sys.fs_hz\x7f\n",
 }
 for k, v in CLI.items():
     put("fuzz_cli", k, v)

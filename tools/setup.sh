@@ -15,6 +15,7 @@ APT_PKGS=(
   valgrind               # callgrind instruction counts (benchmarks)
   clang                  # libFuzzer harnesses
   qemu-system-arm        # boots the emulator bring-up image (ctest label qemu)
+  tmux picocom           # console mode at a real terminal (ctest e2e_console_picocom)
   python3 python3-pip python3-venv
 )
 PIP_PKGS=(numpy scipy matplotlib allantools pyserial pytest)

@@ -39,7 +39,8 @@ static bool loop_safe(void *ctx)
 static void cli_write(void *ctx, const char *data, size_t len)
 {
   (void)ctx;
-  /* A line is only executed with room for its whole reply (feed_lines): all fits. */
+  /* A line is only executed, and a console echo only written, with room for the
+   * longest reply (feed_lines): all fits, and nothing cuts a telemetry frame. */
   (void)hal_uart_write((const uint8_t *)data, len);
 }
 

@@ -198,6 +198,8 @@ static void execute(cli_t *cli)
   }
 }
 
+static void write_raw(cli_t *cli, const char *s, size_t n) { cli->cfg.write(cli->cfg.write_ctx, s, n); }
+
 static void end_of_line(cli_t *cli)
 {
   cli->replied = false;
@@ -216,6 +218,121 @@ static void end_of_line(cli_t *cli)
   }
   cli->len = 0u;
   cli->discard = (uint8_t)CLI_DISCARD_NONE;
+  if (cli->console) {
+    write_raw(cli, CLI_PROMPT, sizeof CLI_PROMPT - 1u); /* also after "console on" */
+  }
+}
+
+void cli_set_console(cli_t *cli, bool on)
+{
+  cli->console = on;
+  cli->esc = 0u;
+}
+
+/* ---- console mode (grammar in cli.h) ---- */
+
+enum { ESC_NONE = 0, ESC_START, ESC_CSI, ESC_SS3 };
+
+/* Erase n characters left of the cursor. */
+static void rub_out(cli_t *cli, uint32_t n)
+{
+  static const char k_rub[] = "\b \b\b \b\b \b\b \b\b \b\b \b\b \b\b \b"; /* 8 of them */
+  while (n > 0u) {
+    const uint32_t k = (n > 8u) ? 8u : n;
+    write_raw(cli, k_rub, 3u * (size_t)k);
+    n -= k;
+  }
+}
+
+static void drop_line(cli_t *cli)
+{
+  cli->len = 0u;
+  cli->discard = (uint8_t)CLI_DISCARD_NONE;
+}
+
+static void recall_last(cli_t *cli)
+{
+  rub_out(cli, cli->len);
+  memcpy(cli->line, cli->last, cli->last_len);
+  drop_line(cli);
+  cli->len = cli->last_len;
+  if (cli->len > 0u) { /* Up before any line was run: nothing to bring back */
+    write_raw(cli, cli->line, cli->len);
+  }
+}
+
+/* An escape sequence in progress takes ch; false: ch ended it without being part of it
+ * (a control byte), to be handled as usual. */
+static bool escape_byte(cli_t *cli, uint8_t ch)
+{
+  const uint8_t st = cli->esc;
+  cli->esc = (uint8_t)ESC_NONE;
+  if (ch < 0x20u || ch >= 0x7Fu) {
+    return false;
+  }
+  if (st == (uint8_t)ESC_START) {
+    if (ch == '[') {
+      cli->esc = (uint8_t)ESC_CSI;
+    } else if (ch == 'O') {
+      cli->esc = (uint8_t)ESC_SS3;
+    }
+    return true; /* else ESC x (Alt-x): both consumed */
+  }
+  if (st == (uint8_t)ESC_CSI && ch < 0x40u) {
+    cli->esc = (uint8_t)ESC_CSI; /* parameter or intermediate byte */
+    return true;
+  }
+  if (ch == 'A') {
+    recall_last(cli); /* Up: ESC [ A, ESC [ 1 ; 5 A, ESC O A */
+  }
+  return true;
+}
+
+static void console_byte(cli_t *cli, uint8_t ch)
+{
+  if (cli->esc != (uint8_t)ESC_NONE && escape_byte(cli, ch)) {
+    return;
+  }
+  if (ch == 0x1Bu) {
+    cli->esc = (uint8_t)ESC_START;
+  } else if (ch == 0x08u || ch == 0x7Fu) { /* Ctrl-H, Backspace/DEL */
+    if (cli->len > 0u) {
+      cli->len--;
+      rub_out(cli, 1u);
+    }
+  } else if (ch == 0x15u) { /* Ctrl-U */
+    rub_out(cli, cli->len);
+    drop_line(cli);
+  } else if (ch == 0x03u) { /* Ctrl-C */
+    drop_line(cli);
+    write_raw(cli, "^C\r\n" CLI_PROMPT, 4u + sizeof CLI_PROMPT - 1u);
+  } else if (ch == '\t' || (ch >= 0x20u && ch <= 0x7Eu)) {
+    if (cli->len >= CLI_LINE_MAX) {
+      write_raw(cli, "\a", 1u);
+    } else {
+      const char c = (ch == '\t') ? ' ' : (char)ch;
+      cli->line[cli->len++] = c;
+      write_raw(cli, &c, 1u);
+    }
+  }
+  /* any other byte: ignored */
+}
+
+static void console_eol(cli_t *cli)
+{
+  cli->esc = (uint8_t)ESC_NONE;
+  write_raw(cli, "\r\n", 2u);
+  if (cli->discard == (uint8_t)CLI_DISCARD_NONE && cli->len > 0u) {
+    bool blank = true;
+    for (uint32_t i = 0; i < cli->len; i++) {
+      blank = blank && is_wsp(cli->line[i]);
+    }
+    if (!blank) {
+      memcpy(cli->last, cli->line, cli->len);
+      cli->last_len = cli->len;
+    }
+  }
+  end_of_line(cli);
 }
 
 void cli_rx_lost(cli_t *cli)
@@ -238,8 +355,19 @@ size_t cli_feed_line(cli_t *cli, const uint8_t *data, size_t len)
   for (size_t i = 0; i < len; i++) {
     const uint8_t ch = data[i];
     if (ch == '\r' || ch == '\n') {
-      end_of_line(cli);
+      const bool lf_of_crlf = (ch == '\n' && cli->after_cr);
+      cli->after_cr = (ch == '\r');
+      if (!cli->console) {
+        end_of_line(cli);
+      } else if (!lf_of_crlf) {
+        console_eol(cli);
+      }
       return i + 1u;
+    }
+    cli->after_cr = false;
+    if (cli->console) {
+      console_byte(cli, ch);
+      return i + 1u; /* one byte at a time: the caller checks for room before each echo */
     }
     if (cli->discard != (uint8_t)CLI_DISCARD_NONE) {
       continue;

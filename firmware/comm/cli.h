@@ -16,6 +16,25 @@
  *     in progress, answered "err OVERFLOW ..." at the next EOL: a line missing bytes is
  *     never executed; the losses are counted (rx_overflows);
  *   - no echo, no prompt, no line editing; names are case-sensitive.
+ *   This is machine mode, the default, for programs (gyroctl, scripts).
+ *
+ * Console mode ("console on", for a person at a terminal: picocom, minicom, screen,
+ * PuTTY; "console off" goes back; not persisted, every start is in machine mode)
+ *   - a prompt CLI_PROMPT after every reply (and after "console on");
+ *   - printable bytes are echoed; a tab is taken and echoed as a space; at CLI_LINE_MAX
+ *     bytes further ones are refused with BEL (no TOOLONG);
+ *   - BS (Ctrl-H) and DEL erase the last byte ("\b \b"); Ctrl-U erases the line;
+ *     Ctrl-C drops the line ("^C", a new prompt);
+ *   - escape sequences (ESC [ ... final, ESC O x, ESC x: arrow and function keys) are
+ *     consumed without a reply; Up (ESC [ A, ESC O A) brings back the last line run;
+ *   - other control bytes and bytes >= 0x80 are ignored (no BADCHAR);
+ *   - CR, LF or CR LF ends the line: "\r\n" is echoed, then the reply as in machine
+ *     mode, then the prompt; a blank line gives a new prompt only;
+ *   - lost input still discards the line (err OVERFLOW);
+ *   - cli_feed_line takes one byte at a time, so the application checks for TX room
+ *     before each echo.
+ *   Echo, prompt and replies all go through the one output callback, never a byte
+ *   written in between by anyone else: telemetry frames stay whole.
  *
  * Reply grammar: every non-blank line gets exactly one reply,
  *   reply   = *data-line final
@@ -69,6 +88,7 @@
 #define CLI_MAX_ARGS 16u
 #define CLI_MAX_APP_CMDS 8u
 #define CLI_OUT_MAX 256u
+#define CLI_PROMPT "gyro> "
 
 typedef struct cli cli_t;
 
@@ -112,6 +132,11 @@ struct cli {
   uint32_t out_len;
   uint32_t truncated; /* reply lines cut at CLI_OUT_MAX (should stay 0) */
   uint32_t rx_overflows; /* input losses reported by cli_rx_lost */
+  bool console;      /* console mode (prompt, echo, editing); false: machine mode */
+  bool after_cr;     /* the last EOL byte was CR: an LF right after it belongs to it */
+  uint8_t esc;       /* console: state of an escape sequence being consumed */
+  uint32_t last_len; /* console: the last line run, for Up */
+  char last[CLI_LINE_MAX + 1u];
 };
 
 /* Returns 0, or -1 for a missing params/write. */
@@ -125,11 +150,14 @@ const cli_cmd_t *cli_app_cmd(const cli_t *cli, uint32_t i);
 /* Feed received bytes; complete lines are executed and answered before it returns. */
 void cli_feed(cli_t *cli, const uint8_t *data, size_t len);
 /* Feed bytes up to and including the first EOL (executed and answered); returns the
- * number taken (len if there is no EOL). */
+ * number taken (len if there is no EOL). In console mode it takes one byte (its echo
+ * written) per call. */
 size_t cli_feed_line(cli_t *cli, const uint8_t *data, size_t len);
 /* Bytes were lost after the last byte fed: discard the line in progress (err OVERFLOW
  * at its EOL) and count the loss. */
 void cli_rx_lost(cli_t *cli);
+/* Machine mode (false, the default) or console mode (true); the command "console". */
+void cli_set_console(cli_t *cli, bool on);
 
 /* Reply building for handlers: append to the pending line, then emit it. Characters
  * outside %x20-7E are replaced by '?', so a reply is always one line. */

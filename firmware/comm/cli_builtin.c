@@ -481,6 +481,18 @@ static void cmd_version(cli_t *cli, void *ctx, uint32_t argc, const char *const 
   cli_emit_ok(cli);
 }
 
+static void cmd_console(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
+{
+  (void)ctx;
+  if (argc == 2u && (strcmp(argv[1], "on") == 0 || strcmp(argv[1], "off") == 0)) {
+    cli_set_console(cli, argv[1][1] == 'n');
+  } else if (argc != 1u) {
+    cli_err(cli, "ARGS", "usage: console [on|off]");
+    return;
+  }
+  cli_ok(cli, cli->console ? "console on" : "console off");
+}
+
 static const cli_cmd_t k_builtin[] = {
     {"help", "", "list the commands", cmd_help, NULL},
     {"list", "[PREFIX]", "parameters with value, unit, range, default, flags and help", cmd_list, NULL},
@@ -492,6 +504,8 @@ static const cli_cmd_t k_builtin[] = {
     {"defaults", "", "apply the default parameters (not saved)", cmd_defaults, NULL},
     {"diff", "", "parameters that differ from their defaults", cmd_diff, NULL},
     {"version", "", "firmware and parameter layout versions", cmd_version, NULL},
+    {"console", "[on|off]", "terminal mode: prompt, echo, line editing (off: machine mode, "
+                            "the default)", cmd_console, NULL},
 };
 
 uint32_t cli_builtin_count(void) { return (uint32_t)(sizeof k_builtin / sizeof k_builtin[0]); }

@@ -1,5 +1,5 @@
 /* Built-in commands of the command line (help, list, get, set, save, load, defaults,
- * diff, version): thin wrappers over params and param_store. Reply formats in cli.h. */
+ * diff, version, console): thin wrappers over params and param_store. Reply formats in cli.h. */
 #ifndef CLI_BUILTIN_H
 #define CLI_BUILTIN_H
 

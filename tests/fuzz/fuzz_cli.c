@@ -1,8 +1,12 @@
 /* The command line fed arbitrary bytes. Byte 0 picks options: bit 0 the loop is safe
  * (save, non-live sets allowed), bit 1 received bytes are lost after every chunk
- * (cli_rx_lost), bits 4-7 the chunk size the bytes arrive in, with an ISR tick between
- * chunks. Invariants: every reply line is well formed, the held parameters always pass
- * their checks and hold no -0, no staged edit is left behind, every loss is counted. */
+ * (cli_rx_lost), bit 2 it starts in console mode (the input may switch it with
+ * "console on|off" too), bits 4-7 the chunk size the bytes arrive in, with an ISR tick
+ * between chunks. Invariants: every reply line is well formed; any other output (echo,
+ * prompt, erase) comes only in console mode, never as a NUL (the telemetry frame
+ * delimiter) or a byte >= 0x80; the line held stays within CLI_LINE_MAX; the held
+ * parameters always pass their checks and hold no -0, no staged edit is left behind,
+ * every loss is counted. */
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -22,10 +26,27 @@ typedef struct {
 
 static fx_t g;
 
+/* Console output: typed bytes echoed one by one, "\r\n", erase ("\b \b"), BEL, the
+ * prompt, a recalled line. Never written with a CRLF at its end and 4 bytes or more,
+ * which is how every reply line is written. */
+static void check_console(const char *d, size_t n)
+{
+  FUZZ_CHECK(g.cli.console);
+  FUZZ_CHECK(n >= 1u && n <= CLI_LINE_MAX + 16u);
+  for (size_t i = 0; i < n; i++) {
+    const char c = d[i];
+    FUZZ_CHECK((c >= 0x20 && c <= 0x7E) || c == '\b' || c == '\a' || c == '\r' || c == '\n');
+  }
+}
+
 static void check_line(void *ctx, const char *d, size_t n)
 {
   (void)ctx;
-  FUZZ_CHECK(n >= 4 && n <= CLI_OUT_MAX + 32u && d[n - 2] == '\r' && d[n - 1] == '\n');
+  if (!(n >= 4u && d[n - 2] == '\r' && d[n - 1] == '\n')) {
+    check_console(d, n);
+    return;
+  }
+  FUZZ_CHECK(n <= CLI_OUT_MAX + 32u);
   for (size_t i = 0; i + 2 < n; i++) {
     FUZZ_CHECK(d[i] >= 0x20 && d[i] <= 0x7E);
   }
@@ -72,6 +93,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     return 0;
   }
   g.safe = (data[0] & 1u) != 0;
+  if ((data[0] & 4u) != 0) {
+    cli_set_console(&g.cli, true);
+  }
   const bool lossy = (data[0] & 2u) != 0;
   uint32_t losses = 0u;
   const size_t chunk = 1u + (size_t)(data[0] >> 4) * 4u;
@@ -91,6 +115,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     FUZZ_CHECK(memcmp(params_staged(&g.bank), cur, sizeof *cur) == 0);
     FUZZ_CHECK(cur->sys_fs_hz == 50000u);
+    FUZZ_CHECK(g.cli.len <= CLI_LINE_MAX && g.cli.last_len <= CLI_LINE_MAX);
   }
   FUZZ_CHECK(g.cli.truncated == 0u);
   FUZZ_CHECK(g.cli.rx_overflows == losses);

@@ -358,7 +358,7 @@ static void test_app_commands_and_help(void **state)
     assert_non_null(strstr(out, needle));
   }
   assert_non_null(strstr(out, "- stream FIELD... @RATE_HZ : start telemetry\r\n"));
-  assert_non_null(strstr(out, "ok 13 commands\r\n"));
+  assert_non_null(strstr(out, "ok 14 commands\r\n"));
   static cli_cmd_t more[8];
   static char more_names[8][8];
   int added = 0;
@@ -368,6 +368,96 @@ static void test_app_commands_and_help(void **state)
     added += (cli_register(&g.cli, &more[k]) == 0);
   }
   assert_int_equal(added, CLI_MAX_APP_CMDS - 4);
+}
+
+/* Console output has echo and prompts between the reply lines: compared whole. */
+static void cexpect(const char *typed, const char *screen)
+{
+  g.out_len = 0;
+  g.out[0] = '\0';
+  cli_feed(&g.cli, (const uint8_t *)typed, strlen(typed));
+  if (strcmp(g.out, screen) != 0) {
+    fail_msg("'%s' -> '%s', want '%s'", typed, g.out, screen);
+  }
+}
+
+/* Console mode: prompt, echo, editing; machine mode stays the default and unchanged. */
+static void test_console_prompt_and_echo(void **state)
+{
+  (void)state;
+  cexpect("console\n", "ok console off\r\n");
+  cexpect("console on\r\n", "ok console on\r\ngyro> ");
+  /* typed byte by byte as at a terminal, Enter sends CR */
+  g.out_len = 0;
+  const char *typed = "get tlm.rate_hz\r";
+  for (size_t i = 0; i < strlen(typed); i++) {
+    cli_feed(&g.cli, (const uint8_t *)&typed[i], 1u);
+  }
+  assert_string_equal(g.out, "get tlm.rate_hz\r\nok tlm.rate_hz 100 Hz\r\ngyro> ");
+  /* CR LF is one Enter; a blank line gives a new prompt only; a tab is a space */
+  cexpect("get\ttlm.rate_hz\r\n", "get tlm.rate_hz\r\nok tlm.rate_hz 100 Hz\r\ngyro> ");
+  cexpect("\r", "\r\ngyro> ");
+  cexpect("  \n", "  \r\ngyro> ");
+  cexpect("nope\n", "nope\r\nerr UNKNOWN no command 'nope'; try help\r\ngyro> ");
+  cexpect("console bad\r", "console bad\r\nerr ARGS usage: console [on|off]\r\ngyro> ");
+  /* back to machine mode: no prompt, no echo */
+  cexpect("console off\r", "console off\r\nok console off\r\n");
+  cexpect("get tlm.rate_hz\r\n", "ok tlm.rate_hz 100 Hz\r\n");
+  const uint8_t bs[] = {'x', 0x7F, '\n'};
+  g.out_len = 0;
+  cli_feed(&g.cli, bs, sizeof bs);
+  assert_string_equal(g.out, "err BADCHAR line with a non-printable byte discarded\r\n");
+}
+
+static void test_console_editing(void **state)
+{
+  (void)state;
+  cexpect("console on\n", "ok console on\r\ngyro> ");
+  /* Up before any line was run: nothing to bring back, nothing written */
+  cexpect("\x1b[A", "");
+  /* Backspace (DEL) and Ctrl-H */
+  cexpect("get tlm.rate_hx\x7fz\r", "get tlm.rate_hx\b \bz\r\nok tlm.rate_hz 100 Hz\r\ngyro> ");
+  cexpect("get tlm.ratx\be_hz\r", "get tlm.ratx\b \be_hz\r\nok tlm.rate_hz 100 Hz\r\ngyro> ");
+  /* backspace on an empty line does nothing */
+  cexpect("\x7f\b", "");
+  /* Ctrl-U erases the line, Ctrl-C drops it with a new prompt: neither is run */
+  cexpect("set tlm.rate_hz 7\x15", "set tlm.rate_hz 7\b \b\b \b\b \b\b \b\b \b\b \b\b \b\b \b"
+                                  "\b \b\b \b\b \b\b \b\b \b\b \b\b \b\b \b\b \b");
+  cexpect("\r", "\r\ngyro> ");
+  cexpect("set tlm.rate_hz 7\x03", "set tlm.rate_hz 7^C\r\ngyro> ");
+  cexpect("\r", "\r\ngyro> ");
+  assert_int_equal(cur()->tlm_rate_hz, 100u);
+  /* arrows and other keys: consumed, no error, the line goes on */
+  cexpect("get \x1b[C\x1b[D\x1bOB\x1b[1;5D\x1b[3~\x1bxtlm.rate_hz\r",
+         "get tlm.rate_hz\r\nok tlm.rate_hz 100 Hz\r\ngyro> ");
+  /* other control bytes and bytes >= 0x80 are ignored */
+  const uint8_t odd[] = {'g', 0x00, 0x01, 0xC3, 0xA9, 0xFF, 'e', 't', ' ', 's', 'y', 's', '.', 'f', 's', '_', 'h', 'z', '\r'};
+  g.out_len = 0;
+  cli_feed(&g.cli, odd, sizeof odd);
+  assert_string_equal(g.out, "get sys.fs_hz\r\nok sys.fs_hz 50000 Hz\r\ngyro> ");
+  /* Up brings back the last line run, replacing what was typed */
+  cexpect("xy\x1b[A", "xy\b \b\b \bget sys.fs_hz");
+  cexpect("\r", "\r\nok sys.fs_hz 50000 Hz\r\ngyro> ");
+  cexpect("\x1bOA\r", "get sys.fs_hz\r\nok sys.fs_hz 50000 Hz\r\ngyro> ");
+  /* a full line refuses more with BEL instead of discarding it */
+  char line[CLI_LINE_MAX + 8u];
+  memset(line, ' ', sizeof line);
+  memcpy(line, "get tlm.rate_hz", 15);
+  line[CLI_LINE_MAX + 2u] = '\0';
+  g.out_len = 0;
+  cli_feed(&g.cli, (const uint8_t *)line, strlen(line));
+  assert_int_equal(g.out_len, CLI_LINE_MAX + 2u);
+  assert_string_equal(&g.out[CLI_LINE_MAX], "\a\a");
+  cexpect("\r", "\r\nok tlm.rate_hz 100 Hz\r\ngyro> ");
+  /* lost input still discards the line */
+  cexpect("get tlm", "get tlm");
+  cli_rx_lost(&g.cli);
+  cexpect(".rate_hz\r", ".rate_hz\r\nerr OVERFLOW input lost (receive buffer full): line discarded, send it again\r\ngyro> ");
+  /* an escape sequence cut by Enter does not eat the next line */
+  cexpect("\x1b[\r", "\r\ngyro> ");
+  cexpect("get tlm.rate_hz\r", "get tlm.rate_hz\r\nok tlm.rate_hz 100 Hz\r\ngyro> ");
+  /* one byte per call, so the application can check for TX room before each echo */
+  assert_int_equal(cli_feed_line(&g.cli, (const uint8_t *)"ab\r", 3u), 1u);
 }
 
 static void test_version(void **state)
@@ -391,6 +481,8 @@ int main(void)
       cmocka_unit_test_setup(test_list, setup),
       cmocka_unit_test_setup(test_app_commands_and_help, setup),
       cmocka_unit_test_setup(test_version, setup),
+      cmocka_unit_test_setup(test_console_prompt_and_echo, setup),
+      cmocka_unit_test_setup(test_console_editing, setup),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

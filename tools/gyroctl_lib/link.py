@@ -25,6 +25,7 @@ LINE_MAX = 120  # firmware/comm/cli.h CLI_LINE_MAX
 SYNC_LINE = "version"      # harmless, answered in every mode
 SYNC_REPLY = "ok fw "      # how its reply starts (firmware/comm/cli_builtin.c)
 RESEND_S = 1.0             # resend the sync line after this long without a reply
+MACHINE_LINE = "console off"  # machine mode: no prompt, no echo (firmware/comm/cli.h)
 GONE = ("the gyro went away (port closed: the simulator or emulator ended, the cable was "
         "unplugged, or the board reset)")
 
@@ -164,7 +165,8 @@ class Link:
         """Start clean, and make sure the gyro listens: an empty line ends whatever partial
         line it holds, then a harmless command is sent, and resent every RESEND_S, until
         the first reply (a booting emulator drops what arrives before its UART is up)
-        or timeout_s. Late replies to the resent lines are dropped by read_reply."""
+        or timeout_s. Late replies to the resent lines are dropped by read_reply. Then
+        the port is put in machine mode (MACHINE_LINE, once)."""
         self.write(b"\n")
         deadline = time.monotonic() + self.timeout_s
         sends = 0
@@ -178,6 +180,10 @@ class Link:
             if time.monotonic() >= deadline:
                 raise LinkError(self._no_reply_message(f"'{SYNC_LINE}'"))
         self._stale_sync = sends - 1
+        # A person at a terminal may have left the port in console mode (prompt, echo):
+        # back to machine mode, one reply per line. Whatever the answer (an older
+        # firmware has no such command: err UNKNOWN), the link goes on.
+        self.command(MACHINE_LINE)
         self.drain()
 
     def _wait_final(self, t_end) -> bool:

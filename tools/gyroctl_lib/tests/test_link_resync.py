@@ -2,7 +2,8 @@
 command is resent until the first reply (a booting emulator drops it) and late answers
 to the resent lines are not taken for the next reply; the log's wait follows the
 emulator's stretch and --timeout; a closed port, a port held by another program and a
-port that appears late; the header keeps the names asked for; `stream` in the shell
+port that appears late; a port left in console mode is put back in machine mode
+once on connect (an older firmware's err UNKNOWN tolerated); the header keeps the names asked for; `stream` in the shell
 shows values; the firmware's hint names a gyroctl command."""
 
 import errno
@@ -81,6 +82,60 @@ def test_late_sync_answers_are_not_taken_for_the_reply(fast_resend):
     assert port.sent.count("version") >= 2
     assert link.command("status").final == "ok status"
     assert link.command("version").final.startswith("ok fw ")
+
+
+class ConsolePort(TimedPort):
+    """A gyro left in console mode by a person at a terminal: every byte echoed, a
+    prompt after each reply, until "console off"."""
+
+    def __init__(self, known=True, **kw):
+        super().__init__(**kw)
+        self.console, self.known = True, known
+
+    def write(self, b):
+        line = b.decode().strip()
+        self.sent.append(line)
+        now = time.monotonic()
+        if self.console:
+            self.queue.append((now, b.replace(b"\n", b"\r\n")))
+        if line == "console off" and self.known:
+            reply, self.console = b"ok console off\r\n", False
+        elif line == "console off":
+            reply = b"err UNKNOWN no command 'console'; try help\r\n"
+        elif line:
+            word = line.split()[0]
+            reply = (b"ok fw 1.0 layout 1 format 1 params 9\r\n" if word == "version"
+                     else b"ok " + word.encode() + b"\r\n")
+        else:
+            reply = b""
+        self.queue.append((now, reply + (b"gyro> " if self.console else b"")))
+
+
+def test_connect_switches_a_console_to_machine_mode(fast_resend):
+    port = ConsolePort()
+    link = Link("fake", timeout_s=3.0, serial_obj=port)
+    link.sync()
+    assert port.sent.count("console off") == 1 and not port.console
+    assert link.command("status").final == "ok status"
+    assert link.command("get x").final == "ok get"
+
+
+def test_connect_to_a_firmware_without_console_mode(fast_resend):
+    port = ConsolePort(known=False)
+    port.console = False  # an older firmware: machine mode only, console unknown
+    link = Link("fake", timeout_s=3.0, serial_obj=port)
+    link.sync()
+    assert port.sent.count("console off") == 1
+    assert link.command("status").final == "ok status"
+
+
+def test_connect_sends_console_off_after_the_first_reply(fast_resend):
+    port = TimedPort(boot_s=0.35)  # the resync goes on as before, then machine mode once
+    link = Link("fake", timeout_s=3.0, serial_obj=port)
+    link.sync()
+    i = port.sent.index("console off")
+    assert port.sent.count("console off") == 1 and port.sent[i - 1] == "version"
+    assert "console off" not in port.sent[:i]
 
 
 def test_no_reply_says_what_to_check(fast_resend):
