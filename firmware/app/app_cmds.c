@@ -292,7 +292,8 @@ static void cmd_clear(cli_t *cli, void *ctx, uint32_t argc, const char *const *a
 
 /* sweep points: the measured points of the latest finished (or failed) sweep, one data
  * line each in ascending frequency: the force frequency, the mean drive pickoff phasor's
- * amplitude and phase (against the force, which had phase 0), the force command it had
+ * amplitude and phase against the force (force phase P = 0 during the steps; the
+ * convention of gyro-sim's sweep CSV, not arg Z of gyro.h), the force command it had
  * and their ratio |H| (what a frequency-response fit reads), the placement it belongs to.
  * Background only: reads the sequencer's table. */
 static void put_sweep_points(cli_t *cli, const app_t *a)
@@ -323,7 +324,11 @@ static void put_sweep_points(cli_t *cli, const app_t *a)
     cli_put(cli, " amp_v ");
     cli_put_f32(cli, (float)amp);
     cli_put(cli, " phase_deg ");
-    cli_put_f32(cli, (float)(atan2((double)p->z_im, (double)p->z_re) * 57.29577951308232));
+    /* The pickoff v = Im{Z e^{j phi}} = |Z| cos(phi + arg Z - 90 deg) against the force
+     * cos(phi) (gyro.h, drive_synth.h): its phase is arg Z - 90 deg, in (-180, 180]. */
+    double ph = atan2((double)p->z_im, (double)p->z_re) * 57.29577951308232 - 90.0;
+    if (ph <= -180.0) ph += 360.0;
+    cli_put_f32(cli, (float)ph);
     cli_put(cli, " f_cmd_v2 ");
     cli_put_f32(cli, p->f_cmd_v2);
     cli_put(cli, " gain_v_per_v2 ");

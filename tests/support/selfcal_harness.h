@@ -112,8 +112,9 @@ static inline void check_points(const plant_cfg_t *pc)
       f_at_max = f;
     }
     pts[n].f_hz = f;
-    pts[n].h_re = g * cos(ph * M_PI / 180.0);
-    pts[n].h_im = g * sin(ph * M_PI / 180.0);
+    /* phase_deg is the pickoff against the force: arg Z - 90 deg (gyro.h). */
+    pts[n].h_re = g * cos((ph + 90.0) * M_PI / 180.0);
+    pts[n].h_im = g * sin((ph + 90.0) * M_PI / 180.0);
     n++;
     line = strstr(line, "\r\n");
     assert_non_null(line);
@@ -138,6 +139,7 @@ static inline void check_points(const plant_cfg_t *pc)
          (unsigned)n, pts[0].f_hz, pts[n - 1u].f_hz, g_max, f_at_max, fit.f0_hz, tf0, fit.q,
          pc->q_drive, fit.rms_rel, strlen(r));
   assert_true(fabs(fit.f0_hz - tf0) <= fmax(0.1, tf0 / pc->q_drive / 100.0));
+  assert_true(fabs(remainder(fit.phase_rad - s->fit.phase_rad, 2.0 * M_PI)) < 0.01);
   assert_true(fabs(fit.q / pc->q_drive - 1.0) <= 0.02);
 }
 
