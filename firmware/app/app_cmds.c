@@ -305,7 +305,7 @@ static void put_sweep_points(cli_t *cli, const app_t *a)
                                              : "no sweep has measured points yet: run sweep");
     return;
   }
-  uint8_t order[SELFCAL_EXPORT_MAX];
+  uint8_t order[SELFCAL_EXPORT_MAX] = {0};
   for (uint32_t i = 0; i < n; i++) {
     uint32_t k = i; /* insertion by frequency, stable */
     while (k > 0u && s->pts[order[k - 1u]].half_step > s->pts[i].half_step) {
