@@ -1,5 +1,6 @@
 #include "app/app_cmds.h"
 
+#include <math.h>
 #include <string.h>
 
 #include "app/app_selfcal.h"
@@ -289,13 +290,69 @@ static void cmd_clear(cli_t *cli, void *ctx, uint32_t argc, const char *const *a
   cli_ok(cli, "fault cleared");
 }
 
-/* sweep: self-calibration; the drive goes SWEEP -> ACQUIRE with the identified model. */
+/* sweep points: the measured points of the latest finished (or failed) sweep, one data
+ * line each in ascending frequency: the force frequency, the mean drive pickoff phasor's
+ * amplitude and phase against the force (force phase P = 0 during the steps; the
+ * convention of gyro-sim's sweep CSV, not arg Z of gyro.h), the force command it had
+ * and their ratio |H| (what a frequency-response fit reads), the placement it belongs to.
+ * Background only: reads the sequencer's table. */
+static void put_sweep_points(cli_t *cli, const app_t *a)
+{
+  const selfcal_t *s = &a->selfcal;
+  const uint32_t n = selfcal_export_count(s);
+  if (n == 0u) {
+    cli_err(cli, "STATE", selfcal_running(s) ? "a sweep is in progress: wait for it to end"
+                                             : "no sweep has measured points yet: run sweep");
+    return;
+  }
+  uint8_t order[SELFCAL_EXPORT_MAX] = {0};
+  for (uint32_t i = 0; i < n; i++) {
+    uint32_t k = i; /* insertion by frequency, stable */
+    while (k > 0u && s->pts[order[k - 1u]].half_step > s->pts[i].half_step) {
+      order[k] = order[k - 1u];
+      k--;
+    }
+    order[k] = (uint8_t)i;
+  }
+  for (uint32_t k = 0; k < n; k++) {
+    const selfcal_export_pt_t *p = &s->pts[order[k]];
+    const double amp = hypot((double)p->z_re, (double)p->z_im);
+    cli_put(cli, "point ");
+    cli_put_u32(cli, k);
+    cli_put(cli, " f_hz ");
+    cli_put_f32(cli, (float)selfcal_export_f_hz(s, order[k]));
+    cli_put(cli, " amp_v ");
+    cli_put_f32(cli, (float)amp);
+    cli_put(cli, " phase_deg ");
+    /* The pickoff v = Im{Z e^{j phi}} = |Z| cos(phi + arg Z - 90 deg) against the force
+     * cos(phi) (gyro.h, drive_synth.h): its phase is arg Z - 90 deg, in (-180, 180]. */
+    double ph = atan2((double)p->z_im, (double)p->z_re) * 57.29577951308232 - 90.0;
+    if (ph <= -180.0) ph += 360.0;
+    cli_put_f32(cli, (float)ph);
+    cli_put(cli, " f_cmd_v2 ");
+    cli_put_f32(cli, p->f_cmd_v2);
+    cli_put(cli, " gain_v_per_v2 ");
+    cli_put_f32(cli, p->f_cmd_v2 > 0.0f ? (float)(amp / (double)p->f_cmd_v2) : 0.0f);
+    cli_put(cli, " stage ");
+    cli_put_u32(cli, p->stage);
+    cli_emit_data(cli);
+  }
+  cli_put_u32(cli, n);
+  cli_put(cli, " points");
+  cli_emit_ok(cli);
+}
+
+/* sweep: self-calibration; the drive goes SWEEP -> ACQUIRE with the identified model.
+ * sweep points: the latest sweep's measured points (put_sweep_points). */
 static void cmd_sweep(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
 {
-  (void)argv;
   app_t *a = ctx;
+  if (argc == 2u && strcmp(argv[1], "points") == 0) {
+    put_sweep_points(cli, a);
+    return;
+  }
   if (argc != 1u) {
-    cli_err(cli, "ARGS", "usage: sweep");
+    cli_err(cli, "ARGS", "usage: sweep [points]");
     return;
   }
   if (app_selfcal_start(a) != 0) {
@@ -313,8 +370,9 @@ int app_cmds_register(app_t *a)
                             cmd_status, a};
   const cli_cmd_t drive = {"drive", "on|off", "start or stop the drive (acquire / safe mode)",
                            cmd_drive, a};
-  const cli_cmd_t sweep = {"sweep", "", "self-calibration: identify the drive mode, redesign "
-                            "the loops, then acquire", cmd_sweep, a};
+  const cli_cmd_t sweep = {"sweep", "[points]", "self-calibration: identify the drive mode, "
+                            "redesign the loops, then acquire; points: the latest sweep's "
+                            "measured points", cmd_sweep, a};
   cmds[0] = status;
   cmds[1] = drive;
   const cli_cmd_t selftest = {"selftest", "", "built-in self-test: a known force on the sense "

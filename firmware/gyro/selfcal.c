@@ -15,7 +15,12 @@
 #define SC_SETTLE_TAU 7.0
 #define SC_HOLD_TAU 6.0
 
-static const double k_offsets[7] = {-2.0, -1.0, -0.5, 0.0, 0.5, 1.0, 2.0};
+/* Nine points: the fit needs four unknowns, an exported sweep (`sweep points`) needs at
+ * least eight for gyro-freqresp's five; the flanks at +-1.5 half bandwidths are where a
+ * wrong Q shows most. */
+#define SC_STEP_PTS 9u
+static const double k_offsets[SC_STEP_PTS] = {-2.0, -1.5, -1.0, -0.5, 0.0, 0.5, 1.0, 1.5, 2.0};
+_Static_assert(SC_STEP_PTS <= SELFCAL_MAX_PTS, "the executive holds SELFCAL_MAX_PTS points");
 
 /* NCO half-rate phase step of frequency f: the wc step is 2 half_step (nco.h). */
 static uint32_t half_step_of(double f_hz, double fs_hz)
@@ -141,8 +146,8 @@ static void post_steps(selfcal_t *s, double f_c, double hb, double tau_s, double
   if (f_cmd > c->f_cmd_max_v2) f_cmd = c->f_cmd_max_v2;
   s->f_cmd_v2 = f_cmd;
   base_job(s, &j, SELFCAL_JOB_STEPS);
-  j.n_pts = 7u;
-  for (uint32_t i = 0; i < 7u; i++) {
+  j.n_pts = SC_STEP_PTS;
+  for (uint32_t i = 0; i < SC_STEP_PTS; i++) {
     j.half_step[i] = half_step_of(f_c + k_offsets[i] * hb, c->fs_hz);
   }
   j.settle_ticks = ticks_of((SC_SETTLE_TAU + 1.0) * tau_s, c->fs_hz);
@@ -247,6 +252,14 @@ static void on_steps(selfcal_t *s, const selfcal_result_t *r)
   const selfcal_cfg_t *c = &s->cfg;
   const selfcal_job_t *j = &s->x->job;
   selfcal_point_t pts[SELFCAL_MAX_PTS];
+  for (uint32_t i = 0; i < j->n_pts && s->n_pts < SELFCAL_EXPORT_MAX; i++) {
+    selfcal_export_pt_t *e = &s->pts[s->n_pts++];
+    e->half_step = j->half_step[i];
+    e->z_re = r->z_re[i];
+    e->z_im = r->z_im[i];
+    e->f_cmd_v2 = r->f_cmd_v2[i];
+    e->stage = s->refits + 1u;
+  }
   for (uint32_t i = 0; i < j->n_pts; i++) {
     /* P = 0 during the steps: H = Z / f_cmd. */
     const double f = (double)r->f_cmd_v2[i];
@@ -337,6 +350,16 @@ void selfcal_finish(selfcal_t *s, int ok, const char *why)
 void selfcal_abort(selfcal_t *s, const char *why)
 {
   if (s != NULL && selfcal_running(s)) fail(s, why);
+}
+
+uint32_t selfcal_export_count(const selfcal_t *s)
+{
+  return s == NULL || selfcal_running(s) ? 0u : s->n_pts;
+}
+
+double selfcal_export_f_hz(const selfcal_t *s, uint32_t i)
+{
+  return s == NULL || i >= s->n_pts ? 0.0 : freq_of(s->pts[i].half_step, s->cfg.fs_hz);
 }
 
 void selfcal_watch(selfcal_t *s, uint32_t now_ticks)

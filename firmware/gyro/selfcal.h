@@ -11,8 +11,8 @@
  *   2. RINGDOWN at f_c: excite, stop, follow the free decay to 1/e: the time constant
  *      tau = 2Q/wn (6-12) gives Q_rd = pi f tau, the rotation of the LMSD phasor gives
  *      the free frequency f_d.
- *   3. STEPS: 7 points at f_d + {-2,-1,-0.5,0,0.5,1,2} f_d/(2 Q_rd), each settled for
- *      7 tau, averaged 0.1 s, at a force that puts the peak at amp_meas_v; the linear
+ *   3. STEPS: 9 points at f_d + {-2,-1.5,-1,-0.5,0,0.5,1,1.5,2} f_d/(2 Q_rd), each
+ *      settled for 7 tau, averaged 0.1 s, at a force that puts the peak at amp_meas_v; the linear
  *      least-squares fit of selfcal_fit.h (known converter delay of 1.5 samples plus up
  *      to 8 samples of unknown analog-chain delay, searched) gives wn, Q, |H(wn)| and
  *      arg H(wn). If the
@@ -62,6 +62,20 @@ typedef enum {
   SELFCAL_FAILED
 } selfcal_state_t;
 
+/* Every STEPS point of the latest sweep (both placements when the points were placed
+ * again around a first fit), kept for export (`sweep points`): the drive LMSD phasor Z
+ * averaged at the NCO half-step with the force command it had (force phase 0, so
+ * H = Z / f_cmd). Filled by the background as the results arrive; cleared when a sweep
+ * starts. */
+#define SELFCAL_EXPORT_MAX (2u * SELFCAL_MAX_PTS)
+
+typedef struct {
+  uint32_t half_step; /* NCO half-rate phase step: f = 2 half_step fs / 2^32 (nco.h) */
+  float z_re, z_im;   /* mean drive LMSD phasor, V */
+  float f_cmd_v2;     /* force command during the average, Ks*V^2 */
+  uint32_t stage;     /* 1: first placement, 2: placed again around the first fit */
+} selfcal_export_pt_t;
+
 typedef struct {
   selfcal_cfg_t cfg;
   selfcal_exec_t *x;
@@ -81,6 +95,8 @@ typedef struct {
    * posted job may take (samples). */
   selfcal_state_t watch_state;
   uint32_t watch_t0, job_bound_ticks;
+  selfcal_export_pt_t pts[SELFCAL_EXPORT_MAX];
+  uint32_t n_pts;
 } selfcal_t;
 
 /* Bind to the ISR half. Returns 0, or -1 for NULL. State IDLE. */
@@ -101,6 +117,11 @@ void selfcal_abort(selfcal_t *s, const char *why);
  * can never hold the sequencer busy. */
 void selfcal_watch(selfcal_t *s, uint32_t now_ticks);
 int selfcal_running(const selfcal_t *s);
+/* Measured points of the latest sweep for export: the number held (0 while a sweep runs
+ * or before any sweep measured; a failed sweep keeps what it measured), and the
+ * frequency of a point's half-step in Hz. */
+uint32_t selfcal_export_count(const selfcal_t *s);
+double selfcal_export_f_hz(const selfcal_t *s, uint32_t i);
 const char *selfcal_state_name(selfcal_state_t st);
 
 #endif /* SELFCAL_H */

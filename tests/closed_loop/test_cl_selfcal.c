@@ -1,6 +1,7 @@
 /* Self-calibration on the host plant, through the host HAL and the command line: the
  * `sweep` command identifies the drive resonance and Q through the firmware's own
- * signal chain, and the loops designed from the identified model lock.
+ * signal chain, and the loops designed from the identified model lock; `sweep points`
+ * prints the measured points, which alone identify the plant again.
  * Judged against the plant's own parameters (the resonance at the structure
  * temperature, (2-32)) and its true drive amplitude. */
 #include <setjmp.h>
@@ -25,16 +26,22 @@ static void test_default_plant(void **state)
   /* The sweep is commanded while the drive runs locked with the stored design. */
   run_polled_s(0.3);
   assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
+  /* No sweep yet: no points to export; a bad argument is refused. */
+  assert_non_null(strstr(cmd("sweep points\n"), "err STATE no sweep has measured points"));
+  assert_non_null(strstr(cmd("sweep pts\n"), "err ARGS usage: sweep [points]"));
+  assert_non_null(strstr(cmd("sweep points 1\n"), "err ARGS"));
   /* A second request while the sweep runs is refused. */
   assert_true(strncmp(cmd("sweep\n"), "ok", 2) == 0);
   run_polled_s(0.01);
   assert_int_equal(app.gyro.sup.mode, GYRO_MODE_SWEEP);
   assert_non_null(strstr(cmd("sweep\n"), "BUSY"));
   assert_non_null(strstr(cmd("status\n"), "selfcal QUIET_UP"));
+  assert_non_null(strstr(cmd("sweep points\n"), "err STATE a sweep is in progress"));
   const double t = sweep_wait();
   assert_int_equal(app.selfcal.state, SELFCAL_DONE);
   assert_true(t <= 60.0);
   check_identified(&pc);
+  check_points(&pc);
   /* status reports the result */
   const char *r = cmd("status\n");
   assert_non_null(strstr(r, "selfcal DONE"));

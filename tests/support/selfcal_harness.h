@@ -80,6 +80,69 @@ static inline void check_identified(const plant_cfg_t *pc)
   assert_true(fabs((double)v->drive_cal_q / s->fit.q - 1.0) < 1e-6);
 }
 
+/* `sweep points` after the sweep: the measured points as data lines
+ *   - point K f_hz F amp_v A phase_deg P f_cmd_v2 C gain_v_per_v2 G stage S
+ * then "ok N points". Checked: N is the sequencer's table (9 points per placement, both
+ * placements kept), K counts up, the frequencies ascend and bracket the identified f0,
+ * gain = amp / f_cmd, the largest gain lies within half a bandwidth of f0 and agrees
+ * with the fitted |H(f0)|, and the printed points alone identify the plant again
+ * (selfcal_fit_delay on them: f0 and Q within the tolerances of check_identified). */
+static inline void check_points(const plant_cfg_t *pc)
+{
+  const char *r = cmd("sweep points\n");
+  const selfcal_t *s = &app.selfcal;
+  selfcal_point_t pts[SELFCAL_EXPORT_MAX];
+  uint32_t n = 0u;
+  double g_max = 0.0, f_at_max = 0.0;
+  const char *line = r;
+  while (strncmp(line, "- point ", 8) == 0) {
+    unsigned k = 0u, stage = 0u;
+    double f = 0.0, amp = 0.0, ph = 0.0, fc = 0.0, g = 0.0;
+    assert_int_equal(sscanf(line, "- point %u f_hz %lf amp_v %lf phase_deg %lf f_cmd_v2 %lf "
+                                  "gain_v_per_v2 %lf stage %u",
+                            &k, &f, &amp, &ph, &fc, &g, &stage), 7);
+    assert_true(n < SELFCAL_EXPORT_MAX);
+    assert_int_equal(k, n);
+    assert_true(stage == 1u || stage == 2u);
+    assert_true(amp > 0.0 && fc > 0.0 && fabs(ph) <= 180.0);
+    assert_true(fabs(g / (amp / fc) - 1.0) < 1e-5);
+    if (n > 0u) assert_true(f >= pts[n - 1u].f_hz);
+    if (g > g_max) {
+      g_max = g;
+      f_at_max = f;
+    }
+    pts[n].f_hz = f;
+    /* phase_deg is the pickoff against the force: arg Z - 90 deg (gyro.h). */
+    pts[n].h_re = g * cos((ph + 90.0) * M_PI / 180.0);
+    pts[n].h_im = g * sin((ph + 90.0) * M_PI / 180.0);
+    n++;
+    line = strstr(line, "\r\n");
+    assert_non_null(line);
+    line += 2;
+  }
+  char ok[32];
+  snprintf(ok, sizeof ok, "ok %u points\r\n", (unsigned)n);
+  assert_string_equal(line, ok);
+  assert_int_equal(n, s->n_pts);
+  assert_true(n == 9u || n == 18u);
+  const double f0 = s->fit.f0_hz, hb = f0 / (2.0 * s->fit.q);
+  assert_true(pts[0].f_hz < f0 && pts[n - 1u].f_hz > f0);
+  assert_true(fabs(f_at_max - f0) <= 0.6 * hb);
+  assert_true(fabs(g_max / s->fit.gain_v_per_v2 - 1.0) < 0.1);
+  selfcal_fit_t fit;
+  double d = 0.0;
+  assert_int_equal(selfcal_fit_delay(pts, n, s->cfg.delay_s, s->cfg.delay_s + 8.0 / s->cfg.fs_hz,
+                                     &fit, &d), 0);
+  const double tf0 = true_f0(pc);
+  printf("# sweep points: %u, %.3f..%.3f Hz, peak gain %.5g at %.3f Hz; refit on them: f0 "
+         "%.4f Hz (plant %.4f) Q %.2f (plant %.2f) rms %.2g; reply %zu bytes\n",
+         (unsigned)n, pts[0].f_hz, pts[n - 1u].f_hz, g_max, f_at_max, fit.f0_hz, tf0, fit.q,
+         pc->q_drive, fit.rms_rel, strlen(r));
+  assert_true(fabs(fit.f0_hz - tf0) <= fmax(0.1, tf0 / pc->q_drive / 100.0));
+  assert_true(fabs(remainder(fit.phase_rad - s->fit.phase_rad, 2.0 * M_PI)) < 0.01);
+  assert_true(fabs(fit.q / pc->q_drive - 1.0) <= 0.02);
+}
+
 /* True drive amplitude from the plant's position and velocity at the operating
  * frequency. (plant_truth()->drive_amp_m uses the frequency estimated from the force
  * samples, which the loops' response to the pickoff ripple at wc/2 phase-modulates at
@@ -156,6 +219,7 @@ static inline void random_plant_case(double f_hz, double q)
   assert_int_equal(app.selfcal.state, SELFCAL_DONE);
   assert_true(t <= 60.0);
   check_identified(&pc);
+  check_points(&pc);
   check_lock();
   check_resonance_step(&pc, +1.0);
   check_resonance_step(&pc, -2.0);

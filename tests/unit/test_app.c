@@ -127,8 +127,23 @@ static void test_replies_fit_the_reserve(void **state)
   (void)state;
   setup_app();
   hal_host_run(2u);
+  /* sweep points at its longest: a full table (two placements) of failed-sweep points
+   * whose every figure prints with nine significant digits and an exponent. */
+  app.selfcal.state = SELFCAL_FAILED;
+  app.selfcal.why = "frequency response does not fit a resonance";
+  app.selfcal.cfg.fs_hz = 50000.0;
+  app.selfcal.fit.q = 1.23456789e-11;
+  app.selfcal.n_pts = SELFCAL_EXPORT_MAX;
+  for (uint32_t i = 0; i < SELFCAL_EXPORT_MAX; i++) {
+    const selfcal_export_pt_t p = {4000000000u, -1.23456791e-11f, -1.23456791e-17f,
+                                   1.23456791e-30f, 2u};
+    app.selfcal.pts[i] = p;
+  }
+  const char *pts = cmd("sweep points\n");
+  assert_non_null(strstr(pts, "ok 18 points\r\n"));
+  printf("# sweep points at its longest: %zu bytes\n", strlen(pts));
   const char *const lines[] = {"list\n", "help\n", "status\n", "diff\n", "version\n",
-                               "stream\n", "selftest status\n"};
+                               "stream\n", "selftest status\n", "sweep points\n"};
   size_t longest = 0u;
   for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++) {
     const char *r = cmd(lines[i]);

@@ -7,6 +7,9 @@
     gyroctl --port PORT list [PREFIX]
     gyroctl --port PORT drive on|off
     gyroctl --port PORT fields                   the telemetry fields: name, type, unit
+    gyroctl --port PORT sweep-csv [--run] --out FILE.csv   the latest sweep's points (or
+                                                 a new sweep's, --run) as the CSV of
+                                                 gyro-freqresp
     gyroctl --port PORT log FIELD... [--rate HZ] --duration S --out FILE.csv
     gyroctl plot FILE.csv [--columns A,B] [--t-start S] [--t-end S] [--out FILE.png]
 
@@ -18,7 +21,8 @@ PORT: a serial device, a pty (gyro-sim, fw_pty_host) or a pyserial URL
 (socket://127.0.0.1:PORT); default $GYROCTL_PORT.
 
 Exit status: 0 the gyro answered ok; 1 it answered err (the err line is on stderr);
-2 usage; 3 the port cannot be opened or the gyro does not answer; 4 a log or plot failed.
+2 usage; 3 the port cannot be opened or the gyro does not answer; 4 a log, plot or sweep
+export failed (the sweep failed or did not finish).
 Data lines of a reply are printed without their "- " prefix, then the ok text.
 """
 
@@ -28,7 +32,7 @@ import argparse
 import os
 import sys
 
-from . import logger, plot as plot_mod, shell
+from . import logger, plot as plot_mod, shell, sweep as sweep_mod
 from .client import Client
 from .link import CommandError, Link, LinkError
 
@@ -65,6 +69,14 @@ def _parser():
                    help="seconds of gyro time (the stream's clock, not the wall clock)")
     p.add_argument("--out", required=True, help="CSV file")
     p.add_argument("--strict", action="store_true", help="exit 4 if any record or frame was lost")
+    p = sub.add_parser("sweep-csv", help="the self-calibration sweep's measured points as the "
+                                         "frequency-response CSV gyro-freqresp reads")
+    p.add_argument("--out", required=True, help="CSV file (f_hz, amp, phase_deg, ...)")
+    p.add_argument("--run", action="store_true",
+                   help="run a sweep first and wait for it (the drive is re-identified and "
+                        "its loops redesigned, as with `sweep`)")
+    p.add_argument("--sweep-timeout", type=float, default=120.0, metavar="S",
+                   help="with --run: wall-clock seconds to wait for the sweep (default 120)")
     p = sub.add_parser("plot", help="draw a CSV log to PNG")
     p.add_argument("csv")
     p.add_argument("--out", default=None, help="PNG file (default: the CSV's name with .png)")
@@ -121,7 +133,7 @@ def main(argv=None) -> int:
     except LinkError as e:
         print(f"gyroctl: {e}", file=sys.stderr)
         return 3
-    except (logger.LogError, OSError) as e:
+    except (logger.LogError, sweep_mod.SweepError, OSError) as e:
         print(f"gyroctl: {e}", file=sys.stderr)
         return 4
 
@@ -135,6 +147,12 @@ def _run(args, link) -> int:
                          progress=logger.progress_for(sys.stderr), timeout_s=args.timeout)
         print(f"gyroctl: log: {res.summary()}", file=sys.stderr)
         return 4 if (args.strict and not res.clean) else 0
+    if args.cmd == "sweep-csv":
+        n = sweep_mod.export(link, args.out, run=args.run, timeout_s=args.sweep_timeout,
+                             progress=lambda m: print(f"gyroctl: {m}", file=sys.stderr))
+        print(f"gyroctl: sweep-csv: {n} points to {args.out}", file=sys.stderr)
+        print(args.out)
+        return 0
     if args.cmd == "fields":
         for name, ftype, unit in client.fields():
             print(f"{name:16s} {ftype:4s} {unit}")
