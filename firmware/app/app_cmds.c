@@ -28,28 +28,32 @@ static const struct {
 #define FAULT_NAMES (sizeof k_fault_names / sizeof k_fault_names[0])
 _Static_assert(FAULT_NAMES == GYRO_FAULT_KINDS, "a name for every fault kind");
 
-static const char *fault_name(uint32_t bit)
+/* Name of fault kind i (bit i of gyro_fault_t): the table is in bit order. */
+static const char *fault_kind_name(uint32_t i)
 {
-  for (size_t i = 0; i < FAULT_NAMES; i++) {
-    if (k_fault_names[i].bit == bit) return k_fault_names[i].name;
-  }
-  return "?";
+  return i < FAULT_NAMES && k_fault_names[i].bit == (1u << i) ? k_fault_names[i].name : "?";
 }
 
-static void put_faults(cli_t *cli, uint32_t f)
+/* The names of the bits set in `bits` (of n kinds), comma separated; "none" for none. */
+static void put_bit_names(cli_t *cli, uint32_t bits, uint32_t n, const char *(*name)(uint32_t))
 {
-  if (f == 0u) {
+  if (bits == 0u) {
     cli_put(cli, "none");
     return;
   }
   int first = 1;
-  for (size_t i = 0; i < FAULT_NAMES; i++) {
-    if ((f & k_fault_names[i].bit) != 0u) {
+  for (uint32_t i = 0; i < n; i++) {
+    if ((bits & (1u << i)) != 0u) {
       if (!first) cli_put(cli, ",");
-      cli_put(cli, k_fault_names[i].name);
+      cli_put(cli, name(i));
       first = 0;
     }
   }
+}
+
+static void put_faults(cli_t *cli, uint32_t f)
+{
+  put_bit_names(cli, f, GYRO_FAULT_KINDS, fault_kind_name);
 }
 
 /* Output integrity (rate_valid.h, supervisor.h): the verdict with its reasons, then one
@@ -57,18 +61,7 @@ static void put_faults(cli_t *cli, uint32_t f)
  * power-on of its latest onset). */
 static void put_reasons(cli_t *cli, uint32_t r)
 {
-  if (r == 0u) {
-    cli_put(cli, "none");
-    return;
-  }
-  int first = 1;
-  for (uint32_t i = 0; i < RATE_INVALID_KINDS; i++) {
-    if ((r & (1u << i)) != 0u) {
-      if (!first) cli_put(cli, ",");
-      cli_put(cli, rate_valid_reason_name(i));
-      first = 0;
-    }
-  }
+  put_bit_names(cli, r, RATE_INVALID_KINDS, rate_valid_reason_name);
 }
 
 static void put_monitor(cli_t *cli, const char *kind, const char *name, uint32_t count, float t_s)
@@ -99,7 +92,7 @@ static void put_integrity(cli_t *cli, const app_t *a)
   }
   for (uint32_t i = 0; i < GYRO_FAULT_KINDS; i++) {
     if (g->sup.kind_count[i] != 0u) {
-      put_monitor(cli, "fault_", fault_name(1u << i), g->sup.kind_count[i],
+      put_monitor(cli, "fault_", fault_kind_name(i), g->sup.kind_count[i],
                   (float)g->sup.kind_last_step[i] * block_s);
     }
   }

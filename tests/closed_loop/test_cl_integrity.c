@@ -35,22 +35,34 @@ static void test_healthy_default_part(void **state)
   assert_true(j.valid_after_0p3 >= 0.95 * j.blocks_after_0p3);
 }
 
-static void test_resonance_60hz_off(void **state)
-{
-  (void)state;
-  plant_cfg_t pc;
-  default_part(&pc);
-  pc.f_drive_hz = 1550.0;
-  run_case("f_drive 1550 Hz", &pc, NULL, 2.0);
-}
 
-static void test_resonance_40hz_off(void **state)
+
+/* Parts other than the default, on the default firmware values: each plant setting
+ * that differs (0: the default part's), and how long to judge it. */
+typedef struct {
+  const char *name;
+  double f_drive_hz, q_drive, quad_dps, rate_dps;
+  double run_s;
+} part_case_t;
+
+static part_case_t k_parts[] = { /* not const: cmocka passes it as void * */
+    {"f_drive 1550 Hz", 1550.0, 0.0, 0.0, 0.0, 2.0},   /* 60 Hz from drive.freq_hz */
+    {"f_drive 1530 Hz", 1530.0, 0.0, 0.0, 0.0, 2.0},   /* locks with P 60 deg off */
+    {"Q 10000, defaults", 0.0, 10000.0, 0.0, 0.0, 3.0}, /* beyond the default design */
+    {"quad 4000, rate 100", 0.0, 0.0, 4000.0, 100.0, 1.5}, /* sense ADC clips at peaks */
+    {"rate 3000", 0.0, 0.0, 0.0, 3000.0, 1.5},          /* ten times full scale */
+};
+
+static void test_part(void **state)
 {
-  (void)state;
+  const part_case_t *c = *state;
   plant_cfg_t pc;
   default_part(&pc);
-  pc.f_drive_hz = 1530.0;
-  run_case("f_drive 1530 Hz", &pc, NULL, 2.0);
+  if (c->f_drive_hz > 0.0) pc.f_drive_hz = c->f_drive_hz;
+  if (c->q_drive > 0.0) pc.q_drive = c->q_drive;
+  if (c->quad_dps > 0.0) pc.quad_dps = c->quad_dps;
+  if (c->rate_dps > 0.0) pc.rate_dps = c->rate_dps;
+  run_case(c->name, &pc, NULL, c->run_s);
 }
 
 /* Two in-range phase setpoints over the command line: the loop must not pin P. */
@@ -95,33 +107,8 @@ static void test_q5000_calibrated_warm(void **state)
   run_case("Q 5000 calibrated, +22.5 K", &pc, &v, 3.0);
 }
 
-static void test_q10000_defaults(void **state)
-{
-  (void)state;
-  plant_cfg_t pc;
-  default_part(&pc);
-  pc.q_drive = 10000.0;
-  run_case("Q 10000, defaults", &pc, NULL, 3.0);
-}
 
-static void test_quadrature_clips_sense_adc(void **state)
-{
-  (void)state;
-  plant_cfg_t pc;
-  default_part(&pc);
-  pc.quad_dps = 4000.0;
-  pc.rate_dps = 100.0;
-  run_case("quad 4000, rate 100", &pc, NULL, 1.5);
-}
 
-static void test_rate_beyond_range(void **state)
-{
-  (void)state;
-  plant_cfg_t pc;
-  default_part(&pc);
-  pc.rate_dps = 3000.0;
-  run_case("rate 3000", &pc, NULL, 1.5);
-}
 
 static void test_sense_vibration_10g(void **state)
 {
@@ -247,13 +234,13 @@ int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_healthy_default_part),
-      cmocka_unit_test(test_resonance_60hz_off),
-      cmocka_unit_test(test_resonance_40hz_off),
+      cmocka_unit_test_prestate(test_part, &k_parts[0]),
+      cmocka_unit_test_prestate(test_part, &k_parts[1]),
       cmocka_unit_test(test_phase_setpoint_walk),
       cmocka_unit_test(test_q5000_calibrated_warm),
-      cmocka_unit_test(test_q10000_defaults),
-      cmocka_unit_test(test_quadrature_clips_sense_adc),
-      cmocka_unit_test(test_rate_beyond_range),
+      cmocka_unit_test_prestate(test_part, &k_parts[2]),
+      cmocka_unit_test_prestate(test_part, &k_parts[3]),
+      cmocka_unit_test_prestate(test_part, &k_parts[4]),
       cmocka_unit_test(test_sense_vibration_10g),
       cmocka_unit_test(test_amplitude_setpoint_at_limit),
       cmocka_unit_test(test_drive_frequency_5000),
