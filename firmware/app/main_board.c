@@ -58,6 +58,15 @@ static void say(const char *s)
 static void board_status(cli_t *cli, void *ctx)
 {
   (void)ctx;
+  /* What status's isr_cycles_last / isr_cycles_max count on this image: the board's
+   * DWT cycles, or, in the emulator, SysTick counts under -icount, that is instructions
+   * scaled by the tick stretch (`emu`), not a core's cycles. */
+#ifdef STM32F4_QEMU
+  cli_put(cli, "isr_cycles_kind emulated_instructions_x_stretch");
+#else
+  cli_put(cli, "isr_cycles_kind dwt_cycles");
+#endif
+  cli_emit_data(cli);
   stm32f4_sample_stats_t st;
   stm32f4_sample_stats(&st);
   const struct {

@@ -103,9 +103,15 @@ def case_boot(emu, args):
     if st["mode"] != "LOCKED":
         return
     check(st["store"] == "no valid parameter image", f"defaults in use (store: {st['store']})")
+    check(st.get("isr_cycles_kind") == "emulated_instructions_x_stretch",
+          f"status names its ISR figures for what they are ({st.get('isr_cycles_kind')})")
     t = int(st["ticks"])
     if t < SETTLE_TICKS:
         emu.wait_ticks(SETTLE_TICKS - t)
+    st = emu.status()
+    check(st.get("rate_valid") == "1" and st.get("rate_out_v") != "-10",
+          f"the rate is valid once settled (rate_invalid {st.get('rate_invalid')}, "
+          f"rate_out_v {st.get('rate_out_v')})")
     points = []
     for rate in (60.0, -120.0):
         r = emu.command(f"emu rate {rate:g}")
