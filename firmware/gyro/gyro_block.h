@@ -63,6 +63,16 @@ void gyro_block_output(gyro_t *g, float u1_v, float u2_v);
  * excitation (from the next tick on) and NCO step, then the slot's job. */
 void gyro_block_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v);
 
+/* GYRO_SLOT_PROJECT, in every mode: the rail codes of the ticks whose sense sum is
+ * projected now (the verdict's and, drive channel only, the supervisor's evidence). */
+static inline void gyro_block_take_rails(gyro_t *g)
+{
+  g->clip_block = g->clip_count;
+  g->clip_count = 0u;
+  g->clip_drive_block = g->clip_drive_count;
+  g->clip_drive_count = 0u;
+}
+
 /* The job of tick `slot` of the block. Every branch ends in one call (a tail call). */
 static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
 {
@@ -86,11 +96,7 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
     break;
   case GYRO_SLOT_PROJECT:
     /* The clear resets the rate channel, whose projection waits for the next block. */
-    /* The rail codes of the ticks whose sense sum is projected now. */
-    g->clip_block = g->clip_count;
-    g->clip_count = 0u;
-    g->clip_drive_block = g->clip_drive_count;
-    g->clip_drive_count = 0u;
+    gyro_block_take_rails(g);
     if (g->sup.clear_req != 0u) {
       gyro_block_clear(g);
     } else {
@@ -153,10 +159,7 @@ static inline void gyro_block_run_sweep(gyro_t *g, uint32_t slot, float u1_v, fl
     (void)supervisor_step(&g->sup, &g->sup_in);
     break;
   case GYRO_SLOT_PROJECT:
-    g->clip_block = g->clip_count;
-    g->clip_count = 0u;
-    g->clip_drive_block = g->clip_drive_count;
-    g->clip_drive_count = 0u;
+    gyro_block_take_rails(g);
     if (g->sup.clear_req != 0u) gyro_block_clear(g);
     break;
   case GYRO_SLOT_QUAD:
