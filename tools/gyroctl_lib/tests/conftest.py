@@ -9,6 +9,7 @@ Run by hand from a configured tree, e.g.
     FW_PTY_HOST=build/host/tests/fw_pty_host python3 -m pytest tools/gyroctl_lib/tests
 """
 import os
+import subprocess
 import sys
 
 import pytest
@@ -43,3 +44,23 @@ def gyro_sim():
 @pytest.fixture(scope="session")
 def gyroctl():
     return [sys.executable, os.path.join(TOOLS, "gyroctl")]
+
+
+@pytest.fixture
+def sim(gyro_sim, tmp_path):
+    """gyro-sim on the startup scenario with its command line on a pty (real time, at
+    most 120 s): the pty's path."""
+    scen = os.path.join(os.environ.get("GYRO_SCENARIOS", ""), "startup.json")
+    if not os.path.exists(scen):
+        pytest.skip("GYRO_SCENARIOS not set")
+    link = str(tmp_path / "gyro.pty")
+    proc = subprocess.Popen([gyro_sim, "--scenario", scen, "--duration", "120", "--quiet",
+                             f"--uart-pty={link}"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    line = proc.stdout.readline().split()
+    if len(line) != 2 or line[0] != "pty":
+        proc.kill()
+        pytest.fail(f"gyro-sim did not start: {line} {proc.stderr.read()}")
+    yield link
+    proc.terminate()
+    proc.wait(timeout=10)

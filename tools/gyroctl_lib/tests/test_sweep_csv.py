@@ -21,22 +21,6 @@ Q_PLANT = 33.33
 SIM_SWEEP_PHASE_DEG = -115.6   # gyro-sim's open-loop sweep scenario at resonance (README)
 
 
-@pytest.fixture
-def sim(gyro_sim, tmp_path):
-    scen = os.path.join(os.environ.get("GYRO_SCENARIOS", ""), "startup.json")
-    if not os.path.exists(scen):
-        pytest.skip("GYRO_SCENARIOS not set")
-    link = str(tmp_path / "gyro.pty")
-    proc = subprocess.Popen([gyro_sim, "--scenario", scen, "--duration", "120", "--quiet",
-                             f"--uart-pty={link}"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
-    line = proc.stdout.readline().split()
-    if len(line) != 2 or line[0] != "pty":
-        proc.kill()
-        pytest.fail(f"gyro-sim did not start: {line} {proc.stderr.read()}")
-    yield link
-    proc.terminate()
-    proc.wait(timeout=10)
 
 
 def ctl(gyroctl, port, *args, timeout=90):
