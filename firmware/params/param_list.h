@@ -67,8 +67,9 @@
   /* DC+AC only: force = 4 Ks D A (6-21); 5 V leaves headroom under u_max for A */ \
   X(drive_dc_bias_v, 0x010Au, "drive.dc_bias_v", F32, "V", 0.0f, 15.0f, 5.0f, 0u, \
     PF_PERSIST | PF_LIVE, "DC bias D of the DC+AC drive (unused in half-frequency mode)") \
-  /* the force phase P at lock on the default plant at 25 degC; acquisition starts there */ \
-  X(drive_p_init_deg, 0x010Bu, "drive.p_init_deg", F32, "deg", -360.0f, 360.0f, 25.7f, 0u, \
+  /* the force phase P at lock on the default plant at 25 degC ambient (its low-pass reads
+   * 25.747..25.751 in the startup scenario); acquisition starts there */ \
+  X(drive_p_init_deg, 0x010Bu, "drive.p_init_deg", F32, "deg", -360.0f, 360.0f, 25.75f, 0u, \
     PF_PERSIST | PF_LIVE, "force phase P the phase loop starts from, and the reference of P's low-pass") \
   /* 7.2.2 sweep */ \
   X(drive_cal_f0_hz, 0x010Cu, "drive.cal_f0_hz", F32, "Hz", 100.0f, 20000.0f, 1489.9f, 0u, \
@@ -141,9 +142,11 @@
   /* a quarter of the 1 deg/s the output-integrity battery allows, each source alone */ \
   X(rate_valid_tol_dps, 0x0311u, "rate.valid_tol_dps", F32, "deg/s", 0.01f, 100.0f, 0.25f, 0u, \
     PF_PERSIST | PF_LIVE, "largest rate error a monitored source (phase, thermometer, settling) may leave while valid") \
-  /* 8 deg of P is about +-100 K on the air part (0.0765 deg/K): the default covers its
-   * whole -40..85 degC; a calibration narrows it to the range it was fitted over */ \
-  X(rate_p_range_deg, 0x0312u, "rate.p_range_deg", F32, "deg", 0.01f, 180.0f, 8.0f, 0u, \
+  /* the shipped values carry no temperature compensation: on the default plant the bias
+   * moves 34.9 (deg/s)/deg of P (0.0765 deg/K), so they hold within 1 deg/s only for
+   * 0.025 deg of P (+-0.33 K) around P at lock; a temperature calibration widens it to
+   * the range it was fitted over */ \
+  X(rate_p_range_deg, 0x0312u, "rate.p_range_deg", F32, "deg", 0.001f, 180.0f, 0.025f, 0u, \
     PF_PERSIST | PF_LIVE, "thermometer range: largest |P_f - drive.p_init_deg| the compensation holds for") \
   /* 0.05 deg/s of P: 0.65 K/s on the air part, far above any thermal ramp it was run on */ \
   X(rate_p_slew_max_deg_s, 0x0313u, "rate.p_slew_max_deg_s", F32, "deg/s", 0.001f, 100.0f, 0.05f, 0u, \

@@ -81,7 +81,15 @@ static void test_phase_setpoint_walk(void **state)
   judge_run(&j, 2.0);
   judge_print("phase set -179 then 2", &j);
   judge_assert(&j);
-  /* Not a dead end: the drive is locked again on the new setpoint, the rate valid. */
+  /* Locked on the new setpoint; P, which moved with it, is now 2 deg from the
+   * thermometer's reference, beyond the range the (uncompensated) shipped values hold
+   * for: not valid. */
+  assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
+  assert_false(rate_valid_now());
+  /* Not a dead end: back on the setpoint the values were taken at, valid again. */
+  assert_true(strncmp(cmd("set drive.phase_set_deg 0\n"), "ok", 2) == 0);
+  judge_run(&j, 2.0);
+  judge_assert(&j);
   assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
   assert_true(rate_valid_now());
 }
