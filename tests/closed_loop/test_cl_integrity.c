@@ -41,16 +41,19 @@ static void test_healthy_default_part(void **state)
  * that differs (0: the default part's), and how long to judge it. */
 typedef struct {
   const char *name;
-  double f_drive_hz, q_drive, quad_dps, rate_dps;
+  double f_drive_hz, q_drive, quad_dps, rate_dps, temp_k;
   double run_s;
 } part_case_t;
 
 static part_case_t k_parts[] = { /* not const: cmocka passes it as void * */
-    {"f_drive 1550 Hz", 1550.0, 0.0, 0.0, 0.0, 2.0},   /* 60 Hz from drive.freq_hz */
-    {"f_drive 1530 Hz", 1530.0, 0.0, 0.0, 0.0, 2.0},   /* locks with P 60 deg off */
-    {"Q 10000, defaults", 0.0, 10000.0, 0.0, 0.0, 3.0}, /* beyond the default design */
-    {"quad 4000, rate 100", 0.0, 0.0, 4000.0, 100.0, 1.5}, /* sense ADC clips at peaks */
-    {"rate 3000", 0.0, 0.0, 0.0, 3000.0, 1.5},          /* ten times full scale */
+    {"f_drive 1550 Hz", 1550.0, 0.0, 0.0, 0.0, 0.0, 2.0},   /* 60 Hz from drive.freq_hz */
+    {"f_drive 1530 Hz", 1530.0, 0.0, 0.0, 0.0, 0.0, 2.0},   /* locks with P 60 deg off */
+    {"Q 10000, defaults", 0.0, 10000.0, 0.0, 0.0, 0.0, 3.0}, /* beyond the default design */
+    {"quad 4000, rate 100", 0.0, 0.0, 4000.0, 100.0, 0.0, 1.5}, /* sense ADC clips at peaks */
+    {"rate 3000", 0.0, 0.0, 0.0, 3000.0, 0.0, 1.5},          /* ten times full scale */
+    /* uncompensated bias 67 / 93 deg/s away from where the shipped values were taken */
+    {"0 degC ambient", 0.0, 0.0, 0.0, 0.0, 273.15, 1.5},
+    {"60 degC ambient", 0.0, 0.0, 0.0, 0.0, 333.15, 1.5},
 };
 
 static void test_part(void **state)
@@ -62,6 +65,7 @@ static void test_part(void **state)
   if (c->q_drive > 0.0) pc.q_drive = c->q_drive;
   if (c->quad_dps > 0.0) pc.quad_dps = c->quad_dps;
   if (c->rate_dps > 0.0) pc.rate_dps = c->rate_dps;
+  if (c->temp_k > 0.0) pc.temp_k = c->temp_k;
   run_case(c->name, &pc, NULL, c->run_s);
 }
 
@@ -249,6 +253,8 @@ int main(void)
       cmocka_unit_test_prestate(test_part, &k_parts[2]),
       cmocka_unit_test_prestate(test_part, &k_parts[3]),
       cmocka_unit_test_prestate(test_part, &k_parts[4]),
+      cmocka_unit_test_prestate(test_part, &k_parts[5]),
+      cmocka_unit_test_prestate(test_part, &k_parts[6]),
       cmocka_unit_test(test_sense_vibration_10g),
       cmocka_unit_test(test_amplitude_setpoint_at_limit),
       cmocka_unit_test(test_drive_frequency_5000),
