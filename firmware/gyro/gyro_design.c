@@ -1,0 +1,233 @@
+/* gyro_design: the parameter values -> every module's configuration, in the
+ * background (libm allowed here, never in the sample path). The loop designs follow
+ * (6-12), (6-17); the rate channel's reference and compensation rate_channel.h. */
+#include "gyro/gyro.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "dsp/butter.h"
+#include "dsp/fastmath.h"
+#include "gyro/gyro_block.h"
+
+/* The absolute over-amplitude trip, as a fraction of the ADC's range: the highest
+ * drive-pickoff amplitude the ADC still measures with headroom for the carrier's noise. */
+#define GYRO_AMP_MAX_FRAC 0.95f
+
+/* How long acquisition may take before it is a fault (ACQ_TIMEOUT): the drive mode
+ * rings up within a few time constants 2Q/wn at full force (10 of them here), the
+ * slower loop settles within three of its time constants after that, lock needs its
+ * hold time, and 0.1 s covers the demodulator and the noise. The loops' bandwidths are
+ * those of the gains in use (manual gains included): K kp / (2 pi tau) for the
+ * first-order loops of drive_loop.h. */
+static double acq_timeout_s(const param_values_t *v, double tau_s, const gyro_design_t *t)
+{
+  const double bw_amp = (double)v->drive_cal_gain_v_per_v2 * (double)t->drive.amp_kp /
+                        (2.0 * FM_PI * tau_s);
+  const double bw_ph = (double)t->drive.phase_kp / (2.0 * FM_PI * tau_s);
+  double bw = bw_amp < bw_ph ? bw_amp : bw_ph;
+  if (!(bw > 1e-3)) bw = 1e-3; /* a loop of no gain: the hour below */
+  const double t_s = 0.1 + 10.0 * tau_s + 3.0 / (2.0 * FM_PI * bw) + (double)v->sup_lock_hold_s;
+  return t_s < 3600.0 ? t_s : 3600.0; /* an hour: beyond it the part is not acquiring */
+}
+
+/* Largest |dB/dP| of the bias polynomial (absolute P, rate_channel.h) over the
+ * thermometer's range around p_ref, from nine points: how far a lag of P_f moves the
+ * compensation. */
+static double bias_slope_max(const param_values_t *v)
+{
+  const double c1 = (double)v->rate_bias_c1_dps_per_deg;
+  const double c2 = (double)v->rate_bias_c2_dps_per_deg2;
+  const double c3 = (double)v->rate_bias_c3_dps_per_deg3;
+  double m = 0.0;
+  for (int i = -4; i <= 4; i++) {
+    const double p = (double)v->drive_p_init_deg + 0.25 * i * (double)v->rate_p_range_deg;
+    const double d = fabs(c1 + 2.0 * c2 * p + 3.0 * c3 * p * p);
+    if (d > m) m = d;
+  }
+  return m;
+}
+
+/* The rate-valid monitors (rate_valid.h) and the analog fault level. The fault level
+ * must lie outside the span full scale x out_v_per_dps (with 10 % for the output
+ * stage's gain and offset), or a failed gyro could read as a rate. */
+static int design_validity(const param_values_t *v, gyro_design_t *t)
+{
+  const float span_v = v->rate_full_scale_dps * fm_absf(v->rate_out_v_per_dps);
+  if (!(fm_absf(v->rate_fault_out_v) > 1.1f * span_v)) return -1;
+  const double slope = bias_slope_max(v);
+  if (!isfinite(slope) || slope > 1e30) return -1;
+  const float sense_max_v = RATE_VALID_SENSE_FRAC * HAL_ADC_FULL_SCALE_V;
+  const float window_s = (float)(RATE_VALID_SLEW_UPDATES * RATE_P_DECIM) / (float)v->sys_fs_hz;
+  const rate_valid_cfg_t c = {v->rate_valid_tol_dps,
+                              v->rate_full_scale_dps,
+                              v->rate_p_range_deg,
+                              v->rate_p_slew_max_deg_s * window_s,
+                              (float)(1.0 / (2.0 * FM_PI * (double)v->rate_p_lpf_hz)) / window_s,
+                              sense_max_v * sense_max_v,
+                              v->sup_lock_phase_tol_deg * FM_RAD_PER_DEG_F,
+                              (float)slope};
+  t->valid = c;
+  t->rate_fault_out_v = v->rate_fault_out_v;
+  return 0;
+}
+
+/* Continuous self-test's LMS: a convergence time constant of 0.1 s, 2 / mu blocks for
+ * two weights on a reference of power 1/2 each (a notch about 3 Hz wide); its response
+ * is judged after five of them. */
+#define GYRO_CONT_TAU_S 0.1
+
+/* Both self-tests (selftest.h). Their expectations were measured at the setpoint
+ * selftest.ref_amp_v; the rate channel divides by the setpoint, so a response in deg/s
+ * scales as ref_amp_v / amp_set_v. The continuous test's tone must lie above the rate's
+ * output band (the notch would otherwise take rate out of it) and below a quarter of
+ * the block rate. */
+static int design_selftest(const param_values_t *v, gyro_design_t *t)
+{
+  const double th = (double)v->drive_phase_set_deg * FM_PI / 180.0;
+  const double amp_k = (double)v->selftest_ref_amp_v / (double)v->drive_amp_set_v;
+  const double block_hz = (double)v->sys_fs_hz / GYRO_BLOCK;
+  selftest_cfg_t st;
+  memset(&st, 0, sizeof st);
+  st.amp_v = v->selftest_amp_v;
+  st.expect_dps = (float)((double)v->selftest_expect_dps * amp_k);
+  st.tol_rel = v->selftest_tol_rel;
+  st.ref_c = (float)cos(th);
+  st.ref_s = (float)sin(th);
+  st.scale_dps = v->rate_scale_dps;
+  st.base_blocks = v->sys_fs_hz / (5u * GYRO_BLOCK); /* 0.2 s */
+  st.settle_blocks = v->sys_fs_hz / (10u * GYRO_BLOCK); /* 0.1 s */
+  st.meas_blocks = v->sys_fs_hz / (5u * GYRO_BLOCK);    /* 0.2 s */
+  st.cont_on = v->selftest_continuous;
+  st.cont_amp_v = v->selftest_cont_amp_v;
+  const double f_m = (double)v->selftest_cont_freq_hz;
+  if (st.cont_on != 0u && !(f_m >= 1.5 * (double)v->rate_lpf_cutoff_hz && f_m <= block_hz / 4.0)) {
+    return -1;
+  }
+  st.cont_step = (uint32_t)(f_m / block_hz * 4294967296.0 + 0.5);
+  st.cont_mu = (float)(2.0 / (GYRO_CONT_TAU_S * block_hz));
+  st.cont_gain = 1.0f - 0.5f * st.cont_mu;
+  st.cont_settle_blocks = (uint32_t)(5.0 * GYRO_CONT_TAU_S * block_hz);
+  const double scale = fabs((double)v->rate_scale_dps);
+  const double e = scale > 0.0 ? (double)v->selftest_cont_expect_dps * amp_k / scale : 0.0;
+  const double tol = (double)v->selftest_tol_rel;
+  if (st.cont_on != 0u && !(e > 0.0 && tol < 1.0)) return -1;
+  st.cont_lo2 = (float)(e * e * (1.0 - tol) * (1.0 - tol));
+  st.cont_hi2 = (float)(e * e * (1.0 + tol) * (1.0 + tol));
+  t->selftest = st;
+  return 0;
+}
+
+int gyro_design(const param_values_t *v, gyro_design_t *d)
+{
+  if (v == NULL || d == NULL) {
+    return -1;
+  }
+  const float fs_f = (float)v->sys_fs_hz;
+  if (!(fs_f > 0.0f) || !(v->drive_freq_hz < 0.25f * fs_f)) {
+    return -1;
+  }
+  gyro_design_t t;
+  memset(&t, 0, sizeof t);
+  const double fs = (double)v->sys_fs_hz;
+  t.fs_hz = fs_f;
+  const nco_cfg_t nc = {(double)v->drive_freq_hz, fs, 0.0};
+  nco_t probe_nco;
+  if (nco_init(&probe_nco, &nc) != 0) return -1;
+  t.nco = nc;
+  t.nco_half_step = probe_nco.half_step;
+  t.lmsd_drive.mu = v->demod_mu_drive;
+  t.lmsd_sense.mu = v->demod_mu_sense;
+
+  t.synth.mode = v->drive_mode == 1u ? GYRO_DRIVE_DC_AC : GYRO_DRIVE_HALF_FREQ;
+  t.synth.dc_bias_v = v->drive_dc_bias_v;
+  t.synth.u_max_v = v->drive_u_max_v;
+  drive_synth_t probe;
+  if (drive_synth_init(&probe, &t.synth) != 0) return -2;
+
+  /* (6-12), (6-17): amplitude and phase of the drive vibration follow force amplitude
+   * and phase as first-order lags of time constant 2 Q / wn. */
+  const double tau = 2.0 * (double)v->drive_cal_q / (2.0 * FM_PI * (double)v->drive_cal_f0_hz);
+  const double demod_bw = lmsd_bandwidth_hz((double)v->demod_mu_drive, fs);
+  if (!(demod_bw > 0.0)) return -3;
+  const double blk = (double)GYRO_BLOCK;
+  /* The loops run once per block; each measures on its own tick and the command goes
+   * to the synthesis on GYRO_SLOT_COMMAND, reaching the DAC frame one tick later (the
+   * jobs run after their tick's frame). */
+  const double amp_lag = (double)((GYRO_SLOT_COMMAND + GYRO_BLOCK - GYRO_SLOT_AMP) % GYRO_BLOCK + 1u);
+  const double ph_lag =
+      (double)((GYRO_SLOT_COMMAND + GYRO_BLOCK - GYRO_SLOT_PHASE_MEAS) % GYRO_BLOCK + 1u);
+  const drive_loop_design_in_t amp_in = {(double)v->drive_cal_gain_v_per_v2, tau,
+                                         (double)v->drive_amp_bw_hz, demod_bw, fs, blk, amp_lag};
+  const drive_loop_design_in_t ph_in = {1.0, tau, (double)v->drive_phase_bw_hz, demod_bw, fs, blk,
+                                        ph_lag};
+  if (drive_loop_design(&amp_in, &t.amp_design) != 0 ||
+      drive_loop_design(&ph_in, &t.phase_design) != 0) {
+    return -4;
+  }
+  t.drive.dt_s = (float)GYRO_BLOCK / fs_f; /* the loops run once per block */
+  t.drive.amp_set_v = v->drive_amp_set_v;
+  t.drive.phase_set_rad = v->drive_phase_set_deg * FM_RAD_PER_DEG_F;
+  const int manual_amp = v->drive_amp_kp > 0.0f || v->drive_amp_ki > 0.0f;
+  const int manual_ph = v->drive_phase_kp > 0.0f || v->drive_phase_ki > 0.0f;
+  t.drive.amp_kp = manual_amp ? v->drive_amp_kp : (float)t.amp_design.kp;
+  t.drive.amp_ki = manual_amp ? v->drive_amp_ki : (float)t.amp_design.ki;
+  t.drive.phase_kp = manual_ph ? v->drive_phase_kp : (float)t.phase_design.kp;
+  t.drive.phase_ki = manual_ph ? v->drive_phase_ki : (float)t.phase_design.ki;
+  t.drive.f_cmd_max_v2 = drive_synth_f_cmd_max(&probe);
+  t.drive.p_init_rad = v->drive_p_init_deg * FM_RAD_PER_DEG_F;
+
+  const int n = butter_design(BUTTER_LOWPASS, v->rate_lpf_order, (double)v->rate_lpf_cutoff_hz,
+                              0.0, fs / RATE_DECIM, t.rate_lpf, BIQUAD_MAX_SECTIONS);
+  if (n <= 0) return -5;
+  /* Reference of the rate channel: the drive motion as the loops hold it (phase at
+   * its setpoint, amplitude at its setpoint), turned by the demodulation phase. */
+  const double psi =
+      ((double)v->rate_demod_phase_deg + (double)v->drive_phase_set_deg) * FM_PI / 180.0;
+  t.rate.ref_re = (float)(cos(psi) / (double)v->drive_amp_set_v);
+  t.rate.ref_im = (float)(sin(psi) / (double)v->drive_amp_set_v);
+  t.rate.scale_dps = v->rate_scale_dps;
+  t.rate.bias_c_dps[0] = v->rate_bias_c0_dps;
+  t.rate.bias_c_dps[1] = v->rate_bias_c1_dps_per_deg;
+  t.rate.bias_c_dps[2] = v->rate_bias_c2_dps_per_deg2;
+  t.rate.bias_c_dps[3] = v->rate_bias_c3_dps_per_deg3;
+  t.rate.sf_c[1] = v->rate_sf_c1_per_deg;
+  t.rate.sf_c[2] = v->rate_sf_c2_per_deg2;
+  t.rate.sf_c[3] = v->rate_sf_c3_per_deg3;
+  t.rate.p_ref_deg = v->drive_p_init_deg;
+  /* First-order low-pass of P at the decimated rate fs / RATE_P_DECIM. */
+  t.rate.p_lpf_alpha =
+      (float)(1.0 - exp(-2.0 * FM_PI * (double)v->rate_p_lpf_hz * RATE_P_DECIM / fs));
+  t.rate.lpf = NULL; /* gyro_init/gyro_apply point it at t.rate_lpf where it is used */
+  t.rate.p_mode_k = (float)(1.0 - exp(-blk / (fs * tau))); /* per block */
+  t.rate.lpf_sections = (uint32_t)n;
+  t.rate.min_drive_v = 0.05f * v->drive_amp_set_v;
+  t.rate_out_v_per_dps = v->rate_out_v_per_dps;
+
+  t.sup.dt_s = (float)GYRO_BLOCK / fs_f;
+  t.sup.lock_tol_rel = v->sup_lock_tol_rel;
+  t.sup.lock_phase_tol_rad = v->sup_lock_phase_tol_deg * FM_RAD_PER_DEG_F;
+  t.sup.lock_hold_s = v->sup_lock_hold_s;
+  t.sup.lost_tol_rel = v->sup_lost_tol_rel;
+  t.sup.lost_hold_s = v->sup_lost_hold_s;
+  t.sup.amp_trip_rel = v->sup_amp_trip_rel;
+  t.sup.sat_hold_s = v->sup_sat_hold_s;
+  t.sup.retry_s = v->sup_retry_s;
+  t.sup.clip_max_count = v->sup_clip_count;
+  t.sup.lost_phase_tol_rad = (v->sup_lost_phase_tol_deg > v->sup_lock_phase_tol_deg
+                                  ? v->sup_lost_phase_tol_deg
+                                  : v->sup_lock_phase_tol_deg) * FM_RAD_PER_DEG_F;
+  t.sup.amp_set_v = v->drive_amp_set_v;
+  t.sup.amp_max_v = GYRO_AMP_MAX_FRAC * HAL_ADC_FULL_SCALE_V;
+  t.sup.acq_timeout_s = (float)acq_timeout_s(v, tau, &t);
+  if (design_validity(v, &t) != 0) return -7;
+  t.autostart = v->sys_autostart;
+  if (design_selftest(v, &t) != 0) return -8;
+  /* Every module must accept its part: a design that gyro_apply could not apply is
+   * rejected here, in the background, where the error can be reported. */
+  gyro_t scratch;
+  if (gyro_init_from_design(&scratch, &t) != 0) return -6;
+  *d = t;
+  return 0;
+}
