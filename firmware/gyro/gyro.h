@@ -41,7 +41,6 @@
 /* Everything the parameters turn into (background, double-precision design): the
  * derived block of the parameter bank, applied by the ISR at a tick boundary. */
 typedef struct {
-  float fs_hz;
   nco_cfg_t nco;
   uint32_t nco_half_step;
   lmsd_cfg_t lmsd_drive, lmsd_sense;

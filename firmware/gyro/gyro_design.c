@@ -130,7 +130,6 @@ static gyro_design_status_t design_nco(const param_values_t *v, gyro_design_t *t
   const nco_cfg_t nc = {(double)v->drive_freq_hz, (double)v->sys_fs_hz, 0.0};
   nco_t probe;
   if (nco_init(&probe, &nc) != 0) return GYRO_DESIGN_DRIVE_FREQ;
-  t->fs_hz = fs_f;
   t->nco = nc;
   t->nco_half_step = probe.half_step;
   return GYRO_DESIGN_OK;

@@ -157,7 +157,6 @@ static void post_steps(selfcal_t *s, double f_c, double hb, double tau_s, double
   j.avg_ticks = ticks_of(SC_AVG_S, c->fs_hz);
   s->plan_f_hz = f_c;
   s->plan_hb_hz = hb;
-  s->plan_tau_s = tau_s;
   post(s, &j, SELFCAL_FINE);
 }
 
