@@ -49,6 +49,7 @@ static void mu_drive_high(param_values_t *v) { v->demod_mu_drive = 0.6f; }
 static void mu_sense_zero(param_values_t *v) { v->demod_mu_sense = 0.0f; }
 static void cal_gain_zero(param_values_t *v) { v->drive_cal_gain_v_per_v2 = 0.0f; }
 static void phase_bw_zero(param_values_t *v) { v->drive_phase_bw_hz = 0.0f; }
+static void p_init_beyond_reach(param_values_t *v) { v->drive_p_init_deg = 356.0f; }
 static void lpf_above_nyquist(param_values_t *v) { v->rate_lpf_cutoff_hz = 3000.0f; }
 static void lpf_odd_order(param_values_t *v) { v->rate_lpf_order = 3u; }
 static void amp_set_over_adc(param_values_t *v) { v->drive_amp_set_v = 4.9f; }
@@ -65,6 +66,7 @@ static const refusal_t k_refusals[] = {
     {GYRO_DESIGN_MU_SENSE, "demod.mu_sense", mu_sense_zero},
     {GYRO_DESIGN_AMP_LOOP, "drive.cal_gain_v_per_v2", cal_gain_zero},
     {GYRO_DESIGN_PHASE_LOOP, "drive.phase_bw_hz", phase_bw_zero},
+    {GYRO_DESIGN_P_INIT, "drive.p_init_deg", p_init_beyond_reach},
     {GYRO_DESIGN_RATE_LPF, "rate.lpf_cutoff_hz", lpf_above_nyquist},
     {GYRO_DESIGN_RATE_LPF, "rate.lpf_order", lpf_odd_order},
     {GYRO_DESIGN_AMP_SET, "drive.amp_set_v", amp_set_over_adc},
@@ -86,6 +88,11 @@ static void test_defaults_design(void **state)
   gyro_design_t d;
   assert_int_equal(gyro_design(&v, &d), GYRO_DESIGN_OK);
   assert_string_equal(gyro_design_reason(GYRO_DESIGN_OK), "");
+  /* The edges the reasons state: drive.p_init_deg within +-355 deg. */
+  v.drive_p_init_deg = -355.0f;
+  assert_int_equal(gyro_design(&v, &d), GYRO_DESIGN_OK);
+  v.drive_p_init_deg = -355.5f;
+  assert_int_equal(gyro_design(&v, &d), GYRO_DESIGN_P_INIT);
 }
 
 /* Each refusal gives its own status, leaves the output untouched, and its reason names
