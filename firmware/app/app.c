@@ -16,12 +16,12 @@ static int derive(void *ctx, const param_values_t *v, void *derived, const char 
 {
   (void)ctx;
   gyro_design_t *d = derived;
-  const int rc = gyro_design(v, d);
-  if (rc != 0) {
+  const gyro_design_status_t rc = gyro_design(v, d);
+  if (rc != GYRO_DESIGN_OK) {
     if (why != NULL) {
-      *why = "the drive or output filter cannot be designed from these values";
+      *why = gyro_design_reason(rc); /* names the parameters at fault */
     }
-    return rc;
+    return -(int)rc;
   }
   return 0;
 }

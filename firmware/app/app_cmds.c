@@ -177,6 +177,19 @@ static void put_store_now(cli_t *cli, app_t *a)
   cli_emit_data(cli);
 }
 
+/* What the loop designer achieved for the values in use (drive_loop.h): each drive
+ * loop's bandwidth and phase margin. Nonzero manual gains (drive.amp_kp ...) replace
+ * the designed ones in the loops; these lines still report the design. */
+static void put_design(cli_t *cli, const app_t *a)
+{
+  const gyro_design_t *d = params_current_derived(&a->params);
+  if (d == NULL) return;
+  cli_data_f32(cli, "design_amp_bw_hz", (float)d->amp_design.bw_hz);
+  cli_data_f32(cli, "design_amp_pm_deg", (float)d->amp_design.phase_margin_deg);
+  cli_data_f32(cli, "design_phase_bw_hz", (float)d->phase_design.bw_hz);
+  cli_data_f32(cli, "design_phase_pm_deg", (float)d->phase_design.phase_margin_deg);
+}
+
 static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
 {
   (void)argv;
@@ -202,6 +215,7 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   cli_data_f32(cli, "p_deg", o->p_deg);
   cli_data_f32(cli, "p_f_deg", o->p_f_deg);
   cli_data_f32(cli, "f_cmd_v2", o->f_cmd_v2);
+  put_design(cli, a);
   cli_data_u32(cli, "ticks", a->isr_ticks);
   uint32_t cyc_last, cyc_max;
   hal_sample_isr_cycles(&cyc_last, &cyc_max);

@@ -13,7 +13,7 @@ static int noise_valid(float q, float r)
 int kfd_init(kfd_t *s, const kfd_cfg_t *cfg)
 {
   if (s == NULL || cfg == NULL || !noise_valid(cfg->q, cfg->r) ||
-      !(cfg->p0 > 0.0f && cfg->p0 <= KFD_P0_MAX)) {
+      !cov2_p0_valid(cfg->p0)) {
     return -1;
   }
   s->q = cfg->q;
@@ -40,9 +40,7 @@ void kfd_reset(kfd_t *s)
 {
   s->x_i = 0.0f;
   s->x_q = 0.0f;
-  s->p11 = s->p0;
-  s->p12 = 0.0f;
-  s->p22 = s->p0;
+  cov2_restart(&s->cov, s->p0);
 }
 
 int kfd_preset(kfd_t *s, float in_phase, float quadrature)
@@ -58,16 +56,16 @@ int kfd_preset(kfd_t *s, float in_phase, float quadrature)
 void kfd_step(kfd_t *s, float z, float ref_sin, float ref_cos)
 {
   /* Prediction with A = I: x- = x, P- = P + Q (paused above the trace bound). */
-  const float qk = (s->p11 + s->p22 < s->trace_max) ? s->q : 0.0f;
-  const float a11 = s->p11 + qk;
-  const float a12 = s->p12;
-  const float a22 = s->p22 + qk;
+  const float qk = (cov2_trace(&s->cov) < s->trace_max) ? s->q : 0.0f;
+  const float a11 = s->cov.p11 + qk;
+  const float a12 = s->cov.p12;
+  const float a22 = s->cov.p22 + qk;
 
   const float innov = z - (s->x_i * ref_sin + s->x_q * ref_cos);
   const float g1 = a11 * ref_sin + a12 * ref_cos; /* g = P- r */
   const float g2 = a12 * ref_sin + a22 * ref_cos;
   const float sv = ref_sin * g1 + ref_cos * g2 + s->r; /* innovation variance */
-  if (!(fabsf(innov) <= FLT_MAX) || !(sv > 0.0f && sv <= FLT_MAX)) {
+  if (!cov2_usable(innov, sv)) {
     s->skipped++;
     return;
   }
@@ -91,14 +89,5 @@ void kfd_step(kfd_t *s, float z, float ref_sin, float ref_cos)
   const float p11 = t11 * m11 + t12 * m12 + rk1 * k1;
   const float p12 = t11 * m21 + t12 * m22 + rk1 * k2;
   const float p22 = t21 * m21 + t22 * m22 + s->r * k2 * k2;
-  if (p11 > 0.0f && p22 > 0.0f && p11 * p22 > p12 * p12) {
-    s->p11 = p11;
-    s->p12 = p12;
-    s->p22 = p22;
-  } else {
-    s->p11 = s->p0;
-    s->p12 = 0.0f;
-    s->p22 = s->p0;
-    s->cov_resets++;
-  }
+  s->cov_resets += cov2_accept(&s->cov, p11, p12, p22, s->p0);
 }

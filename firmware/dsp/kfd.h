@@ -10,12 +10,12 @@
  *     g    = P- r,   s = r' g + R,   K = g / s
  *     x   += K (z - r' x)
  *     P    = (I - K r') P- (I - K r')' + K R K'     (Joseph form)
- * P is symmetric: only p11, p12, p22 are stored and only the upper triangle of the
+ * P is symmetric: only its upper triangle is stored (cov2.h) and only that of the
  * Joseph product is formed, so symmetry holds by construction; the Joseph form is a sum
  * of two positive semi-definite terms, so rounding cannot drive it indefinite the way
  * the short form P- - K g' can.
  *
- * Health guards as in rlsd.h: Q is added only while trace(P) < 4 p0 (with a reference
+ * Health guards as in rlsd.h (cov2.h): Q is added only while trace(P) < 4 p0 (with a reference
  * that excites one direction only, the random walk would otherwise grow P without
  * bound); a P that is not positive definite (or NaN) restarts at p0 I (cov_resets); a
  * non-finite innovation is ignored (skipped).
@@ -32,19 +32,20 @@
 
 #include <stdint.h>
 
+#include "dsp/cov2.h"
+
 #define KFD_Q_DEFAULT 0.0002f
 #define KFD_R_DEFAULT 0.3f
-#define KFD_P0_MAX 1.0e6f
 
 typedef struct {
   float q;  /* process noise Q = q I, q >= 0; thesis 0.0002 */
   float r;  /* measurement noise R > 0; thesis 0.3 */
-  float p0; /* P(0) = p0 I, 0 < p0 <= KFD_P0_MAX */
+  float p0; /* P(0) = p0 I, 0 < p0 <= COV2_P0_MAX */
 } kfd_cfg_t;
 
 typedef struct {
   float x_i, x_q;      /* state estimate [A1, A2] */
-  float p11, p12, p22; /* upper triangle of the symmetric P */
+  cov2_t cov;          /* P (cov2.h) */
   float q, r;          /* Q = q I, R */
   float p0;            /* restart value of P's diagonal */
   float trace_max;     /* 4 p0: Q is not added above it */
@@ -53,7 +54,7 @@ typedef struct {
 } kfd_t;
 
 /* Validate cfg; x = 0, P = p0 I, counters 0. Returns 0, or -1 and leaves *s unchanged
- * for a NULL pointer, q < 0, R <= 0, p0 not in (0, KFD_P0_MAX] or anything non-finite. */
+ * for a NULL pointer, q < 0, R <= 0, p0 not in (0, COV2_P0_MAX] or anything non-finite. */
 int kfd_init(kfd_t *s, const kfd_cfg_t *cfg);
 
 /* Change Q and R, keeping x and P (bumpless). Returns 0, or -1 and changes nothing. */

@@ -14,11 +14,14 @@ static int freq_valid(double freq_hz, double fs_hz)
          freq_hz < 0.5 * fs_hz;
 }
 
-/* round(f/fs * 2^31): f/fs < 1/2, so the result is below 2^30 and fits. */
-static uint32_t half_step_of(double freq_hz, double fs_hz)
+uint32_t nco_half_step_of(double freq_hz, double fs_hz)
 {
-  return (uint32_t)floor(freq_hz / fs_hz * 2147483648.0 + 0.5);
+  /* llround: the conversion of a negative value to uint32_t is then the defined one of
+   * an integer (modulo 2^32), never that of a double (undefined). */
+  return (uint32_t)llround(freq_hz / fs_hz * 2147483648.0);
 }
+
+double nco_freq_of(uint32_t half_step, double fs_hz) { return (double)half_step * fs_hz / 2147483648.0; }
 
 /* Move the wc phase by a signed change d (two's complement, [-pi, pi)): the wc/2
  * accumulator moves by d/2, an arithmetic shift written without relying on the
@@ -42,7 +45,7 @@ int nco_init(nco_t *nco, const nco_cfg_t *cfg)
     frac = 0.0; /* -tiny rounds up to exactly 1 turn */
   }
   nco->half_phase = (uint32_t)floor(frac * 2147483648.0 + 0.5);
-  nco->half_step = half_step_of(cfg->freq_hz, cfg->fs_hz);
+  nco->half_step = nco_half_step_of(cfg->freq_hz, cfg->fs_hz);
   return 0;
 }
 
@@ -51,7 +54,7 @@ int nco_set_freq(nco_t *nco, double freq_hz, double fs_hz)
   if (nco == NULL || !freq_valid(freq_hz, fs_hz)) {
     return -1;
   }
-  nco->half_step = half_step_of(freq_hz, fs_hz);
+  nco->half_step = nco_half_step_of(freq_hz, fs_hz);
   return 0;
 }
 

@@ -47,6 +47,16 @@ typedef struct {
                         * sincos_lut(half_phase + sincos_rad_to_phase(pc), ...) */
 } nco_out_t;
 
+/* The wc/2 phase step of a frequency: round(freq_hz / fs_hz * 2^31), halves away from
+ * zero; below fs_hz / 2 it is below 2^30. A negative frequency wraps modulo 2^32 (the
+ * oscillator turns backwards). The one conversion of a frequency to a step, for the
+ * NCO and for the self-calibration's sweep plans. Background: double, libm. */
+uint32_t nco_half_step_of(double freq_hz, double fs_hz);
+
+/* The frequency a step realises: half_step * fs_hz / 2^31 (within fs_hz / 2^32 of the
+ * frequency it was made from). */
+double nco_freq_of(uint32_t half_step, double fs_hz);
+
 /* Set frequency and phase. Returns 0, or -1 (nco unchanged) for a NULL pointer, a
  * non-finite value, fs_hz <= 0, or freq_hz outside [0, fs_hz/2). Init-time: uses double. */
 int nco_init(nco_t *nco, const nco_cfg_t *cfg);

@@ -1,6 +1,5 @@
 #include "dsp/rlsd.h"
 
-#include <float.h>
 #include <math.h>
 #include <stddef.h>
 
@@ -12,7 +11,7 @@ static int lambda_valid(float lambda)
 int rlsd_init(rlsd_t *s, const rlsd_cfg_t *cfg)
 {
   if (s == NULL || cfg == NULL || !lambda_valid(cfg->lambda) ||
-      !(cfg->p0 > 0.0f && cfg->p0 <= RLSD_P0_MAX)) {
+      !cov2_p0_valid(cfg->p0)) {
     return -1;
   }
   s->lambda = cfg->lambda;
@@ -40,9 +39,7 @@ void rlsd_reset(rlsd_t *s)
   /* Thesis initialisation: W(0) = 0, P(0) = I (scaled by p0). */
   s->w_i = 0.0f;
   s->w_q = 0.0f;
-  s->p11 = s->p0;
-  s->p12 = 0.0f;
-  s->p22 = s->p0;
+  cov2_restart(&s->cov, s->p0);
 }
 
 int rlsd_preset(rlsd_t *s, float in_phase, float quadrature)
@@ -59,12 +56,12 @@ void rlsd_step(rlsd_t *s, float d, float ref_sin, float ref_cos)
 {
   const float err = d - (s->w_i * ref_sin + s->w_q * ref_cos);
   /* g = P(k-1) phi(k), with P symmetric */
-  const float g1 = s->p11 * ref_sin + s->p12 * ref_cos;
-  const float g2 = s->p12 * ref_sin + s->p22 * ref_cos;
+  const float g1 = s->cov.p11 * ref_sin + s->cov.p12 * ref_cos;
+  const float g2 = s->cov.p12 * ref_sin + s->cov.p22 * ref_cos;
   const float den = s->lambda + ref_sin * g1 + ref_cos * g2;
   /* den >= lambda > 0 while P is positive definite; a non-finite err or den means a
    * corrupted sample or reference: leave the estimate alone. */
-  if (!(fabsf(err) <= FLT_MAX) || !(den > 0.0f && den <= FLT_MAX)) {
+  if (!cov2_usable(err, den)) {
     s->skipped++;
     return;
   }
@@ -75,18 +72,9 @@ void rlsd_step(rlsd_t *s, float d, float ref_sin, float ref_cos)
   s->w_q += k2 * err;
 
   /* Forgetting only below the trace bound (header: no covariance wind-up). */
-  const float f = (s->p11 + s->p22 < s->trace_max) ? s->inv_lambda : 1.0f;
-  const float p11 = (s->p11 - k1 * g1) * f;
-  const float p12 = (s->p12 - k1 * g2) * f;
-  const float p22 = (s->p22 - k2 * g2) * f;
-  if (p11 > 0.0f && p22 > 0.0f && p11 * p22 > p12 * p12) {
-    s->p11 = p11;
-    s->p12 = p12;
-    s->p22 = p22;
-  } else {
-    s->p11 = s->p0;
-    s->p12 = 0.0f;
-    s->p22 = s->p0;
-    s->cov_resets++;
-  }
+  const float f = (cov2_trace(&s->cov) < s->trace_max) ? s->inv_lambda : 1.0f;
+  const float p11 = (s->cov.p11 - k1 * g1) * f;
+  const float p12 = (s->cov.p12 - k1 * g2) * f;
+  const float p22 = (s->cov.p22 - k2 * g2) * f;
+  s->cov_resets += cov2_accept(&s->cov, p11, p12, p22, s->p0);
 }

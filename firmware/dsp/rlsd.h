@@ -18,7 +18,8 @@
  * along phi: about 3.5 % at the steady state P ~ 2 (1 - lambda) I, so there is no
  * cancellation and P stays well conditioned in float.
  *
- * Health guards (cheap compares, no effect in normal operation):
+ * Health guards (cheap compares, no effect in normal operation; the last two are
+ * shared with kfd.h in cov2.h):
  * - Bounded: the division by lambda (forgetting) is applied only while
  *   trace(P) < 4 p0. With a reference that does not excite both directions (a stopped
  *   NCO, a DC "carrier") plain RLS would grow P as lambda^-k until it overflows
@@ -39,17 +40,18 @@
 
 #include <stdint.h>
 
+#include "dsp/cov2.h"
+
 #define RLSD_LAMBDA_DEFAULT 0.982f
-#define RLSD_P0_MAX 1.0e6f
 
 typedef struct {
   float lambda; /* forgetting factor (5-6), 0 < lambda <= 1; thesis 0.982 */
-  float p0;     /* P(0) = p0 I, 0 < p0 <= RLSD_P0_MAX; thesis 1 */
+  float p0;     /* P(0) = p0 I, 0 < p0 <= COV2_P0_MAX; thesis 1 */
 } rlsd_cfg_t;
 
 typedef struct {
   float w_i, w_q;       /* estimates of A1 (sine coefficient), A2 (cosine coefficient) */
-  float p11, p12, p22;  /* upper triangle of the symmetric P */
+  cov2_t cov;           /* P (cov2.h) */
   float lambda;         /* forgetting factor */
   float inv_lambda;     /* 1 / lambda */
   float p0;             /* restart value of P's diagonal */
@@ -59,7 +61,7 @@ typedef struct {
 } rlsd_t;
 
 /* Validate cfg; W = 0, P = p0 I, counters 0. Returns 0, or -1 and leaves *s unchanged
- * for a NULL pointer, lambda not in (0, 1] or p0 not in (0, RLSD_P0_MAX]. */
+ * for a NULL pointer, lambda not in (0, 1] or p0 not in (0, COV2_P0_MAX]. */
 int rlsd_init(rlsd_t *s, const rlsd_cfg_t *cfg);
 
 /* Change lambda, keeping W and P (bumpless). Returns 0, or -1 and changes nothing. */

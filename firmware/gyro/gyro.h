@@ -41,7 +41,6 @@
 /* Everything the parameters turn into (background, double-precision design): the
  * derived block of the parameter bank, applied by the ISR at a tick boundary. */
 typedef struct {
-  float fs_hz;
   nco_cfg_t nco;
   uint32_t nco_half_step;
   lmsd_cfg_t lmsd_drive, lmsd_sense;
@@ -188,9 +187,41 @@ _Static_assert(GYRO_SLOT_PHASE_MEAS < GYRO_SLOT_PHASE_PI && GYRO_SLOT_PHASE_PI <
                    GYRO_SLOT_AMP < GYRO_SLOT_QUAD && GYRO_SLOT_OUTPUT == GYRO_BLOCK - 1u,
                "block jobs out of order (gyro.h slot table)");
 
+/* Why gyro_design refused a set of values: one status per check, each with a reason
+ * (gyro_design_reason) that names the parameters at fault by their user-visible names.
+ * GYRO_DESIGN_OK is 0, so `gyro_design(v, d) != 0` reads as "refused". */
+typedef enum {
+  GYRO_DESIGN_OK = 0,
+  GYRO_DESIGN_NO_VALUES,      /* no values or nowhere to put the design (a caller's bug) */
+  GYRO_DESIGN_FS,             /* sys.fs_hz */
+  GYRO_DESIGN_DRIVE_FREQ,     /* drive.freq_hz against sys.fs_hz */
+  GYRO_DESIGN_DRIVE_VOLTAGES, /* drive.u_max_v, drive.dc_bias_v (DC+AC) */
+  GYRO_DESIGN_MU_DRIVE,       /* demod.mu_drive */
+  GYRO_DESIGN_MU_SENSE,       /* demod.mu_sense */
+  GYRO_DESIGN_AMP_LOOP,       /* drive.cal_*, drive.amp_bw_hz */
+  GYRO_DESIGN_PHASE_LOOP,     /* drive.cal_f0_hz, drive.cal_q, drive.phase_bw_hz */
+  GYRO_DESIGN_P_INIT,         /* drive.p_init_deg against the phase conversion's reach */
+  GYRO_DESIGN_RATE_LPF,       /* rate.lpf_order, rate.lpf_cutoff_hz */
+  GYRO_DESIGN_AMP_SET,        /* drive.amp_set_v against the ADC's range */
+  GYRO_DESIGN_LOST_TOL,       /* sup.lost_tol_rel against sup.lock_tol_rel */
+  GYRO_DESIGN_AMP_TRIP,       /* sup.amp_trip_rel against sup.lost_tol_rel */
+  GYRO_DESIGN_FAULT_OUT,      /* rate.fault_out_v against the valid span */
+  GYRO_DESIGN_BIAS_SLOPE,     /* rate.bias_c*, rate.p_range_deg */
+  GYRO_DESIGN_CONT_FREQ,      /* selftest.cont_freq_hz against rate.lpf_cutoff_hz */
+  GYRO_DESIGN_CONT_EXPECT,    /* selftest.cont_expect_dps, selftest.tol_rel */
+  GYRO_DESIGN_MODULE,         /* a module refused its part: a value outside its range */
+  GYRO_DESIGN_STATUS_COUNT
+} gyro_design_status_t;
+
 /* Turn parameter values into module configurations, checking that every module
- * accepts its part. Returns 0, or a negative value (then *d is untouched). */
-int gyro_design(const param_values_t *v, gyro_design_t *d);
+ * accepts its part. Returns GYRO_DESIGN_OK, or the check that failed (then *d is
+ * untouched). Background only (double precision, libm). */
+gyro_design_status_t gyro_design(const param_values_t *v, gyro_design_t *d);
+
+/* The reason for a status, for `set` and the boot report: a constant string naming
+ * the parameters at fault ("drive.freq_hz must be below sys.fs_hz / 4"); "" for
+ * GYRO_DESIGN_OK and for values outside the enum. Never NULL, never allocated. */
+const char *gyro_design_reason(gyro_design_status_t s);
 
 /* Initialise from a design / from parameter values. Returns 0, or a negative value with
  * *g unchanged. Starts acquiring at once if sys.autostart. */

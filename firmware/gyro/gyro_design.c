@@ -52,12 +52,12 @@ static double bias_slope_max(const param_values_t *v)
 /* The rate-valid monitors (rate_valid.h) and the analog fault level. The fault level
  * must lie outside the span full scale x out_v_per_dps (with 10 % for the output
  * stage's gain and offset), or a failed gyro could read as a rate. */
-static int design_validity(const param_values_t *v, gyro_design_t *t)
+static gyro_design_status_t design_validity(const param_values_t *v, gyro_design_t *t)
 {
   const float span_v = v->rate_full_scale_dps * fm_absf(v->rate_out_v_per_dps);
-  if (!(fm_absf(v->rate_fault_out_v) > 1.1f * span_v)) return -1;
+  if (!(fm_absf(v->rate_fault_out_v) > 1.1f * span_v)) return GYRO_DESIGN_FAULT_OUT;
   const double slope = bias_slope_max(v);
-  if (!isfinite(slope) || slope > 1e30) return -1;
+  if (!isfinite(slope) || slope > 1e30) return GYRO_DESIGN_BIAS_SLOPE;
   const float sense_max_v = RATE_VALID_SENSE_FRAC * HAL_ADC_FULL_SCALE_V;
   const float window_s = (float)(RATE_VALID_SLEW_UPDATES * RATE_P_DECIM) / (float)v->sys_fs_hz;
   const rate_valid_cfg_t c = {v->rate_valid_tol_dps,
@@ -70,7 +70,7 @@ static int design_validity(const param_values_t *v, gyro_design_t *t)
                               (float)slope};
   t->valid = c;
   t->rate_fault_out_v = v->rate_fault_out_v;
-  return 0;
+  return GYRO_DESIGN_OK;
 }
 
 /* Continuous self-test's LMS: a convergence time constant of 0.1 s, 2 / mu blocks for
@@ -83,7 +83,7 @@ static int design_validity(const param_values_t *v, gyro_design_t *t)
  * scales as ref_amp_v / amp_set_v. The continuous test's tone must lie above the rate's
  * output band (the notch would otherwise take rate out of it) and below a quarter of
  * the block rate. */
-static int design_selftest(const param_values_t *v, gyro_design_t *t)
+static gyro_design_status_t design_selftest(const param_values_t *v, gyro_design_t *t)
 {
   const double th = (double)v->drive_phase_set_deg * FM_PI / 180.0;
   const double amp_k = (double)v->selftest_ref_amp_v / (double)v->drive_amp_set_v;
@@ -103,7 +103,7 @@ static int design_selftest(const param_values_t *v, gyro_design_t *t)
   st.cont_amp_v = v->selftest_cont_amp_v;
   const double f_m = (double)v->selftest_cont_freq_hz;
   if (st.cont_on != 0u && !(f_m >= 1.5 * (double)v->rate_lpf_cutoff_hz && f_m <= block_hz / 4.0)) {
-    return -1;
+    return GYRO_DESIGN_CONT_FREQ;
   }
   st.cont_step = (uint32_t)(f_m / block_hz * 4294967296.0 + 0.5);
   st.cont_mu = (float)(2.0 / (GYRO_CONT_TAU_S * block_hz));
@@ -112,122 +112,231 @@ static int design_selftest(const param_values_t *v, gyro_design_t *t)
   const double scale = fabs((double)v->rate_scale_dps);
   const double e = scale > 0.0 ? (double)v->selftest_cont_expect_dps * amp_k / scale : 0.0;
   const double tol = (double)v->selftest_tol_rel;
-  if (st.cont_on != 0u && !(e > 0.0 && tol < 1.0)) return -1;
+  if (st.cont_on != 0u && !(e > 0.0 && tol < 1.0)) return GYRO_DESIGN_CONT_EXPECT;
   st.cont_lo2 = (float)(e * e * (1.0 - tol) * (1.0 - tol));
   st.cont_hi2 = (float)(e * e * (1.0 + tol) * (1.0 + tol));
   t->selftest = st;
-  return 0;
+  return GYRO_DESIGN_OK;
 }
 
-int gyro_design(const param_values_t *v, gyro_design_t *d)
+
+/* The NCO at the drive frequency, below fs / 4: the 2 wc terms of the demodulation
+ * (lmsd.h) then stay below fs / 2. */
+static gyro_design_status_t design_nco(const param_values_t *v, gyro_design_t *t)
 {
-  if (v == NULL || d == NULL) {
-    return -1;
-  }
   const float fs_f = (float)v->sys_fs_hz;
-  if (!(fs_f > 0.0f) || !(v->drive_freq_hz < 0.25f * fs_f)) {
-    return -1;
-  }
-  gyro_design_t t;
-  memset(&t, 0, sizeof t);
+  if (!(fs_f > 0.0f)) return GYRO_DESIGN_FS;
+  if (!(v->drive_freq_hz < 0.25f * fs_f)) return GYRO_DESIGN_DRIVE_FREQ;
+  const nco_cfg_t nc = {(double)v->drive_freq_hz, (double)v->sys_fs_hz, 0.0};
+  nco_t probe;
+  if (nco_init(&probe, &nc) != 0) return GYRO_DESIGN_DRIVE_FREQ;
+  t->nco = nc;
+  t->nco_half_step = probe.half_step;
+  return GYRO_DESIGN_OK;
+}
+
+/* Both demodulators' step sizes: each must give the LMSD a bandwidth (lmsd.h). */
+static gyro_design_status_t design_demod(const param_values_t *v, gyro_design_t *t)
+{
   const double fs = (double)v->sys_fs_hz;
-  t.fs_hz = fs_f;
-  const nco_cfg_t nc = {(double)v->drive_freq_hz, fs, 0.0};
-  nco_t probe_nco;
-  if (nco_init(&probe_nco, &nc) != 0) return -1;
-  t.nco = nc;
-  t.nco_half_step = probe_nco.half_step;
-  t.lmsd_drive.mu = v->demod_mu_drive;
-  t.lmsd_sense.mu = v->demod_mu_sense;
+  if (!(lmsd_bandwidth_hz((double)v->demod_mu_drive, fs) > 0.0)) return GYRO_DESIGN_MU_DRIVE;
+  if (!(lmsd_bandwidth_hz((double)v->demod_mu_sense, fs) > 0.0)) return GYRO_DESIGN_MU_SENSE;
+  t->lmsd_drive.mu = v->demod_mu_drive;
+  t->lmsd_sense.mu = v->demod_mu_sense;
+  return GYRO_DESIGN_OK;
+}
 
-  t.synth.mode = v->drive_mode == 1u ? GYRO_DRIVE_DC_AC : GYRO_DRIVE_HALF_FREQ;
-  t.synth.dc_bias_v = v->drive_dc_bias_v;
-  t.synth.u_max_v = v->drive_u_max_v;
+/* The drive synthesis (scheme, bias, limit) and the force limit it gives the
+ * amplitude loop. */
+static gyro_design_status_t design_synth(const param_values_t *v, gyro_design_t *t)
+{
+  t->synth.mode = v->drive_mode == 1u ? GYRO_DRIVE_DC_AC : GYRO_DRIVE_HALF_FREQ;
+  t->synth.dc_bias_v = v->drive_dc_bias_v;
+  t->synth.u_max_v = v->drive_u_max_v;
   drive_synth_t probe;
-  if (drive_synth_init(&probe, &t.synth) != 0) return -2;
+  if (drive_synth_init(&probe, &t->synth) != 0) return GYRO_DESIGN_DRIVE_VOLTAGES;
+  t->drive.f_cmd_max_v2 = drive_synth_f_cmd_max(&probe);
+  return GYRO_DESIGN_OK;
+}
 
-  /* (6-12), (6-17): amplitude and phase of the drive vibration follow force amplitude
-   * and phase as first-order lags of time constant 2 Q / wn. */
-  const double tau = 2.0 * (double)v->drive_cal_q / (2.0 * FM_PI * (double)v->drive_cal_f0_hz);
+/* (6-12), (6-17): amplitude and phase of the drive vibration follow force amplitude
+ * and phase as first-order lags of time constant 2 Q / wn. */
+static double drive_tau_s(const param_values_t *v)
+{
+  return 2.0 * (double)v->drive_cal_q / (2.0 * FM_PI * (double)v->drive_cal_f0_hz);
+}
+
+/* Samples from a loop's measurement slot to the first DAC frame of its command: the
+ * command goes to the synthesis on GYRO_SLOT_COMMAND and reaches the DAC frame one tick
+ * later (the jobs run after their tick's frame). */
+static double lag_samples(uint32_t slot)
+{
+  return (double)((GYRO_SLOT_COMMAND + GYRO_BLOCK - slot) % GYRO_BLOCK + 1u);
+}
+
+/* Both drive loops (drive_loop.h), once per block; nonzero manual gains override the
+ * designed ones. */
+static gyro_design_status_t design_drive_loops(const param_values_t *v, double tau_s,
+                                               gyro_design_t *t)
+{
+  const double fs = (double)v->sys_fs_hz;
   const double demod_bw = lmsd_bandwidth_hz((double)v->demod_mu_drive, fs);
-  if (!(demod_bw > 0.0)) return -3;
   const double blk = (double)GYRO_BLOCK;
-  /* The loops run once per block; each measures on its own tick and the command goes
-   * to the synthesis on GYRO_SLOT_COMMAND, reaching the DAC frame one tick later (the
-   * jobs run after their tick's frame). */
-  const double amp_lag = (double)((GYRO_SLOT_COMMAND + GYRO_BLOCK - GYRO_SLOT_AMP) % GYRO_BLOCK + 1u);
-  const double ph_lag =
-      (double)((GYRO_SLOT_COMMAND + GYRO_BLOCK - GYRO_SLOT_PHASE_MEAS) % GYRO_BLOCK + 1u);
-  const drive_loop_design_in_t amp_in = {(double)v->drive_cal_gain_v_per_v2, tau,
-                                         (double)v->drive_amp_bw_hz, demod_bw, fs, blk, amp_lag};
-  const drive_loop_design_in_t ph_in = {1.0, tau, (double)v->drive_phase_bw_hz, demod_bw, fs, blk,
-                                        ph_lag};
-  if (drive_loop_design(&amp_in, &t.amp_design) != 0 ||
-      drive_loop_design(&ph_in, &t.phase_design) != 0) {
-    return -4;
-  }
-  t.drive.dt_s = (float)GYRO_BLOCK / fs_f; /* the loops run once per block */
-  t.drive.amp_set_v = v->drive_amp_set_v;
-  t.drive.phase_set_rad = v->drive_phase_set_deg * FM_RAD_PER_DEG_F;
+  const drive_loop_design_in_t amp_in = {(double)v->drive_cal_gain_v_per_v2, tau_s,
+                                         (double)v->drive_amp_bw_hz, demod_bw, fs, blk,
+                                         lag_samples(GYRO_SLOT_AMP)};
+  const drive_loop_design_in_t ph_in = {1.0, tau_s, (double)v->drive_phase_bw_hz, demod_bw, fs, blk,
+                                        lag_samples(GYRO_SLOT_PHASE_MEAS)};
+  if (drive_loop_design(&amp_in, &t->amp_design) != 0) return GYRO_DESIGN_AMP_LOOP;
+  if (drive_loop_design(&ph_in, &t->phase_design) != 0) return GYRO_DESIGN_PHASE_LOOP;
+  const float fs_f = (float)v->sys_fs_hz;
+  t->drive.dt_s = (float)GYRO_BLOCK / fs_f; /* the loops run once per block */
+  t->drive.amp_set_v = v->drive_amp_set_v;
+  t->drive.phase_set_rad = v->drive_phase_set_deg * FM_RAD_PER_DEG_F;
   const int manual_amp = v->drive_amp_kp > 0.0f || v->drive_amp_ki > 0.0f;
   const int manual_ph = v->drive_phase_kp > 0.0f || v->drive_phase_ki > 0.0f;
-  t.drive.amp_kp = manual_amp ? v->drive_amp_kp : (float)t.amp_design.kp;
-  t.drive.amp_ki = manual_amp ? v->drive_amp_ki : (float)t.amp_design.ki;
-  t.drive.phase_kp = manual_ph ? v->drive_phase_kp : (float)t.phase_design.kp;
-  t.drive.phase_ki = manual_ph ? v->drive_phase_ki : (float)t.phase_design.ki;
-  t.drive.f_cmd_max_v2 = drive_synth_f_cmd_max(&probe);
-  t.drive.p_init_rad = v->drive_p_init_deg * FM_RAD_PER_DEG_F;
+  t->drive.amp_kp = manual_amp ? v->drive_amp_kp : (float)t->amp_design.kp;
+  t->drive.amp_ki = manual_amp ? v->drive_amp_ki : (float)t->amp_design.ki;
+  t->drive.phase_kp = manual_ph ? v->drive_phase_kp : (float)t->phase_design.kp;
+  t->drive.phase_ki = manual_ph ? v->drive_phase_ki : (float)t->phase_design.ki;
+  t->drive.p_init_rad = v->drive_p_init_deg * FM_RAD_PER_DEG_F;
+  /* The loops accept P's start value only inside the phase conversion's reach
+   * (drive_loop.c); within the parameters' ranges nothing else of theirs can fail. */
+  drive_loop_t probe;
+  if (drive_loop_init(&probe, &t->drive) != 0) return GYRO_DESIGN_P_INIT;
+  return GYRO_DESIGN_OK;
+}
 
+/* The rate channel (rate_channel.h): output filter, reference, scale, compensation. */
+static gyro_design_status_t design_rate(const param_values_t *v, double tau_s, gyro_design_t *t)
+{
+  const double fs = (double)v->sys_fs_hz;
   const int n = butter_design(BUTTER_LOWPASS, v->rate_lpf_order, (double)v->rate_lpf_cutoff_hz,
-                              0.0, fs / RATE_DECIM, t.rate_lpf, BIQUAD_MAX_SECTIONS);
-  if (n <= 0) return -5;
+                              0.0, fs / RATE_DECIM, t->rate_lpf, BIQUAD_MAX_SECTIONS);
+  if (n <= 0) return GYRO_DESIGN_RATE_LPF;
   /* Reference of the rate channel: the drive motion as the loops hold it (phase at
    * its setpoint, amplitude at its setpoint), turned by the demodulation phase. */
   const double psi =
       ((double)v->rate_demod_phase_deg + (double)v->drive_phase_set_deg) * FM_PI / 180.0;
-  t.rate.ref_re = (float)(cos(psi) / (double)v->drive_amp_set_v);
-  t.rate.ref_im = (float)(sin(psi) / (double)v->drive_amp_set_v);
-  t.rate.scale_dps = v->rate_scale_dps;
-  t.rate.bias_c_dps[0] = v->rate_bias_c0_dps;
-  t.rate.bias_c_dps[1] = v->rate_bias_c1_dps_per_deg;
-  t.rate.bias_c_dps[2] = v->rate_bias_c2_dps_per_deg2;
-  t.rate.bias_c_dps[3] = v->rate_bias_c3_dps_per_deg3;
-  t.rate.sf_c[1] = v->rate_sf_c1_per_deg;
-  t.rate.sf_c[2] = v->rate_sf_c2_per_deg2;
-  t.rate.sf_c[3] = v->rate_sf_c3_per_deg3;
-  t.rate.p_ref_deg = v->drive_p_init_deg;
+  t->rate.ref_re = (float)(cos(psi) / (double)v->drive_amp_set_v);
+  t->rate.ref_im = (float)(sin(psi) / (double)v->drive_amp_set_v);
+  t->rate.scale_dps = v->rate_scale_dps;
+  t->rate.bias_c_dps[0] = v->rate_bias_c0_dps;
+  t->rate.bias_c_dps[1] = v->rate_bias_c1_dps_per_deg;
+  t->rate.bias_c_dps[2] = v->rate_bias_c2_dps_per_deg2;
+  t->rate.bias_c_dps[3] = v->rate_bias_c3_dps_per_deg3;
+  t->rate.sf_c[1] = v->rate_sf_c1_per_deg;
+  t->rate.sf_c[2] = v->rate_sf_c2_per_deg2;
+  t->rate.sf_c[3] = v->rate_sf_c3_per_deg3;
+  t->rate.p_ref_deg = v->drive_p_init_deg;
   /* First-order low-pass of P at the decimated rate fs / RATE_P_DECIM. */
-  t.rate.p_lpf_alpha =
+  t->rate.p_lpf_alpha =
       (float)(1.0 - exp(-2.0 * FM_PI * (double)v->rate_p_lpf_hz * RATE_P_DECIM / fs));
-  t.rate.lpf = NULL; /* gyro_init/gyro_apply point it at t.rate_lpf where it is used */
-  t.rate.p_mode_k = (float)(1.0 - exp(-blk / (fs * tau))); /* per block */
-  t.rate.lpf_sections = (uint32_t)n;
-  t.rate.min_drive_v = 0.05f * v->drive_amp_set_v;
-  t.rate_out_v_per_dps = v->rate_out_v_per_dps;
+  t->rate.lpf = NULL; /* gyro_init/gyro_apply point it at t.rate_lpf where it is used */
+  t->rate.p_mode_k = (float)(1.0 - exp(-(double)GYRO_BLOCK / (fs * tau_s))); /* per block */
+  t->rate.lpf_sections = (uint32_t)n;
+  t->rate.min_drive_v = 0.05f * v->drive_amp_set_v;
+  t->rate_out_v_per_dps = v->rate_out_v_per_dps;
+  return GYRO_DESIGN_OK;
+}
 
-  t.sup.dt_s = (float)GYRO_BLOCK / fs_f;
-  t.sup.lock_tol_rel = v->sup_lock_tol_rel;
-  t.sup.lock_phase_tol_rad = v->sup_lock_phase_tol_deg * FM_RAD_PER_DEG_F;
-  t.sup.lock_hold_s = v->sup_lock_hold_s;
-  t.sup.lost_tol_rel = v->sup_lost_tol_rel;
-  t.sup.lost_hold_s = v->sup_lost_hold_s;
-  t.sup.amp_trip_rel = v->sup_amp_trip_rel;
-  t.sup.sat_hold_s = v->sup_sat_hold_s;
-  t.sup.retry_s = v->sup_retry_s;
-  t.sup.clip_max_count = v->sup_clip_count;
-  t.sup.lost_phase_tol_rad = (v->sup_lost_phase_tol_deg > v->sup_lock_phase_tol_deg
-                                  ? v->sup_lost_phase_tol_deg
-                                  : v->sup_lock_phase_tol_deg) * FM_RAD_PER_DEG_F;
-  t.sup.amp_set_v = v->drive_amp_set_v;
-  t.sup.amp_max_v = GYRO_AMP_MAX_FRAC * HAL_ADC_FULL_SCALE_V;
-  t.sup.acq_timeout_s = (float)acq_timeout_s(v, tau, &t);
-  if (design_validity(v, &t) != 0) return -7;
-  t.autostart = v->sys_autostart;
-  if (design_selftest(v, &t) != 0) return -8;
+/* The supervisor (supervisor.h), once per block. The lost-lock tolerances are at least
+ * the lock ones (hysteresis), the over-amplitude trip above the lost-lock band, and the
+ * setpoint below the absolute trip; the acquisition time-out needs the drive loops'
+ * gains (design_drive_loops first). */
+static gyro_design_status_t design_supervisor(const param_values_t *v, double tau_s,
+                                              gyro_design_t *t)
+{
+  if (!(v->sup_lost_tol_rel >= v->sup_lock_tol_rel)) return GYRO_DESIGN_LOST_TOL;
+  if (!(v->sup_amp_trip_rel > 1.0f + v->sup_lost_tol_rel)) return GYRO_DESIGN_AMP_TRIP;
+  const float amp_max_v = GYRO_AMP_MAX_FRAC * HAL_ADC_FULL_SCALE_V;
+  if (!(v->drive_amp_set_v > 0.0f && v->drive_amp_set_v < amp_max_v)) return GYRO_DESIGN_AMP_SET;
+  t->sup.dt_s = (float)GYRO_BLOCK / (float)v->sys_fs_hz;
+  t->sup.lock_tol_rel = v->sup_lock_tol_rel;
+  t->sup.lock_phase_tol_rad = v->sup_lock_phase_tol_deg * FM_RAD_PER_DEG_F;
+  t->sup.lock_hold_s = v->sup_lock_hold_s;
+  t->sup.lost_tol_rel = v->sup_lost_tol_rel;
+  t->sup.lost_hold_s = v->sup_lost_hold_s;
+  t->sup.amp_trip_rel = v->sup_amp_trip_rel;
+  t->sup.sat_hold_s = v->sup_sat_hold_s;
+  t->sup.retry_s = v->sup_retry_s;
+  t->sup.clip_max_count = v->sup_clip_count;
+  t->sup.lost_phase_tol_rad = (v->sup_lost_phase_tol_deg > v->sup_lock_phase_tol_deg
+                                   ? v->sup_lost_phase_tol_deg
+                                   : v->sup_lock_phase_tol_deg) * FM_RAD_PER_DEG_F;
+  t->sup.amp_set_v = v->drive_amp_set_v;
+  t->sup.amp_max_v = amp_max_v;
+  t->sup.acq_timeout_s = (float)acq_timeout_s(v, tau_s, t);
+  return GYRO_DESIGN_OK;
+}
+
+/* Each part in turn; the first that fails names the reason. */
+static gyro_design_status_t design_parts(const param_values_t *v, gyro_design_t *t)
+{
+  gyro_design_status_t s = design_nco(v, t);
+  if (s == GYRO_DESIGN_OK) s = design_synth(v, t);
+  if (s == GYRO_DESIGN_OK) s = design_demod(v, t);
+  const double tau_s = drive_tau_s(v);
+  if (s == GYRO_DESIGN_OK) s = design_drive_loops(v, tau_s, t);
+  if (s == GYRO_DESIGN_OK) s = design_rate(v, tau_s, t);
+  if (s == GYRO_DESIGN_OK) s = design_supervisor(v, tau_s, t);
+  if (s == GYRO_DESIGN_OK) s = design_validity(v, t);
+  if (s == GYRO_DESIGN_OK) s = design_selftest(v, t);
+  t->autostart = v->sys_autostart;
+  return s;
+}
+
+gyro_design_status_t gyro_design(const param_values_t *v, gyro_design_t *d)
+{
+  if (v == NULL || d == NULL) return GYRO_DESIGN_NO_VALUES;
+  gyro_design_t t;
+  memset(&t, 0, sizeof t);
+  const gyro_design_status_t s = design_parts(v, &t);
+  if (s != GYRO_DESIGN_OK) return s;
   /* Every module must accept its part: a design that gyro_apply could not apply is
-   * rejected here, in the background, where the error can be reported. */
+   * rejected here, in the background, where the error can be reported. The checks
+   * above name the parameters; what is left for this one are values outside their
+   * parameter's range (the parameter bank refuses those before a design). */
   gyro_t scratch;
-  if (gyro_init_from_design(&scratch, &t) != 0) return -6;
+  if (gyro_init_from_design(&scratch, &t) != 0) return GYRO_DESIGN_MODULE;
   *d = t;
-  return 0;
+  return GYRO_DESIGN_OK;
+}
+
+static const char *const k_reasons[GYRO_DESIGN_STATUS_COUNT] = {
+    [GYRO_DESIGN_OK] = "",
+    [GYRO_DESIGN_NO_VALUES] = "no parameter values to design from",
+    [GYRO_DESIGN_FS] = "sys.fs_hz must be above 0",
+    [GYRO_DESIGN_DRIVE_FREQ] = "drive.freq_hz must lie between 0 and sys.fs_hz / 4",
+    [GYRO_DESIGN_DRIVE_VOLTAGES] = "drive.u_max_v must be above 0, and drive.dc_bias_v between 0 "
+                                   "and drive.u_max_v in DC+AC drive (drive.mode 1)",
+    [GYRO_DESIGN_MU_DRIVE] = "demod.mu_drive must lie above 0 and at most 0.5",
+    [GYRO_DESIGN_MU_SENSE] = "demod.mu_sense must lie above 0 and at most 0.5",
+    [GYRO_DESIGN_AMP_LOOP] = "drive.cal_gain_v_per_v2, drive.cal_q, drive.cal_f0_hz and "
+                             "drive.amp_bw_hz must be positive for the amplitude loop's design",
+    [GYRO_DESIGN_PHASE_LOOP] = "drive.cal_q, drive.cal_f0_hz and drive.phase_bw_hz must be "
+                               "positive for the phase loop's design",
+    [GYRO_DESIGN_P_INIT] = "drive.p_init_deg must lie within +-355 deg (6.2 rad, the reach of the "
+                           "drive's phase conversion)",
+    [GYRO_DESIGN_RATE_LPF] = "rate.lpf_cutoff_hz must be below half the block rate "
+                             "(sys.fs_hz / 20), rate.lpf_order even and at most 8",
+    [GYRO_DESIGN_AMP_SET] = "drive.amp_set_v must lie between 0 and 95 % of the ADC's range",
+    [GYRO_DESIGN_LOST_TOL] = "sup.lost_tol_rel must not be below sup.lock_tol_rel",
+    [GYRO_DESIGN_AMP_TRIP] = "sup.amp_trip_rel must be above 1 + sup.lost_tol_rel",
+    [GYRO_DESIGN_FAULT_OUT] = "rate.fault_out_v must lie outside rate.full_scale_dps x "
+                              "rate.out_v_per_dps plus 10 %",
+    [GYRO_DESIGN_BIAS_SLOPE] = "rate.bias_c1_dps_per_deg .. rate.bias_c3_dps_per_deg3 must give a "
+                               "finite bias slope over rate.p_range_deg",
+    [GYRO_DESIGN_CONT_FREQ] = "selftest.cont_freq_hz must lie between 1.5 x rate.lpf_cutoff_hz and "
+                              "a quarter of the block rate (sys.fs_hz / 40)",
+    [GYRO_DESIGN_CONT_EXPECT] = "selftest.cont_expect_dps and rate.scale_dps must not be 0, and "
+                                "selftest.tol_rel must be below 1",
+    [GYRO_DESIGN_MODULE] = "a value outside its parameter's range: a module refused its part of "
+                           "the design",
+};
+
+const char *gyro_design_reason(gyro_design_status_t s)
+{
+  const unsigned i = (unsigned)s;
+  return i < (unsigned)GYRO_DESIGN_STATUS_COUNT ? k_reasons[i] : "";
 }

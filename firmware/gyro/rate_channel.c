@@ -101,7 +101,6 @@ void rate_channel_reset(rate_channel_t *rc, float p_deg)
   rc->p_acc_deg = 0.0f;
   rc->p_count = 0u;
   rc->p_dev_deg = p_deg - rc->p_ref_deg;
-  rc->p_mean_dev_deg = rc->p_dev_deg;
   rc->p_held_dev_deg = rc->p_dev_deg;
   rc->p_held_w = 0.0f;
   rc->p_mode_rad = rc->p_dev_deg * FM_RAD_PER_DEG_F;
@@ -164,7 +163,6 @@ void rate_channel_shift_p(rate_channel_t *rc, float shift_deg)
 {
   rc->p_dev_deg += shift_deg;
   rc->p_f_deg += shift_deg;
-  rc->p_mean_dev_deg += shift_deg;
   rc->p_held_dev_deg += shift_deg;
   rc->p_acc_deg += shift_deg * (float)rc->p_count;
   rc->p_mode_rad += shift_deg * FM_RAD_PER_DEG_F;
@@ -205,7 +203,6 @@ int rate_channel_update_p(rate_channel_t *rc, float p_rad)
        * by (1 - a): it tells how far P_f may still be from P (rate_valid_thermo). */
       rc->p_held_w *= 1.0f - a;
       rc->p_dev_deg += a * (mean - rc->p_dev_deg);
-      rc->p_mean_dev_deg = mean;
       rc->p_f_deg = rc->p_ref_deg + rc->p_dev_deg;
       rc->p_acc_deg = 0.0f;
       rc->p_count = 0u;

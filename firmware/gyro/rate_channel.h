@@ -70,7 +70,6 @@ typedef struct {
   float p_acc_deg;            /* sum of (P - p_ref), one sample per block, over RATE_P_DECIM ticks */
   uint32_t p_count;
   float p_dev_deg;            /* low-passed P - p_ref */
-  float p_mean_dev_deg;       /* the latest mean of P - p_ref the low-pass took */
   float p_held_dev_deg;       /* P_f - p_ref while held: where the fast start began */
   float p_held_w;             /* weight the held value still has in P_f (1 while held) */
   float p_mode_k;

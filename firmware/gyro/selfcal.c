@@ -5,8 +5,8 @@
 #include <string.h>
 
 #include "dsp/fastmath.h"
+#include "dsp/nco.h"
 
-#define SC_TWO31 2147483648.0
 #define SC_MIN_PEAK_V 0.02     /* chirp peak below this: not resolved from the noise */
 #define SC_MAX_RETRIES 6u
 #define SC_EXCITE_MAX_S 1.5    /* ring-down excitation, at most */
@@ -21,14 +21,6 @@
 #define SC_STEP_PTS 9u
 static const double k_offsets[SC_STEP_PTS] = {-2.0, -1.5, -1.0, -0.5, 0.0, 0.5, 1.0, 1.5, 2.0};
 _Static_assert(SC_STEP_PTS <= SELFCAL_MAX_PTS, "the executive holds SELFCAL_MAX_PTS points");
-
-/* NCO half-rate phase step of frequency f: the wc step is 2 half_step (nco.h). */
-static uint32_t half_step_of(double f_hz, double fs_hz)
-{
-  return (uint32_t)llround(f_hz / fs_hz * SC_TWO31);
-}
-
-static double freq_of(uint32_t half_step, double fs_hz) { return (double)half_step * fs_hz / SC_TWO31; }
 
 static uint32_t ticks_of(double t_s, double fs_hz)
 {
@@ -119,7 +111,7 @@ static void post_quiet(selfcal_t *s, selfcal_state_t next)
   selfcal_job_t j;
   base_job(s, &j, SELFCAL_JOB_QUIET);
   j.f_cmd_v2 = 0.0f;
-  j.half_step[0] = half_step_of(s->cfg.f_lo_hz, s->cfg.fs_hz);
+  j.half_step[0] = nco_half_step_of(s->cfg.f_lo_hz, s->cfg.fs_hz);
   j.avg_ticks = ticks_of(s->cfg.quiet_s, s->cfg.fs_hz);
   post(s, &j, next);
 }
@@ -129,7 +121,7 @@ static void post_chirp(selfcal_t *s, int up, selfcal_state_t next)
   const selfcal_cfg_t *c = &s->cfg;
   selfcal_job_t j;
   base_job(s, &j, SELFCAL_JOB_CHIRP);
-  const uint32_t lo = half_step_of(c->f_lo_hz, c->fs_hz), hi = half_step_of(c->f_hi_hz, c->fs_hz);
+  const uint32_t lo = nco_half_step_of(c->f_lo_hz, c->fs_hz), hi = nco_half_step_of(c->f_hi_hz, c->fs_hz);
   j.chirp_ticks = ticks_of((c->f_hi_hz - c->f_lo_hz) / c->chirp_hz_per_s, c->fs_hz);
   const int32_t d = (int32_t)((hi - lo) / j.chirp_ticks);
   j.chirp_delta = up ? d : -d;
@@ -148,7 +140,7 @@ static void post_steps(selfcal_t *s, double f_c, double hb, double tau_s, double
   base_job(s, &j, SELFCAL_JOB_STEPS);
   j.n_pts = SC_STEP_PTS;
   for (uint32_t i = 0; i < SC_STEP_PTS; i++) {
-    j.half_step[i] = half_step_of(f_c + k_offsets[i] * hb, c->fs_hz);
+    j.half_step[i] = nco_half_step_of(f_c + k_offsets[i] * hb, c->fs_hz);
   }
   j.settle_ticks = ticks_of((SC_SETTLE_TAU + 1.0) * tau_s, c->fs_hz);
   j.step_settle_ticks = ticks_of(SC_SETTLE_TAU * tau_s, c->fs_hz);
@@ -157,7 +149,6 @@ static void post_steps(selfcal_t *s, double f_c, double hb, double tau_s, double
   j.avg_ticks = ticks_of(SC_AVG_S, c->fs_hz);
   s->plan_f_hz = f_c;
   s->plan_hb_hz = hb;
-  s->plan_tau_s = tau_s;
   post(s, &j, SELFCAL_FINE);
 }
 
@@ -190,7 +181,7 @@ static void on_chirp(selfcal_t *s, const selfcal_result_t *r, int up)
     else post_quiet(s, up ? SELFCAL_QUIET_UP : SELFCAL_QUIET_DOWN);
     return;
   }
-  const double f = freq_of(r->peak_half_step, c->fs_hz);
+  const double f = nco_freq_of(r->peak_half_step, c->fs_hz);
   if (up) {
     s->f_up_hz = f;
     s->chirp_peak_v = (double)r->peak_amp_v;
@@ -208,7 +199,7 @@ static void on_chirp(selfcal_t *s, const selfcal_result_t *r, int up)
   double f_cmd = s->f_cmd_v2 * c->amp_meas_v / s->chirp_peak_v;
   s->f_cmd_v2 = f_cmd > c->f_cmd_max_v2 ? c->f_cmd_max_v2 : f_cmd;
   base_job(s, &j, SELFCAL_JOB_RINGDOWN);
-  j.half_step[0] = half_step_of(s->f_coarse_hz, c->fs_hz);
+  j.half_step[0] = nco_half_step_of(s->f_coarse_hz, c->fs_hz);
   j.amp_target_v = (float)c->amp_meas_v;
   j.avg_ticks = ticks_of(SC_EXCITE_MAX_S > SC_RING_MAX_S ? SC_EXCITE_MAX_S : SC_RING_MAX_S,
                          c->fs_hz);
@@ -263,7 +254,7 @@ static void on_steps(selfcal_t *s, const selfcal_result_t *r)
   for (uint32_t i = 0; i < j->n_pts; i++) {
     /* P = 0 during the steps: H = Z / f_cmd. */
     const double f = (double)r->f_cmd_v2[i];
-    pts[i].f_hz = freq_of(j->half_step[i], c->fs_hz);
+    pts[i].f_hz = nco_freq_of(j->half_step[i], c->fs_hz);
     pts[i].h_re = (double)r->z_re[i] / f;
     pts[i].h_im = (double)r->z_im[i] / f;
   }
@@ -299,7 +290,7 @@ static void on_steps(selfcal_t *s, const selfcal_result_t *r)
   base_job(s, &h, SELFCAL_JOB_HOLD);
   h.f_cmd_v2 = (float)s->hold_f_cmd_v2;
   h.p_rad = (float)s->hold_p_rad;
-  h.half_step[0] = half_step_of((double)s->f0_hz_f, c->fs_hz);
+  h.half_step[0] = nco_half_step_of((double)s->f0_hz_f, c->fs_hz);
   h.avg_ticks = ticks_of(SC_HOLD_TAU * tau > 0.02 ? SC_HOLD_TAU * tau : 0.02, c->fs_hz);
   post(s, &h, SELFCAL_HOLD);
 }
@@ -359,7 +350,7 @@ uint32_t selfcal_export_count(const selfcal_t *s)
 
 double selfcal_export_f_hz(const selfcal_t *s, uint32_t i)
 {
-  return s == NULL || i >= s->n_pts ? 0.0 : freq_of(s->pts[i].half_step, s->cfg.fs_hz);
+  return s == NULL || i >= s->n_pts ? 0.0 : nco_freq_of(s->pts[i].half_step, s->cfg.fs_hz);
 }
 
 void selfcal_watch(selfcal_t *s, uint32_t now_ticks)

@@ -83,7 +83,7 @@ typedef struct {
   double f_cmd_v2;
   double f_up_hz, f_down_hz, f_coarse_hz, chirp_peak_v;
   double rd_f_hz, rd_q, rd_gain;
-  double plan_f_hz, plan_hb_hz, plan_tau_s; /* centre, half bandwidth, tau of the steps */
+  double plan_f_hz, plan_hb_hz; /* centre and half bandwidth of the steps */
   selfcal_fit_t fit;
   double delay_s;                 /* total chain delay found by the fit */
   double hold_f_cmd_v2, hold_p_rad;

@@ -300,7 +300,6 @@ param_store_status_t param_store_save(param_store_t *st, const param_values_t *v
     fs = hal_flash_program(sec, len - 4u, &st->buf[len - 4u], 4u);
   }
   if (fs != HAL_FLASH_OK) {
-    rep->flash_status = (int32_t)fs;
     return PARAM_STORE_ERR_FLASH;
   }
   slot_hdr_t check;

@@ -113,7 +113,6 @@ typedef struct {
   uint16_t dropped;      /* load: records with unknown or non-persistent ids */
   uint16_t rejected;     /* load: records with a bad type, duplicate id or bad value */
   uint16_t defaulted;    /* load: persistent parameters missing from the image */
-  int32_t flash_status;  /* hal_flash_status_t of a failed operation, else 0 */
 } param_store_report_t;
 
 param_store_status_t param_store_init(param_store_t *st, const param_store_cfg_t *cfg);

@@ -291,6 +291,8 @@ param_status_t params_set(params_t *p, param_idx_t i, param_value_t val, params_
 
 const param_values_t *params_current(const params_t *p) { return &p->block[active_index(p)]; }
 
+const void *params_current_derived(const params_t *p) { return p->cfg.derived[active_index(p)]; }
+
 const param_values_t *params_staged(const params_t *p) { return &p->staged; }
 
 bool params_loop_safe(const params_t *p)

@@ -166,6 +166,8 @@ param_status_t params_set(params_t *p, param_idx_t i, param_value_t val, params_
 
 /* Background view of the values the ISR is (or will next tick be) using. */
 const param_values_t *params_current(const params_t *p);
+/* The derived block of those values (NULL if none); valid until the next commit. */
+const void *params_current_derived(const params_t *p);
 const param_values_t *params_staged(const params_t *p);
 bool params_loop_safe(const params_t *p);
 

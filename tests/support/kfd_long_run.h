@@ -13,7 +13,7 @@
 
 static inline double rel_err_x(const kfd_t *s, const double x[2]) { return rel_err_vec(s->x_i, s->x_q, x); }
 
-static inline double rel_err_p(const kfd_t *s, const double p[4]) { return rel_err_cov(s->p11, s->p12, s->p22, p); }
+static inline double rel_err_p(const kfd_t *s, const double p[4]) { return rel_err_cov(s->cov.p11, s->cov.p12, s->cov.p22, p); }
 
 static inline void init_default(kfd_t *s)
 {
@@ -42,9 +42,9 @@ static inline void run_long(uint64_t n)
     if (k >= ref_start) {
       ref_kf_step(&r, x.d, x.s, x.c);
     }
-    const float tr = s.p11 + s.p22;
-    const float ratio = (s.p11 * s.p22 - s.p12 * s.p12) / (0.25f * tr * tr);
-    if (!(s.p11 > 0.0f && s.p22 > 0.0f && ratio > 0.0f)) {
+    const float tr = s.cov.p11 + s.cov.p22;
+    const float ratio = (s.cov.p11 * s.cov.p22 - s.cov.p12 * s.cov.p12) / (0.25f * tr * tr);
+    if (!(s.cov.p11 > 0.0f && s.cov.p22 > 0.0f && ratio > 0.0f)) {
       fail_msg("P not positive definite at sample %llu", (unsigned long long)k);
     }
     if (k > 1000u) { /* steady state: the 2 wc ripple makes P mildly anisotropic */
@@ -54,7 +54,7 @@ static inline void run_long(uint64_t n)
   }
   print_message("%llu samples: min det/(tr/2)^2 %.3f, max trace %.4g, end P %.4g %.4g %.4g\n",
                 (unsigned long long)n, (double)min_det_ratio, (double)max_trace,
-                (double)s.p11, (double)s.p12, (double)s.p22);
+                (double)s.cov.p11, (double)s.cov.p12, (double)s.cov.p22);
   assert_int_equal(s.cov_resets, 0);
   assert_int_equal(s.skipped, 0);
   assert_true(min_det_ratio > 0.9f);

@@ -158,6 +158,30 @@ static void test_replies_fit_the_reserve(void **state)
   assert_true(longest > 3000u); /* list is the long one: the test looks at it */
 }
 
+/* A set that cannot be designed is refused with the reason naming the parameter, and
+ * status reports what the loop designer achieved. */
+static void test_design_reason_and_status(void **state)
+{
+  (void)state;
+  setup_app();
+  assert_string_equal(cmd("drive off\n"), "ok drive off\r\n");
+  hal_host_run(1u);
+  const char *e = cmd("set sup.lock_tol_rel 0.1 sup.lost_tol_rel 0.05\n");
+  assert_non_null(strstr(e, "err REJECTED "));
+  assert_non_null(strstr(e, gyro_design_reason(GYRO_DESIGN_LOST_TOL)));
+  const char *r = cmd("status\n");
+  float amp_bw = 0.0f, amp_pm = 0.0f, ph_bw = 0.0f, ph_pm = 0.0f;
+  assert_int_equal(sscanf(strstr(r, "- design_amp_bw_hz "), "- design_amp_bw_hz %f", &amp_bw), 1);
+  assert_int_equal(sscanf(strstr(r, "- design_amp_pm_deg "), "- design_amp_pm_deg %f", &amp_pm), 1);
+  assert_int_equal(sscanf(strstr(r, "- design_phase_bw_hz "), "- design_phase_bw_hz %f", &ph_bw), 1);
+  assert_int_equal(sscanf(strstr(r, "- design_phase_pm_deg "), "- design_phase_pm_deg %f", &ph_pm), 1);
+  printf("# designed: amplitude %.2f Hz %.1f deg, phase %.2f Hz %.1f deg\n", (double)amp_bw,
+         (double)amp_pm, (double)ph_bw, (double)ph_pm);
+  /* the defaults ask for 30 Hz each, which the designer grants with at least 60 deg */
+  assert_true(fabsf(amp_bw - 30.0f) < 0.01f && fabsf(ph_bw - 30.0f) < 0.01f);
+  assert_true(amp_pm >= 60.0f && ph_pm >= 60.0f);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -166,6 +190,7 @@ int main(void)
       cmocka_unit_test(test_save_and_restart),
       cmocka_unit_test(test_isr_cycles),
       cmocka_unit_test(test_replies_fit_the_reserve),
+      cmocka_unit_test(test_design_reason_and_status),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -77,7 +77,7 @@ static void test_steady_state_covariance_matches_analysis(void **state)
     const sample_t x = make_sample(k, &g);
     kfd_step(&s, x.d, x.s, x.c);
     if (k >= 5000u) {
-      sum_tr += (double)(s.p11 + s.p22);
+      sum_tr += (double)(s.cov.p11 + s.cov.p22);
       m++;
     }
   }
@@ -107,7 +107,7 @@ static void test_covariance_bounded_without_excitation(void **state)
   assert_int_equal(kfd_init(&s, &(kfd_cfg_t){.q = 0.01f, .r = 0.3f, .p0 = 1.0f}), 0);
   for (int k = 0; k < 200000; k++) {
     kfd_step(&s, 0.01f, 1.0f, 0.0f);
-    assert_true(s.p11 > 0.0f && s.p22 > 0.0f && s.p11 + s.p22 <= 4.0f + 2.0f * 0.01f + 1e-5f);
+    assert_true(s.cov.p11 > 0.0f && s.cov.p22 > 0.0f && s.cov.p11 + s.cov.p22 <= 4.0f + 2.0f * 0.01f + 1e-5f);
   }
   assert_true(isfinite(s.x_i) && fabsf(s.x_i - 0.01f) < 1e-6f);
   assert_int_equal(s.cov_resets, 0);
@@ -146,16 +146,16 @@ static void test_set_noise_bumpless_reset_preset(void **state)
   }
   const kfd_t before = s;
   assert_int_equal(kfd_set_noise(&s, 0.0001f, 0.9f), 0);
-  assert_true(s.x_i == before.x_i && s.x_q == before.x_q && s.p11 == before.p11 &&
-              s.p12 == before.p12 && s.p22 == before.p22);
+  assert_true(s.x_i == before.x_i && s.x_q == before.x_q && s.cov.p11 == before.cov.p11 &&
+              s.cov.p12 == before.cov.p12 && s.cov.p22 == before.cov.p22);
   assert_true(s.q == 0.0001f && s.r == 0.9f);
   assert_int_equal(kfd_set_noise(&s, 0.0f, 0.9f), 0); /* q = 0: constant amplitudes */
 
   assert_int_equal(kfd_preset(&s, 0.02f, 0.01f), 0);
-  assert_true(s.x_i == 0.02f && s.x_q == 0.01f && s.p11 == before.p11);
+  assert_true(s.x_i == 0.02f && s.x_q == 0.01f && s.cov.p11 == before.cov.p11);
   kfd_reset(&s);
-  assert_true(s.x_i == 0.0f && s.x_q == 0.0f && s.p11 == 1.0f && s.p12 == 0.0f &&
-              s.p22 == 1.0f);
+  assert_true(s.x_i == 0.0f && s.x_q == 0.0f && s.cov.p11 == 1.0f && s.cov.p12 == 0.0f &&
+              s.cov.p22 == 1.0f);
   const kfd_t after = s;
   assert_int_equal(kfd_preset(&s, 0.0f, NAN), -1);
   assert_memory_equal(&s, &after, sizeof s);

@@ -379,6 +379,34 @@ static void test_sfdr_detects_a_spur(void **state)
   assert_true(d > 108.0 && d < 112.0);
 }
 
+/* One conversion of a frequency to a step (the NCO's and the self-calibration's sweep
+ * plans): round to nearest with halves away from zero, negative frequencies wrapping
+ * modulo 2^32, and nco_freq_of its inverse within fs/2^32. */
+static void test_half_step_of(void **state)
+{
+  (void)state;
+  const double fs_unit = 2147483648.0; /* fs = 2^31 Hz: the step is the frequency in Hz */
+  assert_int_equal(nco_half_step_of(1000.5, fs_unit), 1001u);
+  assert_int_equal(nco_half_step_of(1000.4999, fs_unit), 1000u);
+  assert_int_equal(nco_half_step_of(0.0, fs_unit), 0u);
+  assert_int_equal(nco_half_step_of(-3.0, fs_unit), 0xFFFFFFFDu);
+  assert_int_equal(nco_half_step_of(-2.5, fs_unit), 0xFFFFFFFDu);
+  nco_t n;
+  const nco_cfg_t c = {1489.9, 50000.0, 0.0};
+  assert_int_equal(nco_init(&n, &c), 0);
+  assert_int_equal(n.half_step, nco_half_step_of(1489.9, 50000.0));
+  assert_true(fabs(nco_freq_of(n.half_step, 50000.0) - 1489.9) <= 50000.0 / 4294967296.0);
+  /* Over the frequencies the firmware asks for (sweeps from 100 Hz, up to fs/4) the step
+   * is the one the NCO computed before the two conversions became one, floor(x + 0.5). */
+  for (double f = 100.0; f < 12500.0; f += 0.0123) {
+    const double x = f / 50000.0 * 2147483648.0;
+    if (nco_half_step_of(f, 50000.0) != (uint32_t)floor(x + 0.5)) {
+      print_message("# %.17g Hz\n", f);
+      fail();
+    }
+  }
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -389,6 +417,7 @@ int main(void)
       cmocka_unit_test(test_phase_shift_moves_half_by_half),
       cmocka_unit_test(test_sfdr),
       cmocka_unit_test(test_sfdr_detects_a_spur),
+      cmocka_unit_test(test_half_step_of),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

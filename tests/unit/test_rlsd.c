@@ -120,7 +120,7 @@ static void test_covariance_bounded_without_excitation(void **state)
   init_default(&s);
   for (int k = 0; k < 200000; k++) {
     rlsd_step(&s, 0.01f, 1.0f, 0.0f);
-    assert_true(s.p11 > 0.0f && s.p22 > 0.0f && s.p11 + s.p22 <= 4.0f / 0.982f + 1e-5f);
+    assert_true(s.cov.p11 > 0.0f && s.cov.p22 > 0.0f && s.cov.p11 + s.cov.p22 <= 4.0f / 0.982f + 1e-5f);
   }
   assert_true(isfinite(s.w_i) && fabsf(s.w_i - 0.01f) < 2e-6f);
   assert_int_equal(s.cov_resets, 0);
@@ -160,16 +160,16 @@ static void test_set_lambda_bumpless_reset_preset(void **state)
   }
   const rlsd_t before = s;
   assert_int_equal(rlsd_set_lambda(&s, 0.995f), 0);
-  assert_true(s.w_i == before.w_i && s.w_q == before.w_q && s.p11 == before.p11 &&
-              s.p12 == before.p12 && s.p22 == before.p22);
+  assert_true(s.w_i == before.w_i && s.w_q == before.w_q && s.cov.p11 == before.cov.p11 &&
+              s.cov.p12 == before.cov.p12 && s.cov.p22 == before.cov.p22);
   assert_true(s.lambda == 0.995f);
   assert_int_equal(rlsd_set_lambda(&s, 1.0f), 0); /* growing window is allowed */
 
   assert_int_equal(rlsd_preset(&s, 0.02f, 0.01f), 0);
-  assert_true(s.w_i == 0.02f && s.w_q == 0.01f && s.p11 == before.p11);
+  assert_true(s.w_i == 0.02f && s.w_q == 0.01f && s.cov.p11 == before.cov.p11);
   rlsd_reset(&s);
-  assert_true(s.w_i == 0.0f && s.w_q == 0.0f && s.p11 == 1.0f && s.p12 == 0.0f &&
-              s.p22 == 1.0f);
+  assert_true(s.w_i == 0.0f && s.w_q == 0.0f && s.cov.p11 == 1.0f && s.cov.p12 == 0.0f &&
+              s.cov.p22 == 1.0f);
   const rlsd_t after = s;
   assert_int_equal(rlsd_preset(&s, NAN, 0.0f), -1);
   assert_memory_equal(&s, &after, sizeof s);
