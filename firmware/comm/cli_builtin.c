@@ -3,7 +3,7 @@
 #include <string.h>
 
 #include "comm/numparse.h"
-#include "gyro/fw_version.h"
+#include "params/fw_version.h"
 
 static void put_value(cli_t *cli, param_idx_t i, param_value_t v)
 {

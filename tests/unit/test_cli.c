@@ -11,7 +11,7 @@
 
 #include "comm/cli.h"
 #include "comm/numparse.h"
-#include "gyro/fw_version.h"
+#include "params/fw_version.h"
 #include "hal_flash_host.h"
 
 typedef struct {
