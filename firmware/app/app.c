@@ -10,6 +10,7 @@
 #include "hal/hal_sample_timer.h"
 #include "hal/hal_uart.h"
 #include "app/app_cmds.h"
+#include "comm/cli_builtin.h"
 #include "app/app_selfcal.h"
 
 static int derive(void *ctx, const param_values_t *v, void *derived, const char **why)
@@ -133,7 +134,7 @@ int app_init_with(app_t *a, const param_values_t *values)
   gyro_attach_lost_counter(&a->gyro, hal_sample_lost_counter());
   a->applied = view.derived;
 
-  const cli_cfg_t cc = {&a->params, &a->store, cli_write, a};
+  const cli_cfg_t cc = {&a->params, &a->store, cli_write, a, cli_builtin_cmds, cli_builtin_count()};
   if (cli_init(&a->cli, &cc) != 0 || app_cmds_register(a) != 0 ||
       app_tlm_init(&a->tlm, &a->cli, &a->params) != 0 ||
       selfcal_init(&a->selfcal, &a->gyro.cal) != 0) {

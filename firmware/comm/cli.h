@@ -111,6 +111,11 @@ typedef struct {
   param_store_t *store;  /* NULL: save/load answer err NOSTORE */
   cli_write_fn write;    /* required */
   void *write_ctx;
+  /* Commands found before the registered ones, listed first by help: the parameter
+   * commands (comm/cli_builtin.h), given here so that the line discipline does not
+   * depend on them. NULL (n_builtin 0): none. */
+  const cli_cmd_t *builtin;
+  uint32_t n_builtin;
 } cli_cfg_t;
 
 typedef enum {
@@ -144,9 +149,9 @@ int cli_init(cli_t *cli, const cli_cfg_t *cfg);
 /* Register an application command (kept by pointer). Returns 0, or -1 if the table is
  * full, the name is empty, not one word, or already taken, or fn is NULL. */
 int cli_register(cli_t *cli, const cli_cmd_t *cmd);
-/* Registered application commands, for help. */
-uint32_t cli_app_count(const cli_t *cli);
-const cli_cmd_t *cli_app_cmd(const cli_t *cli, uint32_t i);
+/* Every command, built-in ones first then the registered ones in order, for help. */
+uint32_t cli_cmd_count(const cli_t *cli);
+const cli_cmd_t *cli_cmd_at(const cli_t *cli, uint32_t i); /* NULL past the end */
 /* Feed received bytes; complete lines are executed and answered before it returns. */
 void cli_feed(cli_t *cli, const uint8_t *data, size_t len);
 /* Feed bytes up to and including the first EOL (executed and answered); returns the

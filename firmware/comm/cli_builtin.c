@@ -76,21 +76,17 @@ static void cmd_help(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
     cli_err(cli, "ARGS", "usage: help");
     return;
   }
-  uint32_t n = 0u;
-  for (uint32_t pass = 0; pass < 2u; pass++) {
-    const uint32_t count = (pass == 0u) ? cli_builtin_count() : cli_app_count(cli);
-    for (uint32_t i = 0; i < count; i++) {
-      const cli_cmd_t *c = (pass == 0u) ? cli_builtin_at(i) : cli_app_cmd(cli, i);
-      cli_put(cli, c->name);
-      if (c->args != NULL && c->args[0] != '\0') {
-        cli_put(cli, " ");
-        cli_put(cli, c->args);
-      }
-      cli_put(cli, " : ");
-      cli_put(cli, c->help);
-      cli_emit_data(cli);
-      n++;
+  const uint32_t n = cli_cmd_count(cli);
+  for (uint32_t i = 0; i < n; i++) {
+    const cli_cmd_t *c = cli_cmd_at(cli, i);
+    cli_put(cli, c->name);
+    if (c->args != NULL && c->args[0] != '\0') {
+      cli_put(cli, " ");
+      cli_put(cli, c->args);
     }
+    cli_put(cli, " : ");
+    cli_put(cli, c->help);
+    cli_emit_data(cli);
   }
   cli_put_u32(cli, n);
   cli_put(cli, " commands");
@@ -493,7 +489,7 @@ static void cmd_console(cli_t *cli, void *ctx, uint32_t argc, const char *const 
   cli_ok(cli, cli->console ? "console on" : "console off");
 }
 
-static const cli_cmd_t k_builtin[] = {
+const cli_cmd_t cli_builtin_cmds[] = {
     {"help", "", "list the commands", cmd_help, NULL},
     {"list", "[PREFIX]", "parameters with value, unit, range, default, flags and help", cmd_list, NULL},
     {"get", "NAME", "value of one parameter", cmd_get, NULL},
@@ -508,16 +504,4 @@ static const cli_cmd_t k_builtin[] = {
                             "the default)", cmd_console, NULL},
 };
 
-uint32_t cli_builtin_count(void) { return (uint32_t)(sizeof k_builtin / sizeof k_builtin[0]); }
-
-const cli_cmd_t *cli_builtin_at(uint32_t i) { return (i < cli_builtin_count()) ? &k_builtin[i] : NULL; }
-
-const cli_cmd_t *cli_builtin_find(const char *name)
-{
-  for (uint32_t i = 0; i < cli_builtin_count(); i++) {
-    if (strcmp(k_builtin[i].name, name) == 0) {
-      return &k_builtin[i];
-    }
-  }
-  return NULL;
-}
+uint32_t cli_builtin_count(void) { return (uint32_t)(sizeof cli_builtin_cmds / sizeof cli_builtin_cmds[0]); }

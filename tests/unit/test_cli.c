@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include "comm/cli.h"
+#include "comm/cli_builtin.h"
 #include "comm/numparse.h"
 #include "params/fw_version.h"
 #include "hal_flash_host.h"
@@ -65,7 +66,7 @@ static int setup(void **state)
   if (params_init(&g.bank, &pc, NULL, NULL) != PARAM_OK) {
     return -1;
   }
-  const cli_cfg_t cc = {&g.bank, &g.store, write_out, &g};
+  const cli_cfg_t cc = {&g.bank, &g.store, write_out, &g, cli_builtin_cmds, cli_builtin_count()};
   return cli_init(&g.cli, &cc);
 }
 
