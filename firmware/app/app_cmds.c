@@ -218,7 +218,7 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   cli_put(cli, selftest_state_name(a->gyro.selftest.state));
   cli_emit_data(cli);
   cli_data_f32(cli, "selftest_dps", a->gyro.selftest.result_dps);
-  if (a->status_board != NULL) a->status_board(cli, a->status_board_ctx);
+  if (a->status_board != NULL) a->status_board(cli, NULL);
   cli_ok(cli, mode_name((uint32_t)a->gyro.sup.mode));
 }
 
