@@ -2,6 +2,7 @@
 
 #include <string.h>
 
+#include "app/app_tlm_fields.h"
 #include "comm/numparse.h"
 #include "hal/hal_uart.h"
 
@@ -22,7 +23,7 @@ static void uart_write(void *ctx, const uint8_t *data, size_t len)
 static void list_fields(cli_t *cli)
 {
   for (uint32_t i = 0; i < (uint32_t)TLM_FIELD_COUNT; i++) {
-    const tlm_field_t *f = tlm_field(i);
+    const tlm_field_t *f = app_tlm_field(i);
     cli_put(cli, f->name);
     cli_put(cli, (f->type == (uint8_t)TLM_T_F32) ? " f32 " : " u32 ");
     cli_put(cli, f->unit);
@@ -56,7 +57,7 @@ static void cmd_stream(cli_t *cli, void *ctx, uint32_t argc, const char *const *
       mask |= TLM_FIELD_MASK_ALL;
       continue;
     }
-    const uint32_t i = tlm_field_lookup(w, strlen(w));
+    const uint32_t i = app_tlm_field_lookup(w, strlen(w));
     if (i >= (uint32_t)TLM_FIELD_COUNT) {
       cli->out_len = 0u;
       cli_put(cli, "no field '");
@@ -86,7 +87,7 @@ static void cmd_stream(cli_t *cli, void *ctx, uint32_t argc, const char *const *
     return;
   }
   tlm_plan_t plan;
-  const tlm_status_t st = tlm_plan(t->stream.cfg.fs_hz, t->stream.cfg.baud, mask, rate_hz, &plan);
+  const tlm_status_t st = tlm_plan(&app_tlm_fields, t->stream.cfg.fs_hz, t->stream.cfg.baud, mask, rate_hz, &plan);
   if (st == TLM_ERR_RATE) {
     cli->out_len = 0u;
     cli_put(cli, "rate must be > 0 and within [fs / ");
@@ -177,7 +178,7 @@ static void cmd_stop(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
 int app_tlm_init(app_tlm_t *t, cli_t *cli, const params_t *params)
 {
   t->params = params;
-  const tlm_cfg_t tc = {params_current(params)->sys_fs_hz, APP_TLM_BAUD, uart_room, uart_write, t};
+  const tlm_cfg_t tc = {params_current(params)->sys_fs_hz, APP_TLM_BAUD, uart_room, uart_write, t, &app_tlm_fields};
   if (tlm_init(&t->stream, &tc) != 0) {
     return -1;
   }

@@ -4,7 +4,7 @@
  *
  * Command grammar (replies as in comm/cli.h):
  *   stream                          - NAME TYPE UNIT ...            ok N fields ...
- *       lists the streamable fields (comm/tlm_fields.h), starts nothing
+ *       lists the streamable fields (app_tlm_fields.h), starts nothing
  *   stream FIELD... [@RATE_HZ]      ok stream ID RATE Hz decim D fields F per_frame N
  *                                      link B B/s P% [rounded from R]
  *       FIELD is a field name or `all`; fields go into records in table order whatever
