@@ -30,15 +30,22 @@ def source_files(root, tops):
                     yield os.path.relpath(os.path.join(dirpath, name), root)
 
 
-def resolve(root, including, target, search_dirs):
-    """The repository path an include names, or None when it is outside the tree."""
+def resolve(root, including, target, search_dirs, all_files):
+    """The repository path an include names, or None when it is outside the tree.
+
+    Tried in the compiler's order: beside the including file, then the include roots
+    every target gets; last, a file of the tree that is the only one ending in the
+    included path (board and emulator folders reach each other through -I options).
+    """
     candidates = [os.path.join(os.path.dirname(including), target)]
     candidates += [os.path.join(d, target) for d in search_dirs]
     for cand in candidates:
         path = os.path.normpath(cand)
         if os.path.isfile(os.path.join(root, path)):
             return path
-    return None
+    tail = "/" + os.path.normpath(target)
+    hits = [f for f in all_files if ("/" + f).endswith(tail)]
+    return hits[0] if len(hits) == 1 else None
 
 
 def module_of(path):
@@ -57,7 +64,7 @@ def build_graphs(root, tops, search_dirs):
         mod_edges.setdefault(src_mod, set())
         dir_edges.setdefault(src_dir, set())
         for target in INCLUDE_RE.findall(text):
-            dst = resolve(root, path, target, search_dirs)
+            dst = resolve(root, path, target, search_dirs, files)
             if dst is None:
                 continue
             dst_mod = module_of(dst)
