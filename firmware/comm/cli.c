@@ -94,6 +94,57 @@ void cli_put_u32(cli_t *cli, uint32_t x)
   cli_put_n(cli, buf, n);
 }
 
+static void put_int(cli_t *cli, char conv, const cli_arg_t *a)
+{
+  if (a->kind != (uint8_t)'i') {
+    cli_put(cli, "?");
+  } else if (conv == 'u' && a->i >= 0 && a->i <= (int64_t)UINT32_MAX) {
+    cli_put_u32(cli, (uint32_t)a->i);
+  } else if (conv == 'd' && a->i >= (int64_t)INT32_MIN && a->i <= (int64_t)INT32_MAX) {
+    if (a->i < 0) {
+      cli_put(cli, "-");
+    }
+    cli_put_u32(cli, (uint32_t)(a->i < 0 ? -a->i : a->i));
+  } else {
+    cli_put(cli, "?");
+  }
+}
+
+void cli_putf_args(cli_t *cli, const char *fmt, const cli_arg_t *args, uint32_t n)
+{
+  uint32_t k = 0u;
+  const char *text = fmt;
+  const char *p = fmt;
+  while (*p != '\0') {
+    if (*p != '%') {
+      p++;
+      continue;
+    }
+    cli_put_n(cli, text, (size_t)(p - text));
+    const char conv = p[1];
+    p += (conv != '\0') ? 2 : 1;
+    text = p;
+    if (conv == '%') {
+      cli_put(cli, "%");
+      continue;
+    }
+    const cli_arg_t *a = (k < n) ? &args[k] : NULL;
+    k++;
+    if (a == NULL) {
+      cli_put(cli, "?");
+    } else if (conv == 's' && a->kind == (uint8_t)'s') {
+      cli_put(cli, a->s);
+    } else if (conv == 'f' && a->kind == (uint8_t)'f') {
+      cli_put_f32(cli, a->f);
+    } else if (conv == 'u' || conv == 'd') {
+      put_int(cli, conv, a);
+    } else {
+      cli_put(cli, "?");
+    }
+  }
+  cli_put_n(cli, text, (size_t)(p - text));
+}
+
 void cli_data_u32(cli_t *cli, const char *key, uint32_t v)
 {
   cli_put(cli, key);
