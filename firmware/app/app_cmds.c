@@ -214,15 +214,15 @@ static uint32_t isr_ticks(const app_t *a) { return a->isr_ticks; }
 static uint32_t isr_cycles_last(const app_t *a)
 {
   (void)a;
-  uint32_t last, max;
-  hal_sample_isr_cycles(&last, &max);
+  uint32_t last;
+  hal_sample_isr_cycles(&last, NULL);
   return last;
 }
 static uint32_t isr_cycles_max(const app_t *a)
 {
   (void)a;
-  uint32_t last, max;
-  hal_sample_isr_cycles(&last, &max);
+  uint32_t max;
+  hal_sample_isr_cycles(NULL, &max);
   return max;
 }
 static uint32_t rx_overflows(const app_t *a) { return a->cli.rx_overflows; }
