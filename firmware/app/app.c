@@ -11,6 +11,7 @@
 #include "hal/hal_uart.h"
 #include "app/app_cmds.h"
 #include "app/app_selfcal.h"
+#include "comm/cli_builtin.h"
 
 static int derive(void *ctx, const param_values_t *v, void *derived, const char **why)
 {
@@ -53,12 +54,6 @@ static void mark_dropped(app_t *a, unsigned i, bool on)
 {
   const uint32_t bit = 1u << (i % 32u);
   a->store_dropped[i / 32u] = on ? (a->store_dropped[i / 32u] | bit) : (a->store_dropped[i / 32u] & ~bit);
-}
-
-bool app_store_dropped(const app_t *a, param_idx_t i)
-{
-  const unsigned k = (unsigned)i;
-  return k < (unsigned)PARAM_COUNT && (a->store_dropped[k / 32u] & (1u << (k % 32u))) != 0u;
 }
 
 /* A stored set whose values pass one by one but cannot be designed together: set stored
@@ -133,7 +128,7 @@ int app_init_with(app_t *a, const param_values_t *values)
   gyro_attach_lost_counter(&a->gyro, hal_sample_lost_counter());
   a->applied = view.derived;
 
-  const cli_cfg_t cc = {&a->params, &a->store, cli_write, a};
+  const cli_cfg_t cc = {&a->params, &a->store, cli_write, a, cli_builtin_cmds, cli_builtin_count()};
   if (cli_init(&a->cli, &cc) != 0 || app_cmds_register(a) != 0 ||
       app_tlm_init(&a->tlm, &a->cli, &a->params) != 0 ||
       selfcal_init(&a->selfcal, &a->gyro.cal) != 0) {
@@ -165,44 +160,6 @@ static void take_request(app_t *a, uint32_t req)
   case APP_REQ_NONE:
   default: break;
   }
-}
-
-int app_request(app_t *a, app_req_t r)
-{
-  const uint32_t head = a->req_head;
-  if (head - a->req_tail >= APP_REQ_QUEUE) return -1;
-  a->req_word[head % APP_REQ_QUEUE] = (uint32_t)r;
-  atomic_signal_fence(memory_order_release); /* the word before the head that shows it */
-  a->req_head = head + 1u;
-  return 0;
-}
-
-bool app_requests_pending(const app_t *a) { return a->req_head != a->req_tail; }
-
-static gyro_mode_t mode_after(gyro_mode_t m, uint32_t req)
-{
-  switch ((app_req_t)req) {
-  case APP_REQ_DRIVE_ON:
-    return (m == GYRO_MODE_ACQUIRE || m == GYRO_MODE_LOCKED) ? m : GYRO_MODE_ACQUIRE;
-  case APP_REQ_DRIVE_OFF: return GYRO_MODE_OFF;
-  case APP_REQ_SWEEP: return GYRO_MODE_SWEEP;
-  case APP_REQ_SWEEP_HANDOVER: return GYRO_MODE_ACQUIRE;
-  case APP_REQ_SELFTEST:
-  case APP_REQ_CLEAR:
-  case APP_REQ_NONE:
-  default: return m;
-  }
-}
-
-/* A request the ISR takes during the walk is applied twice: each one is idempotent. */
-gyro_mode_t app_mode_after_queue(const app_t *a)
-{
-  gyro_mode_t m = a->gyro.sup.mode;
-  const uint32_t head = a->req_head;
-  for (uint32_t i = a->req_tail; i != head; i++) {
-    m = mode_after(m, a->req_word[i % APP_REQ_QUEUE]);
-  }
-  return m;
 }
 
 void app_sample_isr(void *ctx)

@@ -66,16 +66,11 @@ static void put_reasons(cli_t *cli, uint32_t r)
 
 static void put_monitor(cli_t *cli, const char *kind, const char *name, uint32_t count, float t_s)
 {
-  cli_put(cli, kind);
-  cli_put(cli, name);
-  cli_put(cli, " count ");
-  cli_put_u32(cli, count);
-  cli_put(cli, " last_s ");
-  cli_put_f32(cli, t_s);
+  cli_putf(cli, "%s%s count %u last_s %f", kind, name, count, t_s);
   cli_emit_data(cli);
 }
 
-static void put_integrity(cli_t *cli, const app_t *a)
+static void put_integrity(cli_t *cli, app_t *a)
 {
   const gyro_t *g = &a->gyro;
   const float block_s = (float)GYRO_BLOCK / (float)params_current(&a->params)->sys_fs_hz;
@@ -99,16 +94,14 @@ static void put_integrity(cli_t *cli, const app_t *a)
 }
 
 /* Self-calibration progress and result (the figures of the latest sweep). */
-static void put_selfcal(cli_t *cli, const app_t *a)
+static void put_selfcal(cli_t *cli, app_t *a)
 {
   const selfcal_t *s = &a->selfcal;
-  cli_put(cli, "selfcal ");
-  cli_put(cli, selfcal_state_name(s->state));
+  cli_putf(cli, "selfcal %s", selfcal_state_name(s->state));
   cli_emit_data(cli);
   if (s->state == SELFCAL_IDLE) return;
   if (s->state == SELFCAL_FAILED && s->why != NULL) {
-    cli_put(cli, "selfcal_why ");
-    cli_put(cli, s->why);
+    cli_putf(cli, "selfcal_why %s", s->why);
     cli_emit_data(cli);
   }
   const uint32_t t = selfcal_running(s) ? a->isr_ticks - a->selfcal_t0_ticks : a->selfcal_ticks;
@@ -128,22 +121,19 @@ static void put_selfcal(cli_t *cli, const app_t *a)
 }
 
 /* Stored values the boot set back to their defaults, each with the reason. */
-static void put_store_dropped(cli_t *cli, const app_t *a)
+static void put_store_dropped(cli_t *cli, app_t *a)
 {
   for (unsigned i = 0; i < (unsigned)PARAM_COUNT; i++) {
     if (!app_store_dropped(a, (param_idx_t)i)) continue;
-    cli_put(cli, "store_dropped ");
-    cli_put(cli, param_info((param_idx_t)i)->name);
-    cli_put(cli, ": cannot be designed with the other stored values (");
-    cli_put(cli, a->store_dropped_why);
-    cli_put(cli, ")");
+    cli_putf(cli, "store_dropped %s: cannot be designed with the other stored values (%s)",
+             param_info((param_idx_t)i)->name, a->store_dropped_why);
     cli_emit_data(cli);
   }
 }
 
 /* The fault history: the latest fault, cleared or not, and when (seconds since start,
  * from the supervisor's step count; it steps once per block). */
-static void put_last_fault(cli_t *cli, const app_t *a)
+static void put_last_fault(cli_t *cli, app_t *a)
 {
   const supervisor_t *sv = &a->gyro.sup;
   cli_put(cli, "last_fault ");
@@ -154,9 +144,6 @@ static void put_last_fault(cli_t *cli, const app_t *a)
   cli_data_f32(cli, "last_fault_s", (float)sv->last_fault_step * step_s);
 }
 
-/* status: one data line per figure, then ok MODE. The snapshot is copied field by
- * field while the ISR may update it; each figure is one aligned word, so each line is a
- * consistent value (lines may come from adjacent ticks). */
 /* What the store holds now (the "store" line is what the boot found): the newest valid
  * image after any save since, read back without applying it. Background only. */
 static void put_store_now(cli_t *cli, app_t *a)
@@ -167,12 +154,10 @@ static void put_store_now(cli_t *cli, app_t *a)
   param_values_t scratch = *params_current(&a->params);
   param_store_report_t rep;
   const param_store_status_t st = param_store_load(&a->store, &scratch, &rep);
-  cli_put(cli, "store_now ");
   if (st == PARAM_STORE_OK && rep.slot >= 0) {
-    cli_put(cli, rep.slot == 0 ? "slot A seq " : "slot B seq ");
-    cli_put_u32(cli, rep.seq);
+    cli_putf(cli, "store_now slot %s seq %u", rep.slot == 0 ? "A" : "B", rep.seq);
   } else {
-    cli_put(cli, param_store_status_str(st));
+    cli_putf(cli, "store_now %s", param_store_status_str(st));
   }
   cli_emit_data(cli);
 }
@@ -180,7 +165,7 @@ static void put_store_now(cli_t *cli, app_t *a)
 /* What the loop designer achieved for the values in use (drive_loop.h): each drive
  * loop's bandwidth and phase margin. Nonzero manual gains (drive.amp_kp ...) replace
  * the designed ones in the loops; these lines still report the design. */
-static void put_design(cli_t *cli, const app_t *a)
+static void put_design(cli_t *cli, app_t *a)
 {
   const gyro_design_t *d = params_current_derived(&a->params);
   if (d == NULL) return;
@@ -190,6 +175,115 @@ static void put_design(cli_t *cli, const app_t *a)
   cli_data_f32(cli, "design_phase_pm_deg", (float)d->phase_design.phase_margin_deg);
 }
 
+/* ---- status: one table of rows, in the order of the reply ---- */
+
+static void put_mode(cli_t *cli, app_t *a)
+{
+  cli_putf(cli, "mode %s", mode_name((uint32_t)a->gyro.sup.mode));
+  cli_emit_data(cli);
+}
+
+static void put_fault(cli_t *cli, app_t *a)
+{
+  cli_put(cli, "fault ");
+  put_faults(cli, a->gyro.sup.fault);
+  cli_emit_data(cli);
+}
+
+static void put_rate(cli_t *cli, app_t *a) { cli_data_f32(cli, "rate_dps", a->gyro.out.rate_dps); }
+
+static void put_drive(cli_t *cli, app_t *a)
+{
+  const gyro_out_t *o = &a->gyro.out;
+  cli_data_f32(cli, "quad_dps", o->quad_dps);
+  cli_data_f32(cli, "drive_amp_v", o->drive_amp_v);
+  cli_data_f32(cli, "drive_phase_deg", o->drive_phase_deg);
+  cli_data_f32(cli, "p_deg", o->p_deg);
+  cli_data_f32(cli, "p_f_deg", o->p_f_deg);
+  cli_data_f32(cli, "f_cmd_v2", o->f_cmd_v2);
+}
+
+static void put_store(cli_t *cli, app_t *a)
+{
+  cli_putf(cli, "store %s", param_store_status_str(a->store_status));
+  cli_emit_data(cli);
+}
+
+static void put_selftest(cli_t *cli, app_t *a)
+{
+  cli_putf(cli, "selftest %s", selftest_state_name(a->gyro.selftest.state));
+  cli_emit_data(cli);
+  cli_data_f32(cli, "selftest_dps", a->gyro.selftest.result_dps);
+}
+
+static void put_board(cli_t *cli, app_t *a)
+{
+  if (a->status_board != NULL) a->status_board(cli, NULL);
+}
+
+/* The health counters and the other one-number figures of status. */
+static uint32_t fault_count(const app_t *a) { return a->gyro.sup.fault_count; }
+static uint32_t isr_ticks(const app_t *a) { return a->isr_ticks; }
+static uint32_t isr_cycles_last(const app_t *a)
+{
+  (void)a;
+  uint32_t last;
+  hal_sample_isr_cycles(&last, NULL);
+  return last;
+}
+static uint32_t isr_cycles_max(const app_t *a)
+{
+  (void)a;
+  uint32_t max;
+  hal_sample_isr_cycles(NULL, &max);
+  return max;
+}
+static uint32_t rx_overflows(const app_t *a) { return a->cli.rx_overflows; }
+static uint32_t samples_lost(const app_t *a)
+{
+  (void)a;
+  const volatile uint32_t *n = hal_sample_lost_counter();
+  return (n != NULL) ? *n : 0u;
+}
+static uint32_t reply_lines_cut(const app_t *a) { return a->cli.truncated; }
+
+/* A row is a counter ("- NAME N" from count) or a group of lines (lines); a new health
+ * counter is one row here. Counters: fault_count (faults since power-on), ticks (sample
+ * ISR runs), isr_cycles_last/max (hal_sample_isr_cycles), rx_overflows (command-line
+ * input lost to a full receive ring), samples_lost (sample ticks the HAL lost: each also
+ * raises LOST_SAMPLE), reply_lines_cut (reply lines cut at CLI_OUT_MAX: a bug if not 0). */
+typedef struct {
+  const char *name;
+  uint32_t (*count)(const app_t *a);
+  void (*lines)(cli_t *cli, app_t *a); /* the background's instance: put_store_now reads flash */
+} status_row_t;
+
+static const status_row_t k_status_rows[] = {
+    {"mode", NULL, put_mode},
+    {"fault", NULL, put_fault},
+    {"fault_count", fault_count, NULL},
+    {"last_fault", NULL, put_last_fault},
+    {"rate_dps", NULL, put_rate},
+    {"rate_valid", NULL, put_integrity},
+    {"drive", NULL, put_drive},
+    {"design", NULL, put_design},
+    {"ticks", isr_ticks, NULL},
+    {"isr_cycles_last", isr_cycles_last, NULL},
+    {"isr_cycles_max", isr_cycles_max, NULL},
+    {"rx_overflows", rx_overflows, NULL},
+    {"samples_lost", samples_lost, NULL},
+    {"reply_lines_cut", reply_lines_cut, NULL},
+    {"store", NULL, put_store},
+    {"store_dropped", NULL, put_store_dropped},
+    {"store_now", NULL, put_store_now},
+    {"selfcal", NULL, put_selfcal},
+    {"selftest", NULL, put_selftest},
+    {"board", NULL, put_board},
+};
+
+/* status: one data line per figure, then ok MODE. The snapshot is copied field by
+ * field while the ISR may update it; each figure is one aligned word, so each line is a
+ * consistent value (lines may come from adjacent ticks). */
 static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
 {
   (void)argv;
@@ -198,41 +292,14 @@ static void cmd_status(cli_t *cli, void *ctx, uint32_t argc, const char *const *
     cli_err(cli, "ARGS", "usage: status");
     return;
   }
-  const gyro_out_t *o = &a->gyro.out;
-  cli_put(cli, "mode ");
-  cli_put(cli, mode_name((uint32_t)a->gyro.sup.mode));
-  cli_emit_data(cli);
-  cli_put(cli, "fault ");
-  put_faults(cli, a->gyro.sup.fault);
-  cli_emit_data(cli);
-  cli_data_u32(cli, "fault_count", a->gyro.sup.fault_count);
-  put_last_fault(cli, a);
-  cli_data_f32(cli, "rate_dps", o->rate_dps);
-  put_integrity(cli, a);
-  cli_data_f32(cli, "quad_dps", o->quad_dps);
-  cli_data_f32(cli, "drive_amp_v", o->drive_amp_v);
-  cli_data_f32(cli, "drive_phase_deg", o->drive_phase_deg);
-  cli_data_f32(cli, "p_deg", o->p_deg);
-  cli_data_f32(cli, "p_f_deg", o->p_f_deg);
-  cli_data_f32(cli, "f_cmd_v2", o->f_cmd_v2);
-  put_design(cli, a);
-  cli_data_u32(cli, "ticks", a->isr_ticks);
-  uint32_t cyc_last, cyc_max;
-  hal_sample_isr_cycles(&cyc_last, &cyc_max);
-  cli_data_u32(cli, "isr_cycles_last", cyc_last);
-  cli_data_u32(cli, "isr_cycles_max", cyc_max);
-  cli_data_u32(cli, "rx_overflows", a->cli.rx_overflows);
-  cli_put(cli, "store ");
-  cli_put(cli, param_store_status_str(a->store_status));
-  cli_emit_data(cli);
-  put_store_dropped(cli, a);
-  put_store_now(cli, a);
-  put_selfcal(cli, a);
-  cli_put(cli, "selftest ");
-  cli_put(cli, selftest_state_name(a->gyro.selftest.state));
-  cli_emit_data(cli);
-  cli_data_f32(cli, "selftest_dps", a->gyro.selftest.result_dps);
-  if (a->status_board != NULL) a->status_board(cli, a->status_board_ctx);
+  for (size_t i = 0; i < sizeof k_status_rows / sizeof k_status_rows[0]; i++) {
+    const status_row_t *r = &k_status_rows[i];
+    if (r->count != NULL) {
+      cli_data_u32(cli, r->name, r->count(a));
+    } else {
+      r->lines(cli, a);
+    }
+  }
   cli_ok(cli, mode_name((uint32_t)a->gyro.sup.mode));
 }
 
@@ -324,28 +391,16 @@ static void put_sweep_points(cli_t *cli, const app_t *a)
   for (uint32_t k = 0; k < n; k++) {
     const selfcal_export_pt_t *p = &s->pts[order[k]];
     const double amp = hypot((double)p->z_re, (double)p->z_im);
-    cli_put(cli, "point ");
-    cli_put_u32(cli, k);
-    cli_put(cli, " f_hz ");
-    cli_put_f32(cli, (float)selfcal_export_f_hz(s, order[k]));
-    cli_put(cli, " amp_v ");
-    cli_put_f32(cli, (float)amp);
-    cli_put(cli, " phase_deg ");
     /* The pickoff v = Im{Z e^{j phi}} = |Z| cos(phi + arg Z - 90 deg) against the force
      * cos(phi) (gyro.h, drive_synth.h): its phase is arg Z - 90 deg, in (-180, 180]. */
     double ph = atan2((double)p->z_im, (double)p->z_re) * 57.29577951308232 - 90.0;
     if (ph <= -180.0) ph += 360.0;
-    cli_put_f32(cli, (float)ph);
-    cli_put(cli, " f_cmd_v2 ");
-    cli_put_f32(cli, p->f_cmd_v2);
-    cli_put(cli, " gain_v_per_v2 ");
-    cli_put_f32(cli, p->f_cmd_v2 > 0.0f ? (float)(amp / (double)p->f_cmd_v2) : 0.0f);
-    cli_put(cli, " stage ");
-    cli_put_u32(cli, p->stage);
+    const float gain = p->f_cmd_v2 > 0.0f ? (float)(amp / (double)p->f_cmd_v2) : 0.0f;
+    cli_putf(cli, "point %u f_hz %f amp_v %f phase_deg %f f_cmd_v2 %f gain_v_per_v2 %f stage %u", k,
+             (float)selfcal_export_f_hz(s, order[k]), (float)amp, (float)ph, p->f_cmd_v2, gain, p->stage);
     cli_emit_data(cli);
   }
-  cli_put_u32(cli, n);
-  cli_put(cli, " points");
+  cli_putf(cli, "%u points", n);
   cli_emit_ok(cli);
 }
 

@@ -4,7 +4,7 @@
 #define APP_CMDS_H
 
 
-#include "app/app.h"
+#include "app/app_core.h"
 
 /* Register the commands with a->cli. Returns 0, or -1 if the table is full. */
 int app_cmds_register(app_t *a);

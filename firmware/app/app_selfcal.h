@@ -4,7 +4,7 @@
 #ifndef APP_SELFCAL_H
 #define APP_SELFCAL_H
 
-#include "app/app.h"
+#include "app/app_core.h"
 
 /* Request SWEEP and start the sequencer. Returns 0, or -1 (nothing changed) when a
  * sweep is running, the request queue is full or the configuration is refused. */

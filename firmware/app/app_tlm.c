@@ -2,6 +2,7 @@
 
 #include <string.h>
 
+#include "app/app_tlm_fields.h"
 #include "comm/numparse.h"
 #include "hal/hal_uart.h"
 
@@ -22,14 +23,11 @@ static void uart_write(void *ctx, const uint8_t *data, size_t len)
 static void list_fields(cli_t *cli)
 {
   for (uint32_t i = 0; i < (uint32_t)TLM_FIELD_COUNT; i++) {
-    const tlm_field_t *f = tlm_field(i);
-    cli_put(cli, f->name);
-    cli_put(cli, (f->type == (uint8_t)TLM_T_F32) ? " f32 " : " u32 ");
-    cli_put(cli, f->unit);
+    const tlm_field_t *f = app_tlm_field(i);
+    cli_putf(cli, "%s %s %s", f->name, (f->type == (uint8_t)TLM_T_F32) ? "f32" : "u32", f->unit);
     cli_emit_data(cli);
   }
-  cli_put_u32(cli, (uint32_t)TLM_FIELD_COUNT);
-  cli_put(cli, " fields; usage: stream FIELD...|all [@RATE_HZ]");
+  cli_putf(cli, "%u fields; usage: stream FIELD...|all [@RATE_HZ]", (uint32_t)TLM_FIELD_COUNT);
   cli_emit_ok(cli);
 }
 
@@ -56,20 +54,16 @@ static void cmd_stream(cli_t *cli, void *ctx, uint32_t argc, const char *const *
       mask |= TLM_FIELD_MASK_ALL;
       continue;
     }
-    const uint32_t i = tlm_field_lookup(w, strlen(w));
+    const uint32_t i = app_tlm_field_lookup(w, strlen(w));
     if (i >= (uint32_t)TLM_FIELD_COUNT) {
       cli->out_len = 0u;
-      cli_put(cli, "no field '");
-      cli_put(cli, w);
-      cli_put(cli, "'; `stream` alone lists them");
+      cli_putf(cli, "no field '%s'; `stream` alone lists them", w);
       cli_emit_err(cli, "NAME");
       return;
     }
     if ((mask >> i) & 1u) {
       cli->out_len = 0u;
-      cli_put(cli, "field '");
-      cli_put(cli, w);
-      cli_put(cli, "' given twice");
+      cli_putf(cli, "field '%s' given twice", w);
       cli_emit_err(cli, "ARGS");
       return;
     }
@@ -86,31 +80,19 @@ static void cmd_stream(cli_t *cli, void *ctx, uint32_t argc, const char *const *
     return;
   }
   tlm_plan_t plan;
-  const tlm_status_t st = tlm_plan(t->stream.cfg.fs_hz, t->stream.cfg.baud, mask, rate_hz, &plan);
+  const tlm_status_t st = tlm_plan(&app_tlm_fields, t->stream.cfg.fs_hz, t->stream.cfg.baud, mask, rate_hz, &plan);
   if (st == TLM_ERR_RATE) {
     cli->out_len = 0u;
-    cli_put(cli, "rate must be > 0 and within [fs / ");
-    cli_put_u32(cli, TLM_DECIM_MAX);
-    cli_put(cli, ", fs], fs = ");
-    cli_put_u32(cli, t->stream.cfg.fs_hz);
-    cli_put(cli, " Hz");
+    cli_putf(cli, "rate must be > 0 and within [fs / %u, fs], fs = %u Hz", TLM_DECIM_MAX, t->stream.cfg.fs_hz);
     cli_emit_err(cli, "RANGE");
     return;
   }
   if (st == TLM_ERR_BANDWIDTH) {
     cli->out_len = 0u;
-    cli_put_u32(cli, plan.n_fields);
-    cli_put(cli, " fields at ");
-    cli_put_f32(cli, plan.rate_hz);
-    cli_put(cli, " Hz need ");
-    cli_put_u32(cli, plan.bytes_per_s);
-    cli_put(cli, " B/s, over ");
-    cli_put_u32(cli, TLM_LINK_MAX_PCT);
-    cli_put(cli, "% of the link (");
-    cli_put_u32(cli, plan.link_bytes_per_s * TLM_LINK_MAX_PCT / 100u);
-    cli_put(cli, " of ");
-    cli_put_u32(cli, plan.link_bytes_per_s);
-    cli_put(cli, " B/s); fewer fields or a lower rate");
+    cli_putf(cli, "%u fields at %f Hz need %u B/s, over %u%% of the link (%u of %u B/s); "
+                  "fewer fields or a lower rate",
+             plan.n_fields, plan.rate_hz, plan.bytes_per_s, TLM_LINK_MAX_PCT,
+             plan.link_bytes_per_s * TLM_LINK_MAX_PCT / 100u, plan.link_bytes_per_s);
     cli_emit_err(cli, "BANDWIDTH");
     return;
   }
@@ -121,26 +103,13 @@ static void cmd_stream(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   tlm_start(&t->stream, &plan);
   tlm_stats_t s;
   tlm_stats(&t->stream, &s);
+  const uint32_t link_pct =
+      (uint32_t)(((uint64_t)plan.bytes_per_s * 100u + plan.link_bytes_per_s / 2u) / plan.link_bytes_per_s);
   cli->out_len = 0u;
-  cli_put(cli, "stream ");
-  cli_put_u32(cli, s.stream_id);
-  cli_put(cli, " ");
-  cli_put_f32(cli, plan.rate_hz);
-  cli_put(cli, " Hz decim ");
-  cli_put_u32(cli, plan.decim);
-  cli_put(cli, " fields ");
-  cli_put_u32(cli, plan.n_fields);
-  cli_put(cli, " per_frame ");
-  cli_put_u32(cli, plan.rec_per_frame);
-  cli_put(cli, " link ");
-  cli_put_u32(cli, plan.bytes_per_s);
-  cli_put(cli, " B/s ");
-  cli_put_u32(cli, (uint32_t)(((uint64_t)plan.bytes_per_s * 100u + plan.link_bytes_per_s / 2u) /
-                              plan.link_bytes_per_s));
-  cli_put(cli, "%");
+  cli_putf(cli, "stream %u %f Hz decim %u fields %u per_frame %u link %u B/s %u%%", s.stream_id, plan.rate_hz,
+           plan.decim, plan.n_fields, plan.rec_per_frame, plan.bytes_per_s, link_pct);
   if (plan.rate_hz != rate_hz) {
-    cli_put(cli, " rounded from ");
-    cli_put_f32(cli, rate_hz);
+    cli_putf(cli, " rounded from %f", rate_hz);
   }
   cli_emit_ok(cli);
 }
@@ -161,23 +130,15 @@ static void cmd_stop(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
   tlm_stats_t s;
   tlm_stats(&t->stream, &s);
   cli->out_len = 0u;
-  cli_put(cli, "stop ");
-  cli_put_u32(cli, s.stream_id);
-  cli_put(cli, " records ");
-  cli_put_u32(cli, s.records);
-  cli_put(cli, " lost ");
-  cli_put_u32(cli, s.lost);
-  cli_put(cli, " frames ");
-  cli_put_u32(cli, s.frames);
-  cli_put(cli, " dropped ");
-  cli_put_u32(cli, s.dropped);
+  cli_putf(cli, "stop %u records %u lost %u frames %u dropped %u", s.stream_id, s.records, s.lost, s.frames,
+           s.dropped);
   cli_emit_ok(cli);
 }
 
 int app_tlm_init(app_tlm_t *t, cli_t *cli, const params_t *params)
 {
   t->params = params;
-  const tlm_cfg_t tc = {params_current(params)->sys_fs_hz, APP_TLM_BAUD, uart_room, uart_write, t};
+  const tlm_cfg_t tc = {params_current(params)->sys_fs_hz, APP_TLM_BAUD, uart_room, uart_write, t, &app_tlm_fields};
   if (tlm_init(&t->stream, &tc) != 0) {
     return -1;
   }

@@ -4,7 +4,7 @@
  *
  * Command grammar (replies as in comm/cli.h):
  *   stream                          - NAME TYPE UNIT ...            ok N fields ...
- *       lists the streamable fields (comm/tlm_fields.h), starts nothing
+ *       lists the streamable fields (app_tlm_fields.h), starts nothing
  *   stream FIELD... [@RATE_HZ]      ok stream ID RATE Hz decim D fields F per_frame N
  *                                      link B B/s P% [rounded from R]
  *       FIELD is a field name or `all`; fields go into records in table order whatever
@@ -29,7 +29,8 @@
 #include "gyro/gyro.h"
 #include "params/params.h"
 
-/* The tuning port's line rate (hal/stm32f4: STM32F4_UART_BAUD, 8N1). */
+/* The tuning port's line rate, 8N1: the rate every board's UART driver is set up for, which
+ * the link budget of a stream (tlm_plan) is computed against. */
 #define APP_TLM_BAUD 921600u
 /* TX-ring bytes telemetry leaves free for command replies, so that the longest (list,
  * about 6.5 KB; status with the self-calibration and output-integrity lines about

@@ -1,10 +1,9 @@
 /* Line discipline, tokenising, dispatch and reply framing of the command line; the
- * built-in parameter commands live in cli_builtin.c. Grammar in cli.h. */
+ * built-in parameter commands (cli_builtin.c) come in through cli_cfg_t. Grammar in cli.h. */
 #include "comm/cli.h"
 
 #include <string.h>
 
-#include "comm/cli_builtin.h"
 #include "comm/numfmt.h"
 
 static bool is_wsp(char c) { return c == ' ' || c == '\t'; }
@@ -12,7 +11,8 @@ static bool is_wsp(char c) { return c == ' ' || c == '\t'; }
 int cli_init(cli_t *cli, const cli_cfg_t *cfg)
 {
   memset(cli, 0, sizeof *cli);
-  if (cfg == NULL || cfg->params == NULL || cfg->write == NULL) {
+  if (cfg == NULL || cfg->params == NULL || cfg->write == NULL ||
+      (cfg->builtin == NULL && cfg->n_builtin != 0u)) {
     return -1;
   }
   cli->cfg = *cfg;
@@ -21,13 +21,10 @@ int cli_init(cli_t *cli, const cli_cfg_t *cfg)
 
 static const cli_cmd_t *find_cmd(const cli_t *cli, const char *name)
 {
-  const cli_cmd_t *c = cli_builtin_find(name);
-  if (c != NULL) {
-    return c;
-  }
-  for (uint32_t i = 0; i < cli->n_app; i++) {
-    if (strcmp(cli->app[i]->name, name) == 0) {
-      return cli->app[i];
+  for (uint32_t i = 0; i < cli_cmd_count(cli); i++) {
+    const cli_cmd_t *c = cli_cmd_at(cli, i);
+    if (strcmp(c->name, name) == 0) {
+      return c;
     }
   }
   return NULL;
@@ -51,9 +48,16 @@ int cli_register(cli_t *cli, const cli_cmd_t *cmd)
   return 0;
 }
 
-uint32_t cli_app_count(const cli_t *cli) { return cli->n_app; }
+uint32_t cli_cmd_count(const cli_t *cli) { return cli->cfg.n_builtin + cli->n_app; }
 
-const cli_cmd_t *cli_app_cmd(const cli_t *cli, uint32_t i) { return (i < cli->n_app) ? cli->app[i] : NULL; }
+const cli_cmd_t *cli_cmd_at(const cli_t *cli, uint32_t i)
+{
+  if (i < cli->cfg.n_builtin) {
+    return &cli->cfg.builtin[i];
+  }
+  i -= cli->cfg.n_builtin;
+  return (i < cli->n_app) ? cli->app[i] : NULL;
+}
 
 /* ---- reply framing ---- */
 
@@ -88,6 +92,57 @@ void cli_put_u32(cli_t *cli, uint32_t x)
   char buf[NUMFMT_U32_MAX];
   const size_t n = numfmt_u32(buf, sizeof buf, x);
   cli_put_n(cli, buf, n);
+}
+
+static void put_int(cli_t *cli, char conv, const cli_arg_t *a)
+{
+  if (a->kind != (uint8_t)'i') {
+    cli_put(cli, "?");
+  } else if (conv == 'u' && a->i >= 0 && a->i <= (int64_t)UINT32_MAX) {
+    cli_put_u32(cli, (uint32_t)a->i);
+  } else if (conv == 'd' && a->i >= (int64_t)INT32_MIN && a->i <= (int64_t)INT32_MAX) {
+    if (a->i < 0) {
+      cli_put(cli, "-");
+    }
+    cli_put_u32(cli, (uint32_t)(a->i < 0 ? -a->i : a->i));
+  } else {
+    cli_put(cli, "?");
+  }
+}
+
+void cli_putf_args(cli_t *cli, const char *fmt, const cli_arg_t *args, uint32_t n)
+{
+  uint32_t k = 0u;
+  const char *text = fmt;
+  const char *p = fmt;
+  while (*p != '\0') {
+    if (*p != '%') {
+      p++;
+      continue;
+    }
+    cli_put_n(cli, text, (size_t)(p - text));
+    const char conv = p[1];
+    p += (conv != '\0') ? 2 : 1;
+    text = p;
+    if (conv == '%') {
+      cli_put(cli, "%");
+      continue;
+    }
+    const cli_arg_t *a = (k < n) ? &args[k] : NULL;
+    k++;
+    if (a == NULL) {
+      cli_put(cli, "?");
+    } else if (conv == 's' && a->kind == (uint8_t)'s') {
+      cli_put(cli, a->s);
+    } else if (conv == 'f' && a->kind == (uint8_t)'f') {
+      cli_put_f32(cli, a->f);
+    } else if (conv == 'u' || conv == 'd') {
+      put_int(cli, conv, a);
+    } else {
+      cli_put(cli, "?");
+    }
+  }
+  cli_put_n(cli, text, (size_t)(p - text));
 }
 
 void cli_data_u32(cli_t *cli, const char *key, uint32_t v)

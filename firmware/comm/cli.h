@@ -111,6 +111,11 @@ typedef struct {
   param_store_t *store;  /* NULL: save/load answer err NOSTORE */
   cli_write_fn write;    /* required */
   void *write_ctx;
+  /* Commands found before the registered ones, listed first by help: the parameter
+   * commands (comm/cli_builtin.h), given here so that the line discipline does not
+   * depend on them. NULL (n_builtin 0): none. */
+  const cli_cmd_t *builtin;
+  uint32_t n_builtin;
 } cli_cfg_t;
 
 typedef enum {
@@ -144,9 +149,9 @@ int cli_init(cli_t *cli, const cli_cfg_t *cfg);
 /* Register an application command (kept by pointer). Returns 0, or -1 if the table is
  * full, the name is empty, not one word, or already taken, or fn is NULL. */
 int cli_register(cli_t *cli, const cli_cmd_t *cmd);
-/* Registered application commands, for help. */
-uint32_t cli_app_count(const cli_t *cli);
-const cli_cmd_t *cli_app_cmd(const cli_t *cli, uint32_t i);
+/* Every command, built-in ones first then the registered ones in order, for help. */
+uint32_t cli_cmd_count(const cli_t *cli);
+const cli_cmd_t *cli_cmd_at(const cli_t *cli, uint32_t i); /* NULL past the end */
 /* Feed received bytes; complete lines are executed and answered before it returns. */
 void cli_feed(cli_t *cli, const uint8_t *data, size_t len);
 /* Feed bytes up to and including the first EOL (executed and answered); returns the
@@ -165,6 +170,64 @@ void cli_put(cli_t *cli, const char *s);
 void cli_put_n(cli_t *cli, const char *s, size_t n);
 void cli_put_f32(cli_t *cli, float x);
 void cli_put_u32(cli_t *cli, uint32_t x);
+/* Formatted append, without printf: cli_putf(cli, "fields %u at %f Hz: %s", n, rate_hz, why)
+ * appends the format with each conversion replaced by the next argument:
+ *   %s  a string (const char *; NULL appends nothing), as cli_put
+ *   %u  an integer in [0, 2^32 - 1], as cli_put_u32
+ *   %d  an integer in [-2^31, 2^31 - 1], with a '-' when negative
+ *   %f  a float, as cli_put_f32 (the shortest text that reads back to the same float)
+ *   %%  one '%'
+ * 1 to CLI_PUTF_MAX_ARGS arguments; each one's type picks its kind at compile time
+ * (cli_arg_t, CLI_ARG): a float, a string, or any integer type; a double does not
+ * compile (single precision on the target: cast it where it is meant). A conversion
+ * whose argument is of another kind or out of its range, an unknown conversion or a
+ * missing argument appends '?', so a mistake shows in the reply (unit-tested). The
+ * output is bounded as every append is (CLI_OUT_MAX). */
+#define CLI_PUTF_MAX_ARGS 12u
+
+typedef struct {
+  uint8_t kind; /* 's', 'i' or 'f' */
+  const char *s;
+  int64_t i;
+  float f;
+} cli_arg_t;
+
+static inline cli_arg_t cli_arg_str(const char *s) { return (cli_arg_t){.kind = 's', .s = s}; }
+static inline cli_arg_t cli_arg_int(int64_t i) { return (cli_arg_t){.kind = 'i', .i = i}; }
+static inline cli_arg_t cli_arg_f32(float f) { return (cli_arg_t){.kind = 'f', .f = f}; }
+/* Declared, never defined: an argument of a type without a kind (double, a struct) has no
+ * conversion to this parameter and does not compile. */
+struct cli_arg_no_kind;
+cli_arg_t cli_arg_refused(struct cli_arg_no_kind *refused);
+
+#define CLI_ARG(x)                                                                   \
+  _Generic((x), float: cli_arg_f32, double: cli_arg_refused, long double: cli_arg_refused, \
+           char *: cli_arg_str, const char *: cli_arg_str, default: cli_arg_int)(x)
+
+void cli_putf_args(cli_t *cli, const char *fmt, const cli_arg_t *args, uint32_t n);
+
+/* clang-format off */
+#define CLI_NARG_(_1, _2, _3, _4, _5, _6, _7, _8, _9, _10, _11, _12, N, ...) N
+#define CLI_NARG(...) CLI_NARG_(__VA_ARGS__, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0)
+#define CLI_MAP_1(x) CLI_ARG(x)
+#define CLI_MAP_2(x, ...) CLI_ARG(x), CLI_MAP_1(__VA_ARGS__)
+#define CLI_MAP_3(x, ...) CLI_ARG(x), CLI_MAP_2(__VA_ARGS__)
+#define CLI_MAP_4(x, ...) CLI_ARG(x), CLI_MAP_3(__VA_ARGS__)
+#define CLI_MAP_5(x, ...) CLI_ARG(x), CLI_MAP_4(__VA_ARGS__)
+#define CLI_MAP_6(x, ...) CLI_ARG(x), CLI_MAP_5(__VA_ARGS__)
+#define CLI_MAP_7(x, ...) CLI_ARG(x), CLI_MAP_6(__VA_ARGS__)
+#define CLI_MAP_8(x, ...) CLI_ARG(x), CLI_MAP_7(__VA_ARGS__)
+#define CLI_MAP_9(x, ...) CLI_ARG(x), CLI_MAP_8(__VA_ARGS__)
+#define CLI_MAP_10(x, ...) CLI_ARG(x), CLI_MAP_9(__VA_ARGS__)
+#define CLI_MAP_11(x, ...) CLI_ARG(x), CLI_MAP_10(__VA_ARGS__)
+#define CLI_MAP_12(x, ...) CLI_ARG(x), CLI_MAP_11(__VA_ARGS__)
+#define CLI_CAT_(a, b) a##b
+#define CLI_CAT(a, b) CLI_CAT_(a, b)
+#define cli_putf(cli, fmt, ...)                                                                  \
+  cli_putf_args((cli), (fmt), (const cli_arg_t[]){CLI_CAT(CLI_MAP_, CLI_NARG(__VA_ARGS__))(__VA_ARGS__)}, \
+                (uint32_t)CLI_NARG(__VA_ARGS__))
+/* clang-format on */
+
 void cli_emit_data(cli_t *cli);                  /* "- " text */
 /* One "- KEY VALUE" data line (status-style key/value reports). */
 void cli_data_u32(cli_t *cli, const char *key, uint32_t v);

@@ -3,7 +3,7 @@
 #include <string.h>
 
 #include "comm/numparse.h"
-#include "gyro/fw_version.h"
+#include "params/fw_version.h"
 
 static void put_value(cli_t *cli, param_idx_t i, param_value_t v)
 {
@@ -60,9 +60,7 @@ static param_idx_t lookup_arg(cli_t *cli, const char *name)
 {
   const param_idx_t i = param_lookup(name, strlen(name));
   if (i == PARAM_COUNT) {
-    cli_put(cli, "unknown parameter '");
-    cli_put(cli, name);
-    cli_put(cli, "'; try list");
+    cli_putf(cli, "unknown parameter '%s'; try list", name);
     cli_emit_err(cli, "NAME");
   }
   return i;
@@ -76,24 +74,14 @@ static void cmd_help(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
     cli_err(cli, "ARGS", "usage: help");
     return;
   }
-  uint32_t n = 0u;
-  for (uint32_t pass = 0; pass < 2u; pass++) {
-    const uint32_t count = (pass == 0u) ? cli_builtin_count() : cli_app_count(cli);
-    for (uint32_t i = 0; i < count; i++) {
-      const cli_cmd_t *c = (pass == 0u) ? cli_builtin_at(i) : cli_app_cmd(cli, i);
-      cli_put(cli, c->name);
-      if (c->args != NULL && c->args[0] != '\0') {
-        cli_put(cli, " ");
-        cli_put(cli, c->args);
-      }
-      cli_put(cli, " : ");
-      cli_put(cli, c->help);
-      cli_emit_data(cli);
-      n++;
-    }
+  const uint32_t n = cli_cmd_count(cli);
+  for (uint32_t i = 0; i < n; i++) {
+    const cli_cmd_t *c = cli_cmd_at(cli, i);
+    const bool has_args = c->args != NULL && c->args[0] != '\0';
+    cli_putf(cli, "%s%s%s : %s", c->name, has_args ? " " : "", has_args ? c->args : "", c->help);
+    cli_emit_data(cli);
   }
-  cli_put_u32(cli, n);
-  cli_put(cli, " commands");
+  cli_putf(cli, "%u commands", n);
   cli_emit_ok(cli);
 }
 
@@ -114,24 +102,19 @@ static void cmd_list(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
     if (strncmp(pi->name, prefix, plen) != 0) {
       continue;
     }
-    cli_put(cli, pi->name);
-    cli_put(cli, " ");
+    cli_putf(cli, "%s ", pi->name);
     put_value(cli, i, param_get(cur, i));
-    cli_put(cli, " ");
-    cli_put(cli, pi->unit);
-    cli_put(cli, " ");
+    cli_putf(cli, " %s ", pi->unit);
     put_range(cli, i);
     cli_put(cli, " def=");
     put_value(cli, i, pi->def);
     cli_put(cli, " flags=");
     put_flags(cli, pi->flags);
-    cli_put(cli, " ");
-    cli_put(cli, pi->help);
+    cli_putf(cli, " %s", pi->help);
     cli_emit_data(cli);
     n++;
   }
-  cli_put_u32(cli, n);
-  cli_put(cli, " parameters");
+  cli_putf(cli, "%u parameters", n);
   cli_emit_ok(cli);
 }
 
@@ -147,11 +130,9 @@ static void cmd_get(cli_t *cli, void *ctx, uint32_t argc, const char *const *arg
     return;
   }
   const param_info_t *pi = param_info(i);
-  cli_put(cli, pi->name);
-  cli_put(cli, " ");
+  cli_putf(cli, "%s ", pi->name);
   put_value(cli, i, param_get(params_current(cli->cfg.params), i));
-  cli_put(cli, " ");
-  cli_put(cli, pi->unit);
+  cli_putf(cli, " %s", pi->unit);
   cli_emit_ok(cli);
 }
 
@@ -159,16 +140,10 @@ static void cmd_get(cli_t *cli, void *ctx, uint32_t argc, const char *const *arg
 static void value_error(cli_t *cli, const char *code, param_idx_t i, const char *text, const char *what)
 {
   const param_info_t *pi = param_info(i);
-  cli_put(cli, pi->name);
-  cli_put(cli, ": '");
-  cli_put(cli, text);
-  cli_put(cli, "' ");
-  cli_put(cli, what);
-  cli_put(cli, "; allowed ");
+  cli_putf(cli, "%s: '%s' %s; allowed ", pi->name, text, what);
   put_range(cli, i);
   if (strcmp(pi->unit, "-") != 0) {
-    cli_put(cli, " ");
-    cli_put(cli, pi->unit);
+    cli_putf(cli, " %s", pi->unit);
   }
   cli_emit_err(cli, code);
 }
@@ -183,8 +158,7 @@ static bool stage_pair(cli_t *cli, const char *name, const char *text)
   }
   const param_info_t *pi = param_info(i);
   if ((pi->flags & PF_READONLY) != 0u) {
-    cli_put(cli, pi->name);
-    cli_put(cli, " is read-only");
+    cli_putf(cli, "%s is read-only", pi->name);
     cli_emit_err(cli, "RO");
     return false;
   }
@@ -215,8 +189,7 @@ static void commit_error(cli_t *cli, param_status_t st, const params_err_t *err)
   switch (st) {
   case PARAM_ERR_BUSY:
     if (param_info(err->idx) != NULL) {
-      cli_put(cli, param_info(err->idx)->name);
-      cli_put(cli, " cannot change while the drive runs: stop the drive first");
+      cli_putf(cli, "%s cannot change while the drive runs: stop the drive first", param_info(err->idx)->name);
     } else {
       cli_put(cli, "drive running: stop the drive first");
     }
@@ -237,8 +210,7 @@ static void commit_error(cli_t *cli, param_status_t st, const params_err_t *err)
   default:
     cli_put(cli, param_status_str(st));
     if (param_info(err->idx) != NULL) {
-      cli_put(cli, ": ");
-      cli_put(cli, param_info(err->idx)->name);
+      cli_putf(cli, ": %s", param_info(err->idx)->name);
     }
     cli_emit_err(cli, "RANGE");
     break;
@@ -249,10 +221,7 @@ static void commit_error(cli_t *cli, param_status_t st, const params_err_t *err)
 static void rejected_set(cli_t *cli, uint32_t argc, const char *const *argv, const params_err_t *err)
 {
   for (uint32_t k = 1; k + 1u < argc; k += 2u) {
-    cli_put(cli, argv[k]);
-    cli_put(cli, " ");
-    cli_put(cli, argv[k + 1u]);
-    cli_put(cli, (k + 3u < argc) ? ", " : ": ");
+    cli_putf(cli, "%s %s%s", argv[k], argv[k + 1u], (k + 3u < argc) ? ", " : ": ");
   }
   cli_put(cli, (err->why != NULL) ? err->why : param_status_str(PARAM_ERR_REJECTED));
   cli_emit_err(cli, "REJECTED");
@@ -286,11 +255,7 @@ static void cmd_set(cli_t *cli, void *ctx, uint32_t argc, const char *const *arg
   const param_values_t *cur = params_current(p);
   for (uint32_t k = 1; k + 1u < argc; k += 2u) {
     const param_idx_t i = param_lookup(argv[k], strlen(argv[k]));
-    if (k > 1u) {
-      cli_put(cli, " ");
-    }
-    cli_put(cli, param_info(i)->name);
-    cli_put(cli, " ");
+    cli_putf(cli, "%s%s ", (k > 1u) ? " " : "", param_info(i)->name);
     put_value(cli, i, param_get(cur, i));
   }
   cli_emit_ok(cli);
@@ -298,10 +263,7 @@ static void cmd_set(cli_t *cli, void *ctx, uint32_t argc, const char *const *arg
 
 static void put_slot(cli_t *cli, const param_store_report_t *rep)
 {
-  cli_put(cli, " slot ");
-  cli_put(cli, (rep->slot == 0) ? "A" : "B");
-  cli_put(cli, " seq ");
-  cli_put_u32(cli, rep->seq);
+  cli_putf(cli, " slot %s seq %u", (rep->slot == 0) ? "A" : "B", rep->seq);
 }
 
 static void cmd_save(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
@@ -341,8 +303,7 @@ static void cmd_save(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
   case PARAM_STORE_ERR_VERIFY:
   case PARAM_STORE_ERR_CONFIG:
   default:
-    cli_put(cli, param_store_status_str(st));
-    cli_put(cli, "; the previous image is kept");
+    cli_putf(cli, "%s; the previous image is kept", param_store_status_str(st));
     cli_emit_err(cli, "FLASH");
     break;
   }
@@ -391,11 +352,8 @@ static void cmd_load(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
   param_values_t v = *params_current(cli->cfg.params);
   param_store_report_t rep;
   if (param_store_load(cli->cfg.store, &v, &rep) != PARAM_STORE_OK) {
-    cli_put(cli, "no valid parameter image (slot A ");
-    cli_put(cli, slot_state_str(rep.slot_state[0]));
-    cli_put(cli, ", slot B ");
-    cli_put(cli, slot_state_str(rep.slot_state[1]));
-    cli_put(cli, "); nothing changed");
+    cli_putf(cli, "no valid parameter image (slot A %s, slot B %s); nothing changed",
+             slot_state_str(rep.slot_state[0]), slot_state_str(rep.slot_state[1]));
     cli_emit_err(cli, "NOSTORE");
     return;
   }
@@ -406,12 +364,7 @@ static void cmd_load(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
   }
   cli_put(cli, "loaded");
   put_slot(cli, &rep);
-  cli_put(cli, " dropped ");
-  cli_put_u32(cli, rep.dropped);
-  cli_put(cli, " rejected ");
-  cli_put_u32(cli, rep.rejected);
-  cli_put(cli, " defaulted ");
-  cli_put_u32(cli, rep.defaulted);
+  cli_putf(cli, " dropped %u rejected %u defaulted %u", rep.dropped, rep.rejected, rep.defaulted);
   cli_emit_ok(cli);
 }
 
@@ -449,16 +402,14 @@ static void cmd_diff(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
     if (param_value_equal(i, v, pi->def)) {
       continue;
     }
-    cli_put(cli, pi->name);
-    cli_put(cli, " ");
+    cli_putf(cli, "%s ", pi->name);
     put_value(cli, i, v);
     cli_put(cli, " default ");
     put_value(cli, i, pi->def);
     cli_emit_data(cli);
     n++;
   }
-  cli_put_u32(cli, n);
-  cli_put(cli, " differ");
+  cli_putf(cli, "%u differ", n);
   cli_emit_ok(cli);
 }
 
@@ -470,14 +421,8 @@ static void cmd_version(cli_t *cli, void *ctx, uint32_t argc, const char *const 
     cli_err(cli, "ARGS", "usage: version");
     return;
   }
-  cli_put(cli, "fw ");
-  cli_put(cli, fw_version_string());
-  cli_put(cli, " layout ");
-  cli_put_u32(cli, PARAM_LAYOUT_VERSION);
-  cli_put(cli, " format ");
-  cli_put_u32(cli, PARAM_STORE_FORMAT);
-  cli_put(cli, " params ");
-  cli_put_u32(cli, (uint32_t)PARAM_COUNT);
+  cli_putf(cli, "fw %s layout %u format %u params %u", fw_version_string(), PARAM_LAYOUT_VERSION,
+           PARAM_STORE_FORMAT, (uint32_t)PARAM_COUNT);
   cli_emit_ok(cli);
 }
 
@@ -493,7 +438,7 @@ static void cmd_console(cli_t *cli, void *ctx, uint32_t argc, const char *const 
   cli_ok(cli, cli->console ? "console on" : "console off");
 }
 
-static const cli_cmd_t k_builtin[] = {
+const cli_cmd_t cli_builtin_cmds[] = {
     {"help", "", "list the commands", cmd_help, NULL},
     {"list", "[PREFIX]", "parameters with value, unit, range, default, flags and help", cmd_list, NULL},
     {"get", "NAME", "value of one parameter", cmd_get, NULL},
@@ -508,16 +453,4 @@ static const cli_cmd_t k_builtin[] = {
                             "the default)", cmd_console, NULL},
 };
 
-uint32_t cli_builtin_count(void) { return (uint32_t)(sizeof k_builtin / sizeof k_builtin[0]); }
-
-const cli_cmd_t *cli_builtin_at(uint32_t i) { return (i < cli_builtin_count()) ? &k_builtin[i] : NULL; }
-
-const cli_cmd_t *cli_builtin_find(const char *name)
-{
-  for (uint32_t i = 0; i < cli_builtin_count(); i++) {
-    if (strcmp(k_builtin[i].name, name) == 0) {
-      return &k_builtin[i];
-    }
-  }
-  return NULL;
-}
+uint32_t cli_builtin_count(void) { return (uint32_t)(sizeof cli_builtin_cmds / sizeof cli_builtin_cmds[0]); }

@@ -7,9 +7,9 @@
 
 #include "comm/cli.h"
 
-/* NULL if name is not a built-in command. */
-const cli_cmd_t *cli_builtin_find(const char *name);
+/* The built-in command rows, for cli_cfg_t's builtin / n_builtin:
+ *   const cli_cfg_t cc = {params, store, write, ctx, cli_builtin_cmds, cli_builtin_count()}; */
+extern const cli_cmd_t cli_builtin_cmds[];
 uint32_t cli_builtin_count(void);
-const cli_cmd_t *cli_builtin_at(uint32_t i);
 
 #endif /* CLI_BUILTIN_H */

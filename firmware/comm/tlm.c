@@ -11,13 +11,28 @@ static uint32_t popcount32(uint32_t m)
   return n;
 }
 
+static bool fields_ok(const tlm_fields_t *f)
+{
+  if (f == NULL || f->row == NULL || f->count == 0u || f->count > TLM_FIELDS_MAX) {
+    return false;
+  }
+  for (uint32_t i = 0; i < f->count; i++) {
+    if (f->row[i].name == NULL || strlen(f->row[i].name) > TLM_NAME_MAX || f->row[i].offset % 4u != 0u) {
+      return false;
+    }
+  }
+  return true;
+}
+
 int tlm_init(tlm_t *t, const tlm_cfg_t *cfg)
 {
   memset(t, 0, sizeof *t);
-  if (cfg == NULL || cfg->room == NULL || cfg->write == NULL || cfg->fs_hz == 0u || cfg->baud == 0u) {
+  if (cfg == NULL || cfg->room == NULL || cfg->write == NULL || cfg->fs_hz == 0u || cfg->baud == 0u ||
+      !fields_ok(cfg->fields)) {
     return -1;
   }
   t->cfg = *cfg;
+  t->rows = cfg->fields->row;
   tlm_ring_init(&t->ring);
   atomic_store_explicit(&t->isr_gen, 0u, memory_order_relaxed);
   atomic_store_explicit(&t->isr_rec, 0u, memory_order_relaxed);
@@ -37,31 +52,33 @@ static uint32_t rec_per_frame(uint32_t fs_hz, uint32_t decim, uint32_t n_fields)
   return (n > 255u) ? 255u : n;
 }
 
-static uint32_t header_payload_len(uint32_t mask)
+static uint32_t header_payload_len(const tlm_fields_t *fields, uint32_t mask)
 {
   uint32_t n = TLM_HEADER_FIXED;
-  for (uint32_t i = 0; i < (uint32_t)TLM_FIELD_COUNT; i++) {
+  for (uint32_t i = 0; i < fields->count; i++) {
     if ((mask >> i) & 1u) {
-      n += 2u + (uint32_t)strlen(tlm_field(i)->name);
+      n += 2u + (uint32_t)strlen(fields->row[i].name);
     }
   }
   return n;
 }
 
-uint32_t tlm_plan_bytes_per_s(uint32_t fs_hz, uint32_t mask, uint32_t decim, uint32_t rec_per_frame_)
+uint32_t tlm_plan_bytes_per_s(const tlm_fields_t *fields, uint32_t fs_hz, uint32_t mask, uint32_t decim,
+                              uint32_t rec_per_frame_)
 {
   const uint32_t f = popcount32(mask);
   const uint32_t data_wire = tlm_wire_len_max(TLM_FRAME_OVERHEAD + TLM_DATA_FIXED + 4u * rec_per_frame_ * f);
-  const uint32_t hdr_wire = tlm_wire_len_max(TLM_FRAME_OVERHEAD + header_payload_len(mask));
+  const uint32_t hdr_wire = tlm_wire_len_max(TLM_FRAME_OVERHEAD + header_payload_len(fields, mask));
   /* frames/s = fs / (decim N), rounded up */
   const uint64_t num = (uint64_t)fs_hz * data_wire;
   const uint64_t den = (uint64_t)decim * rec_per_frame_;
   return (uint32_t)((num + den - 1u) / den) + hdr_wire;
 }
 
-tlm_status_t tlm_plan(uint32_t fs_hz, uint32_t baud, uint32_t mask, float rate_hz, tlm_plan_t *plan)
+tlm_status_t tlm_plan(const tlm_fields_t *fields, uint32_t fs_hz, uint32_t baud, uint32_t mask, float rate_hz,
+                      tlm_plan_t *plan)
 {
-  if (mask == 0u || (mask & ~TLM_FIELD_MASK_ALL) != 0u) {
+  if (mask == 0u || (mask & ~tlm_fields_mask_all(fields)) != 0u) {
     return TLM_ERR_FIELDS;
   }
   /* also rejects NaN: every comparison with it is false */
@@ -82,7 +99,7 @@ tlm_status_t tlm_plan(uint32_t fs_hz, uint32_t baud, uint32_t mask, float rate_h
   p.decim = decim;
   p.rate_hz = (float)fs_hz / (float)decim;
   p.rec_per_frame = rec_per_frame(fs_hz, decim, p.n_fields);
-  p.bytes_per_s = tlm_plan_bytes_per_s(fs_hz, mask, decim, p.rec_per_frame);
+  p.bytes_per_s = tlm_plan_bytes_per_s(fields, fs_hz, mask, decim, p.rec_per_frame);
   p.link_bytes_per_s = baud / 10u;
   *plan = p;
   if ((uint64_t)p.bytes_per_s * 100u > (uint64_t)p.link_bytes_per_s * TLM_LINK_MAX_PCT) {
@@ -93,7 +110,7 @@ tlm_status_t tlm_plan(uint32_t fs_hz, uint32_t baud, uint32_t mask, float rate_h
 
 /* ---- ISR ---- */
 
-void tlm_isr_record(tlm_t *t, const gyro_out_t *out, uint32_t gen)
+void tlm_isr_record(tlm_t *t, const void *snapshot, uint32_t gen)
 {
   if (gen != t->isr_seen) {
     t->isr_seen = gen; /* a new stream takes its first record at once */
@@ -113,11 +130,11 @@ void tlm_isr_record(tlm_t *t, const gyro_out_t *out, uint32_t gen)
   uint32_t rec[1u + TLM_FIELDS_MAX];
   uint32_t n = 0u;
   rec[n++] = k;
-  const uint8_t *base = (const uint8_t *)out;
+  const uint8_t *base = snapshot;
   /* set bits only, lowest first (table order): the cost follows the number of fields,
    * not the index of the highest one (count trailing zeros: RBIT + CLZ on the M4) */
   for (uint32_t m = mask; m != 0u; m &= m - 1u) {
-    memcpy(&rec[n++], base + tlm_field((uint32_t)__builtin_ctz(m))->offset, 4u);
+    memcpy(&rec[n++], base + t->rows[__builtin_ctz(m)].offset, 4u);
   }
   (void)tlm_ring_push(&t->ring, rec, n);
 }
@@ -158,9 +175,9 @@ static void queue_header(tlm_t *t)
   tlm_put_u32(&p[19], t->dropped);
   p[23] = (uint8_t)t->plan.n_fields;
   size_t n = TLM_HEADER_FIXED;
-  for (uint32_t i = 0; i < (uint32_t)TLM_FIELD_COUNT; i++) {
+  for (uint32_t i = 0; i < t->cfg.fields->count; i++) {
     if (((t->plan.mask >> i) & 1u) != 0u) {
-      const tlm_field_t *f = tlm_field(i);
+      const tlm_field_t *f = &t->rows[i];
       const size_t len = strlen(f->name);
       p[n++] = f->type;
       p[n++] = (uint8_t)len;

@@ -1,6 +1,7 @@
-/* Telemetry stream: selected fields of the gyro's per-tick snapshot, decimated in the
- * sample ISR, framed in the background loop, sent on the tuning UART next to the command
- * line (frame format and the text/frame rule: tlm_frame.h; fields: tlm_fields.h).
+/* Telemetry stream: selected fields of the application's per-tick snapshot, decimated in
+ * the sample ISR, framed in the background loop, sent on the tuning UART next to the
+ * command line (frame format and the text/frame rule: tlm_frame.h; the field table the
+ * application registers: tlm_fields.h).
  *
  *   ISR (50 kHz)   tlm_isr_push(): one 32-bit load and a compare while not streaming;
  *                  otherwise a decimation counter, and every decim-th tick (two more
@@ -71,7 +72,6 @@
 #include "comm/tlm_fields.h"
 #include "comm/tlm_frame.h"
 #include "comm/tlm_ring.h"
-#include "gyro/gyro.h"
 
 #define TLM_LINK_MAX_PCT 70u
 #define TLM_FRAMES_PER_S 50u
@@ -90,11 +90,12 @@ typedef struct {
   tlm_room_fn room;
   tlm_write_fn write;
   void *ctx;
+  const tlm_fields_t *fields; /* the snapshot's field table, kept by pointer */
 } tlm_cfg_t;
 
 /* A checked stream selection (tlm_plan). */
 typedef struct {
-  uint32_t mask;          /* bit i: tlm_field(i) */
+  uint32_t mask;          /* bit i: row i of the field table */
   uint32_t n_fields;
   uint32_t decim;         /* ticks per record */
   float rate_hz;          /* fs / decim, what the stream delivers */
@@ -121,13 +122,14 @@ typedef struct {
 
 /* A selection as the ISR reads it (configuration handoff above). */
 typedef struct {
-  uint32_t mask;  /* bit i: tlm_field(i) */
+  uint32_t mask;  /* bit i: row i of the field table */
   uint32_t decim; /* ticks per record, >= 1 */
 } tlm_isr_sel_t;
 
 typedef struct {
   tlm_ring_t ring;
   /* ISR side */
+  const tlm_field_t *rows;  /* cfg.fields->row: one load fewer per record */
   tlm_isr_sel_t isr_sel[2]; /* written by the background, never the slot isr_gen names */
   _Atomic uint32_t isr_gen; /* 0 = off, else g: selection isr_sel[g & 1]; background */
   uint32_t isr_seen;        /* last isr_gen the ISR acted on */
@@ -153,14 +155,18 @@ typedef struct {
   uint8_t wire[TLM_WIRE_MAX];
 } tlm_t;
 
-/* Returns 0, or -1 for a missing callback, fs_hz == 0 or baud == 0. */
+/* Returns 0, or -1 for a missing callback, fs_hz == 0, baud == 0, or a field table
+ * that is missing, empty, longer than TLM_FIELDS_MAX, or has a row with a name longer
+ * than TLM_NAME_MAX or an offset that is not a multiple of 4. */
 int tlm_init(tlm_t *t, const tlm_cfg_t *cfg);
 
 /* Check a selection and choose decim = round(fs / rate_hz) (>= 1), the frame size and the
  * wire load. Pure; *plan is filled on TLM_OK and on TLM_ERR_BANDWIDTH (for the message). */
-tlm_status_t tlm_plan(uint32_t fs_hz, uint32_t baud, uint32_t mask, float rate_hz, tlm_plan_t *plan);
+tlm_status_t tlm_plan(const tlm_fields_t *fields, uint32_t fs_hz, uint32_t baud, uint32_t mask, float rate_hz,
+                      tlm_plan_t *plan);
 /* Wire bytes per second of a plan: data frames at their worst-case size plus headers. */
-uint32_t tlm_plan_bytes_per_s(uint32_t fs_hz, uint32_t mask, uint32_t decim, uint32_t rec_per_frame);
+uint32_t tlm_plan_bytes_per_s(const tlm_fields_t *fields, uint32_t fs_hz, uint32_t mask, uint32_t decim,
+                              uint32_t rec_per_frame);
 
 /* Stop any running stream (as tlm_stop) and start plan (from tlm_plan with this t's
  * fs and baud). Background only. */
@@ -181,14 +187,15 @@ uint32_t tlm_sel_write(tlm_t *t, uint32_t mask, uint32_t decim);
 void tlm_sel_publish(tlm_t *t, uint32_t gen);
 
 /* ISR, streaming: gen is the isr_gen this tick loaded (non-zero). */
-void tlm_isr_record(tlm_t *t, const gyro_out_t *out, uint32_t gen);
+void tlm_isr_record(tlm_t *t, const void *snapshot, uint32_t gen);
 
-/* ISR: call once per tick after gyro_tick, with the tick's snapshot. */
-static inline void tlm_isr_push(tlm_t *t, const gyro_out_t *out)
+/* ISR: call once per tick with the tick's snapshot, the object the field table's
+ * offsets are taken in. */
+static inline void tlm_isr_push(tlm_t *t, const void *snapshot)
 {
   const uint32_t gen = atomic_load_explicit(&t->isr_gen, memory_order_relaxed);
   if (gen != 0u) {
-    tlm_isr_record(t, out, gen);
+    tlm_isr_record(t, snapshot, gen);
   }
 }
 

@@ -2,36 +2,12 @@
 
 #include <string.h>
 
-#include "comm/tlm_frame.h"
-#include "gyro/gyro.h"
-
-#define TLM_X_ROW(member, type, unit) \
-  {#member, unit, (uint16_t)offsetof(gyro_out_t, member), (uint8_t)TLM_T_##type},
-static const tlm_field_t k_fields[TLM_FIELD_COUNT] = {TLM_FIELD_LIST(TLM_X_ROW)};
-#undef TLM_X_ROW
-
-/* Every field is one aligned 4-byte word of the snapshot, so the ISR copies words and a
- * record never holds a torn value; the type letter must match the member's C type. */
-#define TLM_X_CHECK(member, type, unit)                                                   \
-  _Static_assert(sizeof(((gyro_out_t *)0)->member) == 4u, #member " is not 4 bytes");    \
-  _Static_assert(offsetof(gyro_out_t, member) % 4u == 0u, #member " is not aligned");    \
-  _Static_assert(_Generic(((gyro_out_t *)0)->member, float: TLM_T_F32, uint32_t: TLM_T_U32) \
-                     == TLM_T_##type, #member " has another type");
-TLM_FIELD_LIST(TLM_X_CHECK)
-#undef TLM_X_CHECK
-/* The selection is one 32-bit mask (tlm.h: tlm_isr_sel_t), and a header frame lists at
- * most TLM_FIELDS_MAX fields (tlm_frame.h). */
-_Static_assert(TLM_FIELD_COUNT >= 1 && TLM_FIELD_COUNT <= 32, "the selection mask has 32 bits");
-_Static_assert(TLM_FIELD_COUNT <= TLM_FIELDS_MAX, "a header lists every field");
-
-const tlm_field_t *tlm_field(uint32_t i) { return (i < (uint32_t)TLM_FIELD_COUNT) ? &k_fields[i] : NULL; }
-
-uint32_t tlm_field_lookup(const char *name, size_t len)
+uint32_t tlm_fields_lookup(const tlm_fields_t *f, const char *name, size_t len)
 {
-  for (uint32_t i = 0; i < (uint32_t)TLM_FIELD_COUNT; i++) {
-    if (strlen(k_fields[i].name) == len && memcmp(k_fields[i].name, name, len) == 0) {
+  for (uint32_t i = 0; i < f->count; i++) {
+    if (strlen(f->row[i].name) == len && memcmp(f->row[i].name, name, len) == 0) {
       return i;
     }
   }
-  return (uint32_t)TLM_FIELD_COUNT;
+  return f->count;
 }

@@ -57,8 +57,8 @@
  *   F3 frames flow only between the `ok stream ...` reply that starts a stream and the
  *      `ok stop ...` reply (or the next `stream` reply) that ends it: `stop` sends the
  *      last frames before its reply.
- * A host parser (tlm_decode.h, and gyroctl's frames.py, which follows it) is a
- * three-state machine, starting in TEXT:
+ * A host parser (tools/tlm_decode/tlm_decode.h, and gyroctl's frames.py, which follows
+ * it) is a three-state machine, starting in TEXT:
  *   TEXT   0x01 starts a frame (-> FRAME, the 0x01 is its first COBS byte; a partial
  *          line is dropped as garbage); LF ends a line (one trailing CR is removed, an
  *          empty line is ignored); 0x20-0x7E, TAB and CR extend the line; 0x00 drops a

@@ -2,7 +2,7 @@
 
 #include <string.h>
 
-#include "gyro/fw_version.h"
+#include "params/fw_version.h"
 #include "hal/hal_flash.h"
 #include "params/crc32.h"
 

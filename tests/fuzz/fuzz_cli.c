@@ -6,13 +6,14 @@
  * prompt, erase) comes only in console mode, never as a NUL (the telemetry frame
  * delimiter) or a byte >= 0x80; the line held stays within CLI_LINE_MAX; the held
  * parameters always pass their checks and hold no -0, no staged edit is left behind,
- * every loss is counted. */
+ * every loss is counted; the input as a cli_putf format builds a well-formed line. */
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
 
 #include "comm/cli.h"
+#include "comm/cli_builtin.h"
 #include "fuzz_check.h"
 #include "hal_flash_host.h"
 
@@ -76,6 +77,25 @@ static int derive(void *ctx, const param_values_t *v, void *d, const char **why)
 
 static bool loop_safe(void *ctx) { return ((fx_t *)ctx)->safe; }
 
+/* The input, up to its first NUL, as a cli_putf format over one argument of each kind
+ * (and fewer arguments than conversions, when it has many): the line it builds is well
+ * formed (check_line) and within CLI_OUT_MAX whatever the format. */
+static void putf_any(const uint8_t *data, size_t size)
+{
+  char fmt[2u * CLI_LINE_MAX + 1u];
+  size_t n = 0u;
+  while (n < size && n + 1u < sizeof fmt && data[n] != 0u) {
+    fmt[n] = (char)data[n];
+    n++;
+  }
+  fmt[n] = '\0';
+  g.cli.replied = false;
+  g.cli.out_len = 0u;
+  cli_putf(&g.cli, fmt, "text", 4294967295u, -2147483647 - 1, -1.5e-38f, (const char *)NULL, 0);
+  FUZZ_CHECK(g.cli.out_len + 2u <= CLI_OUT_MAX);
+  cli_emit_data(&g.cli);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -87,7 +107,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
   FUZZ_CHECK(param_store_init(&g.store, &sc) == PARAM_STORE_OK);
   const params_cfg_t pc = {derive, {&g.derived[0], &g.derived[1]}, loop_safe, &g};
   FUZZ_CHECK(params_init(&g.bank, &pc, NULL, NULL) == PARAM_OK);
-  const cli_cfg_t cc = {&g.bank, &g.store, check_line, &g};
+  const cli_cfg_t cc = {&g.bank, &g.store, check_line, &g, cli_builtin_cmds, cli_builtin_count()};
   FUZZ_CHECK(cli_init(&g.cli, &cc) == 0);
   if (size == 0) {
     return 0;
@@ -119,5 +139,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
   }
   FUZZ_CHECK(g.cli.truncated == 0u);
   FUZZ_CHECK(g.cli.rx_overflows == losses);
+  putf_any(data + 1, size - 1u);
   return 0;
 }

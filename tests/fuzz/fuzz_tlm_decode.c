@@ -13,8 +13,10 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "app/app_tlm_fields.h"
 #include "comm/tlm.h"
-#include "comm/tlm_decode.h"
+#include "gyro/gyro.h"
+#include "tlm_decode.h"
 #include "fuzz_check.h"
 
 typedef struct {
@@ -103,10 +105,10 @@ static void build_good(void)
   if (g_good_len != 0u) {
     return;
   }
-  const tlm_cfg_t c = {50000u, 921600u, room, take, NULL};
+  const tlm_cfg_t c = {50000u, 921600u, room, take, NULL, &app_tlm_fields};
   FUZZ_CHECK(tlm_init(&g_tx, &c) == 0);
   tlm_plan_t p;
-  FUZZ_CHECK(tlm_plan(50000u, 921600u, (1u << TLM_FIELD_rate_dps) | (1u << TLM_FIELD_tick), 1000.0f, &p) ==
+  FUZZ_CHECK(tlm_plan(&app_tlm_fields, 50000u, 921600u, (1u << TLM_FIELD_rate_dps) | (1u << TLM_FIELD_tick), 1000.0f, &p) ==
              TLM_OK);
   tlm_start(&g_tx, &p);
   gyro_out_t o;

@@ -77,6 +77,22 @@ static void test_drive_and_status(void **state)
   assert_int_equal(app.gyro.sup.mode, GYRO_MODE_ACQUIRE);
 }
 
+/* The health counters of status (one table in app_cmds.c): a lost sample shows in
+ * samples_lost, and the counters that must stay 0 are there. */
+static void test_status_health_counters(void **state)
+{
+  (void)state;
+  setup_app();
+  hal_host_lose_sample();
+  char want[48];
+  snprintf(want, sizeof want, "- samples_lost %u\r\n", (unsigned)*hal_sample_lost_counter());
+  const char *r = cmd("status\n");
+  assert_non_null(strstr(r, want));
+  assert_true(*hal_sample_lost_counter() >= 1u);
+  assert_non_null(strstr(r, "- rx_overflows 0\r\n- samples_lost "));
+  assert_non_null(strstr(r, "- reply_lines_cut 0\r\n- store "));
+}
+
 /* A save is refused while the drive runs; with the drive off it is stored and a
  * restart loads it. */
 static void test_save_and_restart(void **state)
@@ -189,6 +205,7 @@ int main(void)
       cmocka_unit_test(test_drive_and_status),
       cmocka_unit_test(test_save_and_restart),
       cmocka_unit_test(test_isr_cycles),
+      cmocka_unit_test(test_status_health_counters),
       cmocka_unit_test(test_replies_fit_the_reserve),
       cmocka_unit_test(test_design_reason_and_status),
   };

@@ -1,6 +1,6 @@
 /* The stream/stop commands of the application, end to end through the host UART stub:
  * the real app (ISR glue, background loop, command line), the TX bytes split by the
- * receiver (comm/tlm_decode) into reply lines and frames. */
+ * receiver (tools/tlm_decode) into reply lines and frames. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -10,7 +10,8 @@
 #include <cmocka.h>
 
 #include "app/app.h"
-#include "comm/tlm_decode.h"
+#include "app/app_tlm_fields.h"
+#include "tlm_decode.h"
 #include "hal/hal_sample_timer.h"
 #include "hal_flash_host.h"
 #include "hal_host.h"
@@ -224,7 +225,7 @@ static void test_rate_rounding_and_default(void **state)
 static void test_stream_field_past_16(void **state)
 {
   (void)state;
-  assert_int_equal(tlm_field_lookup("rate_valid", 10u), 16u);
+  assert_int_equal(app_tlm_field_lookup("rate_valid", 10u), 16u);
   const char *want = "ok stream 1 1000 Hz decim 50 fields 2 ";
   assert_true(strncmp(cmd("stream rate_valid tick @1000\n"), want, strlen(want)) == 0);
   run_ms(200u);

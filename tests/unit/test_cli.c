@@ -10,8 +10,9 @@
 #include <cmocka.h>
 
 #include "comm/cli.h"
+#include "comm/cli_builtin.h"
 #include "comm/numparse.h"
-#include "gyro/fw_version.h"
+#include "params/fw_version.h"
 #include "hal_flash_host.h"
 
 typedef struct {
@@ -65,7 +66,7 @@ static int setup(void **state)
   if (params_init(&g.bank, &pc, NULL, NULL) != PARAM_OK) {
     return -1;
   }
-  const cli_cfg_t cc = {&g.bank, &g.store, write_out, &g};
+  const cli_cfg_t cc = {&g.bank, &g.store, write_out, &g, cli_builtin_cmds, cli_builtin_count()};
   return cli_init(&g.cli, &cc);
 }
 
@@ -469,6 +470,52 @@ static void test_version(void **state)
   expect("version\n", want);
 }
 
+/* cli_putf: the text of each conversion equals what the single-purpose appends give,
+ * every mistake shows as '?', and the line stays bounded. */
+static const char *putf_line(void)
+{
+  g.out_len = 0u;
+  g.cli.replied = false;
+  cli_emit_ok(&g.cli);
+  return g.out;
+}
+
+static void test_putf(void **state)
+{
+  (void)state;
+  const uint32_t u = 4294967295u;
+  const int32_t d = -2147483647 - 1;
+  const float f = 0.1f;
+  const char *s = "rate";
+  cli_putf(&g.cli, "%s %u %d %f %%x", s, u, d, f);
+  assert_string_equal(putf_line(), "ok rate 4294967295 -2147483648 0.1 %x\r\n");
+  cli_putf(&g.cli, "%u%u|%d|%f", (uint8_t)7, 0, 12, 1e-7f);
+  assert_string_equal(putf_line(), "ok 70|12|1e-7\r\n");
+  /* kind mismatches, out-of-range integers, an unknown conversion, a missing argument,
+   * a NULL string, a '%' at the very end */
+  const char *none = NULL;
+  cli_putf(&g.cli, "%f %s %u %d %x %s%s %u %", 1u, 2.0f, -1, (int64_t)1 << 40, 5u, none, "z");
+  assert_string_equal(putf_line(), "ok ? ? ? ? ? z ? ?\r\n");
+  /* as the appends it replaces: the same bytes */
+  cli_put(&g.cli, "stream ");
+  cli_put_u32(&g.cli, 3u);
+  cli_put(&g.cli, " ");
+  cli_put_f32(&g.cli, 333.33334f);
+  cli_put(&g.cli, " Hz");
+  char want[64];
+  snprintf(want, sizeof want, "%s", putf_line());
+  cli_putf(&g.cli, "stream %u %f Hz", 3u, 333.33334f);
+  assert_string_equal(putf_line(), want);
+  /* bounded: a long argument is cut at CLI_OUT_MAX like any append, and counted */
+  char big[2u * CLI_OUT_MAX];
+  memset(big, 'a', sizeof big - 1u);
+  big[sizeof big - 1u] = '\0';
+  const uint32_t cut = g.cli.truncated;
+  cli_putf(&g.cli, "%s%u", big, 1u);
+  assert_int_equal(strlen(putf_line()), CLI_OUT_MAX - 2u + 3u + 2u);
+  assert_true(g.cli.truncated > cut);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -481,6 +528,7 @@ int main(void)
       cmocka_unit_test_setup(test_list, setup),
       cmocka_unit_test_setup(test_app_commands_and_help, setup),
       cmocka_unit_test_setup(test_version, setup),
+      cmocka_unit_test_setup(test_putf, setup),
       cmocka_unit_test_setup(test_console_prompt_and_echo, setup),
       cmocka_unit_test_setup(test_console_editing, setup),
   };

@@ -5,7 +5,7 @@
 #include <stdio.h>
 #include <cmocka.h>
 
-#include "gyro/fw_version.h"
+#include "params/fw_version.h"
 
 /* The string and the packed number must describe the same version. */
 static void test_string_matches_number(void **state)

@@ -1,6 +1,6 @@
 /* The telemetry stream (comm/tlm): plan and link budget against hand-computed figures
  * and against the bytes the encoder really emits; records through the ISR ring, frames
- * and the receiver (comm/tlm_decode) back to the values of the snapshot at the tick
+ * and the receiver (tools/tlm_decode) back to the values of the snapshot at the tick
  * each record claims; overruns, a blocked link, stop and restart accounted exactly. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -12,8 +12,10 @@
 #include <string.h>
 #include <cmocka.h>
 
+#include "app/app_tlm_fields.h"
 #include "comm/tlm.h"
-#include "comm/tlm_decode.h"
+#include "gyro/gyro.h"
+#include "tlm_decode.h"
 #include "tlm_test_link.h"
 
 #define FS 50000u
@@ -142,7 +144,7 @@ static void setup_all(void)
   memset(&link_, 0, sizeof link_);
   link_.buf = link_buf;
   link_.room = (size_t)-1;
-  const tlm_cfg_t cfg = {FS, BAUD, tlm_test_room, tlm_test_write, &link_};
+  const tlm_cfg_t cfg = {FS, BAUD, tlm_test_room, tlm_test_write, &link_, &app_tlm_fields};
   assert_int_equal(tlm_init(&tx, &cfg), 0);
   memset(&got, 0, sizeof got);
   const tlm_decode_cfg_t dc = {on_text, on_header, on_data, &got};
@@ -174,7 +176,7 @@ static uint32_t mask_of(const char *const *names, size_t n)
 {
   uint32_t m = 0u;
   for (size_t i = 0; i < n; i++) {
-    const uint32_t k = tlm_field_lookup(names[i], strlen(names[i]));
+    const uint32_t k = app_tlm_field_lookup(names[i], strlen(names[i]));
     assert_true(k < (uint32_t)TLM_FIELD_COUNT);
     m |= 1u << k;
   }
@@ -190,27 +192,27 @@ static void test_plan_rate_rounding(void **state)
   (void)state;
   tlm_plan_t p;
   const uint32_t m = mask_of(four, 4);
-  assert_int_equal(tlm_plan(FS, BAUD, m, 1000.0f, &p), TLM_OK);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, m, 1000.0f, &p), TLM_OK);
   assert_int_equal(p.decim, 50u);
   assert_true(p.rate_hz == 1000.0f);
   /* 50000 / 3000 = 16.67 -> 17 ticks -> 2941.18 Hz */
-  assert_int_equal(tlm_plan(FS, BAUD, m, 3000.0f, &p), TLM_OK);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, m, 3000.0f, &p), TLM_OK);
   assert_int_equal(p.decim, 17u);
   assert_float_equal(p.rate_hz, 50000.0f / 17.0f, 1e-3f);
   /* 50000 / 0.763 = 65531 ticks: the slowest rate still in 16 bits */
-  assert_int_equal(tlm_plan(FS, BAUD, m, 0.763f, &p), TLM_OK);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, m, 0.763f, &p), TLM_OK);
   assert_int_equal(p.decim, 65531u);
   assert_int_equal(p.rec_per_frame, 1u);
   const float bad[] = {0.0f, -1.0f, 0.5f, 50001.0f, NAN, INFINITY, -INFINITY};
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-    assert_int_equal(tlm_plan(FS, BAUD, m, bad[i], &p), TLM_ERR_RATE);
+    assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, m, bad[i], &p), TLM_ERR_RATE);
   }
-  assert_int_equal(tlm_plan(FS, BAUD, 0u, 100.0f, &p), TLM_ERR_FIELDS);
-  assert_int_equal(tlm_plan(FS, BAUD, (uint32_t)((uint64_t)1u << TLM_FIELD_COUNT), 100.0f, &p), TLM_ERR_FIELDS);
-  assert_int_equal(tlm_plan(FS, BAUD, 1u << 31, 100.0f, &p), TLM_ERR_FIELDS);
-  assert_int_equal(tlm_plan(FS, BAUD, 1u << TLM_FIELD_rate_valid, 100.0f, &p), TLM_OK);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, 0u, 100.0f, &p), TLM_ERR_FIELDS);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, (uint32_t)((uint64_t)1u << TLM_FIELD_COUNT), 100.0f, &p), TLM_ERR_FIELDS);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, 1u << 31, 100.0f, &p), TLM_ERR_FIELDS);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, 1u << TLM_FIELD_rate_valid, 100.0f, &p), TLM_OK);
   /* one u32 at the full tick rate is far beyond the link */
-  assert_int_equal(tlm_plan(FS, BAUD, 1u, 50000.0f, &p), TLM_ERR_BANDWIDTH);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, 1u, 50000.0f, &p), TLM_ERR_BANDWIDTH);
 }
 
 /* The worked examples of tlm.h, by hand:
@@ -222,29 +224,29 @@ static void test_link_budget_by_hand(void **state)
   tlm_plan_t p;
   /* 4 f32 at 1 kHz: N = min(20, 240/16) = 15, raw 253, wire 256, 1000/15 frames/s =
    * 17066.7 -> 17067 B/s; header 30 + 10+10+13+7 = 70 -> 73 B */
-  assert_int_equal(tlm_plan(FS, BAUD, mask_of(four, 4), 1000.0f, &p), TLM_OK);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, mask_of(four, 4), 1000.0f, &p), TLM_OK);
   assert_int_equal(p.rec_per_frame, 15u);
   assert_int_equal(p.bytes_per_s, 17067u + 73u);
   /* 4 f32 at 200 Hz: N = 4, raw 77, wire 80, 50 frames/s */
-  assert_int_equal(tlm_plan(FS, BAUD, mask_of(four, 4), 200.0f, &p), TLM_OK);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, mask_of(four, 4), 200.0f, &p), TLM_OK);
   assert_int_equal(p.rec_per_frame, 4u);
   assert_int_equal(p.bytes_per_s, 50u * 80u + 73u);
   assert_int_equal(p.link_bytes_per_s, 92160u);
   /* all 17 at 1 kHz: N = min(20, 240/68) = 3, raw 13 + 12 * 17 = 217, wire 220,
    * 1000/3 frames = 73333.3 -> 73334; header names 128 bytes + 34 + 30 = 192 -> 195 B:
    * 73529 B/s > 70 % of 92160 = 64512 */
-  assert_int_equal(tlm_plan(FS, BAUD, TLM_FIELD_MASK_ALL, 1000.0f, &p), TLM_ERR_BANDWIDTH);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, TLM_FIELD_MASK_ALL, 1000.0f, &p), TLM_ERR_BANDWIDTH);
   assert_int_equal(p.rec_per_frame, 3u);
   assert_int_equal(p.bytes_per_s, 73334u + 195u);
   /* all 17 at 500 Hz: 36666.7 -> 36667 + 195 */
-  assert_int_equal(tlm_plan(FS, BAUD, TLM_FIELD_MASK_ALL, 500.0f, &p), TLM_OK);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, TLM_FIELD_MASK_ALL, 500.0f, &p), TLM_OK);
   assert_int_equal(p.bytes_per_s, 36667u + 195u);
   /* 12 f32 (the twelve floats) at 1 kHz: N = 5, raw 253, wire 256, 200 frames/s */
-  assert_int_equal(tlm_plan(FS, BAUD, 0x0FFFu, 1000.0f, &p), TLM_OK);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, 0x0FFFu, 1000.0f, &p), TLM_OK);
   assert_int_equal(p.rec_per_frame, 5u);
   assert_true(p.bytes_per_s > 51200u && p.bytes_per_s < 51200u + 200u);
   /* 8 f32 at 1 kHz: N = 7, raw 237, wire 240, 1000/7 frames/s */
-  assert_int_equal(tlm_plan(FS, BAUD, 0x00FFu, 1000.0f, &p), TLM_OK);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, 0x00FFu, 1000.0f, &p), TLM_OK);
   assert_int_equal(p.rec_per_frame, 7u);
   assert_true(p.bytes_per_s >= 34286u && p.bytes_per_s < 34286u + 200u);
 }
@@ -262,7 +264,7 @@ static void test_link_budget_matches_encoder(void **state)
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     setup_all();
     tlm_plan_t p;
-    assert_int_equal(tlm_plan(FS, BAUD, cases[c].mask, cases[c].rate, &p), TLM_OK);
+    assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, cases[c].mask, cases[c].rate, &p), TLM_OK);
     tlm_start(&tx, &p);
     tick_now = 0u;
     run(10u * FS, 50u);
@@ -278,7 +280,7 @@ static void test_link_budget_matches_encoder(void **state)
 static void start(uint32_t mask, float rate)
 {
   tlm_plan_t p;
-  assert_int_equal(tlm_plan(FS, BAUD, mask, rate, &p), TLM_OK);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, mask, rate, &p), TLM_OK);
   tlm_start(&tx, &p);
   got.t0 = tick_now; /* a new stream takes its first record at the next tick */
 }
@@ -471,7 +473,7 @@ static void expect_records(uint32_t mask, uint32_t decim, uint32_t k0, uint32_t 
     for (uint32_t i = 0; i < (uint32_t)TLM_FIELD_COUNT; i++) {
       if ((mask >> i) & 1u) {
         uint32_t want;
-        (void)truth(tlm_field(i)->name, k0 + r * decim, &want);
+        (void)truth(app_tlm_field(i)->name, k0 + r * decim, &want);
         assert_int_equal(rec[j++], want);
       }
     }

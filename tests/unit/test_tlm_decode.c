@@ -1,4 +1,4 @@
-/* The receiver (comm/tlm_decode): text and frames interleaved on one wire, header layout
+/* The receiver (tools/tlm_decode): text and frames interleaved on one wire, header layout
  * parsing and its rejections, and damage of every kind (bit errors, lost and inserted
  * bytes, cut frames, garbage) detected and counted, never delivered as data. Frames come
  * from the real encoder (comm/tlm) or are built by hand with the documented byte layout. */
@@ -10,8 +10,10 @@
 #include <string.h>
 #include <cmocka.h>
 
+#include "app/app_tlm_fields.h"
 #include "comm/tlm.h"
-#include "comm/tlm_decode.h"
+#include "gyro/gyro.h"
+#include "tlm_decode.h"
 #include "tlm_test_link.h"
 
 static tlm_decode_t rx;
@@ -100,11 +102,11 @@ static stream_t make_stream(uint32_t seconds)
   memset(&link_, 0, sizeof link_);
   link_.buf = link_buf;
   link_.room = (size_t)-1;
-  const tlm_cfg_t cfg = {50000u, 921600u, tlm_test_room, tlm_test_write, &link_};
+  const tlm_cfg_t cfg = {50000u, 921600u, tlm_test_room, tlm_test_write, &link_, &app_tlm_fields};
   assert_int_equal(tlm_init(&tx, &cfg), 0);
   tlm_plan_t p;
   const uint32_t mask = (1u << TLM_FIELD_tick) | (1u << TLM_FIELD_rate_dps);
-  assert_int_equal(tlm_plan(50000u, 921600u, mask, 1000.0f, &p), TLM_OK);
+  assert_int_equal(tlm_plan(&app_tlm_fields, 50000u, 921600u, mask, 1000.0f, &p), TLM_OK);
   text_line("ok stream 1 1000 Hz\r\n");
   tlm_start(&tx, &p);
   t0 = 0u;

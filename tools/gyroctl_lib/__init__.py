@@ -1,7 +1,7 @@
 """gyroctl: the host side of the gyro's tuning UART (command line + telemetry frames).
 
 Modules
-    frames   COBS / CRC-16 frames and the text/frame receiver (mirrors firmware/comm/tlm_decode)
+    frames   COBS / CRC-16 frames and the text/frame receiver (mirrors tools/tlm_decode)
     link     a serial port (device, pty or pyserial URL) speaking the command-line protocol
     client   parameter and command helpers over a link (get, set, list, fields, ...)
     logger   `log`: a telemetry stream to CSV

@@ -1,7 +1,7 @@
 """Telemetry frames of the tuning UART and the receiver that separates them from text.
 
 The byte layout and the text/frame rule are defined in firmware/comm/tlm_frame.h; this
-module follows firmware/comm/tlm_decode.c rule for rule (same states, same checks, same
+module follows tools/tlm_decode/tlm_decode.c rule for rule (same states, same checks, same
 counters), and its tests compare the two on the same bytes (tests/test_frames.py, with
 streams written by the firmware's own encoder through the tlm-vectors program).
 
@@ -205,7 +205,7 @@ class Decoder:
 
     on_text(str) gets a line without CR LF; on_header(Layout) every valid header;
     on_data(DataFrame) every valid data frame of the stream whose header came last.
-    Counters in .stats (see firmware/comm/tlm_decode.h for their meaning).
+    Counters in .stats (see tools/tlm_decode/tlm_decode.h for their meaning).
     """
 
     def __init__(self, on_text=None, on_header=None, on_data=None):

@@ -3,7 +3,7 @@ dictionary docs/fields.md (tools/gen-fields-doc).
 
 Two producers name the same quantities (tools/gyrotools/csvlog.py): gyro-sim's CSV and
 `gyroctl log`, whose columns are the firmware's telemetry field names
-(firmware/comm/tlm_fields.h). They differ in one name only, the drive amplitude
+(firmware/app/app_tlm_fields.h). They differ in one name only, the drive amplitude
 (gyro-sim `drive_amp`, telemetry `drive_amp_v`); ALIASES lets every tool accept both.
 Units follow the name's suffix, which the firmware's table keeps by rule
 (_dps, _v, _deg, _v2); the simulator's truth columns add _c, _m, _s.

@@ -6,7 +6,7 @@
  *                            DIR/expected.json (the lines, and for each stream its layout
  *                            and every record as the 32-bit words of the snapshot the ISR
  *                            was given: the truth, not a decode)
- *   tlm-vectors decode FILE  run the C receiver (comm/tlm_decode) over FILE and print its
+ *   tlm-vectors decode FILE  run the C receiver (tools/tlm_decode) over FILE and print its
  *                            counters and a digest of what it delivered as JSON, so the
  *                            Python receiver can be compared on damaged input.
  */
@@ -15,8 +15,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "app/app_tlm_fields.h"
 #include "comm/tlm.h"
-#include "comm/tlm_decode.h"
+#include "gyro/gyro.h"
+#include "tlm_decode.h"
 
 #define FS 50000u
 static uint8_t wire[4u << 20];
@@ -76,7 +78,7 @@ static void stream(FILE *js, uint32_t *tick, uint32_t mask, float rate, uint32_t
                    uint32_t stall_from, uint32_t stall_to, int first)
 {
   tlm_plan_t p;
-  if (tlm_plan(FS, 921600u, mask, rate, &p) != TLM_OK) {
+  if (tlm_plan(&app_tlm_fields, FS, 921600u, mask, rate, &p) != TLM_OK) {
     fprintf(stderr, "plan refused\n");
     exit(1);
   }
@@ -86,7 +88,7 @@ static void stream(FILE *js, uint32_t *tick, uint32_t mask, float rate, uint32_t
   int f1 = 1;
   for (uint32_t i = 0; i < (uint32_t)TLM_FIELD_COUNT; i++) {
     if ((mask >> i) & 1u) {
-      fprintf(js, "%s[\"%s\", %u]", f1 ? "" : ", ", tlm_field(i)->name, tlm_field(i)->type);
+      fprintf(js, "%s[\"%s\", %u]", f1 ? "" : ", ", app_tlm_field(i)->name, app_tlm_field(i)->type);
       f1 = 0;
     }
   }
@@ -103,7 +105,7 @@ static void stream(FILE *js, uint32_t *tick, uint32_t mask, float rate, uint32_t
       for (uint32_t i = 0; i < (uint32_t)TLM_FIELD_COUNT; i++) {
         if ((mask >> i) & 1u) {
           uint32_t w;
-          memcpy(&w, (const uint8_t *)&o + tlm_field(i)->offset, 4u);
+          memcpy(&w, (const uint8_t *)&o + app_tlm_field(i)->offset, 4u);
           fprintf(js, ", %" PRIu32, w);
         }
       }
@@ -132,7 +134,7 @@ static int make(const char *dir)
     perror(path);
     return 1;
   }
-  const tlm_cfg_t c = {FS, 921600u, room, put, NULL};
+  const tlm_cfg_t c = {FS, 921600u, room, put, NULL, &app_tlm_fields};
   if (tlm_init(&tx, &c) != 0) return 1;
   uint32_t tick = 12345u;
   fprintf(js, "{\"lines\": [");

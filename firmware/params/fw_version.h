@@ -1,4 +1,6 @@
-/* Firmware identity, reported by the `version` command and stored in parameter images. */
+/* Firmware identity, reported by the `version` command and stored in parameter images.
+ * It sits beside the parameter store, the lowest layer that needs it, so that the store
+ * and the command line above it include it without a cycle between folders. */
 #ifndef FW_VERSION_H
 #define FW_VERSION_H
 

@@ -1,4 +1,4 @@
-#include "gyro/fw_version.h"
+#include "params/fw_version.h"
 
 #ifndef GYRO_FW_VERSION_MAJOR
 #error "GYRO_FW_VERSION_MAJOR/MINOR/PATCH come from the CMake project version"

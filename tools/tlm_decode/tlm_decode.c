@@ -1,4 +1,4 @@
-#include "comm/tlm_decode.h"
+#include "tlm_decode.h"
 
 enum { ST_TEXT = 0, ST_FRAME = 1, ST_SKIP = 2 };
 

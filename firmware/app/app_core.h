@@ -1,0 +1,82 @@
+/* The application instance and what its parts share: the request queue from the
+ * background to the sample ISR, and the boot's record of stored values it dropped.
+ * The parts (app_selfcal, app_cmds, app_tlm) and the top level (app.c: init, ISR,
+ * background loop) all build on this; nothing here calls them, so the dependencies run
+ * one way: app -> app_cmds -> app_selfcal -> app_core. The queue's rules are in app.h.
+ */
+#ifndef APP_CORE_H
+#define APP_CORE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "app/app_tlm.h"
+#include "comm/cli.h"
+#include "gyro/gyro.h"
+#include "gyro/selfcal.h"
+#include "params/param_store.h"
+#include "params/params.h"
+
+#define APP_MAX_CMDS 8u
+/* Requests waiting for the ISR (a power of two); it takes one per tick, so a full queue
+ * drains in 160 us: a command finding it full is refused (err BUSY), never dropped. */
+#define APP_REQ_QUEUE 8u
+
+typedef enum {
+  APP_REQ_NONE = 0u,
+  APP_REQ_DRIVE_ON = 1u,
+  APP_REQ_DRIVE_OFF = 2u,
+  APP_REQ_SWEEP = 3u,         /* enter SWEEP: self-calibration (app_selfcal.h) */
+  APP_REQ_SWEEP_HANDOVER = 4u, /* SWEEP -> ACQUIRE with the newly applied design */
+  APP_REQ_SELFTEST = 5u,       /* run the built-in self-test (selftest.h) */
+  APP_REQ_CLEAR = 6u           /* clear the shown fault; its record stays (last_fault) */
+} app_req_t;
+
+/* Lines an image adds to the status reply (board figures: stack, sample clock), written
+ * with cli_put / cli_emit_data before the final ok line; ctx is NULL. */
+typedef void (*app_status_fn)(cli_t *cli, void *ctx);
+
+typedef struct {
+  params_t params;
+  gyro_design_t derived[2];  /* the bank's derived blocks */
+  const void *applied;       /* derived block the ISR runs with */
+  gyro_t gyro;
+  param_store_t store;
+  param_store_status_t store_status; /* result of the boot-time load */
+  /* Stored values the boot could not design with the rest, set back to their defaults
+   * (bit i: parameter i), and why the stored set as a whole was refused. */
+  uint32_t store_dropped[(PARAM_COUNT + 31u) / 32u];
+  const char *store_dropped_why;
+  cli_t cli;
+  cli_cmd_t cmds[APP_MAX_CMDS]; /* the application's command rows (app_cmds.c) */
+  /* Bytes read from the UART, fed to the command line a line at a time (app_poll). */
+  uint8_t rx_buf[64];
+  uint32_t rx_len, rx_pos;
+  /* Request queue: words written by the background before it advances req_head; the
+   * ISR takes req_word[req_tail % APP_REQ_QUEUE] and advances req_tail. */
+  volatile uint32_t req_word[APP_REQ_QUEUE];
+  volatile uint32_t req_head, req_tail;
+  bool sweep_owns_drive;     /* the sequencer, not a command, decides the drive's next mode */
+  app_tlm_t tlm;             /* telemetry stream and its commands (app_tlm.c) */
+  selfcal_t selfcal;         /* self-calibration sequencer (background, app_selfcal.c) */
+  uint32_t selfcal_t0_ticks; /* isr_ticks when the sweep was requested */
+  uint32_t selfcal_ticks;    /* its length up to the hand-over */
+  /* Self-measurement of the sample ISR (DWT cycles on the board). */
+  uint32_t isr_ticks;
+  /* Set by the image's main after app_init (NULL: nothing added, as on the host). */
+  app_status_fn status_board;
+} app_t;
+
+/* Boot: stored value i set back to its default because the stored set could not be
+ * designed with it (status lists them). */
+bool app_store_dropped(const app_t *a, param_idx_t i);
+
+/* Background: queue a request for the ISR. Returns 0, or -1 (nothing queued) when full. */
+int app_request(app_t *a, app_req_t r);
+/* Background: requests queued and not yet taken. */
+bool app_requests_pending(const app_t *a);
+
+/* Background: the drive's mode once the queued requests are taken. */
+gyro_mode_t app_mode_after_queue(const app_t *a);
+
+#endif /* APP_CORE_H */
