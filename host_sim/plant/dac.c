@@ -4,8 +4,9 @@
 #include <string.h>
 
 #include "plant/expm.h"
+#include "plant/plant_const.h"
 
-static const double k_pi = 3.14159265358979323846;
+static const double k_pi = PLANT_PI;
 
 double dac_code_to_v(uint16_t code)
 {

@@ -3,8 +3,9 @@
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
+#include "plant/plant_const.h"
 
-static const double kPi = 3.14159265358979323846;
+static const double kPi = PLANT_PI;
 
 #define NA (MECH_NS + MECH_NU)           /* augmented [state; input] size */
 

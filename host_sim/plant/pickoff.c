@@ -4,9 +4,10 @@
 #include <string.h>
 
 #include "plant/expm.h"
+#include "plant/plant_const.h"
 
-static const double k_pi = 3.14159265358979323846;
-static const double k_deg = 3.14159265358979323846 / 180.0;
+static const double k_pi = PLANT_PI;
+static const double k_deg = PLANT_RAD_PER_DEG;
 
 /* SISO state space in time normalised to the sample period. */
 typedef struct {

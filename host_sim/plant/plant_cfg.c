@@ -6,6 +6,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+#include "plant/plant_const.h"
 
 #define PLANT_DESC(ctype, name, kind, lo, hi, unit, doc) \
   {#name, offsetof(plant_cfg_t, name), PLANT_PARAM_##kind, (lo), (hi), (unit), (doc)},
@@ -282,7 +283,7 @@ int plant_cfg_check(const plant_cfg_t *c, char *buf, size_t n)
     if (check_value(&kParams[i], plant_param_get(c, &kParams[i]), buf, n) != 0) return -1;
   /* cross-field limits, each named by the parameter that has to move */
   const double nyq = 0.45 * c->fs_hz, T = 1.0 / c->fs_hz;
-  const double kDeg = 3.14159265358979323846 / 180.0;
+  const double kDeg = PLANT_RAD_PER_DEG;
   if (c->f_drive_hz > nyq) {
     errf(buf, n, "%s: must be below 0.45 fs_hz (%g Hz)", "f_drive_hz", nyq);
     return -1;
