@@ -25,12 +25,13 @@
 #define APP_TLM_H
 
 #include "comm/cli.h"
+#include "board.h"
 #include "comm/tlm.h"
 #include "gyro/gyro.h"
 #include "params/params.h"
 
-/* The tuning port's line rate (hal/stm32f4: STM32F4_UART_BAUD, 8N1). */
-#define APP_TLM_BAUD 921600u
+/* The tuning port's line rate (8N1), the board's. */
+#define APP_TLM_BAUD BOARD_UART_BAUD
 /* TX-ring bytes telemetry leaves free for command replies, so that the longest (list,
  * about 6.5 KB; status with the self-calibration and output-integrity lines about
  * 1.5 KB) comes out whole while a stream runs (test_app: every reply fits). The rings

@@ -1,7 +1,7 @@
 /* Parameter store: persistent parameters in two flash sectors (slots A and B) used in
  * turn, so that a power cut at any byte of a save leaves the previous image loadable.
  *
- * Image (little-endian, every field 4-byte aligned; the STM32F4 programs 32-bit words):
+ * Image (little-endian, every field 4-byte aligned, programmed as 32-bit words):
  *
  *   offset      size  field
  *   0           4     magic       0x4D524750 ("PGRM" in byte order)
@@ -41,7 +41,7 @@
  * other slot), unless the caller forces it (PARAM_SAVE_FORCE); a forced save still
  * writes the slot without it when it can.
  *
- * Why save needs the loop safe: on a single-bank STM32F4 a 16 KB sector erase stalls
+ * Why save needs the loop safe: on a single-bank part a 16 KB sector erase stalls
  * every instruction fetch from flash for 250 ms typical (500 ms max), and the drive
  * amplitude decays with tau = 2 Q1 / wn1 = 7 ms (6-12): a save while the gyro runs
  * would stop the 50 kHz tick for ~35 time constants and drop the loop. Running the
