@@ -69,6 +69,9 @@ void hal_flash_geometry(hal_flash_geometry_t *geo)
   if (geo == 0) return;
   geo->num_sectors = STM32F4_PARAM_NUM_SECTORS;
   geo->sector_size = STM32F4_PARAM_SECTOR_BYTES;
+  /* The driver takes any byte range, but a whole aligned word is one x32 program
+   * operation (RM0090 3.5.2): the store writes words. */
+  geo->program_bytes = 4u;
 }
 
 CM4_RAMFUNC hal_flash_status_t hal_flash_erase(uint32_t sector)
