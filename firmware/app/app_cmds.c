@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "app/app_selfcal.h"
+#include "dsp/math_const.h"
 #include "hal/hal_sample_timer.h"
 
 static const char *mode_name(uint32_t m)
@@ -115,7 +116,7 @@ static void put_selfcal(cli_t *cli, app_t *a)
     cli_data_f32(cli, "selfcal_f0_hz", (float)s->fit.f0_hz);
     cli_data_f32(cli, "selfcal_q", (float)s->fit.q);
     cli_data_f32(cli, "selfcal_gain_v_per_v2", (float)s->fit.gain_v_per_v2);
-    cli_data_f32(cli, "selfcal_p_init_deg", (float)(s->hold_p_rad * 57.29577951308232));
+    cli_data_f32(cli, "selfcal_p_init_deg", (float)(s->hold_p_rad * FM_DEG_PER_RAD));
     cli_data_f32(cli, "selfcal_fit_rms_rel", (float)s->fit.rms_rel);
   }
 }
@@ -393,7 +394,7 @@ static void put_sweep_points(cli_t *cli, const app_t *a)
     const double amp = hypot((double)p->z_re, (double)p->z_im);
     /* The pickoff v = Im{Z e^{j phi}} = |Z| cos(phi + arg Z - 90 deg) against the force
      * cos(phi) (gyro.h, drive_synth.h): its phase is arg Z - 90 deg, in (-180, 180]. */
-    double ph = atan2((double)p->z_im, (double)p->z_re) * 57.29577951308232 - 90.0;
+    double ph = atan2((double)p->z_im, (double)p->z_re) * FM_DEG_PER_RAD - 90.0;
     if (ph <= -180.0) ph += 360.0;
     const float gain = p->f_cmd_v2 > 0.0f ? (float)(amp / (double)p->f_cmd_v2) : 0.0f;
     cli_putf(cli, "point %u f_hz %f amp_v %f phase_deg %f f_cmd_v2 %f gain_v_per_v2 %f stage %u", k,

@@ -3,7 +3,7 @@
 #include <stddef.h>
 
 #include "dsp/fastmath.h"
-#include "hal/hal_converters.h"
+#include "board.h"
 
 /* Search range of the drive resonance: the part family's 1.3-2.0 kHz with margin. */
 #define SC_F_LO_HZ 1250.0

@@ -25,13 +25,14 @@
 #define APP_TLM_H
 
 #include "comm/cli.h"
+#include "board.h"
 #include "comm/tlm.h"
 #include "gyro/gyro.h"
 #include "params/params.h"
 
-/* The tuning port's line rate, 8N1: the rate every board's UART driver is set up for, which
- * the link budget of a stream (tlm_plan) is computed against. */
-#define APP_TLM_BAUD 921600u
+/* The tuning port's line rate, 8N1: the board's (board.h), which the link budget of a
+ * stream (tlm_plan) is computed against. */
+#define APP_TLM_BAUD BOARD_UART_BAUD
 /* TX-ring bytes telemetry leaves free for command replies, so that the longest (list,
  * about 6.5 KB; status with the self-calibration and output-integrity lines about
  * 1.5 KB) comes out whole while a stream runs (test_app: every reply fits). The rings

@@ -3,7 +3,7 @@
 #include <math.h>
 #include <stddef.h>
 
-#define BUTTER_PI 3.141592653589793238463
+#include "dsp/math_const.h"
 
 typedef struct {
   double re, im;
@@ -86,7 +86,7 @@ static void set_numerator(butter_type_t type, double g, butter_sos_f64_t *s)
 
 static double prewarp(double f_hz, double fs_hz)
 {
-  return 2.0 * fs_hz * tan(BUTTER_PI * f_hz / fs_hz);
+  return 2.0 * fs_hz * tan(FM_PI * f_hz / fs_hz);
 }
 
 static int freq_in_range(double f_hz, double fs_hz)
@@ -159,7 +159,7 @@ static void design_denominators(butter_type_t type, unsigned order, double f1_hz
   /* Upper-half-plane prototype poles, k = 0 .. n/2 - 1; the lower ones are their
    * conjugates and belong to the same sections. */
   for (unsigned k = 0u; k < n / 2u; k++) {
-    const double theta = BUTTER_PI * (double)(2u * k + n + 1u) / (double)(2u * n);
+    const double theta = FM_PI * (double)(2u * k + n + 1u) / (double)(2u * n);
     const cplx_t p = c_make(cos(theta), sin(theta));
     if (type == BUTTER_LOWPASS) {
       section_from_pair(c_make(w1 * p.re, w1 * p.im), fs_hz, &out[k_out++]);

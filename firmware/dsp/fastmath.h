@@ -12,11 +12,8 @@
 #include <stdint.h>
 #include <string.h>
 
-#define FM_PI 3.14159265358979323846 /* double, for init-time design code */
-#define FM_PI_F 3.14159265358979f
-#define FM_TWO_PI_F 6.28318530717959f
-#define FM_DEG_PER_RAD_F 57.2957795130823f
-#define FM_RAD_PER_DEG_F 0.0174532925199433f
+#include "dsp/math_const.h"
+
 
 static inline float fm_sqrtf(float x) { return __builtin_sqrtf(x); }
 

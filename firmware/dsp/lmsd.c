@@ -3,7 +3,7 @@
 #include <math.h>
 #include <stddef.h>
 
-static const double k_pi = 3.14159265358979323846;
+#include "dsp/math_const.h"
 
 static int mu_valid(float mu)
 {
@@ -62,5 +62,5 @@ double lmsd_bandwidth_hz(double mu, double fs_hz)
   if (c < -1.0) {
     c = -1.0;
   }
-  return fs_hz / (2.0 * k_pi) * acos(c);
+  return fs_hz / (2.0 * FM_PI) * acos(c);
 }

@@ -3,10 +3,10 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "dsp/math_const.h"
 #include "dsp/sincos.h"
 
 #define NCO_SIGN_BIT 0x80000000u
-#define NCO_TWO_PI 6.283185307179586476925
 
 static int freq_valid(double freq_hz, double fs_hz)
 {
@@ -39,7 +39,7 @@ int nco_init(nco_t *nco, const nco_cfg_t *cfg)
     return -1;
   }
   /* Wrap to [0, 1) turn in double; the wc/2 oscillator starts at half of that. */
-  const double turns = cfg->phase_rad / NCO_TWO_PI;
+  const double turns = cfg->phase_rad / FM_TWO_PI;
   double frac = turns - floor(turns);
   if (!(frac < 1.0)) {
     frac = 0.0; /* -tiny rounds up to exactly 1 turn */

@@ -1,13 +1,14 @@
 #include "dsp/sincos.h"
 
-#define SINCOS_INV_TWO_PI_F 0.159154943f        /* 1/(2*pi) */
+#include "dsp/math_const.h"
+
 #define SINCOS_TWO_PI_OVER_2P32_F 1.46291808e-9f /* 2*pi/2^32, rad per phase count */
 #define SINCOS_TURNS_LIMIT_F 8388608.0f          /* 2^23 turns: no fraction left */
 #define SINCOS_2P31_F 2147483648.0f
 
 uint32_t sincos_rad_to_phase(float rad)
 {
-  const float turns = rad * SINCOS_INV_TWO_PI_F;
+  const float turns = rad * FM_INV_TWO_PI_F;
   /* Written so that NaN fails it too. */
   if (!(turns > -SINCOS_TURNS_LIMIT_F && turns < SINCOS_TURNS_LIMIT_F)) {
     return 0u;

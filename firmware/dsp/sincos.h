@@ -51,10 +51,14 @@ static inline void sincos_lut(uint32_t phase, float *sin_out, float *cos_out)
   *cos_out = c0 + x * (sincos_table[ic + 1u] - c0);
 }
 
+/* Domain of sincos_half_rad_to_phase: just inside 2 pi, where rad * 2^30 / pi reaches
+ * 2^31 and the int32 conversion would overflow (6.28 * 2^30 / pi = 2146395000). */
+#define SINCOS_HALF_RAD_MAX_F 6.28f
+
 /* Half an angle in radians to a phase (2^32 = 2 pi) of rad / 2: one multiply and one
- * conversion, for the drive phase of each new command. The caller guarantees |rad| < 2 pi (the
- * drive loop limits P to +-6.2 rad); sincos_rad_to_phase reduces any angle and is for
- * everything else. */
+ * conversion, for the drive phase of each new command. The caller guarantees
+ * |rad| < SINCOS_HALF_RAD_MAX_F (drive synthesis keeps P within 1.5 pi of whole turns
+ * and checks it); sincos_rad_to_phase reduces any angle and is for everything else. */
 static inline uint32_t sincos_half_rad_to_phase(float rad)
 {
   /* rad / 2 in counts of 2^32 per turn: rad * 2^31 / (2 pi) = rad * 2^30 / pi. */

@@ -5,8 +5,10 @@
 
 #include "dsp/fastmath.h"
 
-/* Just inside +-2 pi: drive synthesis converts P/2 to a phase with one int32 conversion. */
-#define DRIVE_P_LIMIT_RAD 6.2f
+/* Start value of P: one turn either way, the range of drive.p_init_deg (+-360 deg). Drive
+ * synthesis carries whole turns of P itself (drive_synth_set), so the phase conversion's
+ * domain (SINCOS_HALF_RAD_MAX_F) sets no limit here. */
+#define DRIVE_P_LIMIT_RAD FM_TWO_PI_F
 
 int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t *out)
 {

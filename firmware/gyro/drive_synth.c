@@ -54,7 +54,7 @@ void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad)
    * block) drives nothing rather than a rail voltage; a P still outside the +-2 pi that
    * the phase conversion needs (NaN included: the comparison fails) is replaced by 0
    * and the turns are forgotten. */
-  if (!(fm_absf(p_rad) < 6.28f)) {
+  if (!(fm_absf(p_rad) < SINCOS_HALF_RAD_MAX_F)) {
     p_rad = 0.0f;
     ds->p_turn_rad = 0.0f;
   }

@@ -200,7 +200,7 @@ typedef enum {
   GYRO_DESIGN_MU_SENSE,       /* demod.mu_sense */
   GYRO_DESIGN_AMP_LOOP,       /* drive.cal_*, drive.amp_bw_hz */
   GYRO_DESIGN_PHASE_LOOP,     /* drive.cal_f0_hz, drive.cal_q, drive.phase_bw_hz */
-  GYRO_DESIGN_P_INIT,         /* drive.p_init_deg against the phase conversion's reach */
+  GYRO_DESIGN_P_INIT,         /* drive.p_init_deg beyond one turn */
   GYRO_DESIGN_RATE_LPF,       /* rate.lpf_order, rate.lpf_cutoff_hz */
   GYRO_DESIGN_AMP_SET,        /* drive.amp_set_v against the ADC's range */
   GYRO_DESIGN_LOST_TOL,       /* sup.lost_tol_rel against sup.lock_tol_rel */

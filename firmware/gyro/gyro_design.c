@@ -200,8 +200,8 @@ static gyro_design_status_t design_drive_loops(const param_values_t *v, double t
   t->drive.phase_kp = manual_ph ? v->drive_phase_kp : (float)t->phase_design.kp;
   t->drive.phase_ki = manual_ph ? v->drive_phase_ki : (float)t->phase_design.ki;
   t->drive.p_init_rad = v->drive_p_init_deg * FM_RAD_PER_DEG_F;
-  /* The loops accept P's start value only inside the phase conversion's reach
-   * (drive_loop.c); within the parameters' ranges nothing else of theirs can fail. */
+  /* The loops accept P's start value within one turn either way (drive_loop.c), the
+   * parameter's range; within the parameters' ranges nothing else of theirs can fail. */
   drive_loop_t probe;
   if (drive_loop_init(&probe, &t->drive) != 0) return GYRO_DESIGN_P_INIT;
   return GYRO_DESIGN_OK;
@@ -316,8 +316,7 @@ static const char *const k_reasons[GYRO_DESIGN_STATUS_COUNT] = {
                              "drive.amp_bw_hz must be positive for the amplitude loop's design",
     [GYRO_DESIGN_PHASE_LOOP] = "drive.cal_q, drive.cal_f0_hz and drive.phase_bw_hz must be "
                                "positive for the phase loop's design",
-    [GYRO_DESIGN_P_INIT] = "drive.p_init_deg must lie within +-355 deg (6.2 rad, the reach of the "
-                           "drive's phase conversion)",
+    [GYRO_DESIGN_P_INIT] = "drive.p_init_deg must lie within +-360 deg (one turn)",
     [GYRO_DESIGN_RATE_LPF] = "rate.lpf_cutoff_hz must be below half the block rate "
                              "(sys.fs_hz / 20), rate.lpf_order even and at most 8",
     [GYRO_DESIGN_AMP_SET] = "drive.amp_set_v must lie between 0 and 95 % of the ADC's range",

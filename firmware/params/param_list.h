@@ -31,6 +31,8 @@
 #ifndef PARAM_LIST_H
 #define PARAM_LIST_H
 
+#include "board.h" /* sys.fs_hz: the board's sample rate */
+
 #define PARAM_LAYOUT_VERSION 4u
 
 #define PARAM_CHOICE(v) (1u << (v))
@@ -215,8 +217,8 @@
   /* 100 Hz matches the 100 Hz output bandwidth */ \
   X(tlm_rate_hz, 0x0501u, "tlm.rate_hz", U32, "Hz", 1u, 5000u, 100u, 0u, \
     PF_PERSIST | PF_LIVE, "telemetry frame rate") \
-  /* 4.4.2: the 50 kHz tick; fixed by the timer and the filter designs */ \
-  X(sys_fs_hz, 0x0601u, "sys.fs_hz", U32, "Hz", 50000u, 50000u, 50000u, 0u, \
+  /* 4.4.2: the 50 kHz tick (board.h); fixed by the timer and the filter designs */ \
+  X(sys_fs_hz, 0x0601u, "sys.fs_hz", U32, "Hz", BOARD_SAMPLE_RATE_HZ, BOARD_SAMPLE_RATE_HZ, BOARD_SAMPLE_RATE_HZ, 0u, \
     PF_READONLY, "sample rate of the tick")
 /* clang-format on */
 

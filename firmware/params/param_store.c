@@ -30,6 +30,13 @@ static uint32_t get_u32(const uint8_t *p)
 }
 
 /* Serial-number order: a is newer than b. */
+/* End of the commit word's programming unit, for an image of len bytes (commit word
+ * included): the commit word starts at len - 4, a multiple of 8 and so of the unit. */
+static uint32_t commit_end(uint32_t len, uint32_t unit)
+{
+  return (unit > 4u) ? len - 4u + unit : len;
+}
+
 static bool seq_newer(uint32_t a, uint32_t b) { return (int32_t)(a - b) > 0; }
 
 typedef struct {
@@ -48,12 +55,15 @@ static void report_clear(param_store_report_t *rep)
 param_store_status_t param_store_init(param_store_t *st, const param_store_cfg_t *cfg)
 {
   memset(st, 0, sizeof *st);
-  hal_flash_geometry_t geo = {0u, 0u};
+  hal_flash_geometry_t geo = {0u, 0u, 0u};
   hal_flash_geometry(&geo);
+  const uint32_t unit = geo.program_bytes;
   if (cfg->sector_a == cfg->sector_b || cfg->sector_a >= geo.num_sectors ||
-      cfg->sector_b >= geo.num_sectors || geo.sector_size < PARAM_STORE_IMAGE_MAX) {
+      cfg->sector_b >= geo.num_sectors || unit == 0u || (unit & (unit - 1u)) != 0u ||
+      unit > PARAM_STORE_PROGRAM_MAX || geo.sector_size < commit_end(PARAM_STORE_IMAGE_MAX, unit)) {
     return PARAM_STORE_ERR_CONFIG;
   }
+  st->program_bytes = unit;
   st->sector[0] = cfg->sector_a;
   st->sector[1] = cfg->sector_b;
   st->sector_size = geo.sector_size;
@@ -293,11 +303,15 @@ param_store_status_t param_store_save(param_store_t *st, const param_values_t *v
   const uint32_t sec = st->sector[target];
   hal_flash_status_t fs = hal_flash_erase(sec);
   if (fs == HAL_FLASH_OK) {
+    /* 24 + 8n bytes: whole units of any programming unit up to 8 */
     fs = hal_flash_program(sec, 0u, st->buf, len - 4u);
   }
   if (fs == HAL_FLASH_OK) {
-    /* the commit word last: only now does the new image become valid */
-    fs = hal_flash_program(sec, len - 4u, &st->buf[len - 4u], 4u);
+    /* the commit word last, in a unit of its own: only now does the new image become
+     * valid */
+    const uint32_t end = commit_end(len, st->program_bytes);
+    memset(&st->buf[len], 0xFF, end - len);
+    fs = hal_flash_program(sec, len - 4u, &st->buf[len - 4u], end - (len - 4u));
   }
   if (fs != HAL_FLASH_OK) {
     return PARAM_STORE_ERR_FLASH;

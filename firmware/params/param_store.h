@@ -1,7 +1,7 @@
 /* Parameter store: persistent parameters in two flash sectors (slots A and B) used in
  * turn, so that a power cut at any byte of a save leaves the previous image loadable.
  *
- * Image (little-endian, every field 4-byte aligned; the STM32F4 programs 32-bit words):
+ * Image (little-endian, every field 4-byte aligned; see "Programming unit" below):
  *
  *   offset      size  field
  *   0           4     magic       0x4D524750 ("PGRM" in byte order)
@@ -15,6 +15,14 @@
  *                                 value: IEEE-754 bits for F32, the integer otherwise
  *   20+8n       4     crc         CRC-32 (crc32.h) of bytes [0, 20+8n)
  *   24+8n       4     commit      0x5AFEC0DE, programmed last
+ *
+ * Programming unit (hal_flash_geometry's program_bytes, a power of two up to
+ * PARAM_STORE_PROGRAM_MAX): header, records and crc end at 24+8n, a multiple of 8, so
+ * they are programmed as whole units in one call, and the commit word starts a unit of
+ * its own; with a unit wider than the commit word (8 bytes: ECC flash that programs
+ * 64-bit double words) the rest of its unit is programmed as 0xFF, which no loader
+ * reads. The image layout is the same for every unit, so an image written with 32-bit
+ * programming loads on a part with 64-bit programming and back.
  *
  * Save: refuse unless the loop is in a safe mode (see below); encode; if the newest
  * valid image holds exactly these records, write nothing (PARAM_STORE_UNCHANGED);
@@ -41,7 +49,7 @@
  * other slot), unless the caller forces it (PARAM_SAVE_FORCE); a forced save still
  * writes the slot without it when it can.
  *
- * Why save needs the loop safe: on a single-bank STM32F4 a 16 KB sector erase stalls
+ * Why save needs the loop safe: on a single-bank part a 16 KB sector erase stalls
  * every instruction fetch from flash for 250 ms typical (500 ms max), and the drive
  * amplitude decays with tau = 2 Q1 / wn1 = 7 ms (6-12): a save while the gyro runs
  * would stop the 50 kHz tick for ~35 time constants and drop the loop. Running the
@@ -65,6 +73,8 @@
 #define PARAM_STORE_REC_BYTES 8u
 /* Largest image this firmware writes: every parameter persistent. */
 #define PARAM_STORE_IMAGE_MAX (PARAM_STORE_HDR_BYTES + PARAM_STORE_REC_BYTES * PARAM_COUNT + 8u)
+/* Widest programming unit the layout serves (header + records + crc is a multiple of 8). */
+#define PARAM_STORE_PROGRAM_MAX 8u
 /* Largest record count a loader accepts (bounded further by the sector size). */
 #define PARAM_STORE_MAX_RECORDS 4096u
 
@@ -101,7 +111,9 @@ typedef struct {
 typedef struct {
   uint32_t sector[2];
   uint32_t sector_size;
-  uint8_t buf[PARAM_STORE_IMAGE_MAX]; /* encode buffer */
+  uint32_t program_bytes;  /* the flash's programming unit (hal_flash_geometry) */
+  /* encode buffer: the image, then the commit word's unit filled up with 0xFF */
+  uint8_t buf[PARAM_STORE_IMAGE_MAX - 4u + PARAM_STORE_PROGRAM_MAX];
 } param_store_t;
 
 typedef struct {

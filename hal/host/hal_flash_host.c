@@ -11,6 +11,8 @@
  * tERASE16KB 250 ms typ (500 ms max), tPROG word 16 us typ. */
 #define DEFAULT_ERASE_US 250000u
 #define DEFAULT_PROGRAM_WORD_US 16u
+#define DEFAULT_PROGRAM_BYTES 4u /* the STM32F4 word */
+#define ECC_PROGRAM_BYTES 8u     /* from here on: whole units, each programmed once */
 #define NO_LIMIT UINT32_MAX
 
 typedef struct {
@@ -19,6 +21,7 @@ typedef struct {
   uint32_t sector_size;
   uint32_t erase_us;
   uint32_t program_word_us;
+  uint32_t program_bytes;
   FILE *file;
   uint32_t program_budget;  /* bytes that may still be programmed before the cut */
   uint32_t erase_cut;       /* NO_LIMIT, or bytes erased by the next (interrupted) erase */
@@ -76,13 +79,16 @@ int hal_flash_host_configure(const hal_flash_host_cfg_t *cfg)
   hal_flash_host_close();
   memset(&g_flash, 0, sizeof g_flash);
   g_flash.mem = g_flash_mem;
-  const hal_flash_host_cfg_t def = {0u, 0u, NULL, 0u, 0u};
+  const hal_flash_host_cfg_t def = {0u, 0u, NULL, 0u, 0u, 0u};
   const hal_flash_host_cfg_t *c = (cfg != NULL) ? cfg : &def;
   const uint32_t n = (c->num_sectors != 0u) ? c->num_sectors : DEFAULT_SECTORS;
   const uint32_t sz = (c->sector_size != 0u) ? c->sector_size : DEFAULT_SECTOR_SIZE;
-  if ((sz % 4u) != 0u || (uint64_t)n * sz > HAL_FLASH_HOST_MAX_BYTES) {
+  const uint32_t unit = (c->program_bytes != 0u) ? c->program_bytes : DEFAULT_PROGRAM_BYTES;
+  if ((sz % 4u) != 0u || (uint64_t)n * sz > HAL_FLASH_HOST_MAX_BYTES ||
+      (unit & (unit - 1u)) != 0u || unit > sz || (sz % unit) != 0u) {
     return -1;
   }
+  g_flash.program_bytes = unit;
   g_flash.num_sectors = n;
   g_flash.sector_size = sz;
   g_flash.erase_us = (c->erase_us != 0u) ? c->erase_us : DEFAULT_ERASE_US;
@@ -166,6 +172,7 @@ void hal_flash_geometry(hal_flash_geometry_t *geo)
   ensure_configured();
   geo->num_sectors = g_flash.num_sectors;
   geo->sector_size = g_flash.sector_size;
+  geo->program_bytes = g_flash.program_bytes;
 }
 
 static bool in_range(uint32_t sector, uint32_t offset, size_t len)
@@ -210,6 +217,17 @@ hal_flash_status_t hal_flash_program(uint32_t sector, uint32_t offset, const voi
   const uint8_t *src = (const uint8_t *)data;
   const uint32_t addr = sector * g_flash.sector_size + offset;
   const uint32_t n = (uint32_t)len;
+  if (g_flash.program_bytes >= ECC_PROGRAM_BYTES) {
+    /* ECC flash: whole units, each written once between erases */
+    if ((offset % g_flash.program_bytes) != 0u || (n % g_flash.program_bytes) != 0u) {
+      return HAL_FLASH_ERR_RANGE;
+    }
+    for (uint32_t i = 0; i < n; i++) {
+      if (g_flash.mem[addr + i] != 0xFFu) {
+        return HAL_FLASH_ERR_WRITE;
+      }
+    }
+  }
   /* NOR: programming can only clear bits; a 1 wanted where a 0 is stored fails whole */
   for (uint32_t i = 0; i < n; i++) {
     if ((uint8_t)(src[i] & (uint8_t)~g_flash.mem[addr + i]) != 0u) {

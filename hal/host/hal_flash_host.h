@@ -4,6 +4,13 @@
  * program can only clear bits (1 -> 0); a program that would have to set a 0 bit back
  * to 1 is refused whole (HAL_FLASH_ERR_WRITE, nothing written).
  *
+ * Programming unit (hal_flash_geometry's program_bytes): 4 by default, the STM32F4's
+ * word, with the NOR rules above (any byte range may be programmed, again and again).
+ * A unit of 8 or more models ECC flash (the STM32G4's 64-bit double word): offset and
+ * length must be whole units (else HAL_FLASH_ERR_RANGE, nothing written), and a unit
+ * that is not fully erased cannot be programmed again (HAL_FLASH_ERR_WRITE, nothing
+ * written).
+ *
  * Busy time is not slept but added to a simulated clock, so tests can reason about how
  * long the flash would have stalled the CPU without being timing-dependent. Defaults are
  * the STM32F405 datasheet figures for x32 parallelism: sector (16 KB) erase 250 ms
@@ -43,6 +50,7 @@ typedef struct {
   const char *path;          /* backing file, or NULL for memory only */
   uint32_t erase_us;         /* busy time of one sector erase; 0 -> 250000 */
   uint32_t program_word_us;  /* busy time per 32-bit word programmed; 0 -> 16 */
+  uint32_t program_bytes;    /* programming unit, power of two <= sector_size; 0 -> 4 */
 } hal_flash_host_cfg_t;
 
 typedef struct {

@@ -30,8 +30,6 @@ typedef enum {
   STM32F4_CLOCK_ERR_SWITCH = -4  /* SYSCLK switch not acknowledged */
 } stm32f4_clock_status_t;
 
-#define STM32F4_HSE_HZ 8000000u
-#define STM32F4_SYSCLK_HZ 168000000u
 
 /* Compute the PLL and bus settings for sysclk_hz from an hse_hz crystal; exact
  * frequencies only. Returns STM32F4_CLOCK_OK or STM32F4_CLOCK_ERR_PLAN (plan unchanged). */

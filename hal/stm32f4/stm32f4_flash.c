@@ -20,7 +20,7 @@
  * sector-erase time in the STM32F405 datasheet. */
 #define FLASH_POLL_LIMIT 50000000u
 
-static STM32F4_RAMFUNC int flash_wait_idle(void)
+static CM4_RAMFUNC int flash_wait_idle(void)
 {
   for (uint32_t i = 0u; i < FLASH_POLL_LIMIT; ++i) {
     STM32F4_POLL_HOOK();
@@ -30,7 +30,7 @@ static STM32F4_RAMFUNC int flash_wait_idle(void)
   return 0;
 }
 
-static STM32F4_RAMFUNC int flash_unlock(void)
+static CM4_RAMFUNC int flash_unlock(void)
 {
   if ((FLASH_R->CR & FLASH_CR_LOCK) != 0u) {
     FLASH_R->KEYR = FLASH_KEY1;
@@ -44,7 +44,7 @@ static STM32F4_RAMFUNC int flash_unlock(void)
   return (FLASH_R->CR & FLASH_CR_LOCK) == 0u;
 }
 
-static STM32F4_RAMFUNC void flash_lock_and_flush(void)
+static CM4_RAMFUNC void flash_lock_and_flush(void)
 {
   FLASH_R->CR = FLASH_CR_LOCK;
   const uint32_t acr = FLASH_R->ACR;
@@ -56,7 +56,7 @@ static STM32F4_RAMFUNC void flash_lock_and_flush(void)
   }
 }
 
-static STM32F4_RAMFUNC int flash_start(void)
+static CM4_RAMFUNC int flash_start(void)
 {
   if (!flash_unlock()) return 0;
   if (!flash_wait_idle()) return 0;
@@ -69,9 +69,12 @@ void hal_flash_geometry(hal_flash_geometry_t *geo)
   if (geo == 0) return;
   geo->num_sectors = STM32F4_PARAM_NUM_SECTORS;
   geo->sector_size = STM32F4_PARAM_SECTOR_BYTES;
+  /* The driver takes any byte range, but a whole aligned word is one x32 program
+   * operation (RM0090 3.5.2): the store writes words. */
+  geo->program_bytes = 4u;
 }
 
-STM32F4_RAMFUNC hal_flash_status_t hal_flash_erase(uint32_t sector)
+CM4_RAMFUNC hal_flash_status_t hal_flash_erase(uint32_t sector)
 {
   if (sector >= STM32F4_PARAM_NUM_SECTORS) return HAL_FLASH_ERR_RANGE;
   hal_flash_status_t st = HAL_FLASH_OK;
@@ -101,7 +104,7 @@ static int range_ok(uint32_t sector, uint32_t offset, size_t len)
          len <= (size_t)(STM32F4_PARAM_SECTOR_BYTES - offset);
 }
 
-STM32F4_RAMFUNC hal_flash_status_t hal_flash_program(uint32_t sector, uint32_t offset,
+CM4_RAMFUNC hal_flash_status_t hal_flash_program(uint32_t sector, uint32_t offset,
                                                      const void *data, size_t len)
 {
   if (!range_ok(sector, offset, len) || (data == 0 && len > 0u)) return HAL_FLASH_ERR_RANGE;

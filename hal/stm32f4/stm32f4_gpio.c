@@ -1,4 +1,4 @@
-#include "stm32f4_board.h"
+#include "stm32f4_gpio.h"
 
 void stm32f4_gpio_config(stm32f4_gpio_t *gpio, uint32_t pin, uint32_t mode, uint32_t af,
                          int pull_up)
@@ -12,11 +12,4 @@ void stm32f4_gpio_config(stm32f4_gpio_t *gpio, uint32_t pin, uint32_t mode, uint
   const uint32_t s4 = (pin & 7u) * 4u;
   gpio->AFR[idx] = (gpio->AFR[idx] & ~(0xFu << s4)) | ((af & 0xFu) << s4);
   gpio->MODER = (gpio->MODER & ~(3u << s2)) | ((mode & 3u) << s2);
-}
-
-void stm32f4_board_reset(void)
-{
-  SCB->AIRCR = SCB_AIRCR_VECTKEY | SCB_AIRCR_SYSRESETREQ;
-  for (;;) {
-  }
 }

@@ -1,12 +1,10 @@
-/* Independent watchdog, clocked by the ~32 kHz LSI (RM0090 §21: 17..47 kHz over
+/* Independent watchdog, clocked by the ~32 kHz LSI (board.h: BOARD_LSI_HZ) (RM0090 §21: 17..47 kHz over
  * temperature and parts, so a timeout is only good to about a factor of 1.5).
  *   t_timeout = 4 * 2^PR * (RLR + 1) / f_lsi,  PR in 0..6, RLR in 0..4095. */
 #ifndef STM32F4_IWDG_H
 #define STM32F4_IWDG_H
 
 #include <stdint.h>
-
-#define STM32F4_LSI_HZ 32000u
 
 typedef struct {
   uint32_t pr;  /* prescaler code: divide by 4 << pr */

@@ -1,9 +1,8 @@
-/* STM32F405 register map: only the peripherals and bits this board port uses.
+/* STM32F405 register map: only the peripherals and bits this port uses (the Cortex-M4
+ * core's registers are in hal/cortex_m4/cm4_regs.h, included here).
  * Addresses and bit positions from RM0090 (STM32F405/415/407/417 reference manual):
  * memory map §2.3 table 1, RCC §7.3, PWR §5.4, FLASH §3.8, GPIO §8.4, TIM1/TIM8 §17.4,
- * TIM2-TIM5 §18.4, SPI §28.5, DMA §10.5, USART §30.6, IWDG §21.4; core peripherals from
- * the Cortex-M4 Devices Generic User Guide (SCB, NVIC, SysTick, CPACR) and the ARMv7-M
- * ARM (DWT, DEMCR).
+ * TIM2-TIM5 §18.4, SPI §28.5, DMA §10.5, USART §30.6, IWDG §21.4.
  *
  * Host builds (STM32F4_HOST_TEST defined) see every peripheral through a pointer in
  * stm32f4_host_map, which a unit test points at RAM structs: the drivers then run their
@@ -14,6 +13,8 @@
 #define STM32F4_REGS_H
 
 #include <stdint.h>
+
+#include "cm4_regs.h"
 
 #define STM32F4_REG volatile uint32_t
 
@@ -63,26 +64,6 @@ typedef struct {
   STM32F4_REG KR, PR, RLR, SR;
 } stm32f4_iwdg_t;
 
-typedef struct {
-  STM32F4_REG CPUID, ICSR, VTOR, AIRCR, SCR, CCR;
-  volatile uint8_t SHPR[12];
-  STM32F4_REG SHCSR, CFSR, HFSR, DFSR, MMFAR, BFAR, AFSR;
-} stm32f4_scb_t;
-
-typedef struct {
-  STM32F4_REG ISER[8], RES0[24], ICER[8], RES1[24], ISPR[8], RES2[24], ICPR[8],
-      RES3[24], IABR[8], RES4[56];
-  volatile uint8_t IP[240];
-} stm32f4_nvic_t;
-
-typedef struct {
-  STM32F4_REG CTRL, LOAD, VAL, CALIB;
-} stm32f4_systick_t;
-
-typedef struct {
-  STM32F4_REG CTRL, CYCCNT;
-} stm32f4_dwt_t;
-
 /* Base addresses (RM0090 table 1; ARMv7-M system address map). */
 #define STM32F4_TIM2_BASE 0x40000000UL
 #define STM32F4_TIM4_BASE 0x40000800UL
@@ -99,12 +80,6 @@ typedef struct {
 #define STM32F4_RCC_BASE 0x40023800UL
 #define STM32F4_FLASH_R_BASE 0x40023C00UL
 #define STM32F4_DMA2_BASE 0x40026400UL
-#define STM32F4_DWT_BASE 0xE0001000UL
-#define STM32F4_SYSTICK_BASE 0xE000E010UL
-#define STM32F4_NVIC_BASE 0xE000E100UL
-#define STM32F4_SCB_BASE 0xE000ED00UL
-#define STM32F4_CPACR_ADDR 0xE000ED88UL
-#define STM32F4_DEMCR_ADDR 0xE000EDFCUL
 
 /* Flash sectors 1 and 2 (16 KB each) hold the A/B parameter store (RM0090 table 5). */
 #define STM32F4_PARAM_FLASH_ADDR 0x08004000UL
@@ -123,18 +98,11 @@ typedef struct {
   stm32f4_dma_t *dma2;
   stm32f4_usart_t *usart1;
   stm32f4_iwdg_t *iwdg;
-  stm32f4_scb_t *scb;
-  stm32f4_nvic_t *nvic;
-  stm32f4_systick_t *systick;
-  stm32f4_dwt_t *dwt;
-  volatile uint32_t *cpacr, *demcr;
   volatile uint8_t *param_flash; /* STM32F4_PARAM_NUM_SECTORS * SECTOR_BYTES bytes */
   void (*poll_hook)(void);       /* the "hardware": called from every busy-wait loop */
-  uint32_t primask;              /* emulated PRIMASK for the critical-section code */
 } stm32f4_host_map_t;
 extern stm32f4_host_map_t stm32f4_host_map;
 #define STM32F4_PERIPH(field, type, addr) (stm32f4_host_map.field)
-#define STM32F4_CORE_REG(field, addr) (stm32f4_host_map.field)
 #define STM32F4_PARAM_FLASH ((volatile uint8_t *)stm32f4_host_map.param_flash)
 #define STM32F4_POLL_HOOK()                                                      \
   do {                                                                           \
@@ -142,7 +110,6 @@ extern stm32f4_host_map_t stm32f4_host_map;
   } while (0)
 #else
 #define STM32F4_PERIPH(field, type, addr) ((type *)(addr))
-#define STM32F4_CORE_REG(field, addr) ((volatile uint32_t *)(addr))
 #define STM32F4_PARAM_FLASH ((volatile uint8_t *)STM32F4_PARAM_FLASH_ADDR)
 #define STM32F4_POLL_HOOK() ((void)0)
 #endif
@@ -177,12 +144,6 @@ void stm32f4_qemu_flash_controller(void);
 #define DMA2 STM32F4_PERIPH(dma2, stm32f4_dma_t, STM32F4_DMA2_BASE)
 #define USART1 STM32F4_PERIPH(usart1, stm32f4_usart_t, STM32F4_USART1_BASE)
 #define IWDG STM32F4_PERIPH(iwdg, stm32f4_iwdg_t, STM32F4_IWDG_BASE)
-#define SCB STM32F4_PERIPH(scb, stm32f4_scb_t, STM32F4_SCB_BASE)
-#define NVIC STM32F4_PERIPH(nvic, stm32f4_nvic_t, STM32F4_NVIC_BASE)
-#define SYSTICK STM32F4_PERIPH(systick, stm32f4_systick_t, STM32F4_SYSTICK_BASE)
-#define DWT STM32F4_PERIPH(dwt, stm32f4_dwt_t, STM32F4_DWT_BASE)
-#define CPACR (*STM32F4_CORE_REG(cpacr, STM32F4_CPACR_ADDR))
-#define DEMCR (*STM32F4_CORE_REG(demcr, STM32F4_DEMCR_ADDR))
 
 /* ---- RCC (RM0090 §7.3) ---- */
 #define RCC_CR_HSION (1u << 0)
@@ -354,21 +315,6 @@ void stm32f4_qemu_flash_controller(void);
 #define IWDG_SR_PVU (1u << 0)
 #define IWDG_SR_RVU (1u << 1)
 
-/* ---- Cortex-M4 core ---- */
-#define SCB_AIRCR_VECTKEY (0x05FAu << 16)
-#define SCB_AIRCR_SYSRESETREQ (1u << 2)
-#define SCB_SHCSR_MEMFAULTENA (1u << 16)
-#define SCB_SHCSR_BUSFAULTENA (1u << 17)
-#define SCB_SHCSR_USGFAULTENA (1u << 18)
-#define SCB_CCR_DIV_0_TRP (1u << 4)
-#define CPACR_CP10_CP11_FULL (0xFu << 20)
-#define DEMCR_TRCENA (1u << 24)
-#define DWT_CTRL_CYCCNTENA (1u << 0)
-#define SYSTICK_CTRL_ENABLE (1u << 0)
-#define SYSTICK_CTRL_TICKINT (1u << 1)
-#define SYSTICK_CTRL_CLKSOURCE (1u << 2) /* processor clock */
-#define SYSTICK_CTRL_COUNTFLAG (1u << 16)
-
 /* STM32F405 interrupt numbers (RM0090 table 61) used by this port. */
 enum stm32f4_irq {
   STM32F4_IRQ_USART1 = 37,
@@ -376,15 +322,9 @@ enum stm32f4_irq {
   STM32F4_NUM_IRQS = 82
 };
 
-/* NVIC priorities: 4 implemented bits, stored in the top nibble (RM0090 §12.1). */
+/* NVIC priorities (cm4_nvic_enable): 4 implemented bits on the STM32F4 (RM0090 §12.1). */
 #define STM32F4_PRIO_SAMPLE 0u /* the 50 kHz sample interrupt: nothing preempts it */
 #define STM32F4_PRIO_UART 8u   /* tuning port: preempted by the sample interrupt */
-
-static inline void stm32f4_nvic_enable(uint32_t irq, uint32_t prio)
-{
-  NVIC->IP[irq] = (uint8_t)((prio & 0xFu) << 4);
-  NVIC->ISER[irq >> 5] = 1u << (irq & 31u);
-}
 
 /* Bit offset of stream n's flags inside LISR/HISR (streams n and n+4 share an offset). */
 static inline uint32_t stm32f4_dma_flag_shift(uint32_t stream)
@@ -406,11 +346,6 @@ static inline void stm32f4_dma_clear(stm32f4_dma_t *dma, uint32_t stream, uint32
   } else {
     dma->HIFCR = v;
   }
-}
-
-static inline void stm32f4_nvic_disable(uint32_t irq)
-{
-  NVIC->ICER[irq >> 5] = 1u << (irq & 31u);
 }
 
 #endif /* STM32F4_REGS_H */

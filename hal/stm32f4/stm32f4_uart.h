@@ -1,13 +1,13 @@
 /* Tuning port on USART1 (PB6 TX, PB7 RX, 8N1): interrupt-driven RX and TX rings behind
  * hal_uart.h. RX: every received byte goes into the RX ring from the USART1 interrupt;
  * a full ring drops the byte and counts it. TX: hal_uart_write queues bytes and enables
- * the TXE interrupt, which feeds the data register until the ring is empty. */
+ * the TXE interrupt, which feeds the data register until the ring is empty. The line
+ * rate is the board's (board.h: BOARD_UART_BAUD). */
 #ifndef STM32F4_UART_H
 #define STM32F4_UART_H
 
 #include <stdint.h>
 
-#define STM32F4_UART_BAUD 921600u
 #define STM32F4_UART_RX_BYTES 256u
 #define STM32F4_UART_TX_BYTES 8192u /* the longest reply (list, ~6.5 KB) beside telemetry */
 

@@ -21,6 +21,7 @@
 #include "post.h"
 #include "scenario.h"
 #include "sim.h"
+#include "plant/plant_const.h"
 
 #define KB_J_PER_K 1.380649e-23
 
@@ -73,10 +74,10 @@ static void list_params(void)
 static double brownian_floor_dph(const plant_cfg_t *pc, double f_drive_hz, double amp_m,
                                  double t_k)
 {
-  const double w1 = 2.0 * M_PI * f_drive_hz;
-  const double w2 = 2.0 * M_PI * pc->f_sense_hz * (1.0 - 0.5 * pc->ket_per_k * (t_k - pc->temp_ref_k));
+  const double w1 = 2.0 * PLANT_PI * f_drive_hz;
+  const double w2 = 2.0 * PLANT_PI * pc->f_sense_hz * (1.0 - 0.5 * pc->ket_per_k * (t_k - pc->temp_ref_k));
   const double om = sqrt(4.0 * KB_J_PER_K * t_k * w2 / (pc->mass_kg * pc->q_sense)) / (2.0 * amp_m * w1);
-  return om * 180.0 / M_PI * 3600.0;
+  return om * 180.0 / PLANT_PI * 3600.0;
 }
 
 static void add_num(cJSON *o, const char *k, double v)

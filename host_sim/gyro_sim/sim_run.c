@@ -19,6 +19,7 @@
 #include <errno.h>
 #include <poll.h>
 #include <signal.h>
+#include "plant/plant_const.h"
 
 /* SIGINT/SIGTERM end a paced (pty) run cleanly; a flag is all a handler may touch. */
 static volatile sig_atomic_t stop_requested;
@@ -118,7 +119,7 @@ static void startup_figures(const double *amp, const double *ph, const double *r
   /* Loop figures from 0.1 s after lock (the last of the acquisition transient). */
   const size_t i0 = last_out + (size_t)(0.1 * fs);
   st->amp_err_rms_pct = 100.0 * band_rms(amp, i0, n, fs) / af;
-  st->phase_err_rms_deg = band_rms(ph, i0, n, fs) * 180.0 / M_PI;
+  st->phase_err_rms_deg = band_rms(ph, i0, n, fs) * 180.0 / PLANT_PI;
   /* Turn-on of the rate output: from here on its error stays within 0.5 deg/s of the
    * error it ends with (bias, filter and P-compensation transients settled). */
   double ef = 0.0;
@@ -205,7 +206,7 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
   uint64_t n_mean = 0;
   size_t it = 0;
   double ph_prev = 0.0, ph_unwrap = 0.0;
-  const double w_fw = 2.0 * M_PI * (double)fw.drive_freq_hz;
+  const double w_fw = 2.0 * PLANT_PI * (double)fw.drive_freq_hz;
   for (uint64_t k = 0; k < n_ticks; k++) {
     hal_host_run(1u);
     const plant_truth_t *tr = plant_truth(plant);
@@ -218,14 +219,14 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
       /* The true drive phasor in the firmware's NCO frame: y = Im{Z e^{j phi}}, so
        * Z = (y'/w + j y) e^{-j phi} with phi the NCO phase of the next tick. */
       const uint32_t phase_u = app->gyro.nco.half_phase << 1;
-      const double phi = 2.0 * M_PI * (double)phase_u / 4294967296.0;
+      const double phi = 2.0 * PLANT_PI * (double)phase_u / 4294967296.0;
       const double re = tr->vy_mps / w_fw, im = tr->y_m;
       const double c = cos(phi), s = sin(phi);
       const double zr = re * c + im * s, zi = im * c - re * s;
       amp[it] = hypot(zr, zi);
       const double p = atan2(zi, zr);
       double d = p - ph_prev;
-      d -= 2.0 * M_PI * floor((d + M_PI) / (2.0 * M_PI));
+      d -= 2.0 * PLANT_PI * floor((d + PLANT_PI) / (2.0 * PLANT_PI));
       ph_unwrap += d;
       ph_prev = p;
       ph[it] = ph_unwrap;
@@ -330,7 +331,7 @@ static void ol_isr(void *ctx)
   dac.code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID;
   hal_dac_write_frame(&dac);
   o->psi += o->dpsi;
-  if (o->psi > 2.0 * M_PI) o->psi -= 2.0 * M_PI;
+  if (o->psi > 2.0 * PLANT_PI) o->psi -= 2.0 * PLANT_PI;
 }
 
 /* Drive at f_hz with amplitude u for dwell_s; measure over the whole cycles after
@@ -339,7 +340,7 @@ static void ol_point(ol_t *o, plant_t *plant, double fs, double f_hz, double u, 
                      double dwell_s, double *amp_v, double *phase_deg, double *amp_m,
                      sim_csv_t *csv, uint64_t *k, uint64_t csv_every)
 {
-  o->dpsi = M_PI * f_hz / fs;
+  o->dpsi = PLANT_PI * f_hz / fs;
   o->u_amp_v = u;
   const uint64_t n_settle = (uint64_t)llround(settle_s * fs);
   const double cycles = floor((dwell_s - settle_s) * f_hz);
@@ -356,7 +357,7 @@ static void ol_point(ol_t *o, plant_t *plant, double fs, double f_hz, double u, 
   }
   const double n = (double)o->acc_n;
   *amp_v = 2.0 * hypot(o->acc_i, o->acc_q) / n;
-  *phase_deg = atan2(-o->acc_q, o->acc_i) * 180.0 / M_PI;
+  *phase_deg = atan2(-o->acc_q, o->acc_i) * 180.0 / PLANT_PI;
   *amp_m = sum_am / n;
 }
 

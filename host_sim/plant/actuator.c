@@ -2,11 +2,12 @@
 
 #include <math.h>
 #include <string.h>
+#include "board.h"
 
 void actuator_default_cfg(actuator_cfg_t *cfg)
 {
   memset(cfg, 0, sizeof *cfg);
-  cfg->fs_hz = 50000.0;
+  cfg->fs_hz = (double)BOARD_SAMPLE_RATE_HZ;
   cfg->ks_drive_mps2_per_v2 = 0.25;
   cfg->drive_noise.white_rthz = 200e-9;
   cfg->drive_noise.flicker_1hz_rthz = 2e-6;

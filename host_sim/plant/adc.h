@@ -1,4 +1,4 @@
-/* 16-bit bipolar ADC of the reference board (hal_converters.h: +-5 V, two's complement,
+/* 16-bit bipolar ADC of the reference board (board.h: +-5 V, two's complement,
  * one code = 10 V / 65536), for the host plant.
  *
  *   code = round(v / lsb) (nearest, half away from zero), lsb = full_scale_v / 32768

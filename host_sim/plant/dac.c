@@ -4,8 +4,10 @@
 #include <string.h>
 
 #include "plant/expm.h"
+#include "plant/plant_const.h"
+#include "board.h"
 
-static const double k_pi = 3.14159265358979323846;
+static const double k_pi = PLANT_PI;
 
 double dac_code_to_v(uint16_t code)
 {
@@ -25,7 +27,7 @@ uint16_t dac_v_to_code(double v)
 void dac_default_cfg(dac_cfg_t *cfg)
 {
   memset(cfg, 0, sizeof *cfg);
-  cfg->fs_hz = 50000.0;
+  cfg->fs_hz = (double)BOARD_SAMPLE_RATE_HZ;
   /* Fig. 4-14: a low-pass that removes the DAC's staircase harmonics while adding
    * little lag at the 745 Hz drive voltage (2nd-order Butterworth at 20 kHz: 3.0 deg at
    * 745 Hz, 6.1 deg at 1490 Hz; the staircase image at 50 kHz - 745 Hz is cut 16 dB). */

@@ -1,7 +1,7 @@
 /* Quad 14-bit DAC of the reference board with its output amplifier and reconstruction
  * low-pass (thesis §4.4.2 fig. 4-14), for the host plant (double precision).
  *
- * Code to volts (hal_converters.h): offset binary over +-15 V,
+ * Code to volts (board.h): offset binary over +-15 V,
  *   u = gain[c] * (code - 8192) * 30 V / 16384 + offset_v[c]
  * so code 0 -> -15 V, 8192 -> 0 V, 16383 -> +15 V - 1 LSB (1.831 mV).
  *
@@ -44,7 +44,7 @@
  * Voltages at the end of the sample (end_v, end_dvdt_v_per_s) are for the pickoff's
  * electrical feedthrough, which interpolates between ticks.
  *
- * Channels (hal_converters.h): 0 drive U1, 1 drive U2, 2 analog rate output, 3 spare.
+ * Channels (hal/hal_dac.h): 0 drive U1, 1 drive U2, 2 analog rate output, 3 spare.
  *
  * One plant sample [t_k, t_k+1) with the electrical modules (the top level's order):
  *   dac_step(&dac, &dout)                         voltages over the sample
@@ -66,7 +66,6 @@
 
 #include <stdint.h>
 
-#include "hal/hal_converters.h"
 #include "hal/hal_dac.h"
 
 #define DAC_NCH HAL_DAC_NUM_CHANNELS

@@ -4,8 +4,9 @@
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
+#include "plant/plant_const.h"
 
-static const double k_pi = 3.14159265358979323846;
+static const double k_pi = PLANT_PI;
 
 /* tools/flicker_design.py: knee pairs, log10 of the position relative to fc. */
 static const double k_knee_zero_log10[2] = {0.19743383, -0.69126035};

@@ -3,8 +3,10 @@
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
+#include "plant/plant_const.h"
+#include "board.h"
 
-static const double kPi = 3.14159265358979323846;
+static const double kPi = PLANT_PI;
 
 #define NA (MECH_NS + MECH_NU)           /* augmented [state; input] size */
 
@@ -37,7 +39,7 @@ void mech_default_cfg(mech_cfg_t *cfg)
   cfg->kq_per_s2 = 0.0;
   cfg->dq_per_s = 0.0;
   cfg->mass_kg = 0.26e-6;   /* §4.6.1: 0.26 mg */
-  cfg->fs_hz = 50e3;        /* §4.4.2 */
+  cfg->fs_hz = (double)BOARD_SAMPLE_RATE_HZ; /* §4.4.2 */
   /* Measured (test_mech, test_refresh_threshold_error): with e expanded to second
    * order the steady-state error of the drive at resonance (Q1 = 33) is about
    * 860 e^3 (8.6e-10 at e = 1e-3, 6.9e-9 at 2e-3). 1e-3 keeps it 100x below 1e-7 and

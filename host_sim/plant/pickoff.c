@@ -4,9 +4,11 @@
 #include <string.h>
 
 #include "plant/expm.h"
+#include "plant/plant_const.h"
+#include "board.h"
 
-static const double k_pi = 3.14159265358979323846;
-static const double k_deg = 3.14159265358979323846 / 180.0;
+static const double k_pi = PLANT_PI;
+static const double k_deg = PLANT_RAD_PER_DEG;
 
 /* SISO state space in time normalised to the sample period. */
 typedef struct {
@@ -43,7 +45,7 @@ void pickoff_default_cfg(pickoff_cfg_t *cfg, pickoff_axis_t axis)
 {
   memset(cfg, 0, sizeof *cfg);
   cfg->axis = axis;
-  cfg->fs_hz = 50000.0;
+  cfg->fs_hz = (double)BOARD_SAMPLE_RATE_HZ;
   cfg->gain_tc_per_k = 0.0;
   cfg->preamp_rail_v = 13.5;
   cfg->lag_kind = PICKOFF_LAG_LOWPASS;

@@ -6,9 +6,10 @@
 #include <stddef.h>
 #include <stdio.h>
 #include <string.h>
+#include "plant/plant_const.h"
 
-static const double kPi = 3.14159265358979323846;
-static const double kDeg = 3.14159265358979323846 / 180.0;
+static const double kPi = PLANT_PI;
+static const double kDeg = PLANT_RAD_PER_DEG;
 
 __attribute__((format(printf, 2, 3))) static void set_err(plant_t *p, const char *fmt, ...)
 {

@@ -3,9 +3,10 @@
 
 #include <complex.h>
 #include <math.h>
+#include "plant/plant_const.h"
 
-static const double kPi = 3.14159265358979323846;
-static const double kDeg = 3.14159265358979323846 / 180.0;
+static const double kPi = PLANT_PI;
+static const double kDeg = PLANT_RAD_PER_DEG;
 
 /* 2nd-order low-pass w0^2 / (s^2 + w0/Q s + w0^2) at f */
 static double complex lp2(double f, double f0, double q)

@@ -6,6 +6,8 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+#include "plant/plant_const.h"
+#include "board.h"
 
 #define PLANT_DESC(ctype, name, kind, lo, hi, unit, doc) \
   {#name, offsetof(plant_cfg_t, name), PLANT_PARAM_##kind, (lo), (hi), (unit), (doc)},
@@ -125,7 +127,7 @@ void plant_default_cfg(plant_cfg_t *c)
 {
   memset(c, 0, sizeof *c);
   /* run */
-  c->fs_hz = 50000.0;          /* §4.4.2, table */
+  c->fs_hz = (double)BOARD_SAMPLE_RATE_HZ;          /* §4.4.2, table */
   c->temp_k = 298.15;          /* room, 25 degC (= T0) */
   c->rate_dps = 0.0;
   c->drive_amp_m = 10e-6;      /* §4.6.1, table (15 um in §2.4.2) */
@@ -245,7 +247,7 @@ void plant_default_cfg(plant_cfg_t *c)
    * step of 1.5e-3 deg/s (5 deg/h) through 1500 deg/s of quadrature, 0.57 mK of sense
    * circuit temperature. In a 0.03 K/s cool-down: 52 per second, 10 ns per sample. */
   c->pick_phase_step_rad = 1e-6;
-  /* ADC: hal_converters.h, +-5 V (§4.4.2) */
+  /* ADC: board.h, +-5 V (§4.4.2) */
   c->adc_full_scale_v = 5.0;
   /* g-sensitivity: a single proof mass on springs feels -m a along its own axis;
    * the thesis's linear gyro has no cancelling twin (§2.2.2) */
@@ -282,7 +284,7 @@ int plant_cfg_check(const plant_cfg_t *c, char *buf, size_t n)
     if (check_value(&kParams[i], plant_param_get(c, &kParams[i]), buf, n) != 0) return -1;
   /* cross-field limits, each named by the parameter that has to move */
   const double nyq = 0.45 * c->fs_hz, T = 1.0 / c->fs_hz;
-  const double kDeg = 3.14159265358979323846 / 180.0;
+  const double kDeg = PLANT_RAD_PER_DEG;
   if (c->f_drive_hz > nyq) {
     errf(buf, n, "%s: must be below 0.45 fs_hz (%g Hz)", "f_drive_hz", nyq);
     return -1;

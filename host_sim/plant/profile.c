@@ -3,8 +3,9 @@
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
+#include "plant/plant_const.h"
 
-static const double kTwoPi = 6.28318530717958647692;
+static const double kTwoPi = PLANT_TWO_PI;
 static const double kMaxAbs = 1e9;
 
 static const char *const kKindNames[PROFILE_NKINDS] = {"const", "steps", "sine", "ramp",

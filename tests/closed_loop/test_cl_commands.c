@@ -312,7 +312,7 @@ static void test_undesignable_stored_set_keeps_the_rest(void **state)
 {
   (void)state;
   const rec_t r[] = {
-      {id_of(PARAM_drive_p_init_deg), PARAM_T_F32, bits_of(356.0f)},
+      {id_of(PARAM_rate_out_v_per_dps), PARAM_T_F32, bits_of(0.05f)}, /* span 15 V > fault 10 V */
       {id_of(PARAM_rate_bias_c0_dps), PARAM_T_F32, bits_of(1.5f)},
       {id_of(PARAM_drive_cal_q), PARAM_T_F32, bits_of(40.0f)},
   };
@@ -320,15 +320,15 @@ static void test_undesignable_stored_set_keeps_the_rest(void **state)
   start_on_flash();
   assert_true(param_f(PARAM_rate_bias_c0_dps) == 1.5f);
   assert_true(param_f(PARAM_drive_cal_q) == 40.0f);
-  assert_true(param_f(PARAM_drive_p_init_deg) == param_info(PARAM_drive_p_init_deg)->def.f);
+  assert_true(param_f(PARAM_rate_out_v_per_dps) == param_info(PARAM_rate_out_v_per_dps)->def.f);
   const char *s = cmd("status\n");
   assert_non_null(strstr(s, "- store ok\r\n"));
-  assert_non_null(strstr(s, "- store_dropped drive.p_init_deg: "));
-  assert_non_null(strstr(s, gyro_design_reason(GYRO_DESIGN_P_INIT))); /* the boot's reason */
+  assert_non_null(strstr(s, "- store_dropped rate.out_v_per_dps: "));
+  assert_non_null(strstr(s, gyro_design_reason(GYRO_DESIGN_FAULT_OUT))); /* the boot's reason */
   /* the same value at `set` time is refused with the reason */
-  const char *e = cmd("set drive.p_init_deg 356\n");
+  const char *e = cmd("set rate.out_v_per_dps 0.05\n");
   assert_non_null(strstr(e, "err REJECTED "));
-  assert_non_null(strstr(e, ": drive.p_init_deg must lie within"));
+  assert_non_null(strstr(e, ": rate.fault_out_v must lie outside"));
 }
 
 /* Subnormal values: refused from a flash record and from gyro-sim --set as they are

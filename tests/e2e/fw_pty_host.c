@@ -76,7 +76,7 @@ int main(int argc, char **argv)
   sigaction(SIGTERM, &sa, NULL);
   sigaction(SIGINT, &sa, NULL);
 
-  const hal_flash_host_cfg_t fc = {2u, 16384u, flash, 0u, 0u};
+  const hal_flash_host_cfg_t fc = {2u, 16384u, flash, 0u, 0u, 0u};
   if (hal_flash_host_configure(&fc) != 0) {
     fprintf(stderr, "fw_pty_host: cannot use flash file %s\n", flash);
     return 1;

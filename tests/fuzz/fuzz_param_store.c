@@ -47,7 +47,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-  const hal_flash_host_cfg_t cfg = {2u, SECTOR, NULL, 0u, 0u};
+  const hal_flash_host_cfg_t cfg = {2u, SECTOR, NULL, 0u, 0u, 0u};
   FUZZ_CHECK(hal_flash_host_configure(&cfg) == 0);
   param_store_t st;
   const param_store_cfg_t sc = {0u, 1u};

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Tests of the emulator image gyro-fw-qemu (the product application with the plant model
-in place of the converters, hal/stm32f4/qemu/stm32f4_qemu_plant.h) in QEMU's
+in place of the converters, hal/boards/ref_f405/qemu/stm32f4_qemu_plant.h) in QEMU's
 netduinoplus2, run with -icount shift=auto and the tuning UART on a TCP port.
 
     test_fw_qemu.py --elf gyro-fw-qemu.elf CASE [--twin fw_qemu_twin] [--gyroctl tools/gyroctl]
@@ -24,7 +24,7 @@ CASE
            bias change on the rate output), log (a short telemetry stream decoded to
            CSV), save refused while the drive runs, then save, set, load and the
            saved value back (the board's flash driver against the emulator's model
-           of the parameter sectors; see hal/stm32f4/README.md).
+           of the parameter sectors; see hal/boards/ref_f405/README.md).
 
 Exit codes: 0 pass, 1 fail, 77 skip (image or twin not built: build the target preset).
 """
@@ -51,7 +51,7 @@ EQUIV_STRETCH = 3      # x 20000 instructions per tick under -icount shift=0
 AUTO_NS_PER_INSN = 8   # -icount shift=auto settles at shift 3 here (plant_ns / instructions)
 STRETCH_MARGIN = 0.6   # worst tick's share of the period
 ICOUNT = {"boot": "auto", "equiv": "0", "gyroctl": "auto"}
-STEP_DPS = 100.0       # hal/stm32f4/qemu/qemu_plant_setup.h QEMU_PLANT_STEP_DPS
+STEP_DPS = 100.0       # hal/boards/ref_f405/qemu/qemu_plant_setup.h QEMU_PLANT_STEP_DPS
 GYROCTL_RATE_DPS = 80.0
 TRACE_LEN = 1000       # QEMU_TRACE_LEN
 TRACE_EVERY = 100      # QEMU_TRACE_EVERY
@@ -169,7 +169,7 @@ def case_equiv(emu, args):
     _, em = print_figures(emu)
     # shift=0: the figures are instructions. The default stretch must leave the worst
     # tick well inside its period at the pace shift=auto settles to on this class of
-    # host (2^3 ns per instruction measured, hal/stm32f4/README.md): a deterministic
+    # host (2^3 ns per instruction measured, hal/boards/ref_f405/README.md): a deterministic
     # check of the margin, where the boot case can only count late ticks.
     worst = int(em["isr_ns_max"]) + int(em["plant_ns_max"])
     period_insn = stretch0 * 20000 // AUTO_NS_PER_INSN

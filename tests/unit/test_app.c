@@ -27,7 +27,7 @@ static app_t app; /* large: keep it off the test's stack */
 
 static void setup_app(void)
 {
-  const hal_flash_host_cfg_t fc = {2u, 16384u, NULL, 250000u, 16u};
+  const hal_flash_host_cfg_t fc = {2u, 16384u, NULL, 250000u, 16u, 0u};
   assert_int_equal(hal_flash_host_configure(&fc), 0);
   hal_uart_host_reset();
   hal_host_attach(quiet_plant, NULL);

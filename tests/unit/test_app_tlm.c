@@ -75,7 +75,7 @@ static void on_data(void *ctx, const tlm_data_t *d)
 static int setup(void **state)
 {
   (void)state;
-  const hal_flash_host_cfg_t fc = {2u, 16384u, NULL, 250000u, 16u};
+  const hal_flash_host_cfg_t fc = {2u, 16384u, NULL, 250000u, 16u, 0u};
   assert_int_equal(hal_flash_host_configure(&fc), 0);
   hal_uart_host_reset();
   hal_host_attach(quiet_plant, NULL);

@@ -54,7 +54,7 @@ static int setup(void **state)
 {
   (void)state;
   memset(&g, 0, sizeof g);
-  const hal_flash_host_cfg_t fc = {2u, 16384u, NULL, 0u, 0u};
+  const hal_flash_host_cfg_t fc = {2u, 16384u, NULL, 0u, 0u, 0u};
   if (hal_flash_host_configure(&fc) != 0) {
     return -1;
   }

@@ -19,7 +19,7 @@ static hal_dac_frame_t frame_all(uint16_t c)
   return f;
 }
 
-/* Offset binary over +-15 V: the end points and mid-scale of hal_converters.h. */
+/* Offset binary over +-15 V: the end points and mid-scale of board.h. */
 static void test_code_to_volts(void **state)
 {
   (void)state;

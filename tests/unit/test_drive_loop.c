@@ -249,13 +249,31 @@ static void test_bad_cfg(void **state)
   assert_true(dl.amp_set_v == 5.0f);
 }
 
+/* The drive phase's start value may be anything the parameter drive.p_init_deg allows
+ * (+-360 deg): drive synthesis carries whole turns of P itself, so the drive loop has no
+ * narrower limit to impose. 355.2 .. 360 deg were refused before (a limit of 6.2 rad, a
+ * stale copy of the phase conversion's domain), so `set drive.p_init_deg 358` failed in
+ * the design although the parameter range accepts it. */
+static void test_p_init_whole_parameter_range(void **state)
+{
+  (void)state;
+  const float deg[] = {355.5f, 358.0f, 360.0f, -358.0f, -360.0f};
+  for (size_t i = 0; i < sizeof deg / sizeof deg[0]; i++) {
+    drive_loop_t dl;
+    drive_loop_cfg_t c = {.dt_s = 2e-5f, .amp_set_v = 2.0f, .f_cmd_max_v2 = 100.0f,
+                          .p_init_rad = deg[i] * 0.0174532925199433f};
+    assert_int_equal(drive_loop_init(&dl, &c), 0);
+    assert_true(dl.p_rad == c.p_init_rad);
+  }
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_design_formula),        cmocka_unit_test(test_design_caps_bandwidth),
       cmocka_unit_test(test_block_schedule),
       cmocka_unit_test(test_closed_loop_first_order), cmocka_unit_test(test_startup_no_overshoot),
-      cmocka_unit_test(test_bad_cfg),
+      cmocka_unit_test(test_bad_cfg), cmocka_unit_test(test_p_init_whole_parameter_range),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -14,7 +14,7 @@
 
 #include "gyro/gyro.h"
 
-static const double lsb_v = 30.0 / 16384.0; /* hal_converters.h: +-15 V, 14 bits */
+static const double lsb_v = 30.0 / 16384.0; /* board.h: +-15 V, 14 bits */
 
 /* The reference code, and whether x lies so close to a half-integer that either
  * neighbour is right (the float product v / LSB carries a relative rounding of 6e-8,

@@ -45,11 +45,11 @@ static void cont_expect_zero(param_values_t *v)
 /* Outside a parameter's range: refused by the parameter bank before a design, but
  * gyro_design is also called directly (simulator, bench) and names them too. */
 static void fs_zero(param_values_t *v) { v->sys_fs_hz = 0u; }
+static void p_init_beyond_reach(param_values_t *v) { v->drive_p_init_deg = 361.0f; }
 static void mu_drive_high(param_values_t *v) { v->demod_mu_drive = 0.6f; }
 static void mu_sense_zero(param_values_t *v) { v->demod_mu_sense = 0.0f; }
 static void cal_gain_zero(param_values_t *v) { v->drive_cal_gain_v_per_v2 = 0.0f; }
 static void phase_bw_zero(param_values_t *v) { v->drive_phase_bw_hz = 0.0f; }
-static void p_init_beyond_reach(param_values_t *v) { v->drive_p_init_deg = 356.0f; }
 static void lpf_above_nyquist(param_values_t *v) { v->rate_lpf_cutoff_hz = 3000.0f; }
 static void lpf_odd_order(param_values_t *v) { v->rate_lpf_order = 3u; }
 static void amp_set_over_adc(param_values_t *v) { v->drive_amp_set_v = 4.9f; }
@@ -88,10 +88,12 @@ static void test_defaults_design(void **state)
   gyro_design_t d;
   assert_int_equal(gyro_design(&v, &d), GYRO_DESIGN_OK);
   assert_string_equal(gyro_design_reason(GYRO_DESIGN_OK), "");
-  /* The edges the reasons state: drive.p_init_deg within +-355 deg. */
-  v.drive_p_init_deg = -355.0f;
+  /* The edges the reasons state: drive.p_init_deg within +-360 deg, its whole range. */
+  v.drive_p_init_deg = -360.0f;
   assert_int_equal(gyro_design(&v, &d), GYRO_DESIGN_OK);
-  v.drive_p_init_deg = -355.5f;
+  v.drive_p_init_deg = 360.0f;
+  assert_int_equal(gyro_design(&v, &d), GYRO_DESIGN_OK);
+  v.drive_p_init_deg = -360.5f;
   assert_int_equal(gyro_design(&v, &d), GYRO_DESIGN_P_INIT);
 }
 

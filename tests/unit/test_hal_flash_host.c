@@ -15,7 +15,7 @@
 static int setup(void **state)
 {
   (void)state;
-  const hal_flash_host_cfg_t cfg = {4u, 1024u, NULL, 0u, 0u};
+  const hal_flash_host_cfg_t cfg = {4u, 1024u, NULL, 0u, 0u, 0u};
   return hal_flash_host_configure(&cfg);
 }
 
@@ -70,9 +70,9 @@ static void test_range_checks(void **state)
   assert_int_equal(hal_flash_program(0u, 1024u, r, 1u), HAL_FLASH_ERR_RANGE);
   assert_int_equal(hal_flash_program(0u, 0xFFFFFFF0u, r, 0x20u), HAL_FLASH_ERR_RANGE);
   assert_int_equal(hal_flash_read(0u, 1016u, r, 8u), HAL_FLASH_OK);
-  const hal_flash_host_cfg_t too_big = {64u, 16384u, NULL, 0u, 0u};
+  const hal_flash_host_cfg_t too_big = {64u, 16384u, NULL, 0u, 0u, 0u};
   assert_int_equal(hal_flash_host_configure(&too_big), -1);
-  const hal_flash_host_cfg_t odd = {2u, 1022u, NULL, 0u, 0u};
+  const hal_flash_host_cfg_t odd = {2u, 1022u, NULL, 0u, 0u, 0u};
   assert_int_equal(hal_flash_host_configure(&odd), -1);
 }
 
@@ -80,7 +80,7 @@ static void test_range_checks(void **state)
 static void test_busy_clock(void **state)
 {
   (void)state;
-  const hal_flash_host_cfg_t cfg = {2u, 16384u, NULL, 0u, 0u}; /* datasheet defaults */
+  const hal_flash_host_cfg_t cfg = {2u, 16384u, NULL, 0u, 0u, 0u}; /* datasheet defaults */
   assert_int_equal(hal_flash_host_configure(&cfg), 0);
   hal_flash_host_stats_t st;
   hal_flash_host_stats(&st);
@@ -151,7 +151,7 @@ static void test_file_backed(void **state)
   const int fd = mkstemp(path);
   assert_true(fd >= 0);
   close(fd); /* empty file: wrong size, so it starts as a blank part */
-  const hal_flash_host_cfg_t cfg = {2u, 512u, path, 0u, 0u};
+  const hal_flash_host_cfg_t cfg = {2u, 512u, path, 0u, 0u, 0u};
   assert_int_equal(hal_flash_host_configure(&cfg), 0);
   uint8_t r[4];
   assert_int_equal(hal_flash_read(1u, 100u, r, 4u), HAL_FLASH_OK);
@@ -171,6 +171,32 @@ static void test_file_backed(void **state)
   remove(path);
 }
 
+/* program_bytes 8 models ECC flash (an STM32G4): whole aligned units, each once. */
+static void test_ecc_program_unit(void **state)
+{
+  (void)state;
+  const hal_flash_host_cfg_t cfg = {2u, 1024u, NULL, 0u, 0u, 8u};
+  assert_int_equal(hal_flash_host_configure(&cfg), 0);
+  hal_flash_geometry_t geo;
+  hal_flash_geometry(&geo);
+  assert_int_equal(geo.program_bytes, 8u);
+  const uint8_t d[16] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16};
+  assert_int_equal(hal_flash_program(0u, 4u, d, 8u), HAL_FLASH_ERR_RANGE); /* misaligned */
+  assert_int_equal(hal_flash_program(0u, 0u, d, 4u), HAL_FLASH_ERR_RANGE); /* part unit */
+  assert_int_equal(hal_flash_program(0u, 0u, d, 16u), HAL_FLASH_OK);
+  /* once: even clearing more bits of a programmed unit is refused */
+  const uint8_t z[8] = {0};
+  assert_int_equal(hal_flash_program(0u, 8u, z, 8u), HAL_FLASH_ERR_WRITE);
+  assert_int_equal(hal_flash_erase(0u), HAL_FLASH_OK);
+  assert_int_equal(hal_flash_program(0u, 8u, z, 8u), HAL_FLASH_OK);
+  /* the default is the STM32F4 word, with byte-wise NOR rules */
+  assert_int_equal(hal_flash_host_configure(NULL), 0);
+  hal_flash_geometry(&geo);
+  assert_int_equal(geo.program_bytes, 4u);
+  const hal_flash_host_cfg_t bad = {2u, 1024u, NULL, 0u, 0u, 12u};
+  assert_int_equal(hal_flash_host_configure(&bad), -1);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -181,6 +207,7 @@ int main(void)
       cmocka_unit_test_setup(test_power_cut_in_program, setup),
       cmocka_unit_test_setup(test_power_cut_in_erase_and_bit_flip, setup),
       cmocka_unit_test_setup(test_file_backed, setup),
+      cmocka_unit_test_setup(test_ecc_program_unit, setup),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

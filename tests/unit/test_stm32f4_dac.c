@@ -1,4 +1,4 @@
-/* AD5554 DAC path (hal/stm32f4/stm32f4_dac.c): word format, the TIM8 framing that makes
+/* AD5554 DAC path (hal/boards/ref_f405/stm32f4_dac.c): word format, the TIM8 framing that makes
  * exactly four chip-select slots in hardware when TIM4 starts it, the circular stream
  * that sends the words every tick, and the frame write that only stores them. */
 #include <setjmp.h>

@@ -1,4 +1,4 @@
-/* The sample chain (hal/stm32f4/stm32f4_sample.c): TIM1 timing plan for 84 and 168 MHz
+/* The sample chain (hal/boards/ref_f405/stm32f4_sample.c): TIM1 timing plan for 84 and 168 MHz
  * timer clocks, the registers that make TIM1 start conversions, reads and (through TIM4)
  * the DAC slots in hardware, and the DMA-complete interrupt that serves the tick. */
 #include <setjmp.h>

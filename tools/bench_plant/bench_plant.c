@@ -16,6 +16,7 @@
 #include <time.h>
 
 #include "plant/plant.h"
+#include "plant/plant_const.h"
 
 static double now_s(void)
 {
@@ -24,7 +25,7 @@ static double now_s(void)
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static const double kPi = 3.14159265358979323846;
+static const double kPi = PLANT_PI;
 
 /* precomputed DAC frames of one period pair (no libm in the timed loop) */
 #define NFR 4096

@@ -12,6 +12,7 @@
 #include "plant/adc.h"
 #include "plant/dac.h"
 #include "plant/pickoff.h"
+#include "plant/plant_const.h"
 
 static double now_s(void)
 {
@@ -41,7 +42,7 @@ int main(int argc, char **argv)
     fprintf(stderr, "init failed\n");
     return 1;
   }
-  const double T = 1.0 / 50000.0, w = 2.0 * 3.14159265358979323846 * 1489.9;
+  const double T = 1.0 / 50000.0, w = 2.0 * PLANT_PI * 1489.9;
   /* precomputed rotation for the motion and the drive voltages (no libm in the loop) */
   const double cw = cos(w * T), sw = sin(w * T), ch = cos(0.5 * w * T), sh = sin(0.5 * w * T);
   double c1 = 1.0, s1 = 0.0, c2 = 1.0, s2 = 0.0, sink = 0.0;

@@ -27,10 +27,11 @@
 #include "dsp/butter.h"
 #include "measure.h"
 #include "signals.h"
+#include "plant/plant_const.h"
 
 extern char **environ;
 
-static const double k_pi = 3.14159265358979323846;
+static const double k_pi = PLANT_PI;
 
 typedef struct {
   double fs_hz, fc_hz, amp, sigma, am_hz;

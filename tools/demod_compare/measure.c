@@ -2,8 +2,9 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include "plant/plant_const.h"
 
-static const double k_pi = 3.14159265358979323846;
+static const double k_pi = PLANT_PI;
 
 /* sin and cos of w k for k = k0, k0+1, ... by rotation, renormalised every step (error
  * ~1e-15 over the lengths used here), instead of two libm calls per sample. */

@@ -19,9 +19,10 @@
 #include <string.h>
 
 #include "plant/plant.h"
+#include "plant/plant_const.h"
 
-static const double kPi = 3.14159265358979323846;
-static const double kDeg = 3.14159265358979323846 / 180.0;
+static const double kPi = PLANT_PI;
+static const double kDeg = PLANT_RAD_PER_DEG;
 
 typedef struct {
   double p_deg, b_dps, tb_k, ta_k;

@@ -3,7 +3,7 @@
 #define HAL_ADC_H
 
 #include <stdint.h>
-#include "hal/hal_converters.h"
+#include "board.h" /* the build's board: HAL_ADC_* scaling */
 
 typedef struct {
   int16_t drive; /* drive-axis pickoff, ADC code */

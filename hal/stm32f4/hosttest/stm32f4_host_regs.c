@@ -2,6 +2,8 @@
 
 #include <string.h>
 
+#include "cm4_host_regs.h"
+
 static stm32f4_rcc_t s_rcc;
 static stm32f4_pwr_t s_pwr;
 static stm32f4_flash_t s_flash;
@@ -11,18 +13,12 @@ static stm32f4_spi_t s_spi1, s_spi2;
 static stm32f4_dma_t s_dma2;
 static stm32f4_usart_t s_usart1;
 static stm32f4_iwdg_t s_iwdg;
-static stm32f4_scb_t s_scb;
-static stm32f4_nvic_t s_nvic;
-static stm32f4_systick_t s_systick;
-static stm32f4_dwt_t s_dwt;
-static volatile uint32_t s_cpacr, s_demcr;
 static uint8_t s_param_flash[STM32F4_PARAM_NUM_SECTORS * STM32F4_PARAM_SECTOR_BYTES]
     __attribute__((aligned(4)));
 
 stm32f4_host_map_t stm32f4_host_map = {
     &s_rcc, &s_pwr, &s_flash, &s_gpioa, &s_gpiob, &s_gpioc, &s_tim1, &s_tim2, &s_tim4, &s_tim8,
-    &s_spi1, &s_spi2, &s_dma2, &s_usart1, &s_iwdg, &s_scb, &s_nvic, &s_systick, &s_dwt,
-    &s_cpacr, &s_demcr, s_param_flash, 0, 0u};
+    &s_spi1, &s_spi2, &s_dma2, &s_usart1, &s_iwdg, s_param_flash, 0};
 
 #define ZERO(x) memset((void *)&(x), 0, sizeof(x))
 
@@ -43,16 +39,10 @@ void stm32f4_host_reset(void)
   ZERO(s_dma2);
   ZERO(s_usart1);
   ZERO(s_iwdg);
-  ZERO(s_scb);
-  ZERO(s_nvic);
-  ZERO(s_systick);
-  ZERO(s_dwt);
-  s_cpacr = 0u;
-  s_demcr = 0u;
   memset(s_param_flash, 0xFF, sizeof(s_param_flash));
   s_flash.CR = FLASH_CR_LOCK; /* RM0090: FLASH_CR reset value 0x8000_0000 */
   stm32f4_host_map.poll_hook = 0;
-  stm32f4_host_map.primask = 0u;
+  cm4_host_reset();
 }
 
 uint8_t *stm32f4_host_param_flash(void)

@@ -6,7 +6,7 @@
 
 #include "stm32f4_regs.h"
 
-/* Zero every fake register, fill the parameter flash with 0xFF (erased), apply the
+/* Zero every fake register (the core's too: cm4_host_reset), fill the parameter flash with 0xFF (erased), apply the
  * reset values the drivers rely on (FLASH_CR.LOCK), clear the hook. */
 void stm32f4_host_reset(void);
 

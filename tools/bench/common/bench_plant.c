@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "dsp/math_const.h"
 #include "dsp/sincos.h"
 
 #define PLANT_DITHER_LSB 2.0f
@@ -14,7 +15,7 @@ int bench_plant_init(bench_plant_t *p, const gyro_design_t *d, const param_value
   if (p == NULL || d == NULL || v == NULL || nco_init(&p->nco, &d->nco) != 0) {
     return -1;
   }
-  const double tau = 2.0 * (double)v->drive_cal_q / (2.0 * 3.14159265358979 * (double)v->drive_cal_f0_hz);
+  const double tau = 2.0 * (double)v->drive_cal_q / (2.0 * FM_PI * (double)v->drive_cal_f0_hz);
   p->alpha = (float)(1.0 / ((double)v->sys_fs_hz * tau));
   p->gain = v->drive_cal_gain_v_per_v2;
   p->amp_v = v->drive_amp_set_v;

@@ -1,4 +1,4 @@
-/* The board's sample interrupt path (hal/stm32f4/stm32f4_sample.c, compiled unchanged
+/* The board's sample interrupt path (hal/boards/ref_f405/stm32f4_sample.c, compiled unchanged
  * into the bench image) with its DMA controller replaced by a register block in RAM that
  * the bench sets as the hardware would leave it at the transfer-complete interrupt.
  *

@@ -44,12 +44,12 @@
 #include "hal/hal_sample_timer.h"
 #include "stm32f4_board.h"
 #include "stm32f4_core.h"
-#include "stm32f4_fault.h"
+#include "cm4_fault.h"
 #include "stm32f4_regs.h"
 
 #define BENCH_N_FULL 2000u
 #define BENCH_N_QUICK 200u
-#define BENCH_FS_HZ 50000u
+#define BENCH_FS_HZ BOARD_SAMPLE_RATE_HZ
 #define BENCH_SPARE_IRQ 57u /* DMA2 stream 1: unused by the port; the baseline IRQ */
 #define BENCH_WARMUP_MAX 400000u
 #define BENCH_SETTLE 5000u
@@ -155,7 +155,7 @@ static bench_mode_t bench_mode(void)
 
 /* ---- board bring-up for the bench: QEMU has no RCC, so no clock tree; no DWT ---- */
 
-void stm32f4_system_init(void) { stm32f4_fault_enable(); }
+void board_system_init(void) { cm4_fault_enable(); }
 
 static void counter_init(void)
 {
@@ -247,8 +247,8 @@ __attribute__((noipa)) static uint32_t run_irq(uint32_t irq, uint32_t n, bk_stat
     bench_board_arm();
     const uint32_t t0 = bk_now();
     NVIC->ISPR[irq >> 5] = 1u << (irq & 31u);
-    stm32f4_dsb();
-    stm32f4_isb();
+    cm4_dsb();
+    cm4_isb();
     const uint32_t t1 = bk_now();
     bk_stat_add(st, t1 - t0);
     if (s_app.gyro.sup.mode != GYRO_MODE_LOCKED) locked = 0u;
@@ -387,8 +387,8 @@ static void bench_app(uint32_t settle, int trace)
   /* Baseline interrupt: a spare vector with a lone BX LR, same priority. */
   volatile uint32_t *vtor = (volatile uint32_t *)(uintptr_t)SCB->VTOR;
   vtor[16u + BENCH_SPARE_IRQ] = (uint32_t)(uintptr_t)bench_spare_handler;
-  stm32f4_dsb();
-  stm32f4_nvic_enable(BENCH_SPARE_IRQ, STM32F4_PRIO_SAMPLE);
+  cm4_dsb();
+  cm4_nvic_enable(BENCH_SPARE_IRQ, STM32F4_PRIO_SAMPLE);
 
   if (trace) {
     /* The rarer LOCKED ticks inside the 100 traced: the continuous self-test judging

@@ -1,0 +1,76 @@
+/* The reference board's description: every hardware fact the firmware, the parameter
+ * table, the host simulator and the board's own code need, written once. The build
+ * selects the board (CMake GYRO_BOARD, default ref_f405): everything that links hal_api
+ * finds this file as "board.h". A new board supplies its own board.h with the same
+ * names (hal/PORTING.md).
+ *
+ * The board: an STM32F405 (Cortex-M4F, 1 MB flash, 128 KB SRAM + 64 KB CCM), an AD7606
+ * ADC on SPI1, an AD5554 DAC on SPI2 behind a x1.5 electrode driver stage, the tuning
+ * port on USART1 (hal/boards/ref_f405/README.md: why these parts, the timing of a tick). */
+#ifndef BOARD_H
+#define BOARD_H
+
+#include <stdint.h>
+
+/* ---- Sample clock -------------------------------------------------------------------
+ * The 50 kHz tick (thesis 4.4.2): the ADC converts both pickoffs, the ISR runs the gyro,
+ * the DAC latches the previous tick's frame. Made by TIM1 from the 168 MHz timer clock
+ * (3360 counts); the filter designs and the parameter table (sys.fs_hz) assume it. */
+#define BOARD_SAMPLE_RATE_HZ 50000u
+
+/* ---- Converter scaling ----------------------------------------------------------------
+ * The HAL's converter contract (hal/hal_adc.h, hal/hal_dac.h): the firmware core works in
+ * volts and converts at the HAL boundary with these.
+ *   ADC: AD7606, 16-bit, bipolar +-5 V (RANGE strapped low), two's complement, one
+ *        code = 10 V / 65536. Drive pickoff on V1, sense pickoff on V2, both sampled by
+ *        one CONVST edge.
+ *   DAC: AD5554, quad 14-bit, 4-quadrant output stage on a 10 V reference, then x1.5
+ *        electrode drivers: offset binary over +-15 V, one code = 30 V / 16384. */
+#define HAL_ADC_BITS 16
+#define HAL_ADC_FULL_SCALE_V 5.0f          /* +-5 V */
+#define HAL_ADC_CODE_MAX 32767
+#define HAL_ADC_CODE_MIN (-32768)
+#define HAL_ADC_V_PER_CODE (HAL_ADC_FULL_SCALE_V / 32768.0f)
+
+#define HAL_DAC_BITS 14
+#define HAL_DAC_FULL_SCALE_V 15.0f         /* +-15 V */
+#define HAL_DAC_CODE_MAX 16383u
+#define HAL_DAC_CODE_MID 8192u
+#define HAL_DAC_V_PER_CODE (2.0f * HAL_DAC_FULL_SCALE_V / 16384.0f)
+
+/* ---- Clocks ---------------------------------------------------------------------------
+ * 8 MHz crystal -> PLL (M 4, N 168, P 2, Q 7) -> 168 MHz SYSCLK = HCLK; APB1 /4 = 42 MHz,
+ * APB2 /2 = 84 MHz, timers on both buses at twice their bus clock (84 / 168 MHz);
+ * 5 flash wait states; the planner (stm32f4_clock.h) derives all of it from these two. */
+#define BOARD_HSE_HZ 8000000u
+#define BOARD_SYSCLK_HZ 168000000u
+#define BOARD_LSI_HZ 32000u          /* the watchdog's RC clock, +-50 % over the part */
+
+/* ---- Tuning port ----------------------------------------------------------------------
+ * USART1 on PB6/PB7, 8N1 (BRR 0x5B from PCLK2 84 MHz: +0.16 %). The telemetry budget of
+ * the application (app_tlm.h) is computed for this rate. */
+#define BOARD_UART_BAUD 921600u
+
+/* ---- Pins -----------------------------------------------------------------------------
+ * (alternate functions from the STM32F405 data sheet, table 9; set up by
+ * stm32f4_board_init, the sample chain by stm32f4_sample.c / stm32f4_dac.c)
+ *
+ *   pin   function         AF  direction  purpose
+ *   PA8   TIM1_CH1         1   out        ADC CONVST A+B: its rising edge is the sample instant
+ *   PA9   TIM1_CH2         1   out        DAC LDAC: latches the four DAC words at once
+ *   PA10  TIM1_CH3         1   out        ADC CS: frames the 32-clock read of V1, V2
+ *   PA5   SPI1_SCK         5   out        ADC SCLK (10.5 MHz)
+ *   PA6   SPI1_MISO        5   in         ADC DOUTA (V1 drive pickoff, V2 sense pickoff)
+ *   PC6   TIM8_CH1         3   out        DAC CS: one slot per DAC word
+ *   PB13  SPI2_SCK         5   out        DAC CLK (21 MHz)
+ *   PB15  SPI2_MOSI        5   out        DAC SDI
+ *   PB0   GPIO             -   out        ADC RESET (pulsed high at start-up)
+ *   PB1   GPIO             -   out        DAC RS, low = reset to mid-scale (0 V)
+ *   PC7   GPIO             -   in         ADC BUSY (diagnostics only)
+ *   PB6   USART1_TX        7   out        tuning port TX
+ *   PB7   USART1_RX        7   in         tuning port RX (pull-up)
+ *
+ * Strapped on the board: AD7606 PAR/SER/BYTE SEL high (serial), RANGE low (+-5 V),
+ * OS[2:0] = 000 (no oversampling); AD5554 MSB high (RS resets to mid-scale = 0 V). */
+
+#endif /* BOARD_H */

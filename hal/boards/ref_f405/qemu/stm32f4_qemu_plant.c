@@ -1,0 +1,78 @@
+#include "stm32f4_qemu_plant.h"
+
+#include "hal/hal_adc.h"
+#include "hal/hal_dac.h"
+#include "plant/plant.h"
+#include "qemu_plant_setup.h"
+#include "stm32f4_core.h"
+
+/* The emulated hardware, of which there is one (as in the host HAL stub). SRAM: QEMU's
+ * netduinoplus2 maps no CCM. */
+static plant_t s_plant;
+static plant_profiles_t s_prof;
+static hal_adc_frame_t s_adc;     /* sampled at the current tick, read by the ISR */
+static hal_dac_frame_t s_active;  /* on the converter outputs during this interval */
+static hal_dac_frame_t s_pending; /* written by the ISR, output from the next tick */
+static uint64_t s_samples;
+static uint32_t s_ticks;          /* ticks of the sample clock (trace index) */
+static volatile double s_rate_req_dps; /* written by the background before s_rate_req is set */
+static volatile uint32_t s_rate_req;
+static const volatile float *s_trace_src;
+static float s_trace[QEMU_TRACE_LEN];
+static volatile uint32_t s_trace_n;
+
+static void midscale(hal_dac_frame_t *f)
+{
+  for (uint32_t i = 0u; i < HAL_DAC_NUM_CHANNELS; ++i) f->code[i] = (uint16_t)HAL_DAC_CODE_MID;
+}
+
+int stm32f4_qemu_plant_init(void)
+{
+  if (qemu_plant_setup(&s_plant, &s_prof) != 0) return -1;
+  midscale(&s_active);
+  midscale(&s_pending);
+  s_adc.drive = 0;
+  s_adc.sense = 0;
+  plant_step(&s_plant, &s_active, &s_adc);
+  s_samples = 1u;
+  return 0;
+}
+
+void stm32f4_qemu_plant_tick(void)
+{
+  if (s_rate_req != 0u) {
+    (void)qemu_plant_rate_ramp(&s_plant, &s_prof, s_rate_req_dps); /* range checked */
+    s_rate_req = 0u;
+  }
+  plant_step(&s_plant, &s_active, &s_adc);
+  s_active = s_pending;
+  s_samples++;
+  s_ticks++;
+  if (s_trace_src != 0 && s_ticks % QEMU_TRACE_EVERY == 0u && s_trace_n < QEMU_TRACE_LEN) {
+    s_trace[s_trace_n] = *s_trace_src;
+    s_trace_n = s_trace_n + 1u;
+  }
+}
+
+uint64_t stm32f4_qemu_plant_samples(void) { return s_samples; }
+
+double stm32f4_qemu_plant_rate_dps(void) { return plant_truth(&s_plant)->rate_dps; }
+
+int stm32f4_qemu_plant_set_rate(double rate_dps)
+{
+  if (!(rate_dps >= -1e4 && rate_dps <= 1e4)) return -1;
+  if (s_rate_req != 0u) return -2;
+  s_rate_req_dps = rate_dps;
+  s_rate_req = 1u;
+  return 0;
+}
+
+void stm32f4_qemu_plant_trace_from(const volatile float *rate_dps) { s_trace_src = rate_dps; }
+
+uint32_t stm32f4_qemu_trace_count(void) { return s_trace_n; }
+
+float stm32f4_qemu_trace_at(uint32_t i) { return i < s_trace_n ? s_trace[i] : 0.0f; }
+
+CM4_RAMFUNC void hal_adc_read_frame(hal_adc_frame_t *frame) { *frame = s_adc; }
+
+CM4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame) { s_pending = *frame; }
