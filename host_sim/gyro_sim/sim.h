@@ -20,7 +20,6 @@
 /* Start-up of the drive, measured on the plant's true motion (not on the firmware's own
  * estimate, which a high gain simply zeroes). */
 typedef struct {
-  int valid;
   double lock_time_s;       /* true amplitude within 1 % of its final value from here on */
   double overshoot_pct;     /* peak true amplitude over the final one, -1, in % */
   double amp_err_rms_pct;   /* true amplitude, 0.1-100 Hz, after lock, % of the mean */
@@ -50,7 +49,6 @@ typedef struct {
   double cpu_s;
   double realtime_factor;      /* simulated / wall-clock time */
   double realtime_factor_cpu;  /* simulated / CPU time of the run (one core) */
-  uint64_t ticks;
   sim_startup_t startup;
   double adc_fraction[2];   /* worst-case budget from plant_adc_fraction */
   uint64_t adc_clips[2];
@@ -61,7 +59,6 @@ typedef struct {
   double mean_struct_k;
   double mean_drive_freq_hz;
   double mean_drive_amp_m;
-  double isr_instr_est;     /* not measured here: see tools/bench */
 } sim_result_t;
 
 typedef struct {

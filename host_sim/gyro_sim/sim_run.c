@@ -111,7 +111,6 @@ static void startup_figures(const double *amp, const double *ph, const double *r
     if (amp[i] > peak) peak = amp[i];
     if (fabs(amp[i] / af - 1.0) > 0.01) last_out = i + 1;
   }
-  st->valid = 1;
   st->final_amp_m = af;
   st->lock_time_s = (double)last_out / fs;
   st->overshoot_pct = peak > af ? 100.0 * (peak / af - 1.0) : 0.0;
@@ -264,7 +263,6 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
   progress_update(&pr, sc->duration_s, 1);
   res->wall_s = wall_now() - t_wall0;
   res->cpu_s = cpu_now() - t_cpu0;
-  res->ticks = n_ticks;
   res->sim_s = (double)n_ticks / fs;
   res->realtime_factor = res->wall_s > 0.0 ? res->sim_s / res->wall_s : 0.0;
   res->realtime_factor_cpu = res->cpu_s > 0.0 ? res->sim_s / res->cpu_s : 0.0;
@@ -420,8 +418,7 @@ int sim_run_open_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_resul
   progress_update(&pr, (double)hal_host_ticks() / fs, 1);
   res->wall_s = wall_now() - t_wall0;
   res->cpu_s = cpu_now() - t_cpu0;
-  res->ticks = hal_host_ticks();
-  res->sim_s = (double)res->ticks / fs;
+  res->sim_s = (double)hal_host_ticks() / fs;
   res->realtime_factor = res->wall_s > 0.0 ? res->sim_s / res->wall_s : 0.0;
   res->realtime_factor_cpu = res->cpu_s > 0.0 ? res->sim_s / res->cpu_s : 0.0;
   res->adc_clips[0] = plant_truth(plant)->adc_clip[0];

@@ -177,7 +177,6 @@ static void truth_temps(plant_t *p, double ambient_k)
   t->circuit_k = thermal_temp(&p->thermal, THERMAL_CIRCUIT);
   t->board_k = thermal_temp(&p->thermal, THERMAL_BOARD);
   t->wn_drive_rad_s = mech_wn1(&p->mech);
-  t->wn_sense_rad_s = mech_wn2(&p->mech);
 }
 
 int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
@@ -396,25 +395,16 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
   t->sample = p->k;
   t->t_s = (double)p->k * T;
   t->rate_dps = rate_dps;
-  t->rate_rad_s = rate_dps * kDeg;
-  t->rate_dot_rad_s2 = slope_dps * kDeg;
   t->y_m = s.y_m;
   t->vy_mps = s.vy_mps;
   t->x_m = s.x_m;
   t->vx_mps = s.vx_mps;
   t->f_drive_mps2 = fd;
   t->f_sense_mps2 = fsn;
-  for (int i = 0; i < DAC_NCH; i++) {
-    t->dac_held_v[i] = dout.ch[i].held_v;
-    t->dac_mean_v[i] = dout.ch[i].mean_v;
-  }
+  for (int i = 0; i < DAC_NCH; i++) t->dac_held_v[i] = dout.ch[i].held_v;
   t->adc_v[0] = vd;
   t->adc_v[1] = vs;
-  for (int i = 0; i < 2; i++) {
-    t->adc_clip[i] = p->adc.clip_count[i];
-    t->adc_fault[i] = p->adc.fault_count[i];
-    t->preamp_clip[i] = p->pick[i].preamp_clip_count;
-  }
+  for (int i = 0; i < 2; i++) t->adc_clip[i] = p->adc.clip_count[i];
   t->mech_refreshes = p->mech.refresh_count;
 
   /* drive-frequency estimate from the actuator's drive force (without accelerations) */

@@ -181,11 +181,11 @@ typedef struct {
   uint64_t sample;            /* samples done; the state below is at t_s */
   double t_s;
   /* inputs */
-  double rate_rad_s, rate_dps, rate_dot_rad_s2;
+  double rate_dps;
   double accel_g[3];          /* mean over the last sample */
   /* temperatures */
   double ambient_k, struct_k, circuit_k, board_k;
-  double wn_drive_rad_s, wn_sense_rad_s; /* resonances now (2-32) */
+  double wn_drive_rad_s;     /* drive resonance now (2-32) */
   /* motion (state at t_s) */
   double y_m, vy_mps, x_m, vx_mps;
   /* phasors at the drive frequency (every truth_decim samples): */
@@ -200,10 +200,9 @@ typedef struct {
   /* electrical */
   double f_drive_mps2, f_sense_mps2; /* actuator + acceleration forces per unit mass */
   double dac_held_v[4];       /* DAC output levels over the last sample */
-  double dac_mean_v[4];       /* after the reconstruction filter, mean over the sample */
   double adc_v[2];            /* analog voltages at the ADC inputs (drive, sense) */
   hal_adc_frame_t adc;        /* the codes returned */
-  uint64_t adc_clip[2], adc_fault[2], preamp_clip[2], dac_rejects;
+  uint64_t adc_clip[2], dac_rejects;
   uint64_t mech_refreshes;
 } plant_truth_t;
 

@@ -98,7 +98,6 @@ void uart_pty_pump(uart_pty_t *p)
   const ssize_t n = read(p->master_fd, buf, sizeof buf);
   if (n > 0) {
     const size_t took = hal_uart_host_rx_push(buf, (size_t)n);
-    p->rx_bytes += took;
     p->rx_dropped += (uint32_t)((size_t)n - took);
   }
   /* n < 0: EAGAIN (nothing), or EIO while no client has the pty open: nothing to do */

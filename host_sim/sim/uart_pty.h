@@ -33,7 +33,7 @@ typedef struct {
   char link_path[UART_PTY_PATH_MAX]; /* symlink made by uart_pty_link, "" if none */
   uint8_t tx[UART_PTY_TX_CHUNK];     /* popped from the TX ring, not yet written */
   size_t tx_len, tx_off;
-  uint64_t rx_bytes, tx_bytes;       /* moved so far */
+  uint64_t tx_bytes;                 /* written to the pty so far */
   uint32_t rx_dropped;               /* bytes the RX ring refused */
 } uart_pty_t;
 
