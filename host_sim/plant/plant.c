@@ -101,43 +101,23 @@ static void make_pickoff_cfg(const plant_cfg_t *c, int axis, pickoff_cfg_t *q)
   q->lag_ref_hz = c->pick_lag_ref_hz;
   q->temp_ref_k = c->temp_ref_k;
   q->phase_step_rad = c->pick_phase_step_rad;
-  if (axis == 0) {
-    q->gain_v_per_m = c->pick_drive_gain_v_per_m;
-    q->gain_tc_per_k = c->pick_drive_gain_tc_per_k;
-    q->preamp_rail_v = c->pick_drive_rail_v;
-    q->ft_u1 = c->pick_drive_ft_u1;
-    q->ft_u2 = c->pick_drive_ft_u2;
-    q->ft_spare = c->pick_drive_ft_spare;
-    q->lag_kind = c->pick_drive_lag_allpass ? PICKOFF_LAG_ALLPASS : PICKOFF_LAG_LOWPASS;
-    q->phi0_rad = c->pick_drive_phi0_deg * kDeg;
-    q->phi1_rad_per_k = c->pick_drive_phi1_deg_per_k * kDeg;
-    q->phi2_rad_per_k2 = c->pick_drive_phi2_deg_per_k2 * kDeg;
-    q->hp_hz = c->pick_drive_hp_hz;
-    q->lp_hz = c->pick_drive_lp_hz;
-    q->lp_q = c->pick_drive_lp_q;
-    q->offset_v = c->pick_drive_offset_v;
-    q->noise_v_rthz = c->pick_drive_noise_v_rthz;
-    q->sample_delay_s = c->pick_drive_delay_s;
-    q->jitter_rms_s = c->pick_drive_jitter_s;
-  } else {
-    q->gain_v_per_m = c->pick_sense_gain_v_per_m;
-    q->gain_tc_per_k = c->pick_sense_gain_tc_per_k;
-    q->preamp_rail_v = c->pick_sense_rail_v;
-    q->ft_u1 = c->pick_sense_ft_u1;
-    q->ft_u2 = c->pick_sense_ft_u2;
-    q->ft_spare = c->pick_sense_ft_spare;
-    q->lag_kind = c->pick_sense_lag_allpass ? PICKOFF_LAG_ALLPASS : PICKOFF_LAG_LOWPASS;
-    q->phi0_rad = c->pick_sense_phi0_deg * kDeg;
-    q->phi1_rad_per_k = c->pick_sense_phi1_deg_per_k * kDeg;
-    q->phi2_rad_per_k2 = c->pick_sense_phi2_deg_per_k2 * kDeg;
-    q->hp_hz = c->pick_sense_hp_hz;
-    q->lp_hz = c->pick_sense_lp_hz;
-    q->lp_q = c->pick_sense_lp_q;
-    q->offset_v = c->pick_sense_offset_v;
-    q->noise_v_rthz = c->pick_sense_noise_v_rthz;
-    q->sample_delay_s = c->pick_sense_delay_s;
-    q->jitter_rms_s = c->pick_sense_jitter_s;
-  }
+  q->gain_v_per_m = PLANT_PICK(c, axis, gain_v_per_m);
+  q->gain_tc_per_k = PLANT_PICK(c, axis, gain_tc_per_k);
+  q->preamp_rail_v = PLANT_PICK(c, axis, rail_v);
+  q->ft_u1 = PLANT_PICK(c, axis, ft_u1);
+  q->ft_u2 = PLANT_PICK(c, axis, ft_u2);
+  q->ft_spare = PLANT_PICK(c, axis, ft_spare);
+  q->lag_kind = PLANT_PICK(c, axis, lag_allpass) ? PICKOFF_LAG_ALLPASS : PICKOFF_LAG_LOWPASS;
+  q->phi0_rad = PLANT_PICK(c, axis, phi0_deg) * kDeg;
+  q->phi1_rad_per_k = PLANT_PICK(c, axis, phi1_deg_per_k) * kDeg;
+  q->phi2_rad_per_k2 = PLANT_PICK(c, axis, phi2_deg_per_k2) * kDeg;
+  q->hp_hz = PLANT_PICK(c, axis, hp_hz);
+  q->lp_hz = PLANT_PICK(c, axis, lp_hz);
+  q->lp_q = PLANT_PICK(c, axis, lp_q);
+  q->offset_v = PLANT_PICK(c, axis, offset_v);
+  q->noise_v_rthz = PLANT_PICK(c, axis, noise_v_rthz);
+  q->sample_delay_s = PLANT_PICK(c, axis, delay_s);
+  q->jitter_rms_s = PLANT_PICK(c, axis, jitter_s);
 }
 
 static void make_accel_cfg(const plant_cfg_t *c, accel_cfg_t *a)
@@ -153,7 +133,7 @@ static void make_accel_cfg(const plant_cfg_t *c, accel_cfg_t *a)
 
 static int pick_node(const plant_cfg_t *c, int axis)
 {
-  return axis == 0 ? c->pick_drive_temp_node : c->pick_sense_temp_node;
+  return PLANT_PICK(c, axis, temp_node);
 }
 
 /* ------------------------------------------------------------------ init ------ */

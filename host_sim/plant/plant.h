@@ -169,6 +169,10 @@
 typedef struct {
   PLANT_PARAMS(PLANT_CFG_FIELD)
 } plant_cfg_t;
+
+/* The pickoff parameter `name` of an axis (0 drive, 1 sense): pick_drive_<name> or
+ * pick_sense_<name>. The two chains are built from one list of parameters this way. */
+#define PLANT_PICK(c, axis, name) ((axis) == 0 ? (c)->pick_drive_##name : (c)->pick_sense_##name)
 #undef PLANT_CFG_FIELD
 
 typedef struct {

@@ -42,18 +42,11 @@ static double circuit_phi(double phi0_deg, double phi1, double phi2, double dt)
 static double complex pick_chain(const plant_cfg_t *c, int axis, double f, double temp_k)
 {
   const double dt = temp_k - c->temp_ref_k;
-  if (axis == 0) {
-    const double phi = circuit_phi(c->pick_drive_phi0_deg, c->pick_drive_phi1_deg_per_k,
-                                   c->pick_drive_phi2_deg_per_k2, dt);
-    return c->pick_drive_gain_v_per_m * (1.0 + c->pick_drive_gain_tc_per_k * dt) *
-           lag_section(f, c->pick_lag_ref_hz, phi, c->pick_drive_lag_allpass) *
-           hp1(f, c->pick_drive_hp_hz) * lp2(f, c->pick_drive_lp_hz, c->pick_drive_lp_q);
-  }
-  const double phi = circuit_phi(c->pick_sense_phi0_deg, c->pick_sense_phi1_deg_per_k,
-                                 c->pick_sense_phi2_deg_per_k2, dt);
-  return c->pick_sense_gain_v_per_m * (1.0 + c->pick_sense_gain_tc_per_k * dt) *
-         lag_section(f, c->pick_lag_ref_hz, phi, c->pick_sense_lag_allpass) *
-         hp1(f, c->pick_sense_hp_hz) * lp2(f, c->pick_sense_lp_hz, c->pick_sense_lp_q);
+  const double phi = circuit_phi(PLANT_PICK(c, axis, phi0_deg), PLANT_PICK(c, axis, phi1_deg_per_k),
+                                 PLANT_PICK(c, axis, phi2_deg_per_k2), dt);
+  return PLANT_PICK(c, axis, gain_v_per_m) * (1.0 + PLANT_PICK(c, axis, gain_tc_per_k) * dt) *
+         lag_section(f, c->pick_lag_ref_hz, phi, PLANT_PICK(c, axis, lag_allpass)) *
+         hp1(f, PLANT_PICK(c, axis, hp_hz)) * lp2(f, PLANT_PICK(c, axis, lp_hz), PLANT_PICK(c, axis, lp_q));
 }
 
 void plant_drive_phase_budget(const plant_cfg_t *c, double f_hz, double temp_k,
