@@ -565,19 +565,19 @@ static void report_figures(report_t *r, const cli_args_t *a, const bench_figs_t 
   const sim_scenario_t *sc = r->sc;
   report_run(r, a->isr_json, isr);
   if (sc->analyses & SIM_AN_STARTUP) report_startup(r);
-  if (sc->mode == SIM_CLOSED_LOOP) report_closed_loop(r);
+  if (sc->loop == SIM_CLOSED_LOOP) report_closed_loop(r);
   add_num(r->fig, "adc_fraction_drive", r->res->adc_fraction[0]);
   add_num(r->fig, "adc_fraction_sense", r->res->adc_fraction[1]);
   add_num(r->fig, "adc_clips_drive", (double)r->res->adc_clips[0]);
   add_num(r->fig, "adc_clips_sense", (double)r->res->adc_clips[1]);
-  if (sc->mode == SIM_OPEN_LOOP_SWEEP && sweep->n > 0) report_sweep(r, sweep, a->analysis);
-  if (sc->mode == SIM_OPEN_LOOP && sq->n > 1) {
+  if (sc->loop == SIM_OPEN_LOOP_SWEEP && sweep->n > 0) report_sweep(r, sweep, a->analysis);
+  if (sc->loop == SIM_OPEN_LOOP && sq->n > 1) {
     report_square_law(r, sq);
-  } else if (sc->mode == SIM_OPEN_LOOP && sq->n == 1) {
+  } else if (sc->loop == SIM_OPEN_LOOP && sq->n == 1) {
     add_num(r->fig, "drive_amp_v", sq->amp_v[0]);
     add_num(r->fig, "drive_amp_m", sq->amp_m[0]);
   }
-  if (need_tools && sc->mode == SIM_CLOSED_LOOP) analyse_trace(r);
+  if (need_tools && sc->loop == SIM_CLOSED_LOOP) analyse_trace(r);
 }
 
 /* Runs the loaded scenario and reports it. Returns the exit code. */
@@ -593,7 +593,7 @@ static int run(const cli_args_t *a, const sim_scenario_t *sc, const bench_figs_t
     fprintf(stderr, "gyro-sim: %s\n", err);
     return 2;
   }
-  if (a->uart_pty && sc->mode != SIM_CLOSED_LOOP) {
+  if (a->uart_pty && sc->loop != SIM_CLOSED_LOOP) {
     fprintf(stderr, "gyro-sim: --uart-pty needs a closed-loop scenario\n");
     return 2;
   }
@@ -603,7 +603,7 @@ static int run(const cli_args_t *a, const sim_scenario_t *sc, const bench_figs_t
   static sim_sweep_t sweep;
   static sim_square_t sq;
   int rc;
-  if (sc->mode == SIM_CLOSED_LOOP) rc = sim_run_closed_loop(sc, &so, &res, err, sizeof err);
+  if (sc->loop == SIM_CLOSED_LOOP) rc = sim_run_closed_loop(sc, &so, &res, err, sizeof err);
   else rc = sim_run_open_loop(sc, &so, &res, &sweep, &sq, err, sizeof err);
   if (rc != 0) {
     fprintf(stderr, "gyro-sim: %s\n", err);
@@ -650,7 +650,7 @@ int main(int argc, char **argv)
   if (rc != 0) return rc;
   char trace[1100];
   const char *csv_path = a.csv_path;
-  if (csv_path == NULL && need_tools && sc.mode == SIM_CLOSED_LOOP) {
+  if (csv_path == NULL && need_tools && sc.loop == SIM_CLOSED_LOOP) {
     snprintf(trace, sizeof trace, "%s/trace.csv", out_dir);
     csv_path = trace;
   }

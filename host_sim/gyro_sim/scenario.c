@@ -32,7 +32,7 @@ void scenario_defaults(sim_scenario_t *sc)
   snprintf(sc->name, sizeof sc->name, "unnamed");
   sc->duration_s = 1.0;
   sc->seed = 1u;
-  sc->mode = SIM_CLOSED_LOOP;
+  sc->loop = SIM_CLOSED_LOOP;
   sc->csv_rate_hz = 1000.0;
   profile_const(&sc->rate_dps, 0.0);
   profile_const(&sc->ambient_c, 25.0);
@@ -312,9 +312,9 @@ int scenario_parse(sim_scenario_t *out, const char *json, char *err, size_t len)
         rc = get_num(it, k, 0.001, 50000.0, &sc->csv_rate_hz, err, len);
       } else if (strcmp(k, "mode") == 0) {
         if (!cJSON_IsString(it)) rc = fail(err, len, "mode: expected closed_loop|open_loop|open_loop_sweep");
-        else if (strcmp(it->valuestring, "closed_loop") == 0) sc->mode = SIM_CLOSED_LOOP;
-        else if (strcmp(it->valuestring, "open_loop") == 0) sc->mode = SIM_OPEN_LOOP;
-        else if (strcmp(it->valuestring, "open_loop_sweep") == 0) sc->mode = SIM_OPEN_LOOP_SWEEP;
+        else if (strcmp(it->valuestring, "closed_loop") == 0) sc->loop = SIM_CLOSED_LOOP;
+        else if (strcmp(it->valuestring, "open_loop") == 0) sc->loop = SIM_OPEN_LOOP;
+        else if (strcmp(it->valuestring, "open_loop_sweep") == 0) sc->loop = SIM_OPEN_LOOP_SWEEP;
         else rc = fail(err, len, "mode: '%s' is not closed_loop|open_loop|open_loop_sweep", it->valuestring);
       } else if (strcmp(k, "analyses") == 0) {
         if (!cJSON_IsArray(it)) { rc = fail(err, len, "analyses: expected a list of names"); break; }

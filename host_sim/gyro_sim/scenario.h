@@ -40,7 +40,7 @@ typedef enum {
   SIM_CLOSED_LOOP = 0,
   SIM_OPEN_LOOP = 1,       /* fixed half-frequency drive, no firmware */
   SIM_OPEN_LOOP_SWEEP = 2  /* stepped half-frequency drive across a band, no firmware */
-} sim_mode_t;
+} sim_loop_t; /* the scenario key "mode" */
 
 typedef enum {
   SIM_AN_STARTUP = 1u << 0,
@@ -73,7 +73,7 @@ typedef struct {
   char description[256];
   double duration_s;
   uint64_t seed;
-  sim_mode_t mode;
+  sim_loop_t loop;
   uint32_t analyses;
   double csv_rate_hz;
   sim_set_t plant_set[SIM_MAX_SETS];

@@ -442,7 +442,7 @@ int sim_run_open_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_resul
   const double t_wall0 = wall_now(), t_cpu0 = cpu_now();
   progress_t pr = {opt->progress, t_wall0, 0.0, 0.0};
   double am;
-  if (sc->mode == SIM_OPEN_LOOP_SWEEP) {
+  if (sc->loop == SIM_OPEN_LOOP_SWEEP) {
     const int np = sc->ol.points > 10000 ? 10000 : sc->ol.points;
     pr.total_s = np * sc->ol.dwell_s;
     for (int i = 0; i < np; i++) {

@@ -95,7 +95,7 @@ static void build_generator(const mech_cfg_t *c, double wr, double wn1, double w
                             double ahat[MECH_NMONO][MECH_NS][NA])
 {
   const double r1 = wn1 / wr, r2 = wn2 / wr;
-  /* cross couplings follow the structure temperature like the modes: stiffness with
+  /* cross couplings follow the structure temperature like the resonances: stiffness with
    * wn^2, damping with wn (Q constant) */
   const double s = wn1 / wn_at(c, c->f1_hz, c->temp_ref_k);
   const double kq = c->kq_per_s2 * s * s / (wr * wr);
@@ -122,14 +122,14 @@ static void build_generator(const mech_cfg_t *c, double wr, double wn1, double w
   ahat[MONO_E2][1][0] = -r1 * r1;
   ahat[MONO_E2][3][0] = -kq;
   ahat[MONO_E2][3][2] = -r2 * r2;
-  /* w: Coriolis 2 Omega y' on the sense mode, (2-22) */
+  /* w: Coriolis 2 Omega y' on the sense axis, (2-22) */
   ahat[MONO_W][3][1] = 2.0;
   if (c->full_kinematics) {
-    ahat[MONO_W][1][3] = -2.0; /* reciprocal Coriolis on the drive mode, (2-20) */
+    ahat[MONO_W][1][3] = -2.0; /* reciprocal Coriolis on the drive axis, (2-20) */
     ahat[MONO_W2][1][0] = 1.0; /* centrifugal Omega^2 y, (2-20) */
     ahat[MONO_W2][3][2] = 1.0; /* centrifugal Omega^2 x */
-    ahat[MONO_A][3][0] = 1.0;  /* Euler force +alpha y on the sense mode */
-    ahat[MONO_A][1][2] = -1.0; /* Euler force -alpha x on the drive mode */
+    ahat[MONO_A][3][0] = 1.0;  /* Euler force +alpha y on the sense axis */
+    ahat[MONO_A][1][2] = -1.0; /* Euler force -alpha x on the drive axis */
   }
 }
 
@@ -409,10 +409,10 @@ void mech_set_state(mech_t *m, const mech_state_t *s)
 double mech_wn1(const mech_t *m) { return wn_at(&m->cfg, m->cfg.f1_hz, m->temp_k); }
 double mech_wn2(const mech_t *m) { return wn_at(&m->cfg, m->cfg.f2_hz, m->temp_k); }
 
-double mech_noise_psd(const mech_t *m, int mode)
+double mech_noise_psd(const mech_t *m, int resonance)
 {
-  const double wn = mode == 1 ? mech_wn1(m) : mech_wn2(m);
-  const double q = mode == 1 ? m->cfg.q1 : m->cfg.q2;
+  const double wn = resonance == 1 ? mech_wn1(m) : mech_wn2(m);
+  const double q = resonance == 1 ? m->cfg.q1 : m->cfg.q2;
   /* (4-20): force PSD 4 kB T D, D = m wn / Q; divided by m^2 */
   return 4.0 * MECH_KB_J_PER_K * m->temp_k * wn / (q * m->cfg.mass_kg);
 }

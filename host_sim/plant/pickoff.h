@@ -1,4 +1,4 @@
-/* Pickoff front end of one axis (drive or sense), from mode displacement to the voltage
+/* Pickoff front end of one axis (drive or sense), from its displacement to the voltage
  * at the ADC input at the sampling instant (thesis §4.3.2, §4.4.2; host plant, double).
  *
  * Signal chain (continuous time):
@@ -73,7 +73,7 @@ typedef struct {
   pickoff_axis_t axis;
   double fs_hz;
   /* ring-diode front end */
-  double gain_v_per_m;       /* output volts per metre of mode displacement at T0 */
+  double gain_v_per_m;       /* output volts per metre of displacement at T0 */
   double gain_tc_per_k;      /* relative gain change per kelvin (diode drop); 0 default */
   double preamp_rail_v;      /* preamp output saturates at +-this, V (> 0) */
   double ft_u1;              /* feedthrough, V at the preamp output per V on U1 */
@@ -143,7 +143,7 @@ int pickoff_init(pickoff_t *p, const pickoff_cfg_t *cfg, double temp_k, uint64_t
  * (1e-4, 1.4) rad (low-pass) or (1e-4, 2.8) rad (all-pass); p is then unchanged. */
 int pickoff_set_temp(pickoff_t *p, double temp_k);
 
-/* Advance one sample to tick t_{k+1}: pos_m, vel_mps are the mode displacement and
+/* Advance one sample to tick t_{k+1}: pos_m, vel_mps are the axis displacement and
  * velocity at t_{k+1}; dac the DAC output of the sample just finished (its end values
  * are the electrode voltages at t_{k+1}), or NULL for no feedthrough. Returns the
  * voltage at the ADC input sampled at t_{k+1} + delay + jitter. */

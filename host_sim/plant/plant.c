@@ -86,7 +86,7 @@ static void make_actuator_cfg(const plant_cfg_t *c, actuator_cfg_t *a)
   a->drive_noise.white_rthz = c->drive_noise_white_v_rthz;
   a->drive_noise.flicker_1hz_rthz = c->drive_noise_1hz_v_rthz;
   a->drive_noise.fmin_hz = c->drive_noise_fmin_hz;
-  a->fb_mode = (actuator_fb_mode_t)c->fb_mode;
+  a->fb = (actuator_fb_t)c->fb_mode;
   a->ks_fb_mps2_per_v2 = c->ks_fb_mps2_per_v2;
   a->fb_bias_v = c->fb_bias_v;
   a->fb_noise.white_rthz = c->fb_noise_white_v_rthz;

@@ -23,7 +23,7 @@
  *      which the firmware reads at tick k+1.
  *
  * Units and signs: rates in deg/s at the API (rad/s inside the mechanics), positive
- * rate gives a Coriolis force +2 Omega y' on the sense mode (thesis (2-22)); the
+ * rate gives a Coriolis force +2 Omega y' on the sense axis (thesis (2-22)); the
  * quadrature coupling is -k_q y with k_q = 2 wc quad_dps (rad), so quad_dps > 0 and a
  * growing sense-channel lag give a growing positive bias, as in table 7-4.
  *
@@ -68,10 +68,10 @@
   X(double, truth_tau_s, DOUBLE, 1e-4, 10.0, "s", "averaging time of the truth's drive-frequency estimate") \
   X(double, truth_force_tau_s, DOUBLE, 1e-5, 1.0, "s", "averaging time of the truth's drive-force phasor") \
   /* mechanics (mech.h) */                                                                \
-  X(double, f_drive_hz, DOUBLE, 10.0, 1e6, "Hz", "drive-mode resonance at temp_ref_k")    \
-  X(double, q_drive, DOUBLE, 0.5, 1e6, "", "drive-mode quality factor")                   \
-  X(double, f_sense_hz, DOUBLE, 10.0, 1e6, "Hz", "sense-mode resonance at temp_ref_k")    \
-  X(double, q_sense, DOUBLE, 0.5, 1e6, "", "sense-mode quality factor")                   \
+  X(double, f_drive_hz, DOUBLE, 10.0, 1e6, "Hz", "drive resonance at temp_ref_k")         \
+  X(double, q_drive, DOUBLE, 0.5, 1e6, "", "drive resonance quality factor")              \
+  X(double, f_sense_hz, DOUBLE, 10.0, 1e6, "Hz", "sense resonance at temp_ref_k")         \
+  X(double, q_sense, DOUBLE, 0.5, 1e6, "", "sense resonance quality factor")              \
   X(double, mass_kg, DOUBLE, 1e-12, 1.0, "kg", "proof mass (Brownian noise, 4-20)")       \
   X(double, temp_ref_k, DOUBLE, 150.0, 450.0, "K", "reference temperature T0 of (2-32) and (2-40)") \
   X(double, ket_per_k, DOUBLE, -1e-3, 1e-3, "1/K", "temperature coefficient of Young's modulus kET (2-29)") \
@@ -138,12 +138,12 @@
   /* ADC (adc.h) */                                                                       \
   X(double, adc_full_scale_v, DOUBLE, 0.01, 100.0, "V", "ADC full scale, +-")            \
   /* acceleration (accel.h): force per unit mass per g */                                 \
-  X(double, gs_drive_from_drive_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "drive-mode force per g along the drive axis") \
-  X(double, gs_drive_from_sense_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "drive-mode force per g along the sense axis") \
-  X(double, gs_drive_from_normal_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "drive-mode force per g along the rate axis") \
-  X(double, gs_sense_from_drive_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "sense-mode force per g along the drive axis") \
-  X(double, gs_sense_from_sense_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "sense-mode force per g along the sense axis") \
-  X(double, gs_sense_from_normal_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "sense-mode force per g along the rate axis") \
+  X(double, gs_drive_from_drive_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "drive-axis force per g along the drive axis") \
+  X(double, gs_drive_from_sense_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "drive-axis force per g along the sense axis") \
+  X(double, gs_drive_from_normal_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "drive-axis force per g along the rate axis") \
+  X(double, gs_sense_from_drive_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "sense-axis force per g along the drive axis") \
+  X(double, gs_sense_from_sense_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "sense-axis force per g along the sense axis") \
+  X(double, gs_sense_from_normal_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "sense-axis force per g along the rate axis") \
   /* thermal network (thermal.h) */                                                       \
   X(double, tau_struct_s, DOUBLE, 1e-3, 1e9, "s", "structure node time constant to ambient") \
   X(double, tau_circuit_s, DOUBLE, 1e-3, 1e9, "s", "pickoff circuit node time constant to ambient") \
@@ -161,7 +161,7 @@
   X(int, pick_drive_temp_node, INT, 0, 2, "", "thermal node of the drive circuit laws: 0 structure, 1 circuit, 2 board") \
   X(int, pick_sense_temp_node, INT, 0, 2, "", "thermal node of the sense circuit laws: 0 structure, 1 circuit, 2 board") \
   X(bool, full_kinematics, BOOL, 0, 1, "", "reciprocal Coriolis, centrifugal and Euler terms of (2-20)") \
-  X(bool, brownian, BOOL, 0, 1, "", "Brownian force noise on both modes (4-20)")         \
+  X(bool, brownian, BOOL, 0, 1, "", "Brownian force noise on both axes (4-20)")          \
   X(bool, pick_drive_lag_allpass, BOOL, 0, 1, "", "drive circuit lag as an all-pass (pure phase) instead of a low-pass") \
   X(bool, pick_sense_lag_allpass, BOOL, 0, 1, "", "sense circuit lag as an all-pass instead of a low-pass")
 

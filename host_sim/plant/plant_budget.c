@@ -91,7 +91,7 @@ double plant_adc_fraction(const plant_cfg_t *c, double frac[2])
   const double kq = 2.0 * w1 * c->quad_dps * kDeg, om = c->rate_fs_dps * kDeg;
   const double complex d2 = wn2 * wn2 - w1 * w1 + I * wn2 * w1 / c->q_sense;
   const double xs = cabs(2.0 * om * w1 * I - kq) * a0 / cabs(d2);
-  /* vibration along the sense axis: quasi-static through the sense mode, then the
+  /* vibration along the sense axis: quasi-static through the sense resonance, then the
    * pickoff band-pass at vib_hz */
   const double wv = 2.0 * kPi * c->vib_hz;
   const double complex dv = wn2 * wn2 - wv * wv + I * wn2 * wv / c->q_sense;

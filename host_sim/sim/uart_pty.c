@@ -26,8 +26,8 @@ int uart_pty_open(uart_pty_t *p, char *path_out, size_t len)
   if (grantpt(m) != 0 || unlockpt(m) != 0 || ptsname_r(m, name, sizeof name) != 0) {
     goto fail;
   }
-  /* the bridge's own slave descriptor: the pty stays up between clients, and raw mode
-   * set on it stays the pty's mode */
+  /* the bridge's own slave descriptor: the pty stays up between clients, and the raw
+   * settings made on it stay the pty's */
   p->slave_fd = open(name, O_RDWR | O_NOCTTY | O_NONBLOCK);
   if (p->slave_fd < 0) {
     goto fail;

@@ -4,7 +4,7 @@
  *
  *   pty slave (/dev/pts/N) <-> kernel <-> master fd <-> uart_pty_pump <-> hal_uart_host
  *                                                                   RX ring / TX ring
- * The pty is in raw mode (no echo, no CR/LF translation, 8-bit clean: 0x00 and 0xFF
+ * The pty is raw (no echo, no CR/LF translation, 8-bit clean: 0x00 and 0xFF
  * pass, as on the wire), and the bridge keeps its own slave descriptor open so that
  * clients may come and go without the pty hanging up.
  *
@@ -37,7 +37,7 @@ typedef struct {
   uint32_t rx_dropped;               /* bytes the RX ring refused */
 } uart_pty_t;
 
-/* Open a pty pair (posix_openpt, grantpt, unlockpt), raw mode, non-blocking; write the
+/* Open a pty pair (posix_openpt, grantpt, unlockpt), raw, non-blocking; write the
  * slave's path into path_out (len bytes, may be NULL). Returns 0, or -1 with errno set
  * (then p is closed). */
 int uart_pty_open(uart_pty_t *p, char *path_out, size_t len);
