@@ -85,7 +85,7 @@ def out_comments(root):
     if not m:
         raise GenError("firmware/gyro/gyro.h: gyro_out_t not found")
     out = {}
-    for decl, names, comment in re.findall(r"(float|uint32_t)\s+([\w\s,]+);\s*(?:/\*(.*?)\*/)?", m.group(1)):
+    for _decl, names, comment in re.findall(r"(float|uint32_t)\s+([\w\s,]+);\s*(?:/\*(.*?)\*/)?", m.group(1)):
         for n in names.split(","):
             out[n.strip()] = " ".join((comment or "").split())
     return src, out

@@ -12,9 +12,9 @@ import math
 
 import numpy as np
 import pytest
+import synth
 from scipy import signal
 
-import synth
 from gyrotools import allan
 from gyrotools.errors import InputError
 
