@@ -60,8 +60,8 @@ static void list_params(void)
     const param_info_t *pi = param_info((param_idx_t)i);
     const param_value_t x = param_get(&v, (param_idx_t)i);
     if (pi->type == PARAM_T_F32) {
-      printf("firmware.%-31s %-12g [%g, %g] %s  %s\n", pi->name, (double)x.f,
-             (double)pi->min.f, (double)pi->max.f, pi->unit, pi->help);
+      printf("firmware.%-31s %-12g [%g, %g] %s  %s\n", pi->name, (double)x.f, (double)pi->min.f,
+             (double)pi->max.f, pi->unit, pi->help);
     } else {
       printf("firmware.%-31s %-12u [%u, %u] %s  %s\n", pi->name, x.u, pi->min.u, pi->max.u,
              pi->unit, pi->help);
@@ -76,8 +76,10 @@ static double brownian_floor_dph(const plant_cfg_t *pc, double f_drive_hz, doubl
                                  double t_k)
 {
   const double w1 = 2.0 * M_PI * f_drive_hz;
-  const double w2 = 2.0 * M_PI * pc->f_sense_hz * (1.0 - 0.5 * pc->ket_per_k * (t_k - pc->temp_ref_k));
-  const double om = sqrt(4.0 * KB_J_PER_K * t_k * w2 / (pc->mass_kg * pc->q_sense)) / (2.0 * amp_m * w1);
+  const double w2 = 2.0 * M_PI * pc->f_sense_hz *
+                    (1.0 - 0.5 * pc->ket_per_k * (t_k - pc->temp_ref_k));
+  const double om = sqrt(4.0 * KB_J_PER_K * t_k * w2 / (pc->mass_kg * pc->q_sense)) /
+                    (2.0 * amp_m * w1);
   return om * 180.0 / M_PI * 3600.0;
 }
 
@@ -133,15 +135,21 @@ typedef struct {
  * --list-params). */
 static int parse_args(int argc, char **argv, cli_args_t *a)
 {
-  static const struct option lo[] = {
-      {"scenario", required_argument, 0, 's'}, {"duration", required_argument, 0, 'd'},
-      {"seed", required_argument, 0, 'S'},     {"csv", required_argument, 0, 'c'},
-      {"csv-rate", required_argument, 0, 'r'}, {"json", required_argument, 0, 'j'},
-      {"out", required_argument, 0, 'o'},      {"set", required_argument, 0, 'x'},
-      {"quiet", no_argument, 0, 'q'},          {"no-analysis", no_argument, 0, 'n'},
-      {"list-params", no_argument, 0, 'L'},    {"help", no_argument, 0, 'h'},
-      {"uart-pty", optional_argument, 0, 'u'}, {"isr-figures", required_argument, 0, 'i'},
-      {0, 0, 0, 0}};
+  static const struct option lo[] = {{"scenario", required_argument, 0, 's'},
+                                     {"duration", required_argument, 0, 'd'},
+                                     {"seed", required_argument, 0, 'S'},
+                                     {"csv", required_argument, 0, 'c'},
+                                     {"csv-rate", required_argument, 0, 'r'},
+                                     {"json", required_argument, 0, 'j'},
+                                     {"out", required_argument, 0, 'o'},
+                                     {"set", required_argument, 0, 'x'},
+                                     {"quiet", no_argument, 0, 'q'},
+                                     {"no-analysis", no_argument, 0, 'n'},
+                                     {"list-params", no_argument, 0, 'L'},
+                                     {"help", no_argument, 0, 'h'},
+                                     {"uart-pty", optional_argument, 0, 'u'},
+                                     {"isr-figures", required_argument, 0, 'i'},
+                                     {0, 0, 0, 0}};
   memset(a, 0, sizeof *a);
   a->duration_s = -1.0;
   a->csv_rate_hz = -1.0;
@@ -156,7 +164,8 @@ static int parse_args(int argc, char **argv, cli_args_t *a)
       errno = 0;
       a->duration_s = strtod(optarg, &end);
       if (*end || errno || !(a->duration_s > 0.0) || a->duration_s > 1e6) {
-        fprintf(stderr, "gyro-sim: --duration: '%s' is not a number of seconds in (0, 1e6]\n", optarg);
+        fprintf(stderr, "gyro-sim: --duration: '%s' is not a number of seconds in (0, 1e6]\n",
+                optarg);
         return 2;
       }
       break;
@@ -235,8 +244,8 @@ typedef struct {
   const char *out_dir;  /* the tools' folder; NULL when no tool runs */
   const char *csv_path; /* the trace the tools read */
   int quiet;
-  cJSON *fig;           /* "figures" of the JSON */
-  int failed;           /* a tool failed */
+  cJSON *fig; /* "figures" of the JSON */
+  int failed; /* a tool failed */
   char err[512];
 } report_t;
 
@@ -288,7 +297,8 @@ static void report_run(report_t *r, const char *isr_json, const bench_figs_t *is
   if (isr_json != NULL) {
     printf("  Cortex-M4F sample interrupt (%s): %.0f instructions per tick (worst %.0f)",
            isr_json, isr->insns_mean, isr->insns_max);
-    if (isr->have_cycles) printf(", about %.0f cycles (worst %.0f)", isr->cycles_mean, isr->cycles_max);
+    if (isr->have_cycles)
+      printf(", about %.0f cycles (worst %.0f)", isr->cycles_mean, isr->cycles_max);
     printf("\n");
   }
 }
@@ -309,8 +319,8 @@ static void report_startup(report_t *r)
   printf("  after lock, 0.1-100 Hz: amplitude error %.4f %% rms, phase error %.5f deg rms\n",
          s->amp_err_rms_pct, s->phase_err_rms_deg);
   printf("  firmware LOCKED at %.3f s; drive amplitude %.3f um; rate output within 0.5 deg/s "
-         "of its final error from %.3f s\n", s->fw_lock_time_s, 1e6 * s->final_amp_m,
-         s->rate_settle_s);
+         "of its final error from %.3f s\n",
+         s->fw_lock_time_s, 1e6 * s->final_amp_m, s->rate_settle_s);
 }
 
 static void report_closed_loop(report_t *r)
@@ -337,7 +347,8 @@ static void report_sweep(report_t *r, const sim_sweep_t *sweep, int analysis)
   FILE *f = fopen(sp, "w");
   if (f != NULL) {
     fputs("f_hz,amp,phase_deg\n", f);
-    for (int i = 0; i < sweep->n; i++) fprintf(f, "%.6f,%.9g,%.6f\n", sweep->f_hz[i], sweep->amp_v[i], sweep->phase_deg[i]);
+    for (int i = 0; i < sweep->n; i++)
+      fprintf(f, "%.6f,%.9g,%.6f\n", sweep->f_hz[i], sweep->amp_v[i], sweep->phase_deg[i]);
     fclose(f);
   }
   if (!analysis || !(r->sc->analyses & SIM_AN_SWEEP)) return;
@@ -354,7 +365,8 @@ static void report_sweep(report_t *r, const sim_sweep_t *sweep, int analysis)
     printf("  identified drive resonance %.3f Hz (plant %.3f Hz), Q %.2f (plant %.2f),\n"
            "    phase at resonance %.2f deg, -3 dB %.2f..%.2f Hz\n",
            post_num(j, "f0_hz"), r->pc->f_drive_hz, post_num(j, "q"), r->pc->q_drive,
-           post_num(j, "phase_at_f0_deg"), post_num(j, "f_3db_lo_hz"), post_num(j, "f_3db_hi_hz"));
+           post_num(j, "phase_at_f0_deg"), post_num(j, "f_3db_lo_hz"),
+           post_num(j, "f_3db_hi_hz"));
   }
   cJSON_Delete(j);
 }
@@ -372,7 +384,8 @@ static void report_square_law(report_t *r, const sim_square_t *sq)
   }
   const double k = sxy / sxx;
   cJSON *tab = cJSON_AddArrayToObject(r->fig, "square_law");
-  if (!r->quiet) printf("  square law (table 7-1): U (V) -> drive pickoff (V), displacement (um), fit k U^2\n");
+  if (!r->quiet)
+    printf("  square law (table 7-1): U (V) -> drive pickoff (V), displacement (um), fit k U^2\n");
   for (int i = 0; i < sq->n; i++) {
     const double fit = k * sq->u_v[i] * sq->u_v[i];
     if (fabs(sq->amp_v[i] - fit) > dmax) dmax = fabs(sq->amp_v[i] - fit);
@@ -381,11 +394,15 @@ static void report_square_law(report_t *r, const sim_square_t *sq)
     add_num(row, "amp_v", sq->amp_v[i]);
     add_num(row, "amp_m", sq->amp_m[i]);
     cJSON_AddItemToArray(tab, row);
-    if (!r->quiet) printf("    %6.2f  %8.4f  %8.4f  %8.4f\n", sq->u_v[i], sq->amp_v[i], 1e6 * sq->amp_m[i], fit);
+    if (!r->quiet)
+      printf("    %6.2f  %8.4f  %8.4f  %8.4f\n", sq->u_v[i], sq->amp_v[i], 1e6 * sq->amp_m[i],
+             fit);
   }
   add_num(r->fig, "square_law_k_v_per_v2", k);
   add_num(r->fig, "square_law_nonlinearity_pct", 100.0 * dmax / amax);
-  if (!r->quiet) printf("  k = %.6g V/V^2, largest deviation %.3f %% of the largest amplitude\n", k, 100.0 * dmax / amax);
+  if (!r->quiet)
+    printf("  k = %.6g V/V^2, largest deviation %.3f %% of the largest amplitude\n", k,
+           100.0 * dmax / amax);
 }
 
 static void analyse_rate_table(report_t *r)
@@ -412,7 +429,8 @@ static void report_noise(report_t *r, const cJSON *j, double sf)
 {
   const sim_result_t *res = r->res;
   const double n_in = post_num(j, "arw_dph_per_rthz") / sf;
-  const double floor = brownian_floor_dph(r->pc, res->mean_drive_freq_hz, res->mean_drive_amp_m, res->mean_struct_k);
+  const double floor = brownian_floor_dph(r->pc, res->mean_drive_freq_hz, res->mean_drive_amp_m,
+                                          res->mean_struct_k);
   add_num(r->fig, "arw_coeff_dph_rthz", n_in);
   add_num(r->fig, "adev_1s_dph", post_num(j, "adev_at_1s_dph") / sf);
   add_num(r->fig, "brownian_floor_dph_rthz", floor);
@@ -449,15 +467,18 @@ static void analyse_noise_allan(report_t *r)
   char tend[32];
   /* Allan on the static part of the run: the scenario's last rate step (if any) is
    * its scale-factor check and is left out. */
-  const int sf_step = sc->has_rate && sc->rate_dps.kind == PROFILE_STEPS && sc->rate_dps.n_steps > 1;
+  const int sf_step = sc->has_rate && sc->rate_dps.kind == PROFILE_STEPS &&
+                      sc->rate_dps.n_steps > 1;
   const double t_end = sf_step ? sc->rate_dps.step_s[0] : sc->duration_s;
   snprintf(tend, sizeof tend, "%.6f", t_end);
   const char *args[] = {r->csv_path, "--t-start", "1", "--t-end", tend, NULL};
   cJSON *j = post_run_tool("gyro-allan", args, r->out_dir, "allan.json", r->err, sizeof r->err);
   double sf = 1.0;
   if (j != NULL && sf_step) {
-    const char *a2[] = {r->csv_path, "--t-start", tend, "--settle", "0.5", "--min-avg", "0.5", NULL};
-    cJSON *s = post_run_tool("gyro-scalefactor", a2, r->out_dir, "scalefactor.json", r->err, sizeof r->err);
+    const char *a2[] = {r->csv_path, "--t-start", tend,  "--settle",
+                        "0.5",       "--min-avg", "0.5", NULL};
+    cJSON *s = post_run_tool("gyro-scalefactor", a2, r->out_dir, "scalefactor.json", r->err,
+                             sizeof r->err);
     if (s != NULL) {
       sf = post_num(s, "scale_factor_out_per_dps");
       add_num(r->fig, "scale_factor", sf);
@@ -476,12 +497,14 @@ static void analyse_noise_allan(report_t *r)
 
 static void analyse_drive_noise(report_t *r)
 {
-  const char *args[] = {r->csv_path, "--column", "drive_amp_true_m", "--band", "1", "10", "--t-start", "2", NULL};
+  const char *args[] = {
+      r->csv_path, "--column", "drive_amp_true_m", "--band", "1", "10", "--t-start", "2", NULL};
   cJSON *j = run_tool(r, "gyro-psd", args, "psd.json");
   if (j == NULL) return;
   const double rel = post_num(j, "white_asd_one_sided_per_rthz") / r->res->mean_drive_amp_m;
   add_num(r->fig, "drive_amp_noise_lf_rel", rel);
-  if (!r->quiet) printf("  drive amplitude noise over 1-10 Hz: %.3g /rtHz relative (one-sided)\n", rel);
+  if (!r->quiet)
+    printf("  drive amplitude noise over 1-10 Hz: %.3g /rtHz relative (one-sided)\n", rel);
   cJSON_Delete(j);
 }
 
@@ -495,8 +518,8 @@ static void analyse_temp(report_t *r)
   if (sc->has_ambient && sc->ambient_c.kind == PROFILE_HEAT_COOL) {
     snprintf(t0, sizeof t0, "%.3f", sc->ambient_c.t_start_s + sc->ambient_c.heat_s);
   }
-  const char *args[] = {r->csv_path, "--column", "rate_dps", "--p-column", "p_f_deg",
-                        "--temp-column", "t_board_c", "--t-start", t0, NULL};
+  const char *args[] = {r->csv_path,     "--column",  "rate_dps",  "--p-column", "p_f_deg",
+                        "--temp-column", "t_board_c", "--t-start", t0,           NULL};
   cJSON *j = run_tool(r, "gyro-tempcomp", args, "tempcomp.json");
   if (j == NULL) return;
   add_num(r->fig, "residual_bias_p_dps", post_num(j, "p_fit.residual_std_dps"));
@@ -597,8 +620,9 @@ static int run(const cli_args_t *a, const sim_scenario_t *sc, const bench_figs_t
     fprintf(stderr, "gyro-sim: --uart-pty needs a closed-loop scenario\n");
     return 2;
   }
-  const sim_opts_t so = {csv_path, sc->csv_rate_hz, !a->quiet && isatty(2) && sc->duration_s > 2.0,
-                         a->uart_pty, a->uart_pty_link};
+  const sim_opts_t so = {csv_path, sc->csv_rate_hz,
+                         !a->quiet && isatty(2) && sc->duration_s > 2.0, a->uart_pty,
+                         a->uart_pty_link};
   static sim_result_t res;
   static sim_sweep_t sweep;
   static sim_square_t sq;
@@ -613,8 +637,13 @@ static int run(const cli_args_t *a, const sim_scenario_t *sc, const bench_figs_t
   cJSON *root = cJSON_CreateObject();
   cJSON_AddStringToObject(root, "scenario", sc->name);
   add_params(root, sc, &pc, &fw);
-  report_t r = {.sc = sc, .pc = &pc, .res = &res, .out_dir = out_dir, .csv_path = csv_path,
-                .quiet = a->quiet, .fig = cJSON_AddObjectToObject(root, "figures")};
+  report_t r = {.sc = sc,
+                .pc = &pc,
+                .res = &res,
+                .out_dir = out_dir,
+                .csv_path = csv_path,
+                .quiet = a->quiet,
+                .fig = cJSON_AddObjectToObject(root, "figures")};
   report_figures(&r, a, isr, &sweep, &sq, need_tools);
   add_num(root, "realtime_factor", res.realtime_factor);
   add_num(root, "realtime_factor_cpu", res.realtime_factor_cpu);

@@ -22,7 +22,11 @@
 
 /* SIGINT/SIGTERM end a paced (pty) run cleanly; a flag is all a handler may touch. */
 static volatile sig_atomic_t stop_requested;
-static void on_signal(int sig) { (void)sig; stop_requested = 1; }
+static void on_signal(int sig)
+{
+  (void)sig;
+  stop_requested = 1;
+}
 
 static double wall_now(void)
 {
@@ -56,9 +60,9 @@ static void progress_update(progress_t *pr, double sim_s, int final)
   const int width = 30, fill = (int)(frac * width + 0.5);
   const double el = now - pr->t0_wall;
   const double eta = frac > 1e-6 ? el * (1.0 - frac) / frac : 0.0;
-  fprintf(stderr, "\r[%.*s%*s] %5.1f%%  sim %.1f/%.1f s  %.0fx real time  eta %.0f s ",
-          fill, "##############################", width - fill, "", 100.0 * frac, sim_s,
-          pr->total_s, el > 0.0 ? sim_s / el : 0.0, eta);
+  fprintf(stderr, "\r[%.*s%*s] %5.1f%%  sim %.1f/%.1f s  %.0fx real time  eta %.0f s ", fill,
+          "##############################", width - fill, "", 100.0 * frac, sim_s, pr->total_s,
+          el > 0.0 ? sim_s / el : 0.0, eta);
   if (final) fputc('\n', stderr);
   fflush(stderr);
 }
@@ -73,7 +77,10 @@ static double band_rms(const double *x, size_t i0, size_t n, double fs)
   double st = 0, sx = 0, stt = 0, stx = 0;
   for (size_t i = 0; i < m; i++) {
     const double t = (double)i;
-    st += t; sx += x[i0 + i]; stt += t * t; stx += t * x[i0 + i];
+    st += t;
+    sx += x[i0 + i];
+    stt += t * t;
+    stx += t * x[i0 + i];
   }
   const double den = (double)m * stt - st * st;
   const double b = den != 0.0 ? ((double)m * stx - st * sx) / den : 0.0;
@@ -91,7 +98,10 @@ static double band_rms(const double *x, size_t i0, size_t n, double fs)
       s2 = sos[0].b2 * v - sos[0].a2 * y;
       v = y;
     }
-    if (i >= skip) { acc += v * v; cnt++; }
+    if (i >= skip) {
+      acc += v * v;
+      cnt++;
+    }
   }
   return cnt ? sqrt(acc / (double)cnt) : NAN;
 }
@@ -132,11 +142,11 @@ static void startup_figures(const double *amp, const double *ph, const double *r
 
 /* The drive's true motion at 1 kHz for the start-up figures, in the firmware's NCO frame. */
 typedef struct {
-  size_t decim;             /* ticks per truth sample */
-  size_t cap, n;            /* samples allocated, taken */
-  double *amp, *ph, *rerr;  /* |Z| (m), unwrapped arg Z (rad), rate error (deg/s) */
+  size_t decim;            /* ticks per truth sample */
+  size_t cap, n;           /* samples allocated, taken */
+  double *amp, *ph, *rerr; /* |Z| (m), unwrapped arg Z (rad), rate error (deg/s) */
   double ph_prev, ph_unwrap;
-  double w_fw;              /* the firmware's drive frequency, rad/s */
+  double w_fw; /* the firmware's drive frequency, rad/s */
 } cl_truth_t;
 
 static void truth_sample(cl_truth_t *t, const app_t *app, const plant_truth_t *tr)
@@ -225,7 +235,8 @@ static int cl_start(cl_run_t *r, const sim_scenario_t *sc, const sim_opts_t *opt
     t->rerr = calloc(t->cap, sizeof *t->rerr);
     if (t->amp == NULL || t->ph == NULL || t->rerr == NULL) t->cap = 0;
   }
-  if (r->plant == NULL || r->app == NULL || ((sc->analyses & SIM_AN_STARTUP) != 0u && t->cap == 0)) {
+  if (r->plant == NULL || r->app == NULL ||
+      ((sc->analyses & SIM_AN_STARTUP) != 0u && t->cap == 0)) {
     snprintf(err, err_len, "out of memory");
     return -1;
   }
@@ -241,7 +252,8 @@ static int cl_start(cl_run_t *r, const sim_scenario_t *sc, const sim_opts_t *opt
     snprintf(err, err_len, "firmware: application did not start");
     return -1;
   }
-  if (opt->csv_path != NULL && sim_csv_open(&r->csv, opt->csv_path, err, err_len) != 0) return -1;
+  if (opt->csv_path != NULL && sim_csv_open(&r->csv, opt->csv_path, err, err_len) != 0)
+    return -1;
   if (opt->uart_pty && cl_open_pty(r, opt, err, err_len) != 0) return -1;
   return 0;
 }
@@ -295,7 +307,8 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
   if (sim_plant_cfg(sc, &pc, &prof, err, err_len) != 0) return -1;
   if (sim_fw_params(sc, &fw, err, err_len) != 0) return -1;
   if (fabs(pc.fs_hz - (double)fw.sys_fs_hz) > 1e-9) {
-    snprintf(err, err_len, "plant.fs_hz %g differs from the firmware's sys.fs_hz %u", pc.fs_hz, fw.sys_fs_hz);
+    snprintf(err, err_len, "plant.fs_hz %g differs from the firmware's sys.fs_hz %u", pc.fs_hz,
+             fw.sys_fs_hz);
     return -1;
   }
   const double fs = pc.fs_hz;
@@ -313,12 +326,14 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
   for (uint64_t k = 0; k < n_ticks; k++) {
     hal_host_run(1u);
     const plant_truth_t *tr = plant_truth(r.plant);
-    if (st.fw_lock_s < 0.0 && app->gyro.sup.mode == GYRO_MODE_LOCKED) st.fw_lock_s = (double)(k + 1u) / fs;
+    if (st.fw_lock_s < 0.0 && app->gyro.sup.mode == GYRO_MODE_LOCKED)
+      st.fw_lock_s = (double)(k + 1u) / fs;
     if (app->gyro.out.rate_valid != 0u) {
       st.valid_ticks++;
       if (st.first_valid_s < 0.0) st.first_valid_s = (double)(k + 1u) / fs;
     }
-    if ((k + 1u) % r.truth.decim == 0u && r.truth.n < r.truth.cap) truth_sample(&r.truth, app, tr);
+    if ((k + 1u) % r.truth.decim == 0u && r.truth.n < r.truth.cap)
+      truth_sample(&r.truth, app, tr);
     if (k % csv_every == 0u) {
       if (r.csv.f != NULL) sim_csv_row(&r.csv, tr, &app->gyro.out);
       st.sum_struct_k += tr->struct_k;
@@ -349,7 +364,7 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
 /* ------------------------------------------------------------------ open loop -- */
 
 typedef struct {
-  double psi, dpsi;         /* half-frequency voltage phase and its advance per tick */
+  double psi, dpsi; /* half-frequency voltage phase and its advance per tick */
   double u_amp_v;
   int measuring;
   double acc_i, acc_q, acc_am;
@@ -419,7 +434,10 @@ int sim_run_open_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_resul
   plant_profiles_t prof;
   if (sim_plant_cfg(sc, &pc, &prof, err, err_len) != 0) return -1;
   plant_t *plant = calloc(1, sizeof *plant);
-  if (plant == NULL) { snprintf(err, err_len, "out of memory"); return -1; }
+  if (plant == NULL) {
+    snprintf(err, err_len, "out of memory");
+    return -1;
+  }
   if (plant_init(plant, &pc, sc->seed) != 0 || plant_set_profiles(plant, &prof) != 0) {
     snprintf(err, err_len, "plant: %s", plant_error(plant));
     free(plant);
@@ -459,8 +477,8 @@ int sim_run_open_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_resul
     for (int i = 0; i < na; i++) {
       const double u = sc->ol.n_amps > 0 ? sc->ol.amps_v[i] : sc->ol.u_amp_v;
       double ph;
-      ol_point(&o, plant, fs, sc->ol.freq_hz, u, sc->ol.settle_s, sc->ol.dwell_s,
-               &sq->amp_v[i], &ph, &sq->amp_m[i], &csv, &k, csv_every);
+      ol_point(&o, plant, fs, sc->ol.freq_hz, u, sc->ol.settle_s, sc->ol.dwell_s, &sq->amp_v[i],
+               &ph, &sq->amp_m[i], &csv, &k, csv_every);
       sq->u_v[i] = u;
       sq->n = i + 1;
       progress_update(&pr, (double)hal_host_ticks() / fs, 0);

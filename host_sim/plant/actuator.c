@@ -73,9 +73,7 @@ void actuator_step(actuator_t *a, const dac_out_t *dac, actuator_out_t *out)
     break;
   }
   case ACTUATOR_FB_OFF:
-  default:
-    out->f_sense_mps2 = 0.0;
-    break;
+  default: out->f_sense_mps2 = 0.0; break;
   }
   for (int i = 0; i < 4; i++) out->noise_v[i] = w[i];
 }

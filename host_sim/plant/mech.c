@@ -6,17 +6,16 @@
 
 static const double kPi = 3.14159265358979323846;
 
-#define NA (MECH_NS + MECH_NU)           /* augmented [state; input] size */
+#define NA (MECH_NS + MECH_NU) /* augmented [state; input] size */
 
 /* Monomials of the truncated algebra, exponents of (w, a, e). The set is closed under
  * taking divisors, so the monomials outside it span an ideal and truncation is an
  * algebra homomorphism. Order: blocks with the same power of w are contiguous. */
-static const int kMono[MECH_NMONO][3] = {
-    {0, 0, 0}, {0, 0, 1}, {0, 0, 2},   /* 1, e, e^2     */
-    {1, 0, 0}, {1, 0, 1}, {1, 0, 2},   /* w, we, we^2   */
-    {2, 0, 0}, {2, 0, 1},              /* w^2, w^2 e    */
-    {3, 0, 0},                         /* w^3           */
-    {0, 1, 0}, {1, 1, 0}, {0, 1, 1}};  /* a, w a, a e   */
+static const int kMono[MECH_NMONO][3] = {{0, 0, 0}, {0, 0, 1}, {0, 0, 2},  /* 1, e, e^2     */
+                                         {1, 0, 0}, {1, 0, 1}, {1, 0, 2},  /* w, we, we^2   */
+                                         {2, 0, 0}, {2, 0, 1},             /* w^2, w^2 e    */
+                                         {3, 0, 0},                        /* w^3           */
+                                         {0, 1, 0}, {1, 1, 0}, {0, 1, 1}}; /* a, w a, a e   */
 
 static int mono_index(int pw, int pa, int pe)
 {
@@ -28,16 +27,16 @@ static int mono_index(int pw, int pa, int pe)
 void mech_default_cfg(mech_cfg_t *cfg)
 {
   memset(cfg, 0, sizeof(*cfg));
-  cfg->f1_hz = 1489.9;      /* §7.2.2 sweep */
-  cfg->q1 = 33.33;          /* §7.2.2, -3 dB points */
-  cfg->f2_hz = 2000.0;      /* design, §2.4.2 */
-  cfg->q2 = 3.0;            /* design, §2.2.2 (air) */
+  cfg->f1_hz = 1489.9; /* §7.2.2 sweep */
+  cfg->q1 = 33.33;     /* §7.2.2, -3 dB points */
+  cfg->f2_hz = 2000.0; /* design, §2.4.2 */
+  cfg->q2 = 3.0;       /* design, §2.2.2 (air) */
   cfg->temp_ref_k = 298.15;
-  cfg->ket_per_k = 40e-6;   /* (2-29) range 25..75 ppm/K; table 7-4 fits 40 (plant_cfg.c) */
+  cfg->ket_per_k = 40e-6; /* (2-29) range 25..75 ppm/K; table 7-4 fits 40 (plant_cfg.c) */
   cfg->kq_per_s2 = 0.0;
   cfg->dq_per_s = 0.0;
-  cfg->mass_kg = 0.26e-6;   /* §4.6.1: 0.26 mg */
-  cfg->fs_hz = 50e3;        /* §4.4.2 */
+  cfg->mass_kg = 0.26e-6; /* §4.6.1: 0.26 mg */
+  cfg->fs_hz = 50e3;      /* §4.4.2 */
   /* Measured (test_mech, test_refresh_threshold_error): with e expanded to second
    * order the steady-state error of the drive at resonance (Q1 = 33) is about
    * 860 e^3 (8.6e-10 at e = 1e-3, 6.9e-9 at 2e-3). 1e-3 keeps it 100x below 1e-7 and
@@ -48,7 +47,10 @@ void mech_default_cfg(mech_cfg_t *cfg)
   cfg->brownian = 1;
 }
 
-static int finite_in(double v, double lo, double hi) { return isfinite(v) && v >= lo && v <= hi; }
+static int finite_in(double v, double lo, double hi)
+{
+  return isfinite(v) && v >= lo && v <= hi;
+}
 
 int mech_cfg_check(const mech_cfg_t *c, const char **key)
 {
@@ -84,7 +86,20 @@ static int temp_ok(const mech_cfg_t *c, double temp_k)
          fabs(0.5 * c->ket_per_k * (temp_k - c->temp_ref_k)) < 0.2;
 }
 
-enum { MONO_1 = 0, MONO_E, MONO_E2, MONO_W, MONO_WE, MONO_WE2, MONO_W2, MONO_W2E, MONO_W3, MONO_A, MONO_WA, MONO_AE };
+enum {
+  MONO_1 = 0,
+  MONO_E,
+  MONO_E2,
+  MONO_W,
+  MONO_WE,
+  MONO_WE2,
+  MONO_W2,
+  MONO_W2E,
+  MONO_W3,
+  MONO_A,
+  MONO_WA,
+  MONO_AE
+};
 
 /* Continuous generator in scaled coordinates, one block per monomial: A(w,a,e) =
  * wr * sum_m Ahat_m * mono_m, augmented with the input columns. Only the four state
@@ -101,7 +116,7 @@ static void build_generator(const mech_cfg_t *c, double wr, double wn1, double w
   const double kq = c->kq_per_s2 * s * s / (wr * wr);
   const double dq = c->dq_per_s * s / wr;
   memset(ahat, 0, sizeof(double) * MECH_NMONO * MECH_NS * NA);
-  double (*a0)[NA] = ahat[MONO_1];
+  double(*a0)[NA] = ahat[MONO_1];
   a0[0][1] = 1.0;
   a0[1][0] = -r1 * r1;
   a0[1][1] = -r1 / c->q1;
@@ -314,7 +329,7 @@ static void build_q(mech_t *m)
   memset(m->q, 0, sizeof(m->q));
   for (int i = 0; i < MECH_NMONO; i++) {
     const double c = ep[kMono[i][2]];
-    double (*dst)[NA] = m->q[kMono[i][0]][kMono[i][1]];
+    double(*dst)[NA] = m->q[kMono[i][0]][kMono[i][1]];
     for (int r = 0; r < MECH_NS; r++)
       for (int q = 0; q < NA; q++) dst[r][q] += c * m->blk[i][r][q];
   }

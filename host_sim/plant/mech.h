@@ -72,9 +72,9 @@
 #include "plant/gauss_zig.h"
 #include "plant/rng.h"
 
-#define MECH_NMONO 12  /* Taylor blocks, see mech.c */
-#define MECH_NS 4      /* states */
-#define MECH_NU 2      /* inputs */
+#define MECH_NMONO 12 /* Taylor blocks, see mech.c */
+#define MECH_NS 4     /* states */
+#define MECH_NU 2     /* inputs */
 
 /* Noise stream ids (rng_seed(seed, stream)): one rng_t per noise source. */
 #define MECH_RNG_STREAM_DRIVE 0x6d01u
@@ -99,26 +99,26 @@ typedef struct {
 } mech_cfg_t;
 
 typedef struct {
-  double y_m, vy_mps;  /* drive displacement, velocity */
-  double x_m, vx_mps;  /* sense displacement, velocity */
+  double y_m, vy_mps; /* drive displacement, velocity */
+  double x_m, vx_mps; /* sense displacement, velocity */
 } mech_state_t;
 
 typedef struct {
   mech_cfg_t cfg;
-  double wr;                  /* scaling frequency wn1(T0), rad/s */
-  double temp_k;              /* structure temperature now */
-  double temp_disc_k;         /* temperature of the current Taylor blocks */
-  double eps;                 /* wn(temp_k)/wn(temp_disc_k) - 1 */
+  double wr;          /* scaling frequency wn1(T0), rad/s */
+  double temp_k;      /* structure temperature now */
+  double temp_disc_k; /* temperature of the current Taylor blocks */
+  double eps;         /* wn(temp_k)/wn(temp_disc_k) - 1 */
   double blk[MECH_NMONO][MECH_NS][MECH_NS + MECH_NU]; /* Taylor blocks [Phi Gamma] */
-  double q[4][2][MECH_NS][MECH_NS + MECH_NU]; /* blocks of w^p a^r summed over e^k */
-  double qmax[4][2];          /* largest entry of each, to skip negligible terms */
-  double k[MECH_NS][MECH_NS + MECH_NU];     /* [Phi Gamma] at the current (w, a, e) */
-  double coef[2];             /* (w, a) that k[][] was built for */
+  double q[4][2][MECH_NS][MECH_NS + MECH_NU];         /* blocks of w^p a^r summed over e^k */
+  double qmax[4][2];                    /* largest entry of each, to skip negligible terms */
+  double k[MECH_NS][MECH_NS + MECH_NU]; /* [Phi Gamma] at the current (w, a, e) */
+  double coef[2];                       /* (w, a) that k[][] was built for */
   int q_valid, k_valid;
-  double z[MECH_NS];          /* scaled state */
-  double noise_sd[MECH_NU];   /* per-sample sd of the held noise, scaled units */
-  rng_t rng[MECH_NU];         /* one source per axis */
-  gauss_zig_t zig;            /* normal deviates from them (gauss_zig.h) */
+  double z[MECH_NS];        /* scaled state */
+  double noise_sd[MECH_NU]; /* per-sample sd of the held noise, scaled units */
+  rng_t rng[MECH_NU];       /* one source per axis */
+  gauss_zig_t zig;          /* normal deviates from them (gauss_zig.h) */
   uint64_t refresh_count;
 } mech_t;
 

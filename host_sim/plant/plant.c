@@ -131,10 +131,7 @@ static void make_accel_cfg(const plant_cfg_t *c, accel_cfg_t *a)
   a->sense_mps2_per_g[ACCEL_AXIS_NORMAL] = c->gs_sense_from_normal_mps2_per_g;
 }
 
-static int pick_node(const plant_cfg_t *c, int axis)
-{
-  return PLANT_PICK(c, axis, temp_node);
-}
+static int pick_node(const plant_cfg_t *c, int axis) { return PLANT_PICK(c, axis, temp_node); }
 
 /* ------------------------------------------------------------------ init ------ */
 
@@ -194,7 +191,8 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   accel_cfg_t gc;
   make_accel_cfg(c, &gc);
 
-  if (thermal_init(&p->thermal, &thc, c->temp_k) != 0) what = "thermal (tau_*, couple_*, rise_*)";
+  if (thermal_init(&p->thermal, &thc, c->temp_k) != 0)
+    what = "thermal (tau_*, couple_*, rise_*)";
   else if (mech_init(&p->mech, &mc, thermal_temp(&p->thermal, THERMAL_STRUCT), seed) != 0)
     what = "mechanics (f_*_hz, q_*, ket_per_k, temp_k)";
   else if (dac_init(&p->dac, &dc) != 0) what = "DAC (dac_*)";
@@ -343,7 +341,8 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
    * queued codes are moved to the held ones (dac.h's own one-sample queue would add a
    * second sample of latency). */
   if (dac != NULL) {
-    if (dac_write(&p->dac, dac) == 0) memcpy(p->dac.latched, p->dac.pending, sizeof p->dac.latched);
+    if (dac_write(&p->dac, dac) == 0)
+      memcpy(p->dac.latched, p->dac.pending, sizeof p->dac.latched);
     else t->dac_rejects++;
   }
   dac_out_t dout;

@@ -49,7 +49,7 @@ typedef struct {
 typedef struct {
   thermal_cfg_t cfg;
   double dphi[THERMAL_NODES][THERMAL_NODES]; /* Phi - I */
-  double g_heat[THERMAL_NODES];               /* g_h */
+  double g_heat[THERMAL_NODES];              /* g_h */
   double t_k[THERMAL_NODES];
 } thermal_t;
 

@@ -28,13 +28,13 @@
 #define UART_PTY_PATH_MAX 256u
 
 typedef struct {
-  int master_fd;  /* -1 when closed */
-  int slave_fd;   /* held open by the bridge */
+  int master_fd;                     /* -1 when closed */
+  int slave_fd;                      /* held open by the bridge */
   char link_path[UART_PTY_PATH_MAX]; /* symlink made by uart_pty_link, "" if none */
   uint8_t tx[UART_PTY_TX_CHUNK];     /* popped from the TX ring, not yet written */
   size_t tx_len, tx_off;
-  uint64_t tx_bytes;                 /* written to the pty so far */
-  uint32_t rx_dropped;               /* bytes the RX ring refused */
+  uint64_t tx_bytes;   /* written to the pty so far */
+  uint32_t rx_dropped; /* bytes the RX ring refused */
 } uart_pty_t;
 
 /* Open a pty pair (posix_openpt, grantpt, unlockpt), raw, non-blocking; write the
