@@ -56,7 +56,9 @@ recs_b = [(0x0101, 0, f32(1600.0)), (0x0103, 0, f32(9.0)), (0x0102, 1, 1), (0x05
 
 
 def slots(a, b):
-    pad = lambda x: x + b"\xff" * (SLOT - len(x))
+    def pad(x):
+        return x + b"\xff" * (SLOT - len(x))
+
     return pad(a) + pad(b)
 
 

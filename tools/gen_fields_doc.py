@@ -85,7 +85,7 @@ def out_comments(root):
     if not m:
         raise GenError("firmware/gyro/gyro.h: gyro_out_t not found")
     out = {}
-    for decl, names, comment in re.findall(r"(float|uint32_t)\s+([\w\s,]+);\s*(?:/\*(.*?)\*/)?", m.group(1)):
+    for _decl, names, comment in re.findall(r"(float|uint32_t)\s+([\w\s,]+);\s*(?:/\*(.*?)\*/)?", m.group(1)):
         for n in names.split(","):
             out[n.strip()] = " ".join((comment or "").split())
     return src, out
@@ -153,6 +153,28 @@ def generate(root):
     return "\n".join(L) + "\n"
 
 
+def emit(root, rel, text, check, prog):
+    """Write text to root/rel or, with check, compare: 0 when current, 1 (with a diff and
+    the command that regenerates it) when stale."""
+    path = os.path.join(root, rel)
+    if check:
+        try:
+            with open(path, encoding="utf-8") as fh:
+                old = fh.read()
+        except OSError:
+            old = ""
+        if old != text:
+            sys.stdout.writelines(difflib.unified_diff(old.splitlines(True), text.splitlines(True),
+                                                       f"{rel} (committed)", "generated"))
+            print(f"{prog}: {rel} is stale: run python3 tools/{prog}.py", file=sys.stderr)
+            return 1
+        return 0
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write(text)
+    print(f"wrote {path}")
+    return 0
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description="Generate docs/fields.md from the field tables.")
     ap.add_argument("--root", default=os.path.dirname(HERE))
@@ -163,23 +185,7 @@ def main(argv=None):
     except GenError as e:
         print(f"gen_fields_doc: {e}", file=sys.stderr)
         return 2
-    path = os.path.join(a.root, "docs", "fields.md")
-    if a.check:
-        try:
-            old = open(path, encoding="utf-8").read()
-        except OSError:
-            old = ""
-        if old != text:
-            sys.stdout.writelines(difflib.unified_diff(old.splitlines(True), text.splitlines(True),
-                                                       "docs/fields.md (committed)", "generated"))
-            print("gen_fields_doc: docs/fields.md is stale: run python3 tools/gen_fields_doc.py",
-                  file=sys.stderr)
-            return 1
-        return 0
-    with open(path, "w", encoding="utf-8") as fh:
-        fh.write(text)
-    print(f"wrote {path}")
-    return 0
+    return emit(a.root, "docs/fields.md", text, a.check, "gen_fields_doc")
 
 
 if __name__ == "__main__":

@@ -38,7 +38,8 @@ DESIGNS = [
     ("HP 2nd 20 Hz @ 57 kHz", HIGHPASS, 2, 20.0, 0.0, 57000.0),
     ("BP N=4 1300-1700 Hz @ 50 kHz: around the drive frequency", BANDPASS, 4, 1300.0, 1700.0, 50000.0),
     ("BP N=1 1400-1600 Hz @ 50 kHz", BANDPASS, 1, 1400.0, 1600.0, 50000.0),
-    ("BP N=3 500-12000 Hz @ 50 kHz: wide, real poles from the real prototype pole", BANDPASS, 3, 500.0, 12000.0, 50000.0),
+    ("BP N=3 500-12000 Hz @ 50 kHz: wide, real poles from the real prototype pole",
+     BANDPASS, 3, 500.0, 12000.0, 50000.0),
 ]
 
 N_TIME = 4000

@@ -11,6 +11,7 @@ APT_PKGS=(
   libeigen3-dev          # host-only C++ reference implementations (tests/reference)
   libcjson-dev           # scenario-file parsing in gyro-sim
   cppcheck               # static analysis of firmware/ and hal/
+  clang-format           # C style check (ctest clang_format, .clang-format)
   gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi  # target build
   valgrind               # callgrind instruction counts (benchmarks)
   clang                  # libFuzzer harnesses
@@ -18,7 +19,7 @@ APT_PKGS=(
   tmux picocom           # console mode at a real terminal (ctest e2e_console_picocom)
   python3 python3-pip python3-venv
 )
-PIP_PKGS=(numpy scipy matplotlib allantools pyserial pytest)
+PIP_PKGS=(numpy scipy matplotlib allantools pyserial pytest ruff)
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
@@ -38,7 +39,7 @@ fi
 
 PY=${PYTHON:-python3}
 need_pip=0
-for m in numpy scipy matplotlib allantools serial pytest; do
+for m in numpy scipy matplotlib allantools serial pytest ruff; do
   if ! "$PY" -c "import $m" >/dev/null 2>&1; then need_pip=1; fi
 done
 if [ "$need_pip" -eq 1 ]; then

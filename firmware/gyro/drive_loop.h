@@ -6,7 +6,7 @@
  * voltages later still; the designer is told that delay (lag_samples).
  *
  * Measurement: the drive pickoff phasor Z = w_s + j w_c from the drive LMSD (see
- * gyro_cfg.h for the phasor convention). Amplitude |Z| by one VSQRT, phase arg(Z) by
+ * gyro.h for the phasor convention). Amplitude |Z| by one VSQRT, phase arg(Z) by
  * fm_atan2f.
  *
  * Amplitude loop: e_A = A_set - |Z| (V). The thesis linearises the measured amplitude

@@ -1,6 +1,6 @@
 /* The gyro: everything the 50 kHz tick runs, as one instance.
  *
- * gyro_tick() is the whole sample path (architecture.md), the same code on host and
+ * gyro_tick() is the whole sample path, the same code on host and
  * target:
  *   NCO -> LMSD(drive), LMSD(sense) -> drive loops -> drive synthesis -> rate channel
  *   -> supervisor -> outputs (DAC frame, telemetry snapshot)

@@ -15,7 +15,7 @@
  * than the Brownian floor). Likewise A_set (held by the amplitude loop) normalises the
  * Coriolis signal, which is proportional to the drive amplitude (2-28).
  * A demodulation-phase error d_phi leaks quadrature into rate as Q sin(d_phi): with
- * 1500 deg/s of quadrature, 0.01 deg is 0.26 deg/s of bias (system.md, 2.4.2 B).
+ * 1500 deg/s of quadrature, 0.01 deg is 0.26 deg/s of bias (thesis §2.4.2 B).
  *
  * Output: rate = scale * Re(R_f) * sf(P_f) - bias(P_f), R_f the Butterworth-filtered R,
  * P_f the low-passed force phase in degrees (temperature is slow: a 1 Hz low-pass keeps

@@ -16,7 +16,7 @@
  *                 range: a little more rate, quadrature or vibration clips it
  *   OVER_RANGE    |rate| above the full scale
  *   PHASE         the drive phase error, turned into rate through the quadrature it
- *                 rotates (Q sin(e), system.md 2.4.2 B), above tol_dps, or the phase
+ *                 rotates (Q sin(e), thesis §2.4.2 B), above tol_dps, or the phase
  *                 error beyond the lock tolerance
  *   THERMO_RANGE  the thermometer P_f outside the range its compensation holds for
  *   THERMO_SLEW   the thermometer moving faster than it was validated for

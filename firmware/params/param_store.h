@@ -51,12 +51,14 @@
  *
  * Why save needs the loop safe: on a single-bank part a 16 KB sector erase stalls
  * every instruction fetch from flash for 250 ms typical (500 ms max), and the drive
- * amplitude decays with tau = 2 Q1 / wn1 = 7 ms (6-12): a save while the gyro runs
- * would stop the 50 kHz tick for ~35 time constants and drop the loop. Running the
- * whole sample path from RAM would avoid the stall, but needs every function and
- * constant the ISR touches (libgcc helpers, const tables) placed in RAM and kept there
- * by the linker script - fragile for a rarely used command. So a save is refused unless
- * the caller says the loop is safe (drive off / not LOCKED).
+ * amplitude decays with tau = 2 Q1 / wn1 = 7 ms (6-12). The flash routines, the vector
+ * table, the UART interrupt and the sample interrupt's path in LOCKED (and the SWEEP
+ * executive) run from SRAM, so a LOCKED tick survives an erase; but the rest does not:
+ * sample-path code of the other modes and of a mode change, and the background loop
+ * (supervisor requests, parameter publication, telemetry drain, command line) stop for
+ * up to ~70 time constants, and telemetry frames are dropped. So a save is refused
+ * unless the caller says the loop is safe (params_loop_safe: drive OFF once the queued
+ * requests are applied, no self-calibration running).
  */
 #ifndef PARAM_STORE_H
 #define PARAM_STORE_H

@@ -7,6 +7,7 @@
  *            [--no-analysis] [--quiet] [--uart-pty[=LINK]]
  *   gyro-sim --list-params
  */
+#define _XOPEN_SOURCE 700 /* nftw */
 #include <cJSON.h>
 #include <errno.h>
 #include <getopt.h>
@@ -14,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <ftw.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -59,8 +61,8 @@ static void list_params(void)
     const param_info_t *pi = param_info((param_idx_t)i);
     const param_value_t x = param_get(&v, (param_idx_t)i);
     if (pi->type == PARAM_T_F32) {
-      printf("firmware.%-31s %-12g [%g, %g] %s  %s\n", pi->name, (double)x.f,
-             (double)pi->min.f, (double)pi->max.f, pi->unit, pi->help);
+      printf("firmware.%-31s %-12g [%g, %g] %s  %s\n", pi->name, (double)x.f, (double)pi->min.f,
+             (double)pi->max.f, pi->unit, pi->help);
     } else {
       printf("firmware.%-31s %-12u [%u, %u] %s  %s\n", pi->name, x.u, pi->min.u, pi->max.u,
              pi->unit, pi->help);
@@ -75,8 +77,10 @@ static double brownian_floor_dph(const plant_cfg_t *pc, double f_drive_hz, doubl
                                  double t_k)
 {
   const double w1 = 2.0 * PLANT_PI * f_drive_hz;
-  const double w2 = 2.0 * PLANT_PI * pc->f_sense_hz * (1.0 - 0.5 * pc->ket_per_k * (t_k - pc->temp_ref_k));
-  const double om = sqrt(4.0 * KB_J_PER_K * t_k * w2 / (pc->mass_kg * pc->q_sense)) / (2.0 * amp_m * w1);
+  const double w2 = 2.0 * PLANT_PI * pc->f_sense_hz *
+                    (1.0 - 0.5 * pc->ket_per_k * (t_k - pc->temp_ref_k));
+  const double om = sqrt(4.0 * KB_J_PER_K * t_k * w2 / (pc->mass_kg * pc->q_sense)) /
+                    (2.0 * amp_m * w1);
   return om * 180.0 / PLANT_PI * 3600.0;
 }
 
@@ -100,416 +104,590 @@ static int mkdir_p(const char *d)
   return (mkdir(buf, 0777) == 0 || errno == EEXIST) ? 0 : -1;
 }
 
-int main(int argc, char **argv)
+/* Removes a file or an emptied folder on the way out of the temporary tree. */
+static int remove_entry(const char *path, const struct stat *st, int flag, struct FTW *ftw)
 {
-  static sim_scenario_t sc;
-  scenario_defaults(&sc);
-  const char *scen_path = NULL, *csv_path = NULL, *json_path = NULL, *out_dir = NULL;
-  double duration = -1.0, csv_rate = -1.0;
-  long long seed = -1;
-  int quiet = 0, analysis = 1, uart_pty = 0;
-  const char *uart_pty_link = NULL;
-  const char *isr_json = NULL;
-  static const struct option lo[] = {
-      {"scenario", required_argument, 0, 's'}, {"duration", required_argument, 0, 'd'},
-      {"seed", required_argument, 0, 'S'},     {"csv", required_argument, 0, 'c'},
-      {"csv-rate", required_argument, 0, 'r'}, {"json", required_argument, 0, 'j'},
-      {"out", required_argument, 0, 'o'},      {"set", required_argument, 0, 'x'},
-      {"quiet", no_argument, 0, 'q'},          {"no-analysis", no_argument, 0, 'n'},
-      {"list-params", no_argument, 0, 'L'},    {"help", no_argument, 0, 'h'},
-      {"uart-pty", optional_argument, 0, 'u'}, {"isr-figures", required_argument, 0, 'i'},
-      {0, 0, 0, 0}};
-  static char sets[SIM_MAX_SETS][160];
-  int n_sets = 0;
+  (void)st;
+  (void)flag;
+  (void)ftw;
+  return remove(path);
+}
+
+/* Removes the folder and everything in it (the analyses' temporary folder), without
+ * following symbolic links. */
+static int remove_tree(const char *dir)
+{
+  return nftw(dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+}
+
+/* The command line, as given. */
+typedef struct {
+  const char *scen_path, *csv_path, *json_path, *out_dir;
+  double duration_s, csv_rate_hz; /* <= 0: the scenario's */
+  long long seed;                 /* < 0: the scenario's */
+  int quiet, analysis, uart_pty;
+  const char *uart_pty_link;
+  const char *isr_json;
+  char sets[SIM_MAX_SETS][160];
+  int n_sets;
+} cli_args_t;
+
+/* Parses the options into a. Returns -1 to go on, else the exit code (usage, --help,
+ * --list-params). */
+static int parse_args(int argc, char **argv, cli_args_t *a)
+{
+  static const struct option lo[] = {{"scenario", required_argument, 0, 's'},
+                                     {"duration", required_argument, 0, 'd'},
+                                     {"seed", required_argument, 0, 'S'},
+                                     {"csv", required_argument, 0, 'c'},
+                                     {"csv-rate", required_argument, 0, 'r'},
+                                     {"json", required_argument, 0, 'j'},
+                                     {"out", required_argument, 0, 'o'},
+                                     {"set", required_argument, 0, 'x'},
+                                     {"quiet", no_argument, 0, 'q'},
+                                     {"no-analysis", no_argument, 0, 'n'},
+                                     {"list-params", no_argument, 0, 'L'},
+                                     {"help", no_argument, 0, 'h'},
+                                     {"uart-pty", optional_argument, 0, 'u'},
+                                     {"isr-figures", required_argument, 0, 'i'},
+                                     {0, 0, 0, 0}};
+  memset(a, 0, sizeof *a);
+  a->duration_s = -1.0;
+  a->csv_rate_hz = -1.0;
+  a->seed = -1;
+  a->analysis = 1;
   int opt;
   char *end;
   while ((opt = getopt_long(argc, argv, "", lo, NULL)) != -1) {
     switch (opt) {
-    case 's': scen_path = optarg; break;
+    case 's': a->scen_path = optarg; break;
     case 'd':
       errno = 0;
-      duration = strtod(optarg, &end);
-      if (*end || errno || !(duration > 0.0) || duration > 1e6) {
-        fprintf(stderr, "gyro-sim: --duration: '%s' is not a number of seconds in (0, 1e6]\n", optarg);
+      a->duration_s = strtod(optarg, &end);
+      if (*end || errno || !(a->duration_s > 0.0) || a->duration_s > 1e6) {
+        fprintf(stderr, "gyro-sim: --duration: '%s' is not a number of seconds in (0, 1e6]\n",
+                optarg);
         return 2;
       }
       break;
     case 'S':
       errno = 0;
-      seed = strtoll(optarg, &end, 10);
-      if (*end || errno || seed < 0) {
+      a->seed = strtoll(optarg, &end, 10);
+      if (*end || errno || a->seed < 0) {
         fprintf(stderr, "gyro-sim: --seed: '%s' is not a non-negative integer\n", optarg);
         return 2;
       }
       break;
-    case 'c': csv_path = optarg; break;
+    case 'c': a->csv_path = optarg; break;
     case 'r':
       errno = 0;
-      csv_rate = strtod(optarg, &end);
-      if (*end || errno || !(csv_rate > 0.0) || csv_rate > 50000.0) {
+      a->csv_rate_hz = strtod(optarg, &end);
+      if (*end || errno || !(a->csv_rate_hz > 0.0) || a->csv_rate_hz > 50000.0) {
         fprintf(stderr, "gyro-sim: --csv-rate: '%s' is not a rate in (0, 50000] Hz\n", optarg);
         return 2;
       }
       break;
-    case 'j': json_path = optarg; break;
-    case 'o': out_dir = optarg; break;
+    case 'j': a->json_path = optarg; break;
+    case 'o': a->out_dir = optarg; break;
     case 'x':
-      if (n_sets >= SIM_MAX_SETS || strlen(optarg) >= sizeof sets[0]) {
+      if (a->n_sets >= SIM_MAX_SETS || strlen(optarg) >= sizeof a->sets[0]) {
         fprintf(stderr, "gyro-sim: too many or too long --set\n");
         return 2;
       }
-      snprintf(sets[n_sets++], sizeof sets[0], "%s", optarg);
+      snprintf(a->sets[a->n_sets++], sizeof a->sets[0], "%s", optarg);
       break;
-    case 'q': quiet = 1; break;
+    case 'q': a->quiet = 1; break;
     case 'u':
-      uart_pty = 1;
-      uart_pty_link = optarg;
+      a->uart_pty = 1;
+      a->uart_pty_link = optarg;
       break;
-    case 'n': analysis = 0; break;
-    case 'i': isr_json = optarg; break;
+    case 'n': a->analysis = 0; break;
+    case 'i': a->isr_json = optarg; break;
     case 'L': list_params(); return 0;
     case 'h': usage(stdout); return 0;
     default: usage(stderr); return 2;
     }
   }
-  if (scen_path == NULL || optind != argc) {
+  if (a->scen_path == NULL || optind != argc) {
     usage(stderr);
     return 2;
   }
+  return -1;
+}
+
+/* Loads the scenario and applies --set, --duration, --seed and --csv-rate. Returns 0, or
+ * the exit code after the message. */
+static int load_scenario(const cli_args_t *a, sim_scenario_t *sc)
+{
   char err[512];
-  if (scenario_load(&sc, scen_path, err, sizeof err) != 0) {
+  scenario_defaults(sc);
+  if (scenario_load(sc, a->scen_path, err, sizeof err) != 0) {
     fprintf(stderr, "gyro-sim: %s\n", err);
     return 2;
   }
-  for (int i = 0; i < n_sets; i++) {
-    if (scenario_add_override(&sc, sets[i], err, sizeof err) != 0) {
+  for (int i = 0; i < a->n_sets; i++) {
+    if (scenario_add_override(sc, a->sets[i], err, sizeof err) != 0) {
       fprintf(stderr, "gyro-sim: %s\n", err);
       return 2;
     }
   }
-  bench_figs_t isr;
-  if (isr_json != NULL && bench_figs_load(isr_json, &isr, err, sizeof err) != 0) {
-    fprintf(stderr, "gyro-sim: %s\n", err);
-    return 2;
-  }
-  if (duration > 0.0) sc.duration_s = duration;
-  if (seed >= 0) sc.seed = (uint64_t)seed;
-  if (csv_rate > 0.0) sc.csv_rate_hz = csv_rate;
+  if (a->duration_s > 0.0) sc->duration_s = a->duration_s;
+  if (a->seed >= 0) sc->seed = (uint64_t)a->seed;
+  if (a->csv_rate_hz > 0.0) sc->csv_rate_hz = a->csv_rate_hz;
+  return 0;
+}
 
-  /* Analyses by the tools need a trace and a folder; without --out they use a temporary
-   * one that is removed afterwards. */
-  const uint32_t tool_analyses = SIM_AN_RATE_TABLE | SIM_AN_NOISE | SIM_AN_ALLAN |
-                                 SIM_AN_DRIVE_NOISE | SIM_AN_TEMP | SIM_AN_SWEEP;
-  const int need_tools = analysis && (sc.analyses & tool_analyses) != 0u;
-  char tmpdir[] = "/tmp/gyro-sim-XXXXXX";
-  int tmp_used = 0;
-  if (out_dir == NULL && need_tools) {
+/* What the figures are built from and where they go. */
+typedef struct {
+  const sim_scenario_t *sc;
+  const plant_cfg_t *pc;
+  const sim_result_t *res;
+  const char *out_dir;  /* the tools' folder; NULL when no tool runs */
+  const char *csv_path; /* the trace the tools read */
+  int quiet;
+  cJSON *fig; /* "figures" of the JSON */
+  int failed; /* a tool failed */
+  char err[512];
+} report_t;
+
+/* Runs one analysis tool; NULL (after the message, marking the run failed) if it fails. */
+static cJSON *run_tool(report_t *r, const char *tool, const char *const *args,
+                       const char *json_name)
+{
+  cJSON *j = post_run_tool(tool, args, r->out_dir, json_name, r->err, sizeof r->err);
+  if (j == NULL) {
+    fprintf(stderr, "gyro-sim: %s\n", r->err);
+    r->failed = 1;
+  }
+  return j;
+}
+
+static void add_params(cJSON *root, const sim_scenario_t *sc, const plant_cfg_t *pc,
+                       const param_values_t *fw)
+{
+  cJSON *params = cJSON_AddObjectToObject(root, "params");
+  for (size_t i = 0; i < plant_param_count(); i++) {
+    const plant_param_desc_t *d = plant_param_at(i);
+    add_num(params, d->name, plant_param_get(pc, d));
+  }
+  for (unsigned i = 0; i < (unsigned)PARAM_COUNT; i++) {
+    const param_info_t *pi = param_info((param_idx_t)i);
+    const param_value_t x = param_get(fw, (param_idx_t)i);
+    add_num(params, pi->name, pi->type == PARAM_T_F32 ? (double)x.f : (double)x.u);
+  }
+  add_num(params, "duration_s", sc->duration_s);
+  add_num(params, "seed", (double)sc->seed);
+}
+
+/* The run's speed and, with --isr-figures, the interrupt cost measured on the target. */
+static void report_run(report_t *r, const char *isr_json, const bench_figs_t *isr)
+{
+  if (isr_json != NULL) {
+    add_num(r->fig, "isr_instructions_per_tick", isr->insns_mean);
+    add_num(r->fig, "isr_instructions_per_tick_max", isr->insns_max);
+    if (isr->have_cycles) {
+      add_num(r->fig, "isr_cycles_est_mean", isr->cycles_mean);
+      add_num(r->fig, "isr_cycles_est_max", isr->cycles_max);
+    }
+  }
+  if (r->quiet) return;
+  const sim_result_t *res = r->res;
+  printf("scenario %s: %s\n", r->sc->name, r->sc->description);
+  printf("  simulated %.1f s in %.2f s wall (%.2f s CPU): %.0fx real time (%.0fx per CPU second)\n",
+         res->sim_s, res->wall_s, res->cpu_s, res->realtime_factor, res->realtime_factor_cpu);
+  if (isr_json != NULL) {
+    printf("  Cortex-M4F sample interrupt (%s): %.0f instructions per tick (worst %.0f)",
+           isr_json, isr->insns_mean, isr->insns_max);
+    if (isr->have_cycles)
+      printf(", about %.0f cycles (worst %.0f)", isr->cycles_mean, isr->cycles_max);
+    printf("\n");
+  }
+}
+
+static void report_startup(report_t *r)
+{
+  const sim_startup_t *s = &r->res->startup;
+  add_num(r->fig, "lock_time_s", s->lock_time_s);
+  add_num(r->fig, "overshoot_pct", s->overshoot_pct);
+  add_num(r->fig, "amp_err_rms_pct", s->amp_err_rms_pct);
+  add_num(r->fig, "phase_err_rms_deg", s->phase_err_rms_deg);
+  add_num(r->fig, "fw_lock_time_s", s->fw_lock_time_s);
+  add_num(r->fig, "rate_settle_s", s->rate_settle_s);
+  add_num(r->fig, "drive_amp_true_m", s->final_amp_m);
+  if (r->quiet) return;
+  printf("  start-up (true motion): within 1 %% and held from %.3f s; overshoot %.2f %%\n",
+         s->lock_time_s, s->overshoot_pct);
+  printf("  after lock, 0.1-100 Hz: amplitude error %.4f %% rms, phase error %.5f deg rms\n",
+         s->amp_err_rms_pct, s->phase_err_rms_deg);
+  printf("  firmware LOCKED at %.3f s; drive amplitude %.3f um; rate output within 0.5 deg/s "
+         "of its final error from %.3f s\n",
+         s->fw_lock_time_s, 1e6 * s->final_amp_m, s->rate_settle_s);
+}
+
+static void report_closed_loop(report_t *r)
+{
+  const sim_result_t *res = r->res;
+  add_num(r->fig, "faults", res->faults);
+  add_num(r->fig, "final_mode", res->final_mode);
+  add_num(r->fig, "rate_valid_fraction", res->rate_valid_fraction);
+  add_num(r->fig, "rate_first_valid_s", res->rate_first_valid_s);
+  if (!r->quiet) {
+    printf("  rate output valid from %.3f s, %.1f %% of the run (faults %u)\n",
+           res->rate_first_valid_s, 100.0 * res->rate_valid_fraction, (unsigned)res->faults);
+  }
+  add_num(r->fig, "mean_drive_freq_hz", res->mean_drive_freq_hz);
+  add_num(r->fig, "mean_drive_amp_m", res->mean_drive_amp_m);
+  add_num(r->fig, "mean_struct_temp_k", res->mean_struct_k);
+}
+
+/* The open-loop sweep's trace (sweep.csv) and the drive resonance identified on it. */
+static void report_sweep(report_t *r, const sim_sweep_t *sweep, int analysis)
+{
+  char sp[1100];
+  snprintf(sp, sizeof sp, "%s/sweep.csv", r->out_dir ? r->out_dir : ".");
+  FILE *f = fopen(sp, "w");
+  if (f != NULL) {
+    fputs("f_hz,amp,phase_deg\n", f);
+    for (int i = 0; i < sweep->n; i++)
+      fprintf(f, "%.6f,%.9g,%.6f\n", sweep->f_hz[i], sweep->amp_v[i], sweep->phase_deg[i]);
+    fclose(f);
+  }
+  if (!analysis || !(r->sc->analyses & SIM_AN_SWEEP)) return;
+  const char *args[] = {sp, NULL};
+  cJSON *j = run_tool(r, "gyro-freqresp", args, "freqresp.json");
+  if (j == NULL) return;
+  add_num(r->fig, "f0_hz", post_num(j, "f0_hz"));
+  add_num(r->fig, "q", post_num(j, "q"));
+  add_num(r->fig, "phase_at_f0_deg", post_num(j, "phase_at_f0_deg"));
+  add_num(r->fig, "peak_gain_v", post_num(j, "peak_gain"));
+  add_num(r->fig, "f_3db_lo_hz", post_num(j, "f_3db_lo_hz"));
+  add_num(r->fig, "f_3db_hi_hz", post_num(j, "f_3db_hi_hz"));
+  if (!r->quiet) {
+    printf("  identified drive resonance %.3f Hz (plant %.3f Hz), Q %.2f (plant %.2f),\n"
+           "    phase at resonance %.2f deg, -3 dB %.2f..%.2f Hz\n",
+           post_num(j, "f0_hz"), r->pc->f_drive_hz, post_num(j, "q"), r->pc->q_drive,
+           post_num(j, "phase_at_f0_deg"), post_num(j, "f_3db_lo_hz"),
+           post_num(j, "f_3db_hi_hz"));
+  }
+  cJSON_Delete(j);
+}
+
+/* Table 7-1: the half-frequency drive's amplitude goes with U^2 (6-19). Fits
+ * amp = k U^2 through the origin and reports the largest deviation. */
+static void report_square_law(report_t *r, const sim_square_t *sq)
+{
+  double sxy = 0, sxx = 0, amax = 0, dmax = 0;
+  for (int i = 0; i < sq->n; i++) {
+    const double u2 = sq->u_v[i] * sq->u_v[i];
+    sxy += u2 * sq->amp_v[i];
+    sxx += u2 * u2;
+    if (sq->amp_v[i] > amax) amax = sq->amp_v[i];
+  }
+  const double k = sxy / sxx;
+  cJSON *tab = cJSON_AddArrayToObject(r->fig, "square_law");
+  if (!r->quiet)
+    printf("  square law (table 7-1): U (V) -> drive pickoff (V), displacement (um), fit k U^2\n");
+  for (int i = 0; i < sq->n; i++) {
+    const double fit = k * sq->u_v[i] * sq->u_v[i];
+    if (fabs(sq->amp_v[i] - fit) > dmax) dmax = fabs(sq->amp_v[i] - fit);
+    cJSON *row = cJSON_CreateObject();
+    add_num(row, "u_v", sq->u_v[i]);
+    add_num(row, "amp_v", sq->amp_v[i]);
+    add_num(row, "amp_m", sq->amp_m[i]);
+    cJSON_AddItemToArray(tab, row);
+    if (!r->quiet)
+      printf("    %6.2f  %8.4f  %8.4f  %8.4f\n", sq->u_v[i], sq->amp_v[i], 1e6 * sq->amp_m[i],
+             fit);
+  }
+  add_num(r->fig, "square_law_k_v_per_v2", k);
+  add_num(r->fig, "square_law_nonlinearity_pct", 100.0 * dmax / amax);
+  if (!r->quiet)
+    printf("  k = %.6g V/V^2, largest deviation %.3f %% of the largest amplitude\n", k,
+           100.0 * dmax / amax);
+}
+
+static void analyse_rate_table(report_t *r)
+{
+  const char *args[] = {r->csv_path, "--settle", "0.5", "--min-avg", "0.5", NULL};
+  cJSON *j = run_tool(r, "gyro-scalefactor", args, "scalefactor.json");
+  if (j == NULL) return;
+  add_num(r->fig, "scale_factor", post_num(j, "scale_factor_out_per_dps"));
+  add_num(r->fig, "bias_dps", post_num(j, "bias_out"));
+  add_num(r->fig, "nonlinearity_pct", post_num(j, "nonlinearity_rms_percent_of_fs"));
+  add_num(r->fig, "nonlinearity_max_pct", post_num(j, "nonlinearity_max_percent_of_fs"));
+  add_num(r->fig, "asymmetry", post_num(j, "asymmetry_fraction"));
+  if (!r->quiet) {
+    printf("  rate table: scale factor %.6f (deg/s)/(deg/s), bias %.4f deg/s, nonlinearity %.4f %% FS rms\n",
+           post_num(j, "scale_factor_out_per_dps"), post_num(j, "bias_out"),
+           post_num(j, "nonlinearity_rms_percent_of_fs"));
+  }
+  cJSON_Delete(j);
+}
+
+/* White rate noise against the Brownian floor (4-24), from the Allan fit j scaled to the
+ * input by the scale factor sf. */
+static void report_noise(report_t *r, const cJSON *j, double sf)
+{
+  const sim_result_t *res = r->res;
+  const double n_in = post_num(j, "arw_dph_per_rthz") / sf;
+  const double floor = brownian_floor_dph(r->pc, res->mean_drive_freq_hz, res->mean_drive_amp_m,
+                                          res->mean_struct_k);
+  add_num(r->fig, "arw_coeff_dph_rthz", n_in);
+  add_num(r->fig, "adev_1s_dph", post_num(j, "adev_at_1s_dph") / sf);
+  add_num(r->fig, "brownian_floor_dph_rthz", floor);
+  add_num(r->fig, "arw_over_floor", n_in / floor);
+  if (!r->quiet) {
+    printf("  rate noise N = %.3f deg/h/rtHz (Allan -1/2 slope, two-sided; one-sided ASD %.3f),\n"
+           "    Brownian floor (4-24) at %.3f Hz, %.3f um, %.2f K: %.3f deg/h/rtHz; ratio %.3f\n",
+           n_in, sqrt(2.0) * n_in, res->mean_drive_freq_hz, 1e6 * res->mean_drive_amp_m,
+           res->mean_struct_k, floor, n_in / floor);
+  }
+}
+
+static void report_allan(report_t *r, const cJSON *j, double sf)
+{
+  add_num(r->fig, "arw_deg_rth", post_num(j, "arw_deg_per_rth") / sf);
+  add_num(r->fig, "bias_instability_dph", post_num(j, "bias_instability_dph") / sf);
+  add_num(r->fig, "rate_ramp_dph_per_h", post_num(j, "rate_ramp_dph_per_h") / sf);
+  /* The fitted three-term model can read a change of white level as flicker; the
+   * measured minimum bounds the bias instability whatever the model says. */
+  add_num(r->fig, "adev_min_dph", post_num(j, "adev_min_measured_dph") / sf);
+  add_num(r->fig, "tau_at_adev_min_s", post_num(j, "tau_at_min_measured_s"));
+  if (!r->quiet) {
+    printf("  Allan: ARW %.4f deg/rt(h), bias instability %.3f deg/h (fit), rate ramp %.3f deg/h/h;\n"
+           "    lowest measured Allan deviation %.3f deg/h at %.0f s\n",
+           post_num(j, "arw_deg_per_rth") / sf, post_num(j, "bias_instability_dph") / sf,
+           post_num(j, "rate_ramp_dph_per_h") / sf, post_num(j, "adev_min_measured_dph") / sf,
+           post_num(j, "tau_at_min_measured_s"));
+  }
+}
+
+static void analyse_noise_allan(report_t *r)
+{
+  const sim_scenario_t *sc = r->sc;
+  char tend[32];
+  /* Allan on the static part of the run: the scenario's last rate step (if any) is
+   * its scale-factor check and is left out. */
+  const int sf_step = sc->has_rate && sc->rate_dps.kind == PROFILE_STEPS &&
+                      sc->rate_dps.n_steps > 1;
+  const double t_end = sf_step ? sc->rate_dps.step_s[0] : sc->duration_s;
+  snprintf(tend, sizeof tend, "%.6f", t_end);
+  const char *args[] = {r->csv_path, "--t-start", "1", "--t-end", tend, NULL};
+  cJSON *j = post_run_tool("gyro-allan", args, r->out_dir, "allan.json", r->err, sizeof r->err);
+  double sf = 1.0;
+  if (j != NULL && sf_step) {
+    const char *a2[] = {r->csv_path, "--t-start", tend,  "--settle",
+                        "0.5",       "--min-avg", "0.5", NULL};
+    cJSON *s = post_run_tool("gyro-scalefactor", a2, r->out_dir, "scalefactor.json", r->err,
+                             sizeof r->err);
+    if (s != NULL) {
+      sf = post_num(s, "scale_factor_out_per_dps");
+      add_num(r->fig, "scale_factor", sf);
+      cJSON_Delete(s);
+    }
+  }
+  if (j == NULL) {
+    fprintf(stderr, "gyro-sim: %s\n", r->err);
+    r->failed = 1;
+    return;
+  }
+  if (sc->analyses & SIM_AN_NOISE) report_noise(r, j, sf);
+  if (sc->analyses & SIM_AN_ALLAN) report_allan(r, j, sf);
+  cJSON_Delete(j);
+}
+
+static void analyse_drive_noise(report_t *r)
+{
+  const char *args[] = {
+      r->csv_path, "--column", "drive_amp_true_m", "--band", "1", "10", "--t-start", "2", NULL};
+  cJSON *j = run_tool(r, "gyro-psd", args, "psd.json");
+  if (j == NULL) return;
+  const double rel = post_num(j, "white_asd_one_sided_per_rthz") / r->res->mean_drive_amp_m;
+  add_num(r->fig, "drive_amp_noise_lf_rel", rel);
+  if (!r->quiet)
+    printf("  drive amplitude noise over 1-10 Hz: %.3g /rtHz relative (one-sided)\n", rel);
+  cJSON_Delete(j);
+}
+
+static void analyse_temp(report_t *r)
+{
+  const sim_scenario_t *sc = r->sc;
+  /* Fit against the firmware's own low-passed P (what its compensation uses; the
+   * instantaneous P carries the phase loop's ripple) and, for a heat-gun run, on
+   * the cool-down only, as the thesis does (7.3.2). */
+  char t0[32] = "0";
+  if (sc->has_ambient && sc->ambient_c.kind == PROFILE_HEAT_COOL) {
+    snprintf(t0, sizeof t0, "%.3f", sc->ambient_c.t_start_s + sc->ambient_c.heat_s);
+  }
+  const char *args[] = {r->csv_path,     "--column",  "rate_dps",  "--p-column", "p_f_deg",
+                        "--temp-column", "t_board_c", "--t-start", t0,           NULL};
+  cJSON *j = run_tool(r, "gyro-tempcomp", args, "tempcomp.json");
+  if (j == NULL) return;
+  add_num(r->fig, "residual_bias_p_dps", post_num(j, "p_fit.residual_std_dps"));
+  add_num(r->fig, "residual_bias_sensor_dps", post_num(j, "t_fit.residual_std_dps"));
+  add_num(r->fig, "residual_bias_p_pp_dps", post_num(j, "p_fit.residual_p2p_dps"));
+  add_num(r->fig, "residual_bias_sensor_pp_dps", post_num(j, "t_fit.residual_p2p_dps"));
+  add_num(r->fig, "bias_p_order", post_num(j, "p_fit.order"));
+  if (!r->quiet) {
+    printf("  temperature compensation: residual bias with P %.4f deg/s (p-p %.4f), with the board sensor %.4f deg/s (p-p %.4f)\n",
+           post_num(j, "p_fit.residual_std_dps"), post_num(j, "p_fit.residual_p2p_dps"),
+           post_num(j, "t_fit.residual_std_dps"), post_num(j, "t_fit.residual_p2p_dps"));
+  }
+  cJSON_Delete(j);
+}
+
+/* The closed-loop figures that the analysis tools compute on the trace. */
+static void analyse_trace(report_t *r)
+{
+  const uint32_t an = r->sc->analyses;
+  if (an & SIM_AN_RATE_TABLE) analyse_rate_table(r);
+  if (an & (SIM_AN_NOISE | SIM_AN_ALLAN)) analyse_noise_allan(r);
+  if (an & SIM_AN_DRIVE_NOISE) analyse_drive_noise(r);
+  if (an & SIM_AN_TEMP) analyse_temp(r);
+}
+
+static int write_json(const cJSON *root, const char *json_path)
+{
+  char *txt = cJSON_Print(root);
+  FILE *f = fopen(json_path, "w");
+  int rc = 0;
+  if (f == NULL || txt == NULL) {
+    fprintf(stderr, "gyro-sim: --json %s: %s\n", json_path, strerror(errno));
+    rc = -1;
+  } else {
+    fputs(txt, f);
+    fputc('\n', f);
+    fclose(f);
+  }
+  free(txt);
+  return rc;
+}
+
+/* Where the analysis tools write: --out (made if missing) or, when tools run without it,
+ * a temporary folder removed at the end (*tmp_used). Returns 0, or the exit code. */
+static int prepare_out_dir(const char **out_dir, char *tmpdir, int need_tools, int *tmp_used)
+{
+  *tmp_used = 0;
+  if (*out_dir == NULL && need_tools) {
     if (mkdtemp(tmpdir) == NULL) {
       fprintf(stderr, "gyro-sim: cannot make a temporary folder: %s\n", strerror(errno));
       return 1;
     }
-    out_dir = tmpdir;
-    tmp_used = 1;
-  } else if (out_dir != NULL && mkdir_p(out_dir) != 0) {
-    fprintf(stderr, "gyro-sim: --out %s: %s\n", out_dir, strerror(errno));
+    *out_dir = tmpdir;
+    *tmp_used = 1;
+  } else if (*out_dir != NULL && mkdir_p(*out_dir) != 0) {
+    fprintf(stderr, "gyro-sim: --out %s: %s\n", *out_dir, strerror(errno));
     return 2;
   }
-  char trace[1100];
-  if (csv_path == NULL && need_tools && sc.mode == SIM_CLOSED_LOOP) {
-    snprintf(trace, sizeof trace, "%s/trace.csv", out_dir);
-    csv_path = trace;
-  }
+  return 0;
+}
 
+/* The figures of a finished run: printed unless quiet, and into the JSON root. */
+static void report_figures(report_t *r, const cli_args_t *a, const bench_figs_t *isr,
+                           const sim_sweep_t *sweep, const sim_square_t *sq, int need_tools)
+{
+  const sim_scenario_t *sc = r->sc;
+  report_run(r, a->isr_json, isr);
+  if (sc->analyses & SIM_AN_STARTUP) report_startup(r);
+  if (sc->loop == SIM_CLOSED_LOOP) report_closed_loop(r);
+  add_num(r->fig, "adc_fraction_drive", r->res->adc_fraction[0]);
+  add_num(r->fig, "adc_fraction_sense", r->res->adc_fraction[1]);
+  add_num(r->fig, "adc_clips_drive", (double)r->res->adc_clips[0]);
+  add_num(r->fig, "adc_clips_sense", (double)r->res->adc_clips[1]);
+  if (sc->loop == SIM_OPEN_LOOP_SWEEP && sweep->n > 0) report_sweep(r, sweep, a->analysis);
+  if (sc->loop == SIM_OPEN_LOOP && sq->n > 1) {
+    report_square_law(r, sq);
+  } else if (sc->loop == SIM_OPEN_LOOP && sq->n == 1) {
+    add_num(r->fig, "drive_amp_v", sq->amp_v[0]);
+    add_num(r->fig, "drive_amp_m", sq->amp_m[0]);
+  }
+  if (need_tools && sc->loop == SIM_CLOSED_LOOP) analyse_trace(r);
+}
+
+/* Runs the loaded scenario and reports it. Returns the exit code. */
+static int run(const cli_args_t *a, const sim_scenario_t *sc, const bench_figs_t *isr,
+               const char *out_dir, const char *csv_path, int need_tools)
+{
+  char err[512];
   plant_cfg_t pc;
   plant_profiles_t prof;
   param_values_t fw;
-  if (sim_plant_cfg(&sc, &pc, &prof, err, sizeof err) != 0 ||
-      sim_fw_params(&sc, &fw, err, sizeof err) != 0) {
+  if (sim_plant_cfg(sc, &pc, &prof, err, sizeof err) != 0 ||
+      sim_fw_params(sc, &fw, err, sizeof err) != 0) {
     fprintf(stderr, "gyro-sim: %s\n", err);
     return 2;
   }
-  if (uart_pty && sc.mode != SIM_CLOSED_LOOP) {
+  if (a->uart_pty && sc->loop != SIM_CLOSED_LOOP) {
     fprintf(stderr, "gyro-sim: --uart-pty needs a closed-loop scenario\n");
     return 2;
   }
-  const sim_opts_t so = {csv_path, sc.csv_rate_hz, !quiet && isatty(2) && sc.duration_s > 2.0,
-                         uart_pty, uart_pty_link};
+  const sim_opts_t so = {csv_path, sc->csv_rate_hz,
+                         !a->quiet && isatty(2) && sc->duration_s > 2.0, a->uart_pty,
+                         a->uart_pty_link};
   static sim_result_t res;
   static sim_sweep_t sweep;
   static sim_square_t sq;
   int rc;
-  if (sc.mode == SIM_CLOSED_LOOP) rc = sim_run_closed_loop(&sc, &so, &res, err, sizeof err);
-  else rc = sim_run_open_loop(&sc, &so, &res, &sweep, &sq, err, sizeof err);
+  if (sc->loop == SIM_CLOSED_LOOP) rc = sim_run_closed_loop(sc, &so, &res, err, sizeof err);
+  else rc = sim_run_open_loop(sc, &so, &res, &sweep, &sq, err, sizeof err);
   if (rc != 0) {
     fprintf(stderr, "gyro-sim: %s\n", err);
     return 1;
   }
 
   cJSON *root = cJSON_CreateObject();
-  cJSON_AddStringToObject(root, "scenario", sc.name);
-  cJSON *params = cJSON_AddObjectToObject(root, "params");
-  for (size_t i = 0; i < plant_param_count(); i++) {
-    const plant_param_desc_t *d = plant_param_at(i);
-    add_num(params, d->name, plant_param_get(&pc, d));
-  }
-  for (unsigned i = 0; i < (unsigned)PARAM_COUNT; i++) {
-    const param_info_t *pi = param_info((param_idx_t)i);
-    const param_value_t x = param_get(&fw, (param_idx_t)i);
-    add_num(params, pi->name, pi->type == PARAM_T_F32 ? (double)x.f : (double)x.u);
-  }
-  add_num(params, "duration_s", sc.duration_s);
-  add_num(params, "seed", (double)sc.seed);
-  cJSON *fig = cJSON_AddObjectToObject(root, "figures");
-  int failed = 0;
-  if (isr_json != NULL) {
-    add_num(fig, "isr_instructions_per_tick", isr.insns_mean);
-    add_num(fig, "isr_instructions_per_tick_max", isr.insns_max);
-    if (isr.have_cycles) {
-      add_num(fig, "isr_cycles_est_mean", isr.cycles_mean);
-      add_num(fig, "isr_cycles_est_max", isr.cycles_max);
-    }
-  }
-
-  if (!quiet) {
-    printf("scenario %s: %s\n", sc.name, sc.description);
-    printf("  simulated %.1f s in %.2f s wall (%.2f s CPU): %.0fx real time (%.0fx per CPU second)\n",
-           res.sim_s, res.wall_s, res.cpu_s, res.realtime_factor, res.realtime_factor_cpu);
-    if (isr_json != NULL) {
-      printf("  Cortex-M4F sample interrupt (%s): %.0f instructions per tick (worst %.0f)",
-             isr_json, isr.insns_mean, isr.insns_max);
-      if (isr.have_cycles) printf(", about %.0f cycles (worst %.0f)", isr.cycles_mean, isr.cycles_max);
-      printf("\n");
-    }
-  }
-  if (sc.analyses & SIM_AN_STARTUP) {
-    const sim_startup_t *s = &res.startup;
-    add_num(fig, "lock_time_s", s->lock_time_s);
-    add_num(fig, "overshoot_pct", s->overshoot_pct);
-    add_num(fig, "amp_err_rms_pct", s->amp_err_rms_pct);
-    add_num(fig, "phase_err_rms_deg", s->phase_err_rms_deg);
-    add_num(fig, "fw_lock_time_s", s->fw_lock_time_s);
-    add_num(fig, "rate_settle_s", s->rate_settle_s);
-    add_num(fig, "drive_amp_true_m", s->final_amp_m);
-    if (!quiet) {
-      printf("  start-up (true motion): within 1 %% and held from %.3f s; overshoot %.2f %%\n",
-             s->lock_time_s, s->overshoot_pct);
-      printf("  after lock, 0.1-100 Hz: amplitude error %.4f %% rms, phase error %.5f deg rms\n",
-             s->amp_err_rms_pct, s->phase_err_rms_deg);
-      printf("  firmware LOCKED at %.3f s; drive amplitude %.3f um; rate output within 0.5 deg/s "
-             "of its final error from %.3f s\n", s->fw_lock_time_s, 1e6 * s->final_amp_m,
-             s->rate_settle_s);
-    }
-  }
-  if (sc.mode == SIM_CLOSED_LOOP) {
-    add_num(fig, "faults", res.faults);
-    add_num(fig, "final_mode", res.final_mode);
-    add_num(fig, "rate_valid_fraction", res.rate_valid_fraction);
-    add_num(fig, "rate_first_valid_s", res.rate_first_valid_s);
-    if (!quiet) {
-      printf("  rate output valid from %.3f s, %.1f %% of the run (faults %u)\n",
-             res.rate_first_valid_s, 100.0 * res.rate_valid_fraction, (unsigned)res.faults);
-    }
-    add_num(fig, "mean_drive_freq_hz", res.mean_drive_freq_hz);
-    add_num(fig, "mean_drive_amp_m", res.mean_drive_amp_m);
-    add_num(fig, "mean_struct_temp_k", res.mean_struct_k);
-  }
-  add_num(fig, "adc_fraction_drive", res.adc_fraction[0]);
-  add_num(fig, "adc_fraction_sense", res.adc_fraction[1]);
-  add_num(fig, "adc_clips_drive", (double)res.adc_clips[0]);
-  add_num(fig, "adc_clips_sense", (double)res.adc_clips[1]);
-
-  if (sc.mode == SIM_OPEN_LOOP_SWEEP && sweep.n > 0) {
-    char sp[1100];
-    snprintf(sp, sizeof sp, "%s/sweep.csv", out_dir ? out_dir : ".");
-    FILE *f = fopen(sp, "w");
-    if (f != NULL) {
-      fputs("f_hz,amp,phase_deg\n", f);
-      for (int i = 0; i < sweep.n; i++) fprintf(f, "%.6f,%.9g,%.6f\n", sweep.f_hz[i], sweep.amp_v[i], sweep.phase_deg[i]);
-      fclose(f);
-    }
-    if (analysis && (sc.analyses & SIM_AN_SWEEP)) {
-      const char *args[] = {sp, NULL};
-      cJSON *j = post_run_tool("gyro-freqresp", args, out_dir, "freqresp.json", err, sizeof err);
-      if (j == NULL) { fprintf(stderr, "gyro-sim: %s\n", err); failed = 1; }
-      else {
-        add_num(fig, "f0_hz", post_num(j, "f0_hz"));
-        add_num(fig, "q", post_num(j, "q"));
-        add_num(fig, "phase_at_f0_deg", post_num(j, "phase_at_f0_deg"));
-        add_num(fig, "peak_gain_v", post_num(j, "peak_gain"));
-        add_num(fig, "f_3db_lo_hz", post_num(j, "f_3db_lo_hz"));
-        add_num(fig, "f_3db_hi_hz", post_num(j, "f_3db_hi_hz"));
-        if (!quiet) {
-          printf("  identified drive resonance %.3f Hz (plant %.3f Hz), Q %.2f (plant %.2f),\n"
-                 "    phase at resonance %.2f deg, -3 dB %.2f..%.2f Hz\n",
-                 post_num(j, "f0_hz"), pc.f_drive_hz, post_num(j, "q"), pc.q_drive,
-                 post_num(j, "phase_at_f0_deg"), post_num(j, "f_3db_lo_hz"), post_num(j, "f_3db_hi_hz"));
-        }
-        cJSON_Delete(j);
-      }
-    }
-  }
-  if (sc.mode == SIM_OPEN_LOOP && sq.n > 1) {
-    /* Table 7-1: the half-frequency drive's amplitude goes with U^2 (6-19). Fit
-     * amp = k U^2 through the origin and report the largest deviation. */
-    double sxy = 0, sxx = 0, amax = 0, dmax = 0;
-    for (int i = 0; i < sq.n; i++) {
-      const double u2 = sq.u_v[i] * sq.u_v[i];
-      sxy += u2 * sq.amp_v[i];
-      sxx += u2 * u2;
-      if (sq.amp_v[i] > amax) amax = sq.amp_v[i];
-    }
-    const double k = sxy / sxx;
-    cJSON *tab = cJSON_AddArrayToObject(fig, "square_law");
-    if (!quiet) printf("  square law (table 7-1): U (V) -> drive pickoff (V), displacement (um), fit k U^2\n");
-    for (int i = 0; i < sq.n; i++) {
-      const double fit = k * sq.u_v[i] * sq.u_v[i];
-      if (fabs(sq.amp_v[i] - fit) > dmax) dmax = fabs(sq.amp_v[i] - fit);
-      cJSON *row = cJSON_CreateObject();
-      add_num(row, "u_v", sq.u_v[i]);
-      add_num(row, "amp_v", sq.amp_v[i]);
-      add_num(row, "amp_m", sq.amp_m[i]);
-      cJSON_AddItemToArray(tab, row);
-      if (!quiet) printf("    %6.2f  %8.4f  %8.4f  %8.4f\n", sq.u_v[i], sq.amp_v[i], 1e6 * sq.amp_m[i], fit);
-    }
-    add_num(fig, "square_law_k_v_per_v2", k);
-    add_num(fig, "square_law_nonlinearity_pct", 100.0 * dmax / amax);
-    if (!quiet) printf("  k = %.6g V/V^2, largest deviation %.3f %% of the largest amplitude\n", k, 100.0 * dmax / amax);
-  } else if (sc.mode == SIM_OPEN_LOOP && sq.n == 1) {
-    add_num(fig, "drive_amp_v", sq.amp_v[0]);
-    add_num(fig, "drive_amp_m", sq.amp_m[0]);
-  }
-
-  if (need_tools && sc.mode == SIM_CLOSED_LOOP) {
-    if (sc.analyses & SIM_AN_RATE_TABLE) {
-      const char *args[] = {csv_path, "--settle", "0.5", "--min-avg", "0.5", NULL};
-      cJSON *j = post_run_tool("gyro-scalefactor", args, out_dir, "scalefactor.json", err, sizeof err);
-      if (j == NULL) { fprintf(stderr, "gyro-sim: %s\n", err); failed = 1; }
-      else {
-        add_num(fig, "scale_factor", post_num(j, "scale_factor_out_per_dps"));
-        add_num(fig, "bias_dps", post_num(j, "bias_out"));
-        add_num(fig, "nonlinearity_pct", post_num(j, "nonlinearity_rms_percent_of_fs"));
-        add_num(fig, "nonlinearity_max_pct", post_num(j, "nonlinearity_max_percent_of_fs"));
-        add_num(fig, "asymmetry", post_num(j, "asymmetry_fraction"));
-        if (!quiet) {
-          printf("  rate table: scale factor %.6f (deg/s)/(deg/s), bias %.4f deg/s, nonlinearity %.4f %% FS rms\n",
-                 post_num(j, "scale_factor_out_per_dps"), post_num(j, "bias_out"),
-                 post_num(j, "nonlinearity_rms_percent_of_fs"));
-        }
-        cJSON_Delete(j);
-      }
-    }
-    if (sc.analyses & (SIM_AN_NOISE | SIM_AN_ALLAN)) {
-      char tend[32];
-      /* Allan on the static part of the run: the scenario's last rate step (if any) is
-       * its scale-factor check and is left out. */
-      double t_end = sc.duration_s;
-      if (sc.has_rate && sc.rate_dps.kind == PROFILE_STEPS && sc.rate_dps.n_steps > 1) t_end = sc.rate_dps.step_s[0];
-      snprintf(tend, sizeof tend, "%.6f", t_end);
-      const char *args[] = {csv_path, "--t-start", "1", "--t-end", tend, NULL};
-      cJSON *j = post_run_tool("gyro-allan", args, out_dir, "allan.json", err, sizeof err);
-      double sf = 1.0;
-      if (j != NULL && sc.has_rate && sc.rate_dps.kind == PROFILE_STEPS && sc.rate_dps.n_steps > 1) {
-        const char *a2[] = {csv_path, "--t-start", tend, "--settle", "0.5", "--min-avg", "0.5", NULL};
-        cJSON *s = post_run_tool("gyro-scalefactor", a2, out_dir, "scalefactor.json", err, sizeof err);
-        if (s != NULL) {
-          sf = post_num(s, "scale_factor_out_per_dps");
-          add_num(fig, "scale_factor", sf);
-          cJSON_Delete(s);
-        }
-      }
-      if (j == NULL) { fprintf(stderr, "gyro-sim: %s\n", err); failed = 1; }
-      else {
-        if (sc.analyses & SIM_AN_NOISE) {
-          const double n_in = post_num(j, "arw_dph_per_rthz") / sf;
-          const double floor = brownian_floor_dph(&pc, res.mean_drive_freq_hz, res.mean_drive_amp_m, res.mean_struct_k);
-          add_num(fig, "arw_coeff_dph_rthz", n_in);
-          add_num(fig, "adev_1s_dph", post_num(j, "adev_at_1s_dph") / sf);
-          add_num(fig, "brownian_floor_dph_rthz", floor);
-          add_num(fig, "arw_over_floor", n_in / floor);
-          if (!quiet) {
-            printf("  rate noise N = %.3f deg/h/rtHz (Allan -1/2 slope, two-sided; one-sided ASD %.3f),\n"
-                   "    Brownian floor (4-24) at %.3f Hz, %.3f um, %.2f K: %.3f deg/h/rtHz; ratio %.3f\n",
-                   n_in, sqrt(2.0) * n_in, res.mean_drive_freq_hz, 1e6 * res.mean_drive_amp_m,
-                   res.mean_struct_k, floor, n_in / floor);
-          }
-        }
-        if (sc.analyses & SIM_AN_ALLAN) {
-          add_num(fig, "arw_deg_rth", post_num(j, "arw_deg_per_rth") / sf);
-          add_num(fig, "bias_instability_dph", post_num(j, "bias_instability_dph") / sf);
-          add_num(fig, "rate_ramp_dph_per_h", post_num(j, "rate_ramp_dph_per_h") / sf);
-          /* The fitted three-term model can read a change of white level as flicker; the
-           * measured minimum bounds the bias instability whatever the model says. */
-          add_num(fig, "adev_min_dph", post_num(j, "adev_min_measured_dph") / sf);
-          add_num(fig, "tau_at_adev_min_s", post_num(j, "tau_at_min_measured_s"));
-          if (!quiet) {
-            printf("  Allan: ARW %.4f deg/rt(h), bias instability %.3f deg/h (fit), rate ramp %.3f deg/h/h;\n"
-                   "    lowest measured Allan deviation %.3f deg/h at %.0f s\n",
-                   post_num(j, "arw_deg_per_rth") / sf, post_num(j, "bias_instability_dph") / sf,
-                   post_num(j, "rate_ramp_dph_per_h") / sf, post_num(j, "adev_min_measured_dph") / sf,
-                   post_num(j, "tau_at_min_measured_s"));
-          }
-        }
-        cJSON_Delete(j);
-      }
-    }
-    if (sc.analyses & SIM_AN_DRIVE_NOISE) {
-      const char *args[] = {csv_path, "--column", "drive_amp_true_m", "--band", "1", "10", "--t-start", "2", NULL};
-      cJSON *j = post_run_tool("gyro-psd", args, out_dir, "psd.json", err, sizeof err);
-      if (j == NULL) { fprintf(stderr, "gyro-sim: %s\n", err); failed = 1; }
-      else {
-        const double rel = post_num(j, "white_asd_one_sided_per_rthz") / res.mean_drive_amp_m;
-        add_num(fig, "drive_amp_noise_lf_rel", rel);
-        if (!quiet) printf("  drive amplitude noise over 1-10 Hz: %.3g /rtHz relative (one-sided)\n", rel);
-        cJSON_Delete(j);
-      }
-    }
-    if (sc.analyses & SIM_AN_TEMP) {
-      /* Fit against the firmware's own low-passed P (what its compensation uses; the
-       * instantaneous P carries the phase loop's ripple) and, for a heat-gun run, on
-       * the cool-down only, as the thesis does (7.3.2). */
-      char t0[32] = "0";
-      if (sc.has_ambient && sc.ambient_c.kind == PROFILE_HEAT_COOL) {
-        snprintf(t0, sizeof t0, "%.3f", sc.ambient_c.t_start_s + sc.ambient_c.heat_s);
-      }
-      const char *args[] = {csv_path, "--column", "rate_dps", "--p-column", "p_f_deg",
-                            "--temp-column", "t_board_c", "--t-start", t0, NULL};
-      cJSON *j = post_run_tool("gyro-tempcomp", args, out_dir, "tempcomp.json", err, sizeof err);
-      if (j == NULL) { fprintf(stderr, "gyro-sim: %s\n", err); failed = 1; }
-      else {
-        add_num(fig, "residual_bias_p_dps", post_num(j, "p_fit.residual_std_dps"));
-        add_num(fig, "residual_bias_sensor_dps", post_num(j, "t_fit.residual_std_dps"));
-        add_num(fig, "residual_bias_p_pp_dps", post_num(j, "p_fit.residual_p2p_dps"));
-        add_num(fig, "residual_bias_sensor_pp_dps", post_num(j, "t_fit.residual_p2p_dps"));
-        add_num(fig, "bias_p_order", post_num(j, "p_fit.order"));
-        if (!quiet) {
-          printf("  temperature compensation: residual bias with P %.4f deg/s (p-p %.4f), with the board sensor %.4f deg/s (p-p %.4f)\n",
-                 post_num(j, "p_fit.residual_std_dps"), post_num(j, "p_fit.residual_p2p_dps"),
-                 post_num(j, "t_fit.residual_std_dps"), post_num(j, "t_fit.residual_p2p_dps"));
-        }
-        cJSON_Delete(j);
-      }
-    }
-  }
+  cJSON_AddStringToObject(root, "scenario", sc->name);
+  add_params(root, sc, &pc, &fw);
+  report_t r = {.sc = sc,
+                .pc = &pc,
+                .res = &res,
+                .out_dir = out_dir,
+                .csv_path = csv_path,
+                .quiet = a->quiet,
+                .fig = cJSON_AddObjectToObject(root, "figures")};
+  report_figures(&r, a, isr, &sweep, &sq, need_tools);
   add_num(root, "realtime_factor", res.realtime_factor);
   add_num(root, "realtime_factor_cpu", res.realtime_factor_cpu);
-  if (json_path != NULL) {
-    char *txt = cJSON_Print(root);
-    FILE *f = fopen(json_path, "w");
-    if (f == NULL || txt == NULL) {
-      fprintf(stderr, "gyro-sim: --json %s: %s\n", json_path, strerror(errno));
-      failed = 1;
-    } else {
-      fputs(txt, f);
-      fputc('\n', f);
-      fclose(f);
-    }
-    free(txt);
-  }
+  if (a->json_path != NULL && write_json(root, a->json_path) != 0) r.failed = 1;
   cJSON_Delete(root);
-  if (tmp_used) {
-    char cmd[1200];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-    if (system(cmd) != 0) fprintf(stderr, "gyro-sim: could not remove %s\n", tmpdir);
+  return r.failed ? 1 : 0;
+}
+
+int main(int argc, char **argv)
+{
+  static cli_args_t a;
+  static sim_scenario_t sc;
+  int rc = parse_args(argc, argv, &a);
+  if (rc >= 0) return rc;
+  rc = load_scenario(&a, &sc);
+  if (rc != 0) return rc;
+  bench_figs_t isr;
+  char err[512];
+  if (a.isr_json != NULL && bench_figs_load(a.isr_json, &isr, err, sizeof err) != 0) {
+    fprintf(stderr, "gyro-sim: %s\n", err);
+    return 2;
   }
-  return failed ? 1 : 0;
+
+  /* Analyses by the tools need a trace and a folder; without --out they use a temporary
+   * one that is removed afterwards. */
+  const uint32_t tool_analyses = SIM_AN_RATE_TABLE | SIM_AN_NOISE | SIM_AN_ALLAN |
+                                 SIM_AN_DRIVE_NOISE | SIM_AN_TEMP | SIM_AN_SWEEP;
+  const int need_tools = a.analysis && (sc.analyses & tool_analyses) != 0u;
+  char tmpdir[] = "/tmp/gyro-sim-XXXXXX";
+  const char *out_dir = a.out_dir;
+  int tmp_used;
+  rc = prepare_out_dir(&out_dir, tmpdir, need_tools, &tmp_used);
+  if (rc != 0) return rc;
+  char trace[1100];
+  const char *csv_path = a.csv_path;
+  if (csv_path == NULL && need_tools && sc.loop == SIM_CLOSED_LOOP) {
+    snprintf(trace, sizeof trace, "%s/trace.csv", out_dir);
+    csv_path = trace;
+  }
+
+  rc = run(&a, &sc, &isr, out_dir, csv_path, need_tools);
+  if (tmp_used && remove_tree(tmpdir) != 0) {
+    fprintf(stderr, "gyro-sim: could not remove %s: %s\n", tmpdir, strerror(errno));
+  }
+  return rc;
 }

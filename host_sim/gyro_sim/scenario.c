@@ -12,10 +12,14 @@ static const struct {
   sim_analysis_t bit;
   const char *name;
 } analyses[] = {
-    {SIM_AN_STARTUP, "startup"},       {SIM_AN_RATE_TABLE, "rate_table"},
-    {SIM_AN_NOISE, "brownian_noise"},  {SIM_AN_ALLAN, "allan"},
-    {SIM_AN_DRIVE_NOISE, "drive_noise"}, {SIM_AN_TEMP, "temp_comp"},
-    {SIM_AN_SWEEP, "sweep"},           {SIM_AN_SQUARE_LAW, "square_law"},
+    {SIM_AN_STARTUP, "startup"},
+    {SIM_AN_RATE_TABLE, "rate_table"},
+    {SIM_AN_NOISE, "brownian_noise"},
+    {SIM_AN_ALLAN, "allan"},
+    {SIM_AN_DRIVE_NOISE, "drive_noise"},
+    {SIM_AN_TEMP, "temp_comp"},
+    {SIM_AN_SWEEP, "sweep"},
+    {SIM_AN_SQUARE_LAW, "square_law"},
 };
 
 const char *scenario_analysis_name(sim_analysis_t a)
@@ -32,7 +36,7 @@ void scenario_defaults(sim_scenario_t *sc)
   snprintf(sc->name, sizeof sc->name, "unnamed");
   sc->duration_s = 1.0;
   sc->seed = 1u;
-  sc->mode = SIM_CLOSED_LOOP;
+  sc->loop = SIM_CLOSED_LOOP;
   sc->csv_rate_hz = 1000.0;
   profile_const(&sc->rate_dps, 0.0);
   profile_const(&sc->ambient_c, 25.0);
@@ -72,10 +76,14 @@ static int get_num(const cJSON *j, const char *where, double lo, double hi, doub
 static int add_set(sim_set_t *arr, int *n, const char *key, double v, const char *where,
                    char *err, size_t len)
 {
-  if (*n >= SIM_MAX_SETS) return fail(err, len, "%s: more than %d settings", where, SIM_MAX_SETS);
+  if (*n >= SIM_MAX_SETS)
+    return fail(err, len, "%s: more than %d settings", where, SIM_MAX_SETS);
   if (strlen(key) >= SIM_NAME_MAX) return fail(err, len, "%s.%s: key too long", where, key);
   for (int i = 0; i < *n; i++) {
-    if (strcmp(arr[i].key, key) == 0) { arr[i].value = v; return 0; }
+    if (strcmp(arr[i].key, key) == 0) {
+      arr[i].value = v;
+      return 0;
+    }
   }
   snprintf(arr[*n].key, SIM_NAME_MAX, "%s", key);
   arr[*n].value = v;
@@ -86,9 +94,11 @@ static int add_set(sim_set_t *arr, int *n, const char *key, double v, const char
 static int parse_sets(const cJSON *obj, const char *where, sim_set_t *arr, int *n, char *err,
                       size_t len)
 {
-  if (!cJSON_IsObject(obj)) return fail(err, len, "%s: expected an object of name: number", where);
+  if (!cJSON_IsObject(obj))
+    return fail(err, len, "%s: expected an object of name: number", where);
   const cJSON *it;
-  cJSON_ArrayForEach(it, obj) {
+  cJSON_ArrayForEach(it, obj)
+  {
     char key[160];
     snprintf(key, sizeof key, "%s.%s", where, it->string);
     double v = 0.0;
@@ -106,33 +116,39 @@ static int parse_sets(const cJSON *obj, const char *where, sim_set_t *arr, int *
 static int parse_profile(const cJSON *obj, const char *where, double offset, double lo,
                          double hi, profile_t *p, char *err, size_t len)
 {
-  if (!cJSON_IsObject(obj)) return fail(err, len, "%s: expected an object with \"kind\"", where);
+  if (!cJSON_IsObject(obj))
+    return fail(err, len, "%s: expected an object with \"kind\"", where);
   const cJSON *kind = cJSON_GetObjectItemCaseSensitive(obj, "kind");
-  if (!cJSON_IsString(kind)) return fail(err, len, "%s.kind: expected const|steps|sine|ramp|heat_cool", where);
+  if (!cJSON_IsString(kind))
+    return fail(err, len, "%s.kind: expected const|steps|sine|ramp|heat_cool", where);
   const int k = profile_kind_from_name(kind->valuestring);
-  if (k < 0) return fail(err, len, "%s.kind: '%s' is not one of const|steps|sine|ramp|heat_cool", where, kind->valuestring);
+  if (k < 0)
+    return fail(err, len, "%s.kind: '%s' is not one of const|steps|sine|ramp|heat_cool", where,
+                kind->valuestring);
   profile_t t;
   memset(&t, 0, sizeof t);
   t.kind = (profile_kind_t)k;
-  static const char *const allowed[] = {"kind", "value", "amp", "freq_hz", "phase_rad",
-                                        "slope_per_s", "t_start_s", "t_end_s", "hot_value",
-                                        "heat_s", "tau_heat_s", "tau_cool_s", "steps",
-                                        "edge_s", "repeat"};
+  static const char *const allowed[] = {"kind",      "value",       "amp",        "freq_hz",
+                                        "phase_rad", "slope_per_s", "t_start_s",  "t_end_s",
+                                        "hot_value", "heat_s",      "tau_heat_s", "tau_cool_s",
+                                        "steps",     "edge_s",      "repeat"};
   const cJSON *it;
-  cJSON_ArrayForEach(it, obj) {
+  cJSON_ArrayForEach(it, obj)
+  {
     int known = 0;
-    for (size_t i = 0; i < sizeof allowed / sizeof allowed[0]; i++) known |= strcmp(it->string, allowed[i]) == 0;
+    for (size_t i = 0; i < sizeof allowed / sizeof allowed[0]; i++)
+      known |= strcmp(it->string, allowed[i]) == 0;
     if (!known) return fail(err, len, "%s.%s: unknown key", where, it->string);
   }
   char key[128];
-#define NUM(field, name, l, h, off)                                                 \
-  do {                                                                              \
-    const cJSON *j_ = cJSON_GetObjectItemCaseSensitive(obj, name);                  \
-    if (j_ != NULL) {                                                               \
-      snprintf(key, sizeof key, "%s.%s", where, name);                              \
-      if (get_num(j_, key, l, h, &t.field, err, len) != 0) return -1;               \
-      t.field += off;                                                               \
-    }                                                                               \
+#define NUM(field, name, l, h, off) \
+  do { \
+    const cJSON *j_ = cJSON_GetObjectItemCaseSensitive(obj, name); \
+    if (j_ != NULL) { \
+      snprintf(key, sizeof key, "%s.%s", where, name); \
+      if (get_num(j_, key, l, h, &t.field, err, len) != 0) return -1; \
+      t.field += off; \
+    } \
   } while (0)
   NUM(value, "value", lo, hi, offset);
   NUM(amp, "amp", -(hi - lo), hi - lo, 0.0);
@@ -156,18 +172,22 @@ static int parse_profile(const cJSON *obj, const char *where, double offset, dou
   if (t.kind == PROFILE_STEPS) {
     if (!cJSON_IsArray(steps) || cJSON_GetArraySize(steps) < 1 ||
         cJSON_GetArraySize(steps) > PROFILE_MAX_STEPS) {
-      return fail(err, len, "%s.steps: expected 1..%d pairs [duration_s, value]", where, PROFILE_MAX_STEPS);
+      return fail(err, len, "%s.steps: expected 1..%d pairs [duration_s, value]", where,
+                  PROFILE_MAX_STEPS);
     }
     int i = 0;
     const cJSON *pair;
-    cJSON_ArrayForEach(pair, steps) {
+    cJSON_ArrayForEach(pair, steps)
+    {
       if (!cJSON_IsArray(pair) || cJSON_GetArraySize(pair) != 2) {
         return fail(err, len, "%s.steps[%d]: expected [duration_s, value]", where, i);
       }
       snprintf(key, sizeof key, "%s.steps[%d][0]", where, i);
-      if (get_num(cJSON_GetArrayItem(pair, 0), key, 1e-6, 1e7, &t.step_s[i], err, len) != 0) return -1;
+      if (get_num(cJSON_GetArrayItem(pair, 0), key, 1e-6, 1e7, &t.step_s[i], err, len) != 0)
+        return -1;
       snprintf(key, sizeof key, "%s.steps[%d][1]", where, i);
-      if (get_num(cJSON_GetArrayItem(pair, 1), key, lo, hi, &t.step_value[i], err, len) != 0) return -1;
+      if (get_num(cJSON_GetArrayItem(pair, 1), key, lo, hi, &t.step_value[i], err, len) != 0)
+        return -1;
       t.step_value[i] += offset;
       i++;
     }
@@ -181,15 +201,18 @@ static int parse_profile(const cJSON *obj, const char *where, double offset, dou
   }
   const char *bad = NULL;
   if (profile_check(&t, &bad) != 0) {
-    return fail(err, len, "%s.%s: invalid for kind %s", where, bad ? bad : "?", kind->valuestring);
+    return fail(err, len, "%s.%s: invalid for kind %s", where, bad ? bad : "?",
+                kind->valuestring);
   }
   *p = t;
   return 0;
 }
 
-static int parse_vec3(const cJSON *j, const char *where, double lim, double out[3], char *err, size_t len)
+static int parse_vec3(const cJSON *j, const char *where, double lim, double out[3], char *err,
+                      size_t len)
 {
-  if (!cJSON_IsArray(j) || cJSON_GetArraySize(j) != 3) return fail(err, len, "%s: expected [x, y, z]", where);
+  if (!cJSON_IsArray(j) || cJSON_GetArraySize(j) != 3)
+    return fail(err, len, "%s: expected [x, y, z]", where);
   for (int i = 0; i < 3; i++) {
     char key[96];
     snprintf(key, sizeof key, "%s[%d]", where, i);
@@ -204,17 +227,25 @@ static int parse_accel(const cJSON *obj, accel_profile_t *a, char *err, size_t l
   accel_profile_t t;
   accel_profile_zero(&t);
   const cJSON *it;
-  cJSON_ArrayForEach(it, obj) {
+  cJSON_ArrayForEach(it, obj)
+  {
     int rc;
-    if (strcmp(it->string, "const") == 0) rc = parse_vec3(it, "accel_g.const", 1000.0, t.const_g, err, len);
-    else if (strcmp(it->string, "amp") == 0) rc = parse_vec3(it, "accel_g.amp", 1000.0, t.amp_g, err, len);
-    else if (strcmp(it->string, "freq_hz") == 0) rc = parse_vec3(it, "accel_g.freq_hz", 1e4, t.freq_hz, err, len);
-    else if (strcmp(it->string, "phase_rad") == 0) rc = parse_vec3(it, "accel_g.phase_rad", 1e3, t.phase_rad, err, len);
-    else return fail(err, len, "accel_g.%s: unknown key (const, amp, freq_hz, phase_rad)", it->string);
+    if (strcmp(it->string, "const") == 0)
+      rc = parse_vec3(it, "accel_g.const", 1000.0, t.const_g, err, len);
+    else if (strcmp(it->string, "amp") == 0)
+      rc = parse_vec3(it, "accel_g.amp", 1000.0, t.amp_g, err, len);
+    else if (strcmp(it->string, "freq_hz") == 0)
+      rc = parse_vec3(it, "accel_g.freq_hz", 1e4, t.freq_hz, err, len);
+    else if (strcmp(it->string, "phase_rad") == 0)
+      rc = parse_vec3(it, "accel_g.phase_rad", 1e3, t.phase_rad, err, len);
+    else
+      return fail(err, len, "accel_g.%s: unknown key (const, amp, freq_hz, phase_rad)",
+                  it->string);
     if (rc != 0) return -1;
   }
   const char *bad = NULL;
-  if (accel_profile_check(&t, &bad) != 0) return fail(err, len, "accel_g.%s: invalid", bad ? bad : "?");
+  if (accel_profile_check(&t, &bad) != 0)
+    return fail(err, len, "accel_g.%s: invalid", bad ? bad : "?");
   *a = t;
   return 0;
 }
@@ -224,49 +255,60 @@ static int parse_open_loop(const cJSON *obj, sim_open_loop_t *ol, char *err, siz
   if (!cJSON_IsObject(obj)) return fail(err, len, "open_loop: expected an object");
   sim_open_loop_t t = *ol;
   const cJSON *it;
-  cJSON_ArrayForEach(it, obj) {
+  cJSON_ArrayForEach(it, obj)
+  {
     const char *k = it->string;
     char key[96];
     snprintf(key, sizeof key, "open_loop.%s", k);
     int rc = 0;
     if (strcmp(k, "u_amp_v") == 0) rc = get_num(it, key, 0.0, 15.0, &t.u_amp_v, err, len);
-    else if (strcmp(k, "freq_hz") == 0) rc = get_num(it, key, 1.0, 12500.0, &t.freq_hz, err, len);
+    else if (strcmp(k, "freq_hz") == 0)
+      rc = get_num(it, key, 1.0, 12500.0, &t.freq_hz, err, len);
     else if (strcmp(k, "amps_v") == 0) {
       if (!cJSON_IsArray(it) || cJSON_GetArraySize(it) < 1 || cJSON_GetArraySize(it) > 16) {
         return fail(err, len, "%s: expected 1..16 voltages", key);
       }
       t.n_amps = 0;
       const cJSON *v;
-      cJSON_ArrayForEach(v, it) {
+      cJSON_ArrayForEach(v, it)
+      {
         char k2[112];
         snprintf(k2, sizeof k2, "%s[%d]", key, t.n_amps);
         if (get_num(v, k2, 0.0, 15.0, &t.amps_v[t.n_amps], err, len) != 0) return -1;
         t.n_amps++;
       }
-    } else if (strcmp(k, "dwell_s") == 0) rc = get_num(it, key, 1e-3, 1e4, &t.dwell_s, err, len);
+    } else if (strcmp(k, "dwell_s") == 0)
+      rc = get_num(it, key, 1e-3, 1e4, &t.dwell_s, err, len);
     else if (strcmp(k, "settle_s") == 0) rc = get_num(it, key, 0.0, 1e4, &t.settle_s, err, len);
     else if (strcmp(k, "sweep") == 0) {
       if (!cJSON_IsObject(it)) return fail(err, len, "%s: expected an object", key);
       const cJSON *s;
-      cJSON_ArrayForEach(s, it) {
+      cJSON_ArrayForEach(s, it)
+      {
         char k2[112];
         snprintf(k2, sizeof k2, "open_loop.sweep.%s", s->string);
         double v = 0.0;
-        if (strcmp(s->string, "f_start_hz") == 0) rc = get_num(s, k2, 1.0, 12500.0, &t.f_start_hz, err, len);
-        else if (strcmp(s->string, "f_stop_hz") == 0) rc = get_num(s, k2, 1.0, 12500.0, &t.f_stop_hz, err, len);
+        if (strcmp(s->string, "f_start_hz") == 0)
+          rc = get_num(s, k2, 1.0, 12500.0, &t.f_start_hz, err, len);
+        else if (strcmp(s->string, "f_stop_hz") == 0)
+          rc = get_num(s, k2, 1.0, 12500.0, &t.f_stop_hz, err, len);
         else if (strcmp(s->string, "points") == 0) {
           rc = get_num(s, k2, 2.0, 10000.0, &v, err, len);
           t.points = (int)v;
-        } else if (strcmp(s->string, "dwell_s") == 0) rc = get_num(s, k2, 1e-3, 1e4, &t.dwell_s, err, len);
-        else if (strcmp(s->string, "settle_s") == 0) rc = get_num(s, k2, 0.0, 1e4, &t.settle_s, err, len);
+        } else if (strcmp(s->string, "dwell_s") == 0)
+          rc = get_num(s, k2, 1e-3, 1e4, &t.dwell_s, err, len);
+        else if (strcmp(s->string, "settle_s") == 0)
+          rc = get_num(s, k2, 0.0, 1e4, &t.settle_s, err, len);
         else return fail(err, len, "%s: unknown key", k2);
         if (rc != 0) return -1;
       }
     } else return fail(err, len, "%s: unknown key", key);
     if (rc != 0) return -1;
   }
-  if (t.f_stop_hz <= t.f_start_hz) return fail(err, len, "open_loop.sweep: f_stop_hz must exceed f_start_hz");
-  if (t.settle_s >= t.dwell_s) return fail(err, len, "open_loop: settle_s must be shorter than dwell_s");
+  if (t.f_stop_hz <= t.f_start_hz)
+    return fail(err, len, "open_loop.sweep: f_stop_hz must exceed f_start_hz");
+  if (t.settle_s >= t.dwell_s)
+    return fail(err, len, "open_loop: settle_s must be shorter than dwell_s");
   *ol = t;
   return 0;
 }
@@ -282,19 +324,28 @@ int scenario_parse(sim_scenario_t *out, const char *json, char *err, size_t len)
   }
   /* Work on a copy: a failure anywhere leaves *out as it was. */
   sim_scenario_t *sc = malloc(sizeof *sc);
-  if (sc == NULL) { cJSON_Delete(root); return fail(err, len, "out of memory"); }
+  if (sc == NULL) {
+    cJSON_Delete(root);
+    return fail(err, len, "out of memory");
+  }
   *sc = *out;
   int rc = 0;
   if (!cJSON_IsObject(root)) rc = fail(err, len, "top level: expected an object");
   const cJSON *it;
   if (rc == 0) {
-    cJSON_ArrayForEach(it, root) {
+    cJSON_ArrayForEach(it, root)
+    {
       const char *k = it->string;
       if (strcmp(k, "name") == 0 || strcmp(k, "description") == 0) {
-        if (!cJSON_IsString(it)) { rc = fail(err, len, "%s: expected a string", k); break; }
+        if (!cJSON_IsString(it)) {
+          rc = fail(err, len, "%s: expected a string", k);
+          break;
+        }
         if (k[0] == 'n') {
-          if (strlen(it->valuestring) >= SIM_NAME_MAX || strpbrk(it->valuestring, "/\\\"") != NULL) {
-            rc = fail(err, len, "name: at most %d characters, no slashes or quotes", SIM_NAME_MAX - 1);
+          if (strlen(it->valuestring) >= SIM_NAME_MAX ||
+              strpbrk(it->valuestring, "/\\\"") != NULL) {
+            rc = fail(err, len, "name: at most %d characters, no slashes or quotes",
+                      SIM_NAME_MAX - 1);
             break;
           }
           snprintf(sc->name, sizeof sc->name, "%s", it->valuestring);
@@ -311,21 +362,34 @@ int scenario_parse(sim_scenario_t *out, const char *json, char *err, size_t len)
       } else if (strcmp(k, "csv_rate_hz") == 0) {
         rc = get_num(it, k, 0.001, 50000.0, &sc->csv_rate_hz, err, len);
       } else if (strcmp(k, "mode") == 0) {
-        if (!cJSON_IsString(it)) rc = fail(err, len, "mode: expected closed_loop|open_loop|open_loop_sweep");
-        else if (strcmp(it->valuestring, "closed_loop") == 0) sc->mode = SIM_CLOSED_LOOP;
-        else if (strcmp(it->valuestring, "open_loop") == 0) sc->mode = SIM_OPEN_LOOP;
-        else if (strcmp(it->valuestring, "open_loop_sweep") == 0) sc->mode = SIM_OPEN_LOOP_SWEEP;
-        else rc = fail(err, len, "mode: '%s' is not closed_loop|open_loop|open_loop_sweep", it->valuestring);
+        if (!cJSON_IsString(it))
+          rc = fail(err, len, "mode: expected closed_loop|open_loop|open_loop_sweep");
+        else if (strcmp(it->valuestring, "closed_loop") == 0) sc->loop = SIM_CLOSED_LOOP;
+        else if (strcmp(it->valuestring, "open_loop") == 0) sc->loop = SIM_OPEN_LOOP;
+        else if (strcmp(it->valuestring, "open_loop_sweep") == 0)
+          sc->loop = SIM_OPEN_LOOP_SWEEP;
+        else
+          rc = fail(err, len, "mode: '%s' is not closed_loop|open_loop|open_loop_sweep",
+                    it->valuestring);
       } else if (strcmp(k, "analyses") == 0) {
-        if (!cJSON_IsArray(it)) { rc = fail(err, len, "analyses: expected a list of names"); break; }
+        if (!cJSON_IsArray(it)) {
+          rc = fail(err, len, "analyses: expected a list of names");
+          break;
+        }
         sc->analyses = 0u;
         const cJSON *a;
-        cJSON_ArrayForEach(a, it) {
+        cJSON_ArrayForEach(a, it)
+        {
           uint32_t bit = 0u;
           for (size_t i = 0; cJSON_IsString(a) && i < sizeof analyses / sizeof analyses[0]; i++) {
             if (strcmp(a->valuestring, analyses[i].name) == 0) bit = analyses[i].bit;
           }
-          if (bit == 0u) { rc = fail(err, len, "analyses: unknown analysis (startup, rate_table, brownian_noise, allan, drive_noise, temp_comp, sweep, square_law)"); break; }
+          if (bit == 0u) {
+            rc = fail(
+                err, len,
+                "analyses: unknown analysis (startup, rate_table, brownian_noise, allan, drive_noise, temp_comp, sweep, square_law)");
+            break;
+          }
           sc->analyses |= bit;
         }
       } else if (strcmp(k, "plant") == 0) {
@@ -366,9 +430,17 @@ int scenario_load(sim_scenario_t *sc, const char *path, char *err, size_t len)
   for (;;) {
     if (n + 4096 + 1 > cap) {
       cap = cap ? 2 * cap : 8192;
-      if (cap > (size_t)16 << 20) { free(buf); fclose(f); return fail(err, len, "%s: larger than 16 MiB", path); }
+      if (cap > (size_t)16 << 20) {
+        free(buf);
+        fclose(f);
+        return fail(err, len, "%s: larger than 16 MiB", path);
+      }
       char *g = realloc(buf, cap);
-      if (g == NULL) { free(buf); fclose(f); return fail(err, len, "out of memory"); }
+      if (g == NULL) {
+        free(buf);
+        fclose(f);
+        return fail(err, len, "out of memory");
+      }
       buf = g;
     }
     const size_t r = fread(buf + n, 1, 4096, f);
@@ -377,7 +449,10 @@ int scenario_load(sim_scenario_t *sc, const char *path, char *err, size_t len)
   }
   fclose(f);
   buf[n] = '\0';
-  if (memchr(buf, '\0', n) != NULL) { free(buf); return fail(err, len, "%s: contains a NUL byte", path); }
+  if (memchr(buf, '\0', n) != NULL) {
+    free(buf);
+    return fail(err, len, "%s: contains a NUL byte", path);
+  }
   char inner[400];
   const int rc = scenario_parse(sc, buf, inner, sizeof inner);
   free(buf);
@@ -388,7 +463,8 @@ int scenario_load(sim_scenario_t *sc, const char *path, char *err, size_t len)
 int scenario_add_override(sim_scenario_t *sc, const char *arg, char *err, size_t len)
 {
   const char *eq = strchr(arg, '=');
-  if (eq == NULL) return fail(err, len, "--set %s: expected plant.KEY=VALUE or firmware.KEY=VALUE", arg);
+  if (eq == NULL)
+    return fail(err, len, "--set %s: expected plant.KEY=VALUE or firmware.KEY=VALUE", arg);
   const char *val = eq + 1;
   char *end = NULL;
   errno = 0;

@@ -38,19 +38,19 @@
 
 typedef enum {
   SIM_CLOSED_LOOP = 0,
-  SIM_OPEN_LOOP = 1,       /* fixed half-frequency drive, no firmware */
-  SIM_OPEN_LOOP_SWEEP = 2  /* stepped half-frequency drive across a band, no firmware */
-} sim_mode_t;
+  SIM_OPEN_LOOP = 1,      /* fixed half-frequency drive, no firmware */
+  SIM_OPEN_LOOP_SWEEP = 2 /* stepped half-frequency drive across a band, no firmware */
+} sim_loop_t;             /* the scenario key "mode" */
 
 typedef enum {
   SIM_AN_STARTUP = 1u << 0,
   SIM_AN_RATE_TABLE = 1u << 1,
-  SIM_AN_NOISE = 1u << 2,      /* Brownian floor comparison (brownian_only) */
-  SIM_AN_ALLAN = 1u << 3,      /* static Allan figures */
+  SIM_AN_NOISE = 1u << 2, /* Brownian floor comparison (brownian_only) */
+  SIM_AN_ALLAN = 1u << 3, /* static Allan figures */
   SIM_AN_DRIVE_NOISE = 1u << 4,
-  SIM_AN_TEMP = 1u << 5,       /* temperature chamber / cool-down compensation */
-  SIM_AN_SWEEP = 1u << 6,      /* open-loop frequency response */
-  SIM_AN_SQUARE_LAW = 1u << 7  /* table 7-1: amplitude versus drive voltage */
+  SIM_AN_TEMP = 1u << 5,      /* temperature chamber / cool-down compensation */
+  SIM_AN_SWEEP = 1u << 6,     /* open-loop frequency response */
+  SIM_AN_SQUARE_LAW = 1u << 7 /* table 7-1: amplitude versus drive voltage */
 } sim_analysis_t;
 
 typedef struct {
@@ -59,12 +59,12 @@ typedef struct {
 } sim_set_t;
 
 typedef struct {
-  double u_amp_v;     /* half-frequency voltage amplitude */
-  double freq_hz;     /* drive (force) frequency */
+  double u_amp_v; /* half-frequency voltage amplitude */
+  double freq_hz; /* drive (force) frequency */
   double f_start_hz, f_stop_hz;
   int points;
   double dwell_s, settle_s;
-  int n_amps;         /* square law: voltage amplitudes stepped at freq_hz */
+  int n_amps; /* square law: voltage amplitudes stepped at freq_hz */
   double amps_v[16];
 } sim_open_loop_t;
 
@@ -73,7 +73,7 @@ typedef struct {
   char description[256];
   double duration_s;
   uint64_t seed;
-  sim_mode_t mode;
+  sim_loop_t loop;
   uint32_t analyses;
   double csv_rate_hz;
   sim_set_t plant_set[SIM_MAX_SETS];

@@ -20,7 +20,6 @@
 /* Start-up of the drive, measured on the plant's true motion (not on the firmware's own
  * estimate, which a high gain simply zeroes). */
 typedef struct {
-  int valid;
   double lock_time_s;       /* true amplitude within 1 % of its final value from here on */
   double overshoot_pct;     /* peak true amplitude over the final one, -1, in % */
   double amp_err_rms_pct;   /* true amplitude, 0.1-100 Hz, after lock, % of the mean */
@@ -34,25 +33,24 @@ typedef struct {
   int n;
   double f_hz[10000];
   double amp_v[10000];
-  double phase_deg[10000];  /* drive pickoff against the drive force cos(wt) */
+  double phase_deg[10000]; /* drive pickoff against the drive force cos(wt) */
 } sim_sweep_t;
 
 typedef struct {
   int n;
   double u_v[16];
   double amp_v[16];
-  double amp_m[16];         /* true displacement amplitude */
+  double amp_m[16]; /* true displacement amplitude */
 } sim_square_t;
 
 typedef struct {
   double sim_s;
   double wall_s;
   double cpu_s;
-  double realtime_factor;      /* simulated / wall-clock time */
-  double realtime_factor_cpu;  /* simulated / CPU time of the run (one core) */
-  uint64_t ticks;
+  double realtime_factor;     /* simulated / wall-clock time */
+  double realtime_factor_cpu; /* simulated / CPU time of the run (one core) */
   sim_startup_t startup;
-  double adc_fraction[2];   /* worst-case budget from plant_adc_fraction */
+  double adc_fraction[2]; /* worst-case budget from plant_adc_fraction */
   uint64_t adc_clips[2];
   uint32_t faults;
   double rate_valid_fraction; /* of the run's ticks with the rate output valid */
@@ -61,21 +59,20 @@ typedef struct {
   double mean_struct_k;
   double mean_drive_freq_hz;
   double mean_drive_amp_m;
-  double isr_instr_est;     /* not measured here: see tools/bench */
 } sim_result_t;
 
 typedef struct {
-  const char *csv_path;     /* NULL: no trace */
+  const char *csv_path; /* NULL: no trace */
   double csv_rate_hz;
-  int progress;             /* progress bar on stderr */
-  int uart_pty;             /* expose the tuning UART as a pty, run paced in real time */
+  int progress;              /* progress bar on stderr */
+  int uart_pty;              /* expose the tuning UART as a pty, run paced in real time */
   const char *uart_pty_link; /* optional symlink to the pty */
 } sim_opts_t;
 
 /* Build the plant configuration and profiles from the scenario (defaults + overrides).
  * Returns 0, or -1 with the offending key in err. */
-int sim_plant_cfg(const sim_scenario_t *sc, plant_cfg_t *cfg, plant_profiles_t *prof,
-                  char *err, size_t err_len);
+int sim_plant_cfg(const sim_scenario_t *sc, plant_cfg_t *cfg, plant_profiles_t *prof, char *err,
+                  size_t err_len);
 /* The firmware parameters from the scenario: defaults + overrides, each checked. */
 int sim_fw_params(const sim_scenario_t *sc, param_values_t *v, char *err, size_t err_len);
 

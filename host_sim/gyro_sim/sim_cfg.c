@@ -5,8 +5,8 @@
 
 #include "sim.h"
 
-int sim_plant_cfg(const sim_scenario_t *sc, plant_cfg_t *cfg, plant_profiles_t *prof,
-                  char *err, size_t err_len)
+int sim_plant_cfg(const sim_scenario_t *sc, plant_cfg_t *cfg, plant_profiles_t *prof, char *err,
+                  size_t err_len)
 {
   plant_cfg_t c;
   plant_default_cfg(&c);
@@ -17,7 +17,8 @@ int sim_plant_cfg(const sim_scenario_t *sc, plant_cfg_t *cfg, plant_profiles_t *
       static const char *const names[] = {"default", "tight", "loose"};
       const int k = (int)s->value;
       if (s->value != (double)k || k < 0 || k > 2 || plant_thermal_preset(&c, names[k]) != 0) {
-        snprintf(err, err_len, "plant.thermal_preset: %g is not 0 (default), 1 (tight) or 2 (loose)", s->value);
+        snprintf(err, err_len,
+                 "plant.thermal_preset: %g is not 0 (default), 1 (tight) or 2 (loose)", s->value);
         return -1;
       }
       continue;
@@ -83,7 +84,8 @@ int sim_fw_params(const sim_scenario_t *sc, param_values_t *v, char *err, size_t
   }
   gyro_design_t d;
   if (gyro_design(&t, &d) != 0) {
-    snprintf(err, err_len, "firmware: these parameter values cannot be designed (drive loops or output filter)");
+    snprintf(err, err_len,
+             "firmware: these parameter values cannot be designed (drive loops or output filter)");
     return -1;
   }
   *v = t;

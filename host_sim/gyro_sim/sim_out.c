@@ -25,12 +25,11 @@ void sim_csv_row(sim_csv_t *c, const plant_truth_t *tr, const gyro_out_t *o)
   fprintf(c->f,
           "%.6f,%.6f,%.7g,%.7g,%.7g,%.7g,%.7g,%.5f,%.5f,%.5f,%.5g,%.5g,%.6g,%.6g,%u,%u,%.5f,"
           "%.7g,%.7g,%.7g,%.6g,%u,%.6g\n",
-          tr->t_s, tr->rate_dps, (double)o->rate_dps, (double)o->quad_dps,
-          (double)o->drive_amp_v, (double)o->drive_phase_deg, (double)o->p_deg,
-          tr->ambient_k - k0, tr->struct_k - k0, tr->board_k - k0, (double)o->u1_v,
-          (double)o->u2_v, tr->adc_v[0], tr->adc_v[1], o->flags, o->mode, tr->circuit_k - k0,
-          (double)o->rate_unc_dps, (double)o->p_f_deg, tr->drive_amp_m, (double)o->f_cmd_v2,
-          o->rate_valid, (double)o->rate_out_v);
+          tr->t_s, tr->rate_dps, (double)o->rate_dps, (double)o->quad_dps, (double)o->drive_amp_v,
+          (double)o->drive_phase_deg, (double)o->p_deg, tr->ambient_k - k0, tr->struct_k - k0,
+          tr->board_k - k0, (double)o->u1_v, (double)o->u2_v, tr->adc_v[0], tr->adc_v[1],
+          o->flags, o->mode, tr->circuit_k - k0, (double)o->rate_unc_dps, (double)o->p_f_deg,
+          tr->drive_amp_m, (double)o->f_cmd_v2, o->rate_valid, (double)o->rate_out_v);
 }
 
 void sim_csv_close(sim_csv_t *c)

@@ -23,7 +23,11 @@
 
 /* SIGINT/SIGTERM end a paced (pty) run cleanly; a flag is all a handler may touch. */
 static volatile sig_atomic_t stop_requested;
-static void on_signal(int sig) { (void)sig; stop_requested = 1; }
+static void on_signal(int sig)
+{
+  (void)sig;
+  stop_requested = 1;
+}
 
 static double wall_now(void)
 {
@@ -57,9 +61,9 @@ static void progress_update(progress_t *pr, double sim_s, int final)
   const int width = 30, fill = (int)(frac * width + 0.5);
   const double el = now - pr->t0_wall;
   const double eta = frac > 1e-6 ? el * (1.0 - frac) / frac : 0.0;
-  fprintf(stderr, "\r[%.*s%*s] %5.1f%%  sim %.1f/%.1f s  %.0fx real time  eta %.0f s ",
-          fill, "##############################", width - fill, "", 100.0 * frac, sim_s,
-          pr->total_s, el > 0.0 ? sim_s / el : 0.0, eta);
+  fprintf(stderr, "\r[%.*s%*s] %5.1f%%  sim %.1f/%.1f s  %.0fx real time  eta %.0f s ", fill,
+          "##############################", width - fill, "", 100.0 * frac, sim_s, pr->total_s,
+          el > 0.0 ? sim_s / el : 0.0, eta);
   if (final) fputc('\n', stderr);
   fflush(stderr);
 }
@@ -74,7 +78,10 @@ static double band_rms(const double *x, size_t i0, size_t n, double fs)
   double st = 0, sx = 0, stt = 0, stx = 0;
   for (size_t i = 0; i < m; i++) {
     const double t = (double)i;
-    st += t; sx += x[i0 + i]; stt += t * t; stx += t * x[i0 + i];
+    st += t;
+    sx += x[i0 + i];
+    stt += t * t;
+    stx += t * x[i0 + i];
   }
   const double den = (double)m * stt - st * st;
   const double b = den != 0.0 ? ((double)m * stx - st * sx) / den : 0.0;
@@ -92,7 +99,10 @@ static double band_rms(const double *x, size_t i0, size_t n, double fs)
       s2 = sos[0].b2 * v - sos[0].a2 * y;
       v = y;
     }
-    if (i >= skip) { acc += v * v; cnt++; }
+    if (i >= skip) {
+      acc += v * v;
+      cnt++;
+    }
   }
   return cnt ? sqrt(acc / (double)cnt) : NAN;
 }
@@ -112,7 +122,6 @@ static void startup_figures(const double *amp, const double *ph, const double *r
     if (amp[i] > peak) peak = amp[i];
     if (fabs(amp[i] / af - 1.0) > 0.01) last_out = i + 1;
   }
-  st->valid = 1;
   st->final_amp_m = af;
   st->lock_time_s = (double)last_out / fs;
   st->overshoot_pct = peak > af ? 100.0 * (peak / af - 1.0) : 0.0;
@@ -132,6 +141,163 @@ static void startup_figures(const double *amp, const double *ph, const double *r
   st->rate_settle_s = (double)last_rate_out / fs;
 }
 
+/* The drive's true motion at 1 kHz for the start-up figures, in the firmware's NCO frame. */
+typedef struct {
+  size_t decim;            /* ticks per truth sample */
+  size_t cap, n;           /* samples allocated, taken */
+  double *amp, *ph, *rerr; /* |Z| (m), unwrapped arg Z (rad), rate error (deg/s) */
+  double ph_prev, ph_unwrap;
+  double w_fw; /* the firmware's drive frequency, rad/s */
+} cl_truth_t;
+
+static void truth_sample(cl_truth_t *t, const app_t *app, const plant_truth_t *tr)
+{
+  /* The true drive phasor in the firmware's NCO frame: y = Im{Z e^{j phi}}, so
+   * Z = (y'/w + j y) e^{-j phi} with phi the NCO phase of the next tick. */
+  const uint32_t phase_u = app->gyro.nco.half_phase << 1;
+  const double phi = 2.0 * PLANT_PI * (double)phase_u / 4294967296.0;
+  const double re = tr->vy_mps / t->w_fw, im = tr->y_m;
+  const double c = cos(phi), s = sin(phi);
+  const double zr = re * c + im * s, zi = im * c - re * s;
+  t->amp[t->n] = hypot(zr, zi);
+  const double p = atan2(zi, zr);
+  double d = p - t->ph_prev;
+  d -= 2.0 * PLANT_PI * floor((d + PLANT_PI) / (2.0 * PLANT_PI));
+  t->ph_unwrap += d;
+  t->ph_prev = p;
+  t->ph[t->n] = t->ph_unwrap;
+  t->rerr[t->n] = (double)app->gyro.out.rate_dps - tr->rate_dps;
+  t->n++;
+}
+
+/* Running sums of a closed-loop run for its figures. */
+typedef struct {
+  double fw_lock_s, first_valid_s; /* -1: not yet */
+  uint64_t valid_ticks;
+  double sum_struct_k, sum_drive_freq_hz, sum_drive_amp_m;
+  uint64_t n_mean;
+} cl_stats_t;
+
+/* What a closed-loop run owns; released by cl_release. */
+typedef struct {
+  plant_t *plant;
+  app_t *app;
+  sim_csv_t csv;
+  uart_pty_t pty;
+  cl_truth_t truth;
+} cl_run_t;
+
+static void cl_release(cl_run_t *r)
+{
+  if (r->pty.master_fd >= 0) uart_pty_close(&r->pty);
+  sim_csv_close(&r->csv);
+  hal_sample_timer_stop();
+  free(r->truth.amp);
+  free(r->truth.ph);
+  free(r->truth.rerr);
+  free(r->plant);
+  free(r->app);
+}
+
+/* Opens the tuning UART's pty for a paced run and prints its path. */
+static int cl_open_pty(cl_run_t *r, const sim_opts_t *opt, char *err, size_t err_len)
+{
+  char path[UART_PTY_PATH_MAX];
+  if (uart_pty_open(&r->pty, path, sizeof path) != 0 ||
+      (opt->uart_pty_link != NULL && uart_pty_link(&r->pty, opt->uart_pty_link) != 0)) {
+    snprintf(err, err_len, "--uart-pty: %s", strerror(errno));
+    return -1;
+  }
+  stop_requested = 0;
+  signal(SIGINT, on_signal);
+  signal(SIGTERM, on_signal);
+  printf("pty %s\n", opt->uart_pty_link != NULL ? opt->uart_pty_link : path);
+  fflush(stdout);
+  return 0;
+}
+
+/* Allocates and starts the plant, the firmware behind the host HAL, the trace and the
+ * pty. Returns 0, or -1 with err set (cl_release frees what was made). */
+static int cl_start(cl_run_t *r, const sim_scenario_t *sc, const sim_opts_t *opt,
+                    const plant_cfg_t *pc, const plant_profiles_t *prof,
+                    const param_values_t *fw, uint64_t n_ticks, char *err, size_t err_len)
+{
+  memset(r, 0, sizeof *r);
+  r->pty.master_fd = -1;
+  r->plant = calloc(1, sizeof *r->plant);
+  r->app = calloc(1, sizeof *r->app);
+  cl_truth_t *t = &r->truth;
+  t->decim = (size_t)llround(pc->fs_hz / 1000.0); /* truth samples at 1 kHz */
+  t->w_fw = 2.0 * PLANT_PI * (double)fw->drive_freq_hz;
+  if ((sc->analyses & SIM_AN_STARTUP) != 0u) {
+    t->cap = (size_t)(n_ticks / t->decim) + 1u;
+    t->amp = calloc(t->cap, sizeof *t->amp);
+    t->ph = calloc(t->cap, sizeof *t->ph);
+    t->rerr = calloc(t->cap, sizeof *t->rerr);
+    if (t->amp == NULL || t->ph == NULL || t->rerr == NULL) t->cap = 0;
+  }
+  if (r->plant == NULL || r->app == NULL ||
+      ((sc->analyses & SIM_AN_STARTUP) != 0u && t->cap == 0)) {
+    snprintf(err, err_len, "out of memory");
+    return -1;
+  }
+  if (plant_init(r->plant, pc, sc->seed) != 0 || plant_set_profiles(r->plant, prof) != 0) {
+    snprintf(err, err_len, "plant: %s", plant_error(r->plant));
+    return -1;
+  }
+  (void)hal_flash_host_configure(NULL);
+  hal_uart_host_reset();
+  hal_host_attach(plant_step_hal, r->plant);
+  if (app_init_with(r->app, fw) != 0 ||
+      hal_sample_timer_start(fw->sys_fs_hz, app_sample_isr, r->app) != 0) {
+    snprintf(err, err_len, "firmware: application did not start");
+    return -1;
+  }
+  if (opt->csv_path != NULL && sim_csv_open(&r->csv, opt->csv_path, err, err_len) != 0)
+    return -1;
+  if (opt->uart_pty && cl_open_pty(r, opt, err, err_len) != 0) return -1;
+  return 0;
+}
+
+/* Paced run: the firmware meets a person or a tool in real time. Sleeps on the pty until
+ * the simulated time t_sim_s has caught up with the wall clock. Returns 1 when a signal
+ * asked to stop. */
+static int cl_pace(cl_run_t *r, double t_sim_s, double t_wall0)
+{
+  uart_pty_pump(&r->pty);
+  const double ahead = t_sim_s - (wall_now() - t_wall0);
+  if (ahead > 0.0) {
+    struct pollfd pfd = {uart_pty_fd(&r->pty), POLLIN, 0};
+    (void)poll(&pfd, 1, (int)(ahead * 1000.0));
+    uart_pty_pump(&r->pty);
+    app_poll(r->app);
+    uart_pty_pump(&r->pty);
+  }
+  return stop_requested != 0;
+}
+
+/* The figures of a finished closed-loop run of n_ticks. */
+static void cl_results(const cl_run_t *r, const cl_stats_t *st, const plant_cfg_t *pc,
+                       uint64_t n_ticks, sim_result_t *res)
+{
+  if (r->truth.cap > 0) {
+    startup_figures(r->truth.amp, r->truth.ph, r->truth.rerr, r->truth.n, 1000.0, &res->startup);
+    res->startup.fw_lock_time_s = st->fw_lock_s;
+  }
+  const plant_truth_t *tr = plant_truth(r->plant);
+  res->adc_clips[0] = tr->adc_clip[0];
+  res->adc_clips[1] = tr->adc_clip[1];
+  (void)plant_adc_fraction(pc, res->adc_fraction);
+  res->faults = r->app->gyro.sup.fault_count;
+  res->rate_valid_fraction = n_ticks > 0u ? (double)st->valid_ticks / (double)n_ticks : 0.0;
+  res->rate_first_valid_s = st->first_valid_s;
+  res->final_mode = (uint32_t)r->app->gyro.sup.mode;
+  const double n = (double)st->n_mean;
+  res->mean_struct_k = st->n_mean ? st->sum_struct_k / n : NAN;
+  res->mean_drive_freq_hz = st->n_mean ? st->sum_drive_freq_hz / n : NAN;
+  res->mean_drive_amp_m = st->n_mean ? st->sum_drive_amp_m / n : NAN;
+}
+
 int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_result_t *res,
                         char *err, size_t err_len)
 {
@@ -142,166 +308,64 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
   if (sim_plant_cfg(sc, &pc, &prof, err, err_len) != 0) return -1;
   if (sim_fw_params(sc, &fw, err, err_len) != 0) return -1;
   if (fabs(pc.fs_hz - (double)fw.sys_fs_hz) > 1e-9) {
-    snprintf(err, err_len, "plant.fs_hz %g differs from the firmware's sys.fs_hz %u", pc.fs_hz, fw.sys_fs_hz);
+    snprintf(err, err_len, "plant.fs_hz %g differs from the firmware's sys.fs_hz %u", pc.fs_hz,
+             fw.sys_fs_hz);
     return -1;
   }
-  plant_t *plant = calloc(1, sizeof *plant);
-  app_t *app = calloc(1, sizeof *app);
   const double fs = pc.fs_hz;
   uint64_t n_ticks = (uint64_t)llround(sc->duration_s * fs);
-  const int want_startup = (sc->analyses & SIM_AN_STARTUP) != 0u;
-  const size_t tdec = (size_t)llround(fs / 1000.0); /* truth samples at 1 kHz */
-  const size_t n_truth = want_startup ? (size_t)(n_ticks / tdec) + 1u : 0u;
-  double *amp = want_startup ? calloc(n_truth, sizeof *amp) : NULL;
-  double *ph = want_startup ? calloc(n_truth, sizeof *ph) : NULL;
-  double *rerr = want_startup ? calloc(n_truth, sizeof *rerr) : NULL;
-  sim_csv_t csv;
-  memset(&csv, 0, sizeof csv);
-  uart_pty_t pty;
-  memset(&pty, 0, sizeof pty);
-  pty.master_fd = -1;
-  int rc = 0;
-  if (plant == NULL || app == NULL || (want_startup && (amp == NULL || ph == NULL))) {
-    snprintf(err, err_len, "out of memory");
-    rc = -1;
-    goto out;
+  cl_run_t r;
+  if (cl_start(&r, sc, opt, &pc, &prof, &fw, n_ticks, err, err_len) != 0) {
+    cl_release(&r);
+    return -1;
   }
-  if (plant_init(plant, &pc, sc->seed) != 0 || plant_set_profiles(plant, &prof) != 0) {
-    snprintf(err, err_len, "plant: %s", plant_error(plant));
-    rc = -1;
-    goto out;
-  }
-  (void)hal_flash_host_configure(NULL);
-  hal_uart_host_reset();
-  hal_host_attach(plant_step_hal, plant);
-  if (app_init_with(app, &fw) != 0 ||
-      hal_sample_timer_start(fw.sys_fs_hz, app_sample_isr, app) != 0) {
-    snprintf(err, err_len, "firmware: application did not start");
-    rc = -1;
-    goto out;
-  }
-  if (opt->csv_path != NULL && sim_csv_open(&csv, opt->csv_path, err, err_len) != 0) {
-    rc = -1;
-    goto out;
-  }
+  const app_t *app = r.app;
   const uint64_t csv_every = (uint64_t)fmax(1.0, llround(fs / opt->csv_rate_hz));
   progress_t pr = {opt->progress && !opt->uart_pty, wall_now(), 0.0, sc->duration_s};
-  if (opt->uart_pty) {
-    char path[UART_PTY_PATH_MAX];
-    if (uart_pty_open(&pty, path, sizeof path) != 0 ||
-        (opt->uart_pty_link != NULL && uart_pty_link(&pty, opt->uart_pty_link) != 0)) {
-      snprintf(err, err_len, "--uart-pty: %s", strerror(errno));
-      rc = -1;
-      goto out;
-    }
-    stop_requested = 0;
-    signal(SIGINT, on_signal);
-    signal(SIGTERM, on_signal);
-    printf("pty %s\n", opt->uart_pty_link != NULL ? opt->uart_pty_link : path);
-    fflush(stdout);
-  }
   const double t_wall0 = wall_now(), t_cpu0 = cpu_now();
-  double fw_lock = -1.0, first_valid = -1.0, sum_tk = 0.0, sum_f = 0.0, sum_a = 0.0;
-  uint64_t valid_ticks = 0;
-  uint64_t n_mean = 0;
-  size_t it = 0;
-  double ph_prev = 0.0, ph_unwrap = 0.0;
-  const double w_fw = 2.0 * PLANT_PI * (double)fw.drive_freq_hz;
+  cl_stats_t st = {.fw_lock_s = -1.0, .first_valid_s = -1.0};
   for (uint64_t k = 0; k < n_ticks; k++) {
     hal_host_run(1u);
-    const plant_truth_t *tr = plant_truth(plant);
-    if (fw_lock < 0.0 && app->gyro.sup.mode == GYRO_MODE_LOCKED) fw_lock = (double)(k + 1u) / fs;
+    const plant_truth_t *tr = plant_truth(r.plant);
+    if (st.fw_lock_s < 0.0 && app->gyro.sup.mode == GYRO_MODE_LOCKED)
+      st.fw_lock_s = (double)(k + 1u) / fs;
     if (app->gyro.out.rate_valid != 0u) {
-      valid_ticks++;
-      if (first_valid < 0.0) first_valid = (double)(k + 1u) / fs;
+      st.valid_ticks++;
+      if (st.first_valid_s < 0.0) st.first_valid_s = (double)(k + 1u) / fs;
     }
-    if (want_startup && (k + 1u) % tdec == 0u && it < n_truth) {
-      /* The true drive phasor in the firmware's NCO frame: y = Im{Z e^{j phi}}, so
-       * Z = (y'/w + j y) e^{-j phi} with phi the NCO phase of the next tick. */
-      const uint32_t phase_u = app->gyro.nco.half_phase << 1;
-      const double phi = 2.0 * PLANT_PI * (double)phase_u / 4294967296.0;
-      const double re = tr->vy_mps / w_fw, im = tr->y_m;
-      const double c = cos(phi), s = sin(phi);
-      const double zr = re * c + im * s, zi = im * c - re * s;
-      amp[it] = hypot(zr, zi);
-      const double p = atan2(zi, zr);
-      double d = p - ph_prev;
-      d -= 2.0 * PLANT_PI * floor((d + PLANT_PI) / (2.0 * PLANT_PI));
-      ph_unwrap += d;
-      ph_prev = p;
-      ph[it] = ph_unwrap;
-      rerr[it] = (double)app->gyro.out.rate_dps - tr->rate_dps;
-      it++;
-    }
+    if ((k + 1u) % r.truth.decim == 0u && r.truth.n < r.truth.cap)
+      truth_sample(&r.truth, app, tr);
     if (k % csv_every == 0u) {
-      if (csv.f != NULL) sim_csv_row(&csv, tr, &app->gyro.out);
-      sum_tk += tr->struct_k;
-      sum_f += tr->drive_freq_hz;
-      sum_a += tr->drive_amp_m;
-      n_mean++;
+      if (r.csv.f != NULL) sim_csv_row(&r.csv, tr, &app->gyro.out);
+      st.sum_struct_k += tr->struct_k;
+      st.sum_drive_freq_hz += tr->drive_freq_hz;
+      st.sum_drive_amp_m += tr->drive_amp_m;
+      st.n_mean++;
     }
     if ((k & 1023u) == 0u) {
-      app_poll(app);
+      app_poll(r.app);
       progress_update(&pr, (double)k / fs, 0);
-      if (opt->uart_pty) {
-        /* Paced run: the firmware meets a person or a tool in real time. Sleep on the
-         * pty until the simulated time has caught up with the wall clock. */
-        uart_pty_pump(&pty);
-        const double ahead = (double)(k + 1u) / fs - (wall_now() - t_wall0);
-        if (ahead > 0.0) {
-          struct pollfd pfd = {uart_pty_fd(&pty), POLLIN, 0};
-          (void)poll(&pfd, 1, (int)(ahead * 1000.0));
-          uart_pty_pump(&pty);
-          app_poll(app);
-          uart_pty_pump(&pty);
-        }
-        if (stop_requested) {
-          n_ticks = k + 1u;
-          break;
-        }
+      if (opt->uart_pty && cl_pace(&r, (double)(k + 1u) / fs, t_wall0)) {
+        n_ticks = k + 1u;
+        break;
       }
     }
   }
   progress_update(&pr, sc->duration_s, 1);
   res->wall_s = wall_now() - t_wall0;
   res->cpu_s = cpu_now() - t_cpu0;
-  res->ticks = n_ticks;
   res->sim_s = (double)n_ticks / fs;
   res->realtime_factor = res->wall_s > 0.0 ? res->sim_s / res->wall_s : 0.0;
   res->realtime_factor_cpu = res->cpu_s > 0.0 ? res->sim_s / res->cpu_s : 0.0;
-  if (want_startup) {
-    startup_figures(amp, ph, rerr, it, 1000.0, &res->startup);
-    res->startup.fw_lock_time_s = fw_lock;
-  }
-  {
-    const plant_truth_t *tr = plant_truth(plant);
-    res->adc_clips[0] = tr->adc_clip[0];
-    res->adc_clips[1] = tr->adc_clip[1];
-  }
-  (void)plant_adc_fraction(&pc, res->adc_fraction);
-  res->faults = app->gyro.sup.fault_count;
-  res->rate_valid_fraction = n_ticks > 0u ? (double)valid_ticks / (double)n_ticks : 0.0;
-  res->rate_first_valid_s = first_valid;
-  res->final_mode = (uint32_t)app->gyro.sup.mode;
-  res->mean_struct_k = n_mean ? sum_tk / (double)n_mean : NAN;
-  res->mean_drive_freq_hz = n_mean ? sum_f / (double)n_mean : NAN;
-  res->mean_drive_amp_m = n_mean ? sum_a / (double)n_mean : NAN;
-out:
-  if (pty.master_fd >= 0) uart_pty_close(&pty);
-  sim_csv_close(&csv);
-  hal_sample_timer_stop();
-  free(amp);
-  free(ph);
-  free(rerr);
-  free(plant);
-  free(app);
-  return rc;
+  cl_results(&r, &st, &pc, n_ticks, res);
+  cl_release(&r);
+  return 0;
 }
 
 /* ------------------------------------------------------------------ open loop -- */
 
 typedef struct {
-  double psi, dpsi;         /* half-frequency voltage phase and its advance per tick */
+  double psi, dpsi; /* half-frequency voltage phase and its advance per tick */
   double u_amp_v;
   int measuring;
   double acc_i, acc_q, acc_am;
@@ -371,7 +435,10 @@ int sim_run_open_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_resul
   plant_profiles_t prof;
   if (sim_plant_cfg(sc, &pc, &prof, err, err_len) != 0) return -1;
   plant_t *plant = calloc(1, sizeof *plant);
-  if (plant == NULL) { snprintf(err, err_len, "out of memory"); return -1; }
+  if (plant == NULL) {
+    snprintf(err, err_len, "out of memory");
+    return -1;
+  }
   if (plant_init(plant, &pc, sc->seed) != 0 || plant_set_profiles(plant, &prof) != 0) {
     snprintf(err, err_len, "plant: %s", plant_error(plant));
     free(plant);
@@ -394,7 +461,7 @@ int sim_run_open_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_resul
   const double t_wall0 = wall_now(), t_cpu0 = cpu_now();
   progress_t pr = {opt->progress, t_wall0, 0.0, 0.0};
   double am;
-  if (sc->mode == SIM_OPEN_LOOP_SWEEP) {
+  if (sc->loop == SIM_OPEN_LOOP_SWEEP) {
     const int np = sc->ol.points > 10000 ? 10000 : sc->ol.points;
     pr.total_s = np * sc->ol.dwell_s;
     for (int i = 0; i < np; i++) {
@@ -411,8 +478,8 @@ int sim_run_open_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_resul
     for (int i = 0; i < na; i++) {
       const double u = sc->ol.n_amps > 0 ? sc->ol.amps_v[i] : sc->ol.u_amp_v;
       double ph;
-      ol_point(&o, plant, fs, sc->ol.freq_hz, u, sc->ol.settle_s, sc->ol.dwell_s,
-               &sq->amp_v[i], &ph, &sq->amp_m[i], &csv, &k, csv_every);
+      ol_point(&o, plant, fs, sc->ol.freq_hz, u, sc->ol.settle_s, sc->ol.dwell_s, &sq->amp_v[i],
+               &ph, &sq->amp_m[i], &csv, &k, csv_every);
       sq->u_v[i] = u;
       sq->n = i + 1;
       progress_update(&pr, (double)hal_host_ticks() / fs, 0);
@@ -421,8 +488,7 @@ int sim_run_open_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_resul
   progress_update(&pr, (double)hal_host_ticks() / fs, 1);
   res->wall_s = wall_now() - t_wall0;
   res->cpu_s = cpu_now() - t_cpu0;
-  res->ticks = hal_host_ticks();
-  res->sim_s = (double)res->ticks / fs;
+  res->sim_s = (double)hal_host_ticks() / fs;
   res->realtime_factor = res->wall_s > 0.0 ? res->sim_s / res->wall_s : 0.0;
   res->realtime_factor_cpu = res->cpu_s > 0.0 ? res->sim_s / res->cpu_s : 0.0;
   res->adc_clips[0] = plant_truth(plant)->adc_clip[0];

@@ -1,4 +1,4 @@
-/* Linear acceleration and vibration acting on the two modes (g-sensitivity, thesis
+/* Linear acceleration and vibration acting on the two axes (g-sensitivity, thesis
  * §2.4.3; §4.4.2: shaking can push the pickoff out of the ADC range). Host plant.
  *
  * The caller passes the case acceleration each sample, in g along the gyro's axes:
@@ -6,10 +6,10 @@
  *   a[ACCEL_AXIS_SENSE]  along the sense motion (x)
  *   a[ACCEL_AXIS_NORMAL] along the rate input axis (z)
  * (use its mean over the sample: the result is held over the sample like the other
- * forces). The modes feel a force per unit mass (m/s^2), added to the actuator forces:
+ * forces). Both axes feel a force per unit mass (m/s^2), added to the actuator forces:
  *   f_drv = sum_i drive_mps2_per_g[i] a[i],   f_sen = sum_i sense_mps2_per_g[i] a[i]
  * For a single proof mass on springs, the inertial force is -m a: the coefficient of a
- * mode's own axis is -9.80665 (m/s^2)/g and the others are misalignment/cross-coupling
+ * axis's own direction is -9.80665 (m/s^2)/g and the others are misalignment/cross-coupling
  * terms. The thesis's linear gyro has no counter-vibrating twin to cancel this (§2.2,
  * "no symmetric cancelling sense mass, acceleration sensitive"), so the defaults are the
  * full inertial response: 1 g static along the sense axis deflects it by
@@ -24,8 +24,8 @@
 #define ACCEL_G0_MPS2 9.80665
 
 typedef struct {
-  double drive_mps2_per_g[3]; /* force per unit mass on the drive mode per g, per axis */
-  double sense_mps2_per_g[3]; /* force per unit mass on the sense mode per g, per axis */
+  double drive_mps2_per_g[3]; /* force per unit mass on the drive axis per g, per axis */
+  double sense_mps2_per_g[3]; /* force per unit mass on the sense axis per g, per axis */
 } accel_cfg_t;
 
 typedef struct {

@@ -12,7 +12,7 @@ void actuator_default_cfg(actuator_cfg_t *cfg)
   cfg->drive_noise.white_rthz = 200e-9;
   cfg->drive_noise.flicker_1hz_rthz = 2e-6;
   cfg->drive_noise.fmin_hz = 1e-3;
-  cfg->fb_mode = ACTUATOR_FB_OFF;
+  cfg->fb = ACTUATOR_FB_OFF;
   cfg->ks_fb_mps2_per_v2 = 0.01;
   cfg->fb_bias_v = 5.0;
   cfg->fb_noise = cfg->drive_noise;
@@ -25,15 +25,15 @@ int actuator_init(actuator_t *a, const actuator_cfg_t *cfg, uint64_t seed)
   if (!(isfinite(cfg->ks_drive_mps2_per_v2) && cfg->ks_drive_mps2_per_v2 >= 0.0)) return -1;
   if (!(isfinite(cfg->ks_fb_mps2_per_v2) && cfg->ks_fb_mps2_per_v2 >= 0.0)) return -1;
   if (!(isfinite(cfg->fb_bias_v) && fabs(cfg->fb_bias_v) <= 100.0)) return -1;
-  if (cfg->fb_mode != ACTUATOR_FB_OFF && cfg->fb_mode != ACTUATOR_FB_SINGLE &&
-      cfg->fb_mode != ACTUATOR_FB_DIFFERENTIAL)
+  if (cfg->fb != ACTUATOR_FB_OFF && cfg->fb != ACTUATOR_FB_SINGLE &&
+      cfg->fb != ACTUATOR_FB_DIFFERENTIAL)
     return -1;
   const flicker_spec_t off = {0.0, 0.0, 0.0};
   const flicker_spec_t *spec[4] = {&cfg->drive_noise, &cfg->drive_noise, &cfg->fb_noise,
                                    &cfg->fb_noise};
   /* the grounded electrode of FB_SINGLE and both electrodes of FB_OFF carry no noise */
-  if (cfg->fb_mode == ACTUATOR_FB_OFF) spec[2] = &off;
-  if (cfg->fb_mode != ACTUATOR_FB_DIFFERENTIAL) spec[3] = &off;
+  if (cfg->fb == ACTUATOR_FB_OFF) spec[2] = &off;
+  if (cfg->fb != ACTUATOR_FB_DIFFERENTIAL) spec[3] = &off;
   /* everything that can fail is checked before a is touched; then built in place */
   for (int i = 0; i < 4; i++)
     if (flicker_check(spec[i], cfg->fs_hz) != 0) return -1;
@@ -60,7 +60,7 @@ void actuator_step(actuator_t *a, const dac_out_t *dac, actuator_out_t *out)
                        mean_sq_with_noise(&dac->ch[HAL_DAC_DRIVE_U2], w[1]));
   const dac_chan_out_t *s = &dac->ch[HAL_DAC_SPARE];
   const double vb = a->cfg.fb_bias_v;
-  switch (a->cfg.fb_mode) {
+  switch (a->cfg.fb) {
   case ACTUATOR_FB_SINGLE:
     out->f_sense_mps2 = a->cfg.ks_fb_mps2_per_v2 * mean_sq_with_noise(s, w[2]);
     break;
@@ -74,9 +74,7 @@ void actuator_step(actuator_t *a, const dac_out_t *dac, actuator_out_t *out)
     break;
   }
   case ACTUATOR_FB_OFF:
-  default:
-    out->f_sense_mps2 = 0.0;
-    break;
+  default: out->f_sense_mps2 = 0.0; break;
   }
   for (int i = 0; i < 4; i++) out->noise_v[i] = w[i];
 }

@@ -1,5 +1,5 @@
 /* Electrostatic actuators of the gyro (thesis §6.2.1): the differential drive comb on
- * the drive mode and optional sense-axis feedback electrodes on the sense mode, with
+ * the drive axis and optional feedback electrodes on the sense axis, with
  * 1/f + white noise on every electrode voltage (§6.3.2). Host plant, double precision.
  *
  * Force per unit mass, (6-7) divided by the proof mass, positive along +y (drive) and
@@ -43,25 +43,25 @@
 #define ACTUATOR_RNG_STREAM_U1 0x6101u /* U2, U3, U4 follow */
 
 typedef enum {
-  ACTUATOR_FB_OFF = 0,          /* no sense-axis force */
-  ACTUATOR_FB_SINGLE = 1,       /* one electrode driven by the spare DAC */
-  ACTUATOR_FB_DIFFERENTIAL = 2  /* bias +- spare DAC on the two electrodes */
-} actuator_fb_mode_t;
+  ACTUATOR_FB_OFF = 0,         /* no sense-axis force */
+  ACTUATOR_FB_SINGLE = 1,      /* one electrode driven by the spare DAC */
+  ACTUATOR_FB_DIFFERENTIAL = 2 /* bias +- spare DAC on the two electrodes */
+} actuator_fb_t;
 
 typedef struct {
   double fs_hz;
-  double ks_drive_mps2_per_v2;  /* Ks/m of the drive comb pair, (m/s^2)/V^2 */
-  flicker_spec_t drive_noise;   /* on U1 and on U2 (independent), V/sqrt(Hz) one-sided */
-  actuator_fb_mode_t fb_mode;
-  double ks_fb_mps2_per_v2;     /* Ks/m of the sense feedback pair, (m/s^2)/V^2 */
-  double fb_bias_v;             /* Vb of FB_DIFFERENTIAL, V */
-  flicker_spec_t fb_noise;      /* on U3 and U4 (independent) */
+  double ks_drive_mps2_per_v2; /* Ks/m of the drive comb pair, (m/s^2)/V^2 */
+  flicker_spec_t drive_noise;  /* on U1 and on U2 (independent), V/sqrt(Hz) one-sided */
+  actuator_fb_t fb;            /* sense feedback electrodes (plant.fb_mode) */
+  double ks_fb_mps2_per_v2;    /* Ks/m of the sense feedback pair, (m/s^2)/V^2 */
+  double fb_bias_v;            /* Vb of FB_DIFFERENTIAL, V */
+  flicker_spec_t fb_noise;     /* on U3 and U4 (independent) */
 } actuator_cfg_t;
 
 typedef struct {
-  double f_drive_mps2;  /* mean drive force per unit mass over the sample, m/s^2 */
-  double f_sense_mps2;  /* mean sense force per unit mass over the sample, m/s^2 */
-  double noise_v[4];    /* w1..w4 drawn for this sample, V */
+  double f_drive_mps2; /* mean drive force per unit mass over the sample, m/s^2 */
+  double f_sense_mps2; /* mean sense force per unit mass over the sample, m/s^2 */
+  double noise_v[4];   /* w1..w4 drawn for this sample, V */
 } actuator_out_t;
 
 typedef struct {

@@ -11,7 +11,8 @@ static const double k_pi = PLANT_PI;
 
 double dac_code_to_v(uint16_t code)
 {
-  return ((double)code - (double)HAL_DAC_CODE_MID) * (2.0 * (double)HAL_DAC_FULL_SCALE_V / 16384.0);
+  return ((double)code - (double)HAL_DAC_CODE_MID) *
+         (2.0 * (double)HAL_DAC_FULL_SCALE_V / 16384.0);
 }
 
 uint16_t dac_v_to_code(double v)
@@ -46,11 +47,13 @@ static int cfg_ok(const dac_cfg_t *c)
   if (!(isfinite(c->recon_cutoff_hz) && c->recon_cutoff_hz >= 0.0 &&
         c->recon_cutoff_hz <= c->fs_hz))
     return 0;
-  if (c->recon_cutoff_hz > 0.0 && !(isfinite(c->recon_q) && c->recon_q >= 0.1 && c->recon_q <= 10.0))
+  if (c->recon_cutoff_hz > 0.0 &&
+      !(isfinite(c->recon_q) && c->recon_q >= 0.1 && c->recon_q <= 10.0))
     return 0;
   for (int i = 0; i < DAC_NCH; i++) {
     if (!(isfinite(c->gain[i]) && fabs(c->gain[i]) > 0.0 && fabs(c->gain[i]) <= 2.0)) return 0;
-    if (!(isfinite(c->offset_v[i]) && fabs(c->offset_v[i]) <= (double)HAL_DAC_FULL_SCALE_V)) return 0;
+    if (!(isfinite(c->offset_v[i]) && fabs(c->offset_v[i]) <= (double)HAL_DAC_FULL_SCALE_V))
+      return 0;
     if (c->initial_code[i] > HAL_DAC_CODE_MAX) return 0;
   }
   return 1;
@@ -174,7 +177,8 @@ void dac_step(dac_t *d, dac_out_t *out)
     const double z0 = d->x[c][0], z1 = d->x[c][1];
     o->held_v = u;
     o->mean_v = d->mv[0] * z0 + d->mv[1] * z1 + d->mv[2] * u;
-    o->mean_sq_v2 = z0 * (q[0] * z0 + q[1] * z1 + q[2] * u) + z1 * (q[3] * z1 + q[4] * u) + q[5] * u * u;
+    o->mean_sq_v2 = z0 * (q[0] * z0 + q[1] * z1 + q[2] * u) + z1 * (q[3] * z1 + q[4] * u) +
+                    q[5] * u * u;
     const double n0 = d->ad[0][0] * z0 + d->ad[0][1] * z1 + d->bd[0] * u;
     const double n1 = d->ad[1][0] * z0 + d->ad[1][1] * z1 + d->bd[1] * u;
     d->x[c][0] = n0;

@@ -44,7 +44,7 @@
  * Voltages at the end of the sample (end_v, end_dvdt_v_per_s) are for the pickoff's
  * electrical feedthrough, which interpolates between ticks.
  *
- * Channels (hal/hal_dac.h): 0 drive U1, 1 drive U2, 2 analog rate output, 3 spare.
+ * Channels (hal/include/hal/hal_dac.h): 0 drive U1, 1 drive U2, 2 analog rate output, 3 spare.
  *
  * One plant sample [t_k, t_k+1) with the electrical modules (the top level's order):
  *   dac_step(&dac, &dout)                         voltages over the sample
@@ -80,11 +80,11 @@ typedef struct {
 } dac_cfg_t;
 
 typedef struct {
-  double held_v;          /* ZOH level u over this sample (before the filter), V */
-  double mean_v;          /* mean of the filtered output over the sample, V */
-  double mean_sq_v2;      /* mean of its square over the sample, V^2 */
-  double end_v;           /* output at the end of the sample, V */
-  double end_dvdt_v_per_s;/* its slope there, V/s */
+  double held_v;           /* ZOH level u over this sample (before the filter), V */
+  double mean_v;           /* mean of the filtered output over the sample, V */
+  double mean_sq_v2;       /* mean of its square over the sample, V^2 */
+  double end_v;            /* output at the end of the sample, V */
+  double end_dvdt_v_per_s; /* its slope there, V/s */
 } dac_chan_out_t;
 
 typedef struct {
@@ -93,17 +93,17 @@ typedef struct {
 
 typedef struct {
   dac_cfg_t cfg;
-  int filtered;                 /* 0 when recon_cutoff_hz == 0 */
-  double w0;                    /* rad/s */
-  double ad[2][2], bd[2];       /* exact ZOH discretisation */
-  double mv[3];                 /* mean form */
-  double msq[3][3];             /* mean-square form */
-  double q2[6];                 /* msq as q00, 2q01, 2q02, q11, 2q12, q22 (per-sample use) */
-  double scale[DAC_NCH];        /* volts per code, gain included */
-  double zero[DAC_NCH];         /* volts at code 0, gain and offset included */
-  double x[DAC_NCH][2];         /* filter states [v, v'/w0] */
-  uint16_t latched[DAC_NCH];    /* code held over the current sample */
-  uint16_t pending[DAC_NCH];    /* code latched at the end of the current sample */
+  int filtered;              /* 0 when recon_cutoff_hz == 0 */
+  double w0;                 /* rad/s */
+  double ad[2][2], bd[2];    /* exact ZOH discretisation */
+  double mv[3];              /* mean form */
+  double msq[3][3];          /* mean-square form */
+  double q2[6];              /* msq as q00, 2q01, 2q02, q11, 2q12, q22 (per-sample use) */
+  double scale[DAC_NCH];     /* volts per code, gain included */
+  double zero[DAC_NCH];      /* volts at code 0, gain and offset included */
+  double x[DAC_NCH][2];      /* filter states [v, v'/w0] */
+  uint16_t latched[DAC_NCH]; /* code held over the current sample */
+  uint16_t pending[DAC_NCH]; /* code latched at the end of the current sample */
 } dac_t;
 
 /* fs 50 kHz, 2nd-order Butterworth at 20 kHz, ideal gain, no offset, mid-scale codes. */

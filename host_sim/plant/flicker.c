@@ -48,8 +48,8 @@ static void bilinear(double z_hz, double p_hz, double fs_hz, double *b0, double 
 
 /* Zeros and poles of the cascade (knee pairs, then one pair per decade down to fmin).
  * Returns the number of sections, or -1 if they do not fit FLICKER_MAX_SECTIONS. */
-static int design_sections(const flicker_spec_t *spec, double fc, double zs[FLICKER_MAX_SECTIONS],
-                           double ps[FLICKER_MAX_SECTIONS])
+static int design_sections(const flicker_spec_t *spec, double fc,
+                           double zs[FLICKER_MAX_SECTIONS], double ps[FLICKER_MAX_SECTIONS])
 {
   int n = 0;
   for (int i = 0; i < 2; i++) {

@@ -40,10 +40,10 @@ typedef struct {
 } flicker_spec_t;
 
 typedef struct {
-  int active;        /* 0: W = K = 0, output 0, no random draws */
-  int nsec;          /* 0: white only */
-  double in_sd;      /* sd of the section input per sample, gain included */
-  double corner_hz;  /* fc actually used (0 for white only) */
+  int active;       /* 0: W = K = 0, output 0, no random draws */
+  int nsec;         /* 0: white only */
+  double in_sd;     /* sd of the section input per sample, gain included */
+  double corner_hz; /* fc actually used (0 for white only) */
   double b0[FLICKER_MAX_SECTIONS], b1[FLICKER_MAX_SECTIONS], a1[FLICKER_MAX_SECTIONS];
   double xp[FLICKER_MAX_SECTIONS], yp[FLICKER_MAX_SECTIONS];
   rng_t rng;

@@ -8,17 +8,16 @@
 
 static const double kPi = PLANT_PI;
 
-#define NA (MECH_NS + MECH_NU)           /* augmented [state; input] size */
+#define NA (MECH_NS + MECH_NU) /* augmented [state; input] size */
 
 /* Monomials of the truncated algebra, exponents of (w, a, e). The set is closed under
  * taking divisors, so the monomials outside it span an ideal and truncation is an
  * algebra homomorphism. Order: blocks with the same power of w are contiguous. */
-static const int kMono[MECH_NMONO][3] = {
-    {0, 0, 0}, {0, 0, 1}, {0, 0, 2},   /* 1, e, e^2     */
-    {1, 0, 0}, {1, 0, 1}, {1, 0, 2},   /* w, we, we^2   */
-    {2, 0, 0}, {2, 0, 1},              /* w^2, w^2 e    */
-    {3, 0, 0},                         /* w^3           */
-    {0, 1, 0}, {1, 1, 0}, {0, 1, 1}};  /* a, w a, a e   */
+static const int kMono[MECH_NMONO][3] = {{0, 0, 0}, {0, 0, 1}, {0, 0, 2},  /* 1, e, e^2     */
+                                         {1, 0, 0}, {1, 0, 1}, {1, 0, 2},  /* w, we, we^2   */
+                                         {2, 0, 0}, {2, 0, 1},             /* w^2, w^2 e    */
+                                         {3, 0, 0},                        /* w^3           */
+                                         {0, 1, 0}, {1, 1, 0}, {0, 1, 1}}; /* a, w a, a e   */
 
 static int mono_index(int pw, int pa, int pe)
 {
@@ -30,15 +29,15 @@ static int mono_index(int pw, int pa, int pe)
 void mech_default_cfg(mech_cfg_t *cfg)
 {
   memset(cfg, 0, sizeof(*cfg));
-  cfg->f1_hz = 1489.9;      /* §7.2.2 sweep */
-  cfg->q1 = 33.33;          /* §7.2.2, -3 dB points */
-  cfg->f2_hz = 2000.0;      /* design, §2.4.2 */
-  cfg->q2 = 3.0;            /* design, §2.2.2 (air) */
+  cfg->f1_hz = 1489.9; /* §7.2.2 sweep */
+  cfg->q1 = 33.33;     /* §7.2.2, -3 dB points */
+  cfg->f2_hz = 2000.0; /* design, §2.4.2 */
+  cfg->q2 = 3.0;       /* design, §2.2.2 (air) */
   cfg->temp_ref_k = 298.15;
-  cfg->ket_per_k = 40e-6;   /* (2-29) range 25..75 ppm/K; table 7-4 fits 40 (plant_cfg.c) */
+  cfg->ket_per_k = 40e-6; /* (2-29) range 25..75 ppm/K; table 7-4 fits 40 (plant_cfg.c) */
   cfg->kq_per_s2 = 0.0;
   cfg->dq_per_s = 0.0;
-  cfg->mass_kg = 0.26e-6;   /* §4.6.1: 0.26 mg */
+  cfg->mass_kg = 0.26e-6; /* §4.6.1: 0.26 mg */
   cfg->fs_hz = (double)BOARD_SAMPLE_RATE_HZ; /* §4.4.2 */
   /* Measured (test_mech, test_refresh_threshold_error): with e expanded to second
    * order the steady-state error of the drive at resonance (Q1 = 33) is about
@@ -50,7 +49,10 @@ void mech_default_cfg(mech_cfg_t *cfg)
   cfg->brownian = 1;
 }
 
-static int finite_in(double v, double lo, double hi) { return isfinite(v) && v >= lo && v <= hi; }
+static int finite_in(double v, double lo, double hi)
+{
+  return isfinite(v) && v >= lo && v <= hi;
+}
 
 int mech_cfg_check(const mech_cfg_t *c, const char **key)
 {
@@ -86,7 +88,20 @@ static int temp_ok(const mech_cfg_t *c, double temp_k)
          fabs(0.5 * c->ket_per_k * (temp_k - c->temp_ref_k)) < 0.2;
 }
 
-enum { MONO_1 = 0, MONO_E, MONO_E2, MONO_W, MONO_WE, MONO_WE2, MONO_W2, MONO_W2E, MONO_W3, MONO_A, MONO_WA, MONO_AE };
+enum {
+  MONO_1 = 0,
+  MONO_E,
+  MONO_E2,
+  MONO_W,
+  MONO_WE,
+  MONO_WE2,
+  MONO_W2,
+  MONO_W2E,
+  MONO_W3,
+  MONO_A,
+  MONO_WA,
+  MONO_AE
+};
 
 /* Continuous generator in scaled coordinates, one block per monomial: A(w,a,e) =
  * wr * sum_m Ahat_m * mono_m, augmented with the input columns. Only the four state
@@ -97,13 +112,13 @@ static void build_generator(const mech_cfg_t *c, double wr, double wn1, double w
                             double ahat[MECH_NMONO][MECH_NS][NA])
 {
   const double r1 = wn1 / wr, r2 = wn2 / wr;
-  /* cross couplings follow the structure temperature like the modes: stiffness with
+  /* cross couplings follow the structure temperature like the resonances: stiffness with
    * wn^2, damping with wn (Q constant) */
   const double s = wn1 / wn_at(c, c->f1_hz, c->temp_ref_k);
   const double kq = c->kq_per_s2 * s * s / (wr * wr);
   const double dq = c->dq_per_s * s / wr;
   memset(ahat, 0, sizeof(double) * MECH_NMONO * MECH_NS * NA);
-  double (*a0)[NA] = ahat[MONO_1];
+  double(*a0)[NA] = ahat[MONO_1];
   a0[0][1] = 1.0;
   a0[1][0] = -r1 * r1;
   a0[1][1] = -r1 / c->q1;
@@ -124,14 +139,14 @@ static void build_generator(const mech_cfg_t *c, double wr, double wn1, double w
   ahat[MONO_E2][1][0] = -r1 * r1;
   ahat[MONO_E2][3][0] = -kq;
   ahat[MONO_E2][3][2] = -r2 * r2;
-  /* w: Coriolis 2 Omega y' on the sense mode, (2-22) */
+  /* w: Coriolis 2 Omega y' on the sense axis, (2-22) */
   ahat[MONO_W][3][1] = 2.0;
   if (c->full_kinematics) {
-    ahat[MONO_W][1][3] = -2.0; /* reciprocal Coriolis on the drive mode, (2-20) */
+    ahat[MONO_W][1][3] = -2.0; /* reciprocal Coriolis on the drive axis, (2-20) */
     ahat[MONO_W2][1][0] = 1.0; /* centrifugal Omega^2 y, (2-20) */
     ahat[MONO_W2][3][2] = 1.0; /* centrifugal Omega^2 x */
-    ahat[MONO_A][3][0] = 1.0;  /* Euler force +alpha y on the sense mode */
-    ahat[MONO_A][1][2] = -1.0; /* Euler force -alpha x on the drive mode */
+    ahat[MONO_A][3][0] = 1.0;  /* Euler force +alpha y on the sense axis */
+    ahat[MONO_A][1][2] = -1.0; /* Euler force -alpha x on the drive axis */
   }
 }
 
@@ -316,7 +331,7 @@ static void build_q(mech_t *m)
   memset(m->q, 0, sizeof(m->q));
   for (int i = 0; i < MECH_NMONO; i++) {
     const double c = ep[kMono[i][2]];
-    double (*dst)[NA] = m->q[kMono[i][0]][kMono[i][1]];
+    double(*dst)[NA] = m->q[kMono[i][0]][kMono[i][1]];
     for (int r = 0; r < MECH_NS; r++)
       for (int q = 0; q < NA; q++) dst[r][q] += c * m->blk[i][r][q];
   }
@@ -411,10 +426,10 @@ void mech_set_state(mech_t *m, const mech_state_t *s)
 double mech_wn1(const mech_t *m) { return wn_at(&m->cfg, m->cfg.f1_hz, m->temp_k); }
 double mech_wn2(const mech_t *m) { return wn_at(&m->cfg, m->cfg.f2_hz, m->temp_k); }
 
-double mech_noise_psd(const mech_t *m, int mode)
+double mech_noise_psd(const mech_t *m, int resonance)
 {
-  const double wn = mode == 1 ? mech_wn1(m) : mech_wn2(m);
-  const double q = mode == 1 ? m->cfg.q1 : m->cfg.q2;
+  const double wn = resonance == 1 ? mech_wn1(m) : mech_wn2(m);
+  const double q = resonance == 1 ? m->cfg.q1 : m->cfg.q2;
   /* (4-20): force PSD 4 kB T D, D = m wn / Q; divided by m^2 */
   return 4.0 * MECH_KB_J_PER_K * m->temp_k * wn / (q * m->cfg.mass_kg);
 }

@@ -1,4 +1,4 @@
-/* Two-mode mechanics of the vibratory gyro: drive mode y, sense mode x, exact
+/* Two-resonance mechanics of the vibratory gyro: drive axis y, sense axis x, exact
  * discretisation per sample (host plant, double precision).
  *
  * Equations (thesis (2-22), per unit mass, completed with the terms of the full
@@ -11,8 +11,8 @@
  *                                 [ + alpha y + Omega^2 x ]                (2-20)
  *
  * Sign convention: the thesis writes the Coriolis term as -2 Omega y' on the left of
- * (2-22), i.e. +2 Omega y' as a force on the sense mode; its reaction on the drive
- * mode is -2 Omega x' ((2-20), first line, 2 m theta' x' on the left). The bracketed
+ * (2-22), i.e. +2 Omega y' as a force on the sense axis; its reaction on the drive
+ * axis is -2 Omega x' ((2-20), first line, 2 m theta' x' on the left). The bracketed
  * (2-20) terms (reciprocal Coriolis, centrifugal softening, Euler force) are present
  * when cfg.full_kinematics is set; they change the drive by < 1e-4 relative at
  * 1000 deg/s and the thesis neglects them, but the reciprocal Coriolis term is real
@@ -27,7 +27,7 @@
  *            frequency, so s^2 = S fs / 2. The sinc^2 droop lowers the resonant
  *            response by 0.3 % (drive, 1.49 kHz) and 0.5 % (sense, 2 kHz) at 50 kHz.
  *
- * Temperature (2-29..2-32): wn_i(T) = wn_i(T0) (1 - 0.5 kET (T - T0)) for both modes
+ * Temperature (2-29..2-32): wn_i(T) = wn_i(T0) (1 - 0.5 kET (T - T0)) for both resonances
  * (the structure temperature); Q constant, so every damping term scales with wn and
  * every stiffness term (including k_q) with wn^2.
  *
@@ -72,9 +72,9 @@
 #include "plant/gauss_zig.h"
 #include "plant/rng.h"
 
-#define MECH_NMONO 12  /* Taylor blocks, see mech.c */
-#define MECH_NS 4      /* states */
-#define MECH_NU 2      /* inputs */
+#define MECH_NMONO 12 /* Taylor blocks, see mech.c */
+#define MECH_NS 4     /* states */
+#define MECH_NU 2     /* inputs */
 
 /* Noise stream ids (rng_seed(seed, stream)): one rng_t per noise source. */
 #define MECH_RNG_STREAM_DRIVE 0x6d01u
@@ -95,30 +95,30 @@ typedef struct {
   double fs_hz;        /* sample rate */
   double refresh_eps;  /* |wn(T)/wn(T_d) - 1| that triggers a re-discretisation */
   int full_kinematics; /* 1: reciprocal Coriolis, centrifugal and Euler terms (2-20) */
-  int brownian;        /* 1: Brownian force noise on both modes */
+  int brownian;        /* 1: Brownian force noise on both axes */
 } mech_cfg_t;
 
 typedef struct {
-  double y_m, vy_mps;  /* drive displacement, velocity */
-  double x_m, vx_mps;  /* sense displacement, velocity */
+  double y_m, vy_mps; /* drive displacement, velocity */
+  double x_m, vx_mps; /* sense displacement, velocity */
 } mech_state_t;
 
 typedef struct {
   mech_cfg_t cfg;
-  double wr;                  /* scaling frequency wn1(T0), rad/s */
-  double temp_k;              /* structure temperature now */
-  double temp_disc_k;         /* temperature of the current Taylor blocks */
-  double eps;                 /* wn(temp_k)/wn(temp_disc_k) - 1 */
+  double wr;          /* scaling frequency wn1(T0), rad/s */
+  double temp_k;      /* structure temperature now */
+  double temp_disc_k; /* temperature of the current Taylor blocks */
+  double eps;         /* wn(temp_k)/wn(temp_disc_k) - 1 */
   double blk[MECH_NMONO][MECH_NS][MECH_NS + MECH_NU]; /* Taylor blocks [Phi Gamma] */
-  double q[4][2][MECH_NS][MECH_NS + MECH_NU]; /* blocks of w^p a^r summed over e^k */
-  double qmax[4][2];          /* largest entry of each, to skip negligible terms */
-  double k[MECH_NS][MECH_NS + MECH_NU];     /* [Phi Gamma] at the current (w, a, e) */
-  double coef[2];             /* (w, a) that k[][] was built for */
+  double q[4][2][MECH_NS][MECH_NS + MECH_NU];         /* blocks of w^p a^r summed over e^k */
+  double qmax[4][2];                    /* largest entry of each, to skip negligible terms */
+  double k[MECH_NS][MECH_NS + MECH_NU]; /* [Phi Gamma] at the current (w, a, e) */
+  double coef[2];                       /* (w, a) that k[][] was built for */
   int q_valid, k_valid;
-  double z[MECH_NS];          /* scaled state */
-  double noise_sd[MECH_NU];   /* per-sample sd of the held noise, scaled units */
-  rng_t rng[MECH_NU];         /* one source per mode */
-  gauss_zig_t zig;            /* normal deviates from them (gauss_zig.h) */
+  double z[MECH_NS];        /* scaled state */
+  double noise_sd[MECH_NU]; /* per-sample sd of the held noise, scaled units */
+  rng_t rng[MECH_NU];       /* one source per axis */
+  gauss_zig_t zig;          /* normal deviates from them (gauss_zig.h) */
   uint64_t refresh_count;
 } mech_t;
 
@@ -152,8 +152,8 @@ void mech_set_state(mech_t *m, const mech_state_t *s);
 double mech_wn1(const mech_t *m);
 double mech_wn2(const mech_t *m);
 
-/* One-sided acceleration noise PSD of mode 1 or 2 at the current temperature,
+/* One-sided acceleration noise PSD of resonance 1 (drive) or 2 (sense) at the current temperature,
  * (m/s^2)^2/Hz (4-20): 4 kB T wn / (Q m). */
-double mech_noise_psd(const mech_t *m, int mode);
+double mech_noise_psd(const mech_t *m, int resonance);
 
 #endif /* PLANT_MECH_H */

@@ -87,11 +87,12 @@ static int finite_all(const double *v, int n)
 
 static int cfg_ok(const pickoff_cfg_t *c)
 {
-  const double vals[] = {c->fs_hz, c->gain_v_per_m, c->gain_tc_per_k, c->preamp_rail_v,
-                         c->ft_u1, c->ft_u2, c->ft_spare, c->lag_ref_hz, c->temp_ref_k,
-                         c->phi0_rad, c->phi1_rad_per_k, c->phi2_rad_per_k2, c->hp_hz,
-                         c->lp_hz, c->lp_q, c->offset_v, c->noise_v_rthz,
-                         c->sample_delay_s, c->jitter_rms_s, c->phase_step_rad};
+  const double vals[] = {
+      c->fs_hz,        c->gain_v_per_m,   c->gain_tc_per_k,  c->preamp_rail_v,
+      c->ft_u1,        c->ft_u2,          c->ft_spare,       c->lag_ref_hz,
+      c->temp_ref_k,   c->phi0_rad,       c->phi1_rad_per_k, c->phi2_rad_per_k2,
+      c->hp_hz,        c->lp_hz,          c->lp_q,           c->offset_v,
+      c->noise_v_rthz, c->sample_delay_s, c->jitter_rms_s,   c->phase_step_rad};
   if (!finite_all(vals, (int)(sizeof vals / sizeof vals[0]))) return 0;
   if (c->axis != PICKOFF_DRIVE && c->axis != PICKOFF_SENSE) return 0;
   if (c->lag_kind != PICKOFF_LAG_LOWPASS && c->lag_kind != PICKOFF_LAG_ALLPASS) return 0;
@@ -185,8 +186,10 @@ static int discretise(pickoff_t *p, const pickoff_cfg_t *c, double phi)
   if (expm(na, f, e) != 0) return -1;
 
   /* Hermite data [s0, m0, s1, m1] (m = T s') -> Taylor coefficients at s = 0 */
-  static const double herm[4][4] = {
-      {1.0, 0.0, 0.0, 0.0}, {0.0, 1.0, 0.0, 0.0}, {-6.0, -4.0, 6.0, -2.0}, {12.0, 6.0, -12.0, 6.0}};
+  static const double herm[4][4] = {{1.0, 0.0, 0.0, 0.0},
+                                    {0.0, 1.0, 0.0, 0.0},
+                                    {-6.0, -4.0, 6.0, -2.0},
+                                    {12.0, 6.0, -12.0, 6.0}};
   p->n = n;
   memset(p->phi, 0, sizeof p->phi);
   memset(p->g, 0, sizeof p->g);

@@ -1,4 +1,4 @@
-/* Pickoff front end of one axis (drive or sense), from mode displacement to the voltage
+/* Pickoff front end of one axis (drive or sense), from its displacement to the voltage
  * at the ADC input at the sampling instant (thesis §4.3.2, §4.4.2; host plant, double).
  *
  * Signal chain (continuous time):
@@ -73,47 +73,47 @@ typedef struct {
   pickoff_axis_t axis;
   double fs_hz;
   /* ring-diode front end */
-  double gain_v_per_m;       /* output volts per metre of mode displacement at T0 */
-  double gain_tc_per_k;      /* relative gain change per kelvin (diode drop); 0 default */
-  double preamp_rail_v;      /* preamp output saturates at +-this, V (> 0) */
-  double ft_u1;              /* feedthrough, V at the preamp output per V on U1 */
-  double ft_u2;              /* ... per V on U2 */
-  double ft_spare;           /* ... per V on the spare (sense feedback) DAC channel */
+  double gain_v_per_m;  /* output volts per metre of displacement at T0 */
+  double gain_tc_per_k; /* relative gain change per kelvin (diode drop); 0 default */
+  double preamp_rail_v; /* preamp output saturates at +-this, V (> 0) */
+  double ft_u1;         /* feedthrough, V at the preamp output per V on U1 */
+  double ft_u2;         /* ... per V on U2 */
+  double ft_spare;      /* ... per V on the spare (sense feedback) DAC channel */
   /* circuit phase (2-40) */
   pickoff_lag_kind_t lag_kind;
-  double lag_ref_hz;         /* frequency at which the lag equals Phi_cir (drive freq) */
-  double temp_ref_k;         /* T0 */
-  double phi0_rad;           /* Phi_cir(T0), lag positive */
-  double phi1_rad_per_k;     /* dPhi/dT at T0 */
-  double phi2_rad_per_k2;    /* d2Phi/dT2 at T0 */
+  double lag_ref_hz;      /* frequency at which the lag equals Phi_cir (drive freq) */
+  double temp_ref_k;      /* T0 */
+  double phi0_rad;        /* Phi_cir(T0), lag positive */
+  double phi1_rad_per_k;  /* dPhi/dT at T0 */
+  double phi2_rad_per_k2; /* d2Phi/dT2 at T0 */
   /* anti-alias band-pass */
-  double hp_hz;              /* first-order high-pass corner; 0: none */
-  double lp_hz;              /* second-order low-pass natural frequency */
-  double lp_q;               /* its quality factor */
+  double hp_hz; /* first-order high-pass corner; 0: none */
+  double lp_hz; /* second-order low-pass natural frequency */
+  double lp_q;  /* its quality factor */
   /* ADC input */
-  double offset_v;           /* added after the filters, V */
-  double noise_v_rthz;       /* white, one-sided, V/sqrt(Hz) */
-  double sample_delay_s;     /* fixed sampling instant after the tick, |.| <= T/2 */
-  double jitter_rms_s;       /* rms random timing error, <= T/20 */
-  double phase_step_rad;     /* Phi_cir change that triggers a re-discretisation, >= 0 */
+  double offset_v;       /* added after the filters, V */
+  double noise_v_rthz;   /* white, one-sided, V/sqrt(Hz) */
+  double sample_delay_s; /* fixed sampling instant after the tick, |.| <= T/2 */
+  double jitter_rms_s;   /* rms random timing error, <= T/20 */
+  double phase_step_rad; /* Phi_cir change that triggers a re-discretisation, >= 0 */
 } pickoff_cfg_t;
 
 typedef struct {
   pickoff_cfg_t cfg;
-  int n;                         /* states in use (3 or 4; the rest stay zero) */
-  double t_s, inv_t;             /* sample period and its inverse */
-  double temp_k;                 /* circuit temperature now */
-  double phi_rad;                /* Phi_cir realised by the current discretisation */
-  uint64_t rediscretise_count;   /* re-discretisations by pickoff_set_temp */
-  double gain_now;               /* g(temp_k) */
+  int n;                       /* states in use (3 or 4; the rest stay zero) */
+  double t_s, inv_t;           /* sample period and its inverse */
+  double temp_k;               /* circuit temperature now */
+  double phi_rad;              /* Phi_cir realised by the current discretisation */
+  uint64_t rediscretise_count; /* re-discretisations by pickoff_set_temp */
+  double gain_now;             /* g(temp_k) */
   double phi[PICKOFF_MAX_N][PICKOFF_MAX_N];
   double g[PICKOFF_MAX_N][4];
-  double out_z[PICKOFF_MAX_N];    /* output at the nominal sampling instant: state row */
-  double out_u[4];               /* ... and weights of [s, T s', T^2 s'', T^3 s'''] */
-  double dout_z[PICKOFF_MAX_N];  /* T d(output)/dt there (for the jitter): state row */
-  double dout_u[4];              /* ... input weights */
+  double out_z[PICKOFF_MAX_N];  /* output at the nominal sampling instant: state row */
+  double out_u[4];              /* ... and weights of [s, T s', T^2 s'', T^3 s'''] */
+  double dout_z[PICKOFF_MAX_N]; /* T d(output)/dt there (for the jitter): state row */
+  double dout_u[4];             /* ... input weights */
   double z[PICKOFF_MAX_N];
-  double s_prev, m_prev;         /* input and T * slope at the previous tick */
+  double s_prev, m_prev; /* input and T * slope at the previous tick */
   double noise_sd;
   rng_t rng_noise, rng_jitter;
   gauss_zig_t zig; /* normal deviates by the ziggurat: no log per sample (gauss_zig.h) */
@@ -143,7 +143,7 @@ int pickoff_init(pickoff_t *p, const pickoff_cfg_t *cfg, double temp_k, uint64_t
  * (1e-4, 1.4) rad (low-pass) or (1e-4, 2.8) rad (all-pass); p is then unchanged. */
 int pickoff_set_temp(pickoff_t *p, double temp_k);
 
-/* Advance one sample to tick t_{k+1}: pos_m, vel_mps are the mode displacement and
+/* Advance one sample to tick t_{k+1}: pos_m, vel_mps are the axis displacement and
  * velocity at t_{k+1}; dac the DAC output of the sample just finished (its end values
  * are the electrode voltages at t_{k+1}), or NULL for no feedthrough. Returns the
  * voltage at the ADC input sampled at t_{k+1} + delay + jitter. */

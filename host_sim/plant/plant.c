@@ -87,7 +87,7 @@ static void make_actuator_cfg(const plant_cfg_t *c, actuator_cfg_t *a)
   a->drive_noise.white_rthz = c->drive_noise_white_v_rthz;
   a->drive_noise.flicker_1hz_rthz = c->drive_noise_1hz_v_rthz;
   a->drive_noise.fmin_hz = c->drive_noise_fmin_hz;
-  a->fb_mode = (actuator_fb_mode_t)c->fb_mode;
+  a->fb = (actuator_fb_t)c->fb_mode;
   a->ks_fb_mps2_per_v2 = c->ks_fb_mps2_per_v2;
   a->fb_bias_v = c->fb_bias_v;
   a->fb_noise.white_rthz = c->fb_noise_white_v_rthz;
@@ -102,43 +102,23 @@ static void make_pickoff_cfg(const plant_cfg_t *c, int axis, pickoff_cfg_t *q)
   q->lag_ref_hz = c->pick_lag_ref_hz;
   q->temp_ref_k = c->temp_ref_k;
   q->phase_step_rad = c->pick_phase_step_rad;
-  if (axis == 0) {
-    q->gain_v_per_m = c->pick_drive_gain_v_per_m;
-    q->gain_tc_per_k = c->pick_drive_gain_tc_per_k;
-    q->preamp_rail_v = c->pick_drive_rail_v;
-    q->ft_u1 = c->pick_drive_ft_u1;
-    q->ft_u2 = c->pick_drive_ft_u2;
-    q->ft_spare = c->pick_drive_ft_spare;
-    q->lag_kind = c->pick_drive_lag_allpass ? PICKOFF_LAG_ALLPASS : PICKOFF_LAG_LOWPASS;
-    q->phi0_rad = c->pick_drive_phi0_deg * kDeg;
-    q->phi1_rad_per_k = c->pick_drive_phi1_deg_per_k * kDeg;
-    q->phi2_rad_per_k2 = c->pick_drive_phi2_deg_per_k2 * kDeg;
-    q->hp_hz = c->pick_drive_hp_hz;
-    q->lp_hz = c->pick_drive_lp_hz;
-    q->lp_q = c->pick_drive_lp_q;
-    q->offset_v = c->pick_drive_offset_v;
-    q->noise_v_rthz = c->pick_drive_noise_v_rthz;
-    q->sample_delay_s = c->pick_drive_delay_s;
-    q->jitter_rms_s = c->pick_drive_jitter_s;
-  } else {
-    q->gain_v_per_m = c->pick_sense_gain_v_per_m;
-    q->gain_tc_per_k = c->pick_sense_gain_tc_per_k;
-    q->preamp_rail_v = c->pick_sense_rail_v;
-    q->ft_u1 = c->pick_sense_ft_u1;
-    q->ft_u2 = c->pick_sense_ft_u2;
-    q->ft_spare = c->pick_sense_ft_spare;
-    q->lag_kind = c->pick_sense_lag_allpass ? PICKOFF_LAG_ALLPASS : PICKOFF_LAG_LOWPASS;
-    q->phi0_rad = c->pick_sense_phi0_deg * kDeg;
-    q->phi1_rad_per_k = c->pick_sense_phi1_deg_per_k * kDeg;
-    q->phi2_rad_per_k2 = c->pick_sense_phi2_deg_per_k2 * kDeg;
-    q->hp_hz = c->pick_sense_hp_hz;
-    q->lp_hz = c->pick_sense_lp_hz;
-    q->lp_q = c->pick_sense_lp_q;
-    q->offset_v = c->pick_sense_offset_v;
-    q->noise_v_rthz = c->pick_sense_noise_v_rthz;
-    q->sample_delay_s = c->pick_sense_delay_s;
-    q->jitter_rms_s = c->pick_sense_jitter_s;
-  }
+  q->gain_v_per_m = PLANT_PICK(c, axis, gain_v_per_m);
+  q->gain_tc_per_k = PLANT_PICK(c, axis, gain_tc_per_k);
+  q->preamp_rail_v = PLANT_PICK(c, axis, rail_v);
+  q->ft_u1 = PLANT_PICK(c, axis, ft_u1);
+  q->ft_u2 = PLANT_PICK(c, axis, ft_u2);
+  q->ft_spare = PLANT_PICK(c, axis, ft_spare);
+  q->lag_kind = PLANT_PICK(c, axis, lag_allpass) ? PICKOFF_LAG_ALLPASS : PICKOFF_LAG_LOWPASS;
+  q->phi0_rad = PLANT_PICK(c, axis, phi0_deg) * kDeg;
+  q->phi1_rad_per_k = PLANT_PICK(c, axis, phi1_deg_per_k) * kDeg;
+  q->phi2_rad_per_k2 = PLANT_PICK(c, axis, phi2_deg_per_k2) * kDeg;
+  q->hp_hz = PLANT_PICK(c, axis, hp_hz);
+  q->lp_hz = PLANT_PICK(c, axis, lp_hz);
+  q->lp_q = PLANT_PICK(c, axis, lp_q);
+  q->offset_v = PLANT_PICK(c, axis, offset_v);
+  q->noise_v_rthz = PLANT_PICK(c, axis, noise_v_rthz);
+  q->sample_delay_s = PLANT_PICK(c, axis, delay_s);
+  q->jitter_rms_s = PLANT_PICK(c, axis, jitter_s);
 }
 
 static void make_accel_cfg(const plant_cfg_t *c, accel_cfg_t *a)
@@ -152,10 +132,7 @@ static void make_accel_cfg(const plant_cfg_t *c, accel_cfg_t *a)
   a->sense_mps2_per_g[ACCEL_AXIS_NORMAL] = c->gs_sense_from_normal_mps2_per_g;
 }
 
-static int pick_node(const plant_cfg_t *c, int axis)
-{
-  return axis == 0 ? c->pick_drive_temp_node : c->pick_sense_temp_node;
-}
+static int pick_node(const plant_cfg_t *c, int axis) { return PLANT_PICK(c, axis, temp_node); }
 
 /* ------------------------------------------------------------------ init ------ */
 
@@ -178,7 +155,6 @@ static void truth_temps(plant_t *p, double ambient_k)
   t->circuit_k = thermal_temp(&p->thermal, THERMAL_CIRCUIT);
   t->board_k = thermal_temp(&p->thermal, THERMAL_BOARD);
   t->wn_drive_rad_s = mech_wn1(&p->mech);
-  t->wn_sense_rad_s = mech_wn2(&p->mech);
 }
 
 int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
@@ -216,7 +192,8 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   accel_cfg_t gc;
   make_accel_cfg(c, &gc);
 
-  if (thermal_init(&p->thermal, &thc, c->temp_k) != 0) what = "thermal (tau_*, couple_*, rise_*)";
+  if (thermal_init(&p->thermal, &thc, c->temp_k) != 0)
+    what = "thermal (tau_*, couple_*, rise_*)";
   else if (mech_init(&p->mech, &mc, thermal_temp(&p->thermal, THERMAL_STRUCT), seed) != 0)
     what = "mechanics (f_*_hz, q_*, ket_per_k, temp_k)";
   else if (dac_init(&p->dac, &dc) != 0) what = "DAC (dac_*)";
@@ -365,7 +342,8 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
    * queued codes are moved to the held ones (dac.h's own one-sample queue would add a
    * second sample of latency). */
   if (dac != NULL) {
-    if (dac_write(&p->dac, dac) == 0) memcpy(p->dac.latched, p->dac.pending, sizeof p->dac.latched);
+    if (dac_write(&p->dac, dac) == 0)
+      memcpy(p->dac.latched, p->dac.pending, sizeof p->dac.latched);
     else t->dac_rejects++;
   }
   dac_out_t dout;
@@ -397,25 +375,16 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
   t->sample = p->k;
   t->t_s = (double)p->k * T;
   t->rate_dps = rate_dps;
-  t->rate_rad_s = rate_dps * kDeg;
-  t->rate_dot_rad_s2 = slope_dps * kDeg;
   t->y_m = s.y_m;
   t->vy_mps = s.vy_mps;
   t->x_m = s.x_m;
   t->vx_mps = s.vx_mps;
   t->f_drive_mps2 = fd;
   t->f_sense_mps2 = fsn;
-  for (int i = 0; i < DAC_NCH; i++) {
-    t->dac_held_v[i] = dout.ch[i].held_v;
-    t->dac_mean_v[i] = dout.ch[i].mean_v;
-  }
+  for (int i = 0; i < DAC_NCH; i++) t->dac_held_v[i] = dout.ch[i].held_v;
   t->adc_v[0] = vd;
   t->adc_v[1] = vs;
-  for (int i = 0; i < 2; i++) {
-    t->adc_clip[i] = p->adc.clip_count[i];
-    t->adc_fault[i] = p->adc.fault_count[i];
-    t->preamp_clip[i] = p->pick[i].preamp_clip_count;
-  }
+  for (int i = 0; i < 2; i++) t->adc_clip[i] = p->adc.clip_count[i];
   t->mech_refreshes = p->mech.refresh_count;
 
   /* drive-frequency estimate from the actuator's drive force (without accelerations) */

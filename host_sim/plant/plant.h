@@ -23,7 +23,7 @@
  *      which the firmware reads at tick k+1.
  *
  * Units and signs: rates in deg/s at the API (rad/s inside the mechanics), positive
- * rate gives a Coriolis force +2 Omega y' on the sense mode (thesis (2-22)); the
+ * rate gives a Coriolis force +2 Omega y' on the sense axis (thesis (2-22)); the
  * quadrature coupling is -k_q y with k_q = 2 wc quad_dps (rad), so quad_dps > 0 and a
  * growing sense-channel lag give a growing positive bias, as in table 7-4.
  *
@@ -56,154 +56,217 @@
 /* The parameter list: X(c_type, name, kind, min, max, unit, doc). It generates the
  * fields of plant_cfg_t and the descriptor table, so every field is a parameter.
  * Ranges are inclusive; cross-field limits (e.g. f < 0.45 fs) are in plant_cfg_check. */
-#define PLANT_PARAMS(X)                                                                    \
-  /* run, truth and range budget */                                                       \
-  X(double, fs_hz, DOUBLE, 1e3, 1e7, "Hz", "converter and plant sample rate")             \
-  X(double, temp_k, DOUBLE, 150.0, 450.0, "K", "ambient temperature when no ambient profile is set") \
+#define PLANT_PARAMS(X) \
+  /* run, truth and range budget */ \
+  X(double, fs_hz, DOUBLE, 1e3, 1e7, "Hz", "converter and plant sample rate") \
+  X(double, temp_k, DOUBLE, 150.0, 450.0, "K", \
+    "ambient temperature when no ambient profile is set") \
   X(double, rate_dps, DOUBLE, -1e4, 1e4, "deg/s", "input rate when no rate profile is set") \
-  X(double, drive_amp_m, DOUBLE, 1e-8, 1e-4, "m", "nominal drive amplitude: design point of gains and budgets") \
+  X(double, drive_amp_m, DOUBLE, 1e-8, 1e-4, "m", \
+    "nominal drive amplitude: design point of gains and budgets") \
   X(double, rate_fs_dps, DOUBLE, 0.0, 1e4, "deg/s", "full-scale rate of the ADC range budget") \
-  X(double, vib_g, DOUBLE, 0.0, 100.0, "g", "vibration amplitude along the sense axis in the range budget") \
-  X(double, vib_hz, DOUBLE, 0.0, 1e4, "Hz", "frequency of that vibration")                 \
-  X(double, truth_tau_s, DOUBLE, 1e-4, 10.0, "s", "averaging time of the truth's drive-frequency estimate") \
-  X(double, truth_force_tau_s, DOUBLE, 1e-5, 1.0, "s", "averaging time of the truth's drive-force phasor") \
-  /* mechanics (mech.h) */                                                                \
-  X(double, f_drive_hz, DOUBLE, 10.0, 1e6, "Hz", "drive-mode resonance at temp_ref_k")    \
-  X(double, q_drive, DOUBLE, 0.5, 1e6, "", "drive-mode quality factor")                   \
-  X(double, f_sense_hz, DOUBLE, 10.0, 1e6, "Hz", "sense-mode resonance at temp_ref_k")    \
-  X(double, q_sense, DOUBLE, 0.5, 1e6, "", "sense-mode quality factor")                   \
-  X(double, mass_kg, DOUBLE, 1e-12, 1.0, "kg", "proof mass (Brownian noise, 4-20)")       \
-  X(double, temp_ref_k, DOUBLE, 150.0, 450.0, "K", "reference temperature T0 of (2-32) and (2-40)") \
-  X(double, ket_per_k, DOUBLE, -1e-3, 1e-3, "1/K", "temperature coefficient of Young's modulus kET (2-29)") \
-  X(double, quad_dps, DOUBLE, -1e5, 1e5, "deg/s", "quadrature (stiffness coupling k_q) as an equivalent rate k_q/(2 wc)") \
-  X(double, inphase_bias_dps, DOUBLE, -1e4, 1e4, "deg/s", "damping coupling d_q as an equivalent rate d_q/2") \
-  X(double, mech_refresh_eps, DOUBLE, 1e-9, 1e-2, "", "relative resonance shift that re-discretises the mechanics") \
-  /* actuators (actuator.h) */                                                            \
-  X(double, ks_drive_mps2_per_v2, DOUBLE, 0.0, 1e3, "(m/s^2)/V^2", "drive comb Ks/m of F = Ks (U1^2 - U2^2) (6-7)") \
-  X(double, drive_noise_white_v_rthz, DOUBLE, 0.0, 1e-3, "V/rtHz", "white noise on each drive electrode voltage, one-sided") \
-  X(double, drive_noise_1hz_v_rthz, DOUBLE, 0.0, 1e-2, "V/rtHz", "1/f noise density at 1 Hz on each drive electrode") \
+  X(double, vib_g, DOUBLE, 0.0, 100.0, "g", \
+    "vibration amplitude along the sense axis in the range budget") \
+  X(double, vib_hz, DOUBLE, 0.0, 1e4, "Hz", "frequency of that vibration") \
+  X(double, truth_tau_s, DOUBLE, 1e-4, 10.0, "s", \
+    "averaging time of the truth's drive-frequency estimate") \
+  X(double, truth_force_tau_s, DOUBLE, 1e-5, 1.0, "s", \
+    "averaging time of the truth's drive-force phasor") \
+  /* mechanics (mech.h) */ \
+  X(double, f_drive_hz, DOUBLE, 10.0, 1e6, "Hz", "drive resonance at temp_ref_k") \
+  X(double, q_drive, DOUBLE, 0.5, 1e6, "", "drive resonance quality factor") \
+  X(double, f_sense_hz, DOUBLE, 10.0, 1e6, "Hz", "sense resonance at temp_ref_k") \
+  X(double, q_sense, DOUBLE, 0.5, 1e6, "", "sense resonance quality factor") \
+  X(double, mass_kg, DOUBLE, 1e-12, 1.0, "kg", "proof mass (Brownian noise, 4-20)") \
+  X(double, temp_ref_k, DOUBLE, 150.0, 450.0, "K", \
+    "reference temperature T0 of (2-32) and (2-40)") \
+  X(double, ket_per_k, DOUBLE, -1e-3, 1e-3, "1/K", \
+    "temperature coefficient of Young's modulus kET (2-29)") \
+  X(double, quad_dps, DOUBLE, -1e5, 1e5, "deg/s", \
+    "quadrature (stiffness coupling k_q) as an equivalent rate k_q/(2 wc)") \
+  X(double, inphase_bias_dps, DOUBLE, -1e4, 1e4, "deg/s", \
+    "damping coupling d_q as an equivalent rate d_q/2") \
+  X(double, mech_refresh_eps, DOUBLE, 1e-9, 1e-2, "", \
+    "relative resonance shift that re-discretises the mechanics") \
+  /* actuators (actuator.h) */ \
+  X(double, ks_drive_mps2_per_v2, DOUBLE, 0.0, 1e3, "(m/s^2)/V^2", \
+    "drive comb Ks/m of F = Ks (U1^2 - U2^2) (6-7)") \
+  X(double, drive_noise_white_v_rthz, DOUBLE, 0.0, 1e-3, "V/rtHz", \
+    "white noise on each drive electrode voltage, one-sided") \
+  X(double, drive_noise_1hz_v_rthz, DOUBLE, 0.0, 1e-2, "V/rtHz", \
+    "1/f noise density at 1 Hz on each drive electrode") \
   X(double, drive_noise_fmin_hz, DOUBLE, 1e-7, 1.0, "Hz", "1/f spectrum flattens below this") \
   X(double, ks_fb_mps2_per_v2, DOUBLE, 0.0, 1e3, "(m/s^2)/V^2", "sense feedback electrodes Ks/m") \
-  X(double, fb_bias_v, DOUBLE, -100.0, 100.0, "V", "bias of differential sense feedback")  \
-  X(double, fb_noise_white_v_rthz, DOUBLE, 0.0, 1e-3, "V/rtHz", "white noise on each feedback electrode") \
-  X(double, fb_noise_1hz_v_rthz, DOUBLE, 0.0, 1e-2, "V/rtHz", "1/f noise at 1 Hz on each feedback electrode") \
-  X(double, fb_noise_fmin_hz, DOUBLE, 1e-7, 1.0, "Hz", "feedback 1/f spectrum flattens below this") \
-  /* DAC (dac.h) */                                                                       \
-  X(double, dac_recon_hz, DOUBLE, 0.0, 1e7, "Hz", "reconstruction low-pass natural frequency, 0 = none") \
-  X(double, dac_recon_q, DOUBLE, 0.1, 10.0, "", "reconstruction low-pass quality factor")  \
+  X(double, fb_bias_v, DOUBLE, -100.0, 100.0, "V", "bias of differential sense feedback") \
+  X(double, fb_noise_white_v_rthz, DOUBLE, 0.0, 1e-3, "V/rtHz", \
+    "white noise on each feedback electrode") \
+  X(double, fb_noise_1hz_v_rthz, DOUBLE, 0.0, 1e-2, "V/rtHz", \
+    "1/f noise at 1 Hz on each feedback electrode") \
+  X(double, fb_noise_fmin_hz, DOUBLE, 1e-7, 1.0, "Hz", \
+    "feedback 1/f spectrum flattens below this") \
+  /* DAC (dac.h) */ \
+  X(double, dac_recon_hz, DOUBLE, 0.0, 1e7, "Hz", \
+    "reconstruction low-pass natural frequency, 0 = none") \
+  X(double, dac_recon_q, DOUBLE, 0.1, 10.0, "", "reconstruction low-pass quality factor") \
   X(double, dac_gain_u1, DOUBLE, -2.0, 2.0, "", "output amplifier gain, drive electrode U1") \
   X(double, dac_gain_u2, DOUBLE, -2.0, 2.0, "", "output amplifier gain, drive electrode U2") \
   X(double, dac_gain_rate, DOUBLE, -2.0, 2.0, "", "output amplifier gain, analog rate output") \
-  X(double, dac_gain_spare, DOUBLE, -2.0, 2.0, "", "output amplifier gain, spare (sense feedback)") \
-  X(double, dac_offset_u1_v, DOUBLE, -15.0, 15.0, "V", "output offset, U1")              \
-  X(double, dac_offset_u2_v, DOUBLE, -15.0, 15.0, "V", "output offset, U2")              \
-  X(double, dac_offset_rate_v, DOUBLE, -15.0, 15.0, "V", "output offset, rate output")   \
-  X(double, dac_offset_spare_v, DOUBLE, -15.0, 15.0, "V", "output offset, spare")        \
-  /* drive pickoff (pickoff.h) */                                                         \
-  X(double, pick_drive_gain_v_per_m, DOUBLE, 1.0, 1e12, "V/m", "drive ring-diode gain at T0 (4-12)") \
-  X(double, pick_drive_gain_tc_per_k, DOUBLE, -0.099, 0.099, "1/K", "relative drive pickoff gain change per kelvin") \
-  X(double, pick_drive_rail_v, DOUBLE, 0.01, 100.0, "V", "drive preamplifier saturation")  \
-  X(double, pick_drive_ft_u1, DOUBLE, -1.0, 1.0, "V/V", "feedthrough of U1 into the drive pickoff") \
-  X(double, pick_drive_ft_u2, DOUBLE, -1.0, 1.0, "V/V", "feedthrough of U2 into the drive pickoff") \
-  X(double, pick_drive_ft_spare, DOUBLE, -1.0, 1.0, "V/V", "feedthrough of the spare channel into the drive pickoff") \
-  X(double, pick_drive_phi0_deg, DOUBLE, 0.006, 80.0, "deg", "drive circuit lag at T0 and pick_lag_ref_hz (2-40)") \
-  X(double, pick_drive_phi1_deg_per_k, DOUBLE, -1.0, 1.0, "deg/K", "its first temperature derivative (2-40)") \
-  X(double, pick_drive_phi2_deg_per_k2, DOUBLE, -0.1, 0.1, "deg/K^2", "its second temperature derivative (2-40)") \
-  X(double, pick_drive_hp_hz, DOUBLE, 0.0, 1e6, "Hz", "drive anti-alias high-pass corner, 0 = none") \
-  X(double, pick_drive_lp_hz, DOUBLE, 1.0, 1e8, "Hz", "drive anti-alias low-pass natural frequency") \
+  X(double, dac_gain_spare, DOUBLE, -2.0, 2.0, "", \
+    "output amplifier gain, spare (sense feedback)") \
+  X(double, dac_offset_u1_v, DOUBLE, -15.0, 15.0, "V", "output offset, U1") \
+  X(double, dac_offset_u2_v, DOUBLE, -15.0, 15.0, "V", "output offset, U2") \
+  X(double, dac_offset_rate_v, DOUBLE, -15.0, 15.0, "V", "output offset, rate output") \
+  X(double, dac_offset_spare_v, DOUBLE, -15.0, 15.0, "V", "output offset, spare") \
+  /* drive pickoff (pickoff.h) */ \
+  X(double, pick_drive_gain_v_per_m, DOUBLE, 1.0, 1e12, "V/m", \
+    "drive ring-diode gain at T0 (4-12)") \
+  X(double, pick_drive_gain_tc_per_k, DOUBLE, -0.099, 0.099, "1/K", \
+    "relative drive pickoff gain change per kelvin") \
+  X(double, pick_drive_rail_v, DOUBLE, 0.01, 100.0, "V", "drive preamplifier saturation") \
+  X(double, pick_drive_ft_u1, DOUBLE, -1.0, 1.0, "V/V", \
+    "feedthrough of U1 into the drive pickoff") \
+  X(double, pick_drive_ft_u2, DOUBLE, -1.0, 1.0, "V/V", \
+    "feedthrough of U2 into the drive pickoff") \
+  X(double, pick_drive_ft_spare, DOUBLE, -1.0, 1.0, "V/V", \
+    "feedthrough of the spare channel into the drive pickoff") \
+  X(double, pick_drive_phi0_deg, DOUBLE, 0.006, 80.0, "deg", \
+    "drive circuit lag at T0 and pick_lag_ref_hz (2-40)") \
+  X(double, pick_drive_phi1_deg_per_k, DOUBLE, -1.0, 1.0, "deg/K", \
+    "its first temperature derivative (2-40)") \
+  X(double, pick_drive_phi2_deg_per_k2, DOUBLE, -0.1, 0.1, "deg/K^2", \
+    "its second temperature derivative (2-40)") \
+  X(double, pick_drive_hp_hz, DOUBLE, 0.0, 1e6, "Hz", \
+    "drive anti-alias high-pass corner, 0 = none") \
+  X(double, pick_drive_lp_hz, DOUBLE, 1.0, 1e8, "Hz", \
+    "drive anti-alias low-pass natural frequency") \
   X(double, pick_drive_lp_q, DOUBLE, 0.1, 10.0, "", "drive anti-alias low-pass quality factor") \
   X(double, pick_drive_offset_v, DOUBLE, -5.0, 5.0, "V", "drive channel offset at the ADC") \
-  X(double, pick_drive_noise_v_rthz, DOUBLE, 0.0, 1e-2, "V/rtHz", "drive channel white noise at the ADC, one-sided") \
-  X(double, pick_drive_delay_s, DOUBLE, -1e-3, 1e-3, "s", "drive sampling instant after the tick (|.| <= T/2)") \
+  X(double, pick_drive_noise_v_rthz, DOUBLE, 0.0, 1e-2, "V/rtHz", \
+    "drive channel white noise at the ADC, one-sided") \
+  X(double, pick_drive_delay_s, DOUBLE, -1e-3, 1e-3, "s", \
+    "drive sampling instant after the tick (|.| <= T/2)") \
   X(double, pick_drive_jitter_s, DOUBLE, 0.0, 1e-3, "s", "drive sampling jitter rms (<= T/20)") \
-  /* sense pickoff */                                                                     \
-  X(double, pick_sense_gain_v_per_m, DOUBLE, 1.0, 1e12, "V/m", "sense ring-diode gain at T0 (4-12)") \
-  X(double, pick_sense_gain_tc_per_k, DOUBLE, -0.099, 0.099, "1/K", "relative sense pickoff gain change per kelvin") \
-  X(double, pick_sense_rail_v, DOUBLE, 0.01, 100.0, "V", "sense preamplifier saturation")  \
-  X(double, pick_sense_ft_u1, DOUBLE, -1.0, 1.0, "V/V", "feedthrough of U1 into the sense pickoff") \
-  X(double, pick_sense_ft_u2, DOUBLE, -1.0, 1.0, "V/V", "feedthrough of U2 into the sense pickoff") \
-  X(double, pick_sense_ft_spare, DOUBLE, -1.0, 1.0, "V/V", "feedthrough of the spare channel into the sense pickoff") \
-  X(double, pick_sense_phi0_deg, DOUBLE, 0.006, 80.0, "deg", "sense circuit lag at T0 and pick_lag_ref_hz (2-40)") \
-  X(double, pick_sense_phi1_deg_per_k, DOUBLE, -1.0, 1.0, "deg/K", "its first temperature derivative (2-40)") \
-  X(double, pick_sense_phi2_deg_per_k2, DOUBLE, -0.1, 0.1, "deg/K^2", "its second temperature derivative (2-40)") \
-  X(double, pick_sense_hp_hz, DOUBLE, 0.0, 1e6, "Hz", "sense anti-alias high-pass corner, 0 = none") \
-  X(double, pick_sense_lp_hz, DOUBLE, 1.0, 1e8, "Hz", "sense anti-alias low-pass natural frequency") \
+  /* sense pickoff */ \
+  X(double, pick_sense_gain_v_per_m, DOUBLE, 1.0, 1e12, "V/m", \
+    "sense ring-diode gain at T0 (4-12)") \
+  X(double, pick_sense_gain_tc_per_k, DOUBLE, -0.099, 0.099, "1/K", \
+    "relative sense pickoff gain change per kelvin") \
+  X(double, pick_sense_rail_v, DOUBLE, 0.01, 100.0, "V", "sense preamplifier saturation") \
+  X(double, pick_sense_ft_u1, DOUBLE, -1.0, 1.0, "V/V", \
+    "feedthrough of U1 into the sense pickoff") \
+  X(double, pick_sense_ft_u2, DOUBLE, -1.0, 1.0, "V/V", \
+    "feedthrough of U2 into the sense pickoff") \
+  X(double, pick_sense_ft_spare, DOUBLE, -1.0, 1.0, "V/V", \
+    "feedthrough of the spare channel into the sense pickoff") \
+  X(double, pick_sense_phi0_deg, DOUBLE, 0.006, 80.0, "deg", \
+    "sense circuit lag at T0 and pick_lag_ref_hz (2-40)") \
+  X(double, pick_sense_phi1_deg_per_k, DOUBLE, -1.0, 1.0, "deg/K", \
+    "its first temperature derivative (2-40)") \
+  X(double, pick_sense_phi2_deg_per_k2, DOUBLE, -0.1, 0.1, "deg/K^2", \
+    "its second temperature derivative (2-40)") \
+  X(double, pick_sense_hp_hz, DOUBLE, 0.0, 1e6, "Hz", \
+    "sense anti-alias high-pass corner, 0 = none") \
+  X(double, pick_sense_lp_hz, DOUBLE, 1.0, 1e8, "Hz", \
+    "sense anti-alias low-pass natural frequency") \
   X(double, pick_sense_lp_q, DOUBLE, 0.1, 10.0, "", "sense anti-alias low-pass quality factor") \
   X(double, pick_sense_offset_v, DOUBLE, -5.0, 5.0, "V", "sense channel offset at the ADC") \
-  X(double, pick_sense_noise_v_rthz, DOUBLE, 0.0, 1e-2, "V/rtHz", "sense channel white noise at the ADC, one-sided") \
-  X(double, pick_sense_delay_s, DOUBLE, -1e-3, 1e-3, "s", "sense sampling instant after the tick (|.| <= T/2)") \
+  X(double, pick_sense_noise_v_rthz, DOUBLE, 0.0, 1e-2, "V/rtHz", \
+    "sense channel white noise at the ADC, one-sided") \
+  X(double, pick_sense_delay_s, DOUBLE, -1e-3, 1e-3, "s", \
+    "sense sampling instant after the tick (|.| <= T/2)") \
   X(double, pick_sense_jitter_s, DOUBLE, 0.0, 1e-3, "s", "sense sampling jitter rms (<= T/20)") \
-  X(double, pick_lag_ref_hz, DOUBLE, 1.0, 1e6, "Hz", "frequency at which the circuit lags equal phi (< fs/2)") \
-  X(double, pick_phase_step_rad, DOUBLE, 0.0, 0.01, "rad", "circuit phase change that re-discretises a pickoff") \
-  /* ADC (adc.h) */                                                                       \
-  X(double, adc_full_scale_v, DOUBLE, 0.01, 100.0, "V", "ADC full scale, +-")            \
-  /* acceleration (accel.h): force per unit mass per g */                                 \
-  X(double, gs_drive_from_drive_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "drive-mode force per g along the drive axis") \
-  X(double, gs_drive_from_sense_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "drive-mode force per g along the sense axis") \
-  X(double, gs_drive_from_normal_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "drive-mode force per g along the rate axis") \
-  X(double, gs_sense_from_drive_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "sense-mode force per g along the drive axis") \
-  X(double, gs_sense_from_sense_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "sense-mode force per g along the sense axis") \
-  X(double, gs_sense_from_normal_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", "sense-mode force per g along the rate axis") \
-  /* thermal network (thermal.h) */                                                       \
+  X(double, pick_lag_ref_hz, DOUBLE, 1.0, 1e6, "Hz", \
+    "frequency at which the circuit lags equal phi (< fs/2)") \
+  X(double, pick_phase_step_rad, DOUBLE, 0.0, 0.01, "rad", \
+    "circuit phase change that re-discretises a pickoff") \
+  /* ADC (adc.h) */ \
+  X(double, adc_full_scale_v, DOUBLE, 0.01, 100.0, "V", "ADC full scale, +-") \
+  /* acceleration (accel.h): force per unit mass per g */ \
+  X(double, gs_drive_from_drive_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", \
+    "drive-axis force per g along the drive axis") \
+  X(double, gs_drive_from_sense_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", \
+    "drive-axis force per g along the sense axis") \
+  X(double, gs_drive_from_normal_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", \
+    "drive-axis force per g along the rate axis") \
+  X(double, gs_sense_from_drive_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", \
+    "sense-axis force per g along the drive axis") \
+  X(double, gs_sense_from_sense_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", \
+    "sense-axis force per g along the sense axis") \
+  X(double, gs_sense_from_normal_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", \
+    "sense-axis force per g along the rate axis") \
+  /* thermal network (thermal.h) */ \
   X(double, tau_struct_s, DOUBLE, 1e-3, 1e9, "s", "structure node time constant to ambient") \
-  X(double, tau_circuit_s, DOUBLE, 1e-3, 1e9, "s", "pickoff circuit node time constant to ambient") \
+  X(double, tau_circuit_s, DOUBLE, 1e-3, 1e9, "s", \
+    "pickoff circuit node time constant to ambient") \
   X(double, tau_board_s, DOUBLE, 1e-3, 1e9, "s", "board sensor node time constant to ambient") \
   X(double, couple_sc_per_s, DOUBLE, 0.0, 1e3, "1/s", "structure-circuit heat exchange rate") \
   X(double, couple_sb_per_s, DOUBLE, 0.0, 1e3, "1/s", "structure-board heat exchange rate") \
-  X(double, couple_cb_per_s, DOUBLE, 0.0, 1e3, "1/s", "circuit-board heat exchange rate")  \
+  X(double, couple_cb_per_s, DOUBLE, 0.0, 1e3, "1/s", "circuit-board heat exchange rate") \
   X(double, rise_struct_k, DOUBLE, -100.0, 500.0, "K", "structure self-heating rise if alone") \
   X(double, rise_circuit_k, DOUBLE, -100.0, 500.0, "K", "circuit self-heating rise if alone") \
-  X(double, rise_board_k, DOUBLE, -100.0, 500.0, "K", "board sensor spot self-heating rise if alone") \
-  X(double, thermal_dt_s, DOUBLE, 1e-5, 10.0, "s", "thermal update period (rounded to whole samples)") \
-  /* switches (kept at the end so the struct has no padding between fields) */            \
+  X(double, rise_board_k, DOUBLE, -100.0, 500.0, "K", \
+    "board sensor spot self-heating rise if alone") \
+  X(double, thermal_dt_s, DOUBLE, 1e-5, 10.0, "s", \
+    "thermal update period (rounded to whole samples)") \
+  /* switches (kept at the end so the struct has no padding between fields) */ \
   X(int, truth_decim, INT, 1, 1000000, "", "phasor truth (amplitudes, phases) every n samples") \
-  X(int, fb_mode, INT, 0, 2, "", "sense feedback actuator: 0 off, 1 single electrode, 2 differential") \
-  X(int, pick_drive_temp_node, INT, 0, 2, "", "thermal node of the drive circuit laws: 0 structure, 1 circuit, 2 board") \
-  X(int, pick_sense_temp_node, INT, 0, 2, "", "thermal node of the sense circuit laws: 0 structure, 1 circuit, 2 board") \
-  X(bool, full_kinematics, BOOL, 0, 1, "", "reciprocal Coriolis, centrifugal and Euler terms of (2-20)") \
-  X(bool, brownian, BOOL, 0, 1, "", "Brownian force noise on both modes (4-20)")         \
-  X(bool, pick_drive_lag_allpass, BOOL, 0, 1, "", "drive circuit lag as an all-pass (pure phase) instead of a low-pass") \
-  X(bool, pick_sense_lag_allpass, BOOL, 0, 1, "", "sense circuit lag as an all-pass instead of a low-pass")
+  X(int, fb_mode, INT, 0, 2, "", \
+    "sense feedback actuator: 0 off, 1 single electrode, 2 differential") \
+  X(int, pick_drive_temp_node, INT, 0, 2, "", \
+    "thermal node of the drive circuit laws: 0 structure, 1 circuit, 2 board") \
+  X(int, pick_sense_temp_node, INT, 0, 2, "", \
+    "thermal node of the sense circuit laws: 0 structure, 1 circuit, 2 board") \
+  X(bool, full_kinematics, BOOL, 0, 1, "", \
+    "reciprocal Coriolis, centrifugal and Euler terms of (2-20)") \
+  X(bool, brownian, BOOL, 0, 1, "", "Brownian force noise on both axes (4-20)") \
+  X(bool, pick_drive_lag_allpass, BOOL, 0, 1, "", \
+    "drive circuit lag as an all-pass (pure phase) instead of a low-pass") \
+  X(bool, pick_sense_lag_allpass, BOOL, 0, 1, "", \
+    "sense circuit lag as an all-pass instead of a low-pass")
 
 #define PLANT_CFG_FIELD(ctype, name, kind, lo, hi, unit, doc) ctype name;
 typedef struct {
   PLANT_PARAMS(PLANT_CFG_FIELD)
 } plant_cfg_t;
+
+/* The pickoff parameter `name` of an axis (0 drive, 1 sense): pick_drive_<name> or
+ * pick_sense_<name>. The two chains are built from one list of parameters this way. */
+#define PLANT_PICK(c, axis, name) \
+  ((axis) == 0 ? (c)->pick_drive_##name : (c)->pick_sense_##name)
 #undef PLANT_CFG_FIELD
 
 typedef struct {
-  profile_t rate_dps;         /* angular rate, deg/s */
-  profile_t ambient_k;        /* ambient temperature, K */
-  accel_profile_t accel_g;    /* case acceleration, g (ACCEL_AXIS_* order) */
+  profile_t rate_dps;      /* angular rate, deg/s */
+  profile_t ambient_k;     /* ambient temperature, K */
+  accel_profile_t accel_g; /* case acceleration, g (ACCEL_AXIS_* order) */
 } plant_profiles_t;
 
 typedef struct {
-  uint64_t sample;            /* samples done; the state below is at t_s */
+  uint64_t sample; /* samples done; the state below is at t_s */
   double t_s;
   /* inputs */
-  double rate_rad_s, rate_dps, rate_dot_rad_s2;
-  double accel_g[3];          /* mean over the last sample */
+  double rate_dps;
+  double accel_g[3]; /* mean over the last sample */
   /* temperatures */
   double ambient_k, struct_k, circuit_k, board_k;
-  double wn_drive_rad_s, wn_sense_rad_s; /* resonances now (2-32) */
+  double wn_drive_rad_s; /* drive resonance now (2-32) */
   /* motion (state at t_s) */
   double y_m, vy_mps, x_m, vx_mps;
   /* phasors at the drive frequency (every truth_decim samples): */
-  double drive_freq_hz;       /* of the drive force, estimated from its samples */
-  double drive_force_mps2;    /* amplitude of the held drive force's fundamental */
-  double drive_amp_m;         /* |drive displacement| */
-  double drive_phase_rad;     /* displacement relative to the held force's fundamental;
+  double drive_freq_hz;    /* of the drive force, estimated from its samples */
+  double drive_force_mps2; /* amplitude of the held drive force's fundamental */
+  double drive_amp_m;      /* |drive displacement| */
+  double drive_phase_rad;  /* displacement relative to the held force's fundamental;
                                  -pi/2 at resonance, (2-24); 0 without force */
-  double sense_vel_m;         /* sense displacement in phase with the drive velocity
+  double sense_vel_m;      /* sense displacement in phase with the drive velocity
                                  (Coriolis direction, (2-28)) */
-  double sense_disp_m;        /* in phase with the drive displacement (quadrature) */
+  double sense_disp_m;     /* in phase with the drive displacement (quadrature) */
   /* electrical */
   double f_drive_mps2, f_sense_mps2; /* actuator + acceleration forces per unit mass */
-  double dac_held_v[4];       /* DAC output levels over the last sample */
-  double dac_mean_v[4];       /* after the reconstruction filter, mean over the sample */
-  double adc_v[2];            /* analog voltages at the ADC inputs (drive, sense) */
-  hal_adc_frame_t adc;        /* the codes returned */
-  uint64_t adc_clip[2], adc_fault[2], preamp_clip[2], dac_rejects;
+  double dac_held_v[4];              /* DAC output levels over the last sample */
+  double adc_v[2];                   /* analog voltages at the ADC inputs (drive, sense) */
+  hal_adc_frame_t adc;               /* the codes returned */
+  uint64_t adc_clip[2], dac_rejects;
   uint64_t mech_refreshes;
 } plant_truth_t;
 
@@ -217,16 +280,16 @@ typedef struct {
   pickoff_t pick[2];
   adc_t adc;
   accel_t accel;
-  double T;                   /* sample period */
-  uint64_t k;                 /* samples done */
-  int thermal_every;          /* samples per thermal update */
+  double T;                     /* sample period */
+  uint64_t k;                   /* samples done */
+  int thermal_every;            /* samples per thermal update */
   int accel_any, accel_dynamic; /* acceleration profile non-zero / has a sine */
   /* truth: drive-frequency estimate from the force samples */
-  double f_prev[2];           /* F_{k-1}, F_{k-2} */
+  double f_prev[2]; /* F_{k-1}, F_{k-2} */
   double est_num, est_den, est_alpha;
-  double cw, sw, inv_sw;      /* cos, sin, 1/sin of w T of the current frequency estimate */
+  double cw, sw, inv_sw; /* cos, sin, 1/sin of w T of the current frequency estimate */
   int thermal_countdown, truth_countdown; /* samples to the next update */
-  double fz_re, fz_im, fz_alpha; /* force phasor at mid-sample, rotating average */
+  double fz_re, fz_im, fz_alpha;          /* force phasor at mid-sample, rotating average */
   plant_truth_t truth;
   char err[192];
 } plant_t;
@@ -280,14 +343,14 @@ const plant_truth_t *plant_truth(const plant_t *p);
 double plant_adc_fraction(const plant_cfg_t *cfg, double frac[2]);
 
 typedef struct {
-  double latency_deg;         /* one-sample DAC latency of the board, wc T */
-  double zoh_deg;             /* zero-order hold, wc T / 2 */
-  double recon_deg;           /* reconstruction low-pass, on the force (2x the voltage's) */
-  double pick_lag_deg;        /* circuit lag Phi_cir(T) of the drive pickoff */
-  double aa_deg;              /* anti-alias band-pass (high-pass lead, low-pass lag) */
-  double sample_delay_deg;    /* drive channel sampling delay */
-  double analog_deg;          /* recon + pick_lag + aa: the thesis's "circuit" lag */
-  double total_deg;           /* everything above */
+  double latency_deg;      /* one-sample DAC latency of the board, wc T */
+  double zoh_deg;          /* zero-order hold, wc T / 2 */
+  double recon_deg;        /* reconstruction low-pass, on the force (2x the voltage's) */
+  double pick_lag_deg;     /* circuit lag Phi_cir(T) of the drive pickoff */
+  double aa_deg;           /* anti-alias band-pass (high-pass lead, low-pass lag) */
+  double sample_delay_deg; /* drive channel sampling delay */
+  double analog_deg;       /* recon + pick_lag + aa: the thesis's "circuit" lag */
+  double total_deg;        /* everything above */
 } plant_phase_budget_t;
 
 /* Phase lags of the drive signal chain at frequency f_hz (force at f, voltages at f/2
@@ -300,13 +363,17 @@ void plant_drive_phase_budget(const plant_cfg_t *cfg, double f_hz, double temp_k
 
 /* ------------------------------------------------------------ parameters ----- */
 
-typedef enum { PLANT_PARAM_DOUBLE = 0, PLANT_PARAM_INT = 1, PLANT_PARAM_BOOL = 2 } plant_param_type_t;
+typedef enum {
+  PLANT_PARAM_DOUBLE = 0,
+  PLANT_PARAM_INT = 1,
+  PLANT_PARAM_BOOL = 2
+} plant_param_type_t;
 
 typedef struct {
-  const char *name;           /* = the plant_cfg_t field */
-  size_t offset;              /* offsetof(plant_cfg_t, field) */
+  const char *name; /* = the plant_cfg_t field */
+  size_t offset;    /* offsetof(plant_cfg_t, field) */
   plant_param_type_t type;
-  double min, max;            /* inclusive */
+  double min, max; /* inclusive */
   const char *unit;
   const char *doc;
 } plant_param_desc_t;

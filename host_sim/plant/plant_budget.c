@@ -43,18 +43,13 @@ static double circuit_phi(double phi0_deg, double phi1, double phi2, double dt)
 static double complex pick_chain(const plant_cfg_t *c, int axis, double f, double temp_k)
 {
   const double dt = temp_k - c->temp_ref_k;
-  if (axis == 0) {
-    const double phi = circuit_phi(c->pick_drive_phi0_deg, c->pick_drive_phi1_deg_per_k,
-                                   c->pick_drive_phi2_deg_per_k2, dt);
-    return c->pick_drive_gain_v_per_m * (1.0 + c->pick_drive_gain_tc_per_k * dt) *
-           lag_section(f, c->pick_lag_ref_hz, phi, c->pick_drive_lag_allpass) *
-           hp1(f, c->pick_drive_hp_hz) * lp2(f, c->pick_drive_lp_hz, c->pick_drive_lp_q);
-  }
-  const double phi = circuit_phi(c->pick_sense_phi0_deg, c->pick_sense_phi1_deg_per_k,
-                                 c->pick_sense_phi2_deg_per_k2, dt);
-  return c->pick_sense_gain_v_per_m * (1.0 + c->pick_sense_gain_tc_per_k * dt) *
-         lag_section(f, c->pick_lag_ref_hz, phi, c->pick_sense_lag_allpass) *
-         hp1(f, c->pick_sense_hp_hz) * lp2(f, c->pick_sense_lp_hz, c->pick_sense_lp_q);
+  const double phi = circuit_phi(PLANT_PICK(c, axis, phi0_deg),
+                                 PLANT_PICK(c, axis, phi1_deg_per_k),
+                                 PLANT_PICK(c, axis, phi2_deg_per_k2), dt);
+  return PLANT_PICK(c, axis, gain_v_per_m) * (1.0 + PLANT_PICK(c, axis, gain_tc_per_k) * dt) *
+         lag_section(f, c->pick_lag_ref_hz, phi, PLANT_PICK(c, axis, lag_allpass)) *
+         hp1(f, PLANT_PICK(c, axis, hp_hz)) *
+         lp2(f, PLANT_PICK(c, axis, lp_hz), PLANT_PICK(c, axis, lp_q));
 }
 
 void plant_drive_phase_budget(const plant_cfg_t *c, double f_hz, double temp_k,
@@ -69,8 +64,11 @@ void plant_drive_phase_budget(const plant_cfg_t *c, double f_hz, double temp_k,
   o->recon_deg = -2.0 * carg(lp2(0.5 * f_hz, c->dac_recon_hz, c->dac_recon_q)) / kDeg;
   const double phi = circuit_phi(c->pick_drive_phi0_deg, c->pick_drive_phi1_deg_per_k,
                                  c->pick_drive_phi2_deg_per_k2, dt);
-  o->pick_lag_deg = -carg(lag_section(f_hz, c->pick_lag_ref_hz, phi, c->pick_drive_lag_allpass)) / kDeg;
-  o->aa_deg = -carg(hp1(f_hz, c->pick_drive_hp_hz) * lp2(f_hz, c->pick_drive_lp_hz, c->pick_drive_lp_q)) / kDeg;
+  o->pick_lag_deg = -carg(lag_section(f_hz, c->pick_lag_ref_hz, phi, c->pick_drive_lag_allpass)) /
+                    kDeg;
+  o->aa_deg = -carg(hp1(f_hz, c->pick_drive_hp_hz) *
+                    lp2(f_hz, c->pick_drive_lp_hz, c->pick_drive_lp_q)) /
+              kDeg;
   o->sample_delay_deg = 360.0 * f_hz * c->pick_drive_delay_s;
   o->analog_deg = o->recon_deg + o->pick_lag_deg + o->aa_deg;
   o->total_deg = o->latency_deg + o->zoh_deg + o->analog_deg + o->sample_delay_deg;
@@ -87,19 +85,21 @@ double plant_adc_fraction(const plant_cfg_t *c, double frac[2])
   const double hr = cabs(lp2(0.5 * f1, c->dac_recon_hz, c->dac_recon_q));
   const double force = a0 * wn1 * wn1 / c->q_drive;
   double u = 0.0;
-  if (c->ks_drive_mps2_per_v2 > 0.0) u = sqrt(force / (c->ks_drive_mps2_per_v2 * hr * hr * sinc * sinc));
+  if (c->ks_drive_mps2_per_v2 > 0.0)
+    u = sqrt(force / (c->ks_drive_mps2_per_v2 * hr * hr * sinc * sinc));
   /* white noise at the ADC over the Nyquist band, 4 sigma */
   const double nd = 4.0 * c->pick_drive_noise_v_rthz * sqrt(0.5 * c->fs_hz);
   const double ns = 4.0 * c->pick_sense_noise_v_rthz * sqrt(0.5 * c->fs_hz);
   /* drive channel: motion, offset, feedthrough of both electrodes (bounded by |U|) */
-  const double vd = a0 * cabs(pick_chain(c, 0, f1, c->temp_ref_k)) + fabs(c->pick_drive_offset_v) +
+  const double vd = a0 * cabs(pick_chain(c, 0, f1, c->temp_ref_k)) +
+                    fabs(c->pick_drive_offset_v) +
                     (fabs(c->pick_drive_ft_u1) + fabs(c->pick_drive_ft_u2)) * u + nd;
   /* sense channel: quadrature and full-scale rate are in phase quadrature, (2-25) with
    * -k_q y: |2 Omega wc j - k_q| A0 / |D2(wc)| */
   const double kq = 2.0 * w1 * c->quad_dps * kDeg, om = c->rate_fs_dps * kDeg;
   const double complex d2 = wn2 * wn2 - w1 * w1 + I * wn2 * w1 / c->q_sense;
   const double xs = cabs(2.0 * om * w1 * I - kq) * a0 / cabs(d2);
-  /* vibration along the sense axis: quasi-static through the sense mode, then the
+  /* vibration along the sense axis: quasi-static through the sense resonance, then the
    * pickoff band-pass at vib_hz */
   const double wv = 2.0 * kPi * c->vib_hz;
   const double complex dv = wn2 * wn2 - wv * wv + I * wn2 * wv / c->q_sense;

@@ -92,8 +92,7 @@ static int check_value(const plant_param_desc_t *d, double value, char *buf, siz
   return 0;
 }
 
-int plant_param_set(plant_cfg_t *cfg, const char *name, double value, char *errbuf,
-                    size_t errlen)
+int plant_param_set(plant_cfg_t *cfg, const char *name, double value, char *errbuf, size_t errlen)
 {
   const plant_param_desc_t *d = plant_param_find(name);
   if (d == NULL) {
@@ -127,11 +126,11 @@ void plant_default_cfg(plant_cfg_t *c)
 {
   memset(c, 0, sizeof *c);
   /* run */
-  c->fs_hz = (double)BOARD_SAMPLE_RATE_HZ;          /* §4.4.2, table */
-  c->temp_k = 298.15;          /* room, 25 degC (= T0) */
+  c->fs_hz = (double)BOARD_SAMPLE_RATE_HZ; /* §4.4.2, table */
+  c->temp_k = 298.15; /* room, 25 degC (= T0) */
   c->rate_dps = 0.0;
-  c->drive_amp_m = 10e-6;      /* §4.6.1, table (15 um in §2.4.2) */
-  c->rate_fs_dps = 160.0;      /* largest rate of the scale-factor test, table 7-2 */
+  c->drive_amp_m = 10e-6; /* §4.6.1, table (15 um in §2.4.2) */
+  c->rate_fs_dps = 160.0; /* largest rate of the scale-factor test, table 7-2 */
   /* Range budget vibration: 0.25 g at 100 Hz along the sense axis (0.7 V at the sense
    * ADC after the 100 Hz high-pass); with 1500 deg/s quadrature at 2.5 mV/(deg/s) there
    * is room for little more (§4.4.2: shaking can push the pickoff out of range). */
@@ -142,14 +141,14 @@ void plant_default_cfg(plant_cfg_t *c)
   c->truth_force_tau_s = 1e-3; /* the 2-sample force phasor carries the DAC's quantisation
                                   (0.03 deg); 1 ms of averaging: 0.003 deg, and 1/7 of the
                                   drive loop's time constant */
-  c->truth_tau_s = 0.02;        /* 14-bit DAC codes make the force a slightly distorted tone:
+  c->truth_tau_s = 0.02;       /* 14-bit DAC codes make the force a slightly distorted tone:
                                   20 ms of averaging keep the frequency within ~1e-5 */
   /* mechanics */
-  c->f_drive_hz = 1489.9;      /* §7.2.2 sweep, table (design 1750 Hz) */
-  c->q_drive = 33.33;          /* §7.2.2 (-3 dB points), table (design 50) */
-  c->f_sense_hz = 2000.0;      /* design, §2.4.2, table */
-  c->q_sense = 3.0;            /* design, §2.2.2 (air), table */
-  c->mass_kg = 0.26e-6;        /* §4.6.1: 0.26 mg, table */
+  c->f_drive_hz = 1489.9; /* §7.2.2 sweep, table (design 1750 Hz) */
+  c->q_drive = 33.33;     /* §7.2.2 (-3 dB points), table (design 50) */
+  c->f_sense_hz = 2000.0; /* design, §2.4.2, table */
+  c->q_sense = 3.0;       /* design, §2.2.2 (air), table */
+  c->mass_kg = 0.26e-6;   /* §4.6.1: 0.26 mg, table */
   c->temp_ref_k = 298.15;
   /* kET: (2-29) gives 25..75 ppm/K and uses 50. Table 7-4 measures the drive phase P
    * moving 0.6919 deg over 9 K = 0.0769 deg/K; with fixed-frequency drive that slope is
@@ -157,11 +156,11 @@ void plant_default_cfg(plant_cfg_t *c)
    * negligible (§2.4.2 C, §7.3.1). 40 ppm/K gives kET Q1 = 0.0764 deg/K with no drive
    * circuit drift; 50 ppm/K would need an invented -0.019 deg/K circuit term. */
   c->ket_per_k = 40e-6;
-  c->quad_dps = 1500.0;        /* §7.2.2: quadrature about 1500 deg/s, table */
-  c->inphase_bias_dps = 0.0;   /* damping coupling: not in the thesis model */
+  c->quad_dps = 1500.0;      /* §7.2.2: quadrature about 1500 deg/s, table */
+  c->inphase_bias_dps = 0.0; /* damping coupling: not in the thesis model */
   c->full_kinematics = true;
   c->brownian = true;
-  c->mech_refresh_eps = 1e-3;  /* mech.c: < 1e-9 error, one refresh per 50 K */
+  c->mech_refresh_eps = 1e-3; /* mech.c: < 1e-9 error, one refresh per 50 K */
   /* actuators. Ks: the 10 um default amplitude needs A0 wn1^2 / Q1 = 26.3 m/s^2 at
    * resonance; Ks/m = 0.411 gives it at 8.0 V half-frequency amplitude (table 7-1
    * drives up to 12.75 V; the DAC gives 15 V). Voltage noise: placeholders (fig. 6-5
@@ -170,7 +169,7 @@ void plant_default_cfg(plant_cfg_t *c)
   c->drive_noise_white_v_rthz = 200e-9;
   c->drive_noise_1hz_v_rthz = 2e-6;
   c->drive_noise_fmin_hz = 1e-3;
-  c->fb_mode = 2;              /* differential sense electrodes, biased: the self-test
+  c->fb_mode = 2; /* differential sense electrodes, biased: the self-test
                                   force (the thesis's sense axis is otherwise open loop) */
   c->ks_fb_mps2_per_v2 = 0.01;
   c->fb_bias_v = 5.0;
@@ -190,9 +189,9 @@ void plant_default_cfg(plant_cfg_t *c)
    * g = 3.494e4 V/m: 10 um gives 0.348 V at the ADC, 12.75 V gives 0.882 V (thesis
    * 0.8754). */
   c->pick_drive_gain_v_per_m = 3.494e4;
-  c->pick_drive_gain_tc_per_k = 0.0;   /* §2.4.2 B: gain changes < 0.78 % over 80 K */
+  c->pick_drive_gain_tc_per_k = 0.0; /* §2.4.2 B: gain changes < 0.78 % over 80 K */
   c->pick_drive_rail_v = 13.5;
-  c->pick_drive_ft_u1 = 2e-4;          /* feedthrough: placeholders for calibration */
+  c->pick_drive_ft_u1 = 2e-4; /* feedthrough: placeholders for calibration */
   c->pick_drive_ft_u2 = -1.5e-4;
   c->pick_drive_ft_spare = 0.0;
   c->pick_drive_lag_allpass = false;
@@ -203,12 +202,12 @@ void plant_default_cfg(plant_cfg_t *c)
    * (plant_drive_phase_budget). The board's sampling delays (one-sample DAC latency,
    * hold) come on top and are the firmware's to compensate. */
   c->pick_drive_phi0_deg = 3.328;
-  c->pick_drive_phi1_deg_per_k = 0.0;  /* see ket_per_k */
+  c->pick_drive_phi1_deg_per_k = 0.0; /* see ket_per_k */
   c->pick_drive_phi2_deg_per_k2 = 0.0;
-  c->pick_drive_hp_hz = 100.0;         /* fig. 4-13 band-pass: keeps < 10 Hz shaking out */
-  c->pick_drive_lp_hz = 20000.0;       /* 2nd-order Butterworth */
+  c->pick_drive_hp_hz = 100.0;   /* fig. 4-13 band-pass: keeps < 10 Hz shaking out */
+  c->pick_drive_lp_hz = 20000.0; /* 2nd-order Butterworth */
   c->pick_drive_lp_q = 0.70710678118654752;
-  c->pick_drive_offset_v = 5e-3;       /* placeholder */
+  c->pick_drive_offset_v = 5e-3; /* placeholder */
   /* 2 uV/rtHz one-sided: the Brownian floor is ~12.5 uV/rtHz at the sense ADC (§4.6.1:
    * 18 deg/h/rtHz x 2.5 mV/(deg/s)); this adds 1.3 % to it */
   c->pick_drive_noise_v_rthz = 2e-6;
@@ -225,7 +224,7 @@ void plant_default_cfg(plant_cfg_t *c)
   c->pick_sense_ft_u2 = 6e-5;
   c->pick_sense_ft_spare = 1e-3;
   c->pick_sense_lag_allpass = false;
-  c->pick_sense_phi0_deg = 3.0;        /* placeholder; the demodulation phase absorbs it */
+  c->pick_sense_phi0_deg = 3.0; /* placeholder; the demodulation phase absorbs it */
   /* Table 7-4: bias 21.21 -> 45.20 deg/s over 26 -> 35 degC = 2.666 deg/s/K; with
    * 1500 deg/s quadrature that is a sense phase drift of 0.1018 deg/K relative to the
    * drive reference. The structural part (2-39) is 0.0017 deg/K (40 ppm/K, 1490 Hz,
@@ -233,12 +232,12 @@ void plant_default_cfg(plant_cfg_t *c)
    * here by 60x; the thesis's 7-10x is for its 1750 Hz design, where (2-39) is larger). */
   c->pick_sense_phi1_deg_per_k = 0.100;
   c->pick_sense_phi2_deg_per_k2 = 0.0;
-  c->pick_sense_hp_hz = 100.0;         /* same circuit design as the drive channel (2-40) */
+  c->pick_sense_hp_hz = 100.0; /* same circuit design as the drive channel (2-40) */
   c->pick_sense_lp_hz = 20000.0;
   c->pick_sense_lp_q = 0.70710678118654752;
-  c->pick_sense_offset_v = -3e-3;      /* placeholder */
+  c->pick_sense_offset_v = -3e-3; /* placeholder */
   c->pick_sense_noise_v_rthz = 2e-6;
-  c->pick_sense_delay_s = 4e-6;        /* multiplexed converter: sense after drive */
+  c->pick_sense_delay_s = 4e-6; /* multiplexed converter: sense after drive */
   c->pick_sense_jitter_s = 0.0;
   c->pick_sense_temp_node = THERMAL_CIRCUIT;
   c->pick_lag_ref_hz = 1489.9;
@@ -305,14 +304,13 @@ int plant_cfg_check(const plant_cfg_t *c, char *buf, size_t n)
     const char *hp, *lp, *delay, *jitter, *phi0;
     double hp_hz, lp_hz, delay_s, jitter_s, phi0_deg;
     bool allpass;
-  } ch[2] = {{"pick_drive_hp_hz", "pick_drive_lp_hz", "pick_drive_delay_s", "pick_drive_jitter_s",
-              "pick_drive_phi0_deg", c->pick_drive_hp_hz, c->pick_drive_lp_hz,
-              c->pick_drive_delay_s, c->pick_drive_jitter_s, c->pick_drive_phi0_deg,
-              c->pick_drive_lag_allpass},
-             {"pick_sense_hp_hz", "pick_sense_lp_hz", "pick_sense_delay_s", "pick_sense_jitter_s",
-              "pick_sense_phi0_deg", c->pick_sense_hp_hz, c->pick_sense_lp_hz,
-              c->pick_sense_delay_s, c->pick_sense_jitter_s, c->pick_sense_phi0_deg,
-              c->pick_sense_lag_allpass}};
+  } ch[2] = {
+      {"pick_drive_hp_hz", "pick_drive_lp_hz", "pick_drive_delay_s", "pick_drive_jitter_s",
+       "pick_drive_phi0_deg", c->pick_drive_hp_hz, c->pick_drive_lp_hz, c->pick_drive_delay_s,
+       c->pick_drive_jitter_s, c->pick_drive_phi0_deg, c->pick_drive_lag_allpass},
+      {"pick_sense_hp_hz", "pick_sense_lp_hz", "pick_sense_delay_s", "pick_sense_jitter_s",
+       "pick_sense_phi0_deg", c->pick_sense_hp_hz, c->pick_sense_lp_hz, c->pick_sense_delay_s,
+       c->pick_sense_jitter_s, c->pick_sense_phi0_deg, c->pick_sense_lag_allpass}};
   for (int i = 0; i < 2; i++) {
     if (ch[i].hp_hz >= 0.5 * c->fs_hz) {
       errf(buf, n, "%s: must be below fs_hz/2 (%g Hz)", ch[i].hp, 0.5 * c->fs_hz);
@@ -342,8 +340,7 @@ int plant_cfg_check(const plant_cfg_t *c, char *buf, size_t n)
     return -1;
   }
   if (c->fb_noise_1hz_v_rthz > 0.0 && c->fb_noise_fmin_hz > c->fs_hz / 1000.0) {
-    errf(buf, n, "%s: must not exceed fs_hz/1000 (%g Hz)", "fb_noise_fmin_hz",
-         c->fs_hz / 1000.0);
+    errf(buf, n, "%s: must not exceed fs_hz/1000 (%g Hz)", "fb_noise_fmin_hz", c->fs_hz / 1000.0);
     return -1;
   }
   const struct {

@@ -48,8 +48,7 @@ void profile_sine(profile_t *p, double offset, double amp, double freq_hz, doubl
   p->phase_rad = phase_rad;
 }
 
-void profile_ramp(profile_t *p, double start, double slope_per_s, double t_start_s,
-                  double t_end_s)
+void profile_ramp(profile_t *p, double start, double slope_per_s, double t_start_s, double t_end_s)
 {
   profile_const(p, start);
   p->kind = PROFILE_RAMP;
@@ -70,8 +69,8 @@ void profile_heat_cool(profile_t *p, double base, double hot, double t_start_s, 
   p->tau_cool_s = tau_cool_s;
 }
 
-int profile_steps(profile_t *p, int n, const double *dur_s, const double *value,
-                  double edge_s, int repeat)
+int profile_steps(profile_t *p, int n, const double *dur_s, const double *value, double edge_s,
+                  int repeat)
 {
   if (p == NULL || dur_s == NULL || value == NULL || n < 1 || n > PROFILE_MAX_STEPS) return -1;
   profile_t tmp;
@@ -94,8 +93,8 @@ static int fin(double v) { return isfinite(v) && fabs(v) <= kMaxAbs; }
 int profile_check(const profile_t *p, const char **key)
 {
   static const char *const dur_keys[PROFILE_MAX_STEPS] = {
-      "step_s[0]", "step_s[1]", "step_s[2]", "step_s[3]", "step_s[4]", "step_s[5]",
-      "step_s[6]", "step_s[7]", "step_s[8]", "step_s[9]", "step_s[10]", "step_s[11]",
+      "step_s[0]",  "step_s[1]",  "step_s[2]",  "step_s[3]",  "step_s[4]",  "step_s[5]",
+      "step_s[6]",  "step_s[7]",  "step_s[8]",  "step_s[9]",  "step_s[10]", "step_s[11]",
       "step_s[12]", "step_s[13]", "step_s[14]", "step_s[15]", "step_s[16]", "step_s[17]",
       "step_s[18]", "step_s[19]", "step_s[20]", "step_s[21]", "step_s[22]", "step_s[23]",
       "step_s[24]", "step_s[25]", "step_s[26]", "step_s[27]", "step_s[28]", "step_s[29]",
@@ -106,16 +105,18 @@ int profile_check(const profile_t *p, const char **key)
       "step_s[54]", "step_s[55]", "step_s[56]", "step_s[57]", "step_s[58]", "step_s[59]",
       "step_s[60]", "step_s[61]", "step_s[62]", "step_s[63]"};
   static const char *const val_keys[PROFILE_MAX_STEPS] = {
-      "step_value[0]", "step_value[1]", "step_value[2]", "step_value[3]", "step_value[4]", "step_value[5]",
-      "step_value[6]", "step_value[7]", "step_value[8]", "step_value[9]", "step_value[10]", "step_value[11]",
-      "step_value[12]", "step_value[13]", "step_value[14]", "step_value[15]", "step_value[16]", "step_value[17]",
-      "step_value[18]", "step_value[19]", "step_value[20]", "step_value[21]", "step_value[22]", "step_value[23]",
-      "step_value[24]", "step_value[25]", "step_value[26]", "step_value[27]", "step_value[28]", "step_value[29]",
-      "step_value[30]", "step_value[31]", "step_value[32]", "step_value[33]", "step_value[34]", "step_value[35]",
-      "step_value[36]", "step_value[37]", "step_value[38]", "step_value[39]", "step_value[40]", "step_value[41]",
-      "step_value[42]", "step_value[43]", "step_value[44]", "step_value[45]", "step_value[46]", "step_value[47]",
-      "step_value[48]", "step_value[49]", "step_value[50]", "step_value[51]", "step_value[52]", "step_value[53]",
-      "step_value[54]", "step_value[55]", "step_value[56]", "step_value[57]", "step_value[58]", "step_value[59]",
+      "step_value[0]",  "step_value[1]",  "step_value[2]",  "step_value[3]",  "step_value[4]",
+      "step_value[5]",  "step_value[6]",  "step_value[7]",  "step_value[8]",  "step_value[9]",
+      "step_value[10]", "step_value[11]", "step_value[12]", "step_value[13]", "step_value[14]",
+      "step_value[15]", "step_value[16]", "step_value[17]", "step_value[18]", "step_value[19]",
+      "step_value[20]", "step_value[21]", "step_value[22]", "step_value[23]", "step_value[24]",
+      "step_value[25]", "step_value[26]", "step_value[27]", "step_value[28]", "step_value[29]",
+      "step_value[30]", "step_value[31]", "step_value[32]", "step_value[33]", "step_value[34]",
+      "step_value[35]", "step_value[36]", "step_value[37]", "step_value[38]", "step_value[39]",
+      "step_value[40]", "step_value[41]", "step_value[42]", "step_value[43]", "step_value[44]",
+      "step_value[45]", "step_value[46]", "step_value[47]", "step_value[48]", "step_value[49]",
+      "step_value[50]", "step_value[51]", "step_value[52]", "step_value[53]", "step_value[54]",
+      "step_value[55]", "step_value[56]", "step_value[57]", "step_value[58]", "step_value[59]",
       "step_value[60]", "step_value[61]", "step_value[62]", "step_value[63]"};
   const char *bad = NULL;
   if (p == NULL) bad = "profile";
@@ -202,8 +203,7 @@ double profile_eval(const profile_t *p, double t, double *slope)
 {
   double s = 0.0, v = p->value;
   switch (p->kind) {
-  case PROFILE_CONST:
-    break;
+  case PROFILE_CONST: break;
   case PROFILE_SINE: {
     const double w = kTwoPi * p->freq_hz;
     v = p->value + p->amp * sin(w * t + p->phase_rad);
@@ -224,20 +224,17 @@ double profile_eval(const profile_t *p, double t, double *slope)
       v = p->hot_value + (p->value - p->hot_value) * e;
       s = (p->hot_value - p->value) * e / p->tau_heat_s;
     } else if (t >= th) {
-      const double v_end =
-          p->hot_value + (p->value - p->hot_value) * exp(-p->heat_s / p->tau_heat_s);
+      const double v_end = p->hot_value +
+                           (p->value - p->hot_value) * exp(-p->heat_s / p->tau_heat_s);
       const double e = exp(-(t - th) / p->tau_cool_s);
       v = p->value + (v_end - p->value) * e;
       s = -(v_end - p->value) * e / p->tau_cool_s;
     }
     break;
   }
-  case PROFILE_STEPS:
-    v = eval_steps(p, t, &s);
-    break;
+  case PROFILE_STEPS: v = eval_steps(p, t, &s); break;
   case PROFILE_NKINDS:
-  default:
-    break;
+  default: break;
   }
   if (slope != NULL) *slope = s;
   return v;
@@ -297,5 +294,6 @@ void accel_profile_mean(const accel_profile_t *a, double t0, double t1,
 
 void accel_profile_peak(const accel_profile_t *a, double peak_g[PROFILE_ACCEL_AXES])
 {
-  for (int i = 0; i < PROFILE_ACCEL_AXES; i++) peak_g[i] = fabs(a->const_g[i]) + fabs(a->amp_g[i]);
+  for (int i = 0; i < PROFILE_ACCEL_AXES; i++)
+    peak_g[i] = fabs(a->const_g[i]) + fabs(a->amp_g[i]);
 }

@@ -44,22 +44,22 @@ typedef enum {
 
 typedef struct {
   profile_kind_t kind;
-  double value;        /* CONST value; SINE offset; RAMP start; HEAT_COOL base */
-  double amp;          /* SINE */
-  double freq_hz;      /* SINE, >= 0 */
-  double phase_rad;    /* SINE */
-  double slope_per_s;  /* RAMP */
-  double t_start_s;    /* RAMP, HEAT_COOL */
-  double t_end_s;      /* RAMP, >= t_start_s */
-  double hot_value;    /* HEAT_COOL */
-  double heat_s;       /* HEAT_COOL heating duration, >= 0 */
-  double tau_heat_s;   /* HEAT_COOL, > 0 */
-  double tau_cool_s;   /* HEAT_COOL, > 0 */
-  int n_steps;         /* STEPS, 1..PROFILE_MAX_STEPS */
-  double step_s[PROFILE_MAX_STEPS];     /* durations, > 0 */
+  double value;                     /* CONST value; SINE offset; RAMP start; HEAT_COOL base */
+  double amp;                       /* SINE */
+  double freq_hz;                   /* SINE, >= 0 */
+  double phase_rad;                 /* SINE */
+  double slope_per_s;               /* RAMP */
+  double t_start_s;                 /* RAMP, HEAT_COOL */
+  double t_end_s;                   /* RAMP, >= t_start_s */
+  double hot_value;                 /* HEAT_COOL */
+  double heat_s;                    /* HEAT_COOL heating duration, >= 0 */
+  double tau_heat_s;                /* HEAT_COOL, > 0 */
+  double tau_cool_s;                /* HEAT_COOL, > 0 */
+  int n_steps;                      /* STEPS, 1..PROFILE_MAX_STEPS */
+  double step_s[PROFILE_MAX_STEPS]; /* durations, > 0 */
   double step_value[PROFILE_MAX_STEPS];
-  double edge_s;       /* STEPS transition time, 0 <= edge_s <= every duration */
-  int repeat;          /* STEPS: 0 hold the last value, 1 repeat the table */
+  double edge_s; /* STEPS transition time, 0 <= edge_s <= every duration */
+  int repeat;    /* STEPS: 0 hold the last value, 1 repeat the table */
 } profile_t;
 
 typedef struct {
@@ -83,8 +83,8 @@ void profile_heat_cool(profile_t *p, double base, double hot, double t_start_s, 
                        double tau_heat_s, double tau_cool_s);
 /* Copies n pairs; returns 0, or -1 (p unchanged) if n is outside 1..PROFILE_MAX_STEPS or
  * the result does not pass profile_check(). */
-int profile_steps(profile_t *p, int n, const double *dur_s, const double *value,
-                  double edge_s, int repeat);
+int profile_steps(profile_t *p, int n, const double *dur_s, const double *value, double edge_s,
+                  int repeat);
 
 /* 0, or -1 with *key naming the first bad field (e.g. "step_s[3]"). Values must be
  * finite with |value| <= 1e9, times within 1e9 s, frequencies 0..1e6 Hz. */

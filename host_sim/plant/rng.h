@@ -9,7 +9,7 @@
 
 typedef struct {
   uint64_t s[4];
-  double spare;   /* second deviate of the polar method */
+  double spare; /* second deviate of the polar method */
   int has_spare;
 } rng_t;
 

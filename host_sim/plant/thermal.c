@@ -53,7 +53,10 @@ void thermal_preset(thermal_cfg_t *cfg, thermal_preset_t which)
 
 void thermal_default_cfg(thermal_cfg_t *cfg) { thermal_preset(cfg, THERMAL_PRESET_DEFAULT); }
 
-static int finite_in(double v, double lo, double hi) { return isfinite(v) && v >= lo && v <= hi; }
+static int finite_in(double v, double lo, double hi)
+{
+  return isfinite(v) && v >= lo && v <= hi;
+}
 
 int thermal_cfg_check(const thermal_cfg_t *c, const char **key)
 {

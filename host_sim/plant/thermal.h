@@ -14,7 +14,7 @@
  *   dT_i/dt = (Ta + r_i - T_i) / tau_i + sum_j g_ij (T_j - T_i)
  *
  * i.e. dT/dt = -L T + b Ta + h, L = diag(1/tau) + Laplacian(g), b_i = 1/tau_i,
- * h_i = r_i/tau_i. L is symmetric positive definite, so every mode decays (real
+ * h_i = r_i/tau_i. L is symmetric positive definite, so every eigenvector decays (real
  * eigenvalues). Exact discretisation over the update period dt with the ambient held
  * (zero-order hold; the caller passes the ambient at the middle of the period, which
  * makes a ramp exact to second order):
@@ -49,7 +49,7 @@ typedef struct {
 typedef struct {
   thermal_cfg_t cfg;
   double dphi[THERMAL_NODES][THERMAL_NODES]; /* Phi - I */
-  double g_heat[THERMAL_NODES];               /* g_h */
+  double g_heat[THERMAL_NODES];              /* g_h */
   double t_k[THERMAL_NODES];
 } thermal_t;
 

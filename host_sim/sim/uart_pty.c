@@ -26,8 +26,8 @@ int uart_pty_open(uart_pty_t *p, char *path_out, size_t len)
   if (grantpt(m) != 0 || unlockpt(m) != 0 || ptsname_r(m, name, sizeof name) != 0) {
     goto fail;
   }
-  /* the bridge's own slave descriptor: the pty stays up between clients, and raw mode
-   * set on it stays the pty's mode */
+  /* the bridge's own slave descriptor: the pty stays up between clients, and the raw
+   * settings made on it stay the pty's */
   p->slave_fd = open(name, O_RDWR | O_NOCTTY | O_NONBLOCK);
   if (p->slave_fd < 0) {
     goto fail;
@@ -98,7 +98,6 @@ void uart_pty_pump(uart_pty_t *p)
   const ssize_t n = read(p->master_fd, buf, sizeof buf);
   if (n > 0) {
     const size_t took = hal_uart_host_rx_push(buf, (size_t)n);
-    p->rx_bytes += took;
     p->rx_dropped += (uint32_t)((size_t)n - took);
   }
   /* n < 0: EAGAIN (nothing), or EIO while no client has the pty open: nothing to do */

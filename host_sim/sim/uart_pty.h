@@ -4,7 +4,7 @@
  *
  *   pty slave (/dev/pts/N) <-> kernel <-> master fd <-> uart_pty_pump <-> hal_uart_host
  *                                                                   RX ring / TX ring
- * The pty is in raw mode (no echo, no CR/LF translation, 8-bit clean: 0x00 and 0xFF
+ * The pty is raw (no echo, no CR/LF translation, 8-bit clean: 0x00 and 0xFF
  * pass, as on the wire), and the bridge keeps its own slave descriptor open so that
  * clients may come and go without the pty hanging up.
  *
@@ -28,16 +28,16 @@
 #define UART_PTY_PATH_MAX 256u
 
 typedef struct {
-  int master_fd;  /* -1 when closed */
-  int slave_fd;   /* held open by the bridge */
+  int master_fd;                     /* -1 when closed */
+  int slave_fd;                      /* held open by the bridge */
   char link_path[UART_PTY_PATH_MAX]; /* symlink made by uart_pty_link, "" if none */
   uint8_t tx[UART_PTY_TX_CHUNK];     /* popped from the TX ring, not yet written */
   size_t tx_len, tx_off;
-  uint64_t rx_bytes, tx_bytes;       /* moved so far */
-  uint32_t rx_dropped;               /* bytes the RX ring refused */
+  uint64_t tx_bytes;   /* written to the pty so far */
+  uint32_t rx_dropped; /* bytes the RX ring refused */
 } uart_pty_t;
 
-/* Open a pty pair (posix_openpt, grantpt, unlockpt), raw mode, non-blocking; write the
+/* Open a pty pair (posix_openpt, grantpt, unlockpt), raw, non-blocking; write the
  * slave's path into path_out (len bytes, may be NULL). Returns 0, or -1 with errno set
  * (then p is closed). */
 int uart_pty_open(uart_pty_t *p, char *path_out, size_t len);

@@ -42,7 +42,8 @@ def main():
             rates[q] = (float(np.mean(t["rate_dps"][m])), float(np.std(t["rate_dps"][m])) / np.sqrt(m.sum() / 40))
         leak = (rates[1500][0] - rates[1000][0]) / 500.0
         se = np.hypot(rates[1500][1], rates[1000][1]) / 500.0
-        print(f"calibrated phase {cal['rate.demod_phase_deg']:.4f} deg (was 58), scale {cal['rate.scale_dps']:.4f} (was 131)")
+        print(f"calibrated phase {cal['rate.demod_phase_deg']:.4f} deg (was 58), "
+              f"scale {cal['rate.scale_dps']:.4f} (was 131)")
         print(f"zero-rate output: {rates[1500][0]:.5f} deg/s at 1500, {rates[1000][0]:.5f} at 1000 deg/s quadrature")
         print(f"leakage {leak:.2e} (+- {se:.1e}); goal <= 1e-4")
         return 0 if abs(leak) <= 1e-4 else 1

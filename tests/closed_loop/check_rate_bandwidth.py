@@ -45,7 +45,8 @@ def main():
     print(" f [Hz]   gain    phase [deg]")
     for f, g, p in rows:
         print(f"{f:7.1f}  {g:.4f}  {p:9.2f}")
-    fr = np.array([r[0] for r in rows]); g = np.array([r[1] for r in rows])
+    fr = np.array([r[0] for r in rows])
+    g = np.array([r[1] for r in rows])
     ph = np.unwrap(np.radians([r[2] for r in rows]))
     g0 = g[0]
     i = int(np.argmax(g < g0 / np.sqrt(2)))

@@ -2,8 +2,8 @@
 """Fail when the #include graph of firmware/ and hal/ has a cycle.
 
 Two graphs are checked:
-  * files: a module is a .c/.h pair (foo.c and foo.h are one node, so the usual
-    "foo.c includes foo.h" is no edge); module A depends on module B when A's .c or .h
+  * files: a module is a .c/.h pair (NAME.c and NAME.h are one node, so the usual
+    "NAME.c includes NAME.h" is no edge); module A depends on module B when A's .c or .h
     includes B's header. A cycle means neither module can be understood, tested or
     replaced without the other.
   * folders: firmware/app, firmware/comm, hal/host, ... ; folder X depends on folder Y when

@@ -15,7 +15,7 @@
 
 static const double k_pi = 3.14159265358979323846;
 #define T0_K 298.15
-#define WN2 (2.0 * 3.14159265358979323846 * 2000.0) /* sense resonance (system.md) */
+#define WN2 (2.0 * 3.14159265358979323846 * 2000.0) /* sense resonance (thesis §2.4.2) */
 #define Q2 3.0
 
 /* Forces are the coefficient-weighted sum of the three acceleration components. */

@@ -160,13 +160,13 @@ static void test_schemes_through_dac(void **state)
 static void test_force_law(void **state)
 {
   (void)state;
-  const actuator_fb_mode_t modes[3] = {ACTUATOR_FB_OFF, ACTUATOR_FB_SINGLE, ACTUATOR_FB_DIFFERENTIAL};
+  const actuator_fb_t modes[3] = {ACTUATOR_FB_OFF, ACTUATOR_FB_SINGLE, ACTUATOR_FB_DIFFERENTIAL};
   for (int mi = 0; mi < 3; mi++) {
     actuator_cfg_t cfg;
     actuator_default_cfg(&cfg);
     cfg.drive_noise.white_rthz = 1e-3; /* large, to see it */
     cfg.fb_noise.white_rthz = 2e-3;
-    cfg.fb_mode = modes[mi];
+    cfg.fb = modes[mi];
     actuator_t a;
     assert_int_equal(actuator_init(&a, &cfg, 77u), 0);
     for (int k = 0; k < 100; k++) {
@@ -216,13 +216,13 @@ static void test_bad_cfg(void **state)
   c.fs_hz = 0.0;
   assert_int_equal(actuator_init(&a, &c, 1u), -1);
   c = good;
-  c.fb_mode = (actuator_fb_mode_t)7;
+  c.fb = (actuator_fb_t)7;
   assert_int_equal(actuator_init(&a, &c, 1u), -1);
   c = good;
   c.drive_noise.fmin_hz = -1.0;
   assert_int_equal(actuator_init(&a, &c, 1u), -1);
   c = good;
-  c.fb_mode = ACTUATOR_FB_DIFFERENTIAL;
+  c.fb = ACTUATOR_FB_DIFFERENTIAL;
   c.fb_noise.white_rthz = NAN;
   assert_int_equal(actuator_init(&a, &c, 1u), -1);
   c = good;

@@ -188,7 +188,8 @@ class CycleModel:
         if base in cls.BRANCH or base in cls.MULTI or base in cls.LDST1:
             return base
         for c in cls.COND:
-            if base.endswith(c) and base[:-2] in cls.BRANCH | cls.LDST1 | cls.FP1 | cls.FP3 | cls.FP14 | {"vmov", "mov", "add", "sub"}:
+            plain = cls.BRANCH | cls.LDST1 | cls.FP1 | cls.FP3 | cls.FP14 | {"vmov", "mov", "add", "sub"}
+            if base.endswith(c) and base[:-2] in plain:
                 return base[:-2]
         return base
 

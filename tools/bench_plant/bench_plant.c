@@ -44,7 +44,8 @@ static double run_plant(int variant, long n, uint64_t *refreshes)
     plant_profiles_t pr = p.prof;
     if (variant == 1 || variant == 4) profile_sine(&pr.rate_dps, 0.0, 100.0, 10.0, 0.0);
     if (variant == 2) profile_ramp(&pr.ambient_k, c.temp_k, -0.05, 0.0, 1e6);
-    if (variant == 3) profile_heat_cool(&pr.ambient_k, c.temp_k, c.temp_k + 60.0, 0.0, 1e6, 2.0, 20.0);
+    if (variant == 3)
+      profile_heat_cool(&pr.ambient_k, c.temp_k, c.temp_k + 60.0, 0.0, 1e6, 2.0, 20.0);
     if (variant == 4) {
       pr.accel_g.amp_g[ACCEL_AXIS_SENSE] = 0.25;
       pr.accel_g.freq_hz[ACCEL_AXIS_SENSE] = 100.0;

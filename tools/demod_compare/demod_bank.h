@@ -44,20 +44,14 @@ int demod_setup(demod_t *d, demod_kind_t kind, double param, double fs_hz);
 static inline float demod_step(demod_t *d, float x, float ref_sin, float ref_cos)
 {
   switch (d->kind) {
-    case DK_LMSD:
-      lmsd_step(&d->u.lmsd, x, ref_sin, ref_cos);
-      return lmsd_in_phase(&d->u.lmsd);
-    case DK_RLSD:
-      rlsd_step(&d->u.rlsd, x, ref_sin, ref_cos);
-      return rlsd_in_phase(&d->u.rlsd);
-    case DK_KFD:
-      kfd_step(&d->u.kfd, x, ref_sin, ref_cos);
-      return kfd_in_phase(&d->u.kfd);
-    case DK_MULT:
-    case DK_COUNT:
-    default:
-      multdemod_step(&d->u.mult, x, ref_sin, ref_cos);
-      return multdemod_in_phase(&d->u.mult);
+  case DK_LMSD: lmsd_step(&d->u.lmsd, x, ref_sin, ref_cos); return lmsd_in_phase(&d->u.lmsd);
+  case DK_RLSD: rlsd_step(&d->u.rlsd, x, ref_sin, ref_cos); return rlsd_in_phase(&d->u.rlsd);
+  case DK_KFD: kfd_step(&d->u.kfd, x, ref_sin, ref_cos); return kfd_in_phase(&d->u.kfd);
+  case DK_MULT:
+  case DK_COUNT:
+  default:
+    multdemod_step(&d->u.mult, x, ref_sin, ref_cos);
+    return multdemod_in_phase(&d->u.mult);
   }
 }
 

@@ -428,8 +428,14 @@ int main(int argc, char **argv)
     usage(argv[0]);
     return 2;
   }
-  protocol_t p = {.fs_hz = 50000.0, .fc_hz = 1750.0, .amp = 0.01, .sigma = 0.002,
-                  .am_hz = 100.0, .out_fc_hz = 100.0, .out_order = 4u, .settle_band = 0.02};
+  protocol_t p = {.fs_hz = 50000.0,
+                  .fc_hz = 1750.0,
+                  .amp = 0.01,
+                  .sigma = 0.002,
+                  .am_hz = 100.0,
+                  .out_fc_hz = 100.0,
+                  .out_order = 4u,
+                  .settle_band = 0.02};
 
   /* References from the firmware NCO, long enough for every measurement. */
   const size_t n_ref = (size_t)(fmax(MEAS_REF_S, 0.5) * p.fs_hz);

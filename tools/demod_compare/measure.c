@@ -120,10 +120,7 @@ double meas_bw_hz(const bench_t *b, demod_kind_t kind, double param)
 }
 
 /* Parameter from the search variable x (the log-bisection runs on x > 0). */
-static double param_of(demod_kind_t kind, double x)
-{
-  return (kind == DK_RLSD) ? 1.0 - x : x;
-}
+static double param_of(demod_kind_t kind, double x) { return (kind == DK_RLSD) ? 1.0 - x : x; }
 
 double meas_tune(const bench_t *b, demod_kind_t kind, double target_hz, double *bw_hz)
 {
@@ -131,20 +128,15 @@ double meas_tune(const bench_t *b, demod_kind_t kind, double target_hz, double *
   double guess;
   int rising = 1; /* bandwidth grows with x */
   switch (kind) {
-    case DK_LMSD: /* lmsd.h: f3 ~ mu fs / (2 pi) */
-    case DK_RLSD: /* rlsd.h: f3 ~ (1 - lambda) fs / (2 pi) */
-      guess = w;
-      break;
-    case DK_KFD: /* kfd.h: pole 1 - sqrt(q / (2 R)) */
-      guess = DEMOD_KFD_Q / (2.0 * w * w);
-      rising = 0;
-      break;
-    case DK_MULT:
-      guess = target_hz;
-      break;
-    case DK_COUNT:
-    default:
-      return NAN;
+  case DK_LMSD: /* lmsd.h: f3 ~ mu fs / (2 pi) */
+  case DK_RLSD: /* rlsd.h: f3 ~ (1 - lambda) fs / (2 pi) */ guess = w; break;
+  case DK_KFD: /* kfd.h: pole 1 - sqrt(q / (2 R)) */
+    guess = DEMOD_KFD_Q / (2.0 * w * w);
+    rising = 0;
+    break;
+  case DK_MULT: guess = target_hz; break;
+  case DK_COUNT:
+  default: return NAN;
   }
   *bw_hz = NAN;
   if (!(target_hz >= MEAS_BW_MIN_HZ && target_hz <= b->fc_hz / 3.0)) {

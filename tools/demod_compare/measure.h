@@ -11,7 +11,7 @@
 typedef struct {
   double fs_hz;
   double fc_hz;
-  const float *ref_sin;  /* NCO references, n_ref samples from phase 0 */
+  const float *ref_sin; /* NCO references, n_ref samples from phase 0 */
   const float *ref_cos;
   const double *carrier; /* the input carrier sin(wc k) in double, n_ref samples */
   size_t n_ref;

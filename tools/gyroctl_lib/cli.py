@@ -32,7 +32,9 @@ import argparse
 import os
 import sys
 
-from . import logger, plot as plot_mod, shell, sweep as sweep_mod
+from . import logger, shell
+from . import plot as plot_mod
+from . import sweep as sweep_mod
 from .client import Client
 from .link import CommandError, Link, LinkError
 

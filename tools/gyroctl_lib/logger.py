@@ -151,7 +151,6 @@ def log(link, fields, rate_hz, duration_s, out_path, progress=None, timeout_s=No
         if lay is None or fr.layout.stream_id != lay.stream_id:
             return
         fh = st["fh"]
-        types = [t for _, t in lay.fields]
         for r, values in enumerate(fr.records):
             idx = fr.first_rec + r
             st["max_index"] = max(st["max_index"], idx)

@@ -1,5 +1,5 @@
 """Names and units of the logged quantities, shared by the tools' axes and the field
-dictionary docs/fields.md (tools/gen-fields-doc).
+dictionary docs/fields.md (tools/gen_fields_doc.py).
 
 Two producers name the same quantities (tools/gyrotools/csvlog.py): gyro-sim's CSV and
 `gyroctl log`, whose columns are the firmware's telemetry field names

@@ -28,7 +28,10 @@ typedef struct {
   double p_deg, b_dps, tb_k, ta_k;
 } obs_t;
 
-static double lag_law(double phi1, double phi2, double dt) { return (phi1 * dt + 0.5 * phi2 * dt * dt) * kDeg; }
+static double lag_law(double phi1, double phi2, double dt)
+{
+  return (phi1 * dt + 0.5 * phi2 * dt * dt) * kDeg;
+}
 
 static void observe(const plant_cfg_t *c, const thermal_t *th, double ta, obs_t *o)
 {
@@ -45,8 +48,10 @@ static void observe(const plant_cfg_t *c, const thermal_t *th, double ta, obs_t 
   const double phi_d0 = -atan2(wc * wc / c->q_drive, 0.0);
   const double lag_s = atan2(wn2 * wc / c->q_sense, wn2 * wn2 - wc * wc);
   const double lag_s0 = atan2(wn20 * wc / c->q_sense, wn20 * wn20 - wc * wc);
-  const double dlag_d = lag_law(c->pick_drive_phi1_deg_per_k, c->pick_drive_phi2_deg_per_k2, tnd - t0);
-  const double dlag_s = lag_law(c->pick_sense_phi1_deg_per_k, c->pick_sense_phi2_deg_per_k2, tns - t0);
+  const double dlag_d = lag_law(c->pick_drive_phi1_deg_per_k, c->pick_drive_phi2_deg_per_k2,
+                                tnd - t0);
+  const double dlag_s = lag_law(c->pick_sense_phi1_deg_per_k, c->pick_sense_phi2_deg_per_k2,
+                                tns - t0);
   o->p_deg = (-(phi_d - phi_d0) + dlag_d) / kDeg;
   o->b_dps = c->quad_dps * sin(dlag_s - dlag_d + (lag_s - lag_s0));
   o->tb_k = thermal_temp(th, THERMAL_BOARD);

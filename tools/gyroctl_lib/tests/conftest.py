@@ -3,7 +3,7 @@
 ctest passes their paths in the environment (tools/gyroctl_lib/CMakeLists.txt):
     TLM_VECTORS   tlm-vectors (firmware telemetry encoder/receiver as a program)
     FW_PTY_HOST   tests/e2e/fw_pty_host (the real application behind a pty)
-    GYRO_SIM      host_sim/gyro-sim (the application on the plant, --uart-pty)
+    GYRO_SIM      gyro-sim (host_sim/gyro_sim: the application on the plant, --uart-pty)
 Run by hand from a configured tree, e.g.
     TLM_VECTORS=build/host/tools/gyroctl_lib/tlm-vectors \
     FW_PTY_HOST=build/host/tests/fw_pty_host python3 -m pytest tools/gyroctl_lib/tests

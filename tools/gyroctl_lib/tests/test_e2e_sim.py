@@ -14,8 +14,6 @@ import time
 import pytest
 
 
-
-
 def ctl(gyroctl, port, *args):
     return subprocess.run(gyroctl + ["--port", port] + list(args), capture_output=True,
                           text=True, timeout=60)
@@ -60,7 +58,7 @@ def test_setpoint_moves_the_loop(sim, gyroctl, tmp_path):
     r = ctl(gyroctl, sim, "log", "drive_amp_v", "rate_dps", "--rate", "200", "--duration", "1.5",
             "--out", str(out))
     assert r.returncode == 0, r.stderr
-    rows = [row for row in csv.reader(l for l in open(out) if not l.startswith("#"))]
+    rows = [row for row in csv.reader(ln for ln in open(out) if not ln.startswith("#"))]
     # Fields come in the firmware's table order (rate before drive amplitude), under
     # the names asked for.
     assert rows[0] == ["t_s", "rate_dps", "drive_amp_v"]

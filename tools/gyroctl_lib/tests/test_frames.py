@@ -13,7 +13,6 @@ import pytest
 
 from gyroctl_lib import frames
 
-
 # ---- primitives ----
 
 def test_crc_check_value():

@@ -15,7 +15,8 @@ import time
 
 import pytest
 
-from gyroctl_lib import cli, frames, link as link_mod, logger, shell
+from gyroctl_lib import cli, frames, logger, shell
+from gyroctl_lib import link as link_mod
 from gyroctl_lib.link import Link, LinkError
 
 

@@ -13,8 +13,6 @@ import os
 import subprocess
 import sys
 
-import pytest
-
 TOOLS = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 F0_REF_HZ = 1489.9   # plant default f_drive_hz at temp_ref_k (host_sim/plant/plant.h)
 Q_PLANT = 33.33
@@ -40,9 +38,9 @@ def test_sweep_csv_fits_the_plant(sim, gyroctl, tmp_path):
     assert "sweep: DONE" in r.stderr
     lines = out.read_text().splitlines()
     assert lines[0].startswith("# gyro self-calibration sweep")
-    header = next(l for l in lines if not l.startswith("#"))
+    header = next(ln for ln in lines if not ln.startswith("#"))
     assert header.split(",")[:3] == ["f_hz", "amp", "phase_deg"]
-    rows = list(csv.DictReader(l for l in lines if not l.startswith("#")))
+    rows = list(csv.DictReader(ln for ln in lines if not ln.startswith("#")))
     assert len(rows) in (9, 18)
     f = [float(x["f_hz"]) for x in rows]
     assert f == sorted(f)

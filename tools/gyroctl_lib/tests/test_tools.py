@@ -73,7 +73,7 @@ def test_logger_with_scripted_port(tmp_path):
     out = tmp_path / "x.csv"
     res = logger.log(link, ["rate_dps", "flags"], 1000, 0.1, out, timeout_s=5)
     assert port.sent == ["emu", "stream rate_dps flags @1000", "stop"]  # emu: no stretch here
-    rows = [l for l in out.read_text().splitlines() if l and not l.startswith("#")]
+    rows = [ln for ln in out.read_text().splitlines() if ln and not ln.startswith("#")]
     assert rows[0] == "t_s,rate_dps,flags"
     body = [r.split(",") for r in rows[1:]]
     idx = [round(float(r[0]) * 1000) for r in body]

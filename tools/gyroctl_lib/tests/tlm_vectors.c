@@ -74,8 +74,8 @@ static tlm_t tx;
 
 /* One stream: start, `ticks` ticks with the background loop every `poll` ticks except
  * between stall_from and stall_to (ticks), stop. Records go to js as words. */
-static void stream(FILE *js, uint32_t *tick, uint32_t mask, float rate, uint32_t ticks, uint32_t poll,
-                   uint32_t stall_from, uint32_t stall_to, int first)
+static void stream(FILE *js, uint32_t *tick, uint32_t mask, float rate, uint32_t ticks,
+                   uint32_t poll, uint32_t stall_from, uint32_t stall_to, int first)
 {
   tlm_plan_t p;
   if (tlm_plan(&app_tlm_fields, FS, 921600u, mask, rate, &p) != TLM_OK) {
@@ -83,8 +83,9 @@ static void stream(FILE *js, uint32_t *tick, uint32_t mask, float rate, uint32_t
     exit(1);
   }
   tlm_start(&tx, &p);
-  fprintf(js, "%s{\"stream_id\": %" PRIu32 ", \"fs_hz\": %u, \"decim\": %" PRIu32 ", \"fields\": [", first ? "" : ", ",
-          tx.stream_id, FS, p.decim);
+  fprintf(js,
+          "%s{\"stream_id\": %" PRIu32 ", \"fs_hz\": %u, \"decim\": %" PRIu32 ", \"fields\": [",
+          first ? "" : ", ", tx.stream_id, FS, p.decim);
   int f1 = 1;
   for (uint32_t i = 0; i < (uint32_t)TLM_FIELD_COUNT; i++) {
     if ((mask >> i) & 1u) {
@@ -121,8 +122,8 @@ static void stream(FILE *js, uint32_t *tick, uint32_t mask, float rate, uint32_t
   tlm_stop(&tx);
   tlm_stats_t st;
   tlm_stats(&tx, &st);
-  fprintf(js, "], \"taken\": %" PRIu32 ", \"lost\": %" PRIu32 ", \"frames\": %" PRIu32 "}", st.records, st.lost,
-          st.frames);
+  fprintf(js, "], \"taken\": %" PRIu32 ", \"lost\": %" PRIu32 ", \"frames\": %" PRIu32 "}",
+          st.records, st.lost, st.frames);
 }
 
 static int make(const char *dir)
@@ -143,15 +144,15 @@ static int make(const char *dir)
   text(js, "ok stream 1 1000 Hz decim 50", &first);
   fprintf(js, "], \"streams\": [");
   /* 1: five fields at 1 kHz, 0.5 s */
-  const uint32_t m1 = (1u << TLM_FIELD_rate_dps) | (1u << TLM_FIELD_quad_dps) | (1u << TLM_FIELD_mode) |
-                      (1u << TLM_FIELD_flags) | (1u << TLM_FIELD_tick);
+  const uint32_t m1 = (1u << TLM_FIELD_rate_dps) | (1u << TLM_FIELD_quad_dps) |
+                      (1u << TLM_FIELD_mode) | (1u << TLM_FIELD_flags) | (1u << TLM_FIELD_tick);
   stream(js, &tick, m1, 1000.0f, 25000u, 50u, 0u, 0u, 1);
   /* 2: all fields at 250 Hz, 2.1 s (three headers) */
   stream(js, &tick, TLM_FIELD_MASK_ALL, 250.0f, 105000u, 100u, 0u, 0u, 0);
   /* 3: two fields at 5 kHz (rounded from 4900), with the background loop stalled for
    * 0.2 s: the ring overflows and records are lost */
-  stream(js, &tick, (1u << TLM_FIELD_drive_amp_v) | (1u << TLM_FIELD_tick), 4900.0f, 50000u, 25u, 10000u,
-         20000u, 0);
+  stream(js, &tick, (1u << TLM_FIELD_drive_amp_v) | (1u << TLM_FIELD_tick), 4900.0f, 50000u,
+         25u, 10000u, 20000u, 0);
   fprintf(js, "], \"trailer\": [");
   first = 1;
   text(js, "ok stop 3 records 5000", &first);
@@ -215,12 +216,12 @@ static int decode(const char *path)
   tlm_decode_init(&rx, &c);
   tlm_decode_feed(&rx, wire, wire_len);
   const tlm_decode_stats_t *st = &rx.st;
-  printf("{\"lines\": %" PRIu32 ", \"lines_bad\": %" PRIu32 ", \"headers\": %" PRIu32 ", \"data\": %" PRIu32
-         ", \"corrupt\": %" PRIu32 ", \"bad_format\": %" PRIu32 ", \"no_layout\": %" PRIu32
-         ", \"seq_missing\": %" PRIu32 ", \"rec_missing\": %" PRIu32 ", \"records\": %" PRIu32
-         ", \"digest\": %" PRIu64 ", \"line_chars\": %" PRIu32 "}\n",
-         st->lines, st->lines_bad, st->headers, st->data, st->corrupt, st->bad_format, st->no_layout,
-         st->seq_missing, st->rec_missing, s.records, s.digest, s.line_chars);
+  printf("{\"lines\": %" PRIu32 ", \"lines_bad\": %" PRIu32 ", \"headers\": %" PRIu32
+         ", \"data\": %" PRIu32 ", \"corrupt\": %" PRIu32 ", \"bad_format\": %" PRIu32
+         ", \"no_layout\": %" PRIu32 ", \"seq_missing\": %" PRIu32 ", \"rec_missing\": %" PRIu32
+         ", \"records\": %" PRIu32 ", \"digest\": %" PRIu64 ", \"line_chars\": %" PRIu32 "}\n",
+         st->lines, st->lines_bad, st->headers, st->data, st->corrupt, st->bad_format,
+         st->no_layout, st->seq_missing, st->rec_missing, s.records, s.digest, s.line_chars);
   return 0;
 }
 

@@ -12,15 +12,15 @@ import math
 
 import numpy as np
 import pytest
+import synth
 from scipy import signal
 
-import synth
 from gyrotools import allan
 from gyrotools.errors import InputError
 
 FS = 100.0
 NS = 2 ** 18
-# The thesis's uncompensated part (table 7-3, system.md 2): N = 26.4/sqrt(2) deg/h/rtHz,
+# The thesis's uncompensated part (thesis table 7-3): N = 26.4/sqrt(2) deg/h/rtHz,
 # B = 31.3 deg/h; the ramp is scaled so that the flat region spans about two decades.
 N_T, B_T, R_T = 18.7, 31.3, 1323.0
 

@@ -10,8 +10,8 @@ import sys
 
 import numpy as np
 import pytest
-
 import synth
+
 from gyrotools import allan
 
 TOOLS = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))

@@ -8,11 +8,10 @@ import sys
 
 import numpy as np
 import pytest
-
 import synth
 from test_freqresp import F, truth
 from test_gyroctl_bridge import FAKE
-from test_scalefactor import RATES, DWELL, table_log
+from test_scalefactor import DWELL, RATES, table_log
 from test_tempcomp import cooldown
 
 TRUTH = ("rate_true_dps", "t_ambient_c", "t_struct_c")

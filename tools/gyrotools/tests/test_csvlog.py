@@ -2,8 +2,8 @@
 located message."""
 import numpy as np
 import pytest
-
 import synth
+
 from gyrotools import csvlog
 from gyrotools.errors import InputError
 

@@ -5,8 +5,8 @@ import math
 
 import numpy as np
 import pytest
-
 import synth
+
 from gyrotools import psd
 from gyrotools.errors import InputError
 

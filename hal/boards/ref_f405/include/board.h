@@ -19,7 +19,7 @@
 #define BOARD_SAMPLE_RATE_HZ 50000u
 
 /* ---- Converter scaling ----------------------------------------------------------------
- * The HAL's converter contract (hal/hal_adc.h, hal/hal_dac.h): the firmware core works in
+ * The HAL's converter contract (hal/include/hal/hal_adc.h, hal/include/hal/hal_dac.h): the firmware core works in
  * volts and converts at the HAL boundary with these.
  *   ADC: AD7606, 16-bit, bipolar +-5 V (RANGE strapped low), two's complement, one
  *        code = 10 V / 65536. Drive pickoff on V1, sense pickoff on V2, both sampled by
