@@ -6,13 +6,18 @@
 # <name>.bin (raw from 0x0800_0000; it spans the parameter sectors, filled with 0xFF)
 # and <name>.hex (sparse: leaves the parameter sectors alone) next to it, and prints
 # a size report at build time: the linker's per-region table (--print-memory-usage)
-# followed by flash / SRAM / CCM used vs available (linker/image_size.cmake).
+# followed by flash / SRAM / CCM used vs available (linker/image_size.cmake). The link
+# fails when a function of the sample interrupt's path lies outside SRAM
+# (linker/check_ramfunc.py: GYRO_RAMFUNC, firmware/dsp/ramfunc.h).
 # Compiler and linker warnings are errors.
 set(GYRO_DEFAULT_LINKER_SCRIPT ${CMAKE_CURRENT_LIST_DIR}/stm32f405.ld)
 # Images that run in QEMU's netduinoplus2 (no CCM there: stm32f405_qemu.ld).
 set(GYRO_QEMU_LINKER_SCRIPT ${CMAKE_CURRENT_LIST_DIR}/stm32f405_qemu.ld)
 set(GYRO_LINKER_SECTIONS ${CMAKE_CURRENT_LIST_DIR}/stm32f405_sections.ld)
 set(GYRO_IMAGE_SIZE_SCRIPT ${CMAKE_CURRENT_LIST_DIR}/image_size.cmake)
+# The post-link check that the sample interrupt's path runs from SRAM (check_ramfunc.py).
+set(GYRO_RAMFUNC_CHECK ${CMAKE_CURRENT_LIST_DIR}/check_ramfunc.py)
+find_package(Python3 REQUIRED COMPONENTS Interpreter)
 
 function(gyro_add_image name)
   cmake_parse_arguments(IMG "" "LINKER_SCRIPT;STACK_BYTES" "SOURCES;LIBS" ${ARGN})
@@ -40,6 +45,8 @@ function(gyro_add_image name)
     target_link_options(${name} PRIVATE -Wl,--defsym=__gyro_stack_size=${IMG_STACK_BYTES})
   endif()
   add_custom_command(TARGET ${name} POST_BUILD
+    COMMAND ${Python3_EXECUTABLE} ${GYRO_RAMFUNC_CHECK} --elf $<TARGET_FILE:${name}>
+            --map ${name}.map --objdump ${CMAKE_OBJDUMP}
     COMMAND ${CMAKE_OBJCOPY} -O binary --gap-fill 0xff $<TARGET_FILE:${name}> ${name}.bin
     COMMAND ${CMAKE_OBJCOPY} -O ihex $<TARGET_FILE:${name}> ${name}.hex
     COMMAND ${CMAKE_COMMAND} -DELF=$<TARGET_FILE:${name}> -DSIZE_TOOL=${CMAKE_SIZE}

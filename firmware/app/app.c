@@ -12,6 +12,7 @@
 #include "app/app_cmds.h"
 #include "app/app_selfcal.h"
 #include "comm/cli_builtin.h"
+#include "dsp/ramfunc.h"
 
 static int derive(void *ctx, const param_values_t *v, void *derived, const char **why)
 {
@@ -162,7 +163,7 @@ static void take_request(app_t *a, uint32_t req)
   }
 }
 
-void app_sample_isr(void *ctx)
+GYRO_RAMFUNC void app_sample_isr(void *ctx)
 {
   app_t *a = ctx;
 

@@ -1,6 +1,7 @@
 #include "comm/tlm.h"
 
 #include <string.h>
+#include "dsp/ramfunc.h"
 
 static uint32_t popcount32(uint32_t m)
 {
@@ -110,7 +111,7 @@ tlm_status_t tlm_plan(const tlm_fields_t *fields, uint32_t fs_hz, uint32_t baud,
 
 /* ---- ISR ---- */
 
-void tlm_isr_record(tlm_t *t, const void *snapshot, uint32_t gen)
+GYRO_RAMFUNC void tlm_isr_record(tlm_t *t, const void *snapshot, uint32_t gen)
 {
   if (gen != t->isr_seen) {
     t->isr_seen = gen; /* a new stream takes its first record at once */

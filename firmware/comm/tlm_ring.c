@@ -2,6 +2,8 @@
 
 #include <string.h>
 
+#include "dsp/ramfunc.h"
+
 #define MASK (TLM_RING_WORDS - 1u)
 
 void tlm_ring_init(tlm_ring_t *r)
@@ -12,7 +14,7 @@ void tlm_ring_init(tlm_ring_t *r)
   atomic_store_explicit(&r->overruns, 0u, memory_order_relaxed);
 }
 
-bool tlm_ring_push(tlm_ring_t *r, const uint32_t *w, uint32_t n)
+GYRO_RAMFUNC bool tlm_ring_push(tlm_ring_t *r, const uint32_t *w, uint32_t n)
 {
   const uint32_t head = atomic_load_explicit(&r->head, memory_order_relaxed);
   const uint32_t tail = atomic_load_explicit(&r->tail, memory_order_relaxed);

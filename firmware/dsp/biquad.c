@@ -2,6 +2,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include "dsp/ramfunc.h"
 
 static int coeffs_finite(const biquad_coeffs_t *c)
 {
@@ -27,7 +28,7 @@ int biquad_cascade_init(biquad_cascade_t *bq, const biquad_coeffs_t *sections, u
   return 0;
 }
 
-void biquad_cascade_reset(biquad_cascade_t *bq, float x_steady)
+GYRO_RAMFUNC void biquad_cascade_reset(biquad_cascade_t *bq, float x_steady)
 {
   if (bq == NULL || bq->num_sections > BIQUAD_MAX_SECTIONS) {
     return; /* not a cascade biquad_cascade_init accepted */

@@ -2,6 +2,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include "dsp/ramfunc.h"
 
 #include "dsp/math_const.h"
 
@@ -31,7 +32,7 @@ int lmsd_set_mu(lmsd_t *s, float mu)
   return 0;
 }
 
-void lmsd_reset(lmsd_t *s)
+GYRO_RAMFUNC void lmsd_reset(lmsd_t *s)
 {
   s->w_i = 0.0f;
   s->w_q = 0.0f;

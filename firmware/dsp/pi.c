@@ -3,6 +3,7 @@
 #include <float.h>
 #include <math.h>
 #include <stddef.h>
+#include "dsp/ramfunc.h"
 
 static int finite_f(float x)
 {
@@ -69,7 +70,7 @@ int pi_set_limits(pi_t *pi, float u_min, float u_max)
   return 0;
 }
 
-int pi_reset(pi_t *pi, float u, float e_prev)
+GYRO_RAMFUNC int pi_reset(pi_t *pi, float u, float e_prev)
 {
   if (pi == NULL || !finite_f(u) || !finite_f(e_prev)) {
     return -1;

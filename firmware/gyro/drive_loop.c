@@ -4,6 +4,7 @@
 #include <stddef.h>
 
 #include "dsp/fastmath.h"
+#include "dsp/ramfunc.h"
 
 /* Start value of P: one turn either way, the range of drive.p_init_deg (+-360 deg). Drive
  * synthesis carries whole turns of P itself (drive_synth_set), so the phase conversion's
@@ -99,7 +100,7 @@ void drive_loop_retune(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
 
 /* Geometric (a constant relative rate: a constant relative lag), the reciprocal moved by
  * the inverse factor; both land exactly on the target. */
-static void slew_amp(drive_loop_t *dl)
+GYRO_RAMFUNC static void slew_amp(drive_loop_t *dl)
 {
   const int up = dl->amp_set_v < dl->amp_target_v;
   dl->amp_set_v *= up ? dl->amp_slew_up : dl->amp_slew_down;
@@ -110,7 +111,7 @@ static void slew_amp(drive_loop_t *dl)
   }
 }
 
-void drive_loop_reset(drive_loop_t *dl)
+GYRO_RAMFUNC void drive_loop_reset(drive_loop_t *dl)
 {
   dl->amp_set_v = dl->amp_target_v;
   dl->inv_amp_set = dl->inv_amp_target;
@@ -125,7 +126,7 @@ void drive_loop_reset(drive_loop_t *dl)
   dl->p_turn_rad = 0.0f;
 }
 
-void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c)
+GYRO_RAMFUNC void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c)
 {
   if (drive_loop_slewing(dl)) slew_amp(dl);
   dl->amp_v = fm_sqrtf(w_s * w_s + w_c * w_c);
@@ -133,12 +134,12 @@ void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c)
   dl->f_cmd_v2 = pi_step(&dl->amp_pi, dl->amp_err_v);
 }
 
-void drive_loop_measure_phase(drive_loop_t *dl, float w_s, float w_c)
+GYRO_RAMFUNC void drive_loop_measure_phase(drive_loop_t *dl, float w_s, float w_c)
 {
   dl->phase_rad = fm_atan2f(w_c, w_s);
 }
 
-void drive_loop_update_phase(drive_loop_t *dl)
+GYRO_RAMFUNC void drive_loop_update_phase(drive_loop_t *dl)
 {
   dl->phase_err_rad = fm_wrap_pi(dl->phase_set_rad - dl->phase_rad);
   /* While the amplitude is still tiny its phase is noise; hold P until there is a

@@ -4,6 +4,7 @@
 #include <stddef.h>
 
 #include "dsp/fastmath.h"
+#include "dsp/ramfunc.h"
 
 int drive_synth_init(drive_synth_t *ds, const drive_synth_cfg_t *cfg)
 {
@@ -38,7 +39,7 @@ float drive_synth_f_cmd_max(const drive_synth_t *ds)
   return ds->u_max_v * ds->u_max_v;
 }
 
-void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad)
+GYRO_RAMFUNC void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad)
 {
   ds->f_set_v2 = f_cmd_v2;
   ds->p_set_rad = p_rad;

@@ -7,6 +7,7 @@
 #include "dsp/butter.h"
 #include "dsp/fastmath.h"
 #include "gyro/gyro_block.h"
+#include "dsp/ramfunc.h"
 
 /* No counter of lost samples attached (gyro_attach_lost_counter): none are lost. */
 static const volatile uint32_t k_no_loss = 0u;
@@ -163,7 +164,7 @@ static inline void count_rails(gyro_t *g, const hal_adc_frame_t *adc)
  * sets the excitation and the NCO's next step on every tick (selfcal_exec.h). The sense
  * channel and the self-test forces rest (the rate is not valid in SWEEP and the sweep
  * does not use it), so that the executive's step fits the tick's budget. */
-static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
+GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
 {
   nco_out_t ref;
   nco_step(&g->nco, &ref);
@@ -181,7 +182,7 @@ static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame
   gyro_block_sweep(g, slot, u1, u2);
 }
 
-void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
+GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
 {
   const gyro_mode_t mode = g->sup.mode;
   if (GYRO_UNLIKELY(mode == GYRO_MODE_SWEEP)) {

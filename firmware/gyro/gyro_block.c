@@ -1,6 +1,7 @@
 #include "gyro/gyro_block.h"
 
 #include "dsp/fastmath.h"
+#include "dsp/ramfunc.h"
 
 /* A NaN anywhere propagates into the loop state within a block (the LMSD weights feed
  * the loops and the rate channel, the loops the command, the rate channel the outputs)
@@ -9,7 +10,7 @@
  * overflowing to infinity would need terms near 1e38: broken state as well). The check
  * comes in two halves on two ticks (GYRO_SLOT_AMP, GYRO_SLOT_QUAD). */
 
-void gyro_block_amp_measure(gyro_t *g)
+GYRO_RAMFUNC void gyro_block_amp_measure(gyro_t *g)
 {
   const float w_s = g->lmsd_drive.w_i, w_c = g->lmsd_drive.w_q;
   g->weights_finite = fm_isfinite(w_s + w_c + g->lmsd_sense.w_i + g->lmsd_sense.w_q) ? 1u : 0u;
@@ -21,7 +22,7 @@ void gyro_block_amp_measure(gyro_t *g)
   }
 }
 
-void gyro_block_amp(gyro_t *g)
+GYRO_RAMFUNC void gyro_block_amp(gyro_t *g)
 {
   gyro_block_amp_measure(g);
   /* The drive-phase and sense-range checks of the rate's validity, on evidence of the
@@ -30,7 +31,7 @@ void gyro_block_amp(gyro_t *g)
   rate_valid_drive(&g->valid, g->sup.phase_err_f, g->rate.quad_dps, s_i * s_i + s_q * s_q);
 }
 
-void gyro_block_command(gyro_t *g)
+GYRO_RAMFUNC void gyro_block_command(gyro_t *g)
 {
   /* The supervisor's evidence of the block, now that both loops have measured. */
   supervisor_in_t *si = &g->sup_in;
@@ -54,7 +55,7 @@ void gyro_block_command(gyro_t *g)
   }
 }
 
-void gyro_block_clear(gyro_t *g)
+GYRO_RAMFUNC void gyro_block_clear(gyro_t *g)
 {
   g->sup.clear_req = 0u;
   lmsd_reset(&g->lmsd_drive);
@@ -64,7 +65,7 @@ void gyro_block_clear(gyro_t *g)
   g->rate_clear_due = 1u; /* the rate channel's half, on the next tick (its budget) */
 }
 
-void gyro_block_phase(gyro_t *g)
+GYRO_RAMFUNC void gyro_block_phase(gyro_t *g)
 {
   drive_loop_update_phase(&g->drive);
   if (GYRO_UNLIKELY(g->drive.p_turn_rad != 0.0f)) {
@@ -76,7 +77,7 @@ void gyro_block_phase(gyro_t *g)
   }
 }
 
-void gyro_block_quad(gyro_t *g)
+GYRO_RAMFUNC void gyro_block_quad(gyro_t *g)
 {
   gyro_block_finite(g);
   rate_channel_t *rc = &g->rate;
@@ -86,7 +87,7 @@ void gyro_block_quad(gyro_t *g)
                       rc->scale_dps);
 }
 
-void gyro_block_project(gyro_t *g)
+GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
 {
   rate_channel_project(&g->rate, g->lmsd_drive.w_i, g->lmsd_drive.w_q, g->drive.p_rad);
   /* The continuous self-test's modulation, for the ticks from here on and for its notch
@@ -95,7 +96,7 @@ void gyro_block_project(gyro_t *g)
   selftest_cont_advance(&g->selftest);
 }
 
-void gyro_block_measure(gyro_t *g, int drive_on)
+GYRO_RAMFUNC void gyro_block_measure(gyro_t *g, int drive_on)
 {
   if (drive_on) drive_loop_measure_phase(&g->drive, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
   /* The last verdict's onsets into the history, on this lighter tick. */
@@ -112,13 +113,13 @@ void gyro_block_measure(gyro_t *g, int drive_on)
   o->sense_q_v = g->lmsd_sense.w_q;
 }
 
-void gyro_block_phase_judge(gyro_t *g, int drive_on)
+GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g, int drive_on)
 {
   if (drive_on) gyro_block_phase(g);
   g->cont_fail = selftest_cont_judge(&g->selftest, g->sup.mode == GYRO_MODE_LOCKED);
 }
 
-void gyro_block_rate(gyro_t *g)
+GYRO_RAMFUNC void gyro_block_rate(gyro_t *g)
 {
   rate_channel_t *rc = &g->rate;
   if (GYRO_UNLIKELY(g->rate_clear_due != 0u)) {
@@ -131,7 +132,7 @@ void gyro_block_rate(gyro_t *g)
   rate_valid_range(&g->valid, rc->rate_dps);
 }
 
-void gyro_block_p(gyro_t *g, int hold)
+GYRO_RAMFUNC void gyro_block_p(gyro_t *g, int hold)
 {
   rate_channel_t *rc = &g->rate;
   if (g->thermo_due != 0u) {
@@ -146,7 +147,7 @@ void gyro_block_p(gyro_t *g, int hold)
   if (rate_channel_update_p(rc, g->drive.p_rad) != 0) g->thermo_due = 1u;
 }
 
-void gyro_block_p_selftest(gyro_t *g)
+GYRO_RAMFUNC void gyro_block_p_selftest(gyro_t *g)
 {
   const int locked = g->sup.mode == GYRO_MODE_LOCKED;
   selftest_update(&g->selftest, locked, g->rate.rate_raw);
@@ -157,7 +158,7 @@ void gyro_block_p_selftest(gyro_t *g)
 
 /* The snapshot for telemetry and status, at fs / GYRO_BLOCK (5 kHz: the telemetry's
  * highest rate); flags hold what happened over the whole block. */
-void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
+GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
 {
   gyro_out_t *o = &g->out;
   const uint32_t block_bits = (g->sup.mode == GYRO_MODE_LOCKED ? 0u : RATE_INVALID_MODE) |
@@ -194,7 +195,7 @@ void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
   g->flags_acc = 0u;
 }
 
-void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v)
+GYRO_RAMFUNC void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v)
 {
   /* The rate channel rests in SWEEP (its outputs keep their last values): the verdict
    * (not valid: MODE) and what does change. */
@@ -213,7 +214,7 @@ void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v)
   g->flags_acc = 0u;
 }
 
-void gyro_block_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
+GYRO_RAMFUNC void gyro_block_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
 {
   selfcal_exec_t *x = &g->cal;
   selfcal_exec_tick(x, g->lmsd_drive.w_i, g->lmsd_drive.w_q);

@@ -3,6 +3,7 @@
 #include <stddef.h>
 
 #include "dsp/fastmath.h"
+#include "dsp/ramfunc.h"
 
 /* Fast start of P's low-pass after a hold (rate_channel_hold_p): the held value counts
  * as RATE_P_PRIOR means; the running mean ends after RATE_P_FAST_MAX means at most. */
@@ -88,7 +89,7 @@ int rate_channel_retune(rate_channel_t *rc, const rate_channel_cfg_t *cfg)
   return 0;
 }
 
-void rate_channel_reset(rate_channel_t *rc, float p_deg)
+GYRO_RAMFUNC void rate_channel_reset(rate_channel_t *rc, float p_deg)
 {
   biquad_cascade_reset(&rc->lpf_rate, 0.0f);
   biquad_cascade_reset(&rc->lpf_quad, 0.0f);
@@ -113,7 +114,7 @@ void rate_channel_reset(rate_channel_t *rc, float p_deg)
 _Static_assert(RATE_P_DECIM % RATE_DECIM == 0u && RATE_P_BLOCKS >= 2u,
                "P's average spans whole blocks, at least two");
 
-void rate_channel_project(rate_channel_t *rc, float d_s, float d_c, float p_rad)
+GYRO_RAMFUNC void rate_channel_project(rate_channel_t *rc, float d_s, float d_c, float p_rad)
 {
   const float k = 1.0f / (float)RATE_DECIM;
   const float s_s = rc->acc_re * k, s_c = rc->acc_im * k;
@@ -136,7 +137,7 @@ void rate_channel_project(rate_channel_t *rc, float d_s, float d_c, float p_rad)
   rc->quad_raw = im;
 }
 
-void rate_channel_filter_rate(rate_channel_t *rc)
+GYRO_RAMFUNC void rate_channel_filter_rate(rate_channel_t *rc)
 {
   rc->rate_unc_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_rate, rc->rate_raw);
   /* Temperature compensation in P_f (the thesis fits the bias linear in P, 7.3.2). */
@@ -147,7 +148,7 @@ void rate_channel_filter_rate(rate_channel_t *rc)
   rc->rate_dps = rc->rate_unc_dps * sf - bias;
 }
 
-void rate_channel_filter_quad(rate_channel_t *rc)
+GYRO_RAMFUNC void rate_channel_filter_quad(rate_channel_t *rc)
 {
   rc->quad_dps = rc->scale_dps * biquad_cascade_step(&rc->lpf_quad, rc->quad_raw);
 }
@@ -159,7 +160,7 @@ void rate_channel_update(rate_channel_t *rc, float d_s, float d_c, float p_rad)
   rate_channel_filter_quad(rc);
 }
 
-void rate_channel_shift_p(rate_channel_t *rc, float shift_deg)
+GYRO_RAMFUNC void rate_channel_shift_p(rate_channel_t *rc, float shift_deg)
 {
   rc->p_dev_deg += shift_deg;
   rc->p_f_deg += shift_deg;
@@ -168,7 +169,7 @@ void rate_channel_shift_p(rate_channel_t *rc, float shift_deg)
   rc->p_mode_rad += shift_deg * FM_RAD_PER_DEG_F;
 }
 
-int rate_channel_update_p(rate_channel_t *rc, float p_rad)
+GYRO_RAMFUNC int rate_channel_update_p(rate_channel_t *rc, float p_rad)
 {
   if (rc->p_hold != 0u) {
     rc->p_acc_deg = 0.0f;

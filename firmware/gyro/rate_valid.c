@@ -3,6 +3,7 @@
 #include <stddef.h>
 
 #include "dsp/fastmath.h"
+#include "dsp/ramfunc.h"
 
 static int cfg_ok(const rate_valid_cfg_t *c)
 {
@@ -39,7 +40,7 @@ int rate_valid_init(rate_valid_t *rv, const rate_valid_cfg_t *cfg)
 
 void rate_valid_retune(rate_valid_t *rv, const rate_valid_cfg_t *cfg) { rv->cfg = *cfg; }
 
-void rate_valid_settling(rate_valid_t *rv, float rate_raw, float quad_raw, float rate_unc_dps,
+GYRO_RAMFUNC void rate_valid_settling(rate_valid_t *rv, float rate_raw, float quad_raw, float rate_unc_dps,
                          float quad_dps, float scale_dps)
 {
   rv->x_rate += RATE_VALID_INPUT_K * (rate_raw - rv->x_rate);
@@ -54,12 +55,12 @@ void rate_valid_settling(rate_valid_t *rv, float rate_raw, float quad_raw, float
 
 /* The rate error a lag of P_f of lag_deg makes: the quadrature rotated by the lag and
  * the bias polynomial moved along its slope. */
-static float lag_error_dps(const rate_valid_cfg_t *c, float lag_deg, float quad_dps)
+GYRO_RAMFUNC static float lag_error_dps(const rate_valid_cfg_t *c, float lag_deg, float quad_dps)
 {
   return lag_deg * (fm_absf(quad_dps) * FM_RAD_PER_DEG_F + c->bias_slope_dps_per_deg);
 }
 
-void rate_valid_thermo(rate_valid_t *rv, float p_dev_deg, float p_held_dev_deg, float p_held_w,
+GYRO_RAMFUNC void rate_valid_thermo(rate_valid_t *rv, float p_dev_deg, float p_held_dev_deg, float p_held_w,
                        float quad_dps)
 {
   const rate_valid_cfg_t *c = &rv->cfg;
@@ -83,7 +84,7 @@ void rate_valid_thermo(rate_valid_t *rv, float p_dev_deg, float p_held_dev_deg, 
   rv->thermo = r;
 }
 
-void rate_valid_slew(rate_valid_t *rv, float quad_dps)
+GYRO_RAMFUNC void rate_valid_slew(rate_valid_t *rv, float quad_dps)
 {
   const rate_valid_cfg_t *c = &rv->cfg;
   const float change = rv->p_window_change_deg;
@@ -94,7 +95,7 @@ void rate_valid_slew(rate_valid_t *rv, float quad_dps)
   rv->slew_due = 0u;
 }
 
-void rate_valid_count_onsets(rate_valid_t *rv, rate_valid_history_t *h)
+GYRO_RAMFUNC void rate_valid_count_onsets(rate_valid_t *rv, rate_valid_history_t *h)
 {
   /* Only the bits that are set (usually one). */
   uint32_t onsets = rv->onsets_pending;
@@ -107,7 +108,7 @@ void rate_valid_count_onsets(rate_valid_t *rv, rate_valid_history_t *h)
   }
 }
 
-void rate_valid_drive(rate_valid_t *rv, float phase_err_rad, float quad_dps, float sense_v2)
+GYRO_RAMFUNC void rate_valid_drive(rate_valid_t *rv, float phase_err_rad, float quad_dps, float sense_v2)
 {
   const rate_valid_cfg_t *c = &rv->cfg;
   /* The lock tolerance on the 100 Hz error; the quadrature it rotates into the rate on

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "dsp/fastmath.h"
+#include "dsp/ramfunc.h"
 
 /* Sums of Z are formed in blocks of this many ticks, then the block sums are added:
  * a single float sum over 10^4..10^5 ticks would lose ~1e-4 of its value. */
@@ -34,7 +35,7 @@ void selfcal_exec_reset(selfcal_exec_t *x, uint32_t half_step)
   x->z_prev_re = x->z_prev_im = x->phase_acc = 0.0f;
 }
 
-static void begin_point(selfcal_exec_t *x)
+GYRO_RAMFUNC static void begin_point(selfcal_exec_t *x)
 {
   x->stage = ST_SETTLE;
   x->check_ticks = 0u;
@@ -43,7 +44,7 @@ static void begin_point(selfcal_exec_t *x)
   x->blk_n = 0u;
 }
 
-static void start_job(selfcal_exec_t *x)
+GYRO_RAMFUNC static void start_job(selfcal_exec_t *x)
 {
   const selfcal_job_t *j = &x->job;
   /* res was cleared by selfcal_exec_post, in the background: not on the tick. */
@@ -66,7 +67,7 @@ static void start_job(selfcal_exec_t *x)
   }
 }
 
-static void finish(selfcal_exec_t *x)
+GYRO_RAMFUNC static void finish(selfcal_exec_t *x)
 {
   x->res.ticks = x->ticks;
   x->active = 0u;
@@ -75,7 +76,7 @@ static void finish(selfcal_exec_t *x)
   atomic_store_explicit(&x->done_seq, x->running_seq, memory_order_relaxed);
 }
 
-static void tick_steps(selfcal_exec_t *x, float w_s, float w_c, float amp2)
+GYRO_RAMFUNC static void tick_steps(selfcal_exec_t *x, float w_s, float w_c, float amp2)
 {
   const selfcal_job_t *j = &x->job;
   if (amp2 > x->amp_max2) {
@@ -116,7 +117,7 @@ static void tick_steps(selfcal_exec_t *x, float w_s, float w_c, float amp2)
   }
 }
 
-static void tick_ringdown(selfcal_exec_t *x, float w_s, float w_c, float amp2)
+GYRO_RAMFUNC static void tick_ringdown(selfcal_exec_t *x, float w_s, float w_c, float amp2)
 {
   const selfcal_job_t *j = &x->job;
   x->check_ticks++;
@@ -160,7 +161,7 @@ static void tick_ringdown(selfcal_exec_t *x, float w_s, float w_c, float amp2)
   }
 }
 
-static void tick_chirp(selfcal_exec_t *x, float amp2)
+GYRO_RAMFUNC static void tick_chirp(selfcal_exec_t *x, float amp2)
 {
   const selfcal_job_t *j = &x->job;
   if (amp2 > x->amp_max2) {
@@ -180,7 +181,7 @@ static void tick_chirp(selfcal_exec_t *x, float amp2)
   }
 }
 
-void selfcal_exec_take(selfcal_exec_t *x)
+GYRO_RAMFUNC void selfcal_exec_take(selfcal_exec_t *x)
 {
   const uint32_t seq = atomic_load_explicit(&x->job_seq, memory_order_relaxed);
   atomic_signal_fence(memory_order_acquire);
@@ -190,7 +191,7 @@ void selfcal_exec_take(selfcal_exec_t *x)
   }
 }
 
-void selfcal_exec_tick(selfcal_exec_t *x, float w_s, float w_c)
+GYRO_RAMFUNC void selfcal_exec_tick(selfcal_exec_t *x, float w_s, float w_c)
 {
   /* The measurement of this tick belongs to the excitation of the previous ones. */
   if (x->active != 0u) {

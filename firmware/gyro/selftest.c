@@ -4,10 +4,11 @@
 
 #include "dsp/fastmath.h"
 #include "dsp/sincos.h"
+#include "dsp/ramfunc.h"
 
 /* The force formed every tick from the on-demand test's state and the continuous test's
  * modulation of the block. */
-static void set_force(selftest_t *st)
+GYRO_RAMFUNC static void set_force(selftest_t *st)
 {
   const selftest_cfg_t *c = &st->cfg;
   float a = st->state == SELFTEST_FORCE ? c->amp_v : 0.0f;
@@ -65,7 +66,7 @@ void selftest_start(selftest_t *st)
   set_force(st);
 }
 
-void selftest_update(selftest_t *st, int locked, float rate_raw)
+GYRO_RAMFUNC void selftest_update(selftest_t *st, int locked, float rate_raw)
 {
   if (!selftest_running(st)) {
     return;
@@ -100,7 +101,7 @@ void selftest_update(selftest_t *st, int locked, float rate_raw)
   }
 }
 
-void selftest_cont_advance(selftest_t *st)
+GYRO_RAMFUNC void selftest_cont_advance(selftest_t *st)
 {
   if (st->cfg.cont_on == 0u) return;
   st->cont_phase += st->cfg.cont_step;
@@ -108,7 +109,7 @@ void selftest_cont_advance(selftest_t *st)
   set_force(st);
 }
 
-uint32_t selftest_cont_judge(selftest_t *st, int locked)
+GYRO_RAMFUNC uint32_t selftest_cont_judge(selftest_t *st, int locked)
 {
   const selftest_cfg_t *c = &st->cfg;
   if (c->cont_on == 0u || !locked) {

@@ -3,6 +3,7 @@
 #include <stddef.h>
 
 #include "dsp/fastmath.h"
+#include "dsp/ramfunc.h"
 
 static uint32_t ticks_of(float t_s, float dt_s)
 {
@@ -62,7 +63,7 @@ void supervisor_retune(supervisor_t *sv, const supervisor_cfg_t *cfg)
   sv->amp_trip_rel = cfg->amp_trip_rel < abs_rel ? cfg->amp_trip_rel : abs_rel;
 }
 
-static void set_mode(supervisor_t *sv, gyro_mode_t m)
+GYRO_RAMFUNC static void set_mode(supervisor_t *sv, gyro_mode_t m)
 {
   sv->primed = 0u;
   sv->mode = m;
@@ -90,7 +91,7 @@ void supervisor_reacquire(supervisor_t *sv)
 
 void supervisor_clear_fault(supervisor_t *sv) { sv->fault = GYRO_FAULT_NONE; }
 
-static int trip(supervisor_t *sv, uint32_t reason)
+GYRO_RAMFUNC static int trip(supervisor_t *sv, uint32_t reason)
 {
   sv->fault = reason;
   sv->last_fault = reason;
@@ -109,7 +110,7 @@ static int trip(supervisor_t *sv, uint32_t reason)
 }
 
 /* Rail codes over the last GYRO_CLIP_WINDOW steps (a running sum over a ring). */
-static uint32_t clip_window_sum(supervisor_t *sv, uint32_t count)
+GYRO_RAMFUNC static uint32_t clip_window_sum(supervisor_t *sv, uint32_t count)
 {
   const uint32_t pos = sv->clip_pos;
   sv->clip_sum += count - sv->clip_window[pos];
@@ -123,7 +124,7 @@ static uint32_t clip_window_sum(supervisor_t *sv, uint32_t count)
  * NaN anywhere would otherwise stay in the integrators forever; a lost sample shifts
  * the NCO against the converters (one sample is 10.7 deg of carrier at 1490 Hz);
  * clipping makes the demodulated amplitude meaningless. */
-static uint32_t fault_seen(supervisor_t *sv, const supervisor_in_t *in, gyro_mode_t mode)
+GYRO_RAMFUNC static uint32_t fault_seen(supervisor_t *sv, const supervisor_in_t *in, gyro_mode_t mode)
 {
   const uint32_t clips = clip_window_sum(sv, in->clip_count);
   if (!in->state_finite) return GYRO_FAULT_NAN;
@@ -135,7 +136,7 @@ static uint32_t fault_seen(supervisor_t *sv, const supervisor_in_t *in, gyro_mod
 
 /* ACQUIRE and LOCKED: the fault checks, the low-pass of the lock errors and the lock
  * decisions. The common path of the sample interrupt, kept straight. */
-static int step_driving(supervisor_t *sv, const supervisor_in_t *in, gyro_mode_t mode)
+GYRO_RAMFUNC static int step_driving(supervisor_t *sv, const supervisor_in_t *in, gyro_mode_t mode)
 {
   const uint32_t f = fault_seen(sv, in, mode);
   if (f != GYRO_FAULT_NONE) {
@@ -178,7 +179,7 @@ static int step_driving(supervisor_t *sv, const supervisor_in_t *in, gyro_mode_t
   return 0;
 }
 
-int supervisor_step(supervisor_t *sv, const supervisor_in_t *in)
+GYRO_RAMFUNC int supervisor_step(supervisor_t *sv, const supervisor_in_t *in)
 {
   const gyro_mode_t mode = sv->mode;
   sv->mode_ticks++;

@@ -1,0 +1,25 @@
+/* GYRO_RAMFUNC marks a function of the sample interrupt's path where it is defined.
+ *
+ * On the target it puts the function into an input section of its own named
+ * .ramfunc.<line>, which the linker script places in SRAM (no flash wait states, and it
+ * runs on while a flash erase or program stalls flash fetches), whatever the function
+ * is called; the target build's post-link check (linker/check_ramfunc.py) fails when a
+ * function of the sample path lands outside SRAM. On the host it is nothing.
+ *
+ * Mark every function the sample interrupt may run (static helpers included: the
+ * compiler may keep one out of line), in the LOCKED mode, SWEEP and a fault's clear.
+ * The budget of the interrupt is in tools/bench/README.md. */
+#ifndef RAMFUNC_H
+#define RAMFUNC_H
+
+#if defined(__arm__) && defined(__ARM_EABI__) && !defined(__linux__)
+#define GYRO_RAMFUNC_STR2(x) #x
+#define GYRO_RAMFUNC_STR(x) GYRO_RAMFUNC_STR2(x)
+/* One input section per function (the line of its definition), so that
+ * --gc-sections still drops what an image does not use. */
+#define GYRO_RAMFUNC __attribute__((section(".ramfunc." GYRO_RAMFUNC_STR(__LINE__))))
+#else
+#define GYRO_RAMFUNC
+#endif
+
+#endif /* RAMFUNC_H */
