@@ -38,13 +38,13 @@ GYRO_RAMFUNC void lmsd_reset(lmsd_t *s)
   s->w_q = 0.0f;
 }
 
-int lmsd_preset(lmsd_t *s, float in_phase, float quadrature)
+int lmsd_preset(lmsd_t *s, float w_i, float w_q)
 {
-  if (s == NULL || !isfinite(in_phase) || !isfinite(quadrature)) {
+  if (s == NULL || !isfinite(w_i) || !isfinite(w_q)) {
     return -1;
   }
-  s->w_i = in_phase;
-  s->w_q = quadrature;
+  s->w_i = w_i;
+  s->w_q = w_q;
   return 0;
 }
 

@@ -61,9 +61,9 @@ int lmsd_set_mu(lmsd_t *s, float mu);
 /* W = 0. */
 void lmsd_reset(lmsd_t *s);
 
-/* W = [in_phase, quadrature]' (e.g. the last good estimate after a restart). Returns 0,
+/* W = [w_i, w_q]' (e.g. the last good estimate after a restart). Returns 0,
  * or -1 and changes nothing for non-finite values. */
-int lmsd_preset(lmsd_t *s, float in_phase, float quadrature);
+int lmsd_preset(lmsd_t *s, float w_i, float w_q);
 
 /* -3 dB bandwidth of the in-phase/quadrature outputs for a given mu (formula above);
  * init-time analysis in double, returns a negative value for invalid arguments. */

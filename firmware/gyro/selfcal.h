@@ -1,4 +1,4 @@
-/* Self-calibration sequencer (background loop): identifies the drive mode through the
+/* Self-calibration sequencer (background loop): identifies the drive resonance through the
  * firmware's own signal chain and prepares the hand-over to the drive loops.
  *
  * The thesis (7.2.2) sweeps in 2 Hz steps; at Q = 600 one step would need seconds to

@@ -76,7 +76,7 @@ GYRO_RAMFUNC static void finish(selfcal_exec_t *x)
   atomic_store_explicit(&x->done_seq, x->running_seq, memory_order_relaxed);
 }
 
-GYRO_RAMFUNC static void tick_steps(selfcal_exec_t *x, float w_s, float w_c, float amp2)
+GYRO_RAMFUNC static void tick_steps(selfcal_exec_t *x, float w_i, float w_q, float amp2)
 {
   const selfcal_job_t *j = &x->job;
   if (amp2 > x->amp_max2) {
@@ -95,8 +95,8 @@ GYRO_RAMFUNC static void tick_steps(selfcal_exec_t *x, float w_s, float w_c, flo
     }
     return;
   }
-  x->blk_re += w_s;
-  x->blk_im += w_c;
+  x->blk_re += w_i;
+  x->blk_im += w_q;
   if (++x->blk_n >= SC_BLOCK) {
     x->acc_re += x->blk_re;
     x->acc_im += x->blk_im;
@@ -117,7 +117,7 @@ GYRO_RAMFUNC static void tick_steps(selfcal_exec_t *x, float w_s, float w_c, flo
   }
 }
 
-GYRO_RAMFUNC static void tick_ringdown(selfcal_exec_t *x, float w_s, float w_c, float amp2)
+GYRO_RAMFUNC static void tick_ringdown(selfcal_exec_t *x, float w_i, float w_q, float amp2)
 {
   const selfcal_job_t *j = &x->job;
   x->check_ticks++;
@@ -137,8 +137,8 @@ GYRO_RAMFUNC static void tick_ringdown(selfcal_exec_t *x, float w_s, float w_c, 
       x->res.rd_f_cmd_v2 = x->f_cmd_v2;
       x->f_cmd_v2 = 0.0f;
       x->amp_ref2 = amp2;
-      x->z_prev_re = w_s;
-      x->z_prev_im = w_c;
+      x->z_prev_re = w_i;
+      x->z_prev_im = w_q;
       x->phase_acc = 0.0f;
       x->check_ticks = 0u;
       x->stage = ST_RING;
@@ -148,11 +148,11 @@ GYRO_RAMFUNC static void tick_ringdown(selfcal_exec_t *x, float w_s, float w_c, 
   const int end = amp2 < SC_INV_E2 * x->amp_ref2 || x->check_ticks >= j->avg_ticks;
   if (end || (x->check_ticks % SC_PHASE_EVERY) == 0u) {
     /* Rotation since the last look: arg(Z conj(Z_prev)). */
-    const float cr = w_c * x->z_prev_re - w_s * x->z_prev_im;
-    const float dt = w_s * x->z_prev_re + w_c * x->z_prev_im;
+    const float cr = w_q * x->z_prev_re - w_i * x->z_prev_im;
+    const float dt = w_i * x->z_prev_re + w_q * x->z_prev_im;
     x->phase_acc += fm_atan2f(cr, dt);
-    x->z_prev_re = w_s;
-    x->z_prev_im = w_c;
+    x->z_prev_re = w_i;
+    x->z_prev_im = w_q;
   }
   if (end) {
     x->res.rd_ticks = x->check_ticks;
@@ -191,15 +191,15 @@ GYRO_RAMFUNC void selfcal_exec_take(selfcal_exec_t *x)
   }
 }
 
-GYRO_RAMFUNC void selfcal_exec_tick(selfcal_exec_t *x, float w_s, float w_c)
+GYRO_RAMFUNC void selfcal_exec_tick(selfcal_exec_t *x, float w_i, float w_q)
 {
   /* The measurement of this tick belongs to the excitation of the previous ones. */
   if (x->active != 0u) {
     x->ticks++;
-    const float amp2 = w_s * w_s + w_c * w_c;
+    const float amp2 = w_i * w_i + w_q * w_q;
     switch ((selfcal_job_kind_t)x->job.kind) {
-    case SELFCAL_JOB_STEPS: tick_steps(x, w_s, w_c, amp2); break;
-    case SELFCAL_JOB_RINGDOWN: tick_ringdown(x, w_s, w_c, amp2); break;
+    case SELFCAL_JOB_STEPS: tick_steps(x, w_i, w_q, amp2); break;
+    case SELFCAL_JOB_RINGDOWN: tick_ringdown(x, w_i, w_q, amp2); break;
     case SELFCAL_JOB_CHIRP: tick_chirp(x, amp2); break;
     case SELFCAL_JOB_HOLD:
     case SELFCAL_JOB_QUIET:

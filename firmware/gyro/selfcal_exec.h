@@ -9,7 +9,7 @@
  * drive's own (drive_synth.h), so the measurement includes every part of the signal
  * chain the loops will see.
  *
- * Measured quantity: the drive LMSD phasor Z = w_s + j w_c (gyro.h convention).
+ * Measured quantity: the drive LMSD phasor Z = w_i + j w_q, from its weights (gyro.h convention).
  *
  * Jobs:
  *   CHIRP     half_step[0] + k chirp_delta for chirp_ticks ticks; records the largest
@@ -29,9 +29,9 @@
  * After a job completes the last excitation is held until the next job.
  *
  * Hand-off: the background writes job, then job_seq + 1 (one writer); the ISR takes it
- * at a tick it calls selfcal_exec_take on, runs it, fills res and then stores done_seq = job_seq. The
- * background reads res only when done_seq == job_seq (signal fences order the stores,
- * the same scheme as params.h).
+ * at a tick it calls selfcal_exec_take on, runs it, fills res and then stores done_seq = job_seq.
+ * The background reads res only when done_seq == job_seq (signal fences order the stores, the same
+ * scheme as params.h).
  */
 #ifndef SELFCAL_EXEC_H
 #define SELFCAL_EXEC_H
@@ -106,7 +106,7 @@ void selfcal_exec_take(selfcal_exec_t *x);
 /* ISR: one tick in SWEEP with this tick's drive LMSD weights. The excitation of this
  * tick and the NCO half-step of the next are then x->f_cmd_v2, x->p_rad, x->half_step
  * (read in place: no outputs through memory on the tick). */
-void selfcal_exec_tick(selfcal_exec_t *x, float w_s, float w_c);
+void selfcal_exec_tick(selfcal_exec_t *x, float w_i, float w_q);
 
 /* Background: publish a job. Returns 0, or -1 (nothing posted) when the previous job
  * has not completed or the job is malformed. */

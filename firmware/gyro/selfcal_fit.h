@@ -1,4 +1,4 @@
-/* Self-calibration: identification of the drive mode from measured frequency-response
+/* Self-calibration: identification of the drive resonance from measured frequency-response
  * points (background, double precision).
  *
  * Model (2-24 with the actuator and pickoff gains and the circuit's constant phase lag

@@ -23,7 +23,7 @@
  * flash images for diagnosis (loading migrates by id, not by this number).
  *
  * The drive loops are designed by the firmware (gyro/drive_loop.h) from the identified
- * drive-mode model (drive.cal_*: resonance, Q, gain, found by the self-calibration
+ * drive-resonance model (drive.cal_*: resonance, Q, gain, found by the self-calibration
  * sweep) for the bandwidths drive.amp_bw_hz / drive.phase_bw_hz; nonzero manual gains
  * drive.amp_kp ... override the design. Defaults: the thesis part, drive resonance
  * 1489.9 Hz, Q1 = 33.33 (7.2.2), in the default simulator plant.

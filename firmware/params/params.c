@@ -94,7 +94,7 @@ param_status_t param_check(param_idx_t i, param_value_t val)
     if (!isfinite(val.f)) {
       return PARAM_ERR_NOT_FINITE;
     }
-    /* A subnormal means nothing to any parameter, and the FPU in flush-to-zero mode
+    /* A subnormal means nothing to any parameter, and the FPU with flush-to-zero on
      * would run a 0 where the bank holds something else. */
     if (fpclassify(val.f) == FP_SUBNORMAL) {
       return PARAM_ERR_RANGE;
