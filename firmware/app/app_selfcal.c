@@ -30,7 +30,7 @@ int app_selfcal_start(app_t *a)
   c.amp_max_v = 0.5 * (double)HAL_ADC_FULL_SCALE_V;
   c.amp_meas_v = 0.25 * (double)HAL_ADC_FULL_SCALE_V;
   c.f_cmd_start_v2 = SC_F_CMD_START_V2;
-  c.f_cmd_max_v2 = (double)a->gyro.f_cmd_max_v2;
+  c.f_cmd_max_v2 = (double)a->gyro.design->drive.f_cmd_max_v2;
   c.amp_set_v = (double)v->drive_amp_set_v;
   c.phase_set_rad = (double)v->drive_phase_set_deg * FM_PI / 180.0;
   /* One sample of DAC latency plus half a sample of zero-order hold. */

@@ -19,8 +19,11 @@
  * and below 1e-7 for the same filter run at 5 kHz. Run narrow low-pass filters at a
  * decimated rate where their DC accuracy matters.
  *
- * The cascade owns a copy of its coefficients (they are designed at init or when a
- * cut-off parameter changes, outside the ISR) and 2 floats of state per section.
+ * Two forms of the same kernel: biquad_sections_* take the coefficients (configuration,
+ * constant while the filter runs; designed outside the ISR) apart from the state (2
+ * floats per section), so that several filters share one set of coefficients and a new
+ * design is a new pointer; biquad_cascade_t bundles a copy of the coefficients with its
+ * state for a caller that owns both.
  */
 #ifndef BIQUAD_H
 #define BIQUAD_H
@@ -44,6 +47,28 @@ typedef struct {
   biquad_state_t state[BIQUAD_MAX_SECTIONS];
 } biquad_cascade_t;
 
+/* n sections (1..BIQUAD_MAX_SECTIONS) whose coefficients are all finite: 1, else 0. */
+int biquad_sections_ok(const biquad_coeffs_t *c, uint32_t n);
+
+/* Clear the state s[0..n-1] of the sections c[0..n-1], or preset it to the steady state
+ * of a constant input x (as biquad_cascade_reset). */
+void biquad_sections_reset(const biquad_coeffs_t *c, biquad_state_t *s, uint32_t n,
+                           float x_steady);
+
+/* One input sample through the n sections c with state s; returns their output. */
+static inline float biquad_sections_step(const biquad_coeffs_t *restrict c,
+                                         biquad_state_t *restrict s, uint32_t n,
+                                         float x)
+{
+  for (uint32_t i = 0; i < n; i++) {
+    const float y = c[i].b0 * x + s[i].s1;
+    s[i].s1 = c[i].b1 * x - c[i].a1 * y + s[i].s2;
+    s[i].s2 = c[i].b2 * x - c[i].a2 * y;
+    x = y;
+  }
+  return x;
+}
+
 /* Copy n sections (1..BIQUAD_MAX_SECTIONS) and clear the state. Returns 0, or -1 (and
  * leaves *bq unchanged) for a bad section count or a non-finite coefficient. */
 int biquad_cascade_init(biquad_cascade_t *bq, const biquad_coeffs_t *sections, uint32_t n);
@@ -56,15 +81,7 @@ void biquad_cascade_reset(biquad_cascade_t *bq, float x_steady);
 /* One input sample through every section; returns the cascade output. */
 static inline float biquad_cascade_step(biquad_cascade_t *bq, float x)
 {
-  for (uint32_t i = 0; i < bq->num_sections; i++) {
-    const biquad_coeffs_t *c = &bq->coeffs[i];
-    biquad_state_t *s = &bq->state[i];
-    const float y = c->b0 * x + s->s1;
-    s->s1 = c->b1 * x - c->a1 * y + s->s2;
-    s->s2 = c->b2 * x - c->a2 * y;
-    x = y;
-  }
-  return x;
+  return biquad_sections_step(bq->coeffs, bq->state, bq->num_sections, x);
 }
 
 #endif /* BIQUAD_H */

@@ -38,38 +38,42 @@ typedef struct {
   float u_init; /* output at start, within the limits */
 } pi_cfg_t;
 
+/* What the step uses, derived from a pi_cfg_t (pi_design): constant while it runs. */
 typedef struct {
-  float u;      /* u(k-1), the clamped output (the integrator) */
-  float e_prev; /* e(k-1) */
   float kp;     /* Kp = b0 */
   float ki_t;   /* Ki T = b0 + b1 */
   float u_min, u_max;
-  float ki;     /* Ki per second and T, kept to recompute Ki T */
-  float dt_s;
+} pi_coeffs_t;
+
+/* What the controller remembers. */
+typedef struct {
+  float u;      /* u(k-1), the clamped output (the integrator) */
+  float e_prev; /* e(k-1) */
 } pi_t;
 
-/* Validate cfg (finite gains, 0 < dt_s, u_min < u_max, u_min <= u_init <= u_max);
- * u = u_init, e(k-1) = 0. Returns 0, or -1 and leaves *pi unchanged. */
-int pi_init(pi_t *pi, const pi_cfg_t *cfg);
+/* Validate cfg (finite gains and Ki T, 0 < dt_s, finite u_min < u_max, u_min <= u_init
+ * <= u_max) and derive the step's coefficients. Returns 0, or -1 and leaves *c
+ * unchanged. */
+int pi_design(const pi_cfg_t *cfg, pi_coeffs_t *c);
 
-/* New Kp, Ki without a step in u (bumpless). Returns 0, or -1 and changes nothing. */
-int pi_set_gains(pi_t *pi, float kp, float ki);
+/* pi_design, then u = u_init, e(k-1) = 0. Returns 0, or -1 and changes nothing. */
+int pi_init(const pi_cfg_t *cfg, pi_coeffs_t *c, pi_t *pi);
 
-/* New output limits; u is clamped into them. Returns 0, or -1 and changes nothing for
- * u_min >= u_max or non-finite limits. */
-int pi_set_limits(pi_t *pi, float u_min, float u_max);
+/* New coefficients c take over (new gains: bumpless, the next increment uses them; new
+ * limits: u is clamped into them now). */
+void pi_limit(const pi_coeffs_t *c, pi_t *pi);
 
 /* Restart from output u (clamped into the limits) with e(k-1) = e_prev: pass the
  * current error so that the first increment has no proportional kick. Returns 0, or -1
  * and changes nothing for non-finite values. */
-int pi_reset(pi_t *pi, float u, float e_prev);
+int pi_reset(const pi_coeffs_t *c, pi_t *pi, float u, float e_prev);
 
 /* One sample of (6-26b) in velocity form with clamping; returns u(k). */
-static inline float pi_step(pi_t *pi, float e)
+static inline float pi_step(const pi_coeffs_t *restrict c, pi_t *restrict pi, float e)
 {
-  float u = pi->u + pi->kp * (e - pi->e_prev) + pi->ki_t * pi->e_prev;
-  u = (u > pi->u_max) ? pi->u_max : u;
-  u = (u < pi->u_min) ? pi->u_min : u;
+  float u = pi->u + c->kp * (e - pi->e_prev) + c->ki_t * pi->e_prev;
+  u = (u > c->u_max) ? c->u_max : u;
+  u = (u < c->u_min) ? c->u_min : u;
   pi->e_prev = e;
   pi->u = u;
   return u;

@@ -43,20 +43,6 @@ int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t 
   return 0;
 }
 
-static void set_targets(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
-{
-  float rate_per_s = DRIVE_AMP_SLEW_MAX_PER_S;
-  if (cfg->amp_ki > 0.0f && cfg->amp_kp > 0.0f && DRIVE_AMP_SLEW_TAU * cfg->amp_ki < rate_per_s * cfg->amp_kp) {
-    rate_per_s = DRIVE_AMP_SLEW_TAU * cfg->amp_ki / cfg->amp_kp; /* DRIVE_AMP_SLEW_TAU / tau */
-  }
-  dl->amp_slew_up = 1.0f + rate_per_s * cfg->dt_s;
-  dl->amp_slew_down = 1.0f / dl->amp_slew_up;
-  dl->amp_target_v = cfg->amp_set_v;
-  dl->inv_amp_target = 1.0f / cfg->amp_set_v;
-  dl->phase_set_rad = cfg->phase_set_rad;
-  dl->p_init_rad = cfg->p_init_rad;
-}
-
 static int cfg_ok(const drive_loop_cfg_t *c)
 {
   return c != NULL && c->dt_s > 0.0f && c->amp_set_v > 0.0f && c->f_cmd_max_v2 > 0.0f &&
@@ -66,9 +52,9 @@ static int cfg_ok(const drive_loop_cfg_t *c)
          fm_isfinite(c->p_init_rad) && fm_absf(c->p_init_rad) <= DRIVE_P_LIMIT_RAD;
 }
 
-int drive_loop_init(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
+int drive_loop_cfg_derive(drive_loop_cfg_t *cfg)
 {
-  if (dl == NULL || !cfg_ok(cfg)) {
+  if (!cfg_ok(cfg)) {
     return -1;
   }
   const pi_cfg_t amp = {cfg->amp_kp, cfg->amp_ki, cfg->dt_s, 0.0f, cfg->f_cmd_max_v2, 0.0f};
@@ -77,76 +63,82 @@ int drive_loop_init(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
   const pi_cfg_t ph = {cfg->phase_kp, cfg->phase_ki, cfg->dt_s,
                        cfg->p_init_rad - 2.0f * FM_TWO_PI_F, cfg->p_init_rad + 2.0f * FM_TWO_PI_F,
                        cfg->p_init_rad};
-  pi_t amp_pi, phase_pi;
-  if (pi_init(&amp_pi, &amp) != 0 || pi_init(&phase_pi, &ph) != 0) {
+  pi_coeffs_t amp_c, ph_c;
+  if (pi_design(&amp, &amp_c) != 0 || pi_design(&ph, &ph_c) != 0) {
     return -1;
   }
-  dl->amp_pi = amp_pi;
-  dl->phase_pi = phase_pi;
-  set_targets(dl, cfg);
-  drive_loop_reset(dl);
+  cfg->amp = amp_c;
+  cfg->phase = ph_c;
+  float rate_per_s = DRIVE_AMP_SLEW_MAX_PER_S;
+  if (cfg->amp_ki > 0.0f && cfg->amp_kp > 0.0f &&
+      DRIVE_AMP_SLEW_TAU * cfg->amp_ki < rate_per_s * cfg->amp_kp) {
+    rate_per_s = DRIVE_AMP_SLEW_TAU * cfg->amp_ki / cfg->amp_kp; /* DRIVE_AMP_SLEW_TAU / tau */
+  }
+  cfg->amp_slew_up = 1.0f + rate_per_s * cfg->dt_s;
+  cfg->amp_slew_down = 1.0f / cfg->amp_slew_up;
+  cfg->inv_amp_set = 1.0f / cfg->amp_set_v;
   return 0;
 }
 
-void drive_loop_retune(drive_loop_t *dl, const drive_loop_cfg_t *cfg)
+void drive_loop_init(const drive_loop_cfg_t *cfg, drive_loop_t *dl) { drive_loop_reset(cfg, dl); }
+
+void drive_loop_reconfigure(const drive_loop_cfg_t *cfg, drive_loop_t *dl)
 {
-  (void)pi_set_gains(&dl->amp_pi, cfg->amp_kp, cfg->amp_ki);
-  (void)pi_set_gains(&dl->phase_pi, cfg->phase_kp, cfg->phase_ki);
-  (void)pi_set_limits(&dl->amp_pi, 0.0f, cfg->f_cmd_max_v2);
-  (void)pi_set_limits(&dl->phase_pi, cfg->p_init_rad - 2.0f * FM_TWO_PI_F,
-                      cfg->p_init_rad + 2.0f * FM_TWO_PI_F);
-  set_targets(dl, cfg);
+  pi_limit(&cfg->amp, &dl->amp_pi);
+  pi_limit(&cfg->phase, &dl->phase_pi);
 }
 
 /* Geometric (a constant relative rate: a constant relative lag), the reciprocal moved by
  * the inverse factor; both land exactly on the target. */
-GYRO_RAMFUNC static void slew_amp(drive_loop_t *dl)
+GYRO_RAMFUNC static void slew_amp(const drive_loop_cfg_t *restrict c, drive_loop_t *restrict dl)
 {
-  const int up = dl->amp_set_v < dl->amp_target_v;
-  dl->amp_set_v *= up ? dl->amp_slew_up : dl->amp_slew_down;
-  dl->inv_amp_set *= up ? dl->amp_slew_down : dl->amp_slew_up;
-  if (up ? dl->amp_set_v >= dl->amp_target_v : dl->amp_set_v <= dl->amp_target_v) {
-    dl->amp_set_v = dl->amp_target_v;
-    dl->inv_amp_set = dl->inv_amp_target;
+  const int up = dl->amp_set_v < c->amp_set_v;
+  dl->amp_set_v *= up ? c->amp_slew_up : c->amp_slew_down;
+  dl->inv_amp_set *= up ? c->amp_slew_down : c->amp_slew_up;
+  if (up ? dl->amp_set_v >= c->amp_set_v : dl->amp_set_v <= c->amp_set_v) {
+    dl->amp_set_v = c->amp_set_v;
+    dl->inv_amp_set = c->inv_amp_set;
   }
 }
 
-GYRO_RAMFUNC void drive_loop_reset(drive_loop_t *dl)
+GYRO_RAMFUNC void drive_loop_reset(const drive_loop_cfg_t *restrict c, drive_loop_t *restrict dl)
 {
-  dl->amp_set_v = dl->amp_target_v;
-  dl->inv_amp_set = dl->inv_amp_target;
-  (void)pi_reset(&dl->amp_pi, 0.0f, 0.0f);
-  (void)pi_reset(&dl->phase_pi, dl->p_init_rad, 0.0f);
+  dl->amp_set_v = c->amp_set_v;
+  dl->inv_amp_set = c->inv_amp_set;
+  (void)pi_reset(&c->amp, &dl->amp_pi, 0.0f, 0.0f);
+  (void)pi_reset(&c->phase, &dl->phase_pi, c->p_init_rad, 0.0f);
   dl->amp_v = 0.0f;
   dl->phase_rad = 0.0f;
   dl->amp_err_v = 0.0f;
   dl->phase_err_rad = 0.0f;
   dl->f_cmd_v2 = 0.0f;
-  dl->p_rad = dl->p_init_rad;
+  dl->p_rad = c->p_init_rad;
   dl->p_turn_rad = 0.0f;
 }
 
-GYRO_RAMFUNC void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c)
+GYRO_RAMFUNC void drive_loop_step_amp(const drive_loop_cfg_t *restrict c, drive_loop_t *restrict dl,
+                                      float w_i, float w_q)
 {
-  if (drive_loop_slewing(dl)) slew_amp(dl);
-  dl->amp_v = fm_sqrtf(w_s * w_s + w_c * w_c);
+  if (drive_loop_slewing(c, dl)) slew_amp(c, dl);
+  dl->amp_v = fm_sqrtf(w_i * w_i + w_q * w_q);
   dl->amp_err_v = dl->amp_set_v - dl->amp_v;
-  dl->f_cmd_v2 = pi_step(&dl->amp_pi, dl->amp_err_v);
+  dl->f_cmd_v2 = pi_step(&c->amp, &dl->amp_pi, dl->amp_err_v);
 }
 
-GYRO_RAMFUNC void drive_loop_measure_phase(drive_loop_t *dl, float w_s, float w_c)
+GYRO_RAMFUNC void drive_loop_measure_phase(drive_loop_t *restrict dl, float w_i, float w_q)
 {
-  dl->phase_rad = fm_atan2f(w_c, w_s);
+  dl->phase_rad = fm_atan2f(w_q, w_i);
 }
 
-GYRO_RAMFUNC void drive_loop_update_phase(drive_loop_t *dl)
+GYRO_RAMFUNC void drive_loop_update_phase(const drive_loop_cfg_t *restrict c,
+                                          drive_loop_t *restrict dl)
 {
-  dl->phase_err_rad = fm_wrap_pi(dl->phase_set_rad - dl->phase_rad);
+  dl->phase_err_rad = fm_wrap_pi(c->phase_set_rad - dl->phase_rad);
   /* While the amplitude is still tiny its phase is noise; hold P until there is a
    * vibration to measure (10 % of the setpoint). */
   if (dl->amp_v > 0.1f * dl->amp_set_v) {
-    float p = pi_step(&dl->phase_pi, dl->phase_err_rad);
-    const float dev = p - dl->p_init_rad;
+    float p = pi_step(&c->phase, &dl->phase_pi, dl->phase_err_rad);
+    const float dev = p - c->p_init_rad;
     if (dev > FM_PI_F || dev < -FM_PI_F) {
       const float turn = dev > 0.0f ? FM_TWO_PI_F : -FM_TWO_PI_F;
       p -= turn;
@@ -155,18 +147,18 @@ GYRO_RAMFUNC void drive_loop_update_phase(drive_loop_t *dl)
     }
     dl->p_rad = p;
   } else {
-    (void)pi_reset(&dl->phase_pi, dl->p_rad, dl->phase_err_rad);
+    (void)pi_reset(&c->phase, &dl->phase_pi, dl->p_rad, dl->phase_err_rad);
   }
 }
 
-void drive_loop_step_phase(drive_loop_t *dl, float w_s, float w_c)
+void drive_loop_step_phase(const drive_loop_cfg_t *cfg, drive_loop_t *dl, float w_i, float w_q)
 {
-  drive_loop_measure_phase(dl, w_s, w_c);
-  drive_loop_update_phase(dl);
+  drive_loop_measure_phase(dl, w_i, w_q);
+  drive_loop_update_phase(cfg, dl);
 }
 
-void drive_loop_step(drive_loop_t *dl, float w_s, float w_c)
+void drive_loop_step(const drive_loop_cfg_t *cfg, drive_loop_t *dl, float w_i, float w_q)
 {
-  drive_loop_step_amp(dl, w_s, w_c);
-  drive_loop_step_phase(dl, w_s, w_c);
+  drive_loop_step_amp(cfg, dl, w_i, w_q);
+  drive_loop_step_phase(cfg, dl, w_i, w_q);
 }

@@ -1,12 +1,12 @@
-/* Drive-mode amplitude and phase loops (thesis 6.4), one update per loop period dt_s
+/* Drive amplitude and phase loops (thesis 6.4), one update per loop period dt_s
  * (gyro_tick: once per block of RATE_DECIM samples, 5 kHz; the loops close at tens of
  * Hz, and the LMSD's few hundred Hz of bandwidth leave nothing at 5 kHz to alias).
  * The caller may spread one update over several ticks (measurement of arg Z, phase PI,
- * amplitude loop, each on its own tick of the block, gyro.h) and turn the command into
+ * amplitude loop, each on its own tick of the block, gyro_state.h) and turn the command into
  * voltages later still; the designer is told that delay (lag_samples).
  *
- * Measurement: the drive pickoff phasor Z = w_s + j w_c from the drive LMSD (see
- * gyro.h for the phasor convention). Amplitude |Z| by one VSQRT, phase arg(Z) by
+ * Measurement: the drive pickoff phasor Z = w_i + j w_q from the drive LMSD's weights
+ * (gyro.h: the phasor convention). Amplitude |Z| by one VSQRT, phase arg(Z) by
  * fm_atan2f.
  *
  * Amplitude loop: e_A = A_set - |Z| (V). The thesis linearises the measured amplitude
@@ -28,7 +28,7 @@
  * thus never pins at a limit; drive synthesis takes the turns off its own phase
  * conversion with hysteresis (drive_synth.h).
  *
- * Amplitude setpoint changes slew (drive_loop_retune sets the target; each update moves
+ * Amplitude setpoint changes slew (a new configuration sets the target; each update moves
  * the setpoint towards it by a constant factor). A step would leave the vibration at the
  * old amplitude while the over-amplitude trip (a multiple of the setpoint) already used
  * the new one: 0.349 V -> 0.2 V tripped at 1.5 x 0.2 V. The vibration cannot fall faster
@@ -58,30 +58,31 @@
 
 #include "dsp/pi.h"
 
+/* What the loops are told (the designer, gyro_design): constant while they run. */
 typedef struct {
   float dt_s;
-  float amp_set_v;
+  float amp_set_v;           /* the amplitude setpoint's target (the loop slews to it) */
   float phase_set_rad;
   float amp_kp, amp_ki;      /* f_cmd (Ks*V^2) per V; per V*s */
   float phase_kp, phase_ki;  /* rad per rad; per rad*s */
   float f_cmd_max_v2;        /* force command limit (u_max^2 for half-frequency drive) */
   float p_init_rad;
+  /* Derived (drive_loop_cfg_derive): */
+  pi_coeffs_t amp, phase;    /* the PIs' coefficients and limits */
+  float inv_amp_set;         /* 1 / amp_set_v */
+  float amp_slew_up;         /* per update: the setpoint x this while below the target ... */
+  float amp_slew_down;       /* ... x this (1 / amp_slew_up) while above */
 } drive_loop_cfg_t;
 
 #define DRIVE_AMP_SLEW_TAU 0.15f
 #define DRIVE_AMP_SLEW_MAX_PER_S 20.0f
 
+/* What the loops remember. */
 typedef struct {
   pi_t amp_pi;
   pi_t phase_pi;
-  float amp_set_v;       /* setpoint the loop uses now, slewing towards amp_target_v */
-  float phase_set_rad;
+  float amp_set_v;       /* setpoint the loop uses now, slewing towards the cfg's */
   float inv_amp_set;     /* 1 / amp_set_v: the supervisor's reference */
-  float amp_target_v;    /* setpoint as configured */
-  float inv_amp_target;
-  float amp_slew_up;     /* per update: amp_set_v x this while below the target ... */
-  float amp_slew_down;   /* ... x this (1 / amp_slew_up) while above */
-  float p_init_rad;
   /* Latest measurement and outputs. */
   float amp_v;
   float phase_rad;
@@ -117,30 +118,37 @@ typedef struct {
  * Returns 0, or -1 for non-physical inputs. */
 int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t *out);
 
-/* Returns 0, or -1 (nothing changed) for a bad configuration. */
-int drive_loop_init(drive_loop_t *dl, const drive_loop_cfg_t *cfg);
+/* Check cfg and fill in its derived fields (background). Returns 0, or -1 for a bad
+ * configuration. */
+int drive_loop_cfg_derive(drive_loop_cfg_t *cfg);
 
-/* New gains, setpoints and limits with the loop state kept (bumpless); the amplitude
- * setpoint slews to its new value. The cfg must have passed drive_loop_init once (the
- * designer checks it); dt_s must not change. */
-void drive_loop_retune(drive_loop_t *dl, const drive_loop_cfg_t *cfg);
+/* Start with the drive off (drive_loop_reset). */
+void drive_loop_init(const drive_loop_cfg_t *cfg, drive_loop_t *dl);
+
+/* A new configuration cfg takes over with the loop state kept (bumpless: new gains act
+ * on the next increment; the PIs' outputs are clamped into the new limits); the
+ * amplitude setpoint slews to its new target. dt_s must not change. */
+void drive_loop_reconfigure(const drive_loop_cfg_t *cfg, drive_loop_t *dl);
 
 /* Drive off: force command 0, P back to its start value, integrators cleared, the
  * amplitude setpoint at its target (a start from rest needs no slew). */
-void drive_loop_reset(drive_loop_t *dl);
+void drive_loop_reset(const drive_loop_cfg_t *cfg, drive_loop_t *dl);
 
-/* One update: measurement from the drive LMSD weights, then both PIs. */
-void drive_loop_step(drive_loop_t *dl, float w_s, float w_c);
+/* One update: measurement from the drive LMSD's weights (w_i, w_q), then both PIs. */
+void drive_loop_step(const drive_loop_cfg_t *cfg, drive_loop_t *dl, float w_i, float w_q);
 /* The parts of drive_loop_step, for a caller that spreads them over several ticks:
  * the amplitude loop (|Z|, f_cmd) and the phase loop (arg Z, P; it uses the latest
  * amplitude to tell whether there is a vibration to measure), the latter itself in two
  * parts: the measurement (arg Z by fm_atan2f and its divide) and the update (the wrapped
  * error of the phase measured last, the PI). */
-void drive_loop_step_amp(drive_loop_t *dl, float w_s, float w_c);
-void drive_loop_step_phase(drive_loop_t *dl, float w_s, float w_c);
-void drive_loop_measure_phase(drive_loop_t *dl, float w_s, float w_c);
+void drive_loop_step_amp(const drive_loop_cfg_t *cfg, drive_loop_t *dl, float w_i, float w_q);
+void drive_loop_step_phase(const drive_loop_cfg_t *cfg, drive_loop_t *dl, float w_i, float w_q);
+void drive_loop_measure_phase(drive_loop_t *dl, float w_i, float w_q);
 /* The amplitude setpoint is still moving to its target. */
-static inline int drive_loop_slewing(const drive_loop_t *dl) { return dl->amp_set_v != dl->amp_target_v; }
-void drive_loop_update_phase(drive_loop_t *dl);
+static inline int drive_loop_slewing(const drive_loop_cfg_t *cfg, const drive_loop_t *dl)
+{
+  return dl->amp_set_v != cfg->amp_set_v;
+}
+void drive_loop_update_phase(const drive_loop_cfg_t *cfg, drive_loop_t *dl);
 
 #endif /* DRIVE_LOOP_H */

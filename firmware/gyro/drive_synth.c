@@ -12,17 +12,17 @@ int drive_synth_init(drive_synth_t *ds, const drive_synth_cfg_t *cfg)
       !fm_isfinite(cfg->dc_bias_v)) {
     return -1;
   }
-  if (cfg->mode == GYRO_DRIVE_DC_AC) {
+  if (cfg->scheme == GYRO_DRIVE_DC_AC) {
     if (!(cfg->dc_bias_v > 0.0f) || !(cfg->dc_bias_v < cfg->u_max_v)) {
       return -1;
     }
-  } else if (cfg->mode != GYRO_DRIVE_HALF_FREQ) {
+  } else if (cfg->scheme != GYRO_DRIVE_HALF_FREQ) {
     return -1;
   }
-  ds->mode = cfg->mode;
+  ds->scheme = cfg->scheme;
   ds->dc_bias_v = cfg->dc_bias_v;
   ds->u_max_v = cfg->u_max_v;
-  ds->inv_4d = (cfg->mode == GYRO_DRIVE_DC_AC) ? 0.25f / cfg->dc_bias_v : 0.0f;
+  ds->inv_4d = (cfg->scheme == GYRO_DRIVE_DC_AC) ? 0.25f / cfg->dc_bias_v : 0.0f;
   ds->a_v = 0.0f;
   ds->off = 0u;
   ds->f_set_v2 = ds->p_set_rad = NAN;
@@ -32,7 +32,7 @@ int drive_synth_init(drive_synth_t *ds, const drive_synth_cfg_t *cfg)
 
 float drive_synth_f_cmd_max(const drive_synth_t *ds)
 {
-  if (ds->mode == GYRO_DRIVE_DC_AC) {
+  if (ds->scheme == GYRO_DRIVE_DC_AC) {
     /* |U| <= D + A <= u_max  =>  A <= u_max - D, f = 4 D A. */
     return 4.0f * ds->dc_bias_v * (ds->u_max_v - ds->dc_bias_v);
   }
@@ -60,7 +60,7 @@ GYRO_RAMFUNC void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad
     ds->p_turn_rad = 0.0f;
   }
   const float f = (f_cmd_v2 > 0.0f && fm_isfinite(f_cmd_v2)) ? f_cmd_v2 : 0.0f;
-  if (ds->mode == GYRO_DRIVE_DC_AC) {
+  if (ds->scheme == GYRO_DRIVE_DC_AC) {
     /* Force phase P = twice the half-angle phase: exact modulo 2^32. */
     ds->off = 2u * sincos_half_rad_to_phase(p_rad);
     ds->a_v = f * ds->inv_4d;

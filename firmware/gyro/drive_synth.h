@@ -29,10 +29,14 @@
 typedef enum {
   GYRO_DRIVE_HALF_FREQ = 0, /* U1 = A cos(phi/2 + P/2), U2 = A sin(phi/2 + P/2), (6-18) */
   GYRO_DRIVE_DC_AC = 1      /* U1 = D + A cos(phi + P), U2 = D - A cos(phi + P), (6-20) */
-} gyro_drive_mode_t;
+} gyro_drive_scheme_t;
 
+/* The synthesiser's state. Its scheme and electrode levels are the drive's own, taken
+ * from the configuration by drive_synth_init (gyro_apply: at a design change that keeps
+ * the scheme, or with the drive off; the scheme itself changes only with the drive off),
+ * so that the per-sample step reads nothing but this. */
 typedef struct {
-  gyro_drive_mode_t mode;
+  gyro_drive_scheme_t scheme;
   float dc_bias_v;   /* D */
   float u_max_v;     /* largest voltage magnitude on either electrode */
   float inv_4d;      /* 1 / (4 D) */
@@ -44,7 +48,7 @@ typedef struct {
 } drive_synth_t;
 
 typedef struct {
-  gyro_drive_mode_t mode;
+  gyro_drive_scheme_t scheme;
   float dc_bias_v;
   float u_max_v;
 } drive_synth_cfg_t;
@@ -88,7 +92,7 @@ static inline void drive_synth_step(const drive_synth_t *ds, uint32_t phase, uin
                                     float *u1_v, float *u2_v)
 {
   float s, c;
-  if (ds->mode == GYRO_DRIVE_DC_AC) {
+  if (ds->scheme == GYRO_DRIVE_DC_AC) {
     sincos_lut(phase + ds->off, &s, &c);
     *u1_v = ds->dc_bias_v + ds->a_v * c;
     *u2_v = ds->dc_bias_v - ds->a_v * c;

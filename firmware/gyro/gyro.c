@@ -25,26 +25,23 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   }
   gyro_t t;
   memset(&t, 0, sizeof t);
-  rate_channel_cfg_t rc = d->rate;
-  rc.lpf = d->rate_lpf;
+  t.design = d;
   if (nco_init(&t.nco, &d->nco) != 0 || lmsd_init(&t.lmsd_drive, &d->lmsd_drive) != 0 ||
-      lmsd_init(&t.lmsd_sense, &d->lmsd_sense) != 0 || drive_loop_init(&t.drive, &d->drive) != 0 ||
-      drive_synth_init(&t.synth, &d->synth) != 0 || rate_channel_init(&t.rate, &rc) != 0 ||
-      supervisor_init(&t.sup, &d->sup) != 0 || rate_valid_init(&t.valid, &d->valid) != 0) {
+      lmsd_init(&t.lmsd_sense, &d->lmsd_sense) != 0 ||
+      drive_synth_init(&t.synth, &d->synth) != 0 || rate_channel_init(&d->rate, &t.rate) != 0 ||
+      rate_valid_init(&d->valid, &t.valid) != 0) {
     return -2;
   }
-  t.rate_fault_out_v = d->rate_fault_out_v;
-  t.rate_fault_code = gyro_volts_to_dac(d->rate_fault_out_v);
+  drive_loop_init(&d->drive, &t.drive);
+  supervisor_init(&t.sup);
   gyro_attach_lost_counter(&t, NULL);
   t.adc_v_per_code = HAL_ADC_V_PER_CODE;
-  selftest_init(&t.selftest, &d->selftest);
-  t.rate_code = t.rate_fault_code; /* not valid until the first verdict says so */
-  t.out.rate_out_v = t.rate_fault_out_v;
+  selftest_init(&d->selftest, &t.selftest);
+  t.rate_code = d->rate_fault_code; /* not valid until the first verdict says so */
+  t.out.rate_out_v = d->rate_fault_out_v;
   t.out.rate_invalid = RATE_INVALID_MODE;
   t.sup_in.state_finite = 1;
   t.weights_finite = 1u;
-  t.rate_out_v_per_dps = d->rate_out_v_per_dps;
-  t.f_cmd_max_v2 = d->drive.f_cmd_max_v2;
   *g = t;
   if (d->autostart != 0u) {
     gyro_start(g);
@@ -52,68 +49,59 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   return 0;
 }
 
-int gyro_init(gyro_t *g, const param_values_t *v)
+int gyro_design_complete(gyro_design_t *d)
 {
-  gyro_design_t d;
-  if (gyro_design(v, &d) != 0) {
+  if (d == NULL || drive_loop_cfg_derive(&d->drive) != 0 || supervisor_cfg_derive(&d->sup) != 0) {
     return -1;
   }
-  return gyro_init_from_design(g, &d);
-}
-
-/* Whether a new rate-channel configuration changes what the output means (reference,
- * scale, compensation, output filter): then the output is not valid until the filters
- * have settled again. */
-static int rate_path_same(const rate_channel_t *r, const rate_channel_cfg_t *c)
-{
-  int same = r->ref_re == c->ref_re && r->ref_im == c->ref_im && r->scale_dps == c->scale_dps &&
-             r->p_ref_deg == c->p_ref_deg && r->lpf_rate.num_sections == c->lpf_sections;
-  for (int i = 0; i < 4; i++) {
-    same = same && r->bias_c_dps[i] == c->bias_c_dps[i] && r->sf_c[i] == c->sf_c[i];
-  }
-  return same && memcmp(r->lpf_rate.coeffs, c->lpf, c->lpf_sections * sizeof c->lpf[0]) == 0;
+  selftest_cfg_derive(&d->selftest);
+  d->rate_fault_code = gyro_volts_to_dac(d->rate_fault_out_v);
+  gyro_t scratch;
+  return gyro_init_from_design(&scratch, d) == 0 ? 0 : -1;
 }
 
 void gyro_apply(gyro_t *g, const gyro_design_t *d)
 {
-  /* Coefficients only: the loop state carries on (bumpless). The design was validated
-   * by gyro_design, so the module calls below cannot fail on it. */
+  /* The design was completed by gyro_design, so every module accepts its part. Only
+   * what a change means beyond new coefficients is done here; the sample path reads the
+   * rest through g->design from the next tick on. */
+  const gyro_design_t *old = g->design;
+  const int driving = supervisor_drive_enabled(&g->sup);
   /* A new amplitude setpoint is a commanded move, not a loss of lock: re-acquire
    * instead of letting the lost-lock detector trip on the step. */
-  if (fm_absf(d->drive.amp_set_v - g->drive.amp_set_v) > g->sup.lock_tol_rel * g->drive.amp_set_v) {
+  if (fm_absf(d->drive.amp_set_v - g->drive.amp_set_v) >
+      old->sup.lock_tol_rel * g->drive.amp_set_v) {
     supervisor_reacquire(&g->sup);
   }
-  /* A new phase setpoint moves P by the same angle (arg Z = P - the mode's phase): that
-   * is no change of temperature, so the thermometer moves with it at once rather than
-   * gliding through its low-pass (which would read as a slew). */
-  const float dphase_rad = d->drive.phase_set_rad - g->drive.phase_set_rad;
-  if (dphase_rad != 0.0f && supervisor_drive_enabled(&g->sup)) {
+  /* A new phase setpoint moves P by the same angle (arg Z = P - the resonance's phase):
+   * that is no change of temperature, so the thermometer moves with it at once rather
+   * than gliding through its low-pass (which would read as a slew). */
+  const float dphase_rad = d->drive.phase_set_rad - old->drive.phase_set_rad;
+  if (dphase_rad != 0.0f && driving) {
     rate_channel_shift_p(&g->rate, dphase_rad * FM_DEG_PER_RAD_F);
   }
   g->nco.half_step = d->nco_half_step;
+  /* The LMSDs' step sizes sit beside their weights (lmsd_t: the one coefficient the
+   * per-sample step reads, within the same load). */
   (void)lmsd_set_mu(&g->lmsd_drive, d->lmsd_drive.mu);
   (void)lmsd_set_mu(&g->lmsd_sense, d->lmsd_sense.mu);
-  drive_loop_retune(&g->drive, &d->drive);
-  selftest_retune(&g->selftest, &d->selftest);
-  /* The drive scheme only changes with the drive off (drive.mode is not live). */
-  if (d->synth.mode == g->synth.mode || !supervisor_drive_enabled(&g->sup)) {
+  drive_loop_reconfigure(&d->drive, &g->drive);
+  selftest_reconfigure(&old->selftest, &d->selftest, &g->selftest);
+  /* The drive scheme only changes with the drive off (drive.mode is not live); the
+   * synthesiser keeps its own scheme and levels (drive_synth_t) until then. */
+  if (d->synth.scheme == g->synth.scheme || !driving) {
     (void)drive_synth_init(&g->synth, &d->synth);
-    if (supervisor_drive_enabled(&g->sup)) {
+    if (driving) {
       drive_synth_set(&g->synth, g->drive.f_cmd_v2, g->drive.p_rad); /* carry on driving */
     }
   }
-  rate_channel_cfg_t rc = d->rate;
-  rc.lpf = d->rate_lpf;
-  if (!rate_path_same(&g->rate, &rc)) {
-    rate_valid_disturb(&g->valid); /* the output filters settle again */
+  /* A change of what the rate output means (reference, scale, compensation, output
+   * filter): the output is not valid until the filters have settled again. */
+  if (!rate_channel_same_path(&old->rate, &d->rate)) {
+    rate_valid_disturb(&g->valid);
   }
-  (void)rate_channel_retune(&g->rate, &rc);
-  supervisor_retune(&g->sup, &d->sup);
-  rate_valid_retune(&g->valid, &d->valid);
-  g->rate_fault_out_v = d->rate_fault_out_v;
-  g->rate_fault_code = gyro_volts_to_dac(d->rate_fault_out_v);
-  g->rate_out_v_per_dps = d->rate_out_v_per_dps;
-  g->f_cmd_max_v2 = d->drive.f_cmd_max_v2;
+  rate_channel_rebase(&old->rate, &d->rate, &g->rate);
+  g->design = d;
 }
 
 void gyro_start(gyro_t *g) { supervisor_start(&g->sup); }
@@ -121,7 +109,7 @@ void gyro_start(gyro_t *g) { supervisor_start(&g->sup); }
 void gyro_stop(gyro_t *g)
 {
   supervisor_stop(&g->sup);
-  drive_loop_reset(&g->drive);
+  drive_loop_reset(&g->design->drive, &g->drive);
 }
 
 void gyro_sweep_begin(gyro_t *g)
@@ -139,8 +127,8 @@ int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d)
   g->nco.half_step = d->nco_half_step;
   /* The sweep's last job held the vibration at the set point with (f_cmd, P): the
    * integrators continue from there instead of from zero force. */
-  (void)pi_reset(&g->drive.amp_pi, g->cal.f_cmd_v2, 0.0f);
-  (void)pi_reset(&g->drive.phase_pi, g->cal.p_rad, 0.0f);
+  (void)pi_reset(&d->drive.amp, &g->drive.amp_pi, g->cal.f_cmd_v2, 0.0f);
+  (void)pi_reset(&d->drive.phase, &g->drive.phase_pi, g->cal.p_rad, 0.0f);
   g->drive.f_cmd_v2 = g->drive.amp_pi.u;
   g->drive.p_rad = g->drive.phase_pi.u;
   supervisor_stop(&g->sup);
@@ -164,7 +152,8 @@ static inline void count_rails(gyro_t *g, const hal_adc_frame_t *adc)
  * sets the excitation and the NCO's next step on every tick (selfcal_exec.h). The sense
  * channel and the self-test forces rest (the rate is not valid in SWEEP and the sweep
  * does not use it), so that the executive's step fits the tick's budget. */
-GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
+GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc,
+                                         hal_dac_frame_t *dac)
 {
   nco_out_t ref;
   nco_step(&g->nco, &ref);
@@ -208,9 +197,10 @@ GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
   dac->code[HAL_DAC_RATE_OUT] = g->rate_code; /* the rate changes once per block */
   /* Built-in self-test force on the sense feedback electrodes (selftest.h). */
-  dac->code[HAL_DAC_SPARE] = g->selftest.force_on != 0u
-                                 ? gyro_volts_to_dac(selftest_force(&g->selftest, ref.sin_wc, ref.cos_wc))
-                                 : (uint16_t)HAL_DAC_CODE_MID;
+  dac->code[HAL_DAC_SPARE] =
+      g->selftest.force_on != 0u
+          ? gyro_volts_to_dac(selftest_force(&g->selftest, ref.sin_wc, ref.cos_wc))
+          : (uint16_t)HAL_DAC_CODE_MID;
   g->out.tick++;
 
   /* Everything slower than the carrier: this tick's job of the block (gyro_block.h),

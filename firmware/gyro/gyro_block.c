@@ -12,13 +12,13 @@
 
 GYRO_RAMFUNC void gyro_block_amp_measure(gyro_t *g)
 {
-  const float w_s = g->lmsd_drive.w_i, w_c = g->lmsd_drive.w_q;
-  g->weights_finite = fm_isfinite(w_s + w_c + g->lmsd_sense.w_i + g->lmsd_sense.w_q) ? 1u : 0u;
+  const float w_i = g->lmsd_drive.w_i, w_q = g->lmsd_drive.w_q;
+  g->weights_finite = fm_isfinite(w_i + w_q + g->lmsd_sense.w_i + g->lmsd_sense.w_q) ? 1u : 0u;
   if (supervisor_drive_enabled(&g->sup)) {
-    drive_loop_step_amp(&g->drive, w_s, w_c);
+    drive_loop_step_amp(&g->design->drive, &g->drive, w_i, w_q);
   } else {
     /* Measure only: the amplitude is still watched for the over-amplitude trip. */
-    g->drive.amp_v = fm_sqrtf(w_s * w_s + w_c * w_c);
+    g->drive.amp_v = fm_sqrtf(w_i * w_i + w_q * w_q);
   }
 }
 
@@ -28,7 +28,8 @@ GYRO_RAMFUNC void gyro_block_amp(gyro_t *g)
   /* The drive-phase and sense-range checks of the rate's validity, on evidence of the
    * last block (phase error: supervisor; quadrature: its filter). */
   const float s_i = g->lmsd_sense.w_i, s_q = g->lmsd_sense.w_q;
-  rate_valid_drive(&g->valid, g->sup.phase_err_f, g->rate.quad_dps, s_i * s_i + s_q * s_q);
+  rate_valid_drive(&g->design->valid, &g->valid, g->sup.phase_err_f, g->rate.quad_dps,
+                   s_i * s_i + s_q * s_q);
 }
 
 GYRO_RAMFUNC void gyro_block_command(gyro_t *g)
@@ -38,9 +39,9 @@ GYRO_RAMFUNC void gyro_block_command(gyro_t *g)
   const int drive_on = supervisor_drive_enabled(&g->sup);
   si->amp_rel = g->drive.amp_v * g->drive.inv_amp_set; /* the slewed setpoint's */
   si->amp_rel_err = si->amp_rel - 1.0f;
-  si->setpoint_moving = drive_loop_slewing(&g->drive);
+  si->setpoint_moving = drive_loop_slewing(&g->design->drive, &g->drive);
   si->phase_err_rad = g->drive.phase_err_rad;
-  si->drive_at_limit = drive_on && g->drive.f_cmd_v2 >= g->f_cmd_max_v2;
+  si->drive_at_limit = drive_on && g->drive.f_cmd_v2 >= g->design->drive.f_cmd_max_v2;
   if (si->drive_at_limit) g->flags_acc |= GYRO_FLAG_DRIVE_LIMIT;
   /* The drive loops' fault is a clipped drive channel. A clipped sense channel (too much
    * quadrature, rate or vibration for its gain) leaves the drive sound: the rate is not
@@ -60,14 +61,14 @@ GYRO_RAMFUNC void gyro_block_clear(gyro_t *g)
   g->sup.clear_req = 0u;
   lmsd_reset(&g->lmsd_drive);
   lmsd_reset(&g->lmsd_sense);
-  drive_loop_reset(&g->drive);
+  drive_loop_reset(&g->design->drive, &g->drive);
   drive_synth_silence(&g->synth);
   g->rate_clear_due = 1u; /* the rate channel's half, on the next tick (its budget) */
 }
 
 GYRO_RAMFUNC void gyro_block_phase(gyro_t *g)
 {
-  drive_loop_update_phase(&g->drive);
+  drive_loop_update_phase(&g->design->drive, &g->drive);
   if (GYRO_UNLIKELY(g->drive.p_turn_rad != 0.0f)) {
     /* A whole turn of P is no change of temperature: the thermometer moves with it,
      * and the filters settle again after the jump of the rate reference's correction. */
@@ -81,19 +82,23 @@ GYRO_RAMFUNC void gyro_block_quad(gyro_t *g)
 {
   gyro_block_finite(g);
   rate_channel_t *rc = &g->rate;
-  selftest_cont_notch(&g->selftest, 1u, &rc->quad_raw);
-  rate_channel_filter_quad(rc);
-  rate_valid_settling(&g->valid, rc->rate_raw, rc->quad_raw, rc->rate_unc_dps, rc->quad_dps,
-                      rc->scale_dps);
+  selftest_cont_notch(&g->design->selftest, &g->selftest, 1u, &rc->quad_raw);
+  rate_channel_filter_quad(&g->design->rate, rc);
+  /* The design is read again after each call rather than kept in a register saved
+   * across it (here and below): a load is cheaper than the save and restore. */
+  const gyro_design_t *d = g->design;
+  rate_valid_settling(&d->valid, &g->valid, rc->rate_raw, rc->quad_raw, rc->rate_unc_dps,
+                      rc->quad_dps, d->rate.scale_dps);
 }
 
 GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
 {
-  rate_channel_project(&g->rate, g->lmsd_drive.w_i, g->lmsd_drive.w_q, g->drive.p_rad);
+  rate_channel_project(&g->design->rate, &g->rate, g->lmsd_drive.w_i, g->lmsd_drive.w_q,
+                       g->drive.p_rad);
   /* The continuous self-test's modulation, for the ticks from here on and for its notch
    * on this projection (GYRO_SLOT_RATE, GYRO_SLOT_QUAD): the force runs a fixed block
    * ahead of the reference, which the LMS's two weights absorb as a phase. */
-  selftest_cont_advance(&g->selftest);
+  selftest_cont_advance(&g->design->selftest, &g->selftest);
 }
 
 GYRO_RAMFUNC void gyro_block_measure(gyro_t *g, int drive_on)
@@ -116,7 +121,8 @@ GYRO_RAMFUNC void gyro_block_measure(gyro_t *g, int drive_on)
 GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g, int drive_on)
 {
   if (drive_on) gyro_block_phase(g);
-  g->cont_fail = selftest_cont_judge(&g->selftest, g->sup.mode == GYRO_MODE_LOCKED);
+  g->cont_fail =
+      selftest_cont_judge(&g->design->selftest, &g->selftest, g->sup.mode == GYRO_MODE_LOCKED);
 }
 
 GYRO_RAMFUNC void gyro_block_rate(gyro_t *g)
@@ -124,33 +130,37 @@ GYRO_RAMFUNC void gyro_block_rate(gyro_t *g)
   rate_channel_t *rc = &g->rate;
   if (GYRO_UNLIKELY(g->rate_clear_due != 0u)) {
     g->rate_clear_due = 0u;
-    rate_channel_reset(rc, rc->p_ref_deg);
+    rate_channel_reset(&g->design->rate, rc, g->design->rate.p_ref_deg);
     return;
   }
-  selftest_cont_notch(&g->selftest, 0u, &rc->rate_raw);
-  rate_channel_filter_rate(rc);
-  rate_valid_range(&g->valid, rc->rate_dps);
+  selftest_cont_notch(&g->design->selftest, &g->selftest, 0u, &rc->rate_raw);
+  rate_channel_filter_rate(&g->design->rate, rc);
+  rate_valid_range(&g->design->valid, &g->valid, rc->rate_dps);
 }
 
 GYRO_RAMFUNC void gyro_block_p(gyro_t *g, int hold)
 {
+  const gyro_design_t *d = g->design; /* kept across the call: a register saved anyway */
   rate_channel_t *rc = &g->rate;
-  if (g->thermo_due != 0u) {
+  /* The hold first (only rate_channel_update_p reads it): hold need not outlive a call. */
+  rate_channel_hold_p(rc, hold);
+  if (rc->p_new != 0u) {
     /* The thermometer checks of the P_f the last block made: P's low-pass runs on one
      * block in RATE_P_BLOCKS, the checks on the next, so that no tick carries both. */
-    g->thermo_due = 0u;
-    rate_valid_thermo(&g->valid, rc->p_dev_deg, rc->p_held_dev_deg, rc->p_held_w, rc->quad_dps);
+    rc->p_new = 0u;
+    rate_valid_thermo(&d->valid, &g->valid, rc->p_dev_deg, rc->p_held_dev_deg, rc->p_held_w,
+                      rc->quad_dps);
   } else if (g->valid.slew_due != 0u) {
-    rate_valid_slew(&g->valid, rc->quad_dps);
+    rate_valid_slew(&d->valid, &g->valid, rc->quad_dps);
   }
-  rate_channel_hold_p(rc, hold);
-  if (rate_channel_update_p(rc, g->drive.p_rad) != 0) g->thermo_due = 1u;
+  /* Last, as a tail call: its new P_f is flagged in rc->p_new. */
+  (void)rate_channel_update_p(&d->rate, rc, g->drive.p_rad);
 }
 
 GYRO_RAMFUNC void gyro_block_p_selftest(gyro_t *g)
 {
   const int locked = g->sup.mode == GYRO_MODE_LOCKED;
-  selftest_update(&g->selftest, locked, g->rate.rate_raw);
+  selftest_update(&g->design->selftest, &g->selftest, locked, g->rate.rate_raw);
   /* The test force disturbs the rate output: its filters settle again afterwards. */
   rate_valid_disturb(&g->valid);
   gyro_block_p(g, !locked);
@@ -168,10 +178,11 @@ GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
   const uint32_t invalid = rate_valid_verdict(&g->valid, block_bits);
   /* Never a valid-looking wrong rate: the analog output goes to the fault level in the
    * same sample as the verdict, without a slew. */
-  float out_v = g->rate_fault_out_v;
-  uint16_t code = g->rate_fault_code;
+  const gyro_design_t *d = g->design;
+  float out_v = d->rate_fault_out_v;
+  uint16_t code = d->rate_fault_code;
   if (invalid == 0u) {
-    out_v = g->rate.rate_dps * g->rate_out_v_per_dps;
+    out_v = g->rate.rate_dps * d->rate_out_v_per_dps;
     code = gyro_volts_to_dac(out_v);
   }
   g->rate_code = code;
@@ -203,8 +214,8 @@ GYRO_RAMFUNC void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v)
   const uint32_t block_bits = RATE_INVALID_MODE | (g->clip_block != 0u ? RATE_INVALID_CLIP : 0u);
   o->rate_invalid = rate_valid_verdict(&g->valid, block_bits);
   o->rate_valid = 0u;
-  o->rate_out_v = g->rate_fault_out_v;
-  g->rate_code = g->rate_fault_code;
+  o->rate_out_v = g->design->rate_fault_out_v;
+  g->rate_code = g->design->rate_fault_code;
   o->u1_v = u1_v;
   o->u2_v = u2_v;
   o->mode = (uint32_t)g->sup.mode;

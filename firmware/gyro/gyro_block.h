@@ -1,4 +1,4 @@
-/* The once-per-block jobs of gyro_tick, one per tick of the block (gyro.h: the block,
+/* The once-per-block jobs of gyro_tick, one per tick of the block (gyro_state.h: the block,
  * its slot table and the order the jobs depend on). Internal to the gyro: only
  * gyro_tick runs them.
  *
@@ -18,7 +18,7 @@
 #include <stdint.h>
 
 #include "dsp/fastmath.h"
-#include "gyro/gyro.h"
+#include "gyro/gyro_state.h"
 
 /* GYRO_SLOT_AMP: the first half of the finiteness check (the LMSD weights), then |Z|
  * and, while the drive runs, the amplitude PI (with the drive off |Z| only, for the
@@ -92,7 +92,7 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
     break;
   case GYRO_SLOT_SUPERVISE:
     /* Its request to clear the loop state (sup.clear_req) is acted on next tick. */
-    (void)supervisor_step(&g->sup, &g->sup_in);
+    (void)supervisor_step(&g->design->sup, &g->sup, &g->sup_in);
     break;
   case GYRO_SLOT_PROJECT:
     /* The clear resets the rate channel, whose projection waits for the next block. */
@@ -156,7 +156,7 @@ static inline void gyro_block_run_sweep(gyro_t *g, uint32_t slot, float u1_v, fl
     gyro_block_command(g);
     break;
   case GYRO_SLOT_SUPERVISE:
-    (void)supervisor_step(&g->sup, &g->sup_in);
+    (void)supervisor_step(&g->design->sup, &g->sup, &g->sup_in);
     break;
   case GYRO_SLOT_PROJECT:
     gyro_block_take_rails(g);

@@ -150,7 +150,7 @@ static gyro_design_status_t design_demod(const param_values_t *v, gyro_design_t 
  * amplitude loop. */
 static gyro_design_status_t design_synth(const param_values_t *v, gyro_design_t *t)
 {
-  t->synth.mode = v->drive_mode == 1u ? GYRO_DRIVE_DC_AC : GYRO_DRIVE_HALF_FREQ;
+  t->synth.scheme = v->drive_mode == 1u ? GYRO_DRIVE_DC_AC : GYRO_DRIVE_HALF_FREQ;
   t->synth.dc_bias_v = v->drive_dc_bias_v;
   t->synth.u_max_v = v->drive_u_max_v;
   drive_synth_t probe;
@@ -202,8 +202,8 @@ static gyro_design_status_t design_drive_loops(const param_values_t *v, double t
   t->drive.p_init_rad = v->drive_p_init_deg * FM_RAD_PER_DEG_F;
   /* The loops accept P's start value within one turn either way (drive_loop.c), the
    * parameter's range; within the parameters' ranges nothing else of theirs can fail. */
-  drive_loop_t probe;
-  if (drive_loop_init(&probe, &t->drive) != 0) return GYRO_DESIGN_P_INIT;
+  drive_loop_cfg_t probe = t->drive;
+  if (drive_loop_cfg_derive(&probe) != 0) return GYRO_DESIGN_P_INIT;
   return GYRO_DESIGN_OK;
 }
 
@@ -212,7 +212,7 @@ static gyro_design_status_t design_rate(const param_values_t *v, double tau_s, g
 {
   const double fs = (double)v->sys_fs_hz;
   const int n = butter_design(BUTTER_LOWPASS, v->rate_lpf_order, (double)v->rate_lpf_cutoff_hz,
-                              0.0, fs / RATE_DECIM, t->rate_lpf, BIQUAD_MAX_SECTIONS);
+                              0.0, fs / RATE_DECIM, t->rate.lpf, BIQUAD_MAX_SECTIONS);
   if (n <= 0) return GYRO_DESIGN_RATE_LPF;
   /* Reference of the rate channel: the drive motion as the loops hold it (phase at
    * its setpoint, amplitude at its setpoint), turned by the demodulation phase. */
@@ -232,7 +232,6 @@ static gyro_design_status_t design_rate(const param_values_t *v, double tau_s, g
   /* First-order low-pass of P at the decimated rate fs / RATE_P_DECIM. */
   t->rate.p_lpf_alpha =
       (float)(1.0 - exp(-2.0 * FM_PI * (double)v->rate_p_lpf_hz * RATE_P_DECIM / fs));
-  t->rate.lpf = NULL; /* gyro_init/gyro_apply point it at t.rate_lpf where it is used */
   t->rate.p_mode_k = (float)(1.0 - exp(-(double)GYRO_BLOCK / (fs * tau_s))); /* per block */
   t->rate.lpf_sections = (uint32_t)n;
   t->rate.min_drive_v = 0.05f * v->drive_amp_set_v;
@@ -297,8 +296,7 @@ gyro_design_status_t gyro_design(const param_values_t *v, gyro_design_t *d)
    * rejected here, in the background, where the error can be reported. The checks
    * above name the parameters; what is left for this one are values outside their
    * parameter's range (the parameter bank refuses those before a design). */
-  gyro_t scratch;
-  if (gyro_init_from_design(&scratch, &t) != 0) return GYRO_DESIGN_MODULE;
+  if (gyro_design_complete(&t) != 0) return GYRO_DESIGN_MODULE;
   *d = t;
   return GYRO_DESIGN_OK;
 }

@@ -5,7 +5,7 @@
 #include "dsp/fastmath.h"
 #include "dsp/ramfunc.h"
 
-static int cfg_ok(const rate_valid_cfg_t *c)
+int rate_valid_cfg_ok(const rate_valid_cfg_t *c)
 {
   return c != NULL && c->tol_dps > 0.0f && fm_isfinite(c->tol_dps) && c->full_scale_dps > 0.0f &&
          fm_isfinite(c->full_scale_dps) && c->p_range_deg > 0.0f && fm_isfinite(c->p_range_deg) &&
@@ -15,12 +15,11 @@ static int cfg_ok(const rate_valid_cfg_t *c)
          c->bias_slope_dps_per_deg >= 0.0f && fm_isfinite(c->bias_slope_dps_per_deg);
 }
 
-int rate_valid_init(rate_valid_t *rv, const rate_valid_cfg_t *cfg)
+int rate_valid_init(const rate_valid_cfg_t *cfg, rate_valid_t *rv)
 {
-  if (rv == NULL || !cfg_ok(cfg)) {
+  if (rv == NULL || !rate_valid_cfg_ok(cfg)) {
     return -1;
   }
-  rv->cfg = *cfg;
   rv->reasons = RATE_INVALID_MODE;
   rv->thermo = rv->drive = rv->range = 0u;
   rv->was_locked = 0u;
@@ -36,17 +35,14 @@ int rate_valid_init(rate_valid_t *rv, const rate_valid_cfg_t *cfg)
   return 0;
 }
 
-
-
-void rate_valid_retune(rate_valid_t *rv, const rate_valid_cfg_t *cfg) { rv->cfg = *cfg; }
-
-GYRO_RAMFUNC void rate_valid_settling(rate_valid_t *rv, float rate_raw, float quad_raw, float rate_unc_dps,
-                         float quad_dps, float scale_dps)
+GYRO_RAMFUNC void rate_valid_settling(const rate_valid_cfg_t *restrict cfg,
+                                      rate_valid_t *restrict rv, float rate_raw, float quad_raw,
+                                      float rate_unc_dps, float quad_dps, float scale_dps)
 {
   rv->x_rate += RATE_VALID_INPUT_K * (rate_raw - rv->x_rate);
   rv->x_quad += RATE_VALID_INPUT_K * (quad_raw - rv->x_quad);
   if (rv->settled != 0u) return;
-  const float tol = rv->cfg.tol_dps;
+  const float tol = cfg->tol_dps;
   const int inside = fm_absf(rate_unc_dps - scale_dps * rv->x_rate) <= tol &&
                      fm_absf(quad_dps - scale_dps * rv->x_quad) <= tol;
   rv->settle_run = inside ? rv->settle_run + 1u : 0u;
@@ -55,17 +51,16 @@ GYRO_RAMFUNC void rate_valid_settling(rate_valid_t *rv, float rate_raw, float qu
 
 /* The rate error a lag of P_f of lag_deg makes: the quadrature rotated by the lag and
  * the bias polynomial moved along its slope. */
-GYRO_RAMFUNC static float lag_error_dps(const rate_valid_cfg_t *c, float lag_deg, float quad_dps)
+GYRO_RAMFUNC static float lag_error_dps(const rate_valid_cfg_t *restrict c, float lag_deg,
+                                        float quad_dps)
 {
   return lag_deg * (fm_absf(quad_dps) * FM_RAD_PER_DEG_F + c->bias_slope_dps_per_deg);
 }
 
-GYRO_RAMFUNC void rate_valid_thermo(rate_valid_t *rv, float p_dev_deg, float p_held_dev_deg, float p_held_w,
-                       float quad_dps)
+GYRO_RAMFUNC void rate_valid_thermo(const rate_valid_cfg_t *restrict c, rate_valid_t *restrict rv,
+                                    float p_dev_deg, float p_held_dev_deg, float p_held_w,
+                                    float quad_dps)
 {
-  const rate_valid_cfg_t *c = &rv->cfg;
-  uint32_t r = rv->slew;
-  if (!(fm_absf(p_dev_deg) <= c->p_range_deg)) r |= RATE_INVALID_THERMO_RANGE;
   if (p_held_w > RATE_VALID_SLEW_W_MAX) {
     /* P_f still converging from a hold (THERMO_SETTLE bounds that): no slew of the
      * temperature can be told from it, the window starts later. */
@@ -78,15 +73,19 @@ GYRO_RAMFUNC void rate_valid_thermo(rate_valid_t *rv, float p_dev_deg, float p_h
     rv->p_dev_window_deg = p_dev_deg;
     rv->p_updates = 0u;
   }
+  /* The reasons after the window's bookkeeping (which leaves slew alone): fewer values
+   * live at once, no register to save. */
+  uint32_t r = rv->slew;
+  if (!(fm_absf(p_dev_deg) <= c->p_range_deg)) r |= RATE_INVALID_THERMO_RANGE;
   /* |P_f - P| <= w / (1 - w) |P_held - P_f|, compared without the divide. */
   const float gap = lag_error_dps(c, p_held_w * fm_absf(p_held_dev_deg - p_dev_deg), quad_dps);
   if (!(gap <= c->tol_dps * (1.0f - p_held_w))) r |= RATE_INVALID_THERMO_SETTLE;
   rv->thermo = r;
 }
 
-GYRO_RAMFUNC void rate_valid_slew(rate_valid_t *rv, float quad_dps)
+GYRO_RAMFUNC void rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_t *restrict rv,
+                                  float quad_dps)
 {
-  const rate_valid_cfg_t *c = &rv->cfg;
   const float change = rv->p_window_change_deg;
   const int slewing = !(change <= c->p_window_max_deg) ||
                       !(lag_error_dps(c, change * c->p_lag_per_deg, quad_dps) <= c->tol_dps);
@@ -95,7 +94,7 @@ GYRO_RAMFUNC void rate_valid_slew(rate_valid_t *rv, float quad_dps)
   rv->slew_due = 0u;
 }
 
-GYRO_RAMFUNC void rate_valid_count_onsets(rate_valid_t *rv, rate_valid_history_t *h)
+GYRO_RAMFUNC void rate_valid_count_onsets(rate_valid_t *restrict rv, rate_valid_history_t *h)
 {
   /* Only the bits that are set (usually one). */
   uint32_t onsets = rv->onsets_pending;
@@ -108,9 +107,9 @@ GYRO_RAMFUNC void rate_valid_count_onsets(rate_valid_t *rv, rate_valid_history_t
   }
 }
 
-GYRO_RAMFUNC void rate_valid_drive(rate_valid_t *rv, float phase_err_rad, float quad_dps, float sense_v2)
+GYRO_RAMFUNC void rate_valid_drive(const rate_valid_cfg_t *restrict c, rate_valid_t *restrict rv,
+                                   float phase_err_rad, float quad_dps, float sense_v2)
 {
-  const rate_valid_cfg_t *c = &rv->cfg;
   /* The lock tolerance on the 100 Hz error; the quadrature it rotates into the rate on
    * its lasting part. */
   rv->phase_err_lp_rad += RATE_VALID_PHASE_K * (phase_err_rad - rv->phase_err_lp_rad);

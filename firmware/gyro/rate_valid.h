@@ -4,7 +4,7 @@
  * when none of these reasons holds (each a bit of rate_valid_t.reasons, counted with the
  * step of its latest onset for `status`):
  *   MODE          the drive is not LOCKED (acquiring, sweeping, off, in a fault)
- *   SELFTEST      the self-test force is on the sense mode
+ *   SELFTEST      the self-test force is on the sense resonance
  *   SETTLING      the output filters have not settled since the last disturbance
  *                 (entering LOCKED, a change of the rate path's coefficients, the end
  *                 of a self-test, a rail code, a wrap of P): settled is measured, both
@@ -82,7 +82,6 @@ typedef struct {
 } rate_valid_cfg_t;
 
 typedef struct {
-  rate_valid_cfg_t cfg;
   uint32_t reasons;         /* RATE_INVALID_* of the latest verdict */
   uint32_t thermo;          /* RATE_INVALID_THERMO_* of the latest P update */
   uint32_t drive;           /* RATE_INVALID_PHASE, _SENSE_RANGE of the latest block */
@@ -109,10 +108,11 @@ typedef struct {
   uint32_t last_block[RATE_INVALID_KINDS]; /* block count of each reason's latest onset */
 } rate_valid_history_t;
 
-/* Returns 0, or -1 (nothing changed) for a bad configuration. */
-int rate_valid_init(rate_valid_t *rv, const rate_valid_cfg_t *cfg);
-/* New configuration; the running state is kept. */
-void rate_valid_retune(rate_valid_t *rv, const rate_valid_cfg_t *cfg);
+/* 1 when the configuration is one the monitors can run, else 0 (the designer checks). */
+int rate_valid_cfg_ok(const rate_valid_cfg_t *cfg);
+/* Start: not valid (MODE), nothing settled. Returns 0, or -1 (nothing changed) for a bad
+ * configuration. */
+int rate_valid_init(const rate_valid_cfg_t *cfg, rate_valid_t *rv);
 
 /* The filters must settle again before the rate is valid. */
 static inline void rate_valid_disturb(rate_valid_t *rv)
@@ -123,27 +123,28 @@ static inline void rate_valid_disturb(rate_valid_t *rv)
 
 /* Once per block, after both output filters ran: (rate_raw, quad_raw) their inputs,
  * (rate_unc_dps, quad_dps) their outputs, scale_dps the scale between the two. */
-void rate_valid_settling(rate_valid_t *rv, float rate_raw, float quad_raw, float rate_unc_dps,
-                         float quad_dps, float scale_dps);
+void rate_valid_settling(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float rate_raw,
+                         float quad_raw, float rate_unc_dps, float quad_dps, float scale_dps);
 
 /* At each new P_f (rate_channel_update_p): p_dev_deg = P_f - p_ref; p_held_dev_deg and
  * p_held_w where P_f's fast start began and the weight that value still has in P_f;
  * quad_dps the quadrature output. */
-void rate_valid_thermo(rate_valid_t *rv, float p_dev_deg, float p_held_dev_deg, float p_held_w,
-                       float quad_dps);
+void rate_valid_thermo(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float p_dev_deg,
+                       float p_held_dev_deg, float p_held_w, float quad_dps);
 /* On a tick after rate_valid_thermo ended a slew window (slew_due): THERMO_SLEW from the
  * window's change of P_f (apart, so that no tick carries both). */
-void rate_valid_slew(rate_valid_t *rv, float quad_dps);
+void rate_valid_slew(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float quad_dps);
 
 /* Once per block, after the quadrature filter: the drive phase error as the supervisor
  * low-passed it, the quadrature output and the squared sense pickoff amplitude ->
  * PHASE, SENSE_RANGE. */
-void rate_valid_drive(rate_valid_t *rv, float phase_err_rad, float quad_dps, float sense_v2);
+void rate_valid_drive(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float phase_err_rad,
+                      float quad_dps, float sense_v2);
 
 /* Once per block, after the rate's output filter: OVER_RANGE. */
-static inline void rate_valid_range(rate_valid_t *rv, float rate_dps)
+static inline void rate_valid_range(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float rate_dps)
 {
-  rv->range = (rate_dps <= rv->cfg.full_scale_dps && rate_dps >= -rv->cfg.full_scale_dps)
+  rv->range = (rate_dps <= cfg->full_scale_dps && rate_dps >= -cfg->full_scale_dps)
                   ? 0u : RATE_INVALID_OVER_RANGE;
 }
 

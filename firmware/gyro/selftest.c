@@ -8,9 +8,8 @@
 
 /* The force formed every tick from the on-demand test's state and the continuous test's
  * modulation of the block. */
-GYRO_RAMFUNC static void set_force(selftest_t *st)
+GYRO_RAMFUNC static void set_force(const selftest_cfg_t *restrict c, selftest_t *restrict st)
 {
-  const selftest_cfg_t *c = &st->cfg;
   float a = st->state == SELFTEST_FORCE ? c->amp_v : 0.0f;
   if (c->cont_on != 0u) a += c->cont_amp_v * st->cont_c;
   st->a_c = a * c->ref_c;
@@ -29,30 +28,28 @@ static void cont_reset(selftest_t *st)
   st->cont_fail = 0u;
 }
 
-static void set_cfg(selftest_t *st, const selftest_cfg_t *cfg)
+void selftest_cfg_derive(selftest_cfg_t *cfg)
 {
-  st->cfg = *cfg;
-  st->inv_base = cfg->base_blocks != 0u ? 1.0f / (float)cfg->base_blocks : 0.0f;
-  st->inv_meas = cfg->meas_blocks != 0u ? 1.0f / (float)cfg->meas_blocks : 0.0f;
-  st->inv_expect = cfg->expect_dps != 0.0f ? 1.0f / cfg->expect_dps : 0.0f;
-  set_force(st);
+  cfg->inv_base = cfg->base_blocks != 0u ? 1.0f / (float)cfg->base_blocks : 0.0f;
+  cfg->inv_meas = cfg->meas_blocks != 0u ? 1.0f / (float)cfg->meas_blocks : 0.0f;
+  cfg->inv_expect = cfg->expect_dps != 0.0f ? 1.0f / cfg->expect_dps : 0.0f;
 }
 
-void selftest_init(selftest_t *st, const selftest_cfg_t *cfg)
+void selftest_init(const selftest_cfg_t *cfg, selftest_t *st)
 {
   st->state = SELFTEST_IDLE;
   cont_reset(st);
-  set_cfg(st, cfg);
+  set_force(cfg, st);
   st->count = 0u;
   st->acc_base = st->acc_meas = 0.0f;
   st->result_dps = 0.0f;
   st->runs = 0u;
 }
 
-void selftest_retune(selftest_t *st, const selftest_cfg_t *cfg)
+void selftest_reconfigure(const selftest_cfg_t *old, const selftest_cfg_t *cfg, selftest_t *st)
 {
-  if (cfg->cont_on != st->cfg.cont_on || cfg->cont_step != st->cfg.cont_step) cont_reset(st);
-  set_cfg(st, cfg);
+  if (cfg->cont_on != old->cont_on || cfg->cont_step != old->cont_step) cont_reset(st);
+  set_force(cfg, st);
 }
 
 void selftest_start(selftest_t *st)
@@ -63,27 +60,27 @@ void selftest_start(selftest_t *st)
   st->state = SELFTEST_BASE;
   st->count = 0u;
   st->acc_base = st->acc_meas = 0.0f;
-  set_force(st);
+  /* The force is the one it was (the test's own comes on with SELFTEST_FORCE). */
 }
 
-GYRO_RAMFUNC void selftest_update(selftest_t *st, int locked, float rate_raw)
+GYRO_RAMFUNC void selftest_update(const selftest_cfg_t *restrict c, selftest_t *restrict st,
+                                  int locked, float rate_raw)
 {
   if (!selftest_running(st)) {
     return;
   }
   if (!locked) {
     st->state = SELFTEST_ABORTED;
-    set_force(st);
+    set_force(c, st);
     return;
   }
-  const selftest_cfg_t *c = &st->cfg;
   st->count++;
   if (st->state == SELFTEST_BASE) {
     st->acc_base += rate_raw;
     if (st->count >= c->base_blocks) {
       st->state = SELFTEST_FORCE;
       st->count = 0u;
-      set_force(st);
+      set_force(c, st);
     }
     return;
   }
@@ -91,27 +88,27 @@ GYRO_RAMFUNC void selftest_update(selftest_t *st, int locked, float rate_raw)
     st->acc_meas += rate_raw;
   }
   if (st->count >= c->settle_blocks + c->meas_blocks) {
-    const float base = st->acc_base * st->inv_base;
-    const float meas = st->acc_meas * st->inv_meas;
+    const float base = st->acc_base * c->inv_base;
+    const float meas = st->acc_meas * c->inv_meas;
     st->result_dps = (meas - base) * c->scale_dps;
-    const float e = c->expect_dps != 0.0f ? fm_absf(st->result_dps * st->inv_expect - 1.0f) : 1.0f;
+    const float e = c->expect_dps != 0.0f ? fm_absf(st->result_dps * c->inv_expect - 1.0f) : 1.0f;
     st->state = e <= c->tol_rel ? SELFTEST_PASS : SELFTEST_FAIL;
     st->runs++;
-    set_force(st);
+    set_force(c, st);
   }
 }
 
-GYRO_RAMFUNC void selftest_cont_advance(selftest_t *st)
+GYRO_RAMFUNC void selftest_cont_advance(const selftest_cfg_t *restrict c, selftest_t *restrict st)
 {
-  if (st->cfg.cont_on == 0u) return;
-  st->cont_phase += st->cfg.cont_step;
+  if (c->cont_on == 0u) return;
+  st->cont_phase += c->cont_step;
   sincos_lut(st->cont_phase, &st->cont_s, &st->cont_c);
-  set_force(st);
+  set_force(c, st);
 }
 
-GYRO_RAMFUNC uint32_t selftest_cont_judge(selftest_t *st, int locked)
+GYRO_RAMFUNC uint32_t selftest_cont_judge(const selftest_cfg_t *restrict c, selftest_t *restrict st,
+                                          int locked)
 {
-  const selftest_cfg_t *c = &st->cfg;
   if (c->cont_on == 0u || !locked) {
     st->cont_blocks = 0u;
     st->cont_fail = 0u;
@@ -122,7 +119,7 @@ GYRO_RAMFUNC uint32_t selftest_cont_judge(selftest_t *st, int locked)
     return st->cont_fail;
   }
   /* The rate axis only: the force's feedthrough into the sense pickoff (a voltage with
-   * no mode response) lands mostly on the quadrature axis, and a test of the rate path
+   * no response of the resonance) lands mostly on the quadrature axis, and a test of the rate path
    * is what the rate's validity needs. A rate (DC at the notch's input) makes the weights
    * ripple at f_m by mu x rate / (2 pi f_m / f_block), as large as the response itself
    * at full scale: their 2 Hz low-pass takes it out (-42 dB at 250 Hz). */

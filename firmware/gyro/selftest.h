@@ -1,4 +1,4 @@
-/* Built-in self-test: a known force on the sense mode through the sense feedback
+/* Built-in self-test: a known force on the sense resonance through the sense feedback
  * electrodes (spare DAC channel), and a check that the rate channel answers it as it
  * did when the part was calibrated, as commercial gyros do at power-on or on command.
  *
@@ -7,7 +7,7 @@
  * lands on the rate axis of the calibrated demodulation: u = A cos(phi + theta_set),
  * with the differential electrodes' force 4 Ks_fb V_bias u. The test runs only while
  * LOCKED: a baseline of the unfiltered rate over BASE blocks, then the force, SETTLE
- * blocks for the sense mode and the output path, the response over MEAS blocks, and the
+ * blocks for the sense resonance and the output path, the response over MEAS blocks, and the
  * force off. A block is the rate channel's (RATE_DECIM ticks): the sequence advances
  * once per block on the block's unfiltered rate (selftest_update), while the force is a
  * carrier and is formed every tick (selftest_force). Pass: |response / expected - 1| <=
@@ -17,7 +17,7 @@
  * carrier force, amplitude-modulated at cont_freq, well above the rate's output band:
  *     u = A_c cos(2 pi f_m t) cos(phi + theta_set)
  * Demodulated, its response is a tone at f_m on the block's rate and quadrature (the
- * sense mode answers the two sidebands wc +- 2 pi f_m a little differently, hence some
+ * sense resonance answers the two sidebands wc +- 2 pi f_m a little differently, hence some
  * on both axes). A two-weight LMS per axis at f_m (the LMS demodulator of (5-5), at the
  * block rate) measures the tone and subtracts it before the output filters: an adaptive
  * notch, so that no tone is left in the output (the 100 Hz Butterworth alone leaves
@@ -60,18 +60,18 @@ typedef struct {
   float ref_c, ref_s; /* cos, sin of the drive phase setpoint */
   float scale_dps;   /* rate channel scale: deg/s per unit of the unfiltered rate */
   uint32_t base_blocks, settle_blocks, meas_blocks;
+  /* Derived (selftest_cfg_derive): 1 / base_blocks, 1 / meas_blocks, 1 / expect_dps (0
+   * where the divisor is 0), so that the verdict's block divides nothing (its tick's
+   * budget). */
+  float inv_base, inv_meas, inv_expect;
 } selftest_cfg_t;
 
 typedef struct {
-  selftest_cfg_t cfg;
   uint32_t state;    /* selftest_state_t */
   uint32_t count;     /* blocks in the current state */
   float acc_base, acc_meas; /* sums of the unfiltered rate */
   float result_dps;  /* measured response of the last test */
   uint32_t runs;
-  /* 1 / base_blocks, 1 / meas_blocks, 1 / expect_dps (0 where the divisor is 0), set with
-   * the configuration: the verdict block divides nothing (its tick's budget). */
-  float inv_base, inv_meas, inv_expect;
   /* The force formed every tick: a_c cos(phi) - a_s sin(phi), set once per block. */
   uint32_t force_on;
   float a_c, a_s;
@@ -84,14 +84,18 @@ typedef struct {
   uint32_t cont_fail;    /* the response is judged and out of its band */
 } selftest_t;
 
-void selftest_init(selftest_t *st, const selftest_cfg_t *cfg);
-/* Coefficients only (a running test carries on). */
-void selftest_retune(selftest_t *st, const selftest_cfg_t *cfg);
-/* Start a test (ignored while one runs). */
+/* The derived fields of cfg from the others (background). */
+void selftest_cfg_derive(selftest_cfg_t *cfg);
+void selftest_init(const selftest_cfg_t *cfg, selftest_t *st);
+/* A new configuration takes over from old (a design change): a running test carries on;
+ * the continuous test's LMS starts again when its tone changed or it was switched. */
+void selftest_reconfigure(const selftest_cfg_t *old, const selftest_cfg_t *cfg, selftest_t *st);
+/* Start a test (ignored while one runs). Its force comes on after the baseline
+ * (selftest_update). */
 void selftest_start(selftest_t *st);
 /* Once per block: locked = drive LOCKED, rate_raw = the rate channel's unfiltered
  * rate of the block. */
-void selftest_update(selftest_t *st, int locked, float rate_raw);
+void selftest_update(const selftest_cfg_t *cfg, selftest_t *st, int locked, float rate_raw);
 
 static inline int selftest_running(const selftest_t *st)
 {
@@ -110,9 +114,9 @@ static inline float selftest_force(const selftest_t *st, float sin_wc, float cos
 /* Once per block and axis (0 rate, 1 quadrature), on the block's projection (x, in
  * place) before its output filter: the continuous test's LMS measures its tone and takes
  * it out. Does nothing unless cont_on. Inline: it runs on ticks near their budget. */
-static inline void selftest_cont_notch(selftest_t *st, uint32_t axis, float *x)
+static inline void selftest_cont_notch(const selftest_cfg_t *restrict c, selftest_t *restrict st,
+                                       uint32_t axis, float *x)
 {
-  const selftest_cfg_t *c = &st->cfg;
   if (c->cont_on == 0u) return;
   /* (5-5) at f_m: the weights' phasor is the tone; the error is the notched signal. */
   const float mc = st->cont_c, ms = st->cont_s, mu = c->cont_mu;
@@ -127,10 +131,10 @@ static inline void selftest_cont_notch(selftest_t *st, uint32_t axis, float *x)
   *x = e * c->cont_gain;
 }
 /* Once per block, after both axes' notch: the next block's modulation and force. */
-void selftest_cont_advance(selftest_t *st);
+void selftest_cont_advance(const selftest_cfg_t *cfg, selftest_t *st);
 /* Once per block: judge the continuous test's response (locked: drive LOCKED; the
  * judgement restarts with the LMS when not). Returns cont_fail. */
-uint32_t selftest_cont_judge(selftest_t *st, int locked);
+uint32_t selftest_cont_judge(const selftest_cfg_t *cfg, selftest_t *st, int locked);
 
 const char *selftest_state_name(uint32_t state);
 

@@ -75,7 +75,7 @@ static double rate_rms(double s, double *mean_out)
 static double cont_response_dps(int axis)
 {
   const float *w = app.gyro.selftest.w + 2 * axis;
-  return sqrt((double)(w[0] * w[0] + w[1] * w[1])) * fabs((double)app.gyro.rate.scale_dps);
+  return sqrt((double)(w[0] * w[0] + w[1] * w[1])) * fabs((double)app.gyro.design->rate.scale_dps);
 }
 
 static void test_continuous_healthy(void **state)
@@ -120,7 +120,7 @@ static void test_continuous_keeps_scale(void **state)
     run_s(1.0);
     (void)rate_rms(2.0, &m[on]);
     resp[on] = hypot((double)app.gyro.selftest.w_avg[0], (double)app.gyro.selftest.w_avg[1]) *
-               fabs((double)app.gyro.rate.scale_dps);
+               fabs((double)app.gyro.design->rate.scale_dps);
   }
   printf("# at 100 deg/s: output %.5f off / %.5f on, judged response %.4f deg/s\n", m[0], m[1],
          resp[1]);

@@ -45,17 +45,17 @@ static void test_set_applies_at_tick(void **state)
   (void)state;
   setup_app();
   hal_host_run(10u);
-  const float before = app.gyro.drive.amp_target_v;
+  const float before = app.gyro.design->drive.amp_set_v;
   assert_true(strncmp(cmd("set drive.amp_set_v 2.5\n"), "ok", 2) == 0);
-  assert_true(app.gyro.drive.amp_target_v == before);
+  assert_true(app.gyro.design->drive.amp_set_v == before);
   hal_host_run(1u);
-  assert_true(app.gyro.drive.amp_target_v == 2.5f); /* the loop's setpoint slews to it */
+  assert_true(app.gyro.design->drive.amp_set_v == 2.5f); /* the loop's setpoint slews to it */
   assert_int_equal(app.gyro.sup.fault_count, 0u);
   /* Designed gains follow a new model: doubling the identified gain halves Kp. */
-  const float kp = app.gyro.drive.amp_pi.kp;
+  const float kp = app.gyro.design->drive.amp.kp;
   assert_true(strncmp(cmd("set drive.cal_gain_v_per_v2 0.01092\n"), "ok", 2) == 0);
   hal_host_run(1u);
-  assert_true(fabsf(app.gyro.drive.amp_pi.kp - 0.5f * kp) < 1e-6f * kp);
+  assert_true(fabsf(app.gyro.design->drive.amp.kp - 0.5f * kp) < 1e-6f * kp);
 }
 
 /* drive off / on through the command line, and status reports the mode. */
@@ -117,7 +117,7 @@ static void test_save_and_restart(void **state)
   assert_int_equal(app_init(&app), 0);
   assert_int_equal(app.store_status, PARAM_STORE_OK);
   assert_true(params_current(&app.params)->rate_bias_c0_dps == 1.25f);
-  assert_true(app.gyro.rate.bias_c_dps[0] == 1.25f);
+  assert_true(app.gyro.design->rate.bias_c_dps[0] == 1.25f);
 }
 
 /* The ISR counts its ticks; its cycles come from the HAL, which measures the whole

@@ -94,6 +94,19 @@ static void env_step(env_plant_t *p, double f, double p_rad)
 /* Small steps (no saturation): amplitude and phase errors decay as the designed
  * first-order closed loop, e^{-wc t}, to a few per cent of the step (the LMSD lag is
  * not in this model, so the response is the ideal one). */
+/* The configuration the loops under test run with (derived by dl_init). */
+static drive_loop_cfg_t s_cfg;
+
+/* Derive c and start dl with it; -1 (nothing changed) for a bad configuration. */
+static int dl_init(drive_loop_t *dl, const drive_loop_cfg_t *c)
+{
+  drive_loop_cfg_t t = *c;
+  if (drive_loop_cfg_derive(&t) != 0) return -1;
+  s_cfg = t;
+  drive_loop_init(&s_cfg, dl);
+  return 0;
+}
+
 /* Loops from the amplitude and phase designs, run every dt_s, starting in equilibrium
  * with the envelope plant (1.9 V at phase 0.3 rad, force matching) and then asked for
  * 2.0 V and 0.35 rad. */
@@ -106,12 +119,12 @@ static void loop_at_equilibrium(drive_loop_t *dl, env_plant_t *p,
                         .amp_kp = (float)amp->kp, .amp_ki = (float)amp->ki,
                         .phase_kp = (float)ph->kp, .phase_ki = (float)ph->ki,
                         .f_cmd_max_v2 = 196.0f, .p_init_rad = 0.3f};
-  assert_int_equal(drive_loop_init(dl, &c), 0);
+  assert_int_equal(dl_init(dl, &c), 0);
   const env_plant_t p0 = {1.9 * cos(0.3), 1.9 * sin(0.3), exp(-1.0 / (fs * tau)), k};
   *p = p0;
   dl->amp_pi.u = (float)(1.9 / k);
   dl->f_cmd_v2 = dl->amp_pi.u;
-  dl->phase_set_rad = 0.35f;
+  s_cfg.phase_set_rad = 0.35f; /* a setpoint step */
 }
 
 static void test_closed_loop_first_order(void **state)
@@ -131,7 +144,7 @@ static void test_closed_loop_first_order(void **state)
   const double wc = 2.0 * M_PI * bw;
   double max_amp = 0.0;
   for (int n = 1; n <= 10000; n++) {
-    drive_loop_step(&dl, (float)p.zr, (float)p.zi);
+    drive_loop_step(&s_cfg, &dl, (float)p.zr, (float)p.zi);
     env_step(&p, dl.f_cmd_v2, dl.p_rad);
     const double t = n / fs;
     const double a = hypot(p.zr, p.zi), ph_now = atan2(p.zi, p.zr);
@@ -162,13 +175,13 @@ static void test_startup_no_overshoot(void **state)
                         .phase_kp = (float)ph.kp, .phase_ki = (float)ph.ki,
                         .f_cmd_max_v2 = 80.0f, .p_init_rad = 0.0f}; /* 2.5 V at the limit */
   drive_loop_t dl;
-  assert_int_equal(drive_loop_init(&dl, &c), 0);
+  assert_int_equal(dl_init(&dl, &c), 0);
   env_plant_t p = {1e-4, 0.0, exp(-1.0 / (fs * tau)), k};
   double max_amp = 0.0;
   int saturated = 0;
   double t_in = -1.0;
   for (int n = 1; n <= 20000; n++) {
-    drive_loop_step(&dl, (float)p.zr, (float)p.zi);
+    drive_loop_step(&s_cfg, &dl, (float)p.zr, (float)p.zi);
     saturated |= dl.f_cmd_v2 >= 80.0f;
     env_step(&p, dl.f_cmd_v2, dl.p_rad);
     const double a = hypot(p.zr, p.zi);
@@ -213,8 +226,8 @@ static void test_block_schedule(void **state)
     const float zs = (float)p.zr, zc = (float)p.zi;
     double f_dac = f_set, p_dac = p_set; /* this tick's DAC frame */
     if (slot == 0) drive_loop_measure_phase(&dl, zs, zc);
-    if (slot == 1) drive_loop_update_phase(&dl);
-    if (slot == 2) drive_loop_step_amp(&dl, zs, zc);
+    if (slot == 1) drive_loop_update_phase(&s_cfg, &dl);
+    if (slot == 2) drive_loop_step_amp(&s_cfg, &dl, zs, zc);
     if (slot == 3) { /* after the frame: from the next tick's on */
       f_set = dl.f_cmd_v2;
       p_set = dl.p_rad;
@@ -239,13 +252,13 @@ static void test_bad_cfg(void **state)
   (void)state;
   drive_loop_t dl = {.amp_set_v = 5.0f};
   drive_loop_cfg_t c = {.dt_s = 2e-5f, .amp_set_v = 0.0f, .f_cmd_max_v2 = 100.0f};
-  assert_int_equal(drive_loop_init(&dl, &c), -1);
+  assert_int_equal(dl_init(&dl, &c), -1);
   c.amp_set_v = 1.0f;
   c.amp_kp = NAN;
-  assert_int_equal(drive_loop_init(&dl, &c), -1);
+  assert_int_equal(dl_init(&dl, &c), -1);
   c.amp_kp = 1.0f;
   c.p_init_rad = 10.0f;
-  assert_int_equal(drive_loop_init(&dl, &c), -1);
+  assert_int_equal(dl_init(&dl, &c), -1);
   assert_true(dl.amp_set_v == 5.0f);
 }
 

@@ -10,10 +10,10 @@
 
 /* (6-7) with (6-18..6-21): U1^2 - U2^2 = f cos(phi + P) for both schemes, at every
  * sample of a run of the real NCO through accumulator wraps. */
-static void check_force(gyro_drive_mode_t mode)
+static void check_force(gyro_drive_scheme_t scheme)
 {
   drive_synth_t ds;
-  drive_synth_cfg_t c = {.mode = mode, .dc_bias_v = 7.0f, .u_max_v = 14.0f};
+  drive_synth_cfg_t c = {.scheme = scheme, .dc_bias_v = 7.0f, .u_max_v = 14.0f};
   assert_int_equal(drive_synth_init(&ds, &c), 0);
   nco_t nco;
   nco_cfg_t nc = {.freq_hz = 1489.9, .fs_hz = 50000.0, .phase_rad = 0.0};
@@ -37,12 +37,16 @@ static void check_force(gyro_drive_mode_t mode)
   }
   assert_true(max_err < 64.0 * 2e-5);
   /* Continuity: no step larger than one sample's advance of the waveform. */
-  const double slope = (mode == GYRO_DRIVE_DC_AC ? 2.0 * M_PI * 1489.9 * 64.0 / 28.0
+  const double slope = (scheme == GYRO_DRIVE_DC_AC ? 2.0 * M_PI * 1489.9 * 64.0 / 28.0
                                                  : M_PI * 1489.9 * 8.0) / 50000.0;
   assert_true(max_jump < 1.05 * slope);
 }
 
-static void test_half_frequency_force(void **state) { (void)state; check_force(GYRO_DRIVE_HALF_FREQ); }
+static void test_half_frequency_force(void **state)
+{
+  (void)state;
+  check_force(GYRO_DRIVE_HALF_FREQ);
+}
 static void test_dc_ac_force(void **state) { (void)state; check_force(GYRO_DRIVE_DC_AC); }
 
 /* Largest force each scheme can make within +-u_max on both electrodes. */
@@ -50,10 +54,10 @@ static void test_limits(void **state)
 {
   (void)state;
   drive_synth_t ds;
-  drive_synth_cfg_t c = {.mode = GYRO_DRIVE_HALF_FREQ, .dc_bias_v = 0.0f, .u_max_v = 14.0f};
+  drive_synth_cfg_t c = {.scheme = GYRO_DRIVE_HALF_FREQ, .dc_bias_v = 0.0f, .u_max_v = 14.0f};
   assert_int_equal(drive_synth_init(&ds, &c), 0);
   assert_true(fabsf(drive_synth_f_cmd_max(&ds) - 196.0f) < 1e-4f);
-  c.mode = GYRO_DRIVE_DC_AC;
+  c.scheme = GYRO_DRIVE_DC_AC;
   c.dc_bias_v = 7.0f;
   assert_int_equal(drive_synth_init(&ds, &c), 0);
   assert_true(fabsf(drive_synth_f_cmd_max(&ds) - 196.0f) < 1e-4f);
@@ -63,7 +67,7 @@ static void test_limits(void **state)
   assert_true(u1 <= 14.0f + 1e-4f && u2 >= -1e-4f);
   c.dc_bias_v = 14.0f; /* no room for AC */
   assert_int_equal(drive_synth_init(&ds, &c), -1);
-  c.mode = (gyro_drive_mode_t)7;
+  c.scheme = (gyro_drive_scheme_t)7;
   assert_int_equal(drive_synth_init(&ds, &c), -1);
 }
 
@@ -72,11 +76,11 @@ static void test_limits(void **state)
 static void test_non_finite_command(void **state)
 {
   (void)state;
-  const gyro_drive_mode_t modes[] = {GYRO_DRIVE_HALF_FREQ, GYRO_DRIVE_DC_AC};
+  const gyro_drive_scheme_t schemes[] = {GYRO_DRIVE_HALF_FREQ, GYRO_DRIVE_DC_AC};
   const float bad[] = {NAN, INFINITY, -INFINITY};
   for (int m = 0; m < 2; m++) {
     drive_synth_t ds;
-    drive_synth_cfg_t c = {.mode = modes[m], .dc_bias_v = 7.0f, .u_max_v = 14.0f};
+    drive_synth_cfg_t c = {.scheme = schemes[m], .dc_bias_v = 7.0f, .u_max_v = 14.0f};
     assert_int_equal(drive_synth_init(&ds, &c), 0);
     for (int i = 0; i < 3; i++) {
       for (int j = 0; j < 3; j++) {
@@ -84,7 +88,7 @@ static void test_non_finite_command(void **state)
         for (uint32_t ph = 0u; ph < 0xF0000000u; ph += 0x10000000u) {
           float u1, u2;
           drive_synth_step(&ds, ph, ph / 2u, &u1, &u2);
-          const float rest = modes[m] == GYRO_DRIVE_DC_AC ? 7.0f : 0.0f;
+          const float rest = schemes[m] == GYRO_DRIVE_DC_AC ? 7.0f : 0.0f;
           assert_true(u1 == rest && u2 == rest);
         }
         drive_synth_set(&ds, 64.0f, bad[i]); /* finite force, bad phase: bounded */

@@ -10,6 +10,58 @@
 
 #include "dsp/pi.h"
 
+/* A controller under test: the configuration it was designed from, the coefficients
+ * the step uses and its state. A change of gains or limits is a new design whose
+ * coefficients take over from the state as it is (the sample path's design change). */
+typedef struct {
+  pi_cfg_t cfg;
+  pi_coeffs_t c;
+  pi_t s;
+} tpi_t;
+
+static int t_init(tpi_t *p, const pi_cfg_t *cfg)
+{
+  if (p == NULL) return pi_init(cfg, NULL, NULL);
+  if (pi_init(cfg, &p->c, &p->s) != 0) return -1;
+  p->cfg = *cfg;
+  return 0;
+}
+
+static float t_step(tpi_t *p, float e) { return pi_step(&p->c, &p->s, e); }
+
+static int t_reset(tpi_t *p, float u, float e_prev)
+{
+  return p == NULL ? pi_reset(NULL, NULL, u, e_prev) : pi_reset(&p->c, &p->s, u, e_prev);
+}
+
+/* A design with the new values (nothing changes when it is rejected), then its
+ * coefficients take over. */
+static int t_redesign(tpi_t *p, pi_cfg_t c)
+{
+  c.u_init = c.u_min;
+  if (pi_design(&c, &p->c) != 0) return -1;
+  p->cfg = c;
+  pi_limit(&p->c, &p->s);
+  return 0;
+}
+
+static int t_set_gains(tpi_t *p, float kp, float ki)
+{
+  if (p == NULL) return -1;
+  pi_cfg_t c = p->cfg;
+  c.kp = kp;
+  c.ki = ki;
+  return t_redesign(p, c);
+}
+
+static int t_set_limits(tpi_t *p, float u_min, float u_max)
+{
+  pi_cfg_t c = p->cfg;
+  c.u_min = u_min;
+  c.u_max = u_max;
+  return t_redesign(p, c);
+}
+
 static pi_cfg_t cfg_default(void)
 {
   return (pi_cfg_t){.kp = 0.5f, .ki = 200.0f, .dt_s = 1.0f / 50000.0f, .u_min = -10.0f,
@@ -22,13 +74,13 @@ static pi_cfg_t cfg_default(void)
 static void test_step_response_analytic(void **state)
 {
   (void)state;
-  pi_t pi;
+  tpi_t pi;
   pi_cfg_t c = cfg_default();
   c.u_init = 0.25f;
-  assert_int_equal(pi_init(&pi, &c), 0);
+  assert_int_equal(t_init(&pi, &c), 0);
   const double e = 0.01, kp = 0.5, kit = 200.0 / 50000.0;
   for (int k = 0; k < 2000; k++) {
-    const double u = (double)pi_step(&pi, (float)e);
+    const double u = (double)t_step(&pi, (float)e);
     const double expect = 0.25 + kp * e + kit * e * k;
     assert_true(fabs(u - expect) < (1e-6 + 1e-7 * (k + 1)) * fabs(expect));
   }
@@ -38,14 +90,14 @@ static void test_step_response_analytic(void **state)
 static void test_ramp_response_analytic(void **state)
 {
   (void)state;
-  pi_t pi;
+  tpi_t pi;
   pi_cfg_t c = cfg_default();
   c.u_min = -1000.0f;
   c.u_max = 1000.0f;
-  assert_int_equal(pi_init(&pi, &c), 0);
+  assert_int_equal(t_init(&pi, &c), 0);
   const double r = 1e-4, kp = 0.5, kit = 200.0 / 50000.0;
   for (int k = 0; k < 3000; k++) {
-    const double u = (double)pi_step(&pi, (float)(r * k));
+    const double u = (double)t_step(&pi, (float)(r * k));
     const double expect = kp * r * k + kit * r * k * (k - 1) / 2.0;
     assert_true(fabs(u - expect) <= (1e-6 + 1e-7 * (k + 1)) * fabs(expect));
   }
@@ -57,17 +109,17 @@ static void test_ramp_response_analytic(void **state)
 static void test_thesis_example_coefficients(void **state)
 {
   (void)state;
-  pi_t pi;
+  tpi_t pi;
   const pi_cfg_t c = {.kp = 2e-5f, .ki = 5.7e-3f, .dt_s = 1.0f / 57000.0f, .u_min = -1.0f,
                       .u_max = 1.0f, .u_init = 0.0f};
-  assert_int_equal(pi_init(&pi, &c), 0);
+  assert_int_equal(t_init(&pi, &c), 0);
   /* b0 = Kp, b1 = Ki T - Kp */
-  assert_true(fabs((double)pi.kp - 2e-5) < 2e-5 * 1e-6);
-  assert_true(fabs(((double)pi.ki_t - (double)pi.kp) + 1.99e-5) < 1.99e-5 * 1e-6);
-  const double u0 = (double)pi_step(&pi, 1.0f);
+  assert_true(fabs((double)pi.c.kp - 2e-5) < 2e-5 * 1e-6);
+  assert_true(fabs(((double)pi.c.ki_t - (double)pi.c.kp) + 1.99e-5) < 1.99e-5 * 1e-6);
+  const double u0 = (double)t_step(&pi, 1.0f);
   assert_true(fabs(u0 - 2e-5) < 2e-5 * 1e-6);
   for (int k = 1; k < 10; k++) {
-    const double u = (double)pi_step(&pi, 0.0f);
+    const double u = (double)t_step(&pi, 0.0f);
     assert_true(fabs(u - 1e-7) < 1e-7 * 1e-5);
   }
 }
@@ -82,10 +134,10 @@ typedef struct {
 static int recovery_samples(int n_sat, loop_opts_t o)
 {
   const double a = 0.99, kplant = 1.0;
-  pi_t pi;
+  tpi_t pi;
   const pi_cfg_t c = {.kp = 0.5f, .ki = 5.0f, .dt_s = 1e-3f, .u_min = -1.0f, .u_max = 1.0f,
                       .u_init = 0.0f};
-  assert_int_equal(pi_init(&pi, &c), 0);
+  assert_int_equal(t_init(&pi, &c), 0);
   double y = 0.0, integ = 0.0;
   int inside_since = -1;
   for (int k = 0; k < n_sat + 60000; k++) {
@@ -96,7 +148,7 @@ static int recovery_samples(int n_sat, loop_opts_t o)
       u = fmin(1.0, fmax(-1.0, 0.5 * e + integ));
       integ += 5.0 * 1e-3 * e; /* (6-26b) integrator with no anti-windup */
     } else {
-      u = (double)pi_step(&pi, (float)e);
+      u = (double)t_step(&pi, (float)e);
       assert_true(u <= 1.0 && u >= -1.0);
     }
     y = a * y + (1.0 - a) * kplant * u;
@@ -135,18 +187,18 @@ static void test_anti_windup_recovery_independent_of_saturation_time(void **stat
 static void test_gain_change_is_bumpless(void **state)
 {
   (void)state;
-  pi_t pi;
-  assert_int_equal(pi_init(&pi, &(pi_cfg_t){cfg_default().kp, 200.0f, 1.0f / 50000.0f, -10.0f,
+  tpi_t pi;
+  assert_int_equal(t_init(&pi, &(pi_cfg_t){cfg_default().kp, 200.0f, 1.0f / 50000.0f, -10.0f,
                                             10.0f, 0.0f}),
                    0);
   const float e = 0.2f;
   float u = 0.0f;
   for (int k = 0; k < 100; k++) {
-    u = pi_step(&pi, e);
+    u = t_step(&pi, e);
   }
-  assert_int_equal(pi_set_gains(&pi, 5.0f, 400.0f), 0);
-  assert_true(pi_output(&pi) == u);
-  const float u_next = pi_step(&pi, e);
+  assert_int_equal(t_set_gains(&pi, 5.0f, 400.0f), 0);
+  assert_true(pi_output(&pi.s) == u);
+  const float u_next = t_step(&pi, e);
   const float expected_increment = 400.0f / 50000.0f * e; /* Ki T e(k-1), e(k-1) = e */
   assert_true(fabsf((u_next - u) - expected_increment) < 1e-6f);
   /* a positional PI would have jumped by (5 - 0.5) * 0.2 = 0.9 */
@@ -157,52 +209,52 @@ static void test_gain_change_is_bumpless(void **state)
 static void test_reset_to_output(void **state)
 {
   (void)state;
-  pi_t pi;
+  tpi_t pi;
   pi_cfg_t c = cfg_default();
-  assert_int_equal(pi_init(&pi, &c), 0);
+  assert_int_equal(t_init(&pi, &c), 0);
   for (int k = 0; k < 50; k++) {
-    (void)pi_step(&pi, 0.3f);
+    (void)t_step(&pi, 0.3f);
   }
-  assert_int_equal(pi_reset(&pi, 2.5f, 0.1f), 0);
-  assert_true(pi_output(&pi) == 2.5f);
-  const float u = pi_step(&pi, 0.1f);
+  assert_int_equal(t_reset(&pi, 2.5f, 0.1f), 0);
+  assert_true(pi_output(&pi.s) == 2.5f);
+  const float u = t_step(&pi, 0.1f);
   assert_true(fabsf(u - (2.5f + 200.0f / 50000.0f * 0.1f)) < 1e-6f); /* integral term only */
   /* a reset outside the limits is clamped into them */
-  assert_int_equal(pi_reset(&pi, 50.0f, 0.0f), 0);
-  assert_true(pi_output(&pi) == 10.0f);
-  const pi_t before = pi;
-  assert_int_equal(pi_reset(&pi, NAN, 0.0f), -1);
-  assert_int_equal(pi_reset(&pi, 0.0f, INFINITY), -1);
-  assert_int_equal(pi_reset(NULL, 0.0f, 0.0f), -1);
+  assert_int_equal(t_reset(&pi, 50.0f, 0.0f), 0);
+  assert_true(pi_output(&pi.s) == 10.0f);
+  const tpi_t before = pi;
+  assert_int_equal(t_reset(&pi, NAN, 0.0f), -1);
+  assert_int_equal(t_reset(&pi, 0.0f, INFINITY), -1);
+  assert_int_equal(t_reset(NULL, 0.0f, 0.0f), -1);
   assert_memory_equal(&pi, &before, sizeof pi);
 }
 
 static void test_limits_hold_and_change(void **state)
 {
   (void)state;
-  pi_t pi;
-  assert_int_equal(pi_init(&pi, &(pi_cfg_t){0.5f, 200.0f, 1e-3f, -1.0f, 2.0f, 0.0f}), 0);
+  tpi_t pi;
+  assert_int_equal(t_init(&pi, &(pi_cfg_t){0.5f, 200.0f, 1e-3f, -1.0f, 2.0f, 0.0f}), 0);
   for (int k = 0; k < 1000; k++) {
-    const float u = pi_step(&pi, (k < 500) ? 100.0f : -100.0f);
+    const float u = t_step(&pi, (k < 500) ? 100.0f : -100.0f);
     assert_true(u <= 2.0f && u >= -1.0f);
   }
-  assert_true(pi_output(&pi) == -1.0f);
-  assert_int_equal(pi_set_limits(&pi, -0.5f, 0.5f), 0);
-  assert_true(pi_output(&pi) == -0.5f);
-  const pi_t before = pi;
-  assert_int_equal(pi_set_limits(&pi, 1.0f, 1.0f), -1);
-  assert_int_equal(pi_set_limits(&pi, 1.0f, -1.0f), -1);
-  assert_int_equal(pi_set_limits(&pi, NAN, 1.0f), -1);
-  assert_int_equal(pi_set_limits(&pi, -INFINITY, 1.0f), -1);
+  assert_true(pi_output(&pi.s) == -1.0f);
+  assert_int_equal(t_set_limits(&pi, -0.5f, 0.5f), 0);
+  assert_true(pi_output(&pi.s) == -0.5f);
+  const tpi_t before = pi;
+  assert_int_equal(t_set_limits(&pi, 1.0f, 1.0f), -1);
+  assert_int_equal(t_set_limits(&pi, 1.0f, -1.0f), -1);
+  assert_int_equal(t_set_limits(&pi, NAN, 1.0f), -1);
+  assert_int_equal(t_set_limits(&pi, -INFINITY, 1.0f), -1);
   assert_memory_equal(&pi, &before, sizeof pi);
 }
 
 static void test_bad_config_rejected_unchanged(void **state)
 {
   (void)state;
-  pi_t pi;
+  tpi_t pi;
   memset(&pi, 0x77, sizeof pi);
-  const pi_t sentinel = pi;
+  const tpi_t sentinel = pi;
   pi_cfg_t bad[12];
   for (size_t i = 0; i < 12; i++) {
     bad[i] = cfg_default();
@@ -221,20 +273,20 @@ static void test_bad_config_rejected_unchanged(void **state)
   bad[10].dt_s = 100.0f; /* Ki T overflows */
   bad[11].u_min = -INFINITY;
   for (size_t i = 0; i < 12; i++) {
-    assert_int_equal(pi_init(&pi, &bad[i]), -1);
+    assert_int_equal(t_init(&pi, &bad[i]), -1);
     assert_memory_equal(&pi, &sentinel, sizeof pi);
   }
-  assert_int_equal(pi_init(&pi, NULL), -1);
+  assert_int_equal(t_init(&pi, NULL), -1);
   pi_cfg_t good_cfg = cfg_default();
-  assert_int_equal(pi_init(NULL, &good_cfg), -1);
+  assert_int_equal(t_init(NULL, &good_cfg), -1);
   assert_memory_equal(&pi, &sentinel, sizeof pi);
 
-  assert_int_equal(pi_init(&pi, &good_cfg), 0);
-  (void)pi_step(&pi, 1.0f);
-  const pi_t good = pi;
-  assert_int_equal(pi_set_gains(&pi, NAN, 1.0f), -1);
-  assert_int_equal(pi_set_gains(&pi, 1.0f, -INFINITY), -1);
-  assert_int_equal(pi_set_gains(NULL, 1.0f, 1.0f), -1);
+  assert_int_equal(t_init(&pi, &good_cfg), 0);
+  (void)t_step(&pi, 1.0f);
+  const tpi_t good = pi;
+  assert_int_equal(t_set_gains(&pi, NAN, 1.0f), -1);
+  assert_int_equal(t_set_gains(&pi, 1.0f, -INFINITY), -1);
+  assert_int_equal(t_set_gains(NULL, 1.0f, 1.0f), -1);
   assert_memory_equal(&pi, &good, sizeof pi);
 }
 

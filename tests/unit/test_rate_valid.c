@@ -26,20 +26,29 @@ static rate_valid_cfg_t cfg(void)
 
 static rate_valid_t rv;
 static rate_valid_history_t hist;
+/* The configuration the monitors under test run with. */
+static rate_valid_cfg_t s_cfg;
+
+static int rv_init(rate_valid_t *v, const rate_valid_cfg_t *c)
+{
+  const int r = rate_valid_init(c, v);
+  if (r == 0) s_cfg = *c;
+  return r;
+}
 
 /* LOCKED and settled on quiet evidence; returns the verdict. */
 static uint32_t settle(void)
 {
   const rate_valid_cfg_t c = cfg();
-  assert_int_equal(rate_valid_init(&rv, &c), 0);
+  assert_int_equal(rv_init(&rv, &c), 0);
   hist = (rate_valid_history_t){{0u}, {0u}};
   uint32_t r = 0u;
   /* The inputs' low-pass (0.2 per block) reaches 1500 deg/s within 0.25 after about 40
    * blocks; then RATE_VALID_SETTLE_BLOCKS inside. */
   for (int i = 0; i < 80; i++) {
-    rate_valid_settling(&rv, 0.0f, 10.0f, 0.0f, 1500.0f, 150.0f);
-    rate_valid_drive(&rv, 0.0f, 1500.0f, 1.0f);
-    rate_valid_range(&rv, 0.0f);
+    rate_valid_settling(&s_cfg, &rv, 0.0f, 10.0f, 0.0f, 1500.0f, 150.0f);
+    rate_valid_drive(&s_cfg, &rv, 0.0f, 1500.0f, 1.0f);
+    rate_valid_range(&s_cfg, &rv, 0.0f);
     r = rate_valid_verdict(&rv, 0u);
   }
   return r;
@@ -50,10 +59,10 @@ static void test_bad_cfg(void **state)
   (void)state;
   rate_valid_cfg_t c = cfg();
   c.tol_dps = 0.0f;
-  assert_int_equal(rate_valid_init(&rv, &c), -1);
+  assert_int_equal(rv_init(&rv, &c), -1);
   c = cfg();
   c.full_scale_dps = NAN;
-  assert_int_equal(rate_valid_init(&rv, &c), -1);
+  assert_int_equal(rv_init(&rv, &c), -1);
 }
 
 /* The output filters' settling is measured: outputs far from their inputs' low-pass keep
@@ -62,9 +71,9 @@ static void test_settling_measured(void **state)
 {
   (void)state;
   const rate_valid_cfg_t c = cfg();
-  assert_int_equal(rate_valid_init(&rv, &c), 0);
+  assert_int_equal(rv_init(&rv, &c), 0);
   for (int i = 0; i < 100; i++) {
-    rate_valid_settling(&rv, 0.0f, 10.0f, 0.0f, 700.0f, 150.0f); /* quad output lags */
+    rate_valid_settling(&s_cfg, &rv, 0.0f, 10.0f, 0.0f, 700.0f, 150.0f); /* quad output lags */
     assert_int_not_equal(rate_valid_verdict(&rv, 0u) & RATE_INVALID_SETTLING, 0u);
   }
   assert_int_equal(settle(), 0u);
@@ -76,12 +85,12 @@ static void test_over_range_and_sense(void **state)
 {
   (void)state;
   assert_int_equal(settle(), 0u);
-  rate_valid_range(&rv, -300.5f);
+  rate_valid_range(&s_cfg, &rv, -300.5f);
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_OVER_RANGE);
-  rate_valid_range(&rv, 299.0f);
-  rate_valid_drive(&rv, 0.0f, 1500.0f, 16.5f);
+  rate_valid_range(&s_cfg, &rv, 299.0f);
+  rate_valid_drive(&s_cfg, &rv, 0.0f, 1500.0f, 16.5f);
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_SENSE_RANGE);
-  rate_valid_range(&rv, NAN);
+  rate_valid_range(&s_cfg, &rv, NAN);
   assert_int_not_equal(rate_valid_verdict(&rv, 0u) & RATE_INVALID_OVER_RANGE, 0u);
 }
 
@@ -91,15 +100,16 @@ static void test_phase_leak(void **state)
 {
   (void)state;
   assert_int_equal(settle(), 0u);
-  for (int i = 0; i < 20000; i++) rate_valid_drive(&rv, 0.008f * 0.0174533f, 1500.0f, 1.0f);
+  for (int i = 0; i < 20000; i++) rate_valid_drive(&s_cfg, &rv, 0.008f * 0.0174533f, 1500.0f, 1.0f);
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
-  for (int i = 0; i < 20000; i++) rate_valid_drive(&rv, 0.0105f * 0.0174533f, 1500.0f, 1.0f);
+  for (int i = 0; i < 20000; i++)
+    rate_valid_drive(&s_cfg, &rv, 0.0105f * 0.0174533f, 1500.0f, 1.0f);
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_PHASE);
   /* Without quadrature the same error leaks nothing. */
-  for (int i = 0; i < 10; i++) rate_valid_drive(&rv, 0.0105f * 0.0174533f, 0.0f, 1.0f);
+  for (int i = 0; i < 10; i++) rate_valid_drive(&s_cfg, &rv, 0.0105f * 0.0174533f, 0.0f, 1.0f);
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   /* Beyond the lock tolerance, at once. */
-  rate_valid_drive(&rv, 0.02f, 0.0f, 1.0f);
+  rate_valid_drive(&s_cfg, &rv, 0.02f, 0.0f, 1.0f);
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_PHASE);
 }
 
@@ -109,11 +119,11 @@ static void test_thermo_settle_bound(void **state)
 {
   (void)state;
   assert_int_equal(settle(), 0u);
-  rate_valid_thermo(&rv, 1.0f, 0.0f, 0.02f, 1500.0f);
+  rate_valid_thermo(&s_cfg, &rv, 1.0f, 0.0f, 0.02f, 1500.0f);
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SETTLE);
-  rate_valid_thermo(&rv, 1.0f, 0.0f, 0.005f, 1500.0f);
+  rate_valid_thermo(&s_cfg, &rv, 1.0f, 0.0f, 0.005f, 1500.0f);
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
-  rate_valid_thermo(&rv, 9.0f, 9.0f, 0.0f, 1500.0f); /* out of the calibrated range */
+  rate_valid_thermo(&s_cfg, &rv, 9.0f, 9.0f, 0.0f, 1500.0f); /* out of the calibrated range */
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_RANGE);
 }
 
@@ -126,16 +136,16 @@ static void test_thermo_slew(void **state)
   float p = 0.0f;
   for (uint32_t i = 0; i < 3u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.004f / (float)RATE_VALID_SLEW_UPDATES; /* 0.04 deg/s, under the cap */
-    rate_valid_thermo(&rv, p, 0.0f, 0.0f, 0.0f);
-    if (rv.slew_due) rate_valid_slew(&rv, 0.0f);
+    rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f, 0.0f);
+    if (rv.slew_due) rate_valid_slew(&s_cfg, &rv, 0.0f);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.004f / (float)RATE_VALID_SLEW_UPDATES;
     /* 0.004 deg per 0.1 s leaves P_f 0.0064 deg behind: 0.33 deg/s of 3000 deg/s of
      * quadrature rotated into the rate, beyond the tolerance though under the cap. */
-    rate_valid_thermo(&rv, p, 0.0f, 0.0f, 3000.0f);
-    if (rv.slew_due) rate_valid_slew(&rv, 3000.0f);
+    rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f, 3000.0f);
+    if (rv.slew_due) rate_valid_slew(&s_cfg, &rv, 3000.0f);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
 }
@@ -145,11 +155,11 @@ static void test_onsets_counted(void **state)
   (void)state;
   assert_int_equal(settle(), 0u);
   for (int i = 0; i < 3; i++) {
-    rate_valid_range(&rv, 400.0f);
+    rate_valid_range(&s_cfg, &rv, 400.0f);
     (void)rate_valid_verdict(&rv, 0u);
     rate_valid_count_onsets(&rv, &hist);
     (void)rate_valid_verdict(&rv, 0u);
-    rate_valid_range(&rv, 0.0f);
+    rate_valid_range(&s_cfg, &rv, 0.0f);
     (void)rate_valid_verdict(&rv, 0u);
     rate_valid_count_onsets(&rv, &hist);
   }

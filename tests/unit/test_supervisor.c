@@ -17,6 +17,24 @@ static supervisor_cfg_t cfg(void)
   return c;
 }
 
+/* The configuration the supervisor under test runs with (sup_step passes it). */
+static supervisor_cfg_t s_cfg;
+
+/* Derive c and start sv with it; -1 (nothing changed) for a bad configuration. */
+static int sup_init(supervisor_t *sv, const supervisor_cfg_t *c)
+{
+  supervisor_cfg_t t = *c;
+  if (supervisor_cfg_derive(&t) != 0) return -1;
+  s_cfg = t;
+  supervisor_init(sv);
+  return 0;
+}
+
+static int sup_step(supervisor_t *sv, const supervisor_in_t *in)
+{
+  return supervisor_step(&s_cfg, sv, in);
+}
+
 static supervisor_in_t good(void)
 {
   supervisor_in_t in = {.amp_rel_err = 0.0f, .amp_rel = 1.0f, .phase_err_rad = 0.0f,
@@ -27,7 +45,7 @@ static supervisor_in_t good(void)
 
 static void run(supervisor_t *sv, const supervisor_in_t *in, int n)
 {
-  for (int i = 0; i < n; i++) (void)supervisor_step(sv, in);
+  for (int i = 0; i < n; i++) (void)sup_step(sv, in);
 }
 
 static void test_bad_cfg_rejected(void **state)
@@ -36,13 +54,13 @@ static void test_bad_cfg_rejected(void **state)
   supervisor_t sv = {.mode = GYRO_MODE_LOCKED, .fault_count = 77u};
   supervisor_cfg_t c = cfg();
   c.amp_trip_rel = 1.05f; /* inside the lost-lock band: could never see lost lock first */
-  assert_int_equal(supervisor_init(&sv, &c), -1);
+  assert_int_equal(sup_init(&sv, &c), -1);
   c = cfg();
   c.clip_max_count = 0u;
-  assert_int_equal(supervisor_init(&sv, &c), -1);
+  assert_int_equal(sup_init(&sv, &c), -1);
   c = cfg();
   c.dt_s = 0.0f;
-  assert_int_equal(supervisor_init(&sv, &c), -1);
+  assert_int_equal(sup_init(&sv, &c), -1);
   assert_int_equal(sv.mode, GYRO_MODE_LOCKED);
   assert_int_equal(sv.fault_count, 77u);
 }
@@ -54,7 +72,7 @@ static void test_lock_sequence(void **state)
   (void)state;
   supervisor_t sv;
   supervisor_cfg_t c = cfg();
-  assert_int_equal(supervisor_init(&sv, &c), 0);
+  assert_int_equal(sup_init(&sv, &c), 0);
   supervisor_in_t in = good();
   run(&sv, &in, 50);
   assert_int_equal(sv.mode, GYRO_MODE_OFF);
@@ -83,7 +101,7 @@ static void test_lost_lock_and_retry(void **state)
   (void)state;
   supervisor_t sv;
   supervisor_cfg_t c = cfg();
-  assert_int_equal(supervisor_init(&sv, &c), 0);
+  assert_int_equal(sup_init(&sv, &c), 0);
   supervisor_start(&sv);
   supervisor_in_t in = good();
   run(&sv, &in, 10);
@@ -92,11 +110,11 @@ static void test_lost_lock_and_retry(void **state)
   in.amp_rel = 0.8f;
   run(&sv, &in, 4);
   assert_int_equal(sv.mode, GYRO_MODE_LOCKED);
-  assert_int_equal(supervisor_step(&sv, &in), 1);
+  assert_int_equal(sup_step(&sv, &in), 1);
   assert_int_equal(sv.mode, GYRO_MODE_FAULT);
   assert_int_equal(sv.fault, GYRO_FAULT_LOST_LOCK);
   int cleared = 0;
-  for (int i = 0; i < 100; i++) cleared += supervisor_step(&sv, &in);
+  for (int i = 0; i < 100; i++) cleared += sup_step(&sv, &in);
   assert_int_equal(cleared, 1);
   assert_int_equal(sv.mode, GYRO_MODE_ACQUIRE);
   assert_int_equal(sv.fault_count, 1u);
@@ -109,23 +127,23 @@ static void test_immediate_faults(void **state)
   supervisor_cfg_t c = cfg();
   supervisor_in_t in;
 
-  assert_int_equal(supervisor_init(&sv, &c), 0);
+  assert_int_equal(sup_init(&sv, &c), 0);
   supervisor_start(&sv);
   in = good();
   in.amp_rel = 1.6f;
-  assert_int_equal(supervisor_step(&sv, &in), 1);
+  assert_int_equal(sup_step(&sv, &in), 1);
   assert_int_equal(sv.fault, GYRO_FAULT_OVER_AMP);
 
-  assert_int_equal(supervisor_init(&sv, &c), 0);
+  assert_int_equal(sup_init(&sv, &c), 0);
   supervisor_start(&sv);
   in = good();
   in.state_finite = 0;
-  assert_int_equal(supervisor_step(&sv, &in), 1);
+  assert_int_equal(sup_step(&sv, &in), 1);
   assert_int_equal(sv.fault, GYRO_FAULT_NAN);
 
   /* Clipping: clip_max_count rail codes within GYRO_CLIP_WINDOW steps (gyro_tick counts
    * them per block), sparse or in a run. */
-  assert_int_equal(supervisor_init(&sv, &c), 0);
+  assert_int_equal(sup_init(&sv, &c), 0);
   supervisor_start(&sv);
   in = good();
   in.clip_count = c.clip_max_count - 1u;
@@ -147,7 +165,7 @@ static void test_drive_saturation(void **state)
   (void)state;
   supervisor_t sv;
   supervisor_cfg_t c = cfg();
-  assert_int_equal(supervisor_init(&sv, &c), 0);
+  assert_int_equal(sup_init(&sv, &c), 0);
   supervisor_start(&sv);
   supervisor_in_t in = good();
   run(&sv, &in, 10);
@@ -167,18 +185,18 @@ static void test_ripple_filtered(void **state)
   supervisor_cfg_t c = cfg();
   c.dt_s = 2e-5f; /* 50 kHz */
   c.lock_hold_s = 0.02f;
-  assert_int_equal(supervisor_init(&sv, &c), 0);
+  assert_int_equal(sup_init(&sv, &c), 0);
   supervisor_start(&sv);
   supervisor_in_t in = good();
   for (int k = 0; k < 5000; k++) {
     in.amp_rel_err = 0.015f * sinf(6.2831853f * 745.0f * 2e-5f * (float)k);
-    (void)supervisor_step(&sv, &in);
+    (void)sup_step(&sv, &in);
   }
   assert_int_equal(sv.mode, GYRO_MODE_LOCKED);
   supervisor_stop(&sv);
   supervisor_start(&sv);
   in.amp_rel_err = 0.015f;
-  for (int k = 0; k < 5000; k++) (void)supervisor_step(&sv, &in);
+  for (int k = 0; k < 5000; k++) (void)sup_step(&sv, &in);
   assert_int_equal(sv.mode, GYRO_MODE_ACQUIRE);
 }
 
@@ -189,7 +207,7 @@ static void test_clear_request_latched(void **state)
   (void)state;
   supervisor_t sv;
   supervisor_cfg_t c = cfg();
-  assert_int_equal(supervisor_init(&sv, &c), 0);
+  assert_int_equal(sup_init(&sv, &c), 0);
   assert_int_equal(sv.clear_req, 0u);
   supervisor_start(&sv);
   supervisor_in_t in = good();
@@ -199,7 +217,7 @@ static void test_clear_request_latched(void **state)
     in.amp_rel_err = (k >= 20 && k < 40) ? -0.2f : 0.0f;
     in.amp_rel = 1.0f + in.amp_rel_err;
     in.state_finite = k != 250;
-    const int r = supervisor_step(&sv, &in);
+    const int r = sup_step(&sv, &in);
     assert_int_equal(sv.clear_req, (uint32_t)r);
     requests += r;
     sv.clear_req = 0u; /* taken */
@@ -217,7 +235,7 @@ static void test_off_and_sweep_faults(void **state)
   supervisor_t sv;
   supervisor_cfg_t c = cfg();
   supervisor_in_t in = good();
-  assert_int_equal(supervisor_init(&sv, &c), 0);
+  assert_int_equal(sup_init(&sv, &c), 0);
   in.state_finite = 0;
   in.clip_count = 100u;
   in.amp_rel = 9.0f;
@@ -232,20 +250,20 @@ static void test_off_and_sweep_faults(void **state)
   run(&sv, &in, 10);
   assert_int_equal(sv.mode, GYRO_MODE_SWEEP);
   in.clip_count = c.clip_max_count;
-  assert_int_equal(supervisor_step(&sv, &in), 1);
+  assert_int_equal(sup_step(&sv, &in), 1);
   assert_int_equal(sv.fault, GYRO_FAULT_ADC_CLIP);
 
   supervisor_enter_sweep(&sv);
   in = good();
   in.state_finite = 0;
   in.clip_count = c.clip_max_count; /* both: the NaN is reported */
-  assert_int_equal(supervisor_step(&sv, &in), 1);
+  assert_int_equal(sup_step(&sv, &in), 1);
   assert_int_equal(sv.fault, GYRO_FAULT_NAN);
 }
 
 static void lock(supervisor_t *sv, const supervisor_cfg_t *c)
 {
-  assert_int_equal(supervisor_init(sv, c), 0);
+  assert_int_equal(sup_init(sv, c), 0);
   supervisor_start(sv);
   const supervisor_in_t in = good();
   run(sv, &in, 20);
@@ -277,7 +295,7 @@ static void test_acquisition_timeout(void **state)
   (void)state;
   supervisor_t sv;
   const supervisor_cfg_t c = cfg();
-  assert_int_equal(supervisor_init(&sv, &c), 0);
+  assert_int_equal(sup_init(&sv, &c), 0);
   supervisor_start(&sv);
   supervisor_in_t in = good();
   in.amp_rel_err = -0.5f;
@@ -308,10 +326,10 @@ static void test_absolute_over_amplitude(void **state)
   supervisor_in_t in = good();
   in.amp_rel = 4.8f / 4.0f; /* 1.2 < amp_trip_rel 1.5, above 4.75 V */
   in.amp_rel_err = in.amp_rel - 1.0f;
-  assert_int_equal(supervisor_step(&sv, &in), 1);
+  assert_int_equal(sup_step(&sv, &in), 1);
   assert_int_equal(sv.fault, GYRO_FAULT_OVER_AMP);
   c.amp_max_v = 3.9f; /* below the setpoint: refused */
-  assert_int_equal(supervisor_init(&sv, &c), -1);
+  assert_int_equal(sup_init(&sv, &c), -1);
 }
 
 static void test_lost_sample(void **state)
@@ -322,7 +340,7 @@ static void test_lost_sample(void **state)
   lock(&sv, &c);
   supervisor_in_t in = good();
   in.sample_lost = 1;
-  assert_int_equal(supervisor_step(&sv, &in), 1);
+  assert_int_equal(sup_step(&sv, &in), 1);
   assert_int_equal(sv.fault, GYRO_FAULT_LOST_SAMPLE);
   assert_int_equal(sv.kind_count[7], 1u);
   assert_true(sv.kind_last_step[7] > 0u);

@@ -48,11 +48,17 @@ static struct {
 static lmsd_t s_lmsd;
 static biquad_cascade_t s_bq1, s_bq2;
 static nco_t s_nco;
-static pi_t s_pi;
+/* The PI kernel's coefficients and state, as one argument for the filter runner. */
+typedef struct {
+  pi_coeffs_t c;
+  pi_t s;
+} bk_pi_t;
+static bk_pi_t s_pi;
 static rlsd_t s_rlsd;
 static kfd_t s_kfd;
 static multdemod_t s_md;
 static gyro_t s_gyro;
+static gyro_design_t s_design; /* the gyro runs with it by pointer */
 static bench_plant_t s_plant;
 static int s_ready;
 
@@ -67,7 +73,7 @@ BK_OPAQUE static void w_multdemod(multdemod_t *s, float d, float rs, float rc)
   multdemod_step(s, d, rs, rc);
 }
 BK_OPAQUE static float w_biquad(biquad_cascade_t *s, float x) { return biquad_cascade_step(s, x); }
-BK_OPAQUE static float w_pi(pi_t *s, float e) { return pi_step(s, e); }
+BK_OPAQUE static float w_pi(bk_pi_t *p, float e) { return pi_step(&p->c, &p->s, e); }
 
 BK_OPAQUE static void e_lmsd(lmsd_t *s, float d, float rs, float rc)
 {
@@ -90,7 +96,7 @@ BK_OPAQUE static float e_biquad(biquad_cascade_t *s, float x)
   (void)s;
   return x;
 }
-BK_OPAQUE static float e_pi(pi_t *s, float e)
+BK_OPAQUE static float e_pi(bk_pi_t *s, float e)
 {
   (void)s;
   return e;
@@ -141,7 +147,7 @@ BK_DEMOD_RUNNER(multdemod, multdemod_t)
   }
 
 BK_FILTER_RUNNER(biquad, biquad_cascade_t, x)
-BK_FILTER_RUNNER(pi, pi_t, e)
+BK_FILTER_RUNNER(pi, bk_pi_t, e)
 
 BK_RUNNER static void run_sincos(void (*fn)(uint32_t, float *, float *), uint32_t n,
                                  bk_stat_t *st)
@@ -248,9 +254,8 @@ static int setup_gyro(void)
 {
   param_values_t v;
   param_values_defaults(&v);
-  gyro_design_t d;
-  if (gyro_design(&v, &d) != 0 || gyro_init_from_design(&s_gyro, &d) != 0 ||
-      bench_plant_init(&s_plant, &d, &v) != 0) {
+  if (gyro_design(&v, &s_design) != 0 || gyro_init_from_design(&s_gyro, &s_design) != 0 ||
+      bench_plant_init(&s_plant, &s_design, &v) != 0) {
     return -1;
   }
   gyro_start(&s_gyro);
@@ -282,8 +287,8 @@ int bk_setup(void)
   if (gyro_design(&v, &d) != 0) return -1;
   const pi_cfg_t pc = {d.drive.amp_kp, d.drive.amp_ki, d.drive.dt_s, 0.0f,
                        d.drive.f_cmd_max_v2, 0.5f * d.drive.f_cmd_max_v2};
-  if (lmsd_init(&s_lmsd, &lc) != 0 || rlsd_init(&s_rlsd, &rc) != 0 ||
-      kfd_init(&s_kfd, &kc) != 0 || nco_init(&s_nco, &nc) != 0 || pi_init(&s_pi, &pc) != 0) {
+  if (lmsd_init(&s_lmsd, &lc) != 0 || rlsd_init(&s_rlsd, &rc) != 0 || kfd_init(&s_kfd, &kc) != 0 ||
+      nco_init(&s_nco, &nc) != 0 || pi_init(&pc, &s_pi.c, &s_pi.s) != 0) {
     return -1;
   }
   /* The rate output low-pass as the product runs it: 100 Hz, 4th order (two sections)

@@ -394,7 +394,7 @@ static void bench_app(uint32_t settle, int trace)
     /* The rarer LOCKED ticks inside the 100 traced: the continuous self-test judging
      * (after its LMS's settling time, longer than the warm-up), and a thermometer slew
      * window ending (once in RATE_VALID_SLEW_UPDATES P updates, one in 100 ticks). */
-    s_app.gyro.selftest.cont_blocks = s_app.gyro.selftest.cfg.cont_settle_blocks;
+    s_app.gyro.selftest.cont_blocks = s_app.gyro.design->selftest.cont_settle_blocks;
     s_app.gyro.valid.p_updates = RATE_VALID_SLEW_UPDATES - 1u;
     s_each = 1;
     put_state("isr_app_cb");

@@ -1,0 +1,80 @@
+/* The gyro's design: everything the parameters turn into (background, double-precision
+ * design, gyro_design.c), the derived block the parameter bank publishes. Every module
+ * of the sample path is told its part of it (a const X_cfg_t *) apart from what it
+ * remembers (X_t, in gyro_t); the sample path reads the published block through one
+ * pointer, so a new design takes over at a tick boundary as a whole (gyro_apply). */
+#ifndef GYRO_DESIGN_H
+#define GYRO_DESIGN_H
+
+#include <stdint.h>
+
+#include "dsp/lmsd.h"
+#include "dsp/nco.h"
+#include "gyro/drive_loop.h"
+#include "gyro/drive_synth.h"
+#include "gyro/rate_channel.h"
+#include "gyro/rate_valid.h"
+#include "gyro/selftest.h"
+#include "gyro/supervisor.h"
+#include "params/params.h"
+
+typedef struct {
+  /* First: the blocks' jobs reach the rate channel's part at the design's own address. */
+  rate_channel_cfg_t rate;
+  rate_valid_cfg_t valid;
+  supervisor_cfg_t sup;
+  drive_loop_cfg_t drive;
+  selftest_cfg_t selftest;
+  float rate_out_v_per_dps;
+  float rate_fault_out_v;  /* analog rate output while the rate is not valid */
+  uint16_t rate_fault_code; /* its DAC code (derived) */
+  nco_cfg_t nco;
+  uint32_t nco_half_step;  /* the NCO's step at the drive frequency: the NCO's start */
+  lmsd_cfg_t lmsd_drive, lmsd_sense;
+  drive_synth_cfg_t synth;
+  drive_loop_design_out_t amp_design, phase_design; /* what the designer achieved */
+  uint32_t autostart;
+} gyro_design_t;
+
+/* Why gyro_design refused a set of values: one status per check, each with a reason
+ * (gyro_design_reason) that names the parameters at fault by their user-visible names.
+ * GYRO_DESIGN_OK is 0, so `gyro_design(v, d) != 0` reads as "refused". */
+typedef enum {
+  GYRO_DESIGN_OK = 0,
+  GYRO_DESIGN_NO_VALUES,      /* no values or nowhere to put the design (a caller's bug) */
+  GYRO_DESIGN_FS,             /* sys.fs_hz */
+  GYRO_DESIGN_DRIVE_FREQ,     /* drive.freq_hz against sys.fs_hz */
+  GYRO_DESIGN_DRIVE_VOLTAGES, /* drive.u_max_v, drive.dc_bias_v (DC+AC) */
+  GYRO_DESIGN_MU_DRIVE,       /* demod.mu_drive */
+  GYRO_DESIGN_MU_SENSE,       /* demod.mu_sense */
+  GYRO_DESIGN_AMP_LOOP,       /* drive.cal_*, drive.amp_bw_hz */
+  GYRO_DESIGN_PHASE_LOOP,     /* drive.cal_f0_hz, drive.cal_q, drive.phase_bw_hz */
+  GYRO_DESIGN_P_INIT,         /* drive.p_init_deg beyond one turn */
+  GYRO_DESIGN_RATE_LPF,       /* rate.lpf_order, rate.lpf_cutoff_hz */
+  GYRO_DESIGN_AMP_SET,        /* drive.amp_set_v against the ADC's range */
+  GYRO_DESIGN_LOST_TOL,       /* sup.lost_tol_rel against sup.lock_tol_rel */
+  GYRO_DESIGN_AMP_TRIP,       /* sup.amp_trip_rel against sup.lost_tol_rel */
+  GYRO_DESIGN_FAULT_OUT,      /* rate.fault_out_v against the valid span */
+  GYRO_DESIGN_BIAS_SLOPE,     /* rate.bias_c*, rate.p_range_deg */
+  GYRO_DESIGN_CONT_FREQ,      /* selftest.cont_freq_hz against rate.lpf_cutoff_hz */
+  GYRO_DESIGN_CONT_EXPECT,    /* selftest.cont_expect_dps, selftest.tol_rel */
+  GYRO_DESIGN_MODULE,         /* a module refused its part: a value outside its range */
+  GYRO_DESIGN_STATUS_COUNT
+} gyro_design_status_t;
+
+/* Turn parameter values into module configurations, checking that every module
+ * accepts its part. Returns GYRO_DESIGN_OK, or the check that failed (then *d is
+ * untouched). Background only (double precision, libm). */
+gyro_design_status_t gyro_design(const param_values_t *v, gyro_design_t *d);
+
+/* The reason for a status, for `set` and the boot report: a constant string naming
+ * the parameters at fault ("drive.freq_hz must be below sys.fs_hz / 4"); "" for
+ * GYRO_DESIGN_OK and for values outside the enum. Never NULL, never allocated. */
+const char *gyro_design_reason(gyro_design_status_t s);
+
+/* The derived fields of every module's configuration from the designer's (background),
+ * and the check that every module accepts its part: a design that gyro_apply could not
+ * apply is rejected here, where the error can be reported. Returns 0, or -1. */
+int gyro_design_complete(gyro_design_t *d);
+
+#endif /* GYRO_DESIGN_H */
