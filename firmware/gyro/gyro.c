@@ -80,7 +80,11 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   if (dphase_rad != 0.0f && driving) {
     rate_channel_shift_p(&g->rate, dphase_rad * FM_DEG_PER_RAD_F);
   }
-  g->nco.half_step = d->nco_half_step;
+  /* The NCO's step is the drive's own (the sweep moves it every tick, a tracking drive
+   * would own it): a design sets it only when the drive frequency changes. */
+  if (d->nco_half_step != old->nco_half_step) {
+    g->nco.half_step = d->nco_half_step;
+  }
   /* The LMSDs' step sizes sit beside their weights (lmsd_t: the one coefficient the
    * per-sample step reads, within the same load). */
   (void)lmsd_set_mu(&g->lmsd_drive, d->lmsd_drive.mu);
