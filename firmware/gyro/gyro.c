@@ -49,17 +49,6 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   return 0;
 }
 
-int gyro_design_complete(gyro_design_t *d)
-{
-  if (d == NULL || drive_loop_cfg_derive(&d->drive) != 0 || supervisor_cfg_derive(&d->sup) != 0) {
-    return -1;
-  }
-  selftest_cfg_derive(&d->selftest);
-  d->rate_fault_code = gyro_volts_to_dac(d->rate_fault_out_v);
-  gyro_t scratch;
-  return gyro_init_from_design(&scratch, d) == 0 ? 0 : -1;
-}
-
 void gyro_apply(gyro_t *g, const gyro_design_t *d)
 {
   /* The design was completed by gyro_design, so every module accepts its part. Only

@@ -1,7 +1,7 @@
 /* gyro_design: the parameter values -> every module's configuration, in the
  * background (libm allowed here, never in the sample path). The loop designs follow
  * (6-12), (6-17); the rate channel's reference and compensation rate_channel.h. */
-#include "gyro/gyro.h"
+#include "gyro/gyro_design.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -9,7 +9,8 @@
 
 #include "dsp/butter.h"
 #include "dsp/fastmath.h"
-#include "gyro/gyro_block.h"
+#include "gyro/gyro_dac.h"
+#include "gyro/gyro_slots.h"
 
 /* The absolute over-amplitude trip, as a fraction of the ADC's range: the highest
  * drive-pickoff amplitude the ADC still measures with headroom for the carrier's noise. */
@@ -283,6 +284,24 @@ static gyro_design_status_t design_parts(const param_values_t *v, gyro_design_t 
   if (s == GYRO_DESIGN_OK) s = design_selftest(v, t);
   t->autostart = v->sys_autostart;
   return s;
+}
+
+int gyro_design_complete(gyro_design_t *d)
+{
+  if (d == NULL || drive_loop_cfg_derive(&d->drive) != 0 || supervisor_cfg_derive(&d->sup) != 0) {
+    return -1;
+  }
+  selftest_cfg_derive(&d->selftest);
+  d->rate_fault_code = gyro_volts_to_dac(d->rate_fault_out_v);
+  /* What gyro_init_from_design checks, on scratch states. */
+  nco_t nco;
+  lmsd_t lmsd;
+  drive_synth_t synth;
+  return nco_init(&nco, &d->nco) == 0 && lmsd_init(&lmsd, &d->lmsd_drive) == 0 &&
+                 lmsd_init(&lmsd, &d->lmsd_sense) == 0 && drive_synth_init(&synth, &d->synth) == 0 &&
+                 rate_channel_cfg_ok(&d->rate) && rate_valid_cfg_ok(&d->valid)
+             ? 0
+             : -1;
 }
 
 gyro_design_status_t gyro_design(const param_values_t *v, gyro_design_t *d)

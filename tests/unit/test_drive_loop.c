@@ -275,7 +275,7 @@ static void test_p_init_whole_parameter_range(void **state)
     drive_loop_t dl;
     drive_loop_cfg_t c = {.dt_s = 2e-5f, .amp_set_v = 2.0f, .f_cmd_max_v2 = 100.0f,
                           .p_init_rad = deg[i] * 0.0174532925199433f};
-    assert_int_equal(drive_loop_init(&dl, &c), 0);
+    assert_int_equal(dl_init(&dl, &c), 0);
     assert_true(dl.p_rad == c.p_init_rad);
   }
 }

@@ -1,0 +1,46 @@
+/* The DAC conversion of the sample path (drive electrodes, analog rate output, the
+ * self-test force), and the design's fault level of the rate output. */
+#ifndef GYRO_DAC_H
+#define GYRO_DAC_H
+
+#include <stdint.h>
+#include <string.h>
+
+#include "hal/hal_dac.h"
+
+/* Volts to an offset-binary DAC code, rounded to the nearest code (ties to even) and
+ * clamped to the converter's range; NaN gives the mid code (0 V).
+ * Per sample, for three channels, so without float compares (each a VCMP, a VMRS and a
+ * branch on the FPv4-SP, which has no VMIN/VMAX): adding 1.5 * 2^23 to the code makes
+ * the float adder round it to an integer (the sum's unit in the last place is 1 for
+ * sums in [2^23, 2^24)) and leaves it in the low mantissa bits: in range, the code is
+ * the sum's bit pattern less that of 1.5 * 2^23, and one unsigned compare tells that it
+ * is in range. Outside, the bit pattern of a float grows with its value while the sign
+ * is clear: below 1.5 * 2^23 or negative is code 0, above is the largest code
+ * (infinity included). IEEE 754 single precision with round-to-nearest, the same on
+ * host and target. */
+#if defined(__GNUC__)
+#define GYRO_UNLIKELY(x) __builtin_expect((x) != 0, 0) /* block layout only */
+#else
+#define GYRO_UNLIKELY(x) ((x) != 0)
+#endif
+#define GYRO_DAC_ROUND_F 12582912.0f    /* 1.5 * 2^23 */
+#define GYRO_DAC_ROUND_BITS 0x4B400000u /* its bit pattern */
+static inline uint16_t gyro_volts_to_dac(float v)
+{
+  const float m = v * (1.0f / HAL_DAC_V_PER_CODE) + ((float)HAL_DAC_CODE_MID + GYRO_DAC_ROUND_F);
+  uint32_t u;
+  memcpy(&u, &m, sizeof u);
+  uint32_t code = u - GYRO_DAC_ROUND_BITS;
+  if (GYRO_UNLIKELY(code > HAL_DAC_CODE_MAX)) {
+    if ((u << 1) > 0xFF000000u) { /* exponent all ones, mantissa not zero: NaN */
+      code = HAL_DAC_CODE_MID;
+    } else {
+      code = (u & 0x80000000u) != 0u || u < GYRO_DAC_ROUND_BITS ? 0u : HAL_DAC_CODE_MAX;
+    }
+  }
+  return (uint16_t)code;
+}
+
+
+#endif /* GYRO_DAC_H */

@@ -1,0 +1,74 @@
+/* The gyro's block and its slot table: which of the block's ticks runs which job (the
+ * sample path, gyro_tick and gyro_block.h), and the delays the loop designer derives
+ * from it (gyro_design.c). */
+#ifndef GYRO_SLOTS_H
+#define GYRO_SLOTS_H
+
+#include "gyro/rate_channel.h" /* RATE_DECIM */
+
+/* The block: GYRO_BLOCK ticks (the rate channel's RATE_DECIM, 0.2 ms at 50 kHz). Per
+ * tick only what moves with the carrier runs: the NCO, both LMSDs, the sum of the sense
+ * phasor, the drive waveform and the self-test force, the rail count and the DAC frame.
+ * Everything else runs once per block, cut into jobs of about the same cost, one job
+ * on each tick of the block: the interrupt's budget is set by its worst tick
+ * (tools/bench/README.md). A job runs after its tick's DAC frame is written (the jobs
+ * are tail calls of gyro_tick, gyro_block.h), so what it changes reaches the DAC from
+ * the next tick on.
+ *
+ *   slot  job                                             uses (slot it comes from)
+ *   0     arg Z (fm_atan2f: one divide); the drive half   drive LMSD
+ *         of the output snapshot                          drive loop (1, 2, last block)
+ *   1     phase loop: wrapped error, PI -> P (P held      arg Z (0), |Z| (2, last block)
+ *         while |Z| < 10 % of its setpoint; a whole
+ *         turn of P passed on to the thermometer); the
+ *         continuous self-test's verdict                  its LMS (6, 7, last block)
+ *   2     finiteness check, first half (LMSD weights);    drive LMSD
+ *         |Z| (square root), amplitude PI -> f_cmd;
+ *         rate-valid drive-phase and sense-range checks   phase error (4), quad (7), sense LMSD
+ *   3     the supervisor's evidence (sup_in);             |Z|, f_cmd (2), phase error (1)
+ *         drive_synth_set(f_cmd, P): the waveform's       f_cmd (2), P (1)
+ *         amplitude (square root) and phase offset
+ *   4     supervisor (its clear request: slot 5)          evidence (3), finiteness (7, last block)
+ *   5     rate channel: block mean of S, projection       sense sum, P (1)
+ *         (or, on request, the loop state cleared);
+ *         the block's rail codes; the continuous
+ *         self-test's modulation
+ *   6     the continuous self-test's notch (rate axis);   projection (5), modulation (5)
+ *         rate: output filter, scale, compensation;       P_f (8, last block)
+ *         its range check (or, after a clear, the rate
+ *         channel's reset)
+ *   7     finiteness check, second half (loop and rate    weights' half (2)
+ *         outputs) and verdict; the continuous            projection (5)
+ *         self-test's notch (quadrature axis),
+ *         quadrature filter; the filters' settling        rate filter (6)
+ *   8     P's hold and low-pass (its mean every 10th      P (1)
+ *         block), the thermometer checks of the P_f       P_f (8, last block)
+ *         made the block before, the slew of a window     P_f (8, last blocks)
+ *         that ended the block before that; the self-
+ *         test sequence while it runs                     projection (5)
+ *   9     rate-valid verdict, rate half of the output     checks (2, 6, 7), rails (5),
+ *         snapshot, analog rate code (the fault level     everything
+ *         when not valid)
+ *
+ * The drive command thus reaches the DAC (COMMAND + 1 - slot) ticks after the sample
+ * the loop measured: 4 for the phase loop, 2 for the amplitude loop; gyro_design adds
+ * that to the loops' delay budget (drive_loop_design). */
+#define GYRO_BLOCK RATE_DECIM
+#define GYRO_SLOT_PHASE_MEAS 0u
+#define GYRO_SLOT_PHASE_PI 1u
+#define GYRO_SLOT_AMP 2u
+#define GYRO_SLOT_COMMAND 3u
+#define GYRO_SLOT_SUPERVISE 4u
+#define GYRO_SLOT_PROJECT 5u
+#define GYRO_SLOT_RATE 6u
+#define GYRO_SLOT_QUAD 7u
+#define GYRO_SLOT_P 8u
+#define GYRO_SLOT_OUTPUT 9u
+_Static_assert(GYRO_SLOT_PHASE_MEAS < GYRO_SLOT_PHASE_PI && GYRO_SLOT_PHASE_PI < GYRO_SLOT_COMMAND &&
+                   GYRO_SLOT_AMP < GYRO_SLOT_COMMAND && GYRO_SLOT_COMMAND < GYRO_SLOT_SUPERVISE &&
+                   GYRO_SLOT_SUPERVISE < GYRO_SLOT_PROJECT && GYRO_SLOT_PROJECT < GYRO_SLOT_RATE &&
+                   GYRO_SLOT_PROJECT < GYRO_SLOT_QUAD && GYRO_SLOT_PROJECT < GYRO_SLOT_P &&
+                   GYRO_SLOT_AMP < GYRO_SLOT_QUAD && GYRO_SLOT_OUTPUT == GYRO_BLOCK - 1u,
+               "block jobs out of order (gyro_slots.h slot table)");
+
+#endif /* GYRO_SLOTS_H */
