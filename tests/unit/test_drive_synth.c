@@ -100,12 +100,34 @@ static void test_non_finite_command(void **state)
   }
 }
 
+/* What drive_synth_set says it does with a P the phase conversion cannot take (NaN
+ * here): the phase is zeroed, not left where it was, and the whole turns it carried
+ * are forgotten, so that the next finite P is converted as from a fresh start. */
+static void test_bad_phase_zeroes_phase_and_turns(void **state)
+{
+  (void)state;
+  drive_synth_t ds, fresh;
+  const drive_synth_cfg_t c = {.scheme = GYRO_DRIVE_HALF_FREQ, .dc_bias_v = 0.0f, .u_max_v = 14.0f};
+  assert_int_equal(drive_synth_init(&ds, &c), 0);
+  assert_int_equal(drive_synth_init(&fresh, &c), 0);
+  drive_synth_set(&ds, 64.0f, 1.0f);
+  drive_synth_set(&ds, 64.0f, 5.0f); /* beyond 1.5 pi: a turn taken off */
+  assert_true(ds.p_turn_rad != 0.0f);
+  drive_synth_set(&ds, 64.0f, NAN);
+  assert_int_equal(ds.off, 0u);
+  assert_true(ds.p_turn_rad == 0.0f);
+  drive_synth_set(&ds, 64.0f, 0.3f);
+  drive_synth_set(&fresh, 64.0f, 0.3f);
+  assert_int_equal(ds.off, fresh.off);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_half_frequency_force),
       cmocka_unit_test(test_dc_ac_force),
       cmocka_unit_test(test_limits),
+      cmocka_unit_test(test_bad_phase_zeroes_phase_and_turns),
       cmocka_unit_test(test_non_finite_command),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
