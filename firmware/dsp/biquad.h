@@ -57,8 +57,7 @@ void biquad_sections_reset(const biquad_coeffs_t *c, biquad_state_t *s, uint32_t
 
 /* One input sample through the n sections c with state s; returns their output. */
 static inline float biquad_sections_step(const biquad_coeffs_t *restrict c,
-                                         biquad_state_t *restrict s, uint32_t n,
-                                         float x)
+                                         biquad_state_t *restrict s, uint32_t n, float x)
 {
   for (uint32_t i = 0; i < n; i++) {
     const float y = c[i].b0 * x + s[i].s1;

@@ -63,17 +63,14 @@ static void section_from_pair(cplx_t s_pole, double fs_hz, butter_sos_f64_t *s)
 static double section_gain(butter_type_t type, double a1, double a2, double w0)
 {
   switch (type) {
-  case BUTTER_LOWPASS:
-    return (1.0 + a1 + a2) / 4.0;
-  case BUTTER_HIGHPASS:
-    return (1.0 - a1 + a2) / 4.0;
+  case BUTTER_LOWPASS: return (1.0 + a1 + a2) / 4.0;
+  case BUTTER_HIGHPASS: return (1.0 - a1 + a2) / 4.0;
   case BUTTER_BANDPASS: {
     const double re = 1.0 + a1 * cos(w0) + a2 * cos(2.0 * w0);
     const double im = a1 * sin(w0) + a2 * sin(2.0 * w0);
     return hypot(re, im) / (2.0 * sin(w0));
   }
-  default:
-    return (double)NAN;
+  default: return (double)NAN;
   }
 }
 
@@ -117,8 +114,7 @@ static int check_args(butter_type_t type, unsigned order, double f1_hz, double f
     }
     n_sections = order;
     break;
-  default:
-    return BUTTER_ERR_ARG;
+  default: return BUTTER_ERR_ARG;
   }
   if (!isfinite(fs_hz) || !(fs_hz > 0.0) || !freq_in_range(f1_hz, fs_hz)) {
     return BUTTER_ERR_FREQ;
@@ -150,8 +146,8 @@ static double pole_radius(const butter_sos_f64_t *s)
 }
 
 /* Denominators of all sections, in the order of the prototype poles. */
-static void design_denominators(butter_type_t type, unsigned order, double f1_hz,
-                                double f2_hz, double fs_hz, butter_sos_f64_t *out)
+static void design_denominators(butter_type_t type, unsigned order, double f1_hz, double f2_hz,
+                                double fs_hz, butter_sos_f64_t *out)
 {
   const unsigned n = order;
   const double w1 = prewarp(f1_hz, fs_hz);
@@ -221,8 +217,8 @@ int butter_design_f64(butter_type_t type, unsigned order, double f1_hz, double f
   return n;
 }
 
-int butter_design(butter_type_t type, unsigned order, double f1_hz, double f2_hz,
-                  double fs_hz, biquad_coeffs_t *sections, uint32_t max_sections)
+int butter_design(butter_type_t type, unsigned order, double f1_hz, double f2_hz, double fs_hz,
+                  biquad_coeffs_t *sections, uint32_t max_sections)
 {
   butter_sos_f64_t exact[BUTTER_MAX_SECTIONS];
   biquad_coeffs_t rounded[BUTTER_MAX_SECTIONS];

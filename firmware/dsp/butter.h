@@ -49,12 +49,14 @@ typedef enum {
 #define BUTTER_MAX_SECTIONS 8u
 
 /* Errors (negative returns); nothing is written to sections on any error. */
-#define BUTTER_ERR_ARG (-1)       /* NULL pointer or unknown type */
-#define BUTTER_ERR_ORDER (-2)     /* order 0, odd (low-/high-pass), or too large */
-#define BUTTER_ERR_FREQ (-3)      /* fs not finite/positive, f outside (0, fs/2), NaN,
+#define BUTTER_ERR_ARG (-1)   /* NULL pointer or unknown type */
+#define BUTTER_ERR_ORDER (-2) /* order 0, odd (low-/high-pass), or too large */
+#define BUTTER_ERR_FREQ \
+  (-3)                        /* fs not finite/positive, f outside (0, fs/2), NaN,
                                    * or f1 >= f2 (band-pass) */
-#define BUTTER_ERR_SPACE (-4)     /* max_sections smaller than the design needs */
-#define BUTTER_ERR_PRECISION (-5) /* a section is not stable once rounded to float (the
+#define BUTTER_ERR_SPACE (-4) /* max_sections smaller than the design needs */
+#define BUTTER_ERR_PRECISION \
+  (-5) /* a section is not stable once rounded to float (the
                                    * cut-off is too close to 0 or fs/2 for float) */
 
 /* One section in double: same equation and sign convention as biquad_coeffs_t. */
@@ -72,7 +74,7 @@ int butter_design_f64(butter_type_t type, unsigned order, double f1_hz, double f
 /* The same design rounded to float sections for biquad_cascade_init, with the
  * numerators renormalised after rounding (see above). Same returns, plus
  * BUTTER_ERR_PRECISION. */
-int butter_design(butter_type_t type, unsigned order, double f1_hz, double f2_hz,
-                  double fs_hz, biquad_coeffs_t *sections, uint32_t max_sections);
+int butter_design(butter_type_t type, unsigned order, double f1_hz, double f2_hz, double fs_hz,
+                  biquad_coeffs_t *sections, uint32_t max_sections);
 
 #endif /* BUTTER_H */

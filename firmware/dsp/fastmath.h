@@ -37,8 +37,10 @@ static inline float fm_clampf(float x, float lo, float hi)
 static inline float fm_atan_unit(float t)
 {
   const float t2 = t * t;
-  return t * (0.99997726f + t2 * (-0.33262347f + t2 * (0.19354346f +
-             t2 * (-0.11643287f + t2 * (0.05265332f + t2 * -0.01172120f)))));
+  return t * (0.99997726f +
+              t2 * (-0.33262347f +
+                    t2 * (0.19354346f +
+                          t2 * (-0.11643287f + t2 * (0.05265332f + t2 * -0.01172120f)))));
 }
 
 /* atan2(y, x) in (-pi, pi]; returns 0 for (0, 0). */

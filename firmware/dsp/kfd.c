@@ -12,8 +12,7 @@ static int noise_valid(float q, float r)
 
 int kfd_init(kfd_t *s, const kfd_cfg_t *cfg)
 {
-  if (s == NULL || cfg == NULL || !noise_valid(cfg->q, cfg->r) ||
-      !cov2_p0_valid(cfg->p0)) {
+  if (s == NULL || cfg == NULL || !noise_valid(cfg->q, cfg->r) || !cov2_p0_valid(cfg->p0)) {
     return -1;
   }
   s->q = cfg->q;

@@ -9,9 +9,9 @@
 #ifndef MATH_CONST_H
 #define MATH_CONST_H
 
-#define FM_PI 3.14159265358979323846     /* double */
+#define FM_PI 3.14159265358979323846      /* double */
 #define FM_TWO_PI 6.283185307179586476925 /* double, exactly 2 * FM_PI */
-#define FM_DEG_PER_RAD 57.29577951308232 /* double, 180 / pi */
+#define FM_DEG_PER_RAD 57.29577951308232  /* double, 180 / pi */
 
 #define FM_PI_F 3.14159265358979f
 #define FM_TWO_PI_F 6.28318530717959f

@@ -21,7 +21,10 @@ uint32_t nco_half_step_of(double freq_hz, double fs_hz)
   return (uint32_t)llround(freq_hz / fs_hz * 2147483648.0);
 }
 
-double nco_freq_of(uint32_t half_step, double fs_hz) { return (double)half_step * fs_hz / 2147483648.0; }
+double nco_freq_of(uint32_t half_step, double fs_hz)
+{
+  return (double)half_step * fs_hz / 2147483648.0;
+}
 
 /* Move the wc phase by a signed change d (two's complement, [-pi, pi)): the wc/2
  * accumulator moves by d/2, an arithmetic shift written without relying on the

@@ -5,15 +5,9 @@
 #include <stddef.h>
 #include "dsp/ramfunc.h"
 
-static int finite_f(float x)
-{
-  return isfinite(x) != 0;
-}
+static int finite_f(float x) { return isfinite(x) != 0; }
 
-static float clampf(float x, float lo, float hi)
-{
-  return (x > hi) ? hi : ((x < lo) ? lo : x);
-}
+static float clampf(float x, float lo, float hi) { return (x > hi) ? hi : ((x < lo) ? lo : x); }
 
 static int gains_valid(float kp, float ki, float dt_s)
 {

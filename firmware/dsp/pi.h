@@ -30,18 +30,18 @@
 #define PI_H
 
 typedef struct {
-  float kp;     /* proportional gain Kp */
-  float ki;     /* integral gain Ki, per second */
-  float dt_s;   /* sample time T, > 0 */
-  float u_min;  /* output limits, u_min < u_max */
+  float kp;    /* proportional gain Kp */
+  float ki;    /* integral gain Ki, per second */
+  float dt_s;  /* sample time T, > 0 */
+  float u_min; /* output limits, u_min < u_max */
   float u_max;
   float u_init; /* output at start, within the limits */
 } pi_cfg_t;
 
 /* What the step uses, derived from a pi_cfg_t (pi_design): constant while it runs. */
 typedef struct {
-  float kp;     /* Kp = b0 */
-  float ki_t;   /* Ki T = b0 + b1 */
+  float kp;   /* Kp = b0 */
+  float ki_t; /* Ki T = b0 + b1 */
   float u_min, u_max;
 } pi_coeffs_t;
 

@@ -10,8 +10,7 @@ static int lambda_valid(float lambda)
 
 int rlsd_init(rlsd_t *s, const rlsd_cfg_t *cfg)
 {
-  if (s == NULL || cfg == NULL || !lambda_valid(cfg->lambda) ||
-      !cov2_p0_valid(cfg->p0)) {
+  if (s == NULL || cfg == NULL || !lambda_valid(cfg->lambda) || !cov2_p0_valid(cfg->p0)) {
     return -1;
   }
   s->lambda = cfg->lambda;

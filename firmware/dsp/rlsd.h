@@ -50,14 +50,14 @@ typedef struct {
 } rlsd_cfg_t;
 
 typedef struct {
-  float w_i, w_q;       /* estimates of A1 (sine coefficient), A2 (cosine coefficient) */
-  cov2_t cov;           /* P (cov2.h) */
-  float lambda;         /* forgetting factor */
-  float inv_lambda;     /* 1 / lambda */
-  float p0;             /* restart value of P's diagonal */
-  float trace_max;      /* 4 p0: forgetting pauses above it */
-  uint32_t cov_resets;  /* P restarts after a loss of positive definiteness */
-  uint32_t skipped;     /* samples ignored for a non-finite innovation */
+  float w_i, w_q;      /* estimates of A1 (sine coefficient), A2 (cosine coefficient) */
+  cov2_t cov;          /* P (cov2.h) */
+  float lambda;        /* forgetting factor */
+  float inv_lambda;    /* 1 / lambda */
+  float p0;            /* restart value of P's diagonal */
+  float trace_max;     /* 4 p0: forgetting pauses above it */
+  uint32_t cov_resets; /* P restarts after a loss of positive definiteness */
+  uint32_t skipped;    /* samples ignored for a non-finite innovation */
 } rlsd_t;
 
 /* Validate cfg; W = 0, P = p0 I, counters 0. Returns 0, or -1 and leaves *s unchanged

@@ -46,10 +46,10 @@ int drive_loop_design(const drive_loop_design_in_t *in, drive_loop_design_out_t 
 static int cfg_ok(const drive_loop_cfg_t *c)
 {
   return c != NULL && c->dt_s > 0.0f && c->amp_set_v > 0.0f && c->f_cmd_max_v2 > 0.0f &&
-         fm_isfinite(c->amp_set_v) && fm_isfinite(c->phase_set_rad) &&
-         fm_isfinite(c->amp_kp) && fm_isfinite(c->amp_ki) && fm_isfinite(c->phase_kp) &&
-         fm_isfinite(c->phase_ki) && fm_isfinite(c->f_cmd_max_v2) &&
-         fm_isfinite(c->p_init_rad) && fm_absf(c->p_init_rad) <= DRIVE_P_LIMIT_RAD;
+         fm_isfinite(c->amp_set_v) && fm_isfinite(c->phase_set_rad) && fm_isfinite(c->amp_kp) &&
+         fm_isfinite(c->amp_ki) && fm_isfinite(c->phase_kp) && fm_isfinite(c->phase_ki) &&
+         fm_isfinite(c->f_cmd_max_v2) && fm_isfinite(c->p_init_rad) &&
+         fm_absf(c->p_init_rad) <= DRIVE_P_LIMIT_RAD;
 }
 
 int drive_loop_cfg_derive(drive_loop_cfg_t *cfg)
@@ -60,8 +60,11 @@ int drive_loop_cfg_derive(drive_loop_cfg_t *cfg)
   const pi_cfg_t amp = {cfg->amp_kp, cfg->amp_ki, cfg->dt_s, 0.0f, cfg->f_cmd_max_v2, 0.0f};
   /* P is kept within +-pi of p_init by whole turns (drive_loop_update_phase): limits a
    * turn beyond that are never reached. */
-  const pi_cfg_t ph = {cfg->phase_kp, cfg->phase_ki, cfg->dt_s,
-                       cfg->p_init_rad - 2.0f * FM_TWO_PI_F, cfg->p_init_rad + 2.0f * FM_TWO_PI_F,
+  const pi_cfg_t ph = {cfg->phase_kp,
+                       cfg->phase_ki,
+                       cfg->dt_s,
+                       cfg->p_init_rad - 2.0f * FM_TWO_PI_F,
+                       cfg->p_init_rad + 2.0f * FM_TWO_PI_F,
                        cfg->p_init_rad};
   pi_coeffs_t amp_c, ph_c;
   if (pi_design(&amp, &amp_c) != 0 || pi_design(&ph, &ph_c) != 0) {
@@ -80,7 +83,10 @@ int drive_loop_cfg_derive(drive_loop_cfg_t *cfg)
   return 0;
 }
 
-void drive_loop_init(const drive_loop_cfg_t *cfg, drive_loop_t *dl) { drive_loop_reset(cfg, dl); }
+void drive_loop_init(const drive_loop_cfg_t *cfg, drive_loop_t *dl)
+{
+  drive_loop_reset(cfg, dl);
+}
 
 void drive_loop_reconfigure(const drive_loop_cfg_t *cfg, drive_loop_t *dl)
 {
@@ -116,8 +122,8 @@ GYRO_RAMFUNC void drive_loop_reset(const drive_loop_cfg_t *restrict c, drive_loo
   dl->p_turn_rad = 0.0f;
 }
 
-GYRO_RAMFUNC void drive_loop_step_amp(const drive_loop_cfg_t *restrict c, drive_loop_t *restrict dl,
-                                      float w_i, float w_q)
+GYRO_RAMFUNC void drive_loop_step_amp(const drive_loop_cfg_t *restrict c,
+                                      drive_loop_t *restrict dl, float w_i, float w_q)
 {
   if (drive_loop_slewing(c, dl)) slew_amp(c, dl);
   dl->amp_v = fm_sqrtf(w_i * w_i + w_q * w_q);

@@ -61,17 +61,17 @@
 /* What the loops are told (the designer, gyro_design): constant while they run. */
 typedef struct {
   float dt_s;
-  float amp_set_v;           /* the amplitude setpoint's target (the loop slews to it) */
+  float amp_set_v; /* the amplitude setpoint's target (the loop slews to it) */
   float phase_set_rad;
-  float amp_kp, amp_ki;      /* f_cmd (Ks*V^2) per V; per V*s */
-  float phase_kp, phase_ki;  /* rad per rad; per rad*s */
-  float f_cmd_max_v2;        /* force command limit (u_max^2 for half-frequency drive) */
+  float amp_kp, amp_ki;     /* f_cmd (Ks*V^2) per V; per V*s */
+  float phase_kp, phase_ki; /* rad per rad; per rad*s */
+  float f_cmd_max_v2;       /* force command limit (u_max^2 for half-frequency drive) */
   float p_init_rad;
   /* Derived (drive_loop_cfg_derive): */
-  pi_coeffs_t amp, phase;    /* the PIs' coefficients and limits */
-  float inv_amp_set;         /* 1 / amp_set_v */
-  float amp_slew_up;         /* per update: the setpoint x this while below the target ... */
-  float amp_slew_down;       /* ... x this (1 / amp_slew_up) while above */
+  pi_coeffs_t amp, phase; /* the PIs' coefficients and limits */
+  float inv_amp_set;      /* 1 / amp_set_v */
+  float amp_slew_up;      /* per update: the setpoint x this while below the target ... */
+  float amp_slew_down;    /* ... x this (1 / amp_slew_up) while above */
 } drive_loop_cfg_t;
 
 #define DRIVE_AMP_SLEW_TAU 0.15f
@@ -81,28 +81,28 @@ typedef struct {
 typedef struct {
   pi_t amp_pi;
   pi_t phase_pi;
-  float amp_set_v;       /* setpoint the loop uses now, slewing towards the cfg's */
-  float inv_amp_set;     /* 1 / amp_set_v: the supervisor's reference */
+  float amp_set_v;   /* setpoint the loop uses now, slewing towards the cfg's */
+  float inv_amp_set; /* 1 / amp_set_v: the supervisor's reference */
   /* Latest measurement and outputs. */
   float amp_v;
   float phase_rad;
   float amp_err_v;
   float phase_err_rad;
-  float f_cmd_v2;  /* force amplitude command, Ks*V^2 */
-  float p_rad;     /* force phase P */
+  float f_cmd_v2;   /* force amplitude command, Ks*V^2 */
+  float p_rad;      /* force phase P */
   float p_turn_rad; /* whole turn taken off P at the latest update (0: none), for the
                      * caller to act on and clear */
 } drive_loop_t;
 
 typedef struct {
-  double plant_gain;   /* K: loop output units -> measured units at resonance */
-  double tau_s;        /* 2 Q / wn */
-  double bw_hz;        /* wanted closed-loop bandwidth */
-  double demod_bw_hz;  /* LMSD bandwidth, (lmsd_bandwidth_hz) */
-  double fs_hz;        /* sample rate */
-  double loop_decim;   /* samples per loop update (the loop runs at fs / loop_decim and
+  double plant_gain;  /* K: loop output units -> measured units at resonance */
+  double tau_s;       /* 2 Q / wn */
+  double bw_hz;       /* wanted closed-loop bandwidth */
+  double demod_bw_hz; /* LMSD bandwidth, (lmsd_bandwidth_hz) */
+  double fs_hz;       /* sample rate */
+  double loop_decim;  /* samples per loop update (the loop runs at fs / loop_decim and
                         * its output is held between updates); 0 or 1: every sample */
-  double lag_samples;  /* samples from the one whose demodulated phasor the loop measures
+  double lag_samples; /* samples from the one whose demodulated phasor the loop measures
                         * to the first one whose DAC frame carries the resulting command
                         * (0: the same sample); the DAC's own latency of one sample comes
                         * on top */
@@ -110,7 +110,7 @@ typedef struct {
 
 typedef struct {
   double kp, ki;
-  double bw_hz;          /* achieved (after the phase-margin cap) */
+  double bw_hz; /* achieved (after the phase-margin cap) */
   double phase_margin_deg;
 } drive_loop_design_out_t;
 

@@ -37,14 +37,14 @@ typedef enum {
  * so that the per-sample step reads nothing but this. */
 typedef struct {
   gyro_drive_scheme_t scheme;
-  float dc_bias_v;   /* D */
-  float u_max_v;     /* largest voltage magnitude on either electrode */
-  float inv_4d;      /* 1 / (4 D) */
+  float dc_bias_v; /* D */
+  float u_max_v;   /* largest voltage magnitude on either electrode */
+  float inv_4d;    /* 1 / (4 D) */
   /* The current command (drive_synth_set): */
-  float a_v;         /* A, the voltage amplitude */
-  uint32_t off;      /* phase offset added to the NCO phase: P/2 (half-freq) or P (DC+AC) */
+  float a_v;    /* A, the voltage amplitude */
+  uint32_t off; /* phase offset added to the NCO phase: P/2 (half-freq) or P (DC+AC) */
   float f_set_v2, p_set_rad; /* the command as last passed to drive_synth_set (NaN: none) */
-  float p_turn_rad;  /* whole turns taken off P before the conversion (hysteresis) */
+  float p_turn_rad;          /* whole turns taken off P before the conversion (hysteresis) */
 } drive_synth_t;
 
 typedef struct {
@@ -88,8 +88,8 @@ static inline void drive_synth_follow(drive_synth_t *ds, float f_cmd_v2, float p
 
 /* One sample of the electrode voltages for the current command. phase: NCO phase at wc
  * of this sample; half_phase: its half-rate companion. */
-static inline void drive_synth_step(const drive_synth_t *ds, uint32_t phase, uint32_t half_phase,
-                                    float *u1_v, float *u2_v)
+static inline void drive_synth_step(const drive_synth_t *ds, uint32_t phase,
+                                    uint32_t half_phase, float *u1_v, float *u2_v)
 {
   float s, c;
   if (ds->scheme == GYRO_DRIVE_DC_AC) {

@@ -190,10 +190,10 @@ GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
   dac->code[HAL_DAC_RATE_OUT] = g->rate_code; /* the rate changes once per block */
   /* Built-in self-test force on the sense feedback electrodes (selftest.h). */
-  dac->code[HAL_DAC_SPARE] =
-      g->selftest.force_on != 0u
-          ? gyro_volts_to_dac(selftest_force(&g->selftest, ref.sin_wc, ref.cos_wc))
-          : (uint16_t)HAL_DAC_CODE_MID;
+  dac->code[HAL_DAC_SPARE] = g->selftest.force_on != 0u
+                                 ? gyro_volts_to_dac(
+                                       selftest_force(&g->selftest, ref.sin_wc, ref.cos_wc))
+                                 : (uint16_t)HAL_DAC_CODE_MID;
   g->out.tick++;
 
   /* Everything slower than the carrier: this tick's job of the block (gyro_block.h),

@@ -121,8 +121,8 @@ GYRO_RAMFUNC void gyro_block_measure(gyro_t *g, int drive_on)
 GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g, int drive_on)
 {
   if (drive_on) gyro_block_phase(g);
-  g->cont_fail =
-      selftest_cont_judge(&g->design->selftest, &g->selftest, g->sup.mode == GYRO_MODE_LOCKED);
+  g->cont_fail = selftest_cont_judge(&g->design->selftest, &g->selftest,
+                                     g->sup.mode == GYRO_MODE_LOCKED);
 }
 
 GYRO_RAMFUNC void gyro_block_rate(gyro_t *g)

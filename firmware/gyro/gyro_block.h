@@ -78,18 +78,10 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
 {
   const int drive_on = supervisor_drive_enabled(&g->sup);
   switch (slot) {
-  case GYRO_SLOT_PHASE_MEAS:
-    gyro_block_measure(g, drive_on);
-    break;
-  case GYRO_SLOT_PHASE_PI:
-    gyro_block_phase_judge(g, drive_on);
-    break;
-  case GYRO_SLOT_AMP:
-    gyro_block_amp(g);
-    break;
-  case GYRO_SLOT_COMMAND:
-    gyro_block_command(g);
-    break;
+  case GYRO_SLOT_PHASE_MEAS: gyro_block_measure(g, drive_on); break;
+  case GYRO_SLOT_PHASE_PI: gyro_block_phase_judge(g, drive_on); break;
+  case GYRO_SLOT_AMP: gyro_block_amp(g); break;
+  case GYRO_SLOT_COMMAND: gyro_block_command(g); break;
   case GYRO_SLOT_SUPERVISE:
     /* Its request to clear the loop state (sup.clear_req) is acted on next tick. */
     (void)supervisor_step(&g->design->sup, &g->sup, &g->sup_in);
@@ -103,12 +95,8 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
       gyro_block_project(g);
     }
     break;
-  case GYRO_SLOT_RATE:
-    gyro_block_rate(g);
-    break;
-  case GYRO_SLOT_QUAD:
-    gyro_block_quad(g);
-    break;
+  case GYRO_SLOT_RATE: gyro_block_rate(g); break;
+  case GYRO_SLOT_QUAD: gyro_block_quad(g); break;
   case GYRO_SLOT_P:
     if (selftest_running(&g->selftest)) {
       gyro_block_p_selftest(g);
@@ -116,9 +104,7 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
       gyro_block_p(g, g->sup.mode != GYRO_MODE_LOCKED);
     }
     break;
-  default: /* GYRO_SLOT_OUTPUT */
-    gyro_block_output(g, u1_v, u2_v);
-    break;
+  default: /* GYRO_SLOT_OUTPUT */ gyro_block_output(g, u1_v, u2_v); break;
   }
 }
 
@@ -146,30 +132,17 @@ static inline void gyro_block_finite(gyro_t *g)
 static inline void gyro_block_run_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
 {
   switch (slot) {
-  case GYRO_SLOT_PHASE_MEAS:
-    gyro_block_measure(g, 0);
-    break;
-  case GYRO_SLOT_AMP:
-    gyro_block_amp_measure(g);
-    break;
-  case GYRO_SLOT_COMMAND:
-    gyro_block_command(g);
-    break;
-  case GYRO_SLOT_SUPERVISE:
-    (void)supervisor_step(&g->design->sup, &g->sup, &g->sup_in);
-    break;
+  case GYRO_SLOT_PHASE_MEAS: gyro_block_measure(g, 0); break;
+  case GYRO_SLOT_AMP: gyro_block_amp_measure(g); break;
+  case GYRO_SLOT_COMMAND: gyro_block_command(g); break;
+  case GYRO_SLOT_SUPERVISE: (void)supervisor_step(&g->design->sup, &g->sup, &g->sup_in); break;
   case GYRO_SLOT_PROJECT:
     gyro_block_take_rails(g);
     if (g->sup.clear_req != 0u) gyro_block_clear(g);
     break;
-  case GYRO_SLOT_QUAD:
-    gyro_block_finite(g);
-    break;
-  case GYRO_SLOT_OUTPUT:
-    gyro_block_output_sweep(g, u1_v, u2_v);
-    break;
-  default: /* the drive loops' and the rate channel's jobs */
-    break;
+  case GYRO_SLOT_QUAD: gyro_block_finite(g); break;
+  case GYRO_SLOT_OUTPUT: gyro_block_output_sweep(g, u1_v, u2_v); break;
+  default: /* the drive loops' and the rate channel's jobs */ break;
   }
 }
 

@@ -97,7 +97,7 @@ static gyro_design_status_t design_selftest(const param_values_t *v, gyro_design
   st.ref_c = (float)cos(th);
   st.ref_s = (float)sin(th);
   st.scale_dps = v->rate_scale_dps;
-  st.base_blocks = v->sys_fs_hz / (5u * GYRO_BLOCK); /* 0.2 s */
+  st.base_blocks = v->sys_fs_hz / (5u * GYRO_BLOCK);    /* 0.2 s */
   st.settle_blocks = v->sys_fs_hz / (10u * GYRO_BLOCK); /* 0.1 s */
   st.meas_blocks = v->sys_fs_hz / (5u * GYRO_BLOCK);    /* 0.2 s */
   st.cont_on = v->selftest_continuous;
@@ -183,11 +183,11 @@ static gyro_design_status_t design_drive_loops(const param_values_t *v, double t
   const double fs = (double)v->sys_fs_hz;
   const double demod_bw = lmsd_bandwidth_hz((double)v->demod_mu_drive, fs);
   const double blk = (double)GYRO_BLOCK;
-  const drive_loop_design_in_t amp_in = {(double)v->drive_cal_gain_v_per_v2, tau_s,
-                                         (double)v->drive_amp_bw_hz, demod_bw, fs, blk,
-                                         lag_samples(GYRO_SLOT_AMP)};
-  const drive_loop_design_in_t ph_in = {1.0, tau_s, (double)v->drive_phase_bw_hz, demod_bw, fs, blk,
-                                        lag_samples(GYRO_SLOT_PHASE_MEAS)};
+  const drive_loop_design_in_t amp_in = {
+      (double)v->drive_cal_gain_v_per_v2, tau_s, (double)v->drive_amp_bw_hz, demod_bw, fs, blk,
+      lag_samples(GYRO_SLOT_AMP)};
+  const drive_loop_design_in_t ph_in = {1.0, tau_s, (double)v->drive_phase_bw_hz,     demod_bw,
+                                        fs,  blk,   lag_samples(GYRO_SLOT_PHASE_MEAS)};
   if (drive_loop_design(&amp_in, &t->amp_design) != 0) return GYRO_DESIGN_AMP_LOOP;
   if (drive_loop_design(&ph_in, &t->phase_design) != 0) return GYRO_DESIGN_PHASE_LOOP;
   const float fs_f = (float)v->sys_fs_hz;
@@ -217,8 +217,8 @@ static gyro_design_status_t design_rate(const param_values_t *v, double tau_s, g
   if (n <= 0) return GYRO_DESIGN_RATE_LPF;
   /* Reference of the rate channel: the drive motion as the loops hold it (phase at
    * its setpoint, amplitude at its setpoint), turned by the demodulation phase. */
-  const double psi =
-      ((double)v->rate_demod_phase_deg + (double)v->drive_phase_set_deg) * FM_PI / 180.0;
+  const double psi = ((double)v->rate_demod_phase_deg + (double)v->drive_phase_set_deg) *
+                     FM_PI / 180.0;
   t->rate.ref_re = (float)(cos(psi) / (double)v->drive_amp_set_v);
   t->rate.ref_im = (float)(sin(psi) / (double)v->drive_amp_set_v);
   t->rate.scale_dps = v->rate_scale_dps;
@@ -231,8 +231,8 @@ static gyro_design_status_t design_rate(const param_values_t *v, double tau_s, g
   t->rate.sf_c[3] = v->rate_sf_c3_per_deg3;
   t->rate.p_ref_deg = v->drive_p_init_deg;
   /* First-order low-pass of P at the decimated rate fs / RATE_P_DECIM. */
-  t->rate.p_lpf_alpha =
-      (float)(1.0 - exp(-2.0 * FM_PI * (double)v->rate_p_lpf_hz * RATE_P_DECIM / fs));
+  t->rate.p_lpf_alpha = (float)(1.0 - exp(-2.0 * FM_PI * (double)v->rate_p_lpf_hz *
+                                          RATE_P_DECIM / fs));
   t->rate.p_mode_k = (float)(1.0 - exp(-(double)GYRO_BLOCK / (fs * tau_s))); /* per block */
   t->rate.lpf_sections = (uint32_t)n;
   t->rate.min_drive_v = 0.05f * v->drive_amp_set_v;
@@ -250,7 +250,8 @@ static gyro_design_status_t design_supervisor(const param_values_t *v, double ta
   if (!(v->sup_lost_tol_rel >= v->sup_lock_tol_rel)) return GYRO_DESIGN_LOST_TOL;
   if (!(v->sup_amp_trip_rel > 1.0f + v->sup_lost_tol_rel)) return GYRO_DESIGN_AMP_TRIP;
   const float amp_max_v = GYRO_AMP_MAX_FRAC * HAL_ADC_FULL_SCALE_V;
-  if (!(v->drive_amp_set_v > 0.0f && v->drive_amp_set_v < amp_max_v)) return GYRO_DESIGN_AMP_SET;
+  if (!(v->drive_amp_set_v > 0.0f && v->drive_amp_set_v < amp_max_v))
+    return GYRO_DESIGN_AMP_SET;
   t->sup.dt_s = (float)GYRO_BLOCK / (float)v->sys_fs_hz;
   t->sup.lock_tol_rel = v->sup_lock_tol_rel;
   t->sup.lock_phase_tol_rad = v->sup_lock_phase_tol_deg * FM_RAD_PER_DEG_F;
@@ -263,7 +264,8 @@ static gyro_design_status_t design_supervisor(const param_values_t *v, double ta
   t->sup.clip_max_count = v->sup_clip_count;
   t->sup.lost_phase_tol_rad = (v->sup_lost_phase_tol_deg > v->sup_lock_phase_tol_deg
                                    ? v->sup_lost_phase_tol_deg
-                                   : v->sup_lock_phase_tol_deg) * FM_RAD_PER_DEG_F;
+                                   : v->sup_lock_phase_tol_deg) *
+                              FM_RAD_PER_DEG_F;
   t->sup.amp_set_v = v->drive_amp_set_v;
   t->sup.amp_max_v = amp_max_v;
   t->sup.acq_timeout_s = (float)acq_timeout_s(v, tau_s, t);
@@ -298,8 +300,9 @@ int gyro_design_complete(gyro_design_t *d)
   lmsd_t lmsd;
   drive_synth_t synth;
   return nco_init(&nco, &d->nco) == 0 && lmsd_init(&lmsd, &d->lmsd_drive) == 0 &&
-                 lmsd_init(&lmsd, &d->lmsd_sense) == 0 && drive_synth_init(&synth, &d->synth) == 0 &&
-                 rate_channel_cfg_ok(&d->rate) && rate_valid_cfg_ok(&d->valid)
+                 lmsd_init(&lmsd, &d->lmsd_sense) == 0 &&
+                 drive_synth_init(&synth, &d->synth) == 0 && rate_channel_cfg_ok(&d->rate) &&
+                 rate_valid_cfg_ok(&d->valid)
              ? 0
              : -1;
 }

@@ -26,10 +26,10 @@ typedef struct {
   drive_loop_cfg_t drive;
   selftest_cfg_t selftest;
   float rate_out_v_per_dps;
-  float rate_fault_out_v;  /* analog rate output while the rate is not valid */
+  float rate_fault_out_v;   /* analog rate output while the rate is not valid */
   uint16_t rate_fault_code; /* its DAC code (derived) */
   nco_cfg_t nco;
-  uint32_t nco_half_step;  /* the NCO's step at the drive frequency: the NCO's start */
+  uint32_t nco_half_step; /* the NCO's step at the drive frequency: the NCO's start */
   lmsd_cfg_t lmsd_drive, lmsd_sense;
   drive_synth_cfg_t synth;
   drive_loop_design_out_t amp_design, phase_design; /* what the designer achieved */

@@ -27,31 +27,31 @@
 /* A snapshot of the outputs of the latest tick (telemetry, status, the simulator). */
 typedef struct {
   uint32_t tick;
-  float rate_dps;        /* compensated, filtered rate */
-  float rate_unc_dps;    /* before temperature compensation */
-  float quad_dps;        /* quadrature, equivalent rate */
-  float drive_amp_v;     /* demodulated drive pickoff amplitude */
-  float drive_phase_deg; /* arg of the drive phasor */
-  float p_deg;           /* force phase P: the temperature signal */
-  float p_f_deg;         /* P low-passed (what the compensation uses) */
-  float f_cmd_v2;        /* drive force command */
-  float u1_v, u2_v;      /* drive electrode voltages written this tick */
+  float rate_dps;             /* compensated, filtered rate */
+  float rate_unc_dps;         /* before temperature compensation */
+  float quad_dps;             /* quadrature, equivalent rate */
+  float drive_amp_v;          /* demodulated drive pickoff amplitude */
+  float drive_phase_deg;      /* arg of the drive phasor */
+  float p_deg;                /* force phase P: the temperature signal */
+  float p_f_deg;              /* P low-passed (what the compensation uses) */
+  float f_cmd_v2;             /* drive force command */
+  float u1_v, u2_v;           /* drive electrode voltages written this tick */
   float sense_i_v, sense_q_v; /* sense LMSD phasor */
-  uint32_t mode;         /* gyro_mode_t */
-  uint32_t fault;        /* gyro_fault_t bits of the last fault */
-  uint32_t flags;        /* GYRO_FLAG_* */
-  uint32_t rate_invalid; /* RATE_INVALID_* reasons of this block (0: valid) */
-  float rate_out_v;      /* voltage commanded on the analog rate output this block */
-  uint32_t rate_valid;   /* 1 when the rate output can be trusted (output integrity), else 0 */
+  uint32_t mode;              /* gyro_mode_t */
+  uint32_t fault;             /* gyro_fault_t bits of the last fault */
+  uint32_t flags;             /* GYRO_FLAG_* */
+  uint32_t rate_invalid;      /* RATE_INVALID_* reasons of this block (0: valid) */
+  float rate_out_v;           /* voltage commanded on the analog rate output this block */
+  uint32_t rate_valid; /* 1 when the rate output can be trusted (output integrity), else 0 */
 } gyro_out_t;
 
 #define GYRO_FLAG_LOCKED (1u << 0)
 #define GYRO_FLAG_ADC_RAIL (1u << 1)
 #define GYRO_FLAG_DRIVE_LIMIT (1u << 2)
 #define GYRO_FLAG_FAULT (1u << 3)
-#define GYRO_FLAG_SELFTEST (1u << 4) /* the self-test force is on: rate output not valid */
-#define GYRO_FLAG_RATE_VALID (1u << 5) /* the rate output can be trusted (rate_valid.h) */
-#define GYRO_FLAG_OVER_RANGE (1u << 6) /* rate magnitude above rate.full_scale_dps */
+#define GYRO_FLAG_SELFTEST (1u << 4)    /* the self-test force is on: rate output not valid */
+#define GYRO_FLAG_RATE_VALID (1u << 5)  /* the rate output can be trusted (rate_valid.h) */
+#define GYRO_FLAG_OVER_RANGE (1u << 6)  /* rate magnitude above rate.full_scale_dps */
 #define GYRO_FLAG_SENSE_RANGE (1u << 7) /* sense pickoff near the ADC's range (warning) */
 
 typedef struct {
@@ -60,31 +60,31 @@ typedef struct {
    * through it; what follows is what the modules remember. */
   const gyro_design_t *design;
   float adc_v_per_code;
-  nco_t nco;             /* its step is the drive's own: set from the design at the start
+  nco_t nco; /* its step is the drive's own: set from the design at the start
                           * and when the drive frequency changes, moved by the sweep */
   lmsd_t lmsd_drive, lmsd_sense;
   drive_loop_t drive;
   drive_synth_t synth;
   rate_channel_t rate;
   supervisor_t sup;
-  uint32_t slot;         /* tick within the block, 0 .. GYRO_BLOCK - 1 */
-  uint32_t clip_count;   /* ADC rail codes since the block's projection (slot 5) */
-  uint32_t clip_block;   /* rail codes over the ticks of the latest projected block */
+  uint32_t slot;       /* tick within the block, 0 .. GYRO_BLOCK - 1 */
+  uint32_t clip_count; /* ADC rail codes since the block's projection (slot 5) */
+  uint32_t clip_block; /* rail codes over the ticks of the latest projected block */
   uint32_t clip_drive_count, clip_drive_block; /* the same, drive channel only */
-  const volatile uint32_t *lost_count; /* the HAL's count of lost samples */
-  uint32_t lost_seen;    /* its value at the last block */
-  uint32_t cont_fail;    /* the continuous self-test's verdict (GYRO_SLOT_P) */
+  const volatile uint32_t *lost_count;         /* the HAL's count of lost samples */
+  uint32_t lost_seen;                          /* its value at the last block */
+  uint32_t cont_fail;      /* the continuous self-test's verdict (GYRO_SLOT_P) */
   uint32_t rate_clear_due; /* the loop-state clear's rate-channel half is due (GYRO_SLOT_RATE) */
-  uint32_t flags_acc;    /* GYRO_FLAG_* seen since the last snapshot */
-  supervisor_in_t sup_in; /* the supervisor's evidence, gathered by the jobs before
+  uint32_t flags_acc;      /* GYRO_FLAG_* seen since the last snapshot */
+  supervisor_in_t sup_in;  /* the supervisor's evidence, gathered by the jobs before
                            * GYRO_SLOT_SUPERVISE (slot table above) */
   uint32_t weights_finite; /* first half of the finiteness check (GYRO_SLOT_AMP) */
-  uint16_t rate_code;    /* analog rate output DAC code, updated with the snapshot */
+  uint16_t rate_code;      /* analog rate output DAC code, updated with the snapshot */
   selftest_t selftest;
-  gyro_out_t out;        /* updated once per block (tick: every tick) */
+  gyro_out_t out; /* updated once per block (tick: every tick) */
   /* Last, so that what the sample path reads every block stays within the reach of
    * one load's immediate offset. */
-  rate_valid_t valid;    /* the rate-valid verdict and its monitors (once per block) */
+  rate_valid_t valid; /* the rate-valid verdict and its monitors (once per block) */
   selfcal_exec_t cal; /* self-calibration jobs, run while the supervisor is in SWEEP */
   rate_valid_history_t valid_history; /* onsets of the reasons, for `status` */
 } gyro_t;

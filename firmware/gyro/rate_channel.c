@@ -23,8 +23,8 @@ int rate_channel_cfg_ok(const rate_channel_cfg_t *cfg)
          cfg->ref_re * cfg->ref_re + cfg->ref_im * cfg->ref_im > 0.0f &&
          fm_isfinite(cfg->scale_dps) && finite4(cfg->bias_c_dps) && finite4(cfg->sf_c) &&
          cfg->p_lpf_alpha > 0.0f && cfg->p_lpf_alpha <= 1.0f && cfg->min_drive_v > 0.0f &&
-         fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg) &&
-         cfg->p_mode_k > 0.0f && cfg->p_mode_k <= 1.0f;
+         fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg) && cfg->p_mode_k > 0.0f &&
+         cfg->p_mode_k <= 1.0f;
 }
 
 int rate_channel_init(const rate_channel_cfg_t *cfg, rate_channel_t *rc)
@@ -35,7 +35,7 @@ int rate_channel_init(const rate_channel_cfg_t *cfg, rate_channel_t *rc)
   rc->p_hold = 0u;
   rc->p_new = 0u;
   rc->p_n = RATE_P_FAST_MAX; /* no fast start without a hold */
-  rc->p_a_mean = 0.0f;        /* set before its use (rate_channel_update_p) */
+  rc->p_a_mean = 0.0f;       /* set before its use (rate_channel_update_p) */
   rate_channel_reset(cfg, rc, cfg->p_ref_deg);
   return 0;
 }
@@ -128,8 +128,8 @@ GYRO_RAMFUNC void rate_channel_filter_rate(const rate_channel_cfg_t *restrict cf
   const float bias = b3[0] + p * (b3[1] + p * (b3[2] + p * b3[3]));
   const float sf = 1.0f + p * (s3[1] + p * (s3[2] + p * s3[3]));
   const float scale = cfg->scale_dps;
-  const float unc =
-      scale * biquad_sections_step(cfg->lpf, rc->lpf_rate, cfg->lpf_sections, rc->rate_raw);
+  const float unc = scale * biquad_sections_step(cfg->lpf, rc->lpf_rate, cfg->lpf_sections,
+                                                 rc->rate_raw);
   rc->rate_unc_dps = unc;
   rc->rate_dps = unc * sf - bias;
 }
@@ -141,8 +141,8 @@ GYRO_RAMFUNC void rate_channel_filter_quad(const rate_channel_cfg_t *restrict cf
                  biquad_sections_step(cfg->lpf, rc->lpf_quad, cfg->lpf_sections, rc->quad_raw);
 }
 
-void rate_channel_update(const rate_channel_cfg_t *cfg, rate_channel_t *rc, float w_i, float w_q,
-                         float p_rad)
+void rate_channel_update(const rate_channel_cfg_t *cfg, rate_channel_t *rc, float w_i,
+                         float w_q, float p_rad)
 {
   rate_channel_project(cfg, rc, w_i, w_q, p_rad);
   rate_channel_filter_rate(cfg, rc);
@@ -203,4 +203,3 @@ GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
   }
   return 0;
 }
-

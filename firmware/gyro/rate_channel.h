@@ -51,14 +51,14 @@
 /* What the channel is told (the designer, gyro_design): constant while it runs. The
  * rate and the quadrature filters share the one set of output low-pass sections. */
 typedef struct {
-  float ref_re, ref_im;       /* e^{j psi} / A_set */
-  float scale_dps;            /* deg/s per unit of Re(R) */
+  float ref_re, ref_im; /* e^{j psi} / A_set */
+  float scale_dps;      /* deg/s per unit of Re(R) */
   float bias_c_dps[4];
   float sf_c[4];
-  float p_ref_deg;            /* P around which its low-pass works (the start value) */
-  float p_lpf_alpha;          /* first-order low-pass of P at fs / RATE_P_DECIM */
-  float p_mode_k; /* per-block factor of the resonance's lag: 1 - exp(-T_block / (2Q/wn)) */
-  float min_drive_v;          /* below this measured drive amplitude no rate is formed */
+  float p_ref_deg;   /* P around which its low-pass works (the start value) */
+  float p_lpf_alpha; /* first-order low-pass of P at fs / RATE_P_DECIM */
+  float p_mode_k;    /* per-block factor of the resonance's lag: 1 - exp(-T_block / (2Q/wn)) */
+  float min_drive_v; /* below this measured drive amplitude no rate is formed */
   uint32_t lpf_sections;
   biquad_coeffs_t lpf[BIQUAD_MAX_SECTIONS]; /* output low-pass, designed for fs / RATE_DECIM */
 } rate_channel_cfg_t;
@@ -67,25 +67,25 @@ typedef struct {
 typedef struct {
   float p_acc_deg; /* sum of (P - p_ref), one sample per block, over RATE_P_DECIM ticks */
   uint32_t p_count;
-  float p_dev_deg;            /* low-passed P - p_ref */
-  float p_held_dev_deg;       /* P_f - p_ref while held: where the fast start began */
-  float p_held_w;             /* weight the held value still has in P_f (1 while held) */
-  float p_mode_rad;           /* P - p_ref through the resonance's lag, rad */
-  uint32_t p_hold;            /* nonzero: P is not the temperature yet, P_f holds */
-  uint32_t p_n;               /* P means since the last hold (fast start) */
-  float p_a_mean;             /* 1 / (p_n + 1 + prior): the fast start's next weight */
-  float acc_re, acc_im;       /* sense phasor summed over the current block */
-  uint32_t p_new;             /* set with each new P_f (rate_channel_update_p), for the
+  float p_dev_deg;      /* low-passed P - p_ref */
+  float p_held_dev_deg; /* P_f - p_ref while held: where the fast start began */
+  float p_held_w;       /* weight the held value still has in P_f (1 while held) */
+  float p_mode_rad;     /* P - p_ref through the resonance's lag, rad */
+  uint32_t p_hold;      /* nonzero: P is not the temperature yet, P_f holds */
+  uint32_t p_n;         /* P means since the last hold (fast start) */
+  float p_a_mean;       /* 1 / (p_n + 1 + prior): the fast start's next weight */
+  float acc_re, acc_im; /* sense phasor summed over the current block */
+  uint32_t p_new;       /* set with each new P_f (rate_channel_update_p), for the
                                * caller's checks of it; the caller clears it */
   biquad_state_t lpf_rate[BIQUAD_MAX_SECTIONS];
   biquad_state_t lpf_quad[BIQUAD_MAX_SECTIONS];
   /* Outputs of the latest block. */
-  float rate_raw;             /* Re(R) of the block mean, before the output filter */
-  float quad_raw;             /* Im(R) of the block mean */
-  float rate_unc_dps;         /* filtered, scaled, not compensated */
-  float quad_dps;             /* filtered, scaled quadrature */
-  float p_f_deg;              /* low-passed P */
-  float rate_dps;             /* compensated rate output */
+  float rate_raw;     /* Re(R) of the block mean, before the output filter */
+  float quad_raw;     /* Im(R) of the block mean */
+  float rate_unc_dps; /* filtered, scaled, not compensated */
+  float quad_dps;     /* filtered, scaled quadrature */
+  float p_f_deg;      /* low-passed P */
+  float rate_dps;     /* compensated rate output */
 } rate_channel_t;
 
 /* 1 when the configuration is one the channel can run, else 0 (the designer checks). */
@@ -131,8 +131,8 @@ static inline void rate_channel_hold_p(rate_channel_t *rc, int hold)
  * holds it over the block), for the reference's correction; the compensation uses P_f
  * as rate_channel_update_p last left it. Rate and quadrature outputs. The same as
  * rate_channel_project, rate_channel_filter_rate and rate_channel_filter_quad in a row. */
-void rate_channel_update(const rate_channel_cfg_t *cfg, rate_channel_t *rc, float w_i, float w_q,
-                         float p_rad);
+void rate_channel_update(const rate_channel_cfg_t *cfg, rate_channel_t *rc, float w_i,
+                         float w_q, float p_rad);
 
 /* The parts of the block update, for a caller that spreads them over the ticks of the
  * block (gyro_state.h), each once per block:
@@ -143,8 +143,8 @@ void rate_channel_update(const rate_channel_cfg_t *cfg, rate_channel_t *rc, floa
  *   rate_channel_filter_quad  after project: the same for quad_raw -> quad_dps
  *   rate_channel_update_p     any time: P's block sum, its low-pass every RATE_P_DECIM
  *                             ticks -> P_f (the compensation's from then on) */
-void rate_channel_project(const rate_channel_cfg_t *cfg, rate_channel_t *rc, float w_i, float w_q,
-                          float p_rad);
+void rate_channel_project(const rate_channel_cfg_t *cfg, rate_channel_t *rc, float w_i,
+                          float w_q, float p_rad);
 void rate_channel_filter_rate(const rate_channel_cfg_t *cfg, rate_channel_t *rc);
 void rate_channel_filter_quad(const rate_channel_cfg_t *cfg, rate_channel_t *rc);
 /* Returns 1 when it made a new P_f (every RATE_P_DECIM ticks while not held; p_new is

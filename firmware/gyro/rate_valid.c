@@ -7,12 +7,14 @@
 
 int rate_valid_cfg_ok(const rate_valid_cfg_t *c)
 {
-  return c != NULL && c->tol_dps > 0.0f && fm_isfinite(c->tol_dps) && c->full_scale_dps > 0.0f &&
-         fm_isfinite(c->full_scale_dps) && c->p_range_deg > 0.0f && fm_isfinite(c->p_range_deg) &&
-         c->p_window_max_deg > 0.0f && fm_isfinite(c->p_window_max_deg) &&
-         c->p_lag_per_deg > 0.0f && fm_isfinite(c->p_lag_per_deg) && c->sense_max_v2 > 0.0f &&
-         fm_isfinite(c->sense_max_v2) && c->phase_tol_rad > 0.0f && fm_isfinite(c->phase_tol_rad) &&
-         c->bias_slope_dps_per_deg >= 0.0f && fm_isfinite(c->bias_slope_dps_per_deg);
+  return c != NULL && c->tol_dps > 0.0f && fm_isfinite(c->tol_dps) &&
+         c->full_scale_dps > 0.0f && fm_isfinite(c->full_scale_dps) && c->p_range_deg > 0.0f &&
+         fm_isfinite(c->p_range_deg) && c->p_window_max_deg > 0.0f &&
+         fm_isfinite(c->p_window_max_deg) && c->p_lag_per_deg > 0.0f &&
+         fm_isfinite(c->p_lag_per_deg) && c->sense_max_v2 > 0.0f &&
+         fm_isfinite(c->sense_max_v2) && c->phase_tol_rad > 0.0f &&
+         fm_isfinite(c->phase_tol_rad) && c->bias_slope_dps_per_deg >= 0.0f &&
+         fm_isfinite(c->bias_slope_dps_per_deg);
 }
 
 int rate_valid_init(const rate_valid_cfg_t *cfg, rate_valid_t *rv)
@@ -57,9 +59,9 @@ GYRO_RAMFUNC static float lag_error_dps(const rate_valid_cfg_t *restrict c, floa
   return lag_deg * (fm_absf(quad_dps) * FM_RAD_PER_DEG_F + c->bias_slope_dps_per_deg);
 }
 
-GYRO_RAMFUNC void rate_valid_thermo(const rate_valid_cfg_t *restrict c, rate_valid_t *restrict rv,
-                                    float p_dev_deg, float p_held_dev_deg, float p_held_w,
-                                    float quad_dps)
+GYRO_RAMFUNC void rate_valid_thermo(const rate_valid_cfg_t *restrict c,
+                                    rate_valid_t *restrict rv, float p_dev_deg,
+                                    float p_held_dev_deg, float p_held_w, float quad_dps)
 {
   if (p_held_w > RATE_VALID_SLEW_W_MAX) {
     /* P_f still converging from a hold (THERMO_SETTLE bounds that): no slew of the
@@ -124,8 +126,7 @@ GYRO_RAMFUNC void rate_valid_drive(const rate_valid_cfg_t *restrict c, rate_vali
 const char *rate_valid_reason_name(uint32_t kind)
 {
   static const char *const names[RATE_INVALID_KINDS] = {
-      "MODE",        "SELFTEST", "SETTLING",     "CLIP",         "SENSE_RANGE",
-      "OVER_RANGE",  "PHASE",    "THERMO_RANGE", "THERMO_SLEW",  "THERMO_SETTLE",
-      "CONT_SELFTEST"};
+      "MODE",  "SELFTEST",     "SETTLING",    "CLIP",          "SENSE_RANGE",  "OVER_RANGE",
+      "PHASE", "THERMO_RANGE", "THERMO_SLEW", "THERMO_SETTLE", "CONT_SELFTEST"};
   return kind < RATE_INVALID_KINDS ? names[kind] : "?";
 }

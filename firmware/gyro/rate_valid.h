@@ -70,35 +70,35 @@
 #define RATE_VALID_SENSE_FRAC 0.8f
 
 typedef struct {
-  float tol_dps;            /* the largest rate error each source may leave */
+  float tol_dps; /* the largest rate error each source may leave */
   float full_scale_dps;
-  float p_range_deg;        /* |P_f - p_ref| the compensation holds for */
-  float p_window_max_deg;   /* largest change of P_f over RATE_VALID_SLEW_UPDATES updates */
-  float p_lag_per_deg;      /* P_f's lag per degree of change over that window:
+  float p_range_deg;            /* |P_f - p_ref| the compensation holds for */
+  float p_window_max_deg;       /* largest change of P_f over RATE_VALID_SLEW_UPDATES updates */
+  float p_lag_per_deg;          /* P_f's lag per degree of change over that window:
                              * its time constant / the window's length */
-  float sense_max_v2;       /* (RATE_VALID_SENSE_FRAC x ADC full scale)^2 */
-  float phase_tol_rad;      /* the lock tolerance of the drive phase */
+  float sense_max_v2;           /* (RATE_VALID_SENSE_FRAC x ADC full scale)^2 */
+  float phase_tol_rad;          /* the lock tolerance of the drive phase */
   float bias_slope_dps_per_deg; /* |dB/dP| of the compensation near p_ref */
 } rate_valid_cfg_t;
 
 typedef struct {
-  uint32_t reasons;         /* RATE_INVALID_* of the latest verdict */
-  uint32_t thermo;          /* RATE_INVALID_THERMO_* of the latest P update */
-  uint32_t drive;           /* RATE_INVALID_PHASE, _SENSE_RANGE of the latest block */
-  uint32_t range;           /* RATE_INVALID_OVER_RANGE of the latest block */
-  uint32_t settled;         /* nonzero once settled since the last disturbance */
-  uint32_t settle_run;      /* blocks in a row inside the settling tolerance */
-  uint32_t was_locked;      /* LOCKED at the previous verdict (entering it disturbs) */
-  float x_rate, x_quad;     /* fast low-passes of the filters' inputs (raw units) */
-  float p_dev_window_deg;   /* P_f - p_ref at the start of the slew window */
-  uint32_t p_updates;       /* P_f updates into the slew window */
-  uint32_t slew;            /* RATE_INVALID_THERMO_SLEW of the latest window */
-  uint32_t slew_due;        /* a window ended: rate_valid_slew judges it */
+  uint32_t reasons;          /* RATE_INVALID_* of the latest verdict */
+  uint32_t thermo;           /* RATE_INVALID_THERMO_* of the latest P update */
+  uint32_t drive;            /* RATE_INVALID_PHASE, _SENSE_RANGE of the latest block */
+  uint32_t range;            /* RATE_INVALID_OVER_RANGE of the latest block */
+  uint32_t settled;          /* nonzero once settled since the last disturbance */
+  uint32_t settle_run;       /* blocks in a row inside the settling tolerance */
+  uint32_t was_locked;       /* LOCKED at the previous verdict (entering it disturbs) */
+  float x_rate, x_quad;      /* fast low-passes of the filters' inputs (raw units) */
+  float p_dev_window_deg;    /* P_f - p_ref at the start of the slew window */
+  uint32_t p_updates;        /* P_f updates into the slew window */
+  uint32_t slew;             /* RATE_INVALID_THERMO_SLEW of the latest window */
+  uint32_t slew_due;         /* a window ended: rate_valid_slew judges it */
   float p_window_change_deg; /* |change of P_f| over the window that ended */
-  float phase_err_lp_rad;   /* the drive phase error through RATE_VALID_PHASE_K */
-  uint32_t blocks;          /* verdicts since power-on */
-  uint32_t onsets_pending;  /* reasons that set in, not yet in the history */
-  uint32_t onset_block;     /* the verdict that saw the latest of them */
+  float phase_err_lp_rad;    /* the drive phase error through RATE_VALID_PHASE_K */
+  uint32_t blocks;           /* verdicts since power-on */
+  uint32_t onsets_pending;   /* reasons that set in, not yet in the history */
+  uint32_t onset_block;      /* the verdict that saw the latest of them */
 } rate_valid_t;
 
 /* The history of the reasons for `status`: written only when a reason sets in, so it
@@ -145,7 +145,8 @@ void rate_valid_drive(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float phase
 static inline void rate_valid_range(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float rate_dps)
 {
   rv->range = (rate_dps <= cfg->full_scale_dps && rate_dps >= -cfg->full_scale_dps)
-                  ? 0u : RATE_INVALID_OVER_RANGE;
+                  ? 0u
+                  : RATE_INVALID_OVER_RANGE;
 }
 
 /* The onsets the verdict noted (onsets_pending) into the history, on a later, lighter

@@ -7,10 +7,10 @@
 #include "dsp/fastmath.h"
 #include "dsp/nco.h"
 
-#define SC_MIN_PEAK_V 0.02     /* chirp peak below this: not resolved from the noise */
+#define SC_MIN_PEAK_V 0.02 /* chirp peak below this: not resolved from the noise */
 #define SC_MAX_RETRIES 6u
-#define SC_EXCITE_MAX_S 1.5    /* ring-down excitation, at most */
-#define SC_RING_MAX_S 2.0      /* Q up to pi f 2 s */
+#define SC_EXCITE_MAX_S 1.5 /* ring-down excitation, at most */
+#define SC_RING_MAX_S 2.0   /* Q up to pi f 2 s */
 #define SC_AVG_S 0.1
 #define SC_SETTLE_TAU 7.0
 #define SC_HOLD_TAU 6.0
@@ -91,7 +91,8 @@ static void base_job(const selfcal_t *s, selfcal_job_t *j, selfcal_job_kind_t ki
 static uint32_t job_bound_ticks(const selfcal_job_t *j)
 {
   const uint64_t per_pt = (uint64_t)j->step_settle_ticks + j->avg_ticks;
-  const uint64_t n = (uint64_t)j->chirp_ticks + j->settle_ticks + ((uint64_t)j->n_pts + 2u) * per_pt;
+  const uint64_t n = (uint64_t)j->chirp_ticks + j->settle_ticks +
+                     ((uint64_t)j->n_pts + 2u) * per_pt;
   return n > 1000000000u ? 1000000000u : (uint32_t)n;
 }
 
@@ -121,7 +122,8 @@ static void post_chirp(selfcal_t *s, int up, selfcal_state_t next)
   const selfcal_cfg_t *c = &s->cfg;
   selfcal_job_t j;
   base_job(s, &j, SELFCAL_JOB_CHIRP);
-  const uint32_t lo = nco_half_step_of(c->f_lo_hz, c->fs_hz), hi = nco_half_step_of(c->f_hi_hz, c->fs_hz);
+  const uint32_t lo = nco_half_step_of(c->f_lo_hz, c->fs_hz),
+                 hi = nco_half_step_of(c->f_hi_hz, c->fs_hz);
   j.chirp_ticks = ticks_of((c->f_hi_hz - c->f_lo_hz) / c->chirp_hz_per_s, c->fs_hz);
   const int32_t d = (int32_t)((hi - lo) / j.chirp_ticks);
   j.chirp_delta = up ? d : -d;
@@ -177,7 +179,8 @@ static void on_chirp(selfcal_t *s, const selfcal_result_t *r, int up)
     return;
   }
   if ((double)r->peak_amp_v < SC_MIN_PEAK_V) {
-    if (more_force(s, (double)r->peak_amp_v) != 0) fail(s, "no resonance found in the search range");
+    if (more_force(s, (double)r->peak_amp_v) != 0)
+      fail(s, "no resonance found in the search range");
     else post_quiet(s, up ? SELFCAL_QUIET_UP : SELFCAL_QUIET_DOWN);
     return;
   }
@@ -262,9 +265,10 @@ static void on_steps(selfcal_t *s, const selfcal_result_t *r)
   double delay_s = c->delay_s;
   /* The converter delay is known; what the analog chain adds (up to 8 samples) is
    * identified with the model (selfcal_fit_delay). */
-  if (selfcal_fit_delay(pts, j->n_pts, c->delay_s, c->delay_s + 8.0 / c->fs_hz, &fit, &delay_s) != 0 ||
-      !(fit.rms_rel < 0.05) ||
-      !(fit.f0_hz > c->f_lo_hz && fit.f0_hz < c->f_hi_hz) || !(fit.q >= 1.0 && fit.q < 1.0e6)) {
+  if (selfcal_fit_delay(pts, j->n_pts, c->delay_s, c->delay_s + 8.0 / c->fs_hz, &fit,
+                        &delay_s) != 0 ||
+      !(fit.rms_rel < 0.05) || !(fit.f0_hz > c->f_lo_hz && fit.f0_hz < c->f_hi_hz) ||
+      !(fit.q >= 1.0 && fit.q < 1.0e6)) {
     fail(s, "frequency response does not fit a resonance");
     return;
   }
@@ -369,6 +373,7 @@ void selfcal_watch(selfcal_t *s, uint32_t now_ticks)
     limit_s = 2.0 * (double)s->job_bound_ticks / fs + 1.0;
   }
   if ((double)(uint32_t)(now_ticks - s->watch_t0) > limit_s * fs) {
-    fail(s, s->state == SELFCAL_WAIT_SWEEP ? "the drive never entered SWEEP" : "sweep step timed out");
+    fail(s, s->state == SELFCAL_WAIT_SWEEP ? "the drive never entered SWEEP"
+                                           : "sweep step timed out");
   }
 }

@@ -35,16 +35,16 @@
 
 typedef struct {
   double fs_hz;
-  double f_lo_hz, f_hi_hz;   /* search range of the resonance */
+  double f_lo_hz, f_hi_hz; /* search range of the resonance */
   double chirp_hz_per_s;
-  double quiet_s;            /* ring-down wait before each chirp */
-  double amp_max_v;          /* back-off threshold: 50 % of the ADC range */
-  double amp_meas_v;         /* peak amplitude aimed at by the measurements */
-  double f_cmd_start_v2;     /* first chirp force (low) */
-  double f_cmd_max_v2;       /* what the drive synthesis can deliver */
-  double amp_set_v;          /* the amplitude loop's set point */
-  double phase_set_rad;      /* the phase loop's set point */
-  double delay_s;            /* DAC latency + zero-order hold: 1.5 samples */
+  double quiet_s;        /* ring-down wait before each chirp */
+  double amp_max_v;      /* back-off threshold: 50 % of the ADC range */
+  double amp_meas_v;     /* peak amplitude aimed at by the measurements */
+  double f_cmd_start_v2; /* first chirp force (low) */
+  double f_cmd_max_v2;   /* what the drive synthesis can deliver */
+  double amp_set_v;      /* the amplitude loop's set point */
+  double phase_set_rad;  /* the phase loop's set point */
+  double delay_s;        /* DAC latency + zero-order hold: 1.5 samples */
 } selfcal_cfg_t;
 
 typedef enum {
@@ -85,12 +85,12 @@ typedef struct {
   double rd_f_hz, rd_q, rd_gain;
   double plan_f_hz, plan_hb_hz; /* centre and half bandwidth of the steps */
   selfcal_fit_t fit;
-  double delay_s;                 /* total chain delay found by the fit */
+  double delay_s; /* total chain delay found by the fit */
   double hold_f_cmd_v2, hold_p_rad;
-  float f0_hz_f;                  /* wn/2pi as the float parameter value */
-  uint32_t ticks;                 /* sweep length so far, samples */
+  float f0_hz_f;  /* wn/2pi as the float parameter value */
+  uint32_t ticks; /* sweep length so far, samples */
   uint32_t retries, refits;
-  const char *why;                /* reason of FAILED */
+  const char *why; /* reason of FAILED */
   /* selfcal_watch: the state last seen, since when (caller's ticks), and how long the
    * posted job may take (samples). */
   selfcal_state_t watch_state;

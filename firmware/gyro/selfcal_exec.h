@@ -51,42 +51,42 @@ typedef enum {
 } selfcal_job_kind_t;
 
 typedef struct {
-  uint32_t kind;                        /* selfcal_job_kind_t */
-  uint32_t n_pts;                       /* STEPS: 1..SELFCAL_MAX_PTS */
-  uint32_t half_step[SELFCAL_MAX_PTS];  /* STEPS: each point; others: [0] */
-  int32_t chirp_delta;                  /* CHIRP: half-step change per tick */
+  uint32_t kind;                       /* selfcal_job_kind_t */
+  uint32_t n_pts;                      /* STEPS: 1..SELFCAL_MAX_PTS */
+  uint32_t half_step[SELFCAL_MAX_PTS]; /* STEPS: each point; others: [0] */
+  int32_t chirp_delta;                 /* CHIRP: half-step change per tick */
   uint32_t chirp_ticks;
   uint32_t settle_ticks, step_settle_ticks;
   uint32_t avg_ticks;
   float f_cmd_v2;
   float p_rad;
-  float amp_max_v;                      /* back-off threshold (ADC budget) */
-  float amp_target_v;                   /* RINGDOWN: stop exciting above */
+  float amp_max_v;    /* back-off threshold (ADC budget) */
+  float amp_target_v; /* RINGDOWN: stop exciting above */
 } selfcal_job_t;
 
 typedef struct {
   float z_re[SELFCAL_MAX_PTS], z_im[SELFCAL_MAX_PTS]; /* STEPS: mean Z per point */
-  float f_cmd_v2[SELFCAL_MAX_PTS];                   /* STEPS: excitation it had */
-  float peak_amp_v;        /* CHIRP */
-  uint32_t peak_half_step; /* CHIRP */
-  float rd_amp0_v;         /* RINGDOWN: |Z| when the excitation stopped */
-  float rd_f_cmd_v2;       /* RINGDOWN: the excitation it had */
-  uint32_t rd_ticks;       /* RINGDOWN: ticks to |Z0| / e */
-  float rd_phase_rad;      /* RINGDOWN: rotation of Z over rd_ticks */
-  uint32_t aborted;        /* CHIRP: over-amplitude */
-  uint32_t backoffs;       /* halvings of f_cmd */
-  uint32_t ticks;          /* length of the job */
+  float f_cmd_v2[SELFCAL_MAX_PTS];                    /* STEPS: excitation it had */
+  float peak_amp_v;                                   /* CHIRP */
+  uint32_t peak_half_step;                            /* CHIRP */
+  float rd_amp0_v;    /* RINGDOWN: |Z| when the excitation stopped */
+  float rd_f_cmd_v2;  /* RINGDOWN: the excitation it had */
+  uint32_t rd_ticks;  /* RINGDOWN: ticks to |Z0| / e */
+  float rd_phase_rad; /* RINGDOWN: rotation of Z over rd_ticks */
+  uint32_t aborted;   /* CHIRP: over-amplitude */
+  uint32_t backoffs;  /* halvings of f_cmd */
+  uint32_t ticks;     /* length of the job */
 } selfcal_result_t;
 
 typedef struct {
-  selfcal_job_t job;        /* background writes before publishing job_seq */
-  selfcal_result_t res;     /* ISR writes before publishing done_seq */
-  _Atomic uint32_t job_seq; /* background writes */
-  _Atomic uint32_t done_seq;/* ISR writes */
+  selfcal_job_t job;         /* background writes before publishing job_seq */
+  selfcal_result_t res;      /* ISR writes before publishing done_seq */
+  _Atomic uint32_t job_seq;  /* background writes */
+  _Atomic uint32_t done_seq; /* ISR writes */
   /* ISR state */
   uint32_t running_seq;
-  uint32_t active;          /* a job is being executed */
-  uint32_t stage;           /* job-specific sub-state */
+  uint32_t active; /* a job is being executed */
+  uint32_t stage;  /* job-specific sub-state */
   uint32_t idx, ticks, check_ticks;
   uint32_t half_step;
   float f_cmd_v2, p_rad;

@@ -97,7 +97,8 @@ int selfcal_fit(const selfcal_point_t *pts, uint32_t n, double delay_s, selfcal_
     const double ph = -w * delay_s;
     const double hr = mr * cos(ph) - mi * sin(ph), hi = mr * sin(ph) + mi * cos(ph);
     const double m2 = pts[i].h_re * pts[i].h_re + pts[i].h_im * pts[i].h_im;
-    rss += ((hr - pts[i].h_re) * (hr - pts[i].h_re) + (hi - pts[i].h_im) * (hi - pts[i].h_im)) / m2;
+    rss += ((hr - pts[i].h_re) * (hr - pts[i].h_re) + (hi - pts[i].h_im) * (hi - pts[i].h_im)) /
+           m2;
   }
   out->f0_hz = wn / (2.0 * FM_PI);
   out->q = un / q;

@@ -24,11 +24,11 @@ typedef struct {
 } selfcal_point_t;
 
 typedef struct {
-  double f0_hz;          /* undamped resonance */
+  double f0_hz; /* undamped resonance */
   double q;
-  double gain_v_per_v2;  /* |H| at f0 */
-  double phase_rad;      /* arg H at f0, including the delay D */
-  double rms_rel;        /* rms relative residual of H */
+  double gain_v_per_v2; /* |H| at f0 */
+  double phase_rad;     /* arg H at f0, including the delay D */
+  double rms_rel;       /* rms relative residual of H */
 } selfcal_fit_t;
 
 /* n >= 2 points (4 unknowns), delay_s >= 0. Returns 0, or -1 (out untouched) for bad

@@ -106,8 +106,8 @@ GYRO_RAMFUNC void selftest_cont_advance(const selftest_cfg_t *restrict c, selfte
   set_force(c, st);
 }
 
-GYRO_RAMFUNC uint32_t selftest_cont_judge(const selftest_cfg_t *restrict c, selftest_t *restrict st,
-                                          int locked)
+GYRO_RAMFUNC uint32_t selftest_cont_judge(const selftest_cfg_t *restrict c,
+                                          selftest_t *restrict st, int locked)
 {
   if (c->cont_on == 0u || !locked) {
     st->cont_blocks = 0u;

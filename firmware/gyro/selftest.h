@@ -47,18 +47,18 @@ typedef enum {
 } selftest_state_t;
 
 typedef struct {
-  float amp_v;       /* force voltage amplitude A on the spare DAC channel */
-  uint32_t cont_on;  /* continuous self-test */
-  float cont_amp_v;  /* its force amplitude A_c */
-  uint32_t cont_step; /* its modulation's phase step per block (2^32 per turn) */
-  float cont_mu;     /* its LMS step size per block */
-  float cont_gain;   /* 1 - mu / 2: the notch's pass-band gain undone */
-  float cont_lo2, cont_hi2; /* bounds of the response's squared magnitude (raw rate units) */
+  float amp_v;                 /* force voltage amplitude A on the spare DAC channel */
+  uint32_t cont_on;            /* continuous self-test */
+  float cont_amp_v;            /* its force amplitude A_c */
+  uint32_t cont_step;          /* its modulation's phase step per block (2^32 per turn) */
+  float cont_mu;               /* its LMS step size per block */
+  float cont_gain;             /* 1 - mu / 2: the notch's pass-band gain undone */
+  float cont_lo2, cont_hi2;    /* bounds of the response's squared magnitude (raw rate units) */
   uint32_t cont_settle_blocks; /* blocks LOCKED before the response is judged */
-  float expect_dps;  /* response expected on the rate axis (calibrated on the part) */
-  float tol_rel;     /* pass band, relative */
-  float ref_c, ref_s; /* cos, sin of the drive phase setpoint */
-  float scale_dps;   /* rate channel scale: deg/s per unit of the unfiltered rate */
+  float expect_dps;            /* response expected on the rate axis (calibrated on the part) */
+  float tol_rel;               /* pass band, relative */
+  float ref_c, ref_s;          /* cos, sin of the drive phase setpoint */
+  float scale_dps;             /* rate channel scale: deg/s per unit of the unfiltered rate */
   uint32_t base_blocks, settle_blocks, meas_blocks;
   /* Derived (selftest_cfg_derive): 1 / base_blocks, 1 / meas_blocks, 1 / expect_dps (0
    * where the divisor is 0), so that the verdict's block divides nothing (its tick's
@@ -67,21 +67,21 @@ typedef struct {
 } selftest_cfg_t;
 
 typedef struct {
-  uint32_t state;    /* selftest_state_t */
-  uint32_t count;     /* blocks in the current state */
+  uint32_t state;           /* selftest_state_t */
+  uint32_t count;           /* blocks in the current state */
   float acc_base, acc_meas; /* sums of the unfiltered rate */
-  float result_dps;  /* measured response of the last test */
+  float result_dps;         /* measured response of the last test */
   uint32_t runs;
   /* The force formed every tick: a_c cos(phi) - a_s sin(phi), set once per block. */
   uint32_t force_on;
   float a_c, a_s;
   /* Continuous self-test. */
-  uint32_t cont_phase;   /* modulation phase */
-  float cont_c, cont_s;  /* cos, sin of the modulation of the current block */
-  float w[4];            /* LMS weights: rate (cos, sin), quadrature (cos, sin) */
-  float w_avg[2];        /* the rate axis's weights through SELFTEST_CONT_AVG_K */
-  uint32_t cont_blocks;  /* blocks LOCKED since the LMS started */
-  uint32_t cont_fail;    /* the response is judged and out of its band */
+  uint32_t cont_phase;  /* modulation phase */
+  float cont_c, cont_s; /* cos, sin of the modulation of the current block */
+  float w[4];           /* LMS weights: rate (cos, sin), quadrature (cos, sin) */
+  float w_avg[2];       /* the rate axis's weights through SELFTEST_CONT_AVG_K */
+  uint32_t cont_blocks; /* blocks LOCKED since the LMS started */
+  uint32_t cont_fail;   /* the response is judged and out of its band */
 } selftest_t;
 
 /* The derived fields of cfg from the others (background). */
@@ -114,8 +114,8 @@ static inline float selftest_force(const selftest_t *st, float sin_wc, float cos
 /* Once per block and axis (0 rate, 1 quadrature), on the block's projection (x, in
  * place) before its output filter: the continuous test's LMS measures its tone and takes
  * it out. Does nothing unless cont_on. Inline: it runs on ticks near their budget. */
-static inline void selftest_cont_notch(const selftest_cfg_t *restrict c, selftest_t *restrict st,
-                                       uint32_t axis, float *x)
+static inline void selftest_cont_notch(const selftest_cfg_t *restrict c,
+                                       selftest_t *restrict st, uint32_t axis, float *x)
 {
   if (c->cont_on == 0u) return;
   /* (5-5) at f_m: the weights' phasor is the tone; the error is the notched signal. */

@@ -17,8 +17,7 @@ int supervisor_cfg_derive(supervisor_cfg_t *cfg)
       !(cfg->lost_tol_rel >= cfg->lock_tol_rel) || !(cfg->lock_phase_tol_rad > 0.0f) ||
       !(cfg->lost_phase_tol_rad >= cfg->lock_phase_tol_rad) ||
       !(cfg->amp_trip_rel > 1.0f + cfg->lost_tol_rel) || !(cfg->lock_hold_s >= 0.0f) ||
-      !(cfg->amp_set_v > 0.0f) ||
-      !(cfg->amp_max_v > cfg->amp_set_v) ||
+      !(cfg->amp_set_v > 0.0f) || !(cfg->amp_max_v > cfg->amp_set_v) ||
       !(cfg->acq_timeout_s > cfg->lock_hold_s) || !(cfg->acq_timeout_s < 1e4f) ||
       !(cfg->lost_hold_s >= 0.0f) || !(cfg->sat_hold_s >= 0.0f) || !(cfg->retry_s >= 0.0f) ||
       !(cfg->lock_hold_s < 1e4f && cfg->lost_hold_s < 1e4f && cfg->sat_hold_s < 1e4f &&
@@ -54,7 +53,8 @@ void supervisor_init(supervisor_t *sv)
   sv->clip_sum = sv->clip_pos = 0u;
   sv->steps = 0u;
   for (uint32_t i = 0; i < GYRO_CLIP_WINDOW; i++) sv->clip_window[i] = 0u;
-  for (uint32_t i = 0; i < GYRO_FAULT_KINDS; i++) sv->kind_count[i] = sv->kind_last_step[i] = 0u;
+  for (uint32_t i = 0; i < GYRO_FAULT_KINDS; i++)
+    sv->kind_count[i] = sv->kind_last_step[i] = 0u;
 }
 
 GYRO_RAMFUNC static void set_mode(supervisor_t *restrict sv, gyro_mode_t m)
@@ -132,8 +132,9 @@ GYRO_RAMFUNC static uint32_t fault_seen(const supervisor_cfg_t *restrict c,
 
 /* ACQUIRE and LOCKED: the fault checks, the low-pass of the lock errors and the lock
  * decisions. The common path of the sample interrupt, kept straight. */
-GYRO_RAMFUNC static int step_driving(const supervisor_cfg_t *restrict c, supervisor_t *restrict sv,
-                                     const supervisor_in_t *in, gyro_mode_t mode)
+GYRO_RAMFUNC static int step_driving(const supervisor_cfg_t *restrict c,
+                                     supervisor_t *restrict sv, const supervisor_in_t *in,
+                                     gyro_mode_t mode)
 {
   const uint32_t f = fault_seen(c, sv, in, mode);
   if (f != GYRO_FAULT_NONE) {
@@ -162,7 +163,8 @@ GYRO_RAMFUNC static int step_driving(const supervisor_cfg_t *restrict c, supervi
     if (sv->sat_blocks >= c->sat_hold_blocks) return trip(sv, GYRO_FAULT_DRIVE_SAT);
   } else {
     sv->in_tol_blocks = (ae <= c->lock_tol_rel && pe <= c->lock_phase_tol_rad)
-                           ? sv->in_tol_blocks + 1u : 0u;
+                            ? sv->in_tol_blocks + 1u
+                            : 0u;
     if (sv->in_tol_blocks >= c->lock_hold_blocks) {
       set_mode(sv, GYRO_MODE_LOCKED);
     } else if (in->setpoint_moving) {

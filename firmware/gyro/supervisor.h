@@ -61,52 +61,51 @@ typedef struct {
   float lost_tol_rel, lost_hold_s;
   float lost_phase_tol_rad;
   float amp_trip_rel;
-  float amp_max_v;     /* absolute over-amplitude trip, V of drive pickoff */
-  float amp_set_v;     /* the setpoint amp_trip_rel multiplies */
+  float amp_max_v; /* absolute over-amplitude trip, V of drive pickoff */
+  float amp_set_v; /* the setpoint amp_trip_rel multiplies */
   float acq_timeout_s;
   float sat_hold_s;
   float retry_s;
   uint32_t clip_max_count;
   /* Derived (supervisor_cfg_derive): the times in supervisor steps (blocks), the lock
    * errors' low-pass and the one relative over-amplitude trip the sample path uses. */
-  uint32_t lock_hold_blocks, lost_hold_blocks, sat_hold_blocks, retry_blocks,
-           acq_timeout_blocks;
-  float err_lpf_k;       /* first-order low-pass (~100 Hz) of the lock errors, per step */
+  uint32_t lock_hold_blocks, lost_hold_blocks, sat_hold_blocks, retry_blocks, acq_timeout_blocks;
+  float err_lpf_k;        /* first-order low-pass (~100 Hz) of the lock errors, per step */
   float amp_trip_min_rel; /* min(amp_trip_rel A_set, amp_max_v) / A_set */
 } supervisor_cfg_t;
 
 typedef struct {
   gyro_mode_t mode;
-  uint32_t fault;          /* reason of the current/last fault (gyro_fault_t bits), shown
+  uint32_t fault;           /* reason of the current/last fault (gyro_fault_t bits), shown
                             * until cleared (supervisor_clear_fault) */
-  uint32_t fault_count;    /* faults since power-on */
-  uint32_t last_fault;     /* history: reason of the latest fault, kept by a clear */
+  uint32_t fault_count;     /* faults since power-on */
+  uint32_t last_fault;      /* history: reason of the latest fault, kept by a clear */
   uint32_t last_fault_step; /* steps count when it tripped */
   uint32_t clip_window[GYRO_CLIP_WINDOW]; /* rail codes of the last steps */
   uint32_t clip_sum, clip_pos;
-  uint32_t steps;          /* supervisor steps since power-on (the fault history's clock) */
+  uint32_t steps; /* supervisor steps since power-on (the fault history's clock) */
   uint32_t kind_count[GYRO_FAULT_KINDS];     /* faults of each kind (bit n of gyro_fault_t) */
   uint32_t kind_last_step[GYRO_FAULT_KINDS]; /* step of each kind's latest fault */
-  uint32_t in_tol_blocks;  /* consecutive steps inside lock tolerance */
-  uint32_t out_tol_blocks; /* consecutive steps outside lost tolerance while LOCKED */
+  uint32_t in_tol_blocks;                    /* consecutive steps inside lock tolerance */
+  uint32_t out_tol_blocks;   /* consecutive steps outside lost tolerance while LOCKED */
   uint32_t out_phase_blocks; /* consecutive steps beyond the lost phase tolerance */
-  uint32_t sat_blocks;      /* consecutive steps with the drive at its limit */
-  uint32_t fault_blocks;   /* steps spent in FAULT */
-  uint32_t mode_blocks;    /* steps spent in the current mode (ACQUIRE: since the end of
+  uint32_t sat_blocks;       /* consecutive steps with the drive at its limit */
+  uint32_t fault_blocks;     /* steps spent in FAULT */
+  uint32_t mode_blocks;      /* steps spent in the current mode (ACQUIRE: since the end of
                             * a setpoint move, the acquisition timeout's clock) */
   float amp_err_f, phase_err_f;
-  uint32_t primed;         /* the low-pass starts from the first error seen in a mode */
-  uint32_t clear_req;      /* set whenever supervisor_step returns 1, for a caller that
+  uint32_t primed;    /* the low-pass starts from the first error seen in a mode */
+  uint32_t clear_req; /* set whenever supervisor_step returns 1, for a caller that
                             * acts on it later; the caller clears it */
 } supervisor_t;
 
 /* What one block saw, for the supervisor to judge. */
 typedef struct {
-  float amp_rel_err;   /* (A - A_set) / A_set */
-  float amp_rel;       /* A / A_set */
+  float amp_rel_err; /* (A - A_set) / A_set */
+  float amp_rel;     /* A / A_set */
   float phase_err_rad;
   int drive_at_limit;  /* amplitude PI pinned at its maximum */
-  uint32_t clip_count;  /* drive-channel ADC rail codes since the last step */
+  uint32_t clip_count; /* drive-channel ADC rail codes since the last step */
   int state_finite;    /* every loop state value finite */
   int sample_lost;     /* a sample was lost since the last step */
   int setpoint_moving; /* the amplitude setpoint is slewing to a new value (drive_loop.h):

@@ -3,22 +3,31 @@
 #include <math.h>
 #include <string.h>
 
-#define PARAM_VAL_F32(x) {.f = (x)}
-#define PARAM_VAL_U32(x) {.u = (x)}
-#define PARAM_VAL_ENUM(x) {.u = (x)}
+#define PARAM_VAL_F32(x) \
+  { \
+    .f = (x) \
+  }
+#define PARAM_VAL_U32(x) \
+  { \
+    .u = (x) \
+  }
+#define PARAM_VAL_ENUM(x) \
+  { \
+    .u = (x) \
+  }
 
 static const param_info_t k_param_table[PARAM_COUNT] = {
 #define PARAM_X_INFO(sym, id_, name_, type_, unit_, min_, max_, def_, choices_, flags_, help_) \
-  {.name = (name_),                                                                           \
-   .unit = (unit_),                                                                           \
-   .help = (help_),                                                                           \
-   .min = PARAM_VAL_##type_(min_),                                                            \
-   .max = PARAM_VAL_##type_(max_),                                                            \
-   .def = PARAM_VAL_##type_(def_),                                                            \
-   .choices = (choices_),                                                                     \
-   .id = (id_),                                                                               \
-   .offset = (uint16_t)offsetof(param_values_t, sym),                                         \
-   .type = (uint8_t)PARAM_T_##type_,                                                          \
+  {.name = (name_), \
+   .unit = (unit_), \
+   .help = (help_), \
+   .min = PARAM_VAL_##type_(min_), \
+   .max = PARAM_VAL_##type_(max_), \
+   .def = PARAM_VAL_##type_(def_), \
+   .choices = (choices_), \
+   .id = (id_), \
+   .offset = (uint16_t)offsetof(param_values_t, sym), \
+   .type = (uint8_t)PARAM_T_##type_, \
    .flags = (uint8_t)(flags_)},
     PARAM_LIST(PARAM_X_INFO)
 #undef PARAM_X_INFO
@@ -53,12 +62,10 @@ param_idx_t param_lookup_id(uint16_t id)
   /* A switch on the ids: a duplicate id in param_list.h is a compile error here. */
   switch (id) {
 #define PARAM_X_CASE(sym, id_, ...) \
-  case (id_):                       \
-    return PARAM_##sym;
+  case (id_): return PARAM_##sym;
     PARAM_LIST(PARAM_X_CASE)
 #undef PARAM_X_CASE
-  default:
-    return PARAM_COUNT;
+  default: return PARAM_COUNT;
   }
 }
 
@@ -107,8 +114,7 @@ param_status_t param_check(param_idx_t i, param_value_t val)
     return (val.u >= pi->min.u && val.u <= pi->max.u) ? PARAM_OK : PARAM_ERR_CHOICE;
   case PARAM_T_U32:
     return (val.u >= pi->min.u && val.u <= pi->max.u) ? PARAM_OK : PARAM_ERR_RANGE;
-  default:
-    return PARAM_ERR_UNKNOWN;
+  default: return PARAM_ERR_UNKNOWN;
   }
 }
 
@@ -291,7 +297,10 @@ param_status_t params_set(params_t *p, param_idx_t i, param_value_t val, params_
 
 const param_values_t *params_current(const params_t *p) { return &p->block[active_index(p)]; }
 
-const void *params_current_derived(const params_t *p) { return p->cfg.derived[active_index(p)]; }
+const void *params_current_derived(const params_t *p)
+{
+  return p->cfg.derived[active_index(p)];
+}
 
 const param_values_t *params_staged(const params_t *p) { return &p->staged; }
 

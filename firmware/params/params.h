@@ -54,7 +54,7 @@ typedef enum {
 #define PARAM_X_IDX(sym, ...) PARAM_##sym,
   PARAM_LIST(PARAM_X_IDX)
 #undef PARAM_X_IDX
-  PARAM_COUNT
+      PARAM_COUNT
 } param_idx_t;
 
 #define PARAM_CTYPE_F32 float
@@ -116,7 +116,8 @@ const char *param_status_str(param_status_t st);
 /* Recompute the application's derived block from v (background loop). Return 0 to
  * accept; nonzero to reject the whole change, optionally pointing *why at a static
  * one-line reason. */
-typedef int (*params_derive_fn)(void *ctx, const param_values_t *v, void *derived, const char **why);
+typedef int (*params_derive_fn)(void *ctx, const param_values_t *v, void *derived,
+                                const char **why);
 /* true when the loop is in a safe mode (drive off / not LOCKED). */
 typedef bool (*params_loop_safe_fn)(void *ctx);
 

@@ -115,10 +115,15 @@ static void loop_at_equilibrium(drive_loop_t *dl, env_plant_t *p,
                                 const drive_loop_design_out_t *ph, double dt_s, double fs,
                                 double tau, double k)
 {
-  drive_loop_cfg_t c = {.dt_s = (float)dt_s, .amp_set_v = 2.0f, .phase_set_rad = 0.3f,
-                        .amp_kp = (float)amp->kp, .amp_ki = (float)amp->ki,
-                        .phase_kp = (float)ph->kp, .phase_ki = (float)ph->ki,
-                        .f_cmd_max_v2 = 196.0f, .p_init_rad = 0.3f};
+  drive_loop_cfg_t c = {.dt_s = (float)dt_s,
+                        .amp_set_v = 2.0f,
+                        .phase_set_rad = 0.3f,
+                        .amp_kp = (float)amp->kp,
+                        .amp_ki = (float)amp->ki,
+                        .phase_kp = (float)ph->kp,
+                        .phase_ki = (float)ph->ki,
+                        .f_cmd_max_v2 = 196.0f,
+                        .p_init_rad = 0.3f};
   assert_int_equal(dl_init(dl, &c), 0);
   const env_plant_t p0 = {1.9 * cos(0.3), 1.9 * sin(0.3), exp(-1.0 / (fs * tau)), k};
   *p = p0;
@@ -170,10 +175,15 @@ static void test_startup_no_overshoot(void **state)
   assert_int_equal(drive_loop_design(&in, &amp), 0);
   in.plant_gain = 1.0;
   assert_int_equal(drive_loop_design(&in, &ph), 0);
-  drive_loop_cfg_t c = {.dt_s = (float)(1.0 / fs), .amp_set_v = 2.0f, .phase_set_rad = 0.0f,
-                        .amp_kp = (float)amp.kp, .amp_ki = (float)amp.ki,
-                        .phase_kp = (float)ph.kp, .phase_ki = (float)ph.ki,
-                        .f_cmd_max_v2 = 80.0f, .p_init_rad = 0.0f}; /* 2.5 V at the limit */
+  drive_loop_cfg_t c = {.dt_s = (float)(1.0 / fs),
+                        .amp_set_v = 2.0f,
+                        .phase_set_rad = 0.0f,
+                        .amp_kp = (float)amp.kp,
+                        .amp_ki = (float)amp.ki,
+                        .phase_kp = (float)ph.kp,
+                        .phase_ki = (float)ph.ki,
+                        .f_cmd_max_v2 = 80.0f,
+                        .p_init_rad = 0.0f}; /* 2.5 V at the limit */
   drive_loop_t dl;
   assert_int_equal(dl_init(&dl, &c), 0);
   env_plant_t p = {1e-4, 0.0, exp(-1.0 / (fs * tau)), k};
@@ -273,7 +283,9 @@ static void test_p_init_whole_parameter_range(void **state)
   const float deg[] = {355.5f, 358.0f, 360.0f, -358.0f, -360.0f};
   for (size_t i = 0; i < sizeof deg / sizeof deg[0]; i++) {
     drive_loop_t dl;
-    drive_loop_cfg_t c = {.dt_s = 2e-5f, .amp_set_v = 2.0f, .f_cmd_max_v2 = 100.0f,
+    drive_loop_cfg_t c = {.dt_s = 2e-5f,
+                          .amp_set_v = 2.0f,
+                          .f_cmd_max_v2 = 100.0f,
                           .p_init_rad = deg[i] * 0.0174532925199433f};
     assert_int_equal(dl_init(&dl, &c), 0);
     assert_true(dl.p_rad == c.p_init_rad);
@@ -283,10 +295,13 @@ static void test_p_init_whole_parameter_range(void **state)
 int main(void)
 {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_design_formula),        cmocka_unit_test(test_design_caps_bandwidth),
+      cmocka_unit_test(test_design_formula),
+      cmocka_unit_test(test_design_caps_bandwidth),
       cmocka_unit_test(test_block_schedule),
-      cmocka_unit_test(test_closed_loop_first_order), cmocka_unit_test(test_startup_no_overshoot),
-      cmocka_unit_test(test_bad_cfg), cmocka_unit_test(test_p_init_whole_parameter_range),
+      cmocka_unit_test(test_closed_loop_first_order),
+      cmocka_unit_test(test_startup_no_overshoot),
+      cmocka_unit_test(test_bad_cfg),
+      cmocka_unit_test(test_p_init_whole_parameter_range),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

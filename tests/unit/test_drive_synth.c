@@ -38,7 +38,8 @@ static void check_force(gyro_drive_scheme_t scheme)
   assert_true(max_err < 64.0 * 2e-5);
   /* Continuity: no step larger than one sample's advance of the waveform. */
   const double slope = (scheme == GYRO_DRIVE_DC_AC ? 2.0 * M_PI * 1489.9 * 64.0 / 28.0
-                                                 : M_PI * 1489.9 * 8.0) / 50000.0;
+                                                   : M_PI * 1489.9 * 8.0) /
+                       50000.0;
   assert_true(max_jump < 1.05 * slope);
 }
 
@@ -47,7 +48,11 @@ static void test_half_frequency_force(void **state)
   (void)state;
   check_force(GYRO_DRIVE_HALF_FREQ);
 }
-static void test_dc_ac_force(void **state) { (void)state; check_force(GYRO_DRIVE_DC_AC); }
+static void test_dc_ac_force(void **state)
+{
+  (void)state;
+  check_force(GYRO_DRIVE_DC_AC);
+}
 
 /* Largest force each scheme can make within +-u_max on both electrodes. */
 static void test_limits(void **state)
@@ -107,7 +112,8 @@ static void test_bad_phase_zeroes_phase_and_turns(void **state)
 {
   (void)state;
   drive_synth_t ds, fresh;
-  const drive_synth_cfg_t c = {.scheme = GYRO_DRIVE_HALF_FREQ, .dc_bias_v = 0.0f, .u_max_v = 14.0f};
+  const drive_synth_cfg_t c = {
+      .scheme = GYRO_DRIVE_HALF_FREQ, .dc_bias_v = 0.0f, .u_max_v = 14.0f};
   assert_int_equal(drive_synth_init(&ds, &c), 0);
   assert_int_equal(drive_synth_init(&fresh, &c), 0);
   drive_synth_set(&ds, 64.0f, 1.0f);

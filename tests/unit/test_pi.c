@@ -64,8 +64,12 @@ static int t_set_limits(tpi_t *p, float u_min, float u_max)
 
 static pi_cfg_t cfg_default(void)
 {
-  return (pi_cfg_t){.kp = 0.5f, .ki = 200.0f, .dt_s = 1.0f / 50000.0f, .u_min = -10.0f,
-                    .u_max = 10.0f, .u_init = 0.0f};
+  return (pi_cfg_t){.kp = 0.5f,
+                    .ki = 200.0f,
+                    .dt_s = 1.0f / 50000.0f,
+                    .u_min = -10.0f,
+                    .u_max = 10.0f,
+                    .u_init = 0.0f};
 }
 
 /* Step e = E from e(-1) = 0: u(k) = u0 + Kp E + Ki T E k, the inverse z-transform of
@@ -110,8 +114,12 @@ static void test_thesis_example_coefficients(void **state)
 {
   (void)state;
   tpi_t pi;
-  const pi_cfg_t c = {.kp = 2e-5f, .ki = 5.7e-3f, .dt_s = 1.0f / 57000.0f, .u_min = -1.0f,
-                      .u_max = 1.0f, .u_init = 0.0f};
+  const pi_cfg_t c = {.kp = 2e-5f,
+                      .ki = 5.7e-3f,
+                      .dt_s = 1.0f / 57000.0f,
+                      .u_min = -1.0f,
+                      .u_max = 1.0f,
+                      .u_init = 0.0f};
   assert_int_equal(t_init(&pi, &c), 0);
   /* b0 = Kp, b1 = Ki T - Kp */
   assert_true(fabs((double)pi.c.kp - 2e-5) < 2e-5 * 1e-6);
@@ -135,8 +143,8 @@ static int recovery_samples(int n_sat, loop_opts_t o)
 {
   const double a = 0.99, kplant = 1.0;
   tpi_t pi;
-  const pi_cfg_t c = {.kp = 0.5f, .ki = 5.0f, .dt_s = 1e-3f, .u_min = -1.0f, .u_max = 1.0f,
-                      .u_init = 0.0f};
+  const pi_cfg_t c = {
+      .kp = 0.5f, .ki = 5.0f, .dt_s = 1e-3f, .u_min = -1.0f, .u_max = 1.0f, .u_init = 0.0f};
   assert_int_equal(t_init(&pi, &c), 0);
   double y = 0.0, integ = 0.0;
   int inside_since = -1;
@@ -175,8 +183,8 @@ static void test_anti_windup_recovery_independent_of_saturation_time(void **stat
   const int r_long = recovery_samples(5000, (loop_opts_t){0});
   const int p_short = recovery_samples(500, (loop_opts_t){1});
   const int p_long = recovery_samples(5000, (loop_opts_t){1});
-  print_message("recovery (samples): velocity form %d / %d, positional form %d / %d\n",
-                r_short, r_long, p_short, p_long);
+  print_message("recovery (samples): velocity form %d / %d, positional form %d / %d\n", r_short,
+                r_long, p_short, p_long);
   assert_true(abs(r_short - r_long) <= 1);
   assert_true(p_long > 2 * p_short); /* the windup the clamped velocity form avoids */
   assert_true(r_long < p_long);
@@ -188,9 +196,9 @@ static void test_gain_change_is_bumpless(void **state)
 {
   (void)state;
   tpi_t pi;
-  assert_int_equal(t_init(&pi, &(pi_cfg_t){cfg_default().kp, 200.0f, 1.0f / 50000.0f, -10.0f,
-                                            10.0f, 0.0f}),
-                   0);
+  assert_int_equal(
+      t_init(&pi, &(pi_cfg_t){cfg_default().kp, 200.0f, 1.0f / 50000.0f, -10.0f, 10.0f, 0.0f}),
+      0);
   const float e = 0.2f;
   float u = 0.0f;
   for (int k = 0; k < 100; k++) {

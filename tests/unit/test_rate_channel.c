@@ -12,8 +12,8 @@
 
 static rate_channel_cfg_t base_cfg(biquad_coeffs_t *sec, float phi_dm)
 {
-  const int n =
-      butter_design(BUTTER_LOWPASS, 4u, 100.0, 0.0, 50000.0 / RATE_DECIM, sec, BIQUAD_MAX_SECTIONS);
+  const int n = butter_design(BUTTER_LOWPASS, 4u, 100.0, 0.0, 50000.0 / RATE_DECIM, sec,
+                              BIQUAD_MAX_SECTIONS);
   assert_int_equal(n, 2);
   rate_channel_cfg_t c = {.ref_re = cosf(phi_dm),
                           .ref_im = sinf(phi_dm),
@@ -63,7 +63,8 @@ static void test_phasor_separation(void **state)
     c.ref_im = (float)(sin(psi) / amp);
     rate_channel_t rc;
     assert_int_equal(rc_init(&rc, &c), 0);
-    const double er = amp * (r * cos(psi) - q * sin(psi)), ei = amp * (r * sin(psi) + q * cos(psi));
+    const double er = amp * (r * cos(psi) - q * sin(psi)),
+                 ei = amp * (r * sin(psi) + q * cos(psi));
     block(&rc, (float)(0.3 * cos(th)), (float)(0.3 * sin(th)), (float)er, (float)ei, 0.0f);
     assert_true(fabs((double)rc.rate_raw - r) < 2e-6);
     assert_true(fabs((double)rc.quad_raw - q) < 2e-6);
@@ -178,9 +179,9 @@ static void test_reference_follows_drive_jitter(void **state)
   assert_int_equal(rc_init(&rc, &c), 0);
   const double q = 0.5, dp = 1e-3, k = 2.8e-3;
   double lag = 0.0, worst = 0.0;
-  for (int n = 0; n < 2500; n++) { /* 50 ms after the step */
-    const double p = dp;           /* P stepped at n = 0 */
-    lag += k * (p - lag);          /* the structure's response (6-17) */
+  for (int n = 0; n < 2500; n++) {                      /* 50 ms after the step */
+    const double p = dp;                                /* P stepped at n = 0 */
+    lag += k * (p - lag);                               /* the structure's response (6-17) */
     const double sr = -q * sin(lag), si = q * cos(lag); /* quadrature turned by the true phase */
     rate_channel_accumulate(&rc, (float)sr, (float)si);
     if (n % RATE_DECIM != RATE_DECIM - 1) continue;

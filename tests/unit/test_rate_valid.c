@@ -12,15 +12,14 @@
 
 static rate_valid_cfg_t cfg(void)
 {
-  const rate_valid_cfg_t c = {
-      .tol_dps = 0.25f,
-      .full_scale_dps = 300.0f,
-      .p_range_deg = 8.0f,
-      .p_window_max_deg = 0.005f,       /* 0.05 deg/s over 0.1 s */
-      .p_lag_per_deg = 0.159f / 0.1f,   /* 1 Hz low-pass, 0.1 s window */
-      .sense_max_v2 = 16.0f,
-      .phase_tol_rad = 0.01745f,
-      .bias_slope_dps_per_deg = 0.0f};
+  const rate_valid_cfg_t c = {.tol_dps = 0.25f,
+                              .full_scale_dps = 300.0f,
+                              .p_range_deg = 8.0f,
+                              .p_window_max_deg = 0.005f,     /* 0.05 deg/s over 0.1 s */
+                              .p_lag_per_deg = 0.159f / 0.1f, /* 1 Hz low-pass, 0.1 s window */
+                              .sense_max_v2 = 16.0f,
+                              .phase_tol_rad = 0.01745f,
+                              .bias_slope_dps_per_deg = 0.0f};
   return c;
 }
 
@@ -100,7 +99,8 @@ static void test_phase_leak(void **state)
 {
   (void)state;
   assert_int_equal(settle(), 0u);
-  for (int i = 0; i < 20000; i++) rate_valid_drive(&s_cfg, &rv, 0.008f * 0.0174533f, 1500.0f, 1.0f);
+  for (int i = 0; i < 20000; i++)
+    rate_valid_drive(&s_cfg, &rv, 0.008f * 0.0174533f, 1500.0f, 1.0f);
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   for (int i = 0; i < 20000; i++)
     rate_valid_drive(&s_cfg, &rv, 0.0105f * 0.0174533f, 1500.0f, 1.0f);

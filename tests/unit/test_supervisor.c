@@ -9,11 +9,20 @@
 
 static supervisor_cfg_t cfg(void)
 {
-  supervisor_cfg_t c = {
-      .dt_s = 1e-3f, .lock_tol_rel = 0.01f, .lock_phase_tol_rad = 0.02f, .lock_hold_s = 0.01f,
-      .lost_tol_rel = 0.1f, .lost_hold_s = 0.005f, .amp_trip_rel = 1.5f, .sat_hold_s = 0.02f,
-      .retry_s = 0.1f, .clip_max_count = 3u, .lost_phase_tol_rad = 0.05f, .amp_max_v = 4.75f,
-      .amp_set_v = 0.35f, .acq_timeout_s = 0.5f};
+  supervisor_cfg_t c = {.dt_s = 1e-3f,
+                        .lock_tol_rel = 0.01f,
+                        .lock_phase_tol_rad = 0.02f,
+                        .lock_hold_s = 0.01f,
+                        .lost_tol_rel = 0.1f,
+                        .lost_hold_s = 0.005f,
+                        .amp_trip_rel = 1.5f,
+                        .sat_hold_s = 0.02f,
+                        .retry_s = 0.1f,
+                        .clip_max_count = 3u,
+                        .lost_phase_tol_rad = 0.05f,
+                        .amp_max_v = 4.75f,
+                        .amp_set_v = 0.35f,
+                        .acq_timeout_s = 0.5f};
   return c;
 }
 
@@ -37,8 +46,12 @@ static int sup_step(supervisor_t *sv, const supervisor_in_t *in)
 
 static supervisor_in_t good(void)
 {
-  supervisor_in_t in = {.amp_rel_err = 0.0f, .amp_rel = 1.0f, .phase_err_rad = 0.0f,
-                        .drive_at_limit = 0, .clip_count = 0u, .state_finite = 1,
+  supervisor_in_t in = {.amp_rel_err = 0.0f,
+                        .amp_rel = 1.0f,
+                        .phase_err_rad = 0.0f,
+                        .drive_at_limit = 0,
+                        .clip_count = 0u,
+                        .state_finite = 1,
                         .sample_lost = 0};
   return in;
 }
@@ -353,10 +366,14 @@ int main(void)
       cmocka_unit_test(test_acquisition_timeout),
       cmocka_unit_test(test_absolute_over_amplitude),
       cmocka_unit_test(test_lost_sample),
-      cmocka_unit_test(test_bad_cfg_rejected),   cmocka_unit_test(test_lock_sequence),
-      cmocka_unit_test(test_lost_lock_and_retry), cmocka_unit_test(test_immediate_faults),
-      cmocka_unit_test(test_drive_saturation),   cmocka_unit_test(test_ripple_filtered),
-      cmocka_unit_test(test_clear_request_latched), cmocka_unit_test(test_off_and_sweep_faults),
+      cmocka_unit_test(test_bad_cfg_rejected),
+      cmocka_unit_test(test_lock_sequence),
+      cmocka_unit_test(test_lost_lock_and_retry),
+      cmocka_unit_test(test_immediate_faults),
+      cmocka_unit_test(test_drive_saturation),
+      cmocka_unit_test(test_ripple_filtered),
+      cmocka_unit_test(test_clear_request_latched),
+      cmocka_unit_test(test_off_and_sweep_faults),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -67,12 +67,18 @@ static volatile uint32_t s_sink_u;
 
 /* ---- wrappers of the inline kernels, and the empty calls of each type ---- */
 
-BK_OPAQUE static void w_lmsd(lmsd_t *s, float d, float rs, float rc) { lmsd_step(s, d, rs, rc); }
+BK_OPAQUE static void w_lmsd(lmsd_t *s, float d, float rs, float rc)
+{
+  lmsd_step(s, d, rs, rc);
+}
 BK_OPAQUE static void w_multdemod(multdemod_t *s, float d, float rs, float rc)
 {
   multdemod_step(s, d, rs, rc);
 }
-BK_OPAQUE static float w_biquad(biquad_cascade_t *s, float x) { return biquad_cascade_step(s, x); }
+BK_OPAQUE static float w_biquad(biquad_cascade_t *s, float x)
+{
+  return biquad_cascade_step(s, x);
+}
 BK_OPAQUE static float w_pi(bk_pi_t *p, float e) { return pi_step(&p->c, &p->s, e); }
 
 BK_OPAQUE static void e_lmsd(lmsd_t *s, float d, float rs, float rc)
@@ -113,18 +119,18 @@ BK_OPAQUE static void e_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_fram
 
 /* ---- runners: identical loops for the kernel and its empty call ---- */
 
-#define BK_DEMOD_RUNNER(tag, T)                                                          \
+#define BK_DEMOD_RUNNER(tag, T) \
   BK_RUNNER static void run_##tag(void (*fn)(T *, float, float, float), T *s, uint32_t n, \
-                                  bk_stat_t *st)                                         \
-  {                                                                                      \
-    for (uint32_t i = 0u; i < n; i++) {                                                  \
-      const uint32_t k = i & BK_MASK;                                                    \
-      const float d = s_in.d[k], rs = s_in.rs[k], rc = s_in.rc[k];                       \
-      const uint32_t t0 = bk_now();                                                      \
-      fn(s, d, rs, rc);                                                                  \
-      const uint32_t t1 = bk_now();                                                      \
-      if (st != NULL) bk_stat_add(st, t1 - t0);                                          \
-    }                                                                                    \
+                                  bk_stat_t *st) \
+  { \
+    for (uint32_t i = 0u; i < n; i++) { \
+      const uint32_t k = i & BK_MASK; \
+      const float d = s_in.d[k], rs = s_in.rs[k], rc = s_in.rc[k]; \
+      const uint32_t t0 = bk_now(); \
+      fn(s, d, rs, rc); \
+      const uint32_t t1 = bk_now(); \
+      if (st != NULL) bk_stat_add(st, t1 - t0); \
+    } \
   }
 
 BK_DEMOD_RUNNER(lmsd, lmsd_t)
@@ -132,25 +138,23 @@ BK_DEMOD_RUNNER(rlsd, rlsd_t)
 BK_DEMOD_RUNNER(kfd, kfd_t)
 BK_DEMOD_RUNNER(multdemod, multdemod_t)
 
-#define BK_FILTER_RUNNER(tag, T, input)                                         \
-  BK_RUNNER static void run_##tag(float (*fn)(T *, float), T *s, uint32_t n,    \
-                                  bk_stat_t *st)                                \
-  {                                                                             \
-    for (uint32_t i = 0u; i < n; i++) {                                         \
-      const float x = s_in.input[i & BK_MASK];                                  \
-      const uint32_t t0 = bk_now();                                             \
-      const float y = fn(s, x);                                                 \
-      const uint32_t t1 = bk_now();                                             \
-      s_sink_f = y;                                                             \
-      if (st != NULL) bk_stat_add(st, t1 - t0);                                 \
-    }                                                                           \
+#define BK_FILTER_RUNNER(tag, T, input) \
+  BK_RUNNER static void run_##tag(float (*fn)(T *, float), T *s, uint32_t n, bk_stat_t *st) \
+  { \
+    for (uint32_t i = 0u; i < n; i++) { \
+      const float x = s_in.input[i & BK_MASK]; \
+      const uint32_t t0 = bk_now(); \
+      const float y = fn(s, x); \
+      const uint32_t t1 = bk_now(); \
+      s_sink_f = y; \
+      if (st != NULL) bk_stat_add(st, t1 - t0); \
+    } \
   }
 
 BK_FILTER_RUNNER(biquad, biquad_cascade_t, x)
 BK_FILTER_RUNNER(pi, bk_pi_t, e)
 
-BK_RUNNER static void run_sincos(void (*fn)(uint32_t, float *, float *), uint32_t n,
-                                 bk_stat_t *st)
+BK_RUNNER static void run_sincos(void (*fn)(uint32_t, float *, float *), uint32_t n, bk_stat_t *st)
 {
   float s = 0.0f, c = 0.0f;
   for (uint32_t i = 0u; i < n; i++) {
@@ -179,7 +183,8 @@ BK_RUNNER static void run_nco(void (*fn)(nco_t *, nco_out_t *), nco_t *nco, uint
 
 /* The gyro: each iteration makes the plant's frame for this tick (not counted), then
  * the tick. Returns 1 if the gyro was LOCKED after every tick. */
-BK_RUNNER static uint32_t run_tick(void (*fn)(gyro_t *, const hal_adc_frame_t *, hal_dac_frame_t *),
+BK_RUNNER static uint32_t run_tick(void (*fn)(gyro_t *, const hal_adc_frame_t *,
+                                              hal_dac_frame_t *),
                                    uint32_t n, bk_stat_t *st)
 {
   hal_adc_frame_t adc;
@@ -216,13 +221,13 @@ void bk_stat_add(bk_stat_t *s, uint32_t v)
 }
 
 static const char *const k_names[BK_COUNT] = {
-    "lmsd_step", "biquad_1sec", "biquad_2sec_lp100", "sincos_lut", "nco_step",
+    "lmsd_step", "biquad_1sec", "biquad_2sec_lp100", "sincos_lut",     "nco_step",
     "pi_step",   "rlsd_step",   "kfd_step",          "multdemod_step", "gyro_tick"};
 
 const char *bk_name(bk_id_t id) { return (unsigned)id < BK_COUNT ? k_names[id] : NULL; }
 
 static const char *const k_symbols[BK_COUNT] = {
-    "w_lmsd", "w_biquad", "w_biquad", "sincos_lut", "nco_step",
+    "w_lmsd", "w_biquad",  "w_biquad", "sincos_lut",  "nco_step",
     "w_pi",   "rlsd_step", "kfd_step", "w_multdemod", "gyro_tick"};
 
 const char *bk_symbol(bk_id_t id) { return (unsigned)id < BK_COUNT ? k_symbols[id] : NULL; }
@@ -285,8 +290,8 @@ int bk_setup(void)
   param_values_defaults(&v);
   gyro_design_t d;
   if (gyro_design(&v, &d) != 0) return -1;
-  const pi_cfg_t pc = {d.drive.amp_kp, d.drive.amp_ki, d.drive.dt_s, 0.0f,
-                       d.drive.f_cmd_max_v2, 0.5f * d.drive.f_cmd_max_v2};
+  const pi_cfg_t pc = {d.drive.amp_kp, d.drive.amp_ki,       d.drive.dt_s,
+                       0.0f,           d.drive.f_cmd_max_v2, 0.5f * d.drive.f_cmd_max_v2};
   if (lmsd_init(&s_lmsd, &lc) != 0 || rlsd_init(&s_rlsd, &rc) != 0 || kfd_init(&s_kfd, &kc) != 0 ||
       nco_init(&s_nco, &nc) != 0 || pi_init(&pc, &s_pi.c, &s_pi.s) != 0) {
     return -1;
@@ -294,7 +299,8 @@ int bk_setup(void)
   /* The rate output low-pass as the product runs it: 100 Hz, 4th order (two sections)
    * at fs/10; one section = the 2nd-order design. */
   biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
-  int n = butter_design(BUTTER_LOWPASS, 2u, 100.0, 0.0, BK_FS_HZ / 10.0, sec, BIQUAD_MAX_SECTIONS);
+  int n = butter_design(BUTTER_LOWPASS, 2u, 100.0, 0.0, BK_FS_HZ / 10.0, sec,
+                        BIQUAD_MAX_SECTIONS);
   if (n != 1 || biquad_cascade_init(&s_bq1, sec, 1u) != 0) return -2;
   n = butter_design(BUTTER_LOWPASS, 4u, 100.0, 0.0, BK_FS_HZ / 10.0, sec, BIQUAD_MAX_SECTIONS);
   if (n != 2 || biquad_cascade_init(&s_bq2, sec, 2u) != 0) return -3;
@@ -362,8 +368,7 @@ static int run_case(bk_id_t id, uint32_t n, bk_stat_t *kern, bk_stat_t *base, ui
     if (base != NULL) (void)run_tick(e_tick, n, base);
     return 0;
   case BK_COUNT:
-  default:
-    return -1;
+  default: return -1;
   }
 }
 

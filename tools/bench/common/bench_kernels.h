@@ -42,8 +42,8 @@ typedef struct {
 } bk_stat_t;
 
 typedef struct {
-  bk_stat_t kern; /* counter deltas around the kernel call */
-  bk_stat_t base; /* the same loop around an empty call */
+  bk_stat_t kern;  /* counter deltas around the kernel call */
+  bk_stat_t base;  /* the same loop around an empty call */
   uint32_t locked; /* gyro_tick: 1 if the gyro stayed LOCKED through the run */
 } bk_result_t;
 

@@ -25,10 +25,10 @@
 
 typedef struct {
   nco_t nco;
-  float amp_v;      /* drive pickoff amplitude a */
-  float theta_rad;  /* drive pickoff phase theta */
-  float gain;       /* K, V per Ks V^2 */
-  float alpha;      /* T / tau */
+  float amp_v;     /* drive pickoff amplitude a */
+  float theta_rad; /* drive pickoff phase theta */
+  float gain;      /* K, V per Ks V^2 */
+  float alpha;     /* T / tau */
   float theta0_rad;
   float sense_re, sense_im; /* sense phasor relative to the drive phasor */
   uint32_t lcg;

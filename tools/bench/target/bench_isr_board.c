@@ -16,9 +16,6 @@ void bench_board_set_frame(const hal_adc_frame_t *frame)
   s_adc_rx[1] = frame->sense;
 }
 
-void bench_board_arm(void)
-{
-  bench_fake_dma2.LISR = DMA_FLAG_TCIF; /* stream 0: shift 0 */
-}
+void bench_board_arm(void) { bench_fake_dma2.LISR = DMA_FLAG_TCIF; /* stream 0: shift 0 */ }
 
 void bench_board_clear_tc(void) { bench_fake_dma2.LISR = 0u; }

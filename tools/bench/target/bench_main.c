@@ -53,8 +53,8 @@
 #define BENCH_SPARE_IRQ 57u /* DMA2 stream 1: unused by the port; the baseline IRQ */
 #define BENCH_WARMUP_MAX 400000u
 #define BENCH_SETTLE 5000u
-#define BENCH_N_TRACE 100u      /* traced ISRs: ten rate-filter ticks, one P-filter tick */
-#define BENCH_N_TRACE_MODE 40u  /* traced ISRs of each other mode: four blocks */
+#define BENCH_N_TRACE 100u     /* traced ISRs: ten rate-filter ticks, one P-filter tick */
+#define BENCH_N_TRACE_MODE 40u /* traced ISRs of each other mode: four blocks */
 #define BENCH_SETTLE_TRACE 500u
 
 #define SYS_WRITE0 0x04u
@@ -173,9 +173,14 @@ static uint32_t reads_around(int nops)
   uint32_t t0, t1;
   if (nops != 0) {
     __asm__ volatile("ldr %0, [%2]\n .rept 100\n nop\n .endr\n ldr %1, [%2]"
-                     : "=&r"(t0), "=&r"(t1) : "r"(cnt) : "memory");
+                     : "=&r"(t0), "=&r"(t1)
+                     : "r"(cnt)
+                     : "memory");
   } else {
-    __asm__ volatile("ldr %0, [%2]\n ldr %1, [%2]" : "=&r"(t0), "=&r"(t1) : "r"(cnt) : "memory");
+    __asm__ volatile("ldr %0, [%2]\n ldr %1, [%2]"
+                     : "=&r"(t0), "=&r"(t1)
+                     : "r"(cnt)
+                     : "memory");
   }
   return t1 - t0;
 }
@@ -195,8 +200,8 @@ static void calibrate(void)
 
 static app_t s_app;
 static bench_plant_t s_plant;
-static uint32_t s_n;    /* iterations per case */
-static int s_each;      /* trace mode: print every interrupt's count */
+static uint32_t s_n; /* iterations per case */
+static int s_each;   /* trace mode: print every interrupt's count */
 
 typedef void (*isr_fn)(void *);
 
