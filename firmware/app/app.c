@@ -54,7 +54,8 @@ static bool designable(app_t *a, const param_values_t *v, const char **why)
 static void mark_dropped(app_t *a, unsigned i, bool on)
 {
   const uint32_t bit = 1u << (i % 32u);
-  a->store_dropped[i / 32u] = on ? (a->store_dropped[i / 32u] | bit) : (a->store_dropped[i / 32u] & ~bit);
+  a->store_dropped[i / 32u] = on ? (a->store_dropped[i / 32u] | bit)
+                                 : (a->store_dropped[i / 32u] & ~bit);
 }
 
 /* A stored set whose values pass one by one but cannot be designed together: set stored
@@ -67,7 +68,8 @@ static void keep_designable(app_t *a, param_values_t *v)
   unsigned end = 0u; /* one past the last value set back */
   for (unsigned i = 0; i < (unsigned)PARAM_COUNT; i++) {
     const param_info_t *pi = param_info((param_idx_t)i);
-    if ((pi->flags & PF_PERSIST) == 0u || param_value_equal((param_idx_t)i, param_get(v, (param_idx_t)i), pi->def)) {
+    if ((pi->flags & PF_PERSIST) == 0u ||
+        param_value_equal((param_idx_t)i, param_get(v, (param_idx_t)i), pi->def)) {
       continue;
     }
     param_put(v, (param_idx_t)i, pi->def);
@@ -129,7 +131,8 @@ int app_init_with(app_t *a, const param_values_t *values)
   gyro_attach_lost_counter(&a->gyro, hal_sample_lost_counter());
   a->applied = view.derived;
 
-  const cli_cfg_t cc = {&a->params, &a->store, cli_write, a, cli_builtin_cmds, cli_builtin_count()};
+  const cli_cfg_t cc = {&a->params, &a->store,        cli_write,
+                        a,          cli_builtin_cmds, cli_builtin_count()};
   if (cli_init(&a->cli, &cc) != 0 || app_cmds_register(a) != 0 ||
       app_tlm_init(&a->tlm, &a->cli, &a->params) != 0 ||
       selfcal_init(&a->selfcal, &a->gyro.cal) != 0) {

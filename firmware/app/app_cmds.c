@@ -22,10 +22,11 @@ static const char *mode_name(uint32_t m)
 static const struct {
   uint32_t bit;
   const char *name;
-} k_fault_names[] = {{GYRO_FAULT_ADC_CLIP, "ADC_CLIP"},   {GYRO_FAULT_NAN, "NAN"},
-               {GYRO_FAULT_LOST_LOCK, "LOST_LOCK"}, {GYRO_FAULT_DRIVE_SAT, "DRIVE_SAT"},
-               {GYRO_FAULT_OVER_AMP, "OVER_AMP"},   {GYRO_FAULT_PHASE_LOST, "PHASE_LOST"},
-               {GYRO_FAULT_ACQ_TIMEOUT, "ACQ_TIMEOUT"}, {GYRO_FAULT_LOST_SAMPLE, "LOST_SAMPLE"}};
+} k_fault_names[] = {
+    {GYRO_FAULT_ADC_CLIP, "ADC_CLIP"},       {GYRO_FAULT_NAN, "NAN"},
+    {GYRO_FAULT_LOST_LOCK, "LOST_LOCK"},     {GYRO_FAULT_DRIVE_SAT, "DRIVE_SAT"},
+    {GYRO_FAULT_OVER_AMP, "OVER_AMP"},       {GYRO_FAULT_PHASE_LOST, "PHASE_LOST"},
+    {GYRO_FAULT_ACQ_TIMEOUT, "ACQ_TIMEOUT"}, {GYRO_FAULT_LOST_SAMPLE, "LOST_SAMPLE"}};
 #define FAULT_NAMES (sizeof k_fault_names / sizeof k_fault_names[0])
 _Static_assert(FAULT_NAMES == GYRO_FAULT_KINDS, "a name for every fault kind");
 
@@ -191,7 +192,10 @@ static void put_fault(cli_t *cli, app_t *a)
   cli_emit_data(cli);
 }
 
-static void put_rate(cli_t *cli, app_t *a) { cli_data_f32(cli, "rate_dps", a->gyro.out.rate_dps); }
+static void put_rate(cli_t *cli, app_t *a)
+{
+  cli_data_f32(cli, "rate_dps", a->gyro.out.rate_dps);
+}
 
 static void put_drive(cli_t *cli, app_t *a)
 {
@@ -376,8 +380,9 @@ static void put_sweep_points(cli_t *cli, const app_t *a)
   const selfcal_t *s = &a->selfcal;
   const uint32_t n = selfcal_export_count(s);
   if (n == 0u) {
-    cli_err(cli, "STATE", selfcal_running(s) ? "a sweep is in progress: wait for it to end"
-                                             : "no sweep has measured points yet: run sweep");
+    cli_err(cli, "STATE",
+            selfcal_running(s) ? "a sweep is in progress: wait for it to end"
+                               : "no sweep has measured points yet: run sweep");
     return;
   }
   uint8_t order[SELFCAL_EXPORT_MAX] = {0};
@@ -397,8 +402,9 @@ static void put_sweep_points(cli_t *cli, const app_t *a)
     double ph = atan2((double)p->z_im, (double)p->z_re) * FM_DEG_PER_RAD - 90.0;
     if (ph <= -180.0) ph += 360.0;
     const float gain = p->f_cmd_v2 > 0.0f ? (float)(amp / (double)p->f_cmd_v2) : 0.0f;
-    cli_putf(cli, "point %u f_hz %f amp_v %f phase_deg %f f_cmd_v2 %f gain_v_per_v2 %f stage %u", k,
-             (float)selfcal_export_f_hz(s, order[k]), (float)amp, (float)ph, p->f_cmd_v2, gain, p->stage);
+    cli_putf(cli, "point %u f_hz %f amp_v %f phase_deg %f f_cmd_v2 %f gain_v_per_v2 %f stage %u",
+             k, (float)selfcal_export_f_hz(s, order[k]), (float)amp, (float)ph, p->f_cmd_v2,
+             gain, p->stage);
     cli_emit_data(cli);
   }
   cli_putf(cli, "%u points", n);
@@ -433,15 +439,19 @@ int app_cmds_register(app_t *a)
                             cmd_status, a};
   const cli_cmd_t drive = {"drive", "on|off", "start or stop the drive (acquire / safe mode)",
                            cmd_drive, a};
-  const cli_cmd_t sweep = {"sweep", "[points]", "self-calibration: identify the drive mode, "
-                            "redesign the loops, then acquire; points: the latest sweep's "
-                            "measured points", cmd_sweep, a};
+  const cli_cmd_t sweep = {"sweep", "[points]",
+                           "self-calibration: identify the drive mode, "
+                           "redesign the loops, then acquire; points: the latest sweep's "
+                           "measured points",
+                           cmd_sweep, a};
   cmds[0] = status;
   cmds[1] = drive;
-  const cli_cmd_t selftest = {"selftest", "", "built-in self-test: a known force on the sense "
-                               "mode, checked on the rate output", cmd_selftest, a};
+  const cli_cmd_t selftest = {"selftest", "",
+                              "built-in self-test: a known force on the sense "
+                              "mode, checked on the rate output",
+                              cmd_selftest, a};
   const cli_cmd_t clear = {"clear", "", "clear the shown fault (status keeps it as last_fault)",
-                            cmd_clear, a};
+                           cmd_clear, a};
   cmds[2] = sweep;
   cmds[3] = selftest;
   cmds[4] = clear;

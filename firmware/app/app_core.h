@@ -26,7 +26,7 @@ typedef enum {
   APP_REQ_NONE = 0u,
   APP_REQ_DRIVE_ON = 1u,
   APP_REQ_DRIVE_OFF = 2u,
-  APP_REQ_SWEEP = 3u,         /* enter SWEEP: self-calibration (app_selfcal.h) */
+  APP_REQ_SWEEP = 3u,          /* enter SWEEP: self-calibration (app_selfcal.h) */
   APP_REQ_SWEEP_HANDOVER = 4u, /* SWEEP -> ACQUIRE with the newly applied design */
   APP_REQ_SELFTEST = 5u,       /* run the built-in self-test (selftest.h) */
   APP_REQ_CLEAR = 6u           /* clear the shown fault; its record stays (last_fault) */
@@ -38,8 +38,8 @@ typedef void (*app_status_fn)(cli_t *cli, void *ctx);
 
 typedef struct {
   params_t params;
-  gyro_design_t derived[2];  /* the bank's derived blocks */
-  const void *applied;       /* derived block the ISR runs with */
+  gyro_design_t derived[2]; /* the bank's derived blocks */
+  const void *applied;      /* derived block the ISR runs with */
   gyro_t gyro;
   param_store_t store;
   param_store_status_t store_status; /* result of the boot-time load */

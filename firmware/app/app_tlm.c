@@ -75,22 +75,26 @@ static void cmd_stream(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   }
   const param_values_t *v = params_current(t->params);
   float rate_hz = (float)v->tlm_rate_hz;
-  if (rate_arg != NULL && numparse_f32(&rate_arg[1], strlen(&rate_arg[1]), &rate_hz) != NUMPARSE_OK) {
+  if (rate_arg != NULL &&
+      numparse_f32(&rate_arg[1], strlen(&rate_arg[1]), &rate_hz) != NUMPARSE_OK) {
     cli_err(cli, "VALUE", "rate is not a number: @RATE_HZ, e.g. @1000");
     return;
   }
   tlm_plan_t plan;
-  const tlm_status_t st = tlm_plan(&app_tlm_fields, t->stream.cfg.fs_hz, t->stream.cfg.baud, mask, rate_hz, &plan);
+  const tlm_status_t st = tlm_plan(&app_tlm_fields, t->stream.cfg.fs_hz, t->stream.cfg.baud,
+                                   mask, rate_hz, &plan);
   if (st == TLM_ERR_RATE) {
     cli->out_len = 0u;
-    cli_putf(cli, "rate must be > 0 and within [fs / %u, fs], fs = %u Hz", TLM_DECIM_MAX, t->stream.cfg.fs_hz);
+    cli_putf(cli, "rate must be > 0 and within [fs / %u, fs], fs = %u Hz", TLM_DECIM_MAX,
+             t->stream.cfg.fs_hz);
     cli_emit_err(cli, "RANGE");
     return;
   }
   if (st == TLM_ERR_BANDWIDTH) {
     cli->out_len = 0u;
-    cli_putf(cli, "%u fields at %f Hz need %u B/s, over %u%% of the link (%u of %u B/s); "
-                  "fewer fields or a lower rate",
+    cli_putf(cli,
+             "%u fields at %f Hz need %u B/s, over %u%% of the link (%u of %u B/s); "
+             "fewer fields or a lower rate",
              plan.n_fields, plan.rate_hz, plan.bytes_per_s, TLM_LINK_MAX_PCT,
              plan.link_bytes_per_s * TLM_LINK_MAX_PCT / 100u, plan.link_bytes_per_s);
     cli_emit_err(cli, "BANDWIDTH");
@@ -103,11 +107,13 @@ static void cmd_stream(cli_t *cli, void *ctx, uint32_t argc, const char *const *
   tlm_start(&t->stream, &plan);
   tlm_stats_t s;
   tlm_stats(&t->stream, &s);
-  const uint32_t link_pct =
-      (uint32_t)(((uint64_t)plan.bytes_per_s * 100u + plan.link_bytes_per_s / 2u) / plan.link_bytes_per_s);
+  const uint32_t link_pct = (uint32_t)(((uint64_t)plan.bytes_per_s * 100u +
+                                        plan.link_bytes_per_s / 2u) /
+                                       plan.link_bytes_per_s);
   cli->out_len = 0u;
-  cli_putf(cli, "stream %u %f Hz decim %u fields %u per_frame %u link %u B/s %u%%", s.stream_id, plan.rate_hz,
-           plan.decim, plan.n_fields, plan.rec_per_frame, plan.bytes_per_s, link_pct);
+  cli_putf(cli, "stream %u %f Hz decim %u fields %u per_frame %u link %u B/s %u%%", s.stream_id,
+           plan.rate_hz, plan.decim, plan.n_fields, plan.rec_per_frame, plan.bytes_per_s,
+           link_pct);
   if (plan.rate_hz != rate_hz) {
     cli_putf(cli, " rounded from %f", rate_hz);
   }
@@ -130,20 +136,26 @@ static void cmd_stop(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
   tlm_stats_t s;
   tlm_stats(&t->stream, &s);
   cli->out_len = 0u;
-  cli_putf(cli, "stop %u records %u lost %u frames %u dropped %u", s.stream_id, s.records, s.lost, s.frames,
-           s.dropped);
+  cli_putf(cli, "stop %u records %u lost %u frames %u dropped %u", s.stream_id, s.records,
+           s.lost, s.frames, s.dropped);
   cli_emit_ok(cli);
 }
 
 int app_tlm_init(app_tlm_t *t, cli_t *cli, const params_t *params)
 {
   t->params = params;
-  const tlm_cfg_t tc = {params_current(params)->sys_fs_hz, APP_TLM_BAUD, uart_room, uart_write, t, &app_tlm_fields};
+  const tlm_cfg_t tc = {params_current(params)->sys_fs_hz,
+                        APP_TLM_BAUD,
+                        uart_room,
+                        uart_write,
+                        t,
+                        &app_tlm_fields};
   if (tlm_init(&t->stream, &tc) != 0) {
     return -1;
   }
   const cli_cmd_t stream = {"stream", "[FIELD...|all [@RATE_HZ]]",
-                            "start the telemetry stream (no argument: list the fields)", cmd_stream, t};
+                            "start the telemetry stream (no argument: list the fields)",
+                            cmd_stream, t};
   const cli_cmd_t stop = {"stop", "", "stop the telemetry stream", cmd_stop, t};
   t->cmds[0] = stream;
   t->cmds[1] = stop;

@@ -51,7 +51,10 @@ typedef struct {
 int app_tlm_init(app_tlm_t *t, cli_t *cli, const params_t *params);
 
 /* Sample ISR, after gyro_tick. */
-static inline void app_tlm_isr(app_tlm_t *t, const gyro_out_t *out) { tlm_isr_push(&t->stream, out); }
+static inline void app_tlm_isr(app_tlm_t *t, const gyro_out_t *out)
+{
+  tlm_isr_push(&t->stream, out);
+}
 
 /* Background loop: frames to the UART. */
 void app_tlm_poll(app_tlm_t *t);

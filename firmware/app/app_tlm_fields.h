@@ -48,7 +48,7 @@ typedef enum {
 #define TLM_X_IDX(member, type, unit) TLM_FIELD_##member,
   TLM_FIELD_LIST(TLM_X_IDX)
 #undef TLM_X_IDX
-  TLM_FIELD_COUNT
+      TLM_FIELD_COUNT
 } tlm_field_idx_t;
 
 /* Mask of every field (a shift by 32, UB, when the table holds 32 fields is avoided). */

@@ -253,7 +253,10 @@ static void execute(cli_t *cli)
   }
 }
 
-static void write_raw(cli_t *cli, const char *s, size_t n) { cli->cfg.write(cli->cfg.write_ctx, s, n); }
+static void write_raw(cli_t *cli, const char *s, size_t n)
+{
+  cli->cfg.write(cli->cfg.write_ctx, s, n);
+}
 
 static void end_of_line(cli_t *cli)
 {

@@ -107,9 +107,9 @@ typedef struct {
 } cli_cmd_t;
 
 typedef struct {
-  params_t *params;      /* required */
-  param_store_t *store;  /* NULL: save/load answer err NOSTORE */
-  cli_write_fn write;    /* required */
+  params_t *params;     /* required */
+  param_store_t *store; /* NULL: save/load answer err NOSTORE */
+  cli_write_fn write;   /* required */
   void *write_ctx;
   /* Commands found before the registered ones, listed first by help: the parameter
    * commands (comm/cli_builtin.h), given here so that the line discipline does not
@@ -131,16 +131,16 @@ struct cli {
   uint32_t n_app;
   char line[CLI_LINE_MAX + 1u];
   uint32_t len;
-  uint8_t discard;   /* cli_discard_t of the line being received */
-  bool replied;      /* final line sent for the current command */
+  uint8_t discard; /* cli_discard_t of the line being received */
+  bool replied;    /* final line sent for the current command */
   char out[CLI_OUT_MAX];
   uint32_t out_len;
-  uint32_t truncated; /* reply lines cut at CLI_OUT_MAX (should stay 0) */
+  uint32_t truncated;    /* reply lines cut at CLI_OUT_MAX (should stay 0) */
   uint32_t rx_overflows; /* input losses reported by cli_rx_lost */
-  bool console;      /* console mode (prompt, echo, editing); false: machine mode */
-  bool after_cr;     /* the last EOL byte was CR: an LF right after it belongs to it */
-  uint8_t esc;       /* console: state of an escape sequence being consumed */
-  uint32_t last_len; /* console: the last line run, for Up */
+  bool console;          /* console mode (prompt, echo, editing); false: machine mode */
+  bool after_cr;         /* the last EOL byte was CR: an LF right after it belongs to it */
+  uint8_t esc;           /* console: state of an escape sequence being consumed */
+  uint32_t last_len;     /* console: the last line run, for Up */
   char last[CLI_LINE_MAX + 1u];
 };
 
@@ -200,7 +200,7 @@ static inline cli_arg_t cli_arg_f32(float f) { return (cli_arg_t){.kind = 'f', .
 struct cli_arg_no_kind;
 cli_arg_t cli_arg_refused(struct cli_arg_no_kind *refused);
 
-#define CLI_ARG(x)                                                                   \
+#define CLI_ARG(x) \
   _Generic((x), float: cli_arg_f32, double: cli_arg_refused, long double: cli_arg_refused, \
            char *: cli_arg_str, const char *: cli_arg_str, default: cli_arg_int)(x)
 
@@ -228,7 +228,7 @@ void cli_putf_args(cli_t *cli, const char *fmt, const cli_arg_t *args, uint32_t 
                 (uint32_t)CLI_NARG(__VA_ARGS__))
 /* clang-format on */
 
-void cli_emit_data(cli_t *cli);                  /* "- " text */
+void cli_emit_data(cli_t *cli); /* "- " text */
 /* One "- KEY VALUE" data line (status-style key/value reports). */
 void cli_data_u32(cli_t *cli, const char *key, uint32_t v);
 void cli_data_f32(cli_t *cli, const char *key, float v);

@@ -137,7 +137,8 @@ static void cmd_get(cli_t *cli, void *ctx, uint32_t argc, const char *const *arg
 }
 
 /* "NAME: 'TEXT' WHAT; allowed RANGE UNIT" */
-static void value_error(cli_t *cli, const char *code, param_idx_t i, const char *text, const char *what)
+static void value_error(cli_t *cli, const char *code, param_idx_t i, const char *text,
+                        const char *what)
 {
   const param_info_t *pi = param_info(i);
   cli_putf(cli, "%s: '%s' %s; allowed ", pi->name, text, what);
@@ -172,12 +173,14 @@ static bool stage_pair(cli_t *cli, const char *name, const char *text)
   }
   if (ns != NUMPARSE_OK) {
     value_error(cli, "VALUE", i, text,
-                (pi->type == (uint8_t)PARAM_T_F32) ? "is not a number" : "is not an unsigned integer");
+                (pi->type == (uint8_t)PARAM_T_F32) ? "is not a number"
+                                                   : "is not an unsigned integer");
     return false;
   }
   const param_status_t st = params_stage(p, i, v);
   if (st != PARAM_OK) {
-    value_error(cli, "RANGE", i, text, (st == PARAM_ERR_CHOICE) ? "is not a choice" : "is out of range");
+    value_error(cli, "RANGE", i, text,
+                (st == PARAM_ERR_CHOICE) ? "is not a choice" : "is out of range");
     return false;
   }
   return true;
@@ -189,15 +192,14 @@ static void commit_error(cli_t *cli, param_status_t st, const params_err_t *err)
   switch (st) {
   case PARAM_ERR_BUSY:
     if (param_info(err->idx) != NULL) {
-      cli_putf(cli, "%s cannot change while the drive runs: stop the drive first", param_info(err->idx)->name);
+      cli_putf(cli, "%s cannot change while the drive runs: stop the drive first",
+               param_info(err->idx)->name);
     } else {
       cli_put(cli, "drive running: stop the drive first");
     }
     cli_emit_err(cli, "BUSY");
     break;
-  case PARAM_ERR_PENDING:
-    cli_err(cli, "PENDING", param_status_str(st));
-    break;
+  case PARAM_ERR_PENDING: cli_err(cli, "PENDING", param_status_str(st)); break;
   case PARAM_ERR_REJECTED:
     cli_err(cli, "REJECTED", (err->why != NULL) ? err->why : param_status_str(st));
     break;
@@ -218,7 +220,8 @@ static void commit_error(cli_t *cli, param_status_t st, const params_err_t *err)
 }
 
 /* A set the application cannot design: which parameters, and its reason. */
-static void rejected_set(cli_t *cli, uint32_t argc, const char *const *argv, const params_err_t *err)
+static void rejected_set(cli_t *cli, uint32_t argc, const char *const *argv,
+                         const params_err_t *err)
 {
   for (uint32_t k = 1; k + 1u < argc; k += 2u) {
     cli_putf(cli, "%s %s%s", argv[k], argv[k + 1u], (k + 3u < argc) ? ", " : ": ");
@@ -290,12 +293,11 @@ static void cmd_save(cli_t *cli, void *ctx, uint32_t argc, const char *const *ar
     put_slot(cli, &rep);
     cli_emit_ok(cli);
     break;
-  case PARAM_STORE_ERR_BUSY:
-    cli_err(cli, "BUSY", "drive running: stop the drive first");
-    break;
+  case PARAM_STORE_ERR_BUSY: cli_err(cli, "BUSY", "drive running: stop the drive first"); break;
   case PARAM_STORE_ERR_NEWER:
-    cli_err(cli, "FORMAT", "the store holds an image of a newer firmware format; "
-                           "save force overwrites it");
+    cli_err(cli, "FORMAT",
+            "the store holds an image of a newer firmware format; "
+            "save force overwrites it");
     break;
   case PARAM_STORE_NONE:
   case PARAM_STORE_NEWER:
@@ -421,8 +423,8 @@ static void cmd_version(cli_t *cli, void *ctx, uint32_t argc, const char *const 
     cli_err(cli, "ARGS", "usage: version");
     return;
   }
-  cli_putf(cli, "fw %s layout %u format %u params %u", fw_version_string(), PARAM_LAYOUT_VERSION,
-           PARAM_STORE_FORMAT, (uint32_t)PARAM_COUNT);
+  cli_putf(cli, "fw %s layout %u format %u params %u", fw_version_string(),
+           PARAM_LAYOUT_VERSION, PARAM_STORE_FORMAT, (uint32_t)PARAM_COUNT);
   cli_emit_ok(cli);
 }
 
@@ -440,17 +442,26 @@ static void cmd_console(cli_t *cli, void *ctx, uint32_t argc, const char *const 
 
 const cli_cmd_t cli_builtin_cmds[] = {
     {"help", "", "list the commands", cmd_help, NULL},
-    {"list", "[PREFIX]", "parameters with value, unit, range, default, flags and help", cmd_list, NULL},
+    {"list", "[PREFIX]", "parameters with value, unit, range, default, flags and help",
+     cmd_list, NULL},
     {"get", "NAME", "value of one parameter", cmd_get, NULL},
-    {"set", "NAME VALUE [NAME VALUE ...]", "change parameters together (all or nothing)", cmd_set, NULL},
-    {"save", "[force]", "write the persistent parameters to flash (drive stopped; force: "
-                        "over an image of a newer format)", cmd_save, NULL},
+    {"set", "NAME VALUE [NAME VALUE ...]", "change parameters together (all or nothing)",
+     cmd_set, NULL},
+    {"save", "[force]",
+     "write the persistent parameters to flash (drive stopped; force: "
+     "over an image of a newer format)",
+     cmd_save, NULL},
     {"load", "", "apply the parameters stored in flash", cmd_load, NULL},
     {"defaults", "", "apply the default parameters (not saved)", cmd_defaults, NULL},
     {"diff", "", "parameters that differ from their defaults", cmd_diff, NULL},
     {"version", "", "firmware and parameter layout versions", cmd_version, NULL},
-    {"console", "[on|off]", "terminal mode: prompt, echo, line editing (off: machine mode, "
-                            "the default)", cmd_console, NULL},
+    {"console", "[on|off]",
+     "terminal mode: prompt, echo, line editing (off: machine mode, "
+     "the default)",
+     cmd_console, NULL},
 };
 
-uint32_t cli_builtin_count(void) { return (uint32_t)(sizeof cli_builtin_cmds / sizeof cli_builtin_cmds[0]); }
+uint32_t cli_builtin_count(void)
+{
+  return (uint32_t)(sizeof cli_builtin_cmds / sizeof cli_builtin_cmds[0]);
+}

@@ -63,7 +63,8 @@ static void exact_digits(uint32_t b, uint8_t *dig, uint32_t *nd, int32_t *point)
 
 /* Round dig[0..nd) to p digits (half-even) into r; returns the digits kept (trailing
  * zeros stripped, >= 1) and adjusts *point on a carry out of the first digit. */
-static uint32_t round_digits(const uint8_t *dig, uint32_t nd, uint32_t p, uint8_t *r, int32_t *point)
+static uint32_t round_digits(const uint8_t *dig, uint32_t nd, uint32_t p, uint8_t *r,
+                             int32_t *point)
 {
   uint32_t n = (nd < p) ? nd : p;
   memcpy(r, dig, n);

@@ -18,7 +18,8 @@ static bool fields_ok(const tlm_fields_t *f)
     return false;
   }
   for (uint32_t i = 0; i < f->count; i++) {
-    if (f->row[i].name == NULL || strlen(f->row[i].name) > TLM_NAME_MAX || f->row[i].offset % 4u != 0u) {
+    if (f->row[i].name == NULL || strlen(f->row[i].name) > TLM_NAME_MAX ||
+        f->row[i].offset % 4u != 0u) {
       return false;
     }
   }
@@ -28,8 +29,8 @@ static bool fields_ok(const tlm_fields_t *f)
 int tlm_init(tlm_t *t, const tlm_cfg_t *cfg)
 {
   memset(t, 0, sizeof *t);
-  if (cfg == NULL || cfg->room == NULL || cfg->write == NULL || cfg->fs_hz == 0u || cfg->baud == 0u ||
-      !fields_ok(cfg->fields)) {
+  if (cfg == NULL || cfg->room == NULL || cfg->write == NULL || cfg->fs_hz == 0u ||
+      cfg->baud == 0u || !fields_ok(cfg->fields)) {
     return -1;
   }
   t->cfg = *cfg;
@@ -64,20 +65,22 @@ static uint32_t header_payload_len(const tlm_fields_t *fields, uint32_t mask)
   return n;
 }
 
-uint32_t tlm_plan_bytes_per_s(const tlm_fields_t *fields, uint32_t fs_hz, uint32_t mask, uint32_t decim,
-                              uint32_t rec_per_frame_)
+uint32_t tlm_plan_bytes_per_s(const tlm_fields_t *fields, uint32_t fs_hz, uint32_t mask,
+                              uint32_t decim, uint32_t rec_per_frame_)
 {
   const uint32_t f = popcount32(mask);
-  const uint32_t data_wire = tlm_wire_len_max(TLM_FRAME_OVERHEAD + TLM_DATA_FIXED + 4u * rec_per_frame_ * f);
-  const uint32_t hdr_wire = tlm_wire_len_max(TLM_FRAME_OVERHEAD + header_payload_len(fields, mask));
+  const uint32_t data_wire = tlm_wire_len_max(TLM_FRAME_OVERHEAD + TLM_DATA_FIXED +
+                                              4u * rec_per_frame_ * f);
+  const uint32_t hdr_wire = tlm_wire_len_max(TLM_FRAME_OVERHEAD +
+                                             header_payload_len(fields, mask));
   /* frames/s = fs / (decim N), rounded up */
   const uint64_t num = (uint64_t)fs_hz * data_wire;
   const uint64_t den = (uint64_t)decim * rec_per_frame_;
   return (uint32_t)((num + den - 1u) / den) + hdr_wire;
 }
 
-tlm_status_t tlm_plan(const tlm_fields_t *fields, uint32_t fs_hz, uint32_t baud, uint32_t mask, float rate_hz,
-                      tlm_plan_t *plan)
+tlm_status_t tlm_plan(const tlm_fields_t *fields, uint32_t fs_hz, uint32_t baud, uint32_t mask,
+                      float rate_hz, tlm_plan_t *plan)
 {
   if (mask == 0u || (mask & ~tlm_fields_mask_all(fields)) != 0u) {
     return TLM_ERR_FIELDS;

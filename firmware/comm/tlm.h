@@ -85,8 +85,8 @@ typedef size_t (*tlm_room_fn)(void *ctx);
 typedef void (*tlm_write_fn)(void *ctx, const uint8_t *data, size_t len);
 
 typedef struct {
-  uint32_t fs_hz;   /* tick rate */
-  uint32_t baud;    /* UART line rate, 8N1 (10 bits per byte) */
+  uint32_t fs_hz; /* tick rate */
+  uint32_t baud;  /* UART line rate, 8N1 (10 bits per byte) */
   tlm_room_fn room;
   tlm_write_fn write;
   void *ctx;
@@ -95,29 +95,29 @@ typedef struct {
 
 /* A checked stream selection (tlm_plan). */
 typedef struct {
-  uint32_t mask;          /* bit i: row i of the field table */
+  uint32_t mask; /* bit i: row i of the field table */
   uint32_t n_fields;
-  uint32_t decim;         /* ticks per record */
-  float rate_hz;          /* fs / decim, what the stream delivers */
+  uint32_t decim; /* ticks per record */
+  float rate_hz;  /* fs / decim, what the stream delivers */
   uint32_t rec_per_frame;
-  uint32_t bytes_per_s;   /* worst-case wire load, headers included */
+  uint32_t bytes_per_s;      /* worst-case wire load, headers included */
   uint32_t link_bytes_per_s; /* what the line carries: baud / 10 */
 } tlm_plan_t;
 
 typedef enum {
   TLM_OK = 0,
-  TLM_ERR_FIELDS,    /* empty or unknown selection */
-  TLM_ERR_RATE,      /* rate not finite, <= 0, above fs, or decim > TLM_DECIM_MAX */
-  TLM_ERR_BANDWIDTH  /* over TLM_LINK_MAX_PCT of the link */
+  TLM_ERR_FIELDS,   /* empty or unknown selection */
+  TLM_ERR_RATE,     /* rate not finite, <= 0, above fs, or decim > TLM_DECIM_MAX */
+  TLM_ERR_BANDWIDTH /* over TLM_LINK_MAX_PCT of the link */
 } tlm_status_t;
 
 typedef struct {
   bool streaming;
   uint32_t stream_id;
-  uint32_t records;  /* records read from the ring this stream */
-  uint32_t lost;     /* records of this stream lost to ring overruns */
-  uint32_t frames;   /* frames handed to the link this stream */
-  uint32_t dropped;  /* frames of this stream the link could not take (at stop) */
+  uint32_t records; /* records read from the ring this stream */
+  uint32_t lost;    /* records of this stream lost to ring overruns */
+  uint32_t frames;  /* frames handed to the link this stream */
+  uint32_t dropped; /* frames of this stream the link could not take (at stop) */
 } tlm_stats_t;
 
 /* A selection as the ISR reads it (configuration handoff above). */
@@ -141,16 +141,16 @@ typedef struct {
   bool streaming;
   bool header_due;
   uint32_t stream_id;
-  uint32_t sel_gen;        /* the last non-zero generation published */
-  uint32_t rec_base;       /* isr_rec when the stream started */
-  uint32_t lost_base;      /* ring overruns when the stream started */
-  uint32_t next_header;    /* record index that triggers the next periodic header */
+  uint32_t sel_gen;     /* the last non-zero generation published */
+  uint32_t rec_base;    /* isr_rec when the stream started */
+  uint32_t lost_base;   /* ring overruns when the stream started */
+  uint32_t next_header; /* record index that triggers the next periodic header */
   uint32_t rec_per_s;
   uint16_t seq;
-  uint32_t acc_n;          /* records collected for the next data frame */
+  uint32_t acc_n; /* records collected for the next data frame */
   uint32_t acc_first;
   uint32_t records, frames, dropped;
-  size_t pending_len;      /* wire bytes of a frame waiting for room */
+  size_t pending_len; /* wire bytes of a frame waiting for room */
   uint8_t raw[TLM_FRAME_MAX];
   uint8_t wire[TLM_WIRE_MAX];
 } tlm_t;
@@ -162,11 +162,11 @@ int tlm_init(tlm_t *t, const tlm_cfg_t *cfg);
 
 /* Check a selection and choose decim = round(fs / rate_hz) (>= 1), the frame size and the
  * wire load. Pure; *plan is filled on TLM_OK and on TLM_ERR_BANDWIDTH (for the message). */
-tlm_status_t tlm_plan(const tlm_fields_t *fields, uint32_t fs_hz, uint32_t baud, uint32_t mask, float rate_hz,
-                      tlm_plan_t *plan);
+tlm_status_t tlm_plan(const tlm_fields_t *fields, uint32_t fs_hz, uint32_t baud, uint32_t mask,
+                      float rate_hz, tlm_plan_t *plan);
 /* Wire bytes per second of a plan: data frames at their worst-case size plus headers. */
-uint32_t tlm_plan_bytes_per_s(const tlm_fields_t *fields, uint32_t fs_hz, uint32_t mask, uint32_t decim,
-                              uint32_t rec_per_frame);
+uint32_t tlm_plan_bytes_per_s(const tlm_fields_t *fields, uint32_t fs_hz, uint32_t mask,
+                              uint32_t decim, uint32_t rec_per_frame);
 
 /* Stop any running stream (as tlm_stop) and start plan (from tlm_plan with this t's
  * fs and baud). Background only. */

@@ -106,7 +106,8 @@ size_t tlm_frame_to_wire(const uint8_t *raw, size_t len, uint8_t *wire, size_t c
   return c + 2u;
 }
 
-tlm_frame_status_t tlm_frame_open(const uint8_t *cobs, size_t n, uint8_t *raw, tlm_frame_view_t *v)
+tlm_frame_status_t tlm_frame_open(const uint8_t *cobs, size_t n, uint8_t *raw,
+                                  tlm_frame_view_t *v)
 {
   size_t len = 0u;
   if (!tlm_cobs_decode(cobs, n, raw, TLM_FRAME_MAX, &len)) {

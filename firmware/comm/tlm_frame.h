@@ -80,8 +80,8 @@
 #include <stdint.h>
 
 #define TLM_FRAME_MARKER 0x00u
-#define TLM_FRAME_HEADER 0x48u /* 'H' */
-#define TLM_FRAME_DATA 0x44u   /* 'D' */
+#define TLM_FRAME_HEADER 0x48u  /* 'H' */
+#define TLM_FRAME_DATA 0x44u    /* 'D' */
 #define TLM_FRAME_HEAD_BYTES 4u /* marker, type, seq */
 #define TLM_FRAME_CRC_BYTES 2u
 #define TLM_FRAME_OVERHEAD (TLM_FRAME_HEAD_BYTES + TLM_FRAME_CRC_BYTES)
@@ -101,7 +101,8 @@
 #define TLM_DATA_RECORD_BYTES_MAX 240u
 
 _Static_assert(TLM_FRAME_OVERHEAD + TLM_HEADER_FIXED + TLM_FIELDS_MAX * (2u + TLM_NAME_MAX) <=
-                   TLM_FRAME_MAX, "the largest header fits");
+                   TLM_FRAME_MAX,
+               "the largest header fits");
 
 #define TLM_CRC16_INIT 0xFFFFu
 
@@ -124,10 +125,10 @@ size_t tlm_frame_to_wire(const uint8_t *raw, size_t len, uint8_t *wire, size_t c
 
 typedef enum {
   TLM_FRAME_OK = 0,
-  TLM_FRAME_ERR_COBS,   /* not valid COBS, or longer than TLM_FRAME_MAX */
-  TLM_FRAME_ERR_SHORT,  /* shorter than marker + type + seq + CRC */
-  TLM_FRAME_ERR_CRC,    /* CRC mismatch */
-  TLM_FRAME_ERR_MARKER  /* byte 0 is not the marker */
+  TLM_FRAME_ERR_COBS,  /* not valid COBS, or longer than TLM_FRAME_MAX */
+  TLM_FRAME_ERR_SHORT, /* shorter than marker + type + seq + CRC */
+  TLM_FRAME_ERR_CRC,   /* CRC mismatch */
+  TLM_FRAME_ERR_MARKER /* byte 0 is not the marker */
 } tlm_frame_status_t;
 
 typedef struct {
@@ -139,7 +140,8 @@ typedef struct {
 
 /* The COBS bytes between two delimiters -> checked raw frame in raw (TLM_FRAME_MAX bytes)
  * and a view of it. On error *v is unspecified. */
-tlm_frame_status_t tlm_frame_open(const uint8_t *cobs, size_t n, uint8_t *raw, tlm_frame_view_t *v);
+tlm_frame_status_t tlm_frame_open(const uint8_t *cobs, size_t n, uint8_t *raw,
+                                  tlm_frame_view_t *v);
 
 /* Worst-case wire bytes of a raw frame of raw_len bytes, delimiters included. */
 static inline uint32_t tlm_wire_len_max(uint32_t raw_len) { return TLM_COBS_MAX(raw_len) + 2u; }

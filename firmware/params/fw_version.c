@@ -9,7 +9,8 @@
 
 const char *fw_version_string(void)
 {
-  return FW_STR(GYRO_FW_VERSION_MAJOR) "." FW_STR(GYRO_FW_VERSION_MINOR) "." FW_STR(GYRO_FW_VERSION_PATCH);
+  return FW_STR(GYRO_FW_VERSION_MAJOR) "." FW_STR(GYRO_FW_VERSION_MINOR) "." FW_STR(
+      GYRO_FW_VERSION_PATCH);
 }
 
 uint32_t fw_version_number(void)

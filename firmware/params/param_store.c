@@ -60,7 +60,8 @@ param_store_status_t param_store_init(param_store_t *st, const param_store_cfg_t
   const uint32_t unit = geo.program_bytes;
   if (cfg->sector_a == cfg->sector_b || cfg->sector_a >= geo.num_sectors ||
       cfg->sector_b >= geo.num_sectors || unit == 0u || (unit & (unit - 1u)) != 0u ||
-      unit > PARAM_STORE_PROGRAM_MAX || geo.sector_size < commit_end(PARAM_STORE_IMAGE_MAX, unit)) {
+      unit > PARAM_STORE_PROGRAM_MAX ||
+      geo.sector_size < commit_end(PARAM_STORE_IMAGE_MAX, unit)) {
     return PARAM_STORE_ERR_CONFIG;
   }
   st->program_bytes = unit;
@@ -139,7 +140,8 @@ static int newest_slot(const param_store_t *st, param_store_report_t *rep, slot_
 
 static bool holds_newer(const param_store_report_t *rep)
 {
-  return rep->slot_state[0] == (uint8_t)PARAM_SLOT_NEWER || rep->slot_state[1] == (uint8_t)PARAM_SLOT_NEWER;
+  return rep->slot_state[0] == (uint8_t)PARAM_SLOT_NEWER ||
+         rep->slot_state[1] == (uint8_t)PARAM_SLOT_NEWER;
 }
 
 static bool type_compatible(uint8_t rec_type, uint8_t table_type)
@@ -150,7 +152,8 @@ static bool type_compatible(uint8_t rec_type, uint8_t table_type)
   return rec_known && rec_float == tab_float;
 }
 
-param_store_status_t param_store_load(param_store_t *st, param_values_t *v, param_store_report_t *rep)
+param_store_status_t param_store_load(param_store_t *st, param_values_t *v,
+                                      param_store_report_t *rep)
 {
   param_store_report_t local;
   if (rep == NULL) {
@@ -295,7 +298,10 @@ param_store_status_t param_store_save(param_store_t *st, const param_values_t *v
   }
   /* never touch the newest valid image: write the other slot (with neither valid, A
    * unless A holds a newer-format image) */
-  const unsigned target = (newest == 0 || (newest < 0 && rep->slot_state[0] == (uint8_t)PARAM_SLOT_NEWER)) ? 1u : 0u;
+  const unsigned target = (newest == 0 ||
+                           (newest < 0 && rep->slot_state[0] == (uint8_t)PARAM_SLOT_NEWER))
+                              ? 1u
+                              : 0u;
   /* refused while either slot holds one: the save after this one would take the other */
   if (holds_newer(rep) && (how & PARAM_SAVE_FORCE) == 0u) {
     return PARAM_STORE_ERR_NEWER;

@@ -82,14 +82,14 @@
 
 typedef enum {
   PARAM_STORE_OK = 0,
-  PARAM_STORE_UNCHANGED,   /* save: the newest image already holds these values */
-  PARAM_STORE_NONE,        /* load: no valid image; nothing loaded */
-  PARAM_STORE_ERR_BUSY,    /* save refused: the loop is not in a safe mode */
-  PARAM_STORE_ERR_FLASH,   /* erase/program failed (including a power cut) */
-  PARAM_STORE_ERR_VERIFY,  /* the written image did not read back valid */
-  PARAM_STORE_ERR_CONFIG,  /* bad sectors or a sector too small for an image */
-  PARAM_STORE_NEWER,       /* load: no valid image, but one of a newer format */
-  PARAM_STORE_ERR_NEWER    /* save refused: it would erase a newer-format image */
+  PARAM_STORE_UNCHANGED,  /* save: the newest image already holds these values */
+  PARAM_STORE_NONE,       /* load: no valid image; nothing loaded */
+  PARAM_STORE_ERR_BUSY,   /* save refused: the loop is not in a safe mode */
+  PARAM_STORE_ERR_FLASH,  /* erase/program failed (including a power cut) */
+  PARAM_STORE_ERR_VERIFY, /* the written image did not read back valid */
+  PARAM_STORE_ERR_CONFIG, /* bad sectors or a sector too small for an image */
+  PARAM_STORE_NEWER,      /* load: no valid image, but one of a newer format */
+  PARAM_STORE_ERR_NEWER   /* save refused: it would erase a newer-format image */
 } param_store_status_t;
 
 /* How a save may go (bits). */
@@ -99,10 +99,10 @@ enum {
 };
 
 typedef enum {
-  PARAM_SLOT_EMPTY = 0,  /* header erased (all 0xFF) */
+  PARAM_SLOT_EMPTY = 0, /* header erased (all 0xFF) */
   PARAM_SLOT_VALID,
-  PARAM_SLOT_CORRUPT,    /* something there, but it does not check */
-  PARAM_SLOT_NEWER       /* an image of a newer format: not read, not overwritten */
+  PARAM_SLOT_CORRUPT, /* something there, but it does not check */
+  PARAM_SLOT_NEWER    /* an image of a newer format: not read, not overwritten */
 } param_slot_state_t;
 
 typedef struct {
@@ -113,7 +113,7 @@ typedef struct {
 typedef struct {
   uint32_t sector[2];
   uint32_t sector_size;
-  uint32_t program_bytes;  /* the flash's programming unit (hal_flash_geometry) */
+  uint32_t program_bytes; /* the flash's programming unit (hal_flash_geometry) */
   /* encode buffer: the image, then the commit word's unit filled up with 0xFF */
   uint8_t buf[PARAM_STORE_IMAGE_MAX - 4u + PARAM_STORE_PROGRAM_MAX];
 } param_store_t;
@@ -135,7 +135,8 @@ param_store_status_t param_store_init(param_store_t *st, const param_store_cfg_t
  * the image or its default); other members are left as the caller set them. Returns
  * PARAM_STORE_OK, or PARAM_STORE_NONE / PARAM_STORE_NEWER with *v untouched. Never
  * writes flash. */
-param_store_status_t param_store_load(param_store_t *st, param_values_t *v, param_store_report_t *rep);
+param_store_status_t param_store_load(param_store_t *st, param_values_t *v,
+                                      param_store_report_t *rep);
 
 /* Save the persistent parameters of *v (all must pass param_check). how: PARAM_SAVE_*
  * bits; without PARAM_SAVE_LOOP_SAFE -> PARAM_STORE_ERR_BUSY, and a save that would erase

@@ -12,7 +12,4 @@ CM4_RAMFUNC uint32_t hal_critical_enter(void)
   return state;
 }
 
-CM4_RAMFUNC void hal_critical_exit(uint32_t state)
-{
-  cm4_set_primask(state);
-}
+CM4_RAMFUNC void hal_critical_exit(uint32_t state) { cm4_set_primask(state); }

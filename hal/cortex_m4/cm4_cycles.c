@@ -12,7 +12,4 @@ void cm4_cycles_init(void)
   DWT->CTRL |= DWT_CTRL_CYCCNTENA;
 }
 
-CM4_RAMFUNC uint32_t hal_cycles_now(void)
-{
-  return DWT->CYCCNT;
-}
+CM4_RAMFUNC uint32_t hal_cycles_now(void) { return DWT->CYCCNT; }

@@ -36,7 +36,7 @@ void cm4_fault_enable(void)
 }
 
 CM4_BOOT_TEXT void cm4_fault_capture(const uint32_t *frame, uint32_t exc_return,
-                                             uint32_t exc_number)
+                                     uint32_t exc_number)
 {
   const uint32_t previous = cm4_fault_get(0) ? s_record.count : 0u;
   s_record.magic = 0u; /* invalid while half written */

@@ -18,8 +18,8 @@ typedef struct {
 } cm4_scb_t;
 
 typedef struct {
-  CM4_REG ISER[8], RES0[24], ICER[8], RES1[24], ISPR[8], RES2[24], ICPR[8],
-      RES3[24], IABR[8], RES4[56];
+  CM4_REG ISER[8], RES0[24], ICER[8], RES1[24], ISPR[8], RES2[24], ICPR[8], RES3[24], IABR[8],
+      RES4[56];
   volatile uint8_t IP[240];
 } cm4_nvic_t;
 
@@ -85,9 +85,6 @@ static inline void cm4_nvic_enable(uint32_t irq, uint32_t prio)
   NVIC->ISER[irq >> 5] = 1u << (irq & 31u);
 }
 
-static inline void cm4_nvic_disable(uint32_t irq)
-{
-  NVIC->ICER[irq >> 5] = 1u << (irq & 31u);
-}
+static inline void cm4_nvic_disable(uint32_t irq) { NVIC->ICER[irq >> 5] = 1u << (irq & 31u); }
 
 #endif /* CM4_REGS_H */

@@ -27,10 +27,7 @@ uint32_t cm4_stack_size_bytes(void)
   return (uint32_t)((uintptr_t)_estack - (uintptr_t)_sstack);
 }
 
-uint32_t cm4_stack_run_bytes(void)
-{
-  return cm4_stack_used_bytes(_sstack, _estack);
-}
+uint32_t cm4_stack_run_bytes(void) { return cm4_stack_used_bytes(_sstack, _estack); }
 
 uint32_t cm4_stack_hwm_bytes(void)
 {

@@ -35,15 +35,14 @@ void *_sbrk(int incr);
  * be the cause of the fault. */
 __attribute__((naked)) CM4_BOOT_TEXT void Default_Handler(void)
 {
-  __asm volatile(
-      "tst lr, #4\n"
-      "ite eq\n"
-      "mrseq r0, msp\n"
-      "mrsne r0, psp\n"
-      "mov r1, lr\n"
-      "mrs r2, ipsr\n"
-      "ldr r3, =cm4_fault_capture\n"
-      "bx r3\n");
+  __asm volatile("tst lr, #4\n"
+                 "ite eq\n"
+                 "mrseq r0, msp\n"
+                 "mrsne r0, psp\n"
+                 "mov r1, lr\n"
+                 "mrs r2, ipsr\n"
+                 "ldr r3, =cm4_fault_capture\n"
+                 "bx r3\n");
 }
 void HardFault_Handler(void) __attribute__((alias("Default_Handler")));
 

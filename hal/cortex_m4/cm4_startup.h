@@ -22,7 +22,7 @@ extern const cm4_vector_t cm4_vectors[];
 extern const uint32_t cm4_num_vectors;
 
 void Reset_Handler(void);
-void Default_Handler(void); /* records the fault or unexpected interrupt, then resets */
+void Default_Handler(void);   /* records the fault or unexpected interrupt, then resets */
 void HardFault_Handler(void); /* the same entry */
 
 void board_system_init(void);

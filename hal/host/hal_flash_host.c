@@ -23,8 +23,8 @@ typedef struct {
   uint32_t program_word_us;
   uint32_t program_bytes;
   FILE *file;
-  uint32_t program_budget;  /* bytes that may still be programmed before the cut */
-  uint32_t erase_cut;       /* NO_LIMIT, or bytes erased by the next (interrupted) erase */
+  uint32_t program_budget; /* bytes that may still be programmed before the cut */
+  uint32_t erase_cut;      /* NO_LIMIT, or bytes erased by the next (interrupted) erase */
   bool power_down;
   hal_flash_host_stats_t stats;
   uint8_t *mem; /* g_flash_mem */
@@ -92,7 +92,8 @@ int hal_flash_host_configure(const hal_flash_host_cfg_t *cfg)
   g_flash.num_sectors = n;
   g_flash.sector_size = sz;
   g_flash.erase_us = (c->erase_us != 0u) ? c->erase_us : DEFAULT_ERASE_US;
-  g_flash.program_word_us = (c->program_word_us != 0u) ? c->program_word_us : DEFAULT_PROGRAM_WORD_US;
+  g_flash.program_word_us = (c->program_word_us != 0u) ? c->program_word_us
+                                                       : DEFAULT_PROGRAM_WORD_US;
   g_flash.program_budget = NO_LIMIT;
   g_flash.erase_cut = NO_LIMIT;
   memset(g_flash.mem, 0xFF, (size_t)n * sz);
@@ -194,7 +195,8 @@ hal_flash_status_t hal_flash_erase(uint32_t sector)
   add_busy(g_flash.erase_us);
   g_flash.stats.erases++;
   if (g_flash.erase_cut != NO_LIMIT) {
-    const uint32_t k = (g_flash.erase_cut < g_flash.sector_size) ? g_flash.erase_cut : g_flash.sector_size;
+    const uint32_t k = (g_flash.erase_cut < g_flash.sector_size) ? g_flash.erase_cut
+                                                                 : g_flash.sector_size;
     memset(&g_flash.mem[base], 0xFF, k);
     write_through(base, k);
     g_flash.power_down = true;
@@ -205,7 +207,8 @@ hal_flash_status_t hal_flash_erase(uint32_t sector)
   return HAL_FLASH_OK;
 }
 
-hal_flash_status_t hal_flash_program(uint32_t sector, uint32_t offset, const void *data, size_t len)
+hal_flash_status_t hal_flash_program(uint32_t sector, uint32_t offset, const void *data,
+                                     size_t len)
 {
   ensure_configured();
   if ((data == NULL && len != 0u) || !in_range(sector, offset, len)) {

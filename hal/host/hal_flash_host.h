@@ -45,12 +45,12 @@
 #define HAL_FLASH_HOST_MAX_BYTES (256u * 1024u)
 
 typedef struct {
-  uint32_t num_sectors;      /* 0 -> 2 */
-  uint32_t sector_size;      /* bytes, multiple of 4; 0 -> 16384 (STM32F4 sectors 0-3) */
-  const char *path;          /* backing file, or NULL for memory only */
-  uint32_t erase_us;         /* busy time of one sector erase; 0 -> 250000 */
-  uint32_t program_word_us;  /* busy time per 32-bit word programmed; 0 -> 16 */
-  uint32_t program_bytes;    /* programming unit, power of two <= sector_size; 0 -> 4 */
+  uint32_t num_sectors;     /* 0 -> 2 */
+  uint32_t sector_size;     /* bytes, multiple of 4; 0 -> 16384 (STM32F4 sectors 0-3) */
+  const char *path;         /* backing file, or NULL for memory only */
+  uint32_t erase_us;        /* busy time of one sector erase; 0 -> 250000 */
+  uint32_t program_word_us; /* busy time per 32-bit word programmed; 0 -> 16 */
+  uint32_t program_bytes;   /* programming unit, power of two <= sector_size; 0 -> 4 */
 } hal_flash_host_cfg_t;
 
 typedef struct {
@@ -72,7 +72,7 @@ void hal_flash_host_close(void);
 /* Faults. */
 void hal_flash_host_power_cut_after(uint32_t program_bytes);
 void hal_flash_host_power_cut_in_erase(uint32_t erased_bytes);
-void hal_flash_host_power_restore(void);   /* clears armed and active power faults */
+void hal_flash_host_power_restore(void); /* clears armed and active power faults */
 bool hal_flash_host_power_is_down(void);
 int hal_flash_host_flip_bit(uint32_t sector, uint32_t offset, uint32_t bit);
 

@@ -13,9 +13,9 @@ static struct {
   hal_sample_isr_fn isr;
   void *isr_ctx;
   uint32_t rate_hz;
-  hal_adc_frame_t adc;      /* sampled at the current tick, read by the ISR */
-  hal_dac_frame_t active;   /* on the converter outputs during this interval */
-  hal_dac_frame_t pending;  /* written by the ISR, output from the next tick */
+  hal_adc_frame_t adc;     /* sampled at the current tick, read by the ISR */
+  hal_dac_frame_t active;  /* on the converter outputs during this interval */
+  hal_dac_frame_t pending; /* written by the ISR, output from the next tick */
   uint64_t ticks;
   int running;
 } host;

@@ -11,7 +11,10 @@ static struct {
   bool rx_gap; /* bytes lost: nothing stored until the reader reaches the gap */
 } uart;
 
-static size_t used(size_t head, size_t tail, size_t size) { return (head + size - tail) % size; }
+static size_t used(size_t head, size_t tail, size_t size)
+{
+  return (head + size - tail) % size;
+}
 
 size_t hal_uart_host_rx_push(const uint8_t *data, size_t len)
 {

@@ -16,11 +16,11 @@
 uint32_t stm32f4_clock_ppre_bits(uint32_t div)
 {
   switch (div) {
-    case 2u: return 4u;
-    case 4u: return 5u;
-    case 8u: return 6u;
-    case 16u: return 7u;
-    default: return 0u;
+  case 2u: return 4u;
+  case 4u: return 5u;
+  case 8u: return 6u;
+  case 16u: return 7u;
+  default: return 0u;
   }
 }
 

@@ -15,7 +15,7 @@
 
 typedef struct {
   uint32_t pllm, plln, pllp, pllq;
-  uint32_t flash_latency;  /* wait states */
+  uint32_t flash_latency; /* wait states */
   uint32_t apb1_div, apb2_div;
   uint32_t sysclk_hz, hclk_hz, pclk1_hz, pclk2_hz;
   uint32_t tim_apb1_hz, tim_apb2_hz; /* timer kernel clocks (TIM2..5 / TIM1, TIM8) */
@@ -24,10 +24,10 @@ typedef struct {
 
 typedef enum {
   STM32F4_CLOCK_OK = 0,
-  STM32F4_CLOCK_ERR_PLAN = -1,   /* no PLL setting makes this SYSCLK from this crystal */
-  STM32F4_CLOCK_ERR_HSE = -2,    /* crystal did not start: still on the 16 MHz HSI */
-  STM32F4_CLOCK_ERR_PLL = -3,    /* PLL did not lock: still on the HSI */
-  STM32F4_CLOCK_ERR_SWITCH = -4  /* SYSCLK switch not acknowledged */
+  STM32F4_CLOCK_ERR_PLAN = -1,  /* no PLL setting makes this SYSCLK from this crystal */
+  STM32F4_CLOCK_ERR_HSE = -2,   /* crystal did not start: still on the 16 MHz HSI */
+  STM32F4_CLOCK_ERR_PLL = -3,   /* PLL did not lock: still on the HSI */
+  STM32F4_CLOCK_ERR_SWITCH = -4 /* SYSCLK switch not acknowledged */
 } stm32f4_clock_status_t;
 
 

@@ -105,7 +105,7 @@ static int range_ok(uint32_t sector, uint32_t offset, size_t len)
 }
 
 CM4_RAMFUNC hal_flash_status_t hal_flash_program(uint32_t sector, uint32_t offset,
-                                                     const void *data, size_t len)
+                                                 const void *data, size_t len)
 {
   if (!range_ok(sector, offset, len) || (data == 0 && len > 0u)) return HAL_FLASH_ERR_RANGE;
   volatile uint8_t *dst = STM32F4_PARAM_FLASH + sector * STM32F4_PARAM_SECTOR_BYTES + offset;
@@ -156,8 +156,8 @@ CM4_RAMFUNC hal_flash_status_t hal_flash_program(uint32_t sector, uint32_t offse
 hal_flash_status_t hal_flash_read(uint32_t sector, uint32_t offset, void *buf, size_t len)
 {
   if (!range_ok(sector, offset, len) || (buf == 0 && len > 0u)) return HAL_FLASH_ERR_RANGE;
-  const volatile uint8_t *src =
-      STM32F4_PARAM_FLASH + sector * STM32F4_PARAM_SECTOR_BYTES + offset;
+  const volatile uint8_t *src = STM32F4_PARAM_FLASH + sector * STM32F4_PARAM_SECTOR_BYTES +
+                                offset;
   uint8_t *out = (uint8_t *)buf;
   for (size_t i = 0u; i < len; ++i) {
     out[i] = src[i];

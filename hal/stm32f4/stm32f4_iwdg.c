@@ -33,7 +33,4 @@ void stm32f4_iwdg_start(const stm32f4_iwdg_plan_t *plan)
   IWDG->KR = IWDG_KEY_RELOAD;
 }
 
-CM4_RAMFUNC void stm32f4_iwdg_kick(void)
-{
-  IWDG->KR = IWDG_KEY_RELOAD;
-}
+CM4_RAMFUNC void stm32f4_iwdg_kick(void) { IWDG->KR = IWDG_KEY_RELOAD; }

@@ -104,9 +104,9 @@ typedef struct {
 extern stm32f4_host_map_t stm32f4_host_map;
 #define STM32F4_PERIPH(field, type, addr) (stm32f4_host_map.field)
 #define STM32F4_PARAM_FLASH ((volatile uint8_t *)stm32f4_host_map.param_flash)
-#define STM32F4_POLL_HOOK()                                                      \
-  do {                                                                           \
-    if (stm32f4_host_map.poll_hook != 0) stm32f4_host_map.poll_hook();           \
+#define STM32F4_POLL_HOOK() \
+  do { \
+    if (stm32f4_host_map.poll_hook != 0) stm32f4_host_map.poll_hook(); \
   } while (0)
 #else
 #define STM32F4_PERIPH(field, type, addr) ((type *)(addr))
@@ -161,7 +161,7 @@ void stm32f4_qemu_flash_controller(void);
 #define RCC_CFGR_SW_MASK 3u
 #define RCC_CFGR_SW_PLL 2u
 #define RCC_CFGR_SWS_POS 2u
-#define RCC_CFGR_HPRE_POS 4u  /* 0xxx: /1 */
+#define RCC_CFGR_HPRE_POS 4u   /* 0xxx: /1 */
 #define RCC_CFGR_PPRE1_POS 10u /* 0xx: /1, 100: /2, 101: /4, 110: /8, 111: /16 */
 #define RCC_CFGR_PPRE2_POS 13u
 #define RCC_CSR_LSION (1u << 0)
@@ -204,7 +204,7 @@ void stm32f4_qemu_flash_controller(void);
 #define FLASH_SR_PGPERR (1u << 6)
 #define FLASH_SR_PGSERR (1u << 7)
 #define FLASH_SR_BSY (1u << 16)
-#define FLASH_SR_ERRORS                                                          \
+#define FLASH_SR_ERRORS \
   (FLASH_SR_OPERR | FLASH_SR_WRPERR | FLASH_SR_PGAERR | FLASH_SR_PGPERR | FLASH_SR_PGSERR)
 #define FLASH_CR_PG (1u << 0)
 #define FLASH_CR_SER (1u << 1)
@@ -238,12 +238,12 @@ void stm32f4_qemu_flash_controller(void);
 #define TIM_MMS_UPDATE 2u /* TRGO = update event */
 #define TIM_MMS_OC1REF 4u /* TRGO = OC1REF */
 #define TIM_SMCR_TS_POS 4u
-#define TIM_TS_ITR0 0u    /* TIM4's ITR0 = TIM1 TRGO (TIM2-TIM5 internal trigger table) */
-#define TIM_TS_ITR2 2u    /* TIM8's ITR2 = TIM4 TRGO (TIM1/TIM8 internal trigger table) */
+#define TIM_TS_ITR0 0u     /* TIM4's ITR0 = TIM1 TRGO (TIM2-TIM5 internal trigger table) */
+#define TIM_TS_ITR2 2u     /* TIM8's ITR2 = TIM4 TRGO (TIM1/TIM8 internal trigger table) */
 #define TIM_SMS_RESET 4u   /* a trigger edge resets the counter */
 #define TIM_SMS_TRIGGER 6u /* a trigger edge sets CEN */
-#define TIM_OCM_PWM1 6u /* active while CNT < CCR */
-#define TIM_OCM_PWM2 7u /* inactive while CNT < CCR */
+#define TIM_OCM_PWM1 6u    /* active while CNT < CCR */
+#define TIM_OCM_PWM2 7u    /* inactive while CNT < CCR */
 #define TIM_CCMR_OC1M_POS 4u
 #define TIM_CCMR_OC1PE (1u << 3)
 #define TIM_CCMR_OC2M_POS 12u

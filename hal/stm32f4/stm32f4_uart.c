@@ -111,7 +111,4 @@ size_t hal_uart_write(const uint8_t *data, size_t len)
   return n;
 }
 
-size_t hal_uart_tx_free(void)
-{
-  return byte_ring_free(&s_tx);
-}
+size_t hal_uart_tx_free(void) { return byte_ring_free(&s_tx); }

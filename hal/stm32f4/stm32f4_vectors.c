@@ -16,10 +16,10 @@ extern uint32_t _estack[];
  * (cm4_startup.c), which records the unexpected interrupt like a fault. A weak stub
  * branches there without touching LR or the stack, so the fault record sees the
  * interrupt's own EXC_RETURN and IPSR. */
-#define WEAK_TO_DEFAULT(name)                                                         \
-  __attribute__((weak, naked)) CM4_BOOT_TEXT void name(void)                          \
-  {                                                                                   \
-    __asm volatile("b Default_Handler\n");                                           \
+#define WEAK_TO_DEFAULT(name) \
+  __attribute__((weak, naked)) CM4_BOOT_TEXT void name(void) \
+  { \
+    __asm volatile("b Default_Handler\n"); \
   }
 void SysTick_Handler(void);
 void USART1_IRQHandler(void);
@@ -28,32 +28,61 @@ WEAK_TO_DEFAULT(SysTick_Handler)
 WEAK_TO_DEFAULT(USART1_IRQHandler)
 WEAK_TO_DEFAULT(DMA2_Stream0_IRQHandler)
 
-#define D {.fn = Default_Handler}
+#define D \
+  { \
+    .fn = Default_Handler \
+  }
 #define D8 D, D, D, D, D, D, D, D
 
 __attribute__((section(".isr_vector"), used)) const cm4_vector_t cm4_vectors[] = {
     {.sp = _estack},
     {.fn = Reset_Handler},
-    D,                           /* NMI */
+    D, /* NMI */
     {.fn = HardFault_Handler},
-    {.fn = HardFault_Handler},   /* MemManage */
-    {.fn = HardFault_Handler},   /* BusFault */
-    {.fn = HardFault_Handler},   /* UsageFault */
-    {.fn = 0}, {.fn = 0}, {.fn = 0}, {.fn = 0},
-    D,                           /* SVCall */
-    D,                           /* DebugMonitor */
+    {.fn = HardFault_Handler}, /* MemManage */
+    {.fn = HardFault_Handler}, /* BusFault */
+    {.fn = HardFault_Handler}, /* UsageFault */
     {.fn = 0},
-    D,                           /* PendSV */
+    {.fn = 0},
+    {.fn = 0},
+    {.fn = 0},
+    D, /* SVCall */
+    D, /* DebugMonitor */
+    {.fn = 0},
+    D, /* PendSV */
     {.fn = SysTick_Handler},
     /* IRQ 0..39 */
-    D8, D8, D8, D8, D, D, D, D, D, {.fn = USART1_IRQHandler} /* 37 */, D, D,
+    D8,
+    D8,
+    D8,
+    D8,
+    D,
+    D,
+    D,
+    D,
+    D,
+    {.fn = USART1_IRQHandler} /* 37 */,
+    D,
+    D,
     /* IRQ 40..55 */
-    D8, D8,
+    D8,
+    D8,
     /* IRQ 56..81 */
-    {.fn = DMA2_Stream0_IRQHandler} /* 56 */, D, D, D, D, D, D, D,
-    D8, D8, D, D,
+    {.fn = DMA2_Stream0_IRQHandler} /* 56 */,
+    D,
+    D,
+    D,
+    D,
+    D,
+    D,
+    D,
+    D8,
+    D8,
+    D,
+    D,
 };
 
-_Static_assert(sizeof(cm4_vectors) == 4u * NUM_VECTORS, "one entry per core exception and per interrupt");
+_Static_assert(sizeof(cm4_vectors) == 4u * NUM_VECTORS,
+               "one entry per core exception and per interrupt");
 
 const uint32_t cm4_num_vectors = NUM_VECTORS;

@@ -37,7 +37,7 @@ void mech_default_cfg(mech_cfg_t *cfg)
   cfg->ket_per_k = 40e-6; /* (2-29) range 25..75 ppm/K; table 7-4 fits 40 (plant_cfg.c) */
   cfg->kq_per_s2 = 0.0;
   cfg->dq_per_s = 0.0;
-  cfg->mass_kg = 0.26e-6; /* §4.6.1: 0.26 mg */
+  cfg->mass_kg = 0.26e-6;                    /* §4.6.1: 0.26 mg */
   cfg->fs_hz = (double)BOARD_SAMPLE_RATE_HZ; /* §4.4.2 */
   /* Measured (test_mech, test_refresh_threshold_error): with e expanded to second
    * order the steady-state error of the drive at resonance (Q1 = 33) is about

@@ -127,7 +127,7 @@ void plant_default_cfg(plant_cfg_t *c)
   memset(c, 0, sizeof *c);
   /* run */
   c->fs_hz = (double)BOARD_SAMPLE_RATE_HZ; /* §4.4.2, table */
-  c->temp_k = 298.15; /* room, 25 degC (= T0) */
+  c->temp_k = 298.15;                      /* room, 25 degC (= T0) */
   c->rate_dps = 0.0;
   c->drive_amp_m = 10e-6; /* §4.6.1, table (15 um in §2.4.2) */
   c->rate_fs_dps = 160.0; /* largest rate of the scale-factor test, table 7-2 */

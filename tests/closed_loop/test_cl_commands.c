@@ -427,8 +427,8 @@ static void test_extra_words_refused(void **state)
 {
   (void)state;
   start();
-  const char *const lines[] = {"help x\n", "version x\n", "save x\n", "load x\n",
-                               "defaults x\n", "diff x\n", "list a b\n", "get a b\n"};
+  const char *const lines[] = {"help x\n",     "version x\n", "save x\n",   "load x\n",
+                               "defaults x\n", "diff x\n",    "list a b\n", "get a b\n"};
   for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++) {
     assert_non_null(strstr(cmd(lines[i]), "err ARGS "));
   }

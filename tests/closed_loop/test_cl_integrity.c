@@ -36,7 +36,6 @@ static void test_healthy_default_part(void **state)
 }
 
 
-
 /* Parts other than the default, on the default firmware values: each plant setting
  * that differs (0: the default part's), and how long to judge it. */
 typedef struct {
@@ -45,12 +44,13 @@ typedef struct {
   double run_s;
 } part_case_t;
 
-static part_case_t k_parts[] = { /* not const: cmocka passes it as void * */
-    {"f_drive 1550 Hz", 1550.0, 0.0, 0.0, 0.0, 0.0, 2.0},   /* 60 Hz from drive.freq_hz */
-    {"f_drive 1530 Hz", 1530.0, 0.0, 0.0, 0.0, 0.0, 2.0},   /* locks with P 60 deg off */
-    {"Q 10000, defaults", 0.0, 10000.0, 0.0, 0.0, 0.0, 3.0}, /* beyond the default design */
+static part_case_t k_parts[] = {
+    /* not const: cmocka passes it as void * */
+    {"f_drive 1550 Hz", 1550.0, 0.0, 0.0, 0.0, 0.0, 2.0},       /* 60 Hz from drive.freq_hz */
+    {"f_drive 1530 Hz", 1530.0, 0.0, 0.0, 0.0, 0.0, 2.0},       /* locks with P 60 deg off */
+    {"Q 10000, defaults", 0.0, 10000.0, 0.0, 0.0, 0.0, 3.0},    /* beyond the default design */
     {"quad 4000, rate 100", 0.0, 0.0, 4000.0, 100.0, 0.0, 1.5}, /* sense ADC clips at peaks */
-    {"rate 3000", 0.0, 0.0, 0.0, 3000.0, 0.0, 1.5},          /* ten times full scale */
+    {"rate 3000", 0.0, 0.0, 0.0, 3000.0, 0.0, 1.5},             /* ten times full scale */
     /* uncompensated bias 67 / 93 deg/s away from where the shipped values were taken */
     {"0 degC ambient", 0.0, 0.0, 0.0, 0.0, 273.15, 1.5},
     {"60 degC ambient", 0.0, 0.0, 0.0, 0.0, 333.15, 1.5},
@@ -118,8 +118,6 @@ static void test_q5000_calibrated_warm(void **state)
   pc.temp_k += 22.5;
   run_case("Q 5000 calibrated, +22.5 K", &pc, &v, 3.0);
 }
-
-
 
 
 static void test_sense_vibration_10g(void **state)

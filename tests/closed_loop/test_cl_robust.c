@@ -16,7 +16,6 @@
 #include "app_plant.h"
 
 
-
 static void start(const plant_cfg_t *pc) { app_plant_start(pc, 21u, NULL); }
 
 static void step_structure(double dk)
@@ -62,8 +61,8 @@ static void test_ambient_ramp(void **state)
   (void)state;
   plant_cfg_t pc;
   plant_default_cfg(&pc);
-  pc.temp_k = 233.15;          /* start settled at -40 degC */
-  pc.tau_struct_s = 0.5;       /* thermal nodes follow in a fraction of a second */
+  pc.temp_k = 233.15;    /* start settled at -40 degC */
+  pc.tau_struct_s = 0.5; /* thermal nodes follow in a fraction of a second */
   pc.tau_circuit_s = 0.5;
   pc.tau_board_s = 0.5;
   /* The sense circuit lag drifts 0.1 deg/K (table 7-4); centred so that it stays a lag

@@ -17,7 +17,6 @@
 #include "app_plant.h"
 
 
-
 static void start(int fb_mode)
 {
   plant_cfg_t pc;
@@ -35,7 +34,8 @@ static void test_pass_on_healthy_part(void **state)
   assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
   assert_true(strncmp(cmd("selftest\n"), "ok", 2) == 0);
   run_s(0.6);
-  printf("# self-test response %.4f deg/s (expected %.4f)\n", (double)app.gyro.selftest.result_dps,
+  printf("# self-test response %.4f deg/s (expected %.4f)\n",
+         (double)app.gyro.selftest.result_dps,
          (double)params_current(&app.params)->selftest_expect_dps);
   assert_int_equal(app.gyro.selftest.state, SELFTEST_PASS);
   assert_non_null(strstr(cmd("status\n"), "- selftest PASS\r\n"));
@@ -75,7 +75,8 @@ static double rate_rms(double s, double *mean_out)
 static double cont_response_dps(int axis)
 {
   const float *w = app.gyro.selftest.w + 2 * axis;
-  return sqrt((double)(w[0] * w[0] + w[1] * w[1])) * fabs((double)app.gyro.design->rate.scale_dps);
+  return sqrt((double)(w[0] * w[0] + w[1] * w[1])) *
+         fabs((double)app.gyro.design->rate.scale_dps);
 }
 
 static void test_continuous_healthy(void **state)
@@ -94,8 +95,7 @@ static void test_continuous_healthy(void **state)
   printf("# continuous self-test: response %.4f deg/s (expected %.4f; quadrature axis %.4f), "
          "rate rms %.4f off / %.4f on deg/s, mean %.4f / %.4f\n",
          cont_response_dps(0), (double)params_current(&app.params)->selftest_cont_expect_dps,
-         cont_response_dps(1),
-         rms_off, rms_on, m_off, m_on);
+         cont_response_dps(1), rms_off, rms_on, m_off, m_on);
   assert_int_equal(app.gyro.cont_fail, 0u);
   assert_true((app.gyro.out.flags & GYRO_FLAG_RATE_VALID) != 0u);
   /* Its 5 deg/s tone is taken out: the output's rms moves by less than 10 % (a tone
@@ -136,7 +136,8 @@ static void test_continuous_dead_electrode(void **state)
   assert_true(strncmp(cmd("set selftest.continuous 1\n"), "ok", 2) == 0);
   run_s(1.5);
   printf("# continuous self-test without the electrodes: response %.4f deg/s (quadrature "
-         "axis %.4f)\n", cont_response_dps(0), cont_response_dps(1));
+         "axis %.4f)\n",
+         cont_response_dps(0), cont_response_dps(1));
   assert_int_equal(app.gyro.cont_fail, 1u);
   assert_true((app.gyro.out.rate_invalid & RATE_INVALID_CONT_SELFTEST) != 0u);
   assert_true((app.gyro.out.flags & GYRO_FLAG_RATE_VALID) == 0u);

@@ -14,7 +14,6 @@
 #include "app_plant.h"
 
 
-
 static void start(void)
 {
   plant_cfg_t pc;

@@ -107,7 +107,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
   FUZZ_CHECK(param_store_init(&g.store, &sc) == PARAM_STORE_OK);
   const params_cfg_t pc = {derive, {&g.derived[0], &g.derived[1]}, loop_safe, &g};
   FUZZ_CHECK(params_init(&g.bank, &pc, NULL, NULL) == PARAM_OK);
-  const cli_cfg_t cc = {&g.bank, &g.store, check_line, &g, cli_builtin_cmds, cli_builtin_count()};
+  const cli_cfg_t cc = {&g.bank, &g.store,         check_line,
+                        &g,      cli_builtin_cmds, cli_builtin_count()};
   FUZZ_CHECK(cli_init(&g.cli, &cc) == 0);
   if (size == 0) {
     return 0;

@@ -73,11 +73,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FUZZ_CHECK(rep.slot_state[rep.slot] == PARAM_SLOT_VALID);
     FUZZ_CHECK(rep.defaulted <= PARAM_COUNT);
   } else {
-    FUZZ_CHECK(rep.slot == -1 && rep.slot_state[0] != PARAM_SLOT_VALID && rep.slot_state[1] != PARAM_SLOT_VALID);
+    FUZZ_CHECK(rep.slot == -1 && rep.slot_state[0] != PARAM_SLOT_VALID &&
+               rep.slot_state[1] != PARAM_SLOT_VALID);
   }
   /* a save never destroys the newest valid image and reads back exactly */
   v.drive_freq_hz = 1234.5f;
-  const bool newer = rep.slot_state[0] == PARAM_SLOT_NEWER || rep.slot_state[1] == PARAM_SLOT_NEWER;
+  const bool newer = rep.slot_state[0] == PARAM_SLOT_NEWER ||
+                     rep.slot_state[1] == PARAM_SLOT_NEWER;
   FUZZ_CHECK((ls == PARAM_STORE_NEWER) == (newer && ls != PARAM_STORE_OK));
   param_store_status_t ss = param_store_save(&st, &v, PARAM_SAVE_LOOP_SAFE, &rep);
   /* a newer-format image is only overwritten by a forced save */

@@ -108,8 +108,8 @@ static void build_good(void)
   const tlm_cfg_t c = {50000u, 921600u, room, take, NULL, &app_tlm_fields};
   FUZZ_CHECK(tlm_init(&g_tx, &c) == 0);
   tlm_plan_t p;
-  FUZZ_CHECK(tlm_plan(&app_tlm_fields, 50000u, 921600u, (1u << TLM_FIELD_rate_dps) | (1u << TLM_FIELD_tick), 1000.0f, &p) ==
-             TLM_OK);
+  FUZZ_CHECK(tlm_plan(&app_tlm_fields, 50000u, 921600u,
+                      (1u << TLM_FIELD_rate_dps) | (1u << TLM_FIELD_tick), 1000.0f, &p) == TLM_OK);
   tlm_start(&g_tx, &p);
   gyro_out_t o;
   memset(&o, 0, sizeof o);
@@ -130,7 +130,8 @@ static void feed_sealed(const uint8_t *data, size_t size)
   while (off < size) {
     size_t len = data[off++];
     if (len > size - off) len = size - off;
-    if (len > TLM_FRAME_MAX - TLM_FRAME_OVERHEAD + 3u) len = TLM_FRAME_MAX - TLM_FRAME_OVERHEAD + 3u;
+    if (len > TLM_FRAME_MAX - TLM_FRAME_OVERHEAD + 3u)
+      len = TLM_FRAME_MAX - TLM_FRAME_OVERHEAD + 3u;
     raw[0] = 0u;
     memset(&raw[1], 0, 3u);
     memcpy(&raw[1], data + off, len);

@@ -4,7 +4,8 @@
 #include <Eigen/Dense>
 #include <cmath>
 
-namespace {
+namespace
+{
 
 using Mat2 = Eigen::Matrix2d;
 using Vec2 = Eigen::Vector2d;

@@ -18,8 +18,8 @@ extern "C" {
 /* Exponentially weighted RLS, thesis 5.4.2, textbook form
  * K = P phi / (lambda + phi' P phi), W += K err, P = (P - K phi' P) / lambda. */
 typedef struct {
-  double w[2];   /* [in-phase, quadrature] */
-  double p[4];   /* P, row-major */
+  double w[2]; /* [in-phase, quadrature] */
+  double p[4]; /* P, row-major */
   double lambda;
 } ref_rls_t;
 

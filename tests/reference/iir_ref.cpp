@@ -16,7 +16,8 @@ extern "C" void iir_ref_sos_filter(const double *sos, size_t n_sections, const d
       const double *c = &sos[6 * s];
       long double *xs = &xh[2 * s], *ys = &yh[2 * s];
       const long double out = (c[0] * v + c[1] * xs[0] + c[2] * xs[1] - c[4] * ys[0] -
-                               c[5] * ys[1]) / c[3];
+                               c[5] * ys[1]) /
+                              c[3];
       xs[1] = xs[0];
       xs[0] = v;
       ys[1] = ys[0];
@@ -30,13 +31,15 @@ extern "C" void iir_ref_sos_filter(const double *sos, size_t n_sections, const d
 extern "C" void iir_ref_sos_freqresp(const double *sos, size_t n_sections, double f_hz,
                                      double fs_hz, double *re, double *im)
 {
-  const std::complex<long double> zi =
-      std::polar(1.0L, -2.0L * 3.141592653589793238462643383279L * f_hz / fs_hz);
+  const std::complex<long double> zi = std::polar(
+      1.0L, -2.0L * 3.141592653589793238462643383279L * f_hz / fs_hz);
   std::complex<long double> h = 1.0L;
   for (size_t s = 0; s < n_sections; s++) {
     const double *c = &sos[6 * s];
-    const std::complex<long double> num = (long double)c[0] + zi * ((long double)c[1] + zi * (long double)c[2]);
-    const std::complex<long double> den = (long double)c[3] + zi * ((long double)c[4] + zi * (long double)c[5]);
+    const std::complex<long double> num = (long double)c[0] +
+                                          zi * ((long double)c[1] + zi * (long double)c[2]);
+    const std::complex<long double> den = (long double)c[3] +
+                                          zi * ((long double)c[4] + zi * (long double)c[5]);
     h *= num / den;
   }
   *re = static_cast<double>(h.real());

@@ -16,14 +16,17 @@
 
 typedef struct {
   uint32_t blocks, valid_blocks, valid_after_0p3, blocks_after_0p3;
-  uint32_t wrong_valid;       /* valid blocks with a wrong rate, once first valid */
-  uint32_t not_at_fault;      /* invalid blocks whose analog output is not the fault level */
+  uint32_t wrong_valid;  /* valid blocks with a wrong rate, once first valid */
+  uint32_t not_at_fault; /* invalid blocks whose analog output is not the fault level */
   double first_valid_s;
   double worst_err_dps, worst_err_t_s;
-  double t0_s;                /* power-on of this run */
+  double t0_s; /* power-on of this run */
 } judge_t;
 
-static inline int rate_valid_now(void) { return (app.gyro.out.flags & GYRO_FLAG_RATE_VALID) != 0u; }
+static inline int rate_valid_now(void)
+{
+  return (app.gyro.out.flags & GYRO_FLAG_RATE_VALID) != 0u;
+}
 
 static inline double analog_out_v(void)
 {
@@ -97,7 +100,8 @@ static inline void start_part(const plant_cfg_t *pc, const param_values_t *v)
 }
 
 /* One case: part pc, firmware values v (NULL: the defaults), s seconds from power-on. */
-static inline void run_case(const char *name, const plant_cfg_t *pc, const param_values_t *v, double s)
+static inline void run_case(const char *name, const plant_cfg_t *pc, const param_values_t *v,
+                            double s)
 {
   judge_t j;
   start_part(pc, v);

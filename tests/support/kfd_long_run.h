@@ -11,14 +11,20 @@
 #include "demod_test_signal.h"
 #include "dsp/kfd.h"
 
-static inline double rel_err_x(const kfd_t *s, const double x[2]) { return rel_err_vec(s->x_i, s->x_q, x); }
+static inline double rel_err_x(const kfd_t *s, const double x[2])
+{
+  return rel_err_vec(s->x_i, s->x_q, x);
+}
 
-static inline double rel_err_p(const kfd_t *s, const double p[4]) { return rel_err_cov(s->cov.p11, s->cov.p12, s->cov.p22, p); }
+static inline double rel_err_p(const kfd_t *s, const double p[4])
+{
+  return rel_err_cov(s->cov.p11, s->cov.p12, s->cov.p22, p);
+}
 
 static inline void init_default(kfd_t *s)
 {
-  assert_int_equal(
-      kfd_init(s, &(kfd_cfg_t){.q = KFD_Q_DEFAULT, .r = KFD_R_DEFAULT, .p0 = 1.0f}), 0);
+  assert_int_equal(kfd_init(s, &(kfd_cfg_t){.q = KFD_Q_DEFAULT, .r = KFD_R_DEFAULT, .p0 = 1.0f}),
+                   0);
 }
 
 /* Long run: P positive definite and bounded at every sample, never restarted, and the

@@ -11,9 +11,15 @@
 #include "demod_test_signal.h"
 #include "dsp/rlsd.h"
 
-static inline double rel_err_w(const rlsd_t *s, const double w[2]) { return rel_err_vec(s->w_i, s->w_q, w); }
+static inline double rel_err_w(const rlsd_t *s, const double w[2])
+{
+  return rel_err_vec(s->w_i, s->w_q, w);
+}
 
-static inline double rel_err_p(const rlsd_t *s, const double p[4]) { return rel_err_cov(s->cov.p11, s->cov.p12, s->cov.p22, p); }
+static inline double rel_err_p(const rlsd_t *s, const double p[4])
+{
+  return rel_err_cov(s->cov.p11, s->cov.p12, s->cov.p22, p);
+}
 
 static inline void init_default(rlsd_t *s)
 {

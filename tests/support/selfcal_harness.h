@@ -43,8 +43,9 @@ static inline double sweep(void)
 
 static inline double sweep_report(uint64_t t0)
 {
-  for (int i = 0; i < 70000 && (app.selfcal.state != SELFCAL_DONE &&
-                                app.selfcal.state != SELFCAL_FAILED); i++) {
+  for (int i = 0;
+       i < 70000 && (app.selfcal.state != SELFCAL_DONE && app.selfcal.state != SELFCAL_FAILED);
+       i++) {
     run_polled_s(0.001);
   }
   const double t = (double)(plant_truth(&plant)->sample - t0) / 50000.0;
@@ -98,9 +99,11 @@ static inline void check_points(const plant_cfg_t *pc)
   while (strncmp(line, "- point ", 8) == 0) {
     unsigned k = 0u, stage = 0u;
     double f = 0.0, amp = 0.0, ph = 0.0, fc = 0.0, g = 0.0;
-    assert_int_equal(sscanf(line, "- point %u f_hz %lf amp_v %lf phase_deg %lf f_cmd_v2 %lf "
-                                  "gain_v_per_v2 %lf stage %u",
-                            &k, &f, &amp, &ph, &fc, &g, &stage), 7);
+    assert_int_equal(sscanf(line,
+                            "- point %u f_hz %lf amp_v %lf phase_deg %lf f_cmd_v2 %lf "
+                            "gain_v_per_v2 %lf stage %u",
+                            &k, &f, &amp, &ph, &fc, &g, &stage),
+                     7);
     assert_true(n < SELFCAL_EXPORT_MAX);
     assert_int_equal(k, n);
     assert_true(stage == 1u || stage == 2u);
@@ -131,8 +134,9 @@ static inline void check_points(const plant_cfg_t *pc)
   assert_true(fabs(g_max / s->fit.gain_v_per_v2 - 1.0) < 0.1);
   selfcal_fit_t fit;
   double d = 0.0;
-  assert_int_equal(selfcal_fit_delay(pts, n, s->cfg.delay_s, s->cfg.delay_s + 8.0 / s->cfg.fs_hz,
-                                     &fit, &d), 0);
+  assert_int_equal(
+      selfcal_fit_delay(pts, n, s->cfg.delay_s, s->cfg.delay_s + 8.0 / s->cfg.fs_hz, &fit, &d),
+      0);
   const double tf0 = true_f0(pc);
   printf("# sweep points: %u, %.3f..%.3f Hz, peak gain %.5g at %.3f Hz; refit on them: f0 "
          "%.4f Hz (plant %.4f) Q %.2f (plant %.2f) rms %.2g; reply %zu bytes\n",

@@ -33,7 +33,11 @@ static inline double *tv_load_csv(const char *name, size_t *rows, size_t *cols)
       if (n == cap) {
         cap *= 2;
         double *grown = realloc(data, cap * sizeof *data);
-        if (!grown) { free(data); data = NULL; break; }
+        if (!grown) {
+          free(data);
+          data = NULL;
+          break;
+        }
         data = grown;
       }
       data[n++] = v;

@@ -12,7 +12,7 @@
 typedef struct {
   uint8_t *buf; /* TLM_TEST_LINK_MAX bytes, caller-provided */
   size_t len;
-  size_t room;  /* what room() reports */
+  size_t room; /* what room() reports */
   size_t writes;
   size_t oversize; /* writes beyond room (must stay 0) */
 } tlm_test_link_t;

@@ -82,7 +82,8 @@ static vib_result_t vibrate(double ag, double f)
   const double complex F = fo.f_sense_mps2 * (-I);
   const double complex X = F / (WN2 * WN2 - w * w + I * w * WN2 / Q2);
   const double th = 1.0 / (2.0 * k_pi * pc.hp_hz), w0 = 2.0 * k_pi * pc.lp_hz;
-  const double complex H = (1.0 / (1.0 + I * w / (2.0 * k_pi * pc.lag_ref_hz) * tan(pc.phi0_rad))) *
+  const double complex H = (1.0 /
+                            (1.0 + I * w / (2.0 * k_pi * pc.lag_ref_hz) * tan(pc.phi0_rad))) *
                            (I * w * th / (1.0 + I * w * th)) *
                            (w0 * w0 / (w0 * w0 - w * w + I * w * w0 / pc.lp_q));
   const int warm = 2500, n = 25000;
@@ -101,7 +102,8 @@ static vib_result_t vibrate(double ag, double f)
     }
     if (k >= warm) {
       y[k - warm] = adc_code_to_v(&adc, code);
-      const double want = pc.gain_v_per_m * creal(X * H * cexp(I * w * (t + pc.sample_delay_s))) + pc.offset_v;
+      const double want = pc.gain_v_per_m * creal(X * H * cexp(I * w * (t + pc.sample_delay_s))) +
+                          pc.offset_v;
       const double q = round(want * 32768.0 / 5.0);
       if (q > 32767.0 || q < -32768.0) r.adc_clips_want++;
     }
@@ -124,24 +126,26 @@ static void test_vibration_clips_adc(void **state)
 {
   (void)state;
   vib_result_t r = vibrate(0.2, 200.0);
-  print_message("0.2 g 200 Hz: ADC %.4f V (want %.4f), ADC clips %llu, preamp clips %llu\n", r.amp, r.amp_want,
-                (unsigned long long)r.adc_clips, (unsigned long long)r.preamp_clips);
+  print_message("0.2 g 200 Hz: ADC %.4f V (want %.4f), ADC clips %llu, preamp clips %llu\n",
+                r.amp, r.amp_want, (unsigned long long)r.adc_clips,
+                (unsigned long long)r.preamp_clips);
   assert_true(fabs(r.amp / r.amp_want - 1.0) < 1e-3);
   assert_int_equal(r.adc_clips, 0);
   assert_int_equal(r.preamp_clips, 0);
 
   r = vibrate(2.0, 200.0);
-  print_message("2 g 200 Hz: amplitude %.3f V wanted, ADC clips %llu (analytic %llu), preamp clips %llu\n",
-                r.amp_want, (unsigned long long)r.adc_clips, (unsigned long long)r.adc_clips_want,
-                (unsigned long long)r.preamp_clips);
+  print_message(
+      "2 g 200 Hz: amplitude %.3f V wanted, ADC clips %llu (analytic %llu), preamp clips %llu\n",
+      r.amp_want, (unsigned long long)r.adc_clips, (unsigned long long)r.adc_clips_want,
+      (unsigned long long)r.preamp_clips);
   assert_true(r.amp_want > 5.0);
   assert_true(r.adc_clips > 1000);
   assert_true(llabs((long long)r.adc_clips - (long long)r.adc_clips_want) <= 2);
   assert_int_equal(r.preamp_clips, 0);
 
   r = vibrate(5.0, 5.0);
-  print_message("5 g 5 Hz: ADC clips %llu, preamp clips %llu\n", (unsigned long long)r.adc_clips,
-                (unsigned long long)r.preamp_clips);
+  print_message("5 g 5 Hz: ADC clips %llu, preamp clips %llu\n",
+                (unsigned long long)r.adc_clips, (unsigned long long)r.preamp_clips);
   assert_true(r.preamp_clips > 1000);
   assert_int_equal(r.adc_clips, 0);
 }

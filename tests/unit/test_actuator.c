@@ -183,7 +183,8 @@ static void test_force_law(void **state)
       actuator_step(&a, &o, &out);
       const double *w = out.noise_v;
       assert_true(w[0] != 0.0 && w[1] != 0.0 && w[0] != w[1]);
-      const double fd = cfg.ks_drive_mps2_per_v2 * ((v1 + w[0]) * (v1 + w[0]) - (v2 + w[1]) * (v2 + w[1]));
+      const double fd = cfg.ks_drive_mps2_per_v2 *
+                        ((v1 + w[0]) * (v1 + w[0]) - (v2 + w[1]) * (v2 + w[1]));
       assert_true(fabs(out.f_drive_mps2 - fd) < 1e-12 * (1.0 + fabs(fd)));
       double fsn = 0.0;
       const double vb = cfg.fb_bias_v;
@@ -191,7 +192,8 @@ static void test_force_law(void **state)
         fsn = cfg.ks_fb_mps2_per_v2 * (u + w[2]) * (u + w[2]);
         assert_true(w[3] == 0.0);
       } else if (modes[mi] == ACTUATOR_FB_DIFFERENTIAL) {
-        fsn = cfg.ks_fb_mps2_per_v2 * ((vb + u + w[2]) * (vb + u + w[2]) - (vb - u + w[3]) * (vb - u + w[3]));
+        fsn = cfg.ks_fb_mps2_per_v2 *
+              ((vb + u + w[2]) * (vb + u + w[2]) - (vb - u + w[3]) * (vb - u + w[3]));
       } else {
         assert_true(w[2] == 0.0 && w[3] == 0.0);
       }
@@ -313,36 +315,42 @@ static void test_low_frequency_noise_placement(void **state)
       if (fabs(f - fd) >= 6.0 && fabs(f - fd) <= 40.0) {
         if (sch == HALF_FREQ)
           sw = 2.0 * ks * ks * car * car *
-               (flicker_target_psd(&noise, fs, fabs(f - fd / 2.0)) + flicker_target_psd(&noise, fs, f + fd / 2.0));
+               (flicker_target_psd(&noise, fs, fabs(f - fd / 2.0)) +
+                flicker_target_psd(&noise, fs, f + fd / 2.0));
         else
           sw = 2.0 * ks * ks * car * car *
-                   (flicker_target_psd(&noise, fs, fabs(f - fd)) + flicker_target_psd(&noise, fs, f + fd)) +
+                   (flicker_target_psd(&noise, fs, fabs(f - fd)) +
+                    flicker_target_psd(&noise, fs, f + fd)) +
                8.0 * ks * ks * lev * lev * flicker_target_psd(&noise, fs, f);
         want += sw;
         cnt++;
       }
       if (sch == HALF_FREQ && fabs(f - fd / 2.0) >= 6.0 && fabs(f - fd / 2.0) <= 40.0) {
         want_h += 2.0 * ks * ks * car * car *
-                  (flicker_target_psd(&noise, fs, fabs(f - fd / 2.0)) + flicker_target_psd(&noise, fs, f + fd / 2.0));
+                  (flicker_target_psd(&noise, fs, fabs(f - fd / 2.0)) +
+                   flicker_target_psd(&noise, fs, f + fd / 2.0));
         cnt_h++;
       }
     }
     want /= cnt;
     near_wc[s] = band(psd, fs, fd, 6.0, 40.0);
     want_wc[s] = want;
-    print_message("%s: carrier %.4f V level %.4f V; force noise 6-40 Hz from wc %.3e (want %.3e) (m/s^2)^2/Hz\n",
-                  sch == HALF_FREQ ? "half-freq" : "DC+AC", car, lev, near_wc[s], want);
+    print_message(
+        "%s: carrier %.4f V level %.4f V; force noise 6-40 Hz from wc %.3e (want %.3e) (m/s^2)^2/Hz\n",
+        sch == HALF_FREQ ? "half-freq" : "DC+AC", car, lev, near_wc[s], want);
     assert_true(fabs(near_wc[s] / want - 1.0) < 0.2);
     if (sch == HALF_FREQ) {
       want_h /= cnt_h;
       const double near_half = band(psd, fs, fd / 2.0, 6.0, 40.0);
-      print_message("half-freq: force noise 6-40 Hz from wc/2 %.3e (want %.3e)\n", near_half, want_h);
+      print_message("half-freq: force noise 6-40 Hz from wc/2 %.3e (want %.3e)\n", near_half,
+                    want_h);
       assert_true(fabs(near_half / want_h - 1.0) < 0.2);
       assert_true(near_half > 5.0 * near_wc[s]); /* the 1/f noise sits at wc/2 */
     }
   }
   const double ratio = near_wc[1] / near_wc[0], ratio_want = want_wc[1] / want_wc[0];
-  print_message("DC+AC / half-frequency force noise near wc: %.2f (analytic %.2f)\n", ratio, ratio_want);
+  print_message("DC+AC / half-frequency force noise near wc: %.2f (analytic %.2f)\n", ratio,
+                ratio_want);
   assert_true(fabs(ratio / ratio_want - 1.0) < 0.2);
   assert_true(ratio > 2.0);
   free(fn);

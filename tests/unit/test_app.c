@@ -158,8 +158,8 @@ static void test_replies_fit_the_reserve(void **state)
   const char *pts = cmd("sweep points\n");
   assert_non_null(strstr(pts, "ok 18 points\r\n"));
   printf("# sweep points at its longest: %zu bytes\n", strlen(pts));
-  const char *const lines[] = {"list\n", "help\n", "status\n", "diff\n", "version\n",
-                               "stream\n", "selftest status\n", "sweep points\n"};
+  const char *const lines[] = {"list\n",    "help\n",   "status\n",          "diff\n",
+                               "version\n", "stream\n", "selftest status\n", "sweep points\n"};
   size_t longest = 0u;
   for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++) {
     const char *r = cmd(lines[i]);
@@ -188,9 +188,12 @@ static void test_design_reason_and_status(void **state)
   const char *r = cmd("status\n");
   float amp_bw = 0.0f, amp_pm = 0.0f, ph_bw = 0.0f, ph_pm = 0.0f;
   assert_int_equal(sscanf(strstr(r, "- design_amp_bw_hz "), "- design_amp_bw_hz %f", &amp_bw), 1);
-  assert_int_equal(sscanf(strstr(r, "- design_amp_pm_deg "), "- design_amp_pm_deg %f", &amp_pm), 1);
-  assert_int_equal(sscanf(strstr(r, "- design_phase_bw_hz "), "- design_phase_bw_hz %f", &ph_bw), 1);
-  assert_int_equal(sscanf(strstr(r, "- design_phase_pm_deg "), "- design_phase_pm_deg %f", &ph_pm), 1);
+  assert_int_equal(sscanf(strstr(r, "- design_amp_pm_deg "), "- design_amp_pm_deg %f", &amp_pm),
+                   1);
+  assert_int_equal(sscanf(strstr(r, "- design_phase_bw_hz "), "- design_phase_bw_hz %f", &ph_bw),
+                   1);
+  assert_int_equal(
+      sscanf(strstr(r, "- design_phase_pm_deg "), "- design_phase_pm_deg %f", &ph_pm), 1);
   printf("# designed: amplitude %.2f Hz %.1f deg, phase %.2f Hz %.1f deg\n", (double)amp_bw,
          (double)amp_pm, (double)ph_bw, (double)ph_pm);
   /* the defaults ask for 30 Hz each, which the designer grants with at least 60 deg */

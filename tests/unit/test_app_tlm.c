@@ -147,7 +147,8 @@ static void test_errors_change_nothing(void **state)
       {"stream rate_dps @-5\n", "err RANGE"},
       {"stream rate_dps @50001\n", "err RANGE"},
       {"stream rate_dps @0.5\n", "err RANGE"},
-      {"stream all @1000\n", "err BANDWIDTH 17 fields at 1000 Hz need 73529 B/s, over 70% of the link (64512 of 92160 B/s)"},
+      {"stream all @1000\n",
+       "err BANDWIDTH 17 fields at 1000 Hz need 73529 B/s, over 70% of the link (64512 of 92160 B/s)"},
       {"stream tick @50000\n", "err BANDWIDTH"},
       {"stop now\n", "err ARGS"},
   };
@@ -181,8 +182,8 @@ static void test_stream_and_stop(void **state)
   r = cmd("stop\n");
   tlm_stats_t st;
   tlm_stats(&app.tlm.stream, &st);
-  snprintf(want, sizeof want, "ok stop 1 records %u lost 0 frames %u dropped 0", (unsigned)st.records,
-           (unsigned)st.frames);
+  snprintf(want, sizeof want, "ok stop 1 records %u lost 0 frames %u dropped 0",
+           (unsigned)st.records, (unsigned)st.frames);
   assert_string_equal(r, want);
   assert_true(got.records > before); /* stop sent the last frames before its reply */
   assert_int_equal(got.records, st.records);

@@ -16,9 +16,9 @@
 
 typedef struct {
   size_t n_sections;
-  double sos[6 * BIQUAD_MAX_SECTIONS]; /* scipy's coefficients, double */
+  double sos[6 * BIQUAD_MAX_SECTIONS];      /* scipy's coefficients, double */
   biquad_coeffs_t f32[BIQUAD_MAX_SECTIONS]; /* the same rounded to float */
-  double sos32[6 * BIQUAD_MAX_SECTIONS];   /* the rounded ones back in double */
+  double sos32[6 * BIQUAD_MAX_SECTIONS];    /* the rounded ones back in double */
   size_t n;
   double *x, *y, *y32; /* input (float values), sosfilt(sos), sosfilt(rounded sos) */
 } design_t;
@@ -148,7 +148,8 @@ static void test_matches_sosfilt_vectors(void **state)
     iir_ref_sos_filter(d.sos32, d.n_sections, d.x, ref, d.n);
     double e_ref = 0.0;
     for (size_t i = 0; i < d.n; i++) e_ref = fmax(e_ref, fabs(ref[i] - d.y32[i]));
-    if (!(e_ref <= 1e-12 * max_abs(d.y32, d.n))) fail_msg("design %zu: vectors off by %.3g", k, e_ref);
+    if (!(e_ref <= 1e-12 * max_abs(d.y32, d.n)))
+      fail_msg("design %zu: vectors off by %.3g", k, e_ref);
 
     const double e = rel_err(out, d.y32, 0, d.n);
     const double e_exact = rel_err(out, d.y, 0, d.n);
@@ -252,7 +253,8 @@ static void test_steady_state_reset_has_no_transient(void **state)
 static void test_init_rejects_bad_arguments_and_changes_nothing(void **state)
 {
   (void)state;
-  const biquad_coeffs_t good[2] = {{0.1f, 0.2f, 0.1f, -0.5f, 0.2f}, {1.0f, 0.0f, -1.0f, 0.1f, 0.3f}};
+  const biquad_coeffs_t good[2] = {{0.1f, 0.2f, 0.1f, -0.5f, 0.2f},
+                                   {1.0f, 0.0f, -1.0f, 0.1f, 0.3f}};
   biquad_cascade_t bq;
   memset(&bq, 0x5A, sizeof bq);
   const biquad_cascade_t before = bq;

@@ -24,12 +24,12 @@ typedef struct {
   unsigned order;
   double f1_hz, f2_hz, fs_hz;
   size_t n_sections;
-  double sos[6 * MAXS];           /* scipy */
+  double sos[6 * MAXS]; /* scipy */
   double poles_re[2 * MAXS], poles_im[2 * MAXS];
   size_t n_freq;
-  double *freq;                   /* f_hz, re, im rows */
+  double *freq; /* f_hz, re, im rows */
   size_t n;
-  double *x, *y;                  /* input (float values), sosfilt(sos, x) */
+  double *x, *y; /* input (float values), sosfilt(sos, x) */
 } design_t;
 
 /* tests/vectors/butter_<idx>_<what>.csv */
@@ -146,7 +146,10 @@ static void check_poles(const design_t *d, const double *sos, const double *tol)
       double bd = INFINITY;
       for (size_t j = 0; j < 2 * d->n_sections; j++) {
         const double dist = hypot(re[k] - d->poles_re[j], im[k] - d->poles_im[j]);
-        if (!used[j] && dist < bd) { bd = dist; best = j; }
+        if (!used[j] && dist < bd) {
+          bd = dist;
+          best = j;
+        }
       }
       if (bd > tol[s]) fail_msg("section %zu pole off by %.3g (tol %.3g)", s, bd, tol[s]);
       used[best] = 1;
@@ -404,9 +407,10 @@ static void test_bad_arguments_are_rejected_and_change_nothing(void **state)
     memset(s, 0x3C, sizeof s);
     memcpy(c0, c, sizeof c);
     memcpy(s0, s, sizeof s);
-    const int r1 = butter_design((butter_type_t)b->type, b->order, b->f1, b->f2, b->fs, c, b->max);
-    const int r2 =
-        butter_design_f64((butter_type_t)b->type, b->order, b->f1, b->f2, b->fs, s, b->max);
+    const int r1 = butter_design((butter_type_t)b->type, b->order, b->f1, b->f2, b->fs, c,
+                                 b->max);
+    const int r2 = butter_design_f64((butter_type_t)b->type, b->order, b->f1, b->f2, b->fs, s,
+                                     b->max);
     if (r1 != b->expect || r2 != b->expect) fail_msg("case %zu: returned %d/%d", i, r1, r2);
     assert_memory_equal(c, c0, sizeof c);
     assert_memory_equal(s, s0, sizeof s);

@@ -66,7 +66,8 @@ static int setup(void **state)
   if (params_init(&g.bank, &pc, NULL, NULL) != PARAM_OK) {
     return -1;
   }
-  const cli_cfg_t cc = {&g.bank, &g.store, write_out, &g, cli_builtin_cmds, cli_builtin_count()};
+  const cli_cfg_t cc = {&g.bank, &g.store,         write_out,
+                        &g,      cli_builtin_cmds, cli_builtin_count()};
   return cli_init(&g.cli, &cc);
 }
 
@@ -142,15 +143,24 @@ static void test_bad_values_change_nothing(void **state)
 {
   (void)state;
   const param_values_t before = *cur();
-  expect("set drive.freq_hz abc\n", "err VALUE drive.freq_hz: 'abc' is not a number; allowed [500,5000] Hz\r\n");
-  expect("set drive.freq_hz 1e999\n", "err RANGE drive.freq_hz: '1e999' is out of range; allowed [500,5000] Hz\r\n");
-  expect("set drive.freq_hz 6000\n", "err RANGE drive.freq_hz: '6000' is out of range; allowed [500,5000] Hz\r\n");
-  expect("set drive.freq_hz nan\n", "err VALUE drive.freq_hz: 'nan' is not a number; allowed [500,5000] Hz\r\n");
-  expect("set drive.freq_hz 1500x\n", "err VALUE drive.freq_hz: '1500x' is not a number; allowed [500,5000] Hz\r\n");
-  expect("set tlm.rate_hz 2.5\n", "err VALUE tlm.rate_hz: '2.5' is not an unsigned integer; allowed [1,5000] Hz\r\n");
-  expect("set tlm.rate_hz -1\n", "err VALUE tlm.rate_hz: '-1' is not an unsigned integer; allowed [1,5000] Hz\r\n");
-  expect("set rate.lpf_order 5\n", "err RANGE rate.lpf_order: '5' is not a choice; allowed {2,4,6,8}\r\n");
-  expect("set demod.mu_sense 0\n", "err RANGE demod.mu_sense: '0' is out of range; allowed [0.0001,0.49]\r\n");
+  expect("set drive.freq_hz abc\n",
+         "err VALUE drive.freq_hz: 'abc' is not a number; allowed [500,5000] Hz\r\n");
+  expect("set drive.freq_hz 1e999\n",
+         "err RANGE drive.freq_hz: '1e999' is out of range; allowed [500,5000] Hz\r\n");
+  expect("set drive.freq_hz 6000\n",
+         "err RANGE drive.freq_hz: '6000' is out of range; allowed [500,5000] Hz\r\n");
+  expect("set drive.freq_hz nan\n",
+         "err VALUE drive.freq_hz: 'nan' is not a number; allowed [500,5000] Hz\r\n");
+  expect("set drive.freq_hz 1500x\n",
+         "err VALUE drive.freq_hz: '1500x' is not a number; allowed [500,5000] Hz\r\n");
+  expect("set tlm.rate_hz 2.5\n",
+         "err VALUE tlm.rate_hz: '2.5' is not an unsigned integer; allowed [1,5000] Hz\r\n");
+  expect("set tlm.rate_hz -1\n",
+         "err VALUE tlm.rate_hz: '-1' is not an unsigned integer; allowed [1,5000] Hz\r\n");
+  expect("set rate.lpf_order 5\n",
+         "err RANGE rate.lpf_order: '5' is not a choice; allowed {2,4,6,8}\r\n");
+  expect("set demod.mu_sense 0\n",
+         "err RANGE demod.mu_sense: '0' is out of range; allowed [0.0001,0.49]\r\n");
   expect("set sys.fs_hz 40000\n", "err RO sys.fs_hz is read-only\r\n");
   expect("set drive.freq_hz\n", "err ARGS usage: set NAME VALUE [NAME VALUE ...]\r\n");
   expect("set drive.freq_hz 1 2\n", "err ARGS usage: set NAME VALUE [NAME VALUE ...]\r\n");
@@ -168,7 +178,8 @@ static void test_loop_running_refusals(void **state)
 {
   (void)state;
   g.safe = false;
-  expect("set drive.mode 1\n", "err BUSY drive.mode cannot change while the drive runs: stop the drive first\r\n");
+  expect("set drive.mode 1\n",
+         "err BUSY drive.mode cannot change while the drive runs: stop the drive first\r\n");
   expect("save\n", "err BUSY drive running: stop the drive first\r\n");
   hal_flash_host_stats_t st;
   hal_flash_host_stats(&st);
@@ -177,7 +188,9 @@ static void test_loop_running_refusals(void **state)
   g.safe = true;
   expect("set drive.mode 1\n", "ok drive.mode 1\r\n");
   /* the application's derive() can refuse a combination */
-  expect("set drive.dc_bias_v 13 drive.u_max_v 12\n", "err REJECTED drive.dc_bias_v 13, drive.u_max_v 12: drive.dc_bias_v must stay below drive.u_max_v\r\n");
+  expect(
+      "set drive.dc_bias_v 13 drive.u_max_v 12\n",
+      "err REJECTED drive.dc_bias_v 13, drive.u_max_v 12: drive.dc_bias_v must stay below drive.u_max_v\r\n");
   assert_true(cur()->drive_u_max_v == 12.75f);
 }
 
@@ -186,7 +199,9 @@ static void test_pending_when_isr_has_not_ticked(void **state)
   (void)state;
   /* two sets in one burst: the ISR has not run in between */
   const char *out = run("set drive.freq_hz 1491\nset drive.freq_hz 1492\n");
-  assert_string_equal(out, "ok drive.freq_hz 1491\r\nerr PENDING previous change not yet taken by the sample loop, retry\r\n");
+  assert_string_equal(
+      out,
+      "ok drive.freq_hz 1491\r\nerr PENDING previous change not yet taken by the sample loop, retry\r\n");
   assert_true(cur()->drive_freq_hz == 1491.0f);
   expect("set drive.freq_hz 1492\n", "ok drive.freq_hz 1492\r\n");
 }
@@ -196,9 +211,13 @@ static void test_save_load_defaults_diff(void **state)
   (void)state;
   g.safe = true;
   expect("diff\n", "ok 0 differ\r\n");
-  expect("load\n", "err NOSTORE no valid parameter image (slot A empty, slot B empty); nothing changed\r\n");
-  expect("set drive.freq_hz 1500 rate.bias_c1_dps_per_deg 34.59\n", "ok drive.freq_hz 1500 rate.bias_c1_dps_per_deg 34.59\r\n");
-  expect("diff\n", "- drive.freq_hz 1500 default 1489.9\r\n- rate.bias_c1_dps_per_deg 34.59 default 0\r\nok 2 differ\r\n");
+  expect("load\n",
+         "err NOSTORE no valid parameter image (slot A empty, slot B empty); nothing changed\r\n");
+  expect("set drive.freq_hz 1500 rate.bias_c1_dps_per_deg 34.59\n",
+         "ok drive.freq_hz 1500 rate.bias_c1_dps_per_deg 34.59\r\n");
+  expect(
+      "diff\n",
+      "- drive.freq_hz 1500 default 1489.9\r\n- rate.bias_c1_dps_per_deg 34.59 default 0\r\nok 2 differ\r\n");
   expect("save\n", "ok saved slot A seq 1\r\n");
   expect("save\n", "ok unchanged slot A seq 1\r\n");
   expect("defaults\n", "ok defaults applied (not saved)\r\n");
@@ -212,12 +231,14 @@ static void test_save_load_defaults_diff(void **state)
   expect("save\n", "ok saved slot A seq 3\r\n");
   expect("set drive.mode 0\n", "ok drive.mode 0\r\n");
   g.safe = false;
-  expect("load\n", "err BUSY drive.mode cannot change while the drive runs: stop the drive first\r\n");
+  expect("load\n",
+         "err BUSY drive.mode cannot change while the drive runs: stop the drive first\r\n");
   assert_int_equal(cur()->drive_mode, 0u);
   g.safe = true;
   expect("set drive.mode 1\n", "ok drive.mode 1\r\n");
   g.safe = false;
-  expect("defaults\n", "err BUSY drive.mode cannot change while the drive runs: stop the drive first\r\n");
+  expect("defaults\n",
+         "err BUSY drive.mode cannot change while the drive runs: stop the drive first\r\n");
 }
 
 static void test_line_discipline(void **state)
@@ -225,7 +246,8 @@ static void test_line_discipline(void **state)
   (void)state;
   /* CR, LF, CRLF and blank lines; several commands in one burst */
   const char *out = run("get tlm.rate_hz\rget tlm.rate_hz\r\n\r\n   \t \nget tlm.rate_hz\n");
-  assert_string_equal(out, "ok tlm.rate_hz 100 Hz\r\nok tlm.rate_hz 100 Hz\r\nok tlm.rate_hz 100 Hz\r\n");
+  assert_string_equal(
+      out, "ok tlm.rate_hz 100 Hz\r\nok tlm.rate_hz 100 Hz\r\nok tlm.rate_hz 100 Hz\r\n");
   /* byte by byte, with tabs and extra spaces */
   g.out_len = 0;
   const char *cmd = "\t get   tlm.rate_hz \r\n";
@@ -247,14 +269,17 @@ static void test_line_discipline(void **state)
   expect(line, "err TOOLONG line longer than 120 bytes discarded\r\n");
   assert_int_equal(cur()->tlm_rate_hz, 100u);
   /* NUL and binary bytes reject the line; the next line works */
-  const uint8_t nul[] = {'s', 'e', 't', ' ', 't', 'l', 'm', '.', 'r', 'a', 't', 'e', '_', 'h', 'z', ' ', '7', 0, '\n'};
+  const uint8_t nul[] = {'s', 'e', 't', ' ', 't', 'l', 'm', '.', 'r', 'a',
+                         't', 'e', '_', 'h', 'z', ' ', '7', 0,   '\n'};
   g.out_len = 0;
   cli_feed(&g.cli, nul, sizeof nul);
   assert_string_equal(g.out, "err BADCHAR line with a non-printable byte discarded\r\n");
-  const uint8_t bin[] = {0xFF, 0x80, 0x1B, '[', 'A', 0x7F, '\n', 'g', 'e', 't', ' ', 's', 'y', 's', '.', 'f', 's', '_', 'h', 'z', '\n'};
+  const uint8_t bin[] = {0xFF, 0x80, 0x1B, '[', 'A', 0x7F, '\n', 'g', 'e', 't', ' ',
+                         's',  'y',  's',  '.', 'f', 's',  '_',  'h', 'z', '\n'};
   g.out_len = 0;
   cli_feed(&g.cli, bin, sizeof bin);
-  assert_string_equal(g.out, "err BADCHAR line with a non-printable byte discarded\r\nok sys.fs_hz 50000 Hz\r\n");
+  assert_string_equal(
+      g.out, "err BADCHAR line with a non-printable byte discarded\r\nok sys.fs_hz 50000 Hz\r\n");
   assert_int_equal(cur()->tlm_rate_hz, 100u);
   expect("frobnicate 1 2\n", "err UNKNOWN no command 'frobnicate'; try help\r\n");
   expect("a b c d e f g h i j k l m n o p q\n", "err ARGS too many words on the line\r\n");
@@ -289,7 +314,8 @@ static void test_list(void **state)
   snprintf(tail, sizeof tail, "ok %d parameters\r\n", PARAM_COUNT);
   assert_string_equal(out + strlen(out) - strlen(tail), tail);
   assert_int_equal(g.cli.truncated, 0u);
-  assert_non_null(strstr(out, "- drive.freq_hz 1489.9 Hz [500,5000] def=1489.9 flags=PL drive frequency"));
+  assert_non_null(
+      strstr(out, "- drive.freq_hz 1489.9 Hz [500,5000] def=1489.9 flags=PL drive frequency"));
   assert_non_null(strstr(out, "- drive.mode 0 - {0,1} def=0 flags=P "));
   assert_non_null(strstr(out, "- sys.fs_hz 50000 Hz [50000,50000] def=50000 flags=R "));
   out = run("list rate.bias\n");
@@ -331,7 +357,8 @@ static void test_app_commands_and_help(void **state)
 {
   (void)state;
   static const cli_cmd_t status = {"status", "", "loop mode and faults", app_status, NULL};
-  static const cli_cmd_t stream = {"stream", "FIELD... @RATE_HZ", "start telemetry", app_status, NULL};
+  static const cli_cmd_t stream = {"stream", "FIELD... @RATE_HZ", "start telemetry", app_status,
+                                   NULL};
   static const cli_cmd_t silent = {"silent", "", "forgets to reply", app_silent, NULL};
   static const cli_cmd_t chatty = {"chatty", "", "replies twice", app_chatty, NULL};
   static const cli_cmd_t dup = {"status", "", "again", app_status, NULL};
@@ -352,7 +379,8 @@ static void test_app_commands_and_help(void **state)
   expect("chatty\n", "- line??with a break\r\nok first\r\n");
   const char *out = run("help\n");
   assert_int_equal(check_grammar(out), 1);
-  const char *names[] = {"help", "list", "get", "set", "save", "load", "defaults", "diff", "version", "status", "stream"};
+  const char *names[] = {"help",     "list", "get",     "set",    "save",  "load",
+                         "defaults", "diff", "version", "status", "stream"};
   for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
     char needle[32];
     snprintf(needle, sizeof needle, "- %s ", names[i]);
@@ -423,16 +451,17 @@ static void test_console_editing(void **state)
   cexpect("\x7f\b", "");
   /* Ctrl-U erases the line, Ctrl-C drops it with a new prompt: neither is run */
   cexpect("set tlm.rate_hz 7\x15", "set tlm.rate_hz 7\b \b\b \b\b \b\b \b\b \b\b \b\b \b\b \b"
-                                  "\b \b\b \b\b \b\b \b\b \b\b \b\b \b\b \b\b \b");
+                                   "\b \b\b \b\b \b\b \b\b \b\b \b\b \b\b \b\b \b");
   cexpect("\r", "\r\ngyro> ");
   cexpect("set tlm.rate_hz 7\x03", "set tlm.rate_hz 7^C\r\ngyro> ");
   cexpect("\r", "\r\ngyro> ");
   assert_int_equal(cur()->tlm_rate_hz, 100u);
   /* arrows and other keys: consumed, no error, the line goes on */
   cexpect("get \x1b[C\x1b[D\x1bOB\x1b[1;5D\x1b[3~\x1bxtlm.rate_hz\r",
-         "get tlm.rate_hz\r\nok tlm.rate_hz 100 Hz\r\ngyro> ");
+          "get tlm.rate_hz\r\nok tlm.rate_hz 100 Hz\r\ngyro> ");
   /* other control bytes and bytes >= 0x80 are ignored */
-  const uint8_t odd[] = {'g', 0x00, 0x01, 0xC3, 0xA9, 0xFF, 'e', 't', ' ', 's', 'y', 's', '.', 'f', 's', '_', 'h', 'z', '\r'};
+  const uint8_t odd[] = {'g', 0x00, 0x01, 0xC3, 0xA9, 0xFF, 'e', 't', ' ', 's',
+                         'y', 's',  '.',  'f',  's',  '_',  'h', 'z', '\r'};
   g.out_len = 0;
   cli_feed(&g.cli, odd, sizeof odd);
   assert_string_equal(g.out, "get sys.fs_hz\r\nok sys.fs_hz 50000 Hz\r\ngyro> ");
@@ -453,7 +482,9 @@ static void test_console_editing(void **state)
   /* lost input still discards the line */
   cexpect("get tlm", "get tlm");
   cli_rx_lost(&g.cli);
-  cexpect(".rate_hz\r", ".rate_hz\r\nerr OVERFLOW input lost (receive buffer full): line discarded, send it again\r\ngyro> ");
+  cexpect(
+      ".rate_hz\r",
+      ".rate_hz\r\nerr OVERFLOW input lost (receive buffer full): line discarded, send it again\r\ngyro> ");
   /* an escape sequence cut by Enter does not eat the next line */
   cexpect("\x1b[\r", "\r\ngyro> ");
   cexpect("get tlm.rate_hz\r", "get tlm.rate_hz\r\nok tlm.rate_hz 100 Hz\r\ngyro> ");

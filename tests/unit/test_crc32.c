@@ -29,7 +29,8 @@ static void test_matches_zlib(void **state)
   }
   for (size_t len = 0; len <= 600u; len++) {
     const size_t off = (len * 7u) % 64u;
-    assert_int_equal(crc32_update(0u, buf + off, len), (uint32_t)crc32(0uL, buf + off, (uInt)len));
+    assert_int_equal(crc32_update(0u, buf + off, len),
+                     (uint32_t)crc32(0uL, buf + off, (uInt)len));
   }
   assert_int_equal(crc32_update(0u, buf, sizeof buf), (uint32_t)crc32(0uL, buf, sizeof buf));
   /* all-0xFF (erased flash) and all-zero runs */

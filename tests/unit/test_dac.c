@@ -27,7 +27,8 @@ static void test_code_to_volts(void **state)
   assert_true(fabs(dac_code_to_v(8192)) < 1e-12);
   assert_true(fabs(dac_code_to_v(16383) - (15.0 - LSB_V)) < 1e-12);
   assert_true(fabs(dac_code_to_v(8193) - LSB_V) < 1e-12);
-  for (uint16_t c = 0; c <= 16383; c = (uint16_t)(c + 97)) assert_int_equal(dac_v_to_code(dac_code_to_v(c)), c);
+  for (uint16_t c = 0; c <= 16383; c = (uint16_t)(c + 97))
+    assert_int_equal(dac_v_to_code(dac_code_to_v(c)), c);
   assert_int_equal(dac_v_to_code(100.0), 16383);
   assert_int_equal(dac_v_to_code(-100.0), 0);
 }
@@ -80,7 +81,8 @@ static void test_bad_write(void **state)
   dac_out_t o;
   dac_step(&d, &o);
   dac_step(&d, &o);
-  for (int c = 0; c < DAC_NCH; c++) assert_true(fabs(o.ch[c].held_v - dac_code_to_v(9000)) < 1e-12);
+  for (int c = 0; c < DAC_NCH; c++)
+    assert_true(fabs(o.ch[c].held_v - dac_code_to_v(9000)) < 1e-12);
 }
 
 /* Invalid configurations are refused with the instance untouched. */
@@ -186,11 +188,12 @@ static void test_filtered_staircase(void **state)
       worst_ms = fmax(worst_ms, fabs(o.ch[0].mean_sq_v2 - sq));
       assert_true(fabs(o.ch[0].held_v - lev[j]) < 1e-12);
     }
-    print_message("Q %.3f: end %.3g V slope %.3g V/s mean %.3g V ms %.3g V2\n", cfg.recon_q, worst_end, worst_slope, worst_mean, worst_ms);
-    assert_true(worst_end < 1e-9);          /* V, on a +-15 V staircase */
-    assert_true(worst_slope < 1e-9 * w0);   /* V/s */
-    assert_true(worst_mean < 1e-8);         /* V (Simpson error ~1e-9) */
-    assert_true(worst_ms < 3e-7);           /* V^2, on up to 225 V^2 */
+    print_message("Q %.3f: end %.3g V slope %.3g V/s mean %.3g V ms %.3g V2\n", cfg.recon_q,
+                  worst_end, worst_slope, worst_mean, worst_ms);
+    assert_true(worst_end < 1e-9);        /* V, on a +-15 V staircase */
+    assert_true(worst_slope < 1e-9 * w0); /* V/s */
+    assert_true(worst_mean < 1e-8);       /* V (Simpson error ~1e-9) */
+    assert_true(worst_ms < 3e-7);         /* V^2, on up to 225 V^2 */
   }
 }
 

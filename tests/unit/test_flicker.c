@@ -84,7 +84,8 @@ static void test_flicker_slope_and_level(void **state)
   double *psd = run_psd(&spec, fs, 1u << 18, n, nseg, 13u);
   const double centres[] = {0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 300.0};
   for (size_t b = 0; b < sizeof centres / sizeof centres[0]; b++) {
-    const double e = band_error_db(psd, &spec, fs, nseg, centres[b] / sqrt(2.0), centres[b] * sqrt(2.0));
+    const double e = band_error_db(psd, &spec, fs, nseg, centres[b] / sqrt(2.0),
+                                   centres[b] * sqrt(2.0));
     print_message("band %6.2f Hz: %+.3f dB\n", centres[b], e);
     assert_true(fabs(e) < 0.75);
   }
@@ -94,7 +95,8 @@ static void test_flicker_slope_and_level(void **state)
   for (size_t i = 1; i <= nseg / 2; i++) {
     const double fr = (double)i * fs / (double)nseg;
     if (fr < 0.3 || fr > 3.0) continue;
-    const double lx = log10(fr), ly = log10(psd[i]), lt = log10(flicker_target_psd(&spec, fs, fr));
+    const double lx = log10(fr), ly = log10(psd[i]),
+                 lt = log10(flicker_target_psd(&spec, fs, fr));
     sx += lx;
     sy += ly;
     sxx += lx * lx;
@@ -121,7 +123,8 @@ static void test_plant_rate(void **state)
   const flicker_spec_t spec = {200e-9, 2e-6, 1e-3};
   const size_t nseg = 1u << 12, n = 1u << 20;
   double *psd = run_psd(&spec, fs, 1u << 16, n, nseg, 14u);
-  const double bands[5][2] = {{20.0, 50.0}, {70.0, 140.0}, {600.0, 900.0}, {1300.0, 1700.0}, {15000.0, 24000.0}};
+  const double bands[5][2] = {
+      {20.0, 50.0}, {70.0, 140.0}, {600.0, 900.0}, {1300.0, 1700.0}, {15000.0, 24000.0}};
   for (int b = 0; b < 5; b++) {
     const double e = band_error_db(psd, &spec, fs, nseg, bands[b][0], bands[b][1]);
     print_message("band %.0f-%.0f Hz: %+.3f dB\n", bands[b][0], bands[b][1], e);
@@ -158,9 +161,9 @@ static void test_bad_and_zero(void **state)
   flicker_t f, before;
   memset(&f, 0x33, sizeof f);
   before = f;
-  const flicker_spec_t bad[] = {
-      {-1e-6, 0.0, 1e-3}, {1e-6, -1.0, 1e-3}, {1e-6, 1e-5, 0.0}, {1e-6, 1e-5, 100.0},
-      {NAN, 1e-5, 1e-3},  {1e-6, INFINITY, 1e-3}, {1e-18, 1.0, 1e-12}};
+  const flicker_spec_t bad[] = {{-1e-6, 0.0, 1e-3},  {1e-6, -1.0, 1e-3}, {1e-6, 1e-5, 0.0},
+                                {1e-6, 1e-5, 100.0}, {NAN, 1e-5, 1e-3},  {1e-6, INFINITY, 1e-3},
+                                {1e-18, 1.0, 1e-12}};
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
     assert_int_equal(flicker_init(&f, &bad[i], 50000.0, 1u, 1u), -1);
   const flicker_spec_t ok = {1e-6, 1e-5, 1e-3};
@@ -175,8 +178,8 @@ static void test_bad_and_zero(void **state)
 int main(void)
 {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_white),      cmocka_unit_test(test_flicker_slope_and_level),
-      cmocka_unit_test(test_plant_rate), cmocka_unit_test(test_seeding),
+      cmocka_unit_test(test_white),        cmocka_unit_test(test_flicker_slope_and_level),
+      cmocka_unit_test(test_plant_rate),   cmocka_unit_test(test_seeding),
       cmocka_unit_test(test_bad_and_zero),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -62,7 +62,8 @@ static void test_distribution(void **state)
   for (int j = 0; j < 9; j++) {
     const double p = 0.5 * erfc(-pts[j] / sqrt(2.0));
     const double sd = sqrt(n * p * (1 - p));
-    if (fabs(below[j] - n * p) > 5.0 * sd) fail_msg("CDF at %g: %ld, expected %.0f", pts[j], below[j], n * p);
+    if (fabs(below[j] - n * p) > 5.0 * sd)
+      fail_msg("CDF at %g: %ld, expected %.0f", pts[j], below[j], n * p);
   }
   const double p35 = erfc(3.5 / sqrt(2.0)), p40 = erfc(4.0 / sqrt(2.0));
   assert_true(fabs(t35 - n * p35) < 5.0 * sqrt(n * p35));
@@ -71,6 +72,7 @@ static void test_distribution(void **state)
 
 int main(void)
 {
-  const struct CMUnitTest tests[] = {cmocka_unit_test(test_table), cmocka_unit_test(test_distribution)};
+  const struct CMUnitTest tests[] = {cmocka_unit_test(test_table),
+                                     cmocka_unit_test(test_distribution)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -107,7 +107,8 @@ static void test_covariance_bounded_without_excitation(void **state)
   assert_int_equal(kfd_init(&s, &(kfd_cfg_t){.q = 0.01f, .r = 0.3f, .p0 = 1.0f}), 0);
   for (int k = 0; k < 200000; k++) {
     kfd_step(&s, 0.01f, 1.0f, 0.0f);
-    assert_true(s.cov.p11 > 0.0f && s.cov.p22 > 0.0f && s.cov.p11 + s.cov.p22 <= 4.0f + 2.0f * 0.01f + 1e-5f);
+    assert_true(s.cov.p11 > 0.0f && s.cov.p22 > 0.0f &&
+                s.cov.p11 + s.cov.p22 <= 4.0f + 2.0f * 0.01f + 1e-5f);
   }
   assert_true(isfinite(s.x_i) && fabsf(s.x_i - 0.01f) < 1e-6f);
   assert_int_equal(s.cov_resets, 0);
@@ -168,10 +169,10 @@ static void test_bad_config_rejected_unchanged(void **state)
   memset(&s, 0x5A, sizeof s);
   const kfd_t sentinel = s;
   const kfd_cfg_t bad[] = {
-      {NAN, 0.3f, 1.0f},       {-0.0002f, 0.3f, 1.0f}, {INFINITY, 0.3f, 1.0f},
-      {0.0002f, 0.0f, 1.0f},   {0.0002f, -0.3f, 1.0f}, {0.0002f, NAN, 1.0f},
-      {0.0002f, INFINITY, 1.0f}, {0.0002f, 0.3f, 0.0f}, {0.0002f, 0.3f, -1.0f},
-      {0.0002f, 0.3f, NAN},    {0.0002f, 0.3f, 2e6f},
+      {NAN, 0.3f, 1.0f},         {-0.0002f, 0.3f, 1.0f}, {INFINITY, 0.3f, 1.0f},
+      {0.0002f, 0.0f, 1.0f},     {0.0002f, -0.3f, 1.0f}, {0.0002f, NAN, 1.0f},
+      {0.0002f, INFINITY, 1.0f}, {0.0002f, 0.3f, 0.0f},  {0.0002f, 0.3f, -1.0f},
+      {0.0002f, 0.3f, NAN},      {0.0002f, 0.3f, 2e6f},
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     assert_int_equal(kfd_init(&s, &bad[i]), -1);

@@ -154,8 +154,8 @@ static void test_open_loop_2_24_2_25(void **state)
   c.dq_per_s = 2.0 * 5.0 * kDeg;          /* 5 deg/s in-phase bias */
   static mech_t m;
   assert_int_equal(mech_init(&m, &c, c.temp_ref_k, 1u), 0);
-  const lin_model_t p = {2 * kPi * c.f1_hz, c.q1, 2 * kPi * c.f2_hz, c.q2, c.kq_per_s2,
-                         c.dq_per_s, omega, 0};
+  const lin_model_t p = {
+      2 * kPi * c.f1_hz, c.q1, 2 * kPi * c.f2_hz, c.q2, c.kq_per_s2, c.dq_per_s, omega, 0};
   const double f_n = 5e-6;
   double complex y, x;
   held_response(&p, wc, c.fs_hz, &y, &x);
@@ -205,8 +205,8 @@ static void test_full_kinematics_steady(void **state)
   c.kq_per_s2 = 2.0 * wc * 1500.0 * kDeg;
   static mech_t m;
   assert_int_equal(mech_init(&m, &c, c.temp_ref_k, 2u), 0);
-  const lin_model_t p = {2 * kPi * c.f1_hz, c.q1, 2 * kPi * c.f2_hz, c.q2, c.kq_per_s2, 0.0,
-                         omega, 1};
+  const lin_model_t p = {
+      2 * kPi * c.f1_hz, c.q1, 2 * kPi * c.f2_hz, c.q2, c.kq_per_s2, 0.0, omega, 1};
   const lin_model_t p22 = {p.wn1, p.q1, p.wn2, p.q2, p.kq, 0.0, omega, 0};
   const double f_n = 5e-6;
   double complex y, x, y22, x22;
@@ -244,8 +244,8 @@ static void test_closed_drive_2_28(void **state)
   const double complex p0 = (1.0 - cexp(-I * wc * T)) / (I * wc * T);
   const double complex d1 = wn1 * wn1 - wc * wc + I * wn1 * wc / c.q1;
   const double complex fph = a0 * d1 / p0 * c.mass_kg; /* N */
-  const double amp28 =
-      2.0 * a0 * wc * omega / sqrt(pow(wn2 * wn2 - wc * wc, 2) + pow(wn2 * wc / c.q2, 2));
+  const double amp28 = 2.0 * a0 * wc * omega /
+                       sqrt(pow(wn2 * wn2 - wc * wc, 2) + pow(wn2 * wc / c.q2, 2));
   const double lag28 = atan2(wn2 * wc / c.q2, wn2 * wn2 - wc * wc);
   double ey = 0.0, ex = 0.0;
   const long n_total = 600000, n_cmp = 20000;
@@ -283,19 +283,36 @@ static void ref_ab(const ref_model_t *r, double om, double al, double tk, double
   const double kq = r->kq0 * s * s, dq = r->dq0 * s;
   /* y'' = -w1^2 y - w1/q1 y' - 2 om x' - al x + om^2 y + u1
    * x'' = -w2^2 x - w2/q2 x' + 2 om y' - kq y - dq y' + al y + om^2 x + u2 */
-  const double A[16] = {0.0, ws, 0.0, 0.0,
-                        (-w1 * w1 + om * om) / ws, -w1 / r->q1, -al / ws, -2.0 * om,
-                        0.0, 0.0, 0.0, ws,
-                        (-kq + al) / ws, 2.0 * om - dq, (-w2 * w2 + om * om) / ws, -w2 / r->q2};
+  const double A[16] = {0.0,
+                        ws,
+                        0.0,
+                        0.0,
+                        (-w1 * w1 + om * om) / ws,
+                        -w1 / r->q1,
+                        -al / ws,
+                        -2.0 * om,
+                        0.0,
+                        0.0,
+                        0.0,
+                        ws,
+                        (-kq + al) / ws,
+                        2.0 * om - dq,
+                        (-w2 * w2 + om * om) / ws,
+                        -w2 / r->q2};
   const double B[8] = {0.0, 0.0, ws, 0.0, 0.0, 0.0, 0.0, ws};
   memcpy(a, A, sizeof A);
   memcpy(b, B, sizeof B);
 }
 
 
-
-static double rate_fn(double t) { return (100.0 + 300.0 * sin(2 * kPi * 20.0 * t) + 400.0 * t) * kDeg; }
-static double rate_dot_fn(double t) { return (300.0 * 2 * kPi * 20.0 * cos(2 * kPi * 20.0 * t) + 400.0) * kDeg; }
+static double rate_fn(double t)
+{
+  return (100.0 + 300.0 * sin(2 * kPi * 20.0 * t) + 400.0 * t) * kDeg;
+}
+static double rate_dot_fn(double t)
+{
+  return (300.0 * 2 * kPi * 20.0 * cos(2 * kPi * 20.0 * t) + 400.0) * kDeg;
+}
 static double temp_fn(double t, double t0) { return t0 - 10.0 + 600.0 * t; } /* 60 K in 0.1 s */
 
 static void varying_run(double kq_dps, int nsub, double *ey_out, double *ex_out,
@@ -309,8 +326,9 @@ static void varying_run(double kq_dps, int nsub, double *ey_out, double *ex_out,
   static mech_t m;
   const double T = 1.0 / c.fs_hz;
   assert_int_equal(mech_init(&m, &c, temp_fn(0.0, c.temp_ref_k), 4u), 0);
-  const ref_model_t r = {2 * kPi * c.f1_hz, c.q1, 2 * kPi * c.f2_hz, c.q2, c.temp_ref_k,
-                         c.ket_per_k, c.kq_per_s2, c.dq_per_s, c.mass_kg, 2 * kPi * 1700.0};
+  const ref_model_t r = {
+      2 * kPi * c.f1_hz, c.q1,        2 * kPi * c.f2_hz, c.q2,      c.temp_ref_k,
+      c.ket_per_k,       c.kq_per_s2, c.dq_per_s,        c.mass_kg, 2 * kPi * 1700.0};
   double xr[4] = {0, 0, 0, 0};
   const double f_n = 6.8e-6;
   const long n_total = 5000;
@@ -360,13 +378,15 @@ static void test_varying_rate_temperature_vs_eigen(void **state)
   for (int i = 0; i < 2; i++) {
     varying_run(kq[i], 1, &ey, &ex, &nref);
     printf("varying rate/temp, quadrature %4.0f deg/s, 1 sub-step: drive rel err %.2e, "
-           "sense rel err %.2e, %llu refreshes\n", kq[i], ey, ex, (unsigned long long)nref);
+           "sense rel err %.2e, %llu refreshes\n",
+           kq[i], ey, ex, (unsigned long long)nref);
     assert_true(ey < 1e-9);
     assert_true(ex < 1e-9);
     assert_true(nref >= 1); /* the 60 K ramp passes the 50 K refresh threshold */
     varying_run(kq[i], 4, &ey, &ex, &nref);
     printf("varying rate/temp, quadrature %4.0f deg/s, 4 sub-steps: drive rel err %.2e, "
-           "sense rel err %.2e\n", kq[i], ey, ex);
+           "sense rel err %.2e\n",
+           kq[i], ey, ex);
     assert_true(ey < 1e-6);
     assert_true(ex < 1e-6);
   }
@@ -390,8 +410,9 @@ static double expansion_error(double eps, double *ex_out)
   assert_int_equal(mech_set_temp(&m, tk), 0);
   assert_true(m.refresh_count == 0);
   assert_true(fabs(m.eps - eps) < 1e-12);
-  const ref_model_t r = {2 * kPi * c.f1_hz, c.q1, 2 * kPi * c.f2_hz, c.q2, c.temp_ref_k,
-                         c.ket_per_k, c.kq_per_s2, c.dq_per_s, c.mass_kg, 2 * kPi * 1700.0};
+  const ref_model_t r = {
+      2 * kPi * c.f1_hz, c.q1,        2 * kPi * c.f2_hz, c.q2,      c.temp_ref_k,
+      c.ket_per_k,       c.kq_per_s2, c.dq_per_s,        c.mass_kg, 2 * kPi * 1700.0};
   const double omega = 100.0 * kDeg, T = 1.0 / c.fs_hz;
   double a[16], b[8], aug[36] = {0}, e[36];
   ref_ab(&r, omega, 0.0, tk, a, b);

@@ -38,8 +38,7 @@ static int mono_of(int pw, int pa, int pe)
 }
 
 /* h A(w, a, e) augmented [A B; 0 0], at structure temperature tk, h = wr / fs. */
-static void gen_at(const mech_cfg_t *c, double tk, double w, double a, double e,
-                   double g[NA][NA])
+static void gen_at(const mech_cfg_t *c, double tk, double w, double a, double e, double g[NA][NA])
 {
   const double wr = 2.0 * kPi * c->f1_hz;
   const double s = (1.0 - 0.5 * c->ket_per_k * (tk - c->temp_ref_k)) * (1.0 + e); /* (2-32) */

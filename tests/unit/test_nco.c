@@ -19,10 +19,7 @@
 #define TWO_POW_32 4294967296.0
 #define FS_HZ 50000.0
 
-static double counts_to_rad(uint32_t c)
-{
-  return TWO_PI * (double)c / TWO_POW_32;
-}
+static double counts_to_rad(uint32_t c) { return TWO_PI * (double)c / TWO_POW_32; }
 
 /* ------------------------------------------------------------------ validation --- */
 
@@ -33,9 +30,9 @@ static void test_init_rejects_bad_config(void **state)
   memset(&nco, 0xA5, sizeof nco);
   nco_t before = nco;
   const nco_cfg_t bad[] = {
-      {NAN, FS_HZ, 0.0},      {1000.0, NAN, 0.0},   {1000.0, FS_HZ, NAN},
-      {1000.0, 0.0, 0.0},     {1000.0, -FS_HZ, 0.0}, {-1.0, FS_HZ, 0.0},
-      {25000.0, FS_HZ, 0.0},  {30000.0, FS_HZ, 0.0}, {INFINITY, FS_HZ, 0.0},
+      {NAN, FS_HZ, 0.0},       {1000.0, NAN, 0.0},        {1000.0, FS_HZ, NAN},
+      {1000.0, 0.0, 0.0},      {1000.0, -FS_HZ, 0.0},     {-1.0, FS_HZ, 0.0},
+      {25000.0, FS_HZ, 0.0},   {30000.0, FS_HZ, 0.0},     {INFINITY, FS_HZ, 0.0},
       {1000.0, INFINITY, 0.0}, {1000.0, FS_HZ, INFINITY},
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
@@ -257,8 +254,12 @@ static void fft(double *re, double *im, size_t n)
     for (; j & bit; bit >>= 1) j ^= bit;
     j ^= bit;
     if (i < j) {
-      double t = re[i]; re[i] = re[j]; re[j] = t;
-      t = im[i]; im[i] = im[j]; im[j] = t;
+      double t = re[i];
+      re[i] = re[j];
+      re[j] = t;
+      t = im[i];
+      im[i] = im[j];
+      im[j] = t;
     }
   }
   for (size_t len = 2; len <= n; len <<= 1) {
@@ -268,8 +269,10 @@ static void fft(double *re, double *im, size_t n)
         const double wr = cos(ang * (double)k), wi = sin(ang * (double)k);
         const size_t a = i + k, b = i + k + len / 2;
         const double xr = re[b] * wr - im[b] * wi, xi = re[b] * wi + im[b] * wr;
-        re[b] = re[a] - xr; im[b] = im[a] - xi;
-        re[a] += xr; im[a] += xi;
+        re[b] = re[a] - xr;
+        im[b] = im[a] - xi;
+        re[a] += xr;
+        im[a] += xi;
       }
     }
   }
@@ -309,7 +312,10 @@ static double sfdr_db(const double *x, size_t n)
   double pmax = -1.0;
   for (size_t k = 0; k <= n / 2; k++) {
     const double p = re[k] * re[k] + im[k] * im[k];
-    if (p > pmax) { pmax = p; peak = k; }
+    if (p > pmax) {
+      pmax = p;
+      peak = k;
+    }
   }
   double spur = 0.0;
   for (size_t k = 0; k <= n / 2; k++) {
@@ -353,8 +359,8 @@ static void test_sfdr(void **state)
       u[i] = u1;
     }
     const double ds = sfdr_db(s, SFDR_N), dc = sfdr_db(c, SFDR_N), du = sfdr_db(u, SFDR_N);
-    printf("nco %.3f Hz: SFDR sin %.1f dB, cos %.1f dB, drive U1 at wc/2 %.1f dB\n", freqs[f], ds,
-           dc, du);
+    printf("nco %.3f Hz: SFDR sin %.1f dB, cos %.1f dB, drive U1 at wc/2 %.1f dB\n", freqs[f],
+           ds, dc, du);
     worst = fmin(worst, fmin(ds, fmin(dc, du)));
   }
   free(s);

@@ -30,12 +30,15 @@ static float from_bits(uint32_t u)
   return f;
 }
 
-static numparse_status_t parse(const char *s, float *out) { return numparse_f32(s, strlen(s), out); }
+static numparse_status_t parse(const char *s, float *out)
+{
+  return numparse_f32(s, strlen(s), out);
+}
 
 /* What a strictly whole-token, normal-only strtof would say, from glibc. */
 typedef struct {
-  bool ok;      /* strtof accepted the whole token and the result is normal or zero */
-  bool range;   /* strtof reported overflow/underflow (or a subnormal) */
+  bool ok;    /* strtof accepted the whole token and the result is normal or zero */
+  bool range; /* strtof reported overflow/underflow (or a subnormal) */
   float value;
 } ref_t;
 
@@ -67,7 +70,8 @@ static void expect_same_as_strtof(const char *s)
   }
   if (r.ok) {
     if (st != NUMPARSE_OK || bits(got) != bits(r.value)) {
-      fail_msg("'%s': got status %d value %a, strtof %a", s, (int)st, (double)got, (double)r.value);
+      fail_msg("'%s': got status %d value %a, strtof %a", s, (int)st, (double)got,
+               (double)r.value);
     }
   } else if (r.range) {
     if (st != NUMPARSE_ERR_RANGE) {
@@ -82,15 +86,54 @@ static void test_accept_corpus(void **state)
 {
   (void)state;
   const char *ok[] = {
-      "0", "-0", "+0", "0.0", "000", "1", "-1", "+1.5", "1489.9", "-99.56", ".5", "5.", "0.03",
-      "1e3", "1E3", "1e+3", "1e-3", "1.5e-7", "12.75", "0.1", "0.2", "0.3", "3.14159265358979323846",
-      "16777216", "16777217", "16777218", "16777219", "33554435", "1e10", "3.4028234e38",
-      "3.40282346638528859811704183484516925440e38", "3.4028235677973366e38",
-      "1.17549435e-38", "1.1754943508222875e-38", "1.17549421e-38", "9.99999999999999999999e-38",
-      "0.000000000000000000000000000000000000011754943508222875", "7.038531e-26",
-      "0000000000000000000000000000001.0000000000000000000000000000", "1.00000005960464477539062500",
-      "1.000000059604644775390625", "1.0000000596046447753906249", "1.0000000596046447753906251",
-      "0e99999999", "0e-99999999", "123456789012345678901234567890", "50000", "1489.900000000000000001",
+      "0",
+      "-0",
+      "+0",
+      "0.0",
+      "000",
+      "1",
+      "-1",
+      "+1.5",
+      "1489.9",
+      "-99.56",
+      ".5",
+      "5.",
+      "0.03",
+      "1e3",
+      "1E3",
+      "1e+3",
+      "1e-3",
+      "1.5e-7",
+      "12.75",
+      "0.1",
+      "0.2",
+      "0.3",
+      "3.14159265358979323846",
+      "16777216",
+      "16777217",
+      "16777218",
+      "16777219",
+      "33554435",
+      "1e10",
+      "3.4028234e38",
+      "3.40282346638528859811704183484516925440e38",
+      "3.4028235677973366e38",
+      "1.17549435e-38",
+      "1.1754943508222875e-38",
+      "1.17549421e-38",
+      "9.99999999999999999999e-38",
+      "0.000000000000000000000000000000000000011754943508222875",
+      "7.038531e-26",
+      "0000000000000000000000000000001.0000000000000000000000000000",
+      "1.00000005960464477539062500",
+      "1.000000059604644775390625",
+      "1.0000000596046447753906249",
+      "1.0000000596046447753906251",
+      "0e99999999",
+      "0e-99999999",
+      "123456789012345678901234567890",
+      "50000",
+      "1489.900000000000000001",
   };
   for (size_t i = 0; i < sizeof ok / sizeof ok[0]; i++) {
     expect_same_as_strtof(ok[i]);
@@ -112,18 +155,41 @@ static void test_reject_corpus(void **state)
     const char *s;
     numparse_status_t st;
   } bad[] = {
-      {"abc", NUMPARSE_ERR_SYNTAX},   {"nan", NUMPARSE_ERR_SYNTAX},     {"NaN", NUMPARSE_ERR_SYNTAX},
-      {"inf", NUMPARSE_ERR_SYNTAX},   {"-inf", NUMPARSE_ERR_SYNTAX},    {"infinity", NUMPARSE_ERR_SYNTAX},
-      {"1.0x", NUMPARSE_ERR_SYNTAX},  {" 1", NUMPARSE_ERR_SYNTAX},      {"1 ", NUMPARSE_ERR_SYNTAX},
-      {"0x10", NUMPARSE_ERR_SYNTAX},  {"0x1p3", NUMPARSE_ERR_SYNTAX},   {"1e", NUMPARSE_ERR_SYNTAX},
-      {"1e+", NUMPARSE_ERR_SYNTAX},   {".", NUMPARSE_ERR_SYNTAX},       {"-", NUMPARSE_ERR_SYNTAX},
-      {"+", NUMPARSE_ERR_SYNTAX},     {"1..2", NUMPARSE_ERR_SYNTAX},    {"1.2.3", NUMPARSE_ERR_SYNTAX},
-      {"1e5.5", NUMPARSE_ERR_SYNTAX}, {"--1", NUMPARSE_ERR_SYNTAX},     {"+-1", NUMPARSE_ERR_SYNTAX},
-      {"1,5", NUMPARSE_ERR_SYNTAX},   {"e5", NUMPARSE_ERR_SYNTAX},      {"1e5e5", NUMPARSE_ERR_SYNTAX},
-      {"1f", NUMPARSE_ERR_SYNTAX},    {"\xd9\xa1", NUMPARSE_ERR_SYNTAX}, {"1\t", NUMPARSE_ERR_SYNTAX},
-      {"1e999", NUMPARSE_ERR_RANGE},  {"-1e999", NUMPARSE_ERR_RANGE},   {"3.5e38", NUMPARSE_ERR_RANGE},
-      {"340282356779733661637539395458142568448", NUMPARSE_ERR_RANGE}, /* FLT_MAX/2^128 midpoint: ties to even = 2^128 */
-      {"1e-39", NUMPARSE_ERR_RANGE},  {"1e-50", NUMPARSE_ERR_RANGE},    {"1e-99999999999", NUMPARSE_ERR_RANGE},
+      {"abc", NUMPARSE_ERR_SYNTAX},
+      {"nan", NUMPARSE_ERR_SYNTAX},
+      {"NaN", NUMPARSE_ERR_SYNTAX},
+      {"inf", NUMPARSE_ERR_SYNTAX},
+      {"-inf", NUMPARSE_ERR_SYNTAX},
+      {"infinity", NUMPARSE_ERR_SYNTAX},
+      {"1.0x", NUMPARSE_ERR_SYNTAX},
+      {" 1", NUMPARSE_ERR_SYNTAX},
+      {"1 ", NUMPARSE_ERR_SYNTAX},
+      {"0x10", NUMPARSE_ERR_SYNTAX},
+      {"0x1p3", NUMPARSE_ERR_SYNTAX},
+      {"1e", NUMPARSE_ERR_SYNTAX},
+      {"1e+", NUMPARSE_ERR_SYNTAX},
+      {".", NUMPARSE_ERR_SYNTAX},
+      {"-", NUMPARSE_ERR_SYNTAX},
+      {"+", NUMPARSE_ERR_SYNTAX},
+      {"1..2", NUMPARSE_ERR_SYNTAX},
+      {"1.2.3", NUMPARSE_ERR_SYNTAX},
+      {"1e5.5", NUMPARSE_ERR_SYNTAX},
+      {"--1", NUMPARSE_ERR_SYNTAX},
+      {"+-1", NUMPARSE_ERR_SYNTAX},
+      {"1,5", NUMPARSE_ERR_SYNTAX},
+      {"e5", NUMPARSE_ERR_SYNTAX},
+      {"1e5e5", NUMPARSE_ERR_SYNTAX},
+      {"1f", NUMPARSE_ERR_SYNTAX},
+      {"\xd9\xa1", NUMPARSE_ERR_SYNTAX},
+      {"1\t", NUMPARSE_ERR_SYNTAX},
+      {"1e999", NUMPARSE_ERR_RANGE},
+      {"-1e999", NUMPARSE_ERR_RANGE},
+      {"3.5e38", NUMPARSE_ERR_RANGE},
+      {"340282356779733661637539395458142568448",
+       NUMPARSE_ERR_RANGE}, /* FLT_MAX/2^128 midpoint: ties to even = 2^128 */
+      {"1e-39", NUMPARSE_ERR_RANGE},
+      {"1e-50", NUMPARSE_ERR_RANGE},
+      {"1e-99999999999", NUMPARSE_ERR_RANGE},
       {"1.1754942e-38", NUMPARSE_ERR_RANGE}, /* rounds to FLT_MIN but is below it */
       {"", NUMPARSE_ERR_EMPTY},
   };
@@ -306,10 +372,24 @@ static void test_format_style(void **state)
     float x;
     const char *s;
   } c[] = {
-      {1489.9f, "1489.9"}, {-99.56f, "-99.56"}, {0.03f, "0.03"}, {12.75f, "12.75"}, {100000.0f, "100000"},
-      {1e9f, "1000000000"}, {1e10f, "1e10"}, {1.5e-7f, "1.5e-7"}, {0.00001f, "0.00001"},
-      {0.000001f, "1e-6"}, {FLT_MAX, "3.4028235e38"}, {FLT_MIN, "1.1754944e-38"}, {0.0f, "0"},
-      {-0.0f, "-0"}, {1.0f, "1"}, {0.1f, "0.1"}, {91.0f, "91"}, {16777216.0f, "16777216"},
+      {1489.9f, "1489.9"},
+      {-99.56f, "-99.56"},
+      {0.03f, "0.03"},
+      {12.75f, "12.75"},
+      {100000.0f, "100000"},
+      {1e9f, "1000000000"},
+      {1e10f, "1e10"},
+      {1.5e-7f, "1.5e-7"},
+      {0.00001f, "0.00001"},
+      {0.000001f, "1e-6"},
+      {FLT_MAX, "3.4028235e38"},
+      {FLT_MIN, "1.1754944e-38"},
+      {0.0f, "0"},
+      {-0.0f, "-0"},
+      {1.0f, "1"},
+      {0.1f, "0.1"},
+      {91.0f, "91"},
+      {16777216.0f, "16777216"},
   };
   char buf[NUMFMT_F32_MAX];
   for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
@@ -331,9 +411,12 @@ static void test_format_style(void **state)
 int main(void)
 {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_accept_corpus),     cmocka_unit_test(test_reject_corpus),
-      cmocka_unit_test(test_random_decimals),   cmocka_unit_test(test_midpoints),
-      cmocka_unit_test(test_u32),               cmocka_unit_test(test_format_round_trip_shortest),
+      cmocka_unit_test(test_accept_corpus),
+      cmocka_unit_test(test_reject_corpus),
+      cmocka_unit_test(test_random_decimals),
+      cmocka_unit_test(test_midpoints),
+      cmocka_unit_test(test_u32),
+      cmocka_unit_test(test_format_round_trip_shortest),
       cmocka_unit_test(test_format_style),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

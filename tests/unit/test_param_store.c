@@ -140,14 +140,16 @@ static void test_unchanged_save_writes_nothing(void **state)
   assert_int_equal(param_store_save(&g_store, &a, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
   hal_flash_host_stats_t s0, s1;
   hal_flash_host_stats(&s0);
-  assert_int_equal(param_store_save(&g_store, &a, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_UNCHANGED);
+  assert_int_equal(param_store_save(&g_store, &a, PARAM_SAVE_LOOP_SAFE, &rep),
+                   PARAM_STORE_UNCHANGED);
   assert_int_equal(rep.slot, 0);
   hal_flash_host_stats(&s1);
   assert_int_equal(s1.erases, s0.erases);
   assert_int_equal(s1.programmed_bytes, s0.programmed_bytes);
   /* a non-persistent member does not count as a change */
   a.sys_fs_hz = 50000u;
-  assert_int_equal(param_store_save(&g_store, &a, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_UNCHANGED);
+  assert_int_equal(param_store_save(&g_store, &a, PARAM_SAVE_LOOP_SAFE, &rep),
+                   PARAM_STORE_UNCHANGED);
 }
 
 /* Why a save needs the loop stopped, measured on the stub's simulated clock. */
@@ -190,7 +192,8 @@ static int save_with_cut(uint32_t cut, bool erase_cut, bool two_old)
   if (two_old) {
     param_values_t older = old;
     older.tlm_rate_hz = 7u;
-    assert_int_equal(param_store_save(&g_store, &older, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
+    assert_int_equal(param_store_save(&g_store, &older, PARAM_SAVE_LOOP_SAFE, &rep),
+                     PARAM_STORE_OK);
   }
   assert_int_equal(param_store_save(&g_store, &old, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
   const int old_slot = rep.slot;
@@ -221,7 +224,8 @@ static int save_with_cut(uint32_t cut, bool erase_cut, bool two_old)
   /* and the store keeps working after the reboot */
   param_values_t again = nw;
   again.drive_freq_hz = 1600.0f;
-  assert_int_equal(param_store_save(&g_store, &again, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK);
+  assert_int_equal(param_store_save(&g_store, &again, PARAM_SAVE_LOOP_SAFE, &rep),
+                   PARAM_STORE_OK);
   param_values_defaults(&got);
   assert_int_equal(param_store_load(&g_store, &got, &rep), PARAM_STORE_OK);
   assert_memory_equal(&got, &again, sizeof got);
@@ -246,7 +250,8 @@ static void test_every_power_cut_point(void **state)
     }
     assert_int_equal(n_old, len);
     assert_int_equal(n_new, 2u);
-    const uint32_t erase_cuts[] = {0u, 1u, 19u, 20u, 21u, 100u, len, SECTOR_SIZE - 1u, SECTOR_SIZE};
+    const uint32_t erase_cuts[] = {0u,         1u, 19u, 20u, 21u, 100u, len, SECTOR_SIZE - 1u,
+                                   SECTOR_SIZE};
     for (size_t k = 0; k < sizeof erase_cuts / sizeof erase_cuts[0]; k++) {
       assert_int_equal(save_with_cut(erase_cuts[k], true, two_old != 0), 0);
     }
@@ -260,8 +265,10 @@ static void test_bit_flips_fall_back(void **state)
   values_a(&a);
   values_b(&b);
   param_store_report_t rep;
-  assert_int_equal(param_store_save(&g_store, &a, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK); /* A, seq 1 */
-  assert_int_equal(param_store_save(&g_store, &b, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_OK); /* B, seq 2 */
+  assert_int_equal(param_store_save(&g_store, &a, PARAM_SAVE_LOOP_SAFE, &rep),
+                   PARAM_STORE_OK); /* A, seq 1 */
+  assert_int_equal(param_store_save(&g_store, &b, PARAM_SAVE_LOOP_SAFE, &rep),
+                   PARAM_STORE_OK); /* B, seq 2 */
   const uint32_t len = 20u + 8u * persistent_count() + 8u;
   for (uint32_t slot = 0; slot < 2u; slot++) {
     for (uint32_t off = 0; off < len; off++) {
@@ -317,8 +324,8 @@ static uint32_t fbits(float f)
   return u;
 }
 
-static void write_image(uint32_t sector, uint16_t format, uint16_t layout, uint32_t seq, const rec_t *r,
-                        uint32_t n, uint32_t count_field)
+static void write_image(uint32_t sector, uint16_t format, uint16_t layout, uint32_t seq,
+                        const rec_t *r, uint32_t n, uint32_t count_field)
 {
   static uint8_t img[4096];
   memset(img, 0, sizeof img);
@@ -348,17 +355,17 @@ static void test_migration_field_by_field(void **state)
 {
   (void)state;
   const rec_t recs[] = {
-      {0x0101, 0, fbits(1600.0f)},  /* drive.freq_hz: loaded */
-      {0x7777, 0, fbits(1.0f)},     /* id unknown to this firmware: dropped */
-      {0x0601, 1, 40000u},          /* sys.fs_hz: not persistent: dropped */
-      {0x0103, 0, fbits(9.0f)},     /* drive.amp_set_v 9 V > 4.5: rejected */
-      {0x0104, 0, fbits(NAN)},      /* drive.phase_set_deg NaN: rejected */
-      {0x0105, 1, 3u},              /* drive.amp_kp as an integer: wrong type, rejected */
-      {0x0303, 2, 5u},              /* rate.lpf_order 5: not a choice, rejected */
-      {0x0501, 1, 500u},            /* tlm.rate_hz: loaded */
-      {0x0501, 1, 600u},            /* duplicate: both rejected, the default stays */
-      {0x0302, 0, fbits(50.0f)},    /* rate.lpf_cutoff_hz: loaded */
-      {0x0102, 1, 1u},              /* drive.mode as U32 into an ENUM: integer, loaded */
+      {0x0101, 0, fbits(1600.0f)}, /* drive.freq_hz: loaded */
+      {0x7777, 0, fbits(1.0f)},    /* id unknown to this firmware: dropped */
+      {0x0601, 1, 40000u},         /* sys.fs_hz: not persistent: dropped */
+      {0x0103, 0, fbits(9.0f)},    /* drive.amp_set_v 9 V > 4.5: rejected */
+      {0x0104, 0, fbits(NAN)},     /* drive.phase_set_deg NaN: rejected */
+      {0x0105, 1, 3u},             /* drive.amp_kp as an integer: wrong type, rejected */
+      {0x0303, 2, 5u},             /* rate.lpf_order 5: not a choice, rejected */
+      {0x0501, 1, 500u},           /* tlm.rate_hz: loaded */
+      {0x0501, 1, 600u},           /* duplicate: both rejected, the default stays */
+      {0x0302, 0, fbits(50.0f)},   /* rate.lpf_cutoff_hz: loaded */
+      {0x0102, 1, 1u},             /* drive.mode as U32 into an ENUM: integer, loaded */
   };
   const uint32_t n = sizeof recs / sizeof recs[0];
   write_image(0u, 1u, 7u, 10u, recs, n, n);
@@ -405,7 +412,8 @@ static void test_bad_headers_are_corrupt(void **state)
   param_values_defaults(&v);
   assert_int_equal(param_store_load(&g_store, &v, &rep), PARAM_STORE_NEWER);
   assert_int_equal(rep.slot_state[0], PARAM_SLOT_NEWER);
-  assert_int_equal(param_store_save(&g_store, &v, PARAM_SAVE_LOOP_SAFE, &rep), PARAM_STORE_ERR_NEWER);
+  assert_int_equal(param_store_save(&g_store, &v, PARAM_SAVE_LOOP_SAFE, &rep),
+                   PARAM_STORE_ERR_NEWER);
   assert_int_equal(param_store_save(&g_store, &v, PARAM_SAVE_LOOP_SAFE | PARAM_SAVE_FORCE, &rep),
                    PARAM_STORE_OK);
   assert_int_equal(rep.slot, 1); /* the newer image is kept while there is room */
@@ -526,7 +534,8 @@ static void test_program_unit_64_bit(void **state)
   const uint32_t len = 20u + 8u * persistent_count() + 8u;
   const uint8_t *img = hal_flash_host_data() + SECTOR_SIZE;
   assert_int_equal(le32(&img[len - 4u]), PARAM_STORE_COMMIT);
-  for (uint32_t i = len; i < len + 4u; i++) assert_int_equal(img[i], 0xFF); /* rest of the unit */
+  for (uint32_t i = len; i < len + 4u; i++)
+    assert_int_equal(img[i], 0xFF); /* rest of the unit */
   param_values_defaults(&got);
   assert_int_equal(param_store_load(&st, &got, NULL), PARAM_STORE_OK);
   assert_memory_equal(&got, &b, sizeof got);

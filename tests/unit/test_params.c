@@ -55,7 +55,7 @@ static void test_table_consistent(void **state)
     }
     if (pi->type == PARAM_T_ENUM) {
       assert_true(pi->choices != 0u);
-      assert_int_equal(1u << pi->min.u, pi->choices & -pi->choices); /* lowest choice */
+      assert_int_equal(1u << pi->min.u, pi->choices & -pi->choices);    /* lowest choice */
       assert_true(pi->max.u < 32u && (pi->choices >> pi->max.u) == 1u); /* highest */
     } else {
       assert_int_equal(pi->choices, 0u);
@@ -131,8 +131,8 @@ typedef struct {
   params_t bank;
   derived_t derived[2];
   bool safe;
-  bool isr_running;     /* the sample timer runs only after params_init */
-  int ticks_in_derive;  /* ISR ticks "preempting" the background inside derive() */
+  bool isr_running;    /* the sample timer runs only after params_init */
+  int ticks_in_derive; /* ISR ticks "preempting" the background inside derive() */
   unsigned ticks, violations, derive_calls;
   float last_kp_seen;
   unsigned kp_changes_seen;
@@ -237,7 +237,8 @@ static void test_bank_never_half_applied(void **state)
       /* an invalid stage in the middle of a transaction is refused on its own */
       assert_int_equal(params_stage(&fx->bank, PARAM_drive_amp_kp, fv(kp)), PARAM_OK);
       sim_isr_tick(fx);
-      assert_int_equal(params_stage(&fx->bank, PARAM_drive_amp_ki, fv(NAN)), PARAM_ERR_NOT_FINITE);
+      assert_int_equal(params_stage(&fx->bank, PARAM_drive_amp_ki, fv(NAN)),
+                       PARAM_ERR_NOT_FINITE);
       sim_isr_tick(fx);
       params_discard(&fx->bank);
       assert_memory_equal(params_staged(&fx->bank), &before, sizeof before);
@@ -248,7 +249,8 @@ static void test_bank_never_half_applied(void **state)
     assert_int_equal(params_stage(&fx->bank, PARAM_drive_amp_ki, fv(2.0f * kp)), PARAM_OK);
     sim_isr_tick(fx);
     assert_int_equal(params_stage(&fx->bank, PARAM_rate_bias_c0_dps, fv(c0)), PARAM_OK);
-    assert_int_equal(params_stage(&fx->bank, PARAM_rate_bias_c1_dps_per_deg, fv(-3.0f * c0)), PARAM_OK);
+    assert_int_equal(params_stage(&fx->bank, PARAM_rate_bias_c1_dps_per_deg, fv(-3.0f * c0)),
+                     PARAM_OK);
     sim_isr_tick(fx);
     /* op 2: commit again before the ISR took the previous publish */
     params_err_t err;
@@ -258,7 +260,8 @@ static void test_bank_never_half_applied(void **state)
       assert_true(params_current(&fx->bank)->drive_amp_kp == kp);
       const bool published = kp != before.drive_amp_kp || c0 != before.rate_bias_c0_dps;
       if (op == 2 && published) {
-        assert_int_equal(params_set(&fx->bank, PARAM_drive_amp_kp, fv(kp * 0.5f), &err), PARAM_ERR_PENDING);
+        assert_int_equal(params_set(&fx->bank, PARAM_drive_amp_kp, fv(kp * 0.5f), &err),
+                         PARAM_ERR_PENDING);
         pending++;
         assert_true(params_current(&fx->bank)->drive_amp_kp == kp);
       }

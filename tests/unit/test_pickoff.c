@@ -78,12 +78,14 @@ static void test_phase_vs_temperature(void **state)
     pickoff_t p;
     assert_int_equal(pickoff_init(&p, &c, T0_K, 3u), 0);
     assert_int_equal(pickoff_set_temp(&p, tk), 0);
-    const double phi = c.phi0_rad + c.phi1_rad_per_k * dts[i] + 0.5 * c.phi2_rad_per_k2 * dts[i] * dts[i];
+    const double phi = c.phi0_rad + c.phi1_rad_per_k * dts[i] +
+                       0.5 * c.phi2_rad_per_k2 * dts[i] * dts[i];
     const double g = c.gain_v_per_m * (1.0 + c.gain_tc_per_k * dts[i]);
     double c0, res;
-    const double complex h = sine_gain(&p, c.lag_ref_hz, 1e-8, &c0, &res) / (g * aa(&c, 2.0 * k_pi * c.lag_ref_hz));
-    print_message("dT %+5.1f K: lag %.6f deg (want %.6f), gain %.7f (want %.7f), offset %.2e\n", dts[i],
-                  -carg(h) / k_deg, phi / k_deg, cabs(h), cos(phi), c0);
+    const double complex h = sine_gain(&p, c.lag_ref_hz, 1e-8, &c0, &res) /
+                             (g * aa(&c, 2.0 * k_pi * c.lag_ref_hz));
+    print_message("dT %+5.1f K: lag %.6f deg (want %.6f), gain %.7f (want %.7f), offset %.2e\n",
+                  dts[i], -carg(h) / k_deg, phi / k_deg, cabs(h), cos(phi), c0);
     assert_true(fabs(-carg(h) - phi) < 1e-5);
     assert_true(fabs(cabs(h) - cos(phi)) < 1e-5);
     assert_true(fabs(c0 - c.offset_v) < 1e-6);
@@ -112,7 +114,8 @@ static void test_allpass(void **state)
   const double fr[2] = {c.lag_ref_hz, 700.0};
   for (int i = 0; i < 2; i++) {
     assert_int_equal(pickoff_init(&p, &c, T0_K, 3u), 0);
-    const double complex h = sine_gain(&p, fr[i], 1e-5, NULL, NULL) / (c.gain_v_per_m * aa(&c, 2.0 * k_pi * fr[i]));
+    const double complex h = sine_gain(&p, fr[i], 1e-5, NULL, NULL) /
+                             (c.gain_v_per_m * aa(&c, 2.0 * k_pi * fr[i]));
     const double lag = 2.0 * atan(fr[i] / c.lag_ref_hz * tan(0.5 * c.phi0_rad));
     assert_true(fabs(cabs(h) - 1.0) < 1e-5);
     assert_true(fabs(-carg(h) - lag) < 1e-5);
@@ -136,7 +139,8 @@ static void test_sample_delay(void **state)
     c.sample_delay_s = delays[i];
     assert_int_equal(pickoff_init(&p, &c, T0_K, 1u), 0);
     const double complex r = sine_gain(&p, f, 1e-8, NULL, NULL) / g0;
-    print_message("delay %+.1f us: |ratio - e^{jwd}| = %.2e\n", delays[i] * 1e6, cabs(r - cexp(I * w * delays[i])));
+    print_message("delay %+.1f us: |ratio - e^{jwd}| = %.2e\n", delays[i] * 1e6,
+                  cabs(r - cexp(I * w * delays[i])));
     assert_true(cabs(r - cexp(I * w * delays[i])) < 1e-5);
   }
 }
@@ -203,7 +207,8 @@ typedef struct {
 
 /* Drive voltages only (no motion) through the real DAC into the sense pickoff, fitted at
  * wc/2 and wc. */
-static void feedthrough_run(int half, double f, double complex *y_half, double complex *y_wc, double *c0)
+static void feedthrough_run(int half, double f, double complex *y_half, double complex *y_wc,
+                            double *c0)
 {
   dac_cfg_t dc;
   dac_default_cfg(&dc);
@@ -261,18 +266,20 @@ static void test_feedthrough(void **state)
   double complex yh, yw;
   double c0;
   /* closed-form chain gain from electrode voltage to ADC at frequency v */
-#define CHAIN(v)                                                                              \
-  ((sin((v) * T / 2.0) / ((v) * T / 2.0)) * (w0 * w0 / (w0 * w0 - (v) * (v) + I * (v) * w0 / dc.recon_q)) * \
+#define CHAIN(v) \
+  ((sin((v)*T / 2.0) / ((v)*T / 2.0)) * \
+   (w0 * w0 / (w0 * w0 - (v) * (v) + I * (v)*w0 / dc.recon_q)) * \
    (1.0 / (1.0 + I * (v) / (2.0 * k_pi * c.lag_ref_hz) * tan(c.phi0_rad))) * aa(&c, (v)))
   feedthrough_run(1, f, &yh, &yw, &c0);
   const double half_want = 10.0 * hypot(c.ft_u1, c.ft_u2) * cabs(CHAIN(w / 2.0));
-  print_message("half-frequency: at wc/2 %.4e V (closed form %.4e), at wc %.2e V\n", cabs(yh), half_want, cabs(yw));
+  print_message("half-frequency: at wc/2 %.4e V (closed form %.4e), at wc %.2e V\n", cabs(yh),
+                half_want, cabs(yw));
   assert_true(cabs(yw) < 1e-4 * cabs(yh));
   assert_true(fabs(cabs(yh) / half_want - 1.0) < 0.02);
   feedthrough_run(0, f, &yh, &yw, &c0);
   const double dcac_want = 5.0 * fabs(c.ft_u1 - c.ft_u2) * cabs(CHAIN(w));
-  print_message("DC+AC: at wc %.4e V (closed form %.4e, error %.2f %%), mean %.2e V\n", cabs(yw), dcac_want,
-                100.0 * (cabs(yw) / dcac_want - 1.0), c0 - c.offset_v);
+  print_message("DC+AC: at wc %.4e V (closed form %.4e, error %.2f %%), mean %.2e V\n",
+                cabs(yw), dcac_want, 100.0 * (cabs(yw) / dcac_want - 1.0), c0 - c.offset_v);
   assert_true(fabs(cabs(yw) / dcac_want - 1.0) < 0.02);
   assert_true(fabs(c0 - c.offset_v) < 1e-6);
 #undef CHAIN
@@ -314,12 +321,14 @@ static void test_phase_step(void **state)
     assert_int_equal(pickoff_set_temp(&p, tk), 0);
     const double law = c.phi0_rad + c.phi1_rad_per_k * (tk - T0_K);
     assert_true(fabs(p.phi_rad - law) < c.phase_step_rad);
-    assert_true(fabs(p.gain_now - c.gain_v_per_m * (1.0 + 1e-3 * (tk - T0_K))) < 1e-9 * c.gain_v_per_m);
+    assert_true(fabs(p.gain_now - c.gain_v_per_m * (1.0 + 1e-3 * (tk - T0_K))) <
+                1e-9 * c.gain_v_per_m);
   }
   const double steps = 0.02 * c.phi1_rad_per_k / c.phase_step_rad; /* 34.9 */
   print_message("re-discretisations over 20 mK: %llu (phase moved %.1f steps)\n",
                 (unsigned long long)p.rediscretise_count, steps);
-  assert_true(p.rediscretise_count >= (uint64_t)floor(steps) - 1 && p.rediscretise_count <= (uint64_t)ceil(steps));
+  assert_true(p.rediscretise_count >= (uint64_t)floor(steps) - 1 &&
+              p.rediscretise_count <= (uint64_t)ceil(steps));
 }
 
 /* Bad configurations and temperatures are refused and change nothing. */
@@ -368,10 +377,14 @@ static void test_bad_input(void **state)
 int main(void)
 {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_phase_vs_temperature), cmocka_unit_test(test_allpass),
-      cmocka_unit_test(test_sample_delay),         cmocka_unit_test(test_jitter),
-      cmocka_unit_test(test_noise),                cmocka_unit_test(test_feedthrough),
-      cmocka_unit_test(test_preamp_clip),          cmocka_unit_test(test_phase_step),
+      cmocka_unit_test(test_phase_vs_temperature),
+      cmocka_unit_test(test_allpass),
+      cmocka_unit_test(test_sample_delay),
+      cmocka_unit_test(test_jitter),
+      cmocka_unit_test(test_noise),
+      cmocka_unit_test(test_feedthrough),
+      cmocka_unit_test(test_preamp_clip),
+      cmocka_unit_test(test_phase_step),
       cmocka_unit_test(test_bad_input),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

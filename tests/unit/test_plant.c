@@ -25,7 +25,9 @@ static const double kDeg = 3.14159265358979323846 / 180.0;
 
 static size_t type_size(plant_param_type_t t)
 {
-  return t == PLANT_PARAM_DOUBLE ? sizeof(double) : t == PLANT_PARAM_INT ? sizeof(int) : sizeof(bool);
+  return t == PLANT_PARAM_DOUBLE ? sizeof(double)
+         : t == PLANT_PARAM_INT  ? sizeof(int)
+                                 : sizeof(bool);
 }
 
 /* Every byte of plant_cfg_t belongs to exactly one parameter, apart from the tail
@@ -84,7 +86,8 @@ static void test_param_set(void **state)
   for (size_t i = 0; i < plant_param_count(); i++) {
     const plant_param_desc_t *d = plant_param_at(i);
     before = c;
-    const double bad[4] = {d->max + 1.0 + fabs(d->max), d->min - 1.0 - fabs(d->min), NAN, INFINITY};
+    const double bad[4] = {d->max + 1.0 + fabs(d->max), d->min - 1.0 - fabs(d->min), NAN,
+                           INFINITY};
     for (int k = 0; k < 4; k++) {
       err[0] = '\0';
       assert_int_equal(plant_param_set(&c, d->name, bad[k], err, sizeof err), -1);
@@ -140,9 +143,10 @@ static void test_init_validation(void **state)
   struct {
     const char *key;
     double value;
-  } cross[] = {{"f_drive_hz", 30000.0}, {"f_sense_hz", 24000.0}, {"pick_lag_ref_hz", 26000.0},
-               {"dac_recon_hz", 60000.0}, {"pick_sense_delay_s", 15e-6},
-               {"pick_drive_jitter_s", 2e-6}, {"thermal_dt_s", 1e-5}, {"dac_gain_u2", 0.0}};
+  } cross[] = {{"f_drive_hz", 30000.0},       {"f_sense_hz", 24000.0},
+               {"pick_lag_ref_hz", 26000.0},  {"dac_recon_hz", 60000.0},
+               {"pick_sense_delay_s", 15e-6}, {"pick_drive_jitter_s", 2e-6},
+               {"thermal_dt_s", 1e-5},        {"dac_gain_u2", 0.0}};
   for (size_t i = 0; i < sizeof cross / sizeof cross[0]; i++) {
     plant_cfg_t b = c;
     assert_int_equal(plant_param_set(&b, cross[i].key, cross[i].value, err, sizeof err), 0);
@@ -185,10 +189,12 @@ typedef struct {
 /* Half-frequency drive of amplitude u_v at the force frequency f_hz (U1 = u cos(wc t/2),
  * U2 = u sin(wc t/2), so U1^2 - U2^2 = u^2 cos(wc t) at the ticks), the frame for tick k
  * held over [t_k, t_k+1). Settles, then fits the last n_fit ADC samples (volts). */
-static void run_open_loop(plant_t *p, double u_v, double f_hz, long n_settle, long n_fit, fit_t *out)
+static void run_open_loop(plant_t *p, double u_v, double f_hz, long n_settle, long n_fit,
+                          fit_t *out)
 {
   const double T = p->T, wc = 2.0 * kPi * f_hz;
-  double *yd = malloc(sizeof(double) * (size_t)n_fit), *ys = malloc(sizeof(double) * (size_t)n_fit);
+  double *yd = malloc(sizeof(double) * (size_t)n_fit),
+         *ys = malloc(sizeof(double) * (size_t)n_fit);
   assert_non_null(yd);
   assert_non_null(ys);
   for (long k = 0; k < n_settle + n_fit; k++) {
@@ -275,10 +281,14 @@ static void test_open_loop_chain(void **state)
   const double complex xs = (2.0 * om * I * wc - kq) * y / d2; /* (2-25) with -k_q y */
   const double phd = (c.pick_drive_phi0_deg + c.pick_drive_phi1_deg_per_k * dtc) * kDeg;
   const double phs = (c.pick_sense_phi0_deg + c.pick_sense_phi1_deg_per_k * dtc) * kDeg;
-  const double complex gd = c.pick_drive_gain_v_per_m / (1.0 + I * tan(phd) * f / c.pick_lag_ref_hz) *
-                            hp1(f, c.pick_drive_hp_hz) * lp2(f, c.pick_drive_lp_hz, c.pick_drive_lp_q);
-  const double complex gs = c.pick_sense_gain_v_per_m / (1.0 + I * tan(phs) * f / c.pick_lag_ref_hz) *
-                            hp1(f, c.pick_sense_hp_hz) * lp2(f, c.pick_sense_lp_hz, c.pick_sense_lp_q) *
+  const double complex gd = c.pick_drive_gain_v_per_m /
+                            (1.0 + I * tan(phd) * f / c.pick_lag_ref_hz) *
+                            hp1(f, c.pick_drive_hp_hz) *
+                            lp2(f, c.pick_drive_lp_hz, c.pick_drive_lp_q);
+  const double complex gs = c.pick_sense_gain_v_per_m /
+                            (1.0 + I * tan(phs) * f / c.pick_lag_ref_hz) *
+                            hp1(f, c.pick_sense_hp_hz) *
+                            lp2(f, c.pick_sense_lp_hz, c.pick_sense_lp_q) *
                             cexp(I * wc * c.pick_sense_delay_s);
   const double complex vd = gd * y, vs = gs * xs;
   /* the ADC fit is relative to sin(wc t); the phasors are relative to cos(wc t) */
@@ -299,8 +309,8 @@ static void test_open_loop_chain(void **state)
   plant_phase_budget_t b;
   plant_drive_phase_budget(&c, f, t->circuit_k, &b);
   printf("phase budget at %.1f Hz: recon %.3f + lag %.3f + aa %.3f = analog %.3f deg; hold %.3f; "
-         "latency %.3f\n", f, b.recon_deg, b.pick_lag_deg, b.aa_deg, b.analog_deg, b.zoh_deg,
-         b.latency_deg);
+         "latency %.3f\n",
+         f, b.recon_deg, b.pick_lag_deg, b.aa_deg, b.analog_deg, b.zoh_deg, b.latency_deg);
   plant_drive_phase_budget(&c, f, c.temp_ref_k, &b);
   assert_true(fabs(b.analog_deg - 9.56) < 0.005);
   plant_drive_phase_budget(&c, f, t->circuit_k, &b);
@@ -309,8 +319,9 @@ static void test_open_loop_chain(void **state)
 
   /* truth phasors: frequency, amplitude, phase (2-24), sense components */
   printf("truth: f %.6f Hz, |y| %.4e m (closed form %.4e), phase %.4f deg, sense vel %.4e "
-         "disp %.4e m\n", t->drive_freq_hz, t->drive_amp_m, cabs(y), t->drive_phase_rad / kDeg,
-         t->sense_vel_m, t->sense_disp_m);
+         "disp %.4e m\n",
+         t->drive_freq_hz, t->drive_amp_m, cabs(y), t->drive_phase_rad / kDeg, t->sense_vel_m,
+         t->sense_disp_m);
   assert_true(fabs(t->drive_freq_hz / f - 1.0) < 1e-5); /* DAC quantisation */
   assert_true(fabs(t->drive_amp_m / cabs(y) - 1.0) < 2e-3);
   assert_true(fabs(t->drive_phase_rad / kDeg + mech_lag) < 0.02);
@@ -343,7 +354,8 @@ static void test_table_7_1_square_law(void **state)
     printf("table 7-1: U %.2f V -> %.4f V (thesis %.4f)\n", u[i], amp[i], thesis[i]);
   }
   /* square law: amplitude / U^2 constant */
-  for (int i = 1; i < 3; i++) assert_true(fabs((amp[i] / (u[i] * u[i])) / (amp[0] / (u[0] * u[0])) - 1.0) < 2e-3);
+  for (int i = 1; i < 3; i++)
+    assert_true(fabs((amp[i] / (u[i] * u[i])) / (amp[0] / (u[0] * u[0])) - 1.0) < 2e-3);
   /* and the thesis's scale, within its own 0.6 % scatter about a line plus the 0.7 %
    * of a line through the origin */
   for (int i = 0; i < 3; i++) assert_true(fabs(amp[i] / thesis[i] - 1.0) < 0.025);
@@ -369,8 +381,9 @@ static void test_table_7_4_slopes(void **state)
     run_open_loop(&p, 8.0, c.f_drive_hz, 20000, 5000, &fit[i]);
   }
   const double p_slope = -(fit[1].drive_lag_deg - fit[0].drive_lag_deg) / dt;
-  const double rel_slope =
-      ((fit[1].sense_lag_deg - fit[1].drive_lag_deg) - (fit[0].sense_lag_deg - fit[0].drive_lag_deg)) / dt;
+  const double rel_slope = ((fit[1].sense_lag_deg - fit[1].drive_lag_deg) -
+                            (fit[0].sense_lag_deg - fit[0].drive_lag_deg)) /
+                           dt;
   const double bias_slope = c.quad_dps * rel_slope * kDeg;
   printf("table 7-4: drive phase %+.4f deg/K (P slope %+.4f, measured +0.0769), sense-drive "
          "lag %+.4f deg/K -> bias %+.3f deg/s/K (measured +2.666)\n",
@@ -389,7 +402,8 @@ static void test_adc_budget(void **state)
   plant_default_cfg(&c);
   double frac[2];
   const double worst = plant_adc_fraction(&c, frac);
-  printf("ADC range used at the design point: drive %.1f %%, sense %.1f %%\n", 100 * frac[0], 100 * frac[1]);
+  printf("ADC range used at the design point: drive %.1f %%, sense %.1f %%\n", 100 * frac[0],
+         100 * frac[1]);
   assert_true(worst < 1.0);
   c.rate_dps = c.rate_fs_dps;
   static plant_t p;
@@ -399,7 +413,8 @@ static void test_adc_budget(void **state)
   pr.accel_g.freq_hz[ACCEL_AXIS_SENSE] = c.vib_hz;
   assert_int_equal(plant_set_profiles(&p, &pr), 0);
   /* drive voltage for 10 um at resonance */
-  const double u = sqrt(c.drive_amp_m * pow(2 * kPi * c.f_drive_hz, 2) / c.q_drive / c.ks_drive_mps2_per_v2);
+  const double u = sqrt(c.drive_amp_m * pow(2 * kPi * c.f_drive_hz, 2) / c.q_drive /
+                        c.ks_drive_mps2_per_v2);
   const double wc = 2.0 * kPi * c.f_drive_hz;
   double peak[2] = {0, 0};
   for (long k = 0; k < 40000; k++) {
@@ -445,15 +460,19 @@ static void test_temperature_plumbing(void **state)
   static thermal_t ref;
   assert_int_equal(thermal_init(&ref, &th, c.temp_k), 0);
   for (int k = 0; k < 10000; k++) thermal_step(&ref, c.temp_k + 20.0);
-  printf("after 10 s of +20 K: structure %.4f circuit %.4f board %.4f K\n", t->struct_k, t->circuit_k, t->board_k);
+  printf("after 10 s of +20 K: structure %.4f circuit %.4f board %.4f K\n", t->struct_k,
+         t->circuit_k, t->board_k);
   assert_true(fabs(t->struct_k - thermal_temp(&ref, THERMAL_STRUCT)) < 1e-9);
   assert_true(fabs(t->board_k - thermal_temp(&ref, THERMAL_BOARD)) < 1e-9);
-  const double wn = 2 * kPi * c.f_drive_hz * (1.0 - 0.5 * c.ket_per_k * (t->struct_k - c.temp_ref_k));
+  const double wn = 2 * kPi * c.f_drive_hz *
+                    (1.0 - 0.5 * c.ket_per_k * (t->struct_k - c.temp_ref_k));
   assert_true(fabs(t->wn_drive_rad_s / wn - 1.0) < 1e-12);
   assert_true(p.pick[1].temp_k == t->board_k);
   assert_true(p.pick[0].temp_k == t->circuit_k);
   /* the sense phase follows (2-40) to within the step */
-  const double phi = (c.pick_sense_phi0_deg + c.pick_sense_phi1_deg_per_k * (t->board_k - c.temp_ref_k)) * kDeg;
+  const double phi = (c.pick_sense_phi0_deg +
+                      c.pick_sense_phi1_deg_per_k * (t->board_k - c.temp_ref_k)) *
+                     kDeg;
   assert_true(fabs(p.pick[1].phi_rad - phi) <= c.pick_phase_step_rad);
   assert_true(t->ambient_k == c.temp_k + 20.0);
   assert_true(t->dac_rejects == 0);

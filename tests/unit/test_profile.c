@@ -36,7 +36,8 @@ static void test_const_sine_ramp(void **state)
   profile_sine(&p, 10.0, 100.0, 7.0, 0.3);
   assert_int_equal(profile_check(&p, NULL), 0);
   for (double t = -0.1; t < 1.0; t += 0.0137) {
-    assert_true(fabs(profile_eval(&p, t, NULL) - (10.0 + 100.0 * sin(kTwoPi * 7.0 * t + 0.3))) < 1e-12);
+    assert_true(fabs(profile_eval(&p, t, NULL) - (10.0 + 100.0 * sin(kTwoPi * 7.0 * t + 0.3))) <
+                1e-12);
     check_slope(&p, t);
   }
 
@@ -63,7 +64,8 @@ static void test_heat_cool(void **state)
   assert_true(fabs(profile_eval(&p, 150.0, NULL) - v150) < 1e-9); /* continuous at the switch */
   assert_true(fabs(profile_eval(&p, 150.0 - 1e-9, NULL) - v150) < 1e-6);
   const double t = 1050.0;
-  assert_true(fabs(profile_eval(&p, t, NULL) - (base + (v150 - base) * exp(-900.0 / 900.0))) < 1e-9);
+  assert_true(fabs(profile_eval(&p, t, NULL) - (base + (v150 - base) * exp(-900.0 / 900.0))) <
+              1e-9);
   check_slope(&p, 100.0);
   check_slope(&p, 700.0);
   double s;

@@ -120,7 +120,8 @@ static void test_covariance_bounded_without_excitation(void **state)
   init_default(&s);
   for (int k = 0; k < 200000; k++) {
     rlsd_step(&s, 0.01f, 1.0f, 0.0f);
-    assert_true(s.cov.p11 > 0.0f && s.cov.p22 > 0.0f && s.cov.p11 + s.cov.p22 <= 4.0f / 0.982f + 1e-5f);
+    assert_true(s.cov.p11 > 0.0f && s.cov.p22 > 0.0f &&
+                s.cov.p11 + s.cov.p22 <= 4.0f / 0.982f + 1e-5f);
   }
   assert_true(isfinite(s.w_i) && fabsf(s.w_i - 0.01f) < 2e-6f);
   assert_int_equal(s.cov_resets, 0);
@@ -182,8 +183,8 @@ static void test_bad_config_rejected_unchanged(void **state)
   memset(&s, 0x5A, sizeof s);
   const rlsd_t sentinel = s;
   const rlsd_cfg_t bad[] = {
-      {NAN, 1.0f},  {0.0f, 1.0f},      {-0.5f, 1.0f}, {1.0001f, 1.0f}, {INFINITY, 1.0f},
-      {0.98f, 0.0f}, {0.98f, -1.0f},   {0.98f, NAN},  {0.98f, 2e6f},   {0.98f, INFINITY},
+      {NAN, 1.0f},   {0.0f, 1.0f},   {-0.5f, 1.0f}, {1.0001f, 1.0f}, {INFINITY, 1.0f},
+      {0.98f, 0.0f}, {0.98f, -1.0f}, {0.98f, NAN},  {0.98f, 2e6f},   {0.98f, INFINITY},
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     assert_int_equal(rlsd_init(&s, &bad[i]), -1);

@@ -13,8 +13,8 @@
 #include "gyro/selfcal_exec.h"
 #include "gyro/selfcal_fit.h"
 
-static void make_points(selfcal_point_t *p, uint32_t n, double f0, double q, double cr, double ci,
-                        double delay_s, double span)
+static void make_points(selfcal_point_t *p, uint32_t n, double f0, double q, double cr,
+                        double ci, double delay_s, double span)
 {
   for (uint32_t i = 0; i < n; i++) {
     const double f = f0 * (1.0 + span * ((double)i / (double)(n - 1u) - 0.5));

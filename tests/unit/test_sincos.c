@@ -12,10 +12,7 @@
 #define TWO_PI 6.283185307179586476925
 #define TWO_POW_32 4294967296.0
 
-static double phase_rad_f64(uint32_t phase)
-{
-  return TWO_PI * (double)phase / TWO_POW_32;
-}
+static double phase_rad_f64(uint32_t phase) { return TWO_PI * (double)phase / TWO_POW_32; }
 
 static double max_err = 0.0;
 

@@ -64,8 +64,8 @@ static void test_init_registers(void **state)
   assert_int_equal(TIM8->CCER, TIM_CCER_CC1E | TIM_CCER_CC1P);
   assert_int_equal(TIM8->DIER, TIM_DIER_CC1DE);
   assert_true((TIM8->BDTR & TIM_BDTR_MOE) != 0u);
-  assert_int_equal(TIM8->SMCR & 7u, 6u);         /* trigger mode */
-  assert_int_equal((TIM8->SMCR >> 4) & 7u, 2u);  /* ITR2 = TIM4 */
+  assert_int_equal(TIM8->SMCR & 7u, 6u);        /* trigger mode */
+  assert_int_equal((TIM8->SMCR >> 4) & 7u, 2u); /* ITR2 = TIM4 */
   /* DMA2 stream 2, channel 7 (TIM8_CH1): the four words into SPI2_DR, circular, armed
    * once here and never again. */
   assert_int_equal(DMA2->S[2].PAR, (uint32_t)(uintptr_t)&SPI2->DR);

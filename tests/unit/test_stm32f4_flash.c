@@ -67,7 +67,8 @@ static void test_erase_sequence(void **state)
                                     FLASH_CR_STRT);
   assert_int_equal(FLASH_R->KEYR, FLASH_KEY2);
   assert_int_equal(FLASH_R->CR, FLASH_CR_LOCK); /* operation bits cleared, locked again */
-  for (uint32_t i = 0; i < SECTOR; ++i) assert_int_equal(stm32f4_host_param_flash()[SECTOR + i], 0xFF);
+  for (uint32_t i = 0; i < SECTOR; ++i)
+    assert_int_equal(stm32f4_host_param_flash()[SECTOR + i], 0xFF);
 
   s_cr_n = 0;
   assert_int_equal(hal_flash_erase(0u), HAL_FLASH_OK);

@@ -54,7 +54,7 @@ static void test_plan_50khz_168mhz(void **state)
   assert_int_equal(p.arr, 3359); /* 168 MHz / 3360 = 50 kHz */
   assert_int_equal(p.ccr_strobe, 42);
   assert_int_equal(p.ccr_read, 807);
-  assert_int_equal(p.ccr_word2, 933);     /* 5.554 us */
+  assert_int_equal(p.ccr_word2, 933); /* 5.554 us */
   assert_int_equal(p.dac_psc, 0);
   assert_int_equal(p.dac_ccr, 1251);      /* 14.893 us at 84 MHz */
   assert_int_equal(p.dac_deadline, 2485); /* 14.792 us at 168 MHz */
@@ -85,7 +85,7 @@ static void test_plan_rejects(void **state)
 {
   (void)state;
   stm32f4_sample_plan_t p = {7u, 7u, 7u, 7u, 7u, 7u, 7u, 7u};
-  assert_int_equal(stm32f4_sample_plan(168000000u, 50001u, &p), -1); /* not exact */
+  assert_int_equal(stm32f4_sample_plan(168000000u, 50001u, &p), -1);  /* not exact */
   assert_int_equal(stm32f4_sample_plan(168000000u, 100000u, &p), -1); /* 10 us too short */
   assert_int_equal(stm32f4_sample_plan(168000000u, 0u, &p), -1);
   assert_int_equal(stm32f4_sample_plan(168000000u, 50000u, NULL), -1);
@@ -153,9 +153,9 @@ static void test_start_programs_hardware_chain(void **state)
    * RX DMA request: the TX words come from the timer's requests. */
   assert_int_equal(SPI1->CR1 & (SPI_CR1_CPOL | SPI_CR1_CPHA), SPI_CR1_CPOL);
   assert_int_equal((SPI1->CR1 >> SPI_CR1_BR_POS) & 7u, 2u);
-  assert_true((SPI1->CR1 & (SPI_CR1_MSTR | SPI_CR1_DFF | SPI_CR1_SSM | SPI_CR1_SSI |
-                            SPI_CR1_SPE)) ==
-              (SPI_CR1_MSTR | SPI_CR1_DFF | SPI_CR1_SSM | SPI_CR1_SSI | SPI_CR1_SPE));
+  assert_true(
+      (SPI1->CR1 & (SPI_CR1_MSTR | SPI_CR1_DFF | SPI_CR1_SSM | SPI_CR1_SSI | SPI_CR1_SPE)) ==
+      (SPI_CR1_MSTR | SPI_CR1_DFF | SPI_CR1_SSM | SPI_CR1_SSI | SPI_CR1_SPE));
   assert_int_equal(SPI1->CR2, SPI_CR2_RXDMAEN);
   /* DMA2 (RM0090 table 43): stream 0 ch 3 SPI1_RX circular with the interrupt; stream 6
    * ch 6 TIM1_CH3 and stream 4 ch 6 TIM1_CH4 each write one word into SPI1_DR. */

@@ -49,8 +49,7 @@ static void test_init_registers(void **state)
 {
   (void)state;
   assert_int_equal(USART1->BRR, 0x5B);
-  assert_int_equal(USART1->CR1,
-                   USART_CR1_UE | USART_CR1_TE | USART_CR1_RE | USART_CR1_RXNEIE);
+  assert_int_equal(USART1->CR1, USART_CR1_UE | USART_CR1_TE | USART_CR1_RE | USART_CR1_RXNEIE);
   assert_true((RCC->APB2ENR & RCC_APB2ENR_USART1EN) != 0u);
   assert_true((NVIC->ISER[37 / 32] & (1u << (37 % 32))) != 0u);
   assert_int_equal(NVIC->IP[37], STM32F4_PRIO_UART << 4);
@@ -69,7 +68,7 @@ static void test_rx_ring_overflow_and_wrap(void **state)
   (void)state;
   for (uint32_t i = 0; i < STM32F4_UART_RX_BYTES + 44u; ++i) receive((uint8_t)i, 0u);
   assert_int_equal(stm32f4_uart_rx_dropped(), 44); /* the ring kept the oldest 256 */
-  assert_false(hal_uart_rx_lost()); /* bytes before the gap still waiting */
+  assert_false(hal_uart_rx_lost());                /* bytes before the gap still waiting */
   uint8_t buf[STM32F4_UART_RX_BYTES + 8u];
   assert_int_equal(hal_uart_read(buf, 8u), 8);
   receive(0xEE, 0u); /* room again, but the gap is not yet reached: dropped */

@@ -24,7 +24,8 @@ static void test_uncoupled_step(void **state)
   c.dt_s = 0.01;
   static thermal_t th;
   assert_int_equal(thermal_init(&th, &c, 300.0), 0);
-  for (int i = 0; i < 3; i++) assert_true(fabs(thermal_temp(&th, i) - (300.0 + c.rise_k[i])) < 1e-9);
+  for (int i = 0; i < 3; i++)
+    assert_true(fabs(thermal_temp(&th, i) - (300.0 + c.rise_k[i])) < 1e-9);
   const double ta = 330.0;
   double worst = 0.0;
   for (int k = 1; k <= 100000; k++) { /* 1000 s */
@@ -210,7 +211,7 @@ static void test_validation(void **state)
 int main(void)
 {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_uncoupled_step), cmocka_unit_test(test_two_node_modes),
+      cmocka_unit_test(test_uncoupled_step),  cmocka_unit_test(test_two_node_modes),
       cmocka_unit_test(test_general_network), cmocka_unit_test(test_ramp_midpoint),
       cmocka_unit_test(test_presets_differ),  cmocka_unit_test(test_validation),
   };

@@ -67,16 +67,23 @@ static int truth(const char *name, uint32_t k, uint32_t *w)
     const char *name;
     size_t off;
     int type;
-  } m[] = {
-      {"rate_dps", offsetof(gyro_out_t, rate_dps), 0},   {"rate_unc_dps", offsetof(gyro_out_t, rate_unc_dps), 0},
-      {"quad_dps", offsetof(gyro_out_t, quad_dps), 0},   {"drive_amp_v", offsetof(gyro_out_t, drive_amp_v), 0},
-      {"drive_phase_deg", offsetof(gyro_out_t, drive_phase_deg), 0},
-      {"p_deg", offsetof(gyro_out_t, p_deg), 0},         {"p_f_deg", offsetof(gyro_out_t, p_f_deg), 0},
-      {"f_cmd_v2", offsetof(gyro_out_t, f_cmd_v2), 0},   {"u1_v", offsetof(gyro_out_t, u1_v), 0},
-      {"u2_v", offsetof(gyro_out_t, u2_v), 0},           {"sense_i_v", offsetof(gyro_out_t, sense_i_v), 0},
-      {"sense_q_v", offsetof(gyro_out_t, sense_q_v), 0}, {"mode", offsetof(gyro_out_t, mode), 1},
-      {"fault", offsetof(gyro_out_t, fault), 1},         {"flags", offsetof(gyro_out_t, flags), 1},
-      {"tick", offsetof(gyro_out_t, tick), 1},           {"rate_valid", offsetof(gyro_out_t, rate_valid), 1}};
+  } m[] = {{"rate_dps", offsetof(gyro_out_t, rate_dps), 0},
+           {"rate_unc_dps", offsetof(gyro_out_t, rate_unc_dps), 0},
+           {"quad_dps", offsetof(gyro_out_t, quad_dps), 0},
+           {"drive_amp_v", offsetof(gyro_out_t, drive_amp_v), 0},
+           {"drive_phase_deg", offsetof(gyro_out_t, drive_phase_deg), 0},
+           {"p_deg", offsetof(gyro_out_t, p_deg), 0},
+           {"p_f_deg", offsetof(gyro_out_t, p_f_deg), 0},
+           {"f_cmd_v2", offsetof(gyro_out_t, f_cmd_v2), 0},
+           {"u1_v", offsetof(gyro_out_t, u1_v), 0},
+           {"u2_v", offsetof(gyro_out_t, u2_v), 0},
+           {"sense_i_v", offsetof(gyro_out_t, sense_i_v), 0},
+           {"sense_q_v", offsetof(gyro_out_t, sense_q_v), 0},
+           {"mode", offsetof(gyro_out_t, mode), 1},
+           {"fault", offsetof(gyro_out_t, fault), 1},
+           {"flags", offsetof(gyro_out_t, flags), 1},
+           {"tick", offsetof(gyro_out_t, tick), 1},
+           {"rate_valid", offsetof(gyro_out_t, rate_valid), 1}};
   for (size_t i = 0; i < sizeof m / sizeof m[0]; i++) {
     if (strcmp(m[i].name, name) == 0) {
       const uint8_t *b = (const uint8_t *)&o;
@@ -97,11 +104,11 @@ static int truth(const char *name, uint32_t k, uint32_t *w)
 /* ---- receiver side ---- */
 
 typedef struct {
-  uint32_t t0;          /* tick of record 0 of the current stream */
+  uint32_t t0; /* tick of record 0 of the current stream */
   uint32_t records;
-  uint32_t next_index;  /* expected first_rec if nothing is missing */
+  uint32_t next_index; /* expected first_rec if nothing is missing */
   uint32_t headers;
-  uint32_t mismatches;  /* a delivered value that is not the truth: must stay 0 */
+  uint32_t mismatches; /* a delivered value that is not the truth: must stay 0 */
   tlm_layout_t last;
   uint32_t lines;
   char line[64][64];
@@ -167,10 +174,7 @@ static void run(uint32_t n, uint32_t poll_every)
   }
 }
 
-static void receive_all(void)
-{
-  tlm_decode_feed(&rx, link_.buf, link_.len);
-}
+static void receive_all(void) { tlm_decode_feed(&rx, link_.buf, link_.len); }
 
 static uint32_t mask_of(const char *const *names, size_t n)
 {
@@ -208,9 +212,12 @@ static void test_plan_rate_rounding(void **state)
     assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, m, bad[i], &p), TLM_ERR_RATE);
   }
   assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, 0u, 100.0f, &p), TLM_ERR_FIELDS);
-  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, (uint32_t)((uint64_t)1u << TLM_FIELD_COUNT), 100.0f, &p), TLM_ERR_FIELDS);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD,
+                            (uint32_t)((uint64_t)1u << TLM_FIELD_COUNT), 100.0f, &p),
+                   TLM_ERR_FIELDS);
   assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, 1u << 31, 100.0f, &p), TLM_ERR_FIELDS);
-  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, 1u << TLM_FIELD_rate_valid, 100.0f, &p), TLM_OK);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, 1u << TLM_FIELD_rate_valid, 100.0f, &p),
+                   TLM_OK);
   /* one u32 at the full tick rate is far beyond the link */
   assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, 1u, 50000.0f, &p), TLM_ERR_BANDWIDTH);
 }
@@ -235,7 +242,8 @@ static void test_link_budget_by_hand(void **state)
   /* all 17 at 1 kHz: N = min(20, 240/68) = 3, raw 13 + 12 * 17 = 217, wire 220,
    * 1000/3 frames = 73333.3 -> 73334; header names 128 bytes + 34 + 30 = 192 -> 195 B:
    * 73529 B/s > 70 % of 92160 = 64512 */
-  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, TLM_FIELD_MASK_ALL, 1000.0f, &p), TLM_ERR_BANDWIDTH);
+  assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, TLM_FIELD_MASK_ALL, 1000.0f, &p),
+                   TLM_ERR_BANDWIDTH);
   assert_int_equal(p.rec_per_frame, 3u);
   assert_int_equal(p.bytes_per_s, 73334u + 195u);
   /* all 17 at 500 Hz: 36666.7 -> 36667 + 195 */
@@ -258,13 +266,18 @@ static void test_link_budget_matches_encoder(void **state)
   const struct {
     uint32_t mask;
     float rate;
-  } cases[] = {{0x000Fu, 1000.0f}, {0x00FFu, 1000.0f}, {0x0FFFu, 1000.0f},
-               {TLM_FIELD_MASK_ALL, 500.0f}, {0x8001u, 100.0f}, {0x0001u, 10000.0f},
+  } cases[] = {{0x000Fu, 1000.0f},
+               {0x00FFu, 1000.0f},
+               {0x0FFFu, 1000.0f},
+               {TLM_FIELD_MASK_ALL, 500.0f},
+               {0x8001u, 100.0f},
+               {0x0001u, 10000.0f},
                {(1u << TLM_FIELD_rate_valid) | 0x8001u, 1000.0f}};
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     setup_all();
     tlm_plan_t p;
-    assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, cases[c].mask, cases[c].rate, &p), TLM_OK);
+    assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, cases[c].mask, cases[c].rate, &p),
+                     TLM_OK);
     tlm_start(&tx, &p);
     tick_now = 0u;
     run(10u * FS, 50u);
@@ -289,8 +302,9 @@ static void test_round_trip(void **state)
 {
   (void)state;
   /* the last two select the field past the 16th (rate_valid), alone and between others */
-  const uint32_t masks[] = {mask_of(four, 4), TLM_FIELD_MASK_ALL, 0x8000u, 0x7001u,
-                            1u << TLM_FIELD_rate_valid, (1u << TLM_FIELD_rate_valid) | 0x9001u};
+  const uint32_t masks[] = {
+      mask_of(four, 4), TLM_FIELD_MASK_ALL,         0x8000u,
+      0x7001u,          1u << TLM_FIELD_rate_valid, (1u << TLM_FIELD_rate_valid) | 0x9001u};
   const float rates[] = {1000.0f, 250.0f, 5000.0f, 3000.0f, 2000.0f, 1000.0f};
   for (size_t c = 0; c < sizeof masks / sizeof masks[0]; c++) {
     setup_all();
@@ -334,9 +348,9 @@ static void test_overrun_counted(void **state)
   setup_all();
   tick_now = 0u;
   start(TLM_FIELD_MASK_ALL, 500.0f);
-  run(20000u, 50u);   /* 0.4 s normal */
-  run(50000u, 0u);    /* 1 s without the background loop: 500 records, the ring holds 120 */
-  run(100000u, 50u);  /* 2 s normal: later headers report the loss */
+  run(20000u, 50u);  /* 0.4 s normal */
+  run(50000u, 0u);   /* 1 s without the background loop: 500 records, the ring holds 120 */
+  run(100000u, 50u); /* 2 s normal: later headers report the loss */
   tlm_stop(&tx);
   receive_all();
   tlm_stats_t st;
@@ -492,7 +506,8 @@ static void test_selection_never_torn(void **state)
   setup_all();
   tick_now = 0u;
   const uint32_t a = mask_of(four, 4) | (1u << TLM_FIELD_tick);
-  const uint32_t b = (1u << TLM_FIELD_flags) | (1u << TLM_FIELD_tick) | (1u << TLM_FIELD_rate_valid);
+  const uint32_t b = (1u << TLM_FIELD_flags) | (1u << TLM_FIELD_tick) |
+                     (1u << TLM_FIELD_rate_valid);
   start(a, 1000.0f); /* decim 50 */
   run(100u, 0u);
   expect_records(a, 50u, 0u, 2u);

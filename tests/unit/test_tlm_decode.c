@@ -91,10 +91,7 @@ typedef struct {
   uint32_t frames, records, lines;
 } stream_t;
 
-static void text_line(const char *s)
-{
-  tlm_test_write(&link_, (const uint8_t *)s, strlen(s));
-}
+static void text_line(const char *s) { tlm_test_write(&link_, (const uint8_t *)s, strlen(s)); }
 
 /* seconds of a 1 kHz stream of tick + rate_dps; a reply line after every 7th poll */
 static stream_t make_stream(uint32_t seconds)
@@ -102,7 +99,8 @@ static stream_t make_stream(uint32_t seconds)
   memset(&link_, 0, sizeof link_);
   link_.buf = link_buf;
   link_.room = (size_t)-1;
-  const tlm_cfg_t cfg = {50000u, 921600u, tlm_test_room, tlm_test_write, &link_, &app_tlm_fields};
+  const tlm_cfg_t cfg = {50000u,         921600u, tlm_test_room,
+                         tlm_test_write, &link_,  &app_tlm_fields};
   assert_int_equal(tlm_init(&tx, &cfg), 0);
   tlm_plan_t p;
   const uint32_t mask = (1u << TLM_FIELD_tick) | (1u << TLM_FIELD_rate_dps);
@@ -242,8 +240,8 @@ static void test_text_rules(void **state)
   (void)state;
   reset_rx();
   feed_s("ok 1489.9 Hz\r\n");
-  feed_s("\n\r\n\n");       /* empty lines: nothing */
-  feed_s("- a\tb\n");       /* TAB kept, bare LF accepted */
+  feed_s("\n\r\n\n"); /* empty lines: nothing */
+  feed_s("- a\tb\n"); /* TAB kept, bare LF accepted */
   assert_int_equal(got.lines, 2u);
   assert_string_equal(got.line[0], "ok 1489.9 Hz");
   assert_string_equal(got.line[1], "- a\tb");
@@ -286,8 +284,16 @@ typedef struct {
 } buf_t;
 
 static void put8(buf_t *b, uint8_t v) { b->b[b->n++] = v; }
-static void put16(buf_t *b, uint16_t v) { put8(b, (uint8_t)v); put8(b, (uint8_t)(v >> 8)); }
-static void put32(buf_t *b, uint32_t v) { put16(b, (uint16_t)v); put16(b, (uint16_t)(v >> 16)); }
+static void put16(buf_t *b, uint16_t v)
+{
+  put8(b, (uint8_t)v);
+  put8(b, (uint8_t)(v >> 8));
+}
+static void put32(buf_t *b, uint32_t v)
+{
+  put16(b, (uint16_t)v);
+  put16(b, (uint16_t)(v >> 16));
+}
 static void putname(buf_t *b, uint8_t type, const char *s)
 {
   put8(b, type);
@@ -344,7 +350,7 @@ static void test_header_layout(void **state)
   put8(&d, 2u);
   t0 = 0u;
   put32(&d, 0u);
-  put32(&d, 0u);         /* 0.0f */
+  put32(&d, 0u);          /* 0.0f */
   put32(&d, 0x3F800000u); /* 1.0f */
   put32(&d, 50u);
   put32(&d, 0x40C80000u); /* 6.25f = 50 / 8 */
@@ -364,18 +370,18 @@ static void test_header_rejections(void **state)
     size_t off;
     uint8_t val;
   } edits[] = {
-      {0u, 2u},                  /* version */
-      {5u, 0u},                  /* fs_hz = 0 (all four bytes, below) */
-      {9u, 0u},                  /* decim = 0 */
-      {13u, 0u},                 /* rec_per_frame = 0 */
-      {23u, 0u},                 /* n_fields = 0 */
-      {23u, 33u},                /* n_fields > 32 */
-      {23u, 4u},                 /* more fields than given */
-      {23u, 2u},                 /* fewer fields than given: trailing bytes */
-      {24u, 2u},                 /* type 2 */
-      {25u, 0u},                 /* empty name */
-      {25u, 32u},                /* name longer than 31 */
-      {26u, (uint8_t)'-'},       /* character outside the name set */
+      {0u, 2u},            /* version */
+      {5u, 0u},            /* fs_hz = 0 (all four bytes, below) */
+      {9u, 0u},            /* decim = 0 */
+      {13u, 0u},           /* rec_per_frame = 0 */
+      {23u, 0u},           /* n_fields = 0 */
+      {23u, 33u},          /* n_fields > 32 */
+      {23u, 4u},           /* more fields than given */
+      {23u, 2u},           /* fewer fields than given: trailing bytes */
+      {24u, 2u},           /* type 2 */
+      {25u, 0u},           /* empty name */
+      {25u, 32u},          /* name longer than 31 */
+      {26u, (uint8_t)'-'}, /* character outside the name set */
   };
   for (size_t i = 0; i < sizeof edits / sizeof edits[0]; i++) {
     buf_t b = good;

@@ -76,9 +76,12 @@ static void test_cobs_examples(void **state)
   check_cobs((const uint8_t *)"\x00", 1u, (const uint8_t *)"\x01\x01", 2u);
   check_cobs((const uint8_t *)"\x00\x00", 2u, (const uint8_t *)"\x01\x01\x01", 3u);
   check_cobs((const uint8_t *)"\x00\x11\x00", 3u, (const uint8_t *)"\x01\x02\x11\x01", 4u);
-  check_cobs((const uint8_t *)"\x11\x22\x00\x33", 4u, (const uint8_t *)"\x03\x11\x22\x02\x33", 5u);
-  check_cobs((const uint8_t *)"\x11\x22\x33\x44", 4u, (const uint8_t *)"\x05\x11\x22\x33\x44", 5u);
-  check_cobs((const uint8_t *)"\x11\x00\x00\x00", 4u, (const uint8_t *)"\x02\x11\x01\x01\x01", 5u);
+  check_cobs((const uint8_t *)"\x11\x22\x00\x33", 4u, (const uint8_t *)"\x03\x11\x22\x02\x33",
+             5u);
+  check_cobs((const uint8_t *)"\x11\x22\x33\x44", 4u, (const uint8_t *)"\x05\x11\x22\x33\x44",
+             5u);
+  check_cobs((const uint8_t *)"\x11\x00\x00\x00", 4u, (const uint8_t *)"\x02\x11\x01\x01\x01",
+             5u);
   uint8_t in[256], want[260];
   /* 01 02 ... FE -> FF 01 02 ... FE */
   for (int i = 0; i < 254; i++) in[i] = (uint8_t)(i + 1);
@@ -157,10 +160,13 @@ static void test_cobs_decode_rejects(void **state)
   (void)state;
   uint8_t out[8];
   size_t n = 77u;
-  assert_false(tlm_cobs_decode((const uint8_t *)"\x03\x11", 2u, out, sizeof out, &n)); /* short block */
-  assert_false(tlm_cobs_decode((const uint8_t *)"\x03\x11\x00", 3u, out, sizeof out, &n)); /* zero inside */
+  assert_false(
+      tlm_cobs_decode((const uint8_t *)"\x03\x11", 2u, out, sizeof out, &n)); /* short block */
+  assert_false(tlm_cobs_decode((const uint8_t *)"\x03\x11\x00", 3u, out, sizeof out,
+                               &n)); /* zero inside */
   assert_false(tlm_cobs_decode((const uint8_t *)"\x00", 1u, out, sizeof out, &n)); /* zero code */
-  assert_false(tlm_cobs_decode((const uint8_t *)"\x05\x01\x02\x03\x04\x01", 6u, out, 4u, &n)); /* cap */
+  assert_false(
+      tlm_cobs_decode((const uint8_t *)"\x05\x01\x02\x03\x04\x01", 6u, out, 4u, &n)); /* cap */
   assert_int_equal(n, 77u);
   assert_true(tlm_cobs_decode((const uint8_t *)"\x05\x01\x02\x03\x04", 5u, out, 4u, &n));
   assert_int_equal(n, 4u);
@@ -203,7 +209,8 @@ static void test_frame_damage_rejected(void **state)
   uint32_t s = 11u;
   const size_t lens[] = {0u, 1u, 9u, 60u, 247u, 248u, 400u};
   for (size_t k = 0; k < sizeof lens / sizeof lens[0]; k++) {
-    for (size_t i = 0; i < lens[k]; i++) raw[TLM_FRAME_HEAD_BYTES + i] = (uint8_t)(lcg(&s) % 3u);
+    for (size_t i = 0; i < lens[k]; i++)
+      raw[TLM_FRAME_HEAD_BYTES + i] = (uint8_t)(lcg(&s) % 3u);
     const size_t rn = tlm_frame_seal(raw, (uint8_t)TLM_FRAME_HEADER, (uint16_t)k, lens[k]);
     const size_t wn = tlm_frame_to_wire(raw, rn, wire, sizeof wire);
     const size_t cn = wn - 2u;
@@ -230,10 +237,10 @@ static void test_frame_damage_rejected(void **state)
 int main(void)
 {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_crc_check_value),     cmocka_unit_test(test_crc_matches_python),
-      cmocka_unit_test(test_crc_chaining),        cmocka_unit_test(test_cobs_examples),
-      cmocka_unit_test(test_cobs_round_trip),     cmocka_unit_test(test_cobs_decode_rejects),
-      cmocka_unit_test(test_frame_round_trip),    cmocka_unit_test(test_frame_damage_rejected),
+      cmocka_unit_test(test_crc_check_value),  cmocka_unit_test(test_crc_matches_python),
+      cmocka_unit_test(test_crc_chaining),     cmocka_unit_test(test_cobs_examples),
+      cmocka_unit_test(test_cobs_round_trip),  cmocka_unit_test(test_cobs_decode_rejects),
+      cmocka_unit_test(test_frame_round_trip), cmocka_unit_test(test_frame_damage_rejected),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

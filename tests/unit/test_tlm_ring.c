@@ -116,7 +116,8 @@ static void test_whole_records_only(void **state)
   tlm_ring_init(&ring);
   uint32_t rec[16];
   for (uint32_t i = 0; i < 16u; i++) rec[i] = i;
-  for (uint32_t k = 0; k < TLM_RING_WORDS / 16u; k++) assert_true(tlm_ring_push(&ring, rec, 16u));
+  for (uint32_t k = 0; k < TLM_RING_WORDS / 16u; k++)
+    assert_true(tlm_ring_push(&ring, rec, 16u));
   assert_int_equal(tlm_ring_used(&ring), TLM_RING_WORDS);
   assert_false(tlm_ring_push(&ring, rec, 1u));
   assert_int_equal(tlm_ring_overruns(&ring), 1u);

@@ -11,7 +11,10 @@ void tlm_decode_init(tlm_decode_t *d, const tlm_decode_cfg_t *cfg)
   d->state = (uint8_t)ST_TEXT;
 }
 
-const tlm_layout_t *tlm_decode_layout(const tlm_decode_t *d) { return d->have_layout ? &d->layout : NULL; }
+const tlm_layout_t *tlm_decode_layout(const tlm_decode_t *d)
+{
+  return d->have_layout ? &d->layout : NULL;
+}
 
 static void line_reset(tlm_decode_t *d)
 {
@@ -77,8 +80,10 @@ static bool name_ok(const uint8_t *s, uint32_t len)
   }
   for (uint32_t i = 0; i < len; i++) {
     const uint8_t c = s[i];
-    const bool ok = (c >= (uint8_t)'a' && c <= (uint8_t)'z') || (c >= (uint8_t)'A' && c <= (uint8_t)'Z') ||
-                    (c >= (uint8_t)'0' && c <= (uint8_t)'9') || c == (uint8_t)'_' || c == (uint8_t)'.';
+    const bool ok = (c >= (uint8_t)'a' && c <= (uint8_t)'z') ||
+                    (c >= (uint8_t)'A' && c <= (uint8_t)'Z') ||
+                    (c >= (uint8_t)'0' && c <= (uint8_t)'9') || c == (uint8_t)'_' ||
+                    c == (uint8_t)'.';
     if (!ok) {
       return false;
     }
@@ -224,9 +229,7 @@ void tlm_decode_feed(tlm_decode_t *d, const uint8_t *data, size_t len)
         d->state = (uint8_t)ST_TEXT;
       }
       break;
-    default:
-      text_byte(d, c);
-      break;
+    default: text_byte(d, c); break;
     }
   }
 }

@@ -87,9 +87,9 @@ typedef struct {
 
 typedef struct {
   tlm_decode_cfg_t cfg;
-  uint8_t state;      /* TEXT, FRAME, SKIP */
+  uint8_t state; /* TEXT, FRAME, SKIP */
   bool line_bad;
-  bool line_cr;       /* a CR was the last byte */
+  bool line_cr; /* a CR was the last byte */
   uint32_t line_len;
   char line[TLM_DECODE_LINE_MAX + 1u];
   uint32_t buf_len;

@@ -39,10 +39,7 @@ void board_system_init(void)
   cm4_cycles_init();
 }
 
-const stm32f4_board_info_t *stm32f4_board_info(void)
-{
-  return &s_info;
-}
+const stm32f4_board_info_t *stm32f4_board_info(void) { return &s_info; }
 
 static void short_delay(void)
 {

@@ -23,8 +23,8 @@ void stm32f4_dac_init(void)
   /* SPI2: transmit-only master (bidirectional mode, output enabled), 16-bit, mode 0,
    * BR = 000: PCLK1 / 2 = 21 MHz. */
   SPI2->CR1 = 0u;
-  SPI2->CR1 = SPI_CR1_BIDIMODE | SPI_CR1_BIDIOE | SPI_CR1_MSTR | SPI_CR1_DFF |
-              SPI_CR1_SSM | SPI_CR1_SSI;
+  SPI2->CR1 = SPI_CR1_BIDIMODE | SPI_CR1_BIDIOE | SPI_CR1_MSTR | SPI_CR1_DFF | SPI_CR1_SSM |
+              SPI_CR1_SSI;
   SPI2->CR2 = SPI_CR2_TXDMAEN;
   SPI2->CR1 |= SPI_CR1_SPE;
 
@@ -65,19 +65,10 @@ CM4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame)
   }
 }
 
-void stm32f4_dac_set_deadline(uint32_t tim1_count)
-{
-  s_deadline = tim1_count;
-}
+void stm32f4_dac_set_deadline(uint32_t tim1_count) { s_deadline = tim1_count; }
 
-uint32_t stm32f4_dac_late(void)
-{
-  return s_late;
-}
+uint32_t stm32f4_dac_late(void) { return s_late; }
 
 #ifdef STM32F4_HOST_TEST
-volatile uint16_t *stm32f4_dac_host_words(void)
-{
-  return s_words;
-}
+volatile uint16_t *stm32f4_dac_host_words(void) { return s_words; }
 #endif

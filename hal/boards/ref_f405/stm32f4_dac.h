@@ -23,8 +23,8 @@
 
 #include "hal/hal_dac.h"
 
-#define STM32F4_DAC_SLOT_TICKS 210u     /* 1.25 us at 168 MHz */
-#define STM32F4_DAC_CS_HIGH_TICKS 16u   /* 95 ns CS high between words */
+#define STM32F4_DAC_SLOT_TICKS 210u   /* 1.25 us at 168 MHz */
+#define STM32F4_DAC_CS_HIGH_TICKS 16u /* 95 ns CS high between words */
 
 /* Configure SPI2, DMA2 stream 2 (enabled, waiting for TIM8) and TIM8 (waiting for its
  * trigger). Call once before the sample chain starts. */

@@ -45,8 +45,8 @@ static uint32_t ns_to_ticks_floor(uint64_t t_ns, uint32_t tim_hz, uint32_t psc)
 int stm32f4_sample_plan(uint32_t tim_hz, uint32_t rate_hz, stm32f4_sample_plan_t *plan)
 {
   if (plan == 0 || rate_hz == 0u || tim_hz == 0u || tim_hz % rate_hz != 0u) return -1;
-  const uint32_t min_ns = STM32F4_ADC_READ_START_NS + STM32F4_ADC_READ_NS +
-                          STM32F4_DAC_SEQ_NS + STM32F4_DAC_GUARD_NS + STM32F4_MIN_TICK_NS;
+  const uint32_t min_ns = STM32F4_ADC_READ_START_NS + STM32F4_ADC_READ_NS + STM32F4_DAC_SEQ_NS +
+                          STM32F4_DAC_GUARD_NS + STM32F4_MIN_TICK_NS;
   if ((uint64_t)rate_hz * min_ns > 1000000000ull) return -1;
   const uint32_t total = tim_hz / rate_hz;
   const uint32_t tim4_hz = tim_hz / 2u;
@@ -89,8 +89,8 @@ void hal_sample_timer_stop(void)
    * LDAC high keeps the DAC outputs latched. */
   TIM1->CCMR1 = (4u << TIM_CCMR_OC1M_POS) | (4u << TIM_CCMR_OC2M_POS);
   TIM1->CCMR2 = (4u << TIM_CCMR_OC1M_POS);
-  TIM1->CCER = TIM_CCER_CC1E | TIM_CCER_CC1P | TIM_CCER_CC2E | TIM_CCER_CC2P |
-               TIM_CCER_CC3E | TIM_CCER_CC3P;
+  TIM1->CCER = TIM_CCER_CC1E | TIM_CCER_CC1P | TIM_CCER_CC2E | TIM_CCER_CC2P | TIM_CCER_CC3E |
+               TIM_CCER_CC3P;
   TIM1->BDTR = TIM_BDTR_MOE;
   TIM1->DIER = 0u;
   cm4_nvic_disable(STM32F4_IRQ_DMA2_STREAM0);
@@ -175,8 +175,8 @@ int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
   TIM1->CCMR1 = (TIM_OCM_PWM1 << TIM_CCMR_OC1M_POS) | TIM_CCMR_OC1PE |
                 (TIM_OCM_PWM1 << TIM_CCMR_OC2M_POS) | TIM_CCMR_OC2PE;
   TIM1->CCMR2 = (TIM_OCM_PWM2 << TIM_CCMR_OC1M_POS) | TIM_CCMR_OC1PE | TIM_CCMR_OC4PE;
-  TIM1->CCER = TIM_CCER_CC1E | TIM_CCER_CC1P | TIM_CCER_CC2E | TIM_CCER_CC2P |
-               TIM_CCER_CC3E | TIM_CCER_CC3P;
+  TIM1->CCER = TIM_CCER_CC1E | TIM_CCER_CC1P | TIM_CCER_CC2E | TIM_CCER_CC2P | TIM_CCER_CC3E |
+               TIM_CCER_CC3P;
   TIM1->CR2 = TIM_MMS_UPDATE << TIM_CR2_MMS_POS;
   TIM1->DIER = TIM_DIER_CC3DE | TIM_DIER_CC4DE;
   TIM1->BDTR = TIM_BDTR_MOE;
@@ -229,8 +229,5 @@ void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
 }
 
 #ifdef STM32F4_HOST_TEST
-volatile int16_t *stm32f4_sample_host_rx(void)
-{
-  return s_adc_rx;
-}
+volatile int16_t *stm32f4_sample_host_rx(void) { return s_adc_rx; }
 #endif

@@ -29,24 +29,26 @@
 #include <stdint.h>
 
 /* Timing of the chain, ns (datasheet figures in hal/boards/ref_f405/README.md). */
-#define STM32F4_STROBE_NS 250u      /* CONVST / LDAC low pulse */
+#define STM32F4_STROBE_NS 250u        /* CONVST / LDAC low pulse */
 #define STM32F4_ADC_CONV_MAX_NS 4150u /* AD7606 t_CONV max, no oversampling */
-#define STM32F4_ADC_READ_START_NS 4800u /* CS falls: strobe + t_CONV max + BUSY delay + margin */
-#define STM32F4_ADC_SPI_HZ 10500000u  /* PCLK2 84 MHz / 8; AD7606 f_SCLK max 17 MHz at VDRIVE 3.3 V */
-#define STM32F4_ADC_READ_NS 3250u     /* 32 SCLK at 10.5 MHz = 3048 ns + DMA latency */
-#define STM32F4_ADC_WORD2_NS 750u     /* CC4 after CC3: half a 16-bit word at 10.5 MHz */
-#define STM32F4_DAC_SEQ_NS 5000u      /* four 1.25 us AD5554 word slots (stm32f4_dac.h) */
-#define STM32F4_DAC_GUARD_NS 100u     /* DMA latency allowance before the next LDAC */
+#define STM32F4_ADC_READ_START_NS \
+  4800u /* CS falls: strobe + t_CONV max + BUSY delay + margin */
+#define STM32F4_ADC_SPI_HZ \
+  10500000u /* PCLK2 84 MHz / 8; AD7606 f_SCLK max 17 MHz at VDRIVE 3.3 V */
+#define STM32F4_ADC_READ_NS 3250u       /* 32 SCLK at 10.5 MHz = 3048 ns + DMA latency */
+#define STM32F4_ADC_WORD2_NS 750u       /* CC4 after CC3: half a 16-bit word at 10.5 MHz */
+#define STM32F4_DAC_SEQ_NS 5000u        /* four 1.25 us AD5554 word slots (stm32f4_dac.h) */
+#define STM32F4_DAC_GUARD_NS 100u       /* DMA latency allowance before the next LDAC */
 #define STM32F4_DAC_WRITE_GUARD_NS 100u /* last frame write to DAC start: check + 4 stores */
-#define STM32F4_MIN_TICK_NS 1000u     /* the least compute time a period must leave */
+#define STM32F4_MIN_TICK_NS 1000u       /* the least compute time a period must leave */
 
 typedef struct {
-  uint32_t psc, arr;   /* TIM1: f_sample = f_tim / ((psc + 1)(arr + 1)) exactly */
-  uint32_t ccr_strobe; /* CONVST and LDAC rise here */
-  uint32_t ccr_read;   /* ADC CS falls, the first read word is written */
-  uint32_t ccr_word2;  /* the second read word is written */
-  uint32_t dac_psc;    /* TIM4 (f_tim / 2): prescaler */
-  uint32_t dac_ccr;    /* TIM4 count at which TIM8 starts the DAC slots */
+  uint32_t psc, arr;     /* TIM1: f_sample = f_tim / ((psc + 1)(arr + 1)) exactly */
+  uint32_t ccr_strobe;   /* CONVST and LDAC rise here */
+  uint32_t ccr_read;     /* ADC CS falls, the first read word is written */
+  uint32_t ccr_word2;    /* the second read word is written */
+  uint32_t dac_psc;      /* TIM4 (f_tim / 2): prescaler */
+  uint32_t dac_ccr;      /* TIM4 count at which TIM8 starts the DAC slots */
   uint32_t dac_deadline; /* last TIM1 count at which a frame may still be written */
 } stm32f4_sample_plan_t;
 
@@ -59,9 +61,9 @@ int stm32f4_sample_plan(uint32_t tim_hz, uint32_t rate_hz, stm32f4_sample_plan_t
 
 /* Diagnostics of the running chain. */
 typedef struct {
-  uint32_t ticks;       /* sample interrupts served */
-  uint32_t overruns;    /* a new frame landed before the ISR returned */
-  uint32_t dma_errors;  /* transfer-error flags seen on the ADC streams */
+  uint32_t ticks;      /* sample interrupts served */
+  uint32_t overruns;   /* a new frame landed before the ISR returned */
+  uint32_t dma_errors; /* transfer-error flags seen on the ADC streams */
 } stm32f4_sample_stats_t;
 void stm32f4_sample_stats(stm32f4_sample_stats_t *stats);
 

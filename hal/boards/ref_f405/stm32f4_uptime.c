@@ -13,7 +13,4 @@ void stm32f4_uptime_init(void)
   TIM2->CR1 = TIM_CR1_CEN;
 }
 
-uint32_t stm32f4_uptime_us(void)
-{
-  return TIM2->CNT;
-}
+uint32_t stm32f4_uptime_us(void) { return TIM2->CNT; }

@@ -16,20 +16,21 @@
 
 typedef enum {
   HAL_FLASH_OK = 0,
-  HAL_FLASH_ERR_RANGE = -1,   /* sector or address outside the store */
-  HAL_FLASH_ERR_WRITE = -2,   /* program failed (tried to set a 0 bit, or hardware error) */
-  HAL_FLASH_ERR_POWER = -3    /* power was lost during the operation (host fault injection) */
+  HAL_FLASH_ERR_RANGE = -1, /* sector or address outside the store */
+  HAL_FLASH_ERR_WRITE = -2, /* program failed (tried to set a 0 bit, or hardware error) */
+  HAL_FLASH_ERR_POWER = -3  /* power was lost during the operation (host fault injection) */
 } hal_flash_status_t;
 
 typedef struct {
-  uint32_t num_sectors;  /* sectors reserved for the parameter store */
-  uint32_t sector_size;  /* bytes per sector */
+  uint32_t num_sectors;   /* sectors reserved for the parameter store */
+  uint32_t sector_size;   /* bytes per sector */
   uint32_t program_bytes; /* programming unit in bytes: a power of two, 1..sector_size */
 } hal_flash_geometry_t;
 
 void hal_flash_geometry(hal_flash_geometry_t *geo);
 hal_flash_status_t hal_flash_erase(uint32_t sector);
-hal_flash_status_t hal_flash_program(uint32_t sector, uint32_t offset, const void *data, size_t len);
+hal_flash_status_t hal_flash_program(uint32_t sector, uint32_t offset, const void *data,
+                                     size_t len);
 hal_flash_status_t hal_flash_read(uint32_t sector, uint32_t offset, void *buf, size_t len);
 
 #endif /* HAL_FLASH_H */

@@ -17,8 +17,8 @@ static uint8_t s_param_flash[STM32F4_PARAM_NUM_SECTORS * STM32F4_PARAM_SECTOR_BY
     __attribute__((aligned(4)));
 
 stm32f4_host_map_t stm32f4_host_map = {
-    &s_rcc, &s_pwr, &s_flash, &s_gpioa, &s_gpiob, &s_gpioc, &s_tim1, &s_tim2, &s_tim4, &s_tim8,
-    &s_spi1, &s_spi2, &s_dma2, &s_usart1, &s_iwdg, s_param_flash, 0};
+    &s_rcc,  &s_pwr,  &s_flash, &s_gpioa, &s_gpiob,  &s_gpioc, &s_tim1,       &s_tim2, &s_tim4,
+    &s_tim8, &s_spi1, &s_spi2,  &s_dma2,  &s_usart1, &s_iwdg,  s_param_flash, 0};
 
 #define ZERO(x) memset((void *)&(x), 0, sizeof(x))
 
@@ -45,7 +45,4 @@ void stm32f4_host_reset(void)
   cm4_host_reset();
 }
 
-uint8_t *stm32f4_host_param_flash(void)
-{
-  return s_param_flash;
-}
+uint8_t *stm32f4_host_param_flash(void) { return s_param_flash; }

@@ -89,7 +89,8 @@ static void stream(FILE *js, uint32_t *tick, uint32_t mask, float rate, uint32_t
   int f1 = 1;
   for (uint32_t i = 0; i < (uint32_t)TLM_FIELD_COUNT; i++) {
     if ((mask >> i) & 1u) {
-      fprintf(js, "%s[\"%s\", %u]", f1 ? "" : ", ", app_tlm_field(i)->name, app_tlm_field(i)->type);
+      fprintf(js, "%s[\"%s\", %u]", f1 ? "" : ", ", app_tlm_field(i)->name,
+              app_tlm_field(i)->type);
       f1 = 0;
     }
   }

@@ -27,13 +27,13 @@
  *   DAC: AD5554, quad 14-bit, 4-quadrant output stage on a 10 V reference, then x1.5
  *        electrode drivers: offset binary over +-15 V, one code = 30 V / 16384. */
 #define HAL_ADC_BITS 16
-#define HAL_ADC_FULL_SCALE_V 5.0f          /* +-5 V */
+#define HAL_ADC_FULL_SCALE_V 5.0f /* +-5 V */
 #define HAL_ADC_CODE_MAX 32767
 #define HAL_ADC_CODE_MIN (-32768)
 #define HAL_ADC_V_PER_CODE (HAL_ADC_FULL_SCALE_V / 32768.0f)
 
 #define HAL_DAC_BITS 14
-#define HAL_DAC_FULL_SCALE_V 15.0f         /* +-15 V */
+#define HAL_DAC_FULL_SCALE_V 15.0f /* +-15 V */
 #define HAL_DAC_CODE_MAX 16383u
 #define HAL_DAC_CODE_MID 8192u
 #define HAL_DAC_V_PER_CODE (2.0f * HAL_DAC_FULL_SCALE_V / 16384.0f)
@@ -44,7 +44,7 @@
  * 5 flash wait states; the planner (stm32f4_clock.h) derives all of it from these two. */
 #define BOARD_HSE_HZ 8000000u
 #define BOARD_SYSCLK_HZ 168000000u
-#define BOARD_LSI_HZ 32000u          /* the watchdog's RC clock, +-50 % over the part */
+#define BOARD_LSI_HZ 32000u /* the watchdog's RC clock, +-50 % over the part */
 
 /* ---- Tuning port ----------------------------------------------------------------------
  * USART1 on PB6/PB7, 8N1 (BRR 0x5B from PCLK2 84 MHz: +0.16 %). The telemetry budget of

@@ -53,7 +53,7 @@ static volatile uint32_t s_wraps;
 static volatile uint32_t s_ticks;
 #ifdef STM32F4_QEMU_PLANT
 static stm32f4_qemu_tick_stats_t s_tick;
-static uint32_t s_t_prev_ns;    /* TIM2 at the previous handler entry */
+static uint32_t s_t_prev_ns;         /* TIM2 at the previous handler entry */
 static uint32_t s_cycles_per_sample; /* 168 MHz / rate_hz */
 static uint32_t s_ns_per_sample;     /* 1e9 / rate_hz */
 static uint32_t s_lost_skip;         /* ticks after a stretch change: periods mixed */
@@ -70,10 +70,7 @@ void board_system_init(void)
   cm4_fault_enable();
 }
 
-const stm32f4_board_info_t *stm32f4_board_info(void)
-{
-  return &s_info;
-}
+const stm32f4_board_info_t *stm32f4_board_info(void) { return &s_info; }
 
 int stm32f4_board_init(void)
 {
@@ -122,10 +119,7 @@ int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
   return 0;
 }
 
-void hal_sample_timer_stop(void)
-{
-  SYSTICK->CTRL = 0u;
-}
+void hal_sample_timer_stop(void) { SYSTICK->CTRL = 0u; }
 
 void SysTick_Handler(void);
 
@@ -195,8 +189,7 @@ void stm32f4_qemu_tick_stats(stm32f4_qemu_tick_stats_t *s)
 
 int stm32f4_qemu_set_stretch(uint32_t stretch)
 {
-  if (s_cycles_per_sample == 0u || stretch == 0u ||
-      stretch > 0x1000000u / s_cycles_per_sample) {
+  if (s_cycles_per_sample == 0u || stretch == 0u || stretch > 0x1000000u / s_cycles_per_sample) {
     return -1;
   }
   const uint32_t pm = hal_critical_enter();
@@ -250,10 +243,7 @@ CM4_RAMFUNC void hal_adc_read_frame(hal_adc_frame_t *frame)
   frame->sense = loopback_code(s_dac.code[HAL_DAC_DRIVE_U2]);
 }
 
-CM4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame)
-{
-  s_dac = *frame;
-}
+CM4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame) { s_dac = *frame; }
 #endif
 
 void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
@@ -268,10 +258,7 @@ void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
   stats->dma_errors = 0u;
 }
 
-uint32_t stm32f4_dac_late(void)
-{
-  return 0u;
-}
+uint32_t stm32f4_dac_late(void) { return 0u; }
 
 void stm32f4_uptime_init(void)
 {
@@ -281,7 +268,4 @@ void stm32f4_uptime_init(void)
   TIM2->CR1 = TIM_CR1_CEN;
 }
 
-uint32_t stm32f4_uptime_us(void)
-{
-  return TIM2->CNT;
-}
+uint32_t stm32f4_uptime_us(void) { return TIM2->CNT; }

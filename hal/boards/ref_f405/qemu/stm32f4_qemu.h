@@ -21,8 +21,8 @@
 #include <stdint.h>
 
 typedef struct {
-  uint32_t stretch;        /* SysTick period in 50 kHz sample periods */
-  uint32_t period_ns;      /* emulated time between ticks */
+  uint32_t stretch;   /* SysTick period in 50 kHz sample periods */
+  uint32_t period_ns; /* emulated time between ticks */
   uint32_t ticks;
   uint32_t overruns;
   uint32_t lost;

@@ -14,7 +14,7 @@ static hal_adc_frame_t s_adc;     /* sampled at the current tick, read by the IS
 static hal_dac_frame_t s_active;  /* on the converter outputs during this interval */
 static hal_dac_frame_t s_pending; /* written by the ISR, output from the next tick */
 static uint64_t s_samples;
-static uint32_t s_ticks;          /* ticks of the sample clock (trace index) */
+static uint32_t s_ticks;               /* ticks of the sample clock (trace index) */
 static volatile double s_rate_req_dps; /* written by the background before s_rate_req is set */
 static volatile uint32_t s_rate_req;
 static const volatile float *s_trace_src;
