@@ -1,4 +1,4 @@
-/* Output integrity on a high-Q part calibrated by its own `sweep` (69 s of simulated
+/* Output integrity on a high-Q part calibrated by its own `sweep` (85 s of simulated
  * time at Q = 5000: label slow; test_cl_integrity runs the same case with the values
  * this sweep identifies): the structure 22.5 K warmer than at the sweep, beyond the
  * fixed-frequency drive's reach, and never a valid wrong rate (integrity_judge.h). */

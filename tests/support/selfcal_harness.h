@@ -25,7 +25,8 @@ static inline void run_polled_s(double s)
   }
 }
 
-/* `sweep`, then run until the sequencer is done or failed (at most 70 s). Returns the
+/* `sweep`, then run until the sequencer is done or failed (at most 150 s: a Q = 5000
+ * sweep with its nine fine points takes about 90 s). Returns the
  * simulated length of the sweep in seconds. */
 static inline double sweep_report(uint64_t t0);
 /* Run until the sweep started by the caller is done or failed; its length from the
@@ -44,7 +45,7 @@ static inline double sweep(void)
 static inline double sweep_report(uint64_t t0)
 {
   for (int i = 0;
-       i < 70000 && (app.selfcal.state != SELFCAL_DONE && app.selfcal.state != SELFCAL_FAILED);
+       i < 150000 && (app.selfcal.state != SELFCAL_DONE && app.selfcal.state != SELFCAL_FAILED);
        i++) {
     run_polled_s(0.001);
   }
