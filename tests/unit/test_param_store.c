@@ -558,6 +558,40 @@ static void test_program_unit_64_bit(void **state)
   assert_int_equal(param_store_init(&st, &sc), PARAM_STORE_ERR_CONFIG);
 }
 
+/* An image as the firmware before the configuration/state split saved it (commit
+ * 0090480; tests/vectors/param_image_0090480.bin: two saves, 1 KB sectors, the second
+ * with six values changed) loads unchanged: stored parts keep their calibration across
+ * the update. */
+static void test_loads_image_of_earlier_firmware(void **state)
+{
+  (void)state;
+  const hal_flash_host_cfg_t cfg = {2u, 1024u, NULL, 0u, 0u, 0u};
+  assert_int_equal(hal_flash_host_configure(&cfg), 0);
+  uint8_t img[2048];
+  FILE *f = fopen(GYRO_TEST_VECTORS_DIR "/param_image_0090480.bin", "rb");
+  assert_non_null(f);
+  assert_int_equal(fread(img, 1, sizeof img, f), sizeof img);
+  fclose(f);
+  assert_int_equal(hal_flash_program(0u, 0u, img, 1024u), HAL_FLASH_OK);
+  assert_int_equal(hal_flash_program(1u, 0u, img + 1024, 1024u), HAL_FLASH_OK);
+  const param_store_cfg_t sc = {0u, 1u};
+  assert_int_equal(param_store_init(&g_store, &sc), PARAM_STORE_OK);
+  param_values_t got, want;
+  param_values_defaults(&got); /* the non-persistent values come from the caller */
+  param_store_report_t rep;
+  assert_int_equal(param_store_load(&g_store, &got, &rep), PARAM_STORE_OK);
+  assert_int_equal(rep.slot, 1); /* the newer save */
+  assert_int_equal(rep.dropped + rep.rejected + rep.defaulted, 0);
+  param_values_defaults(&want);
+  want.drive_freq_hz = 1491.25f;
+  want.rate_scale_dps = 140.5f;
+  want.drive_p_init_deg = 27.5f;
+  want.rate_bias_c0_dps = -1.25f;
+  want.selftest_continuous = 0u;
+  want.drive_mode = 1u;
+  assert_memory_equal(&got, &want, sizeof got);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -573,6 +607,7 @@ int main(void)
       cmocka_unit_test_setup(test_config_errors, setup),
       cmocka_unit_test_setup(test_file_backed_reboot, setup),
       cmocka_unit_test_setup(test_program_unit_64_bit, setup),
+      cmocka_unit_test(test_loads_image_of_earlier_firmware),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
