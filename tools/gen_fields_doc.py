@@ -175,17 +175,24 @@ def emit(root, rel, text, check, prog):
     return 0
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description="Generate docs/fields.md from the field tables.")
+def run(argv, rel, generate_fn, prog):
+    """The command line both generators share: write ROOT/rel from generate_fn(root), or
+    with --check say whether it is current (exit codes of emit; 2 for a table it cannot
+    read)."""
+    ap = argparse.ArgumentParser(description=f"Generate {rel}.")
     ap.add_argument("--root", default=os.path.dirname(HERE))
-    ap.add_argument("--check", action="store_true", help="exit 1 if docs/fields.md is stale")
+    ap.add_argument("--check", action="store_true", help=f"exit 1 if {rel} is stale")
     a = ap.parse_args(argv)
     try:
-        text = generate(a.root)
+        text = generate_fn(a.root)
     except GenError as e:
-        print(f"gen_fields_doc: {e}", file=sys.stderr)
+        print(f"{prog}: {e}", file=sys.stderr)
         return 2
-    return emit(a.root, "docs/fields.md", text, a.check, "gen_fields_doc")
+    return emit(a.root, rel, text, a.check, prog)
+
+
+def main(argv=None):
+    return run(argv, "docs/fields.md", generate, "gen_fields_doc")
 
 
 if __name__ == "__main__":

@@ -11,14 +11,13 @@
 row that cannot be read is an error (exit 2).
 """
 
-import argparse
 import os
 import re
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from gen_fields_doc import GenError, emit, read  # noqa: E402
+from gen_fields_doc import GenError, read, run  # noqa: E402
 
 SRC = "firmware/params/param_list.h"
 # The reference board's facts, which some defaults name (sys.fs_hz: the sample rate).
@@ -174,16 +173,7 @@ def generate(root):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description="Generate docs/parameters.md from the parameter table.")
-    ap.add_argument("--root", default=os.path.dirname(HERE))
-    ap.add_argument("--check", action="store_true", help="exit 1 if docs/parameters.md is stale")
-    a = ap.parse_args(argv)
-    try:
-        text = generate(a.root)
-    except GenError as e:
-        print(f"gen_params_doc: {e}", file=sys.stderr)
-        return 2
-    return emit(a.root, "docs/parameters.md", text, a.check, "gen_params_doc")
+    return run(argv, "docs/parameters.md", generate, "gen_params_doc")
 
 
 if __name__ == "__main__":

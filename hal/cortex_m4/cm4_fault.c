@@ -57,11 +57,5 @@ CM4_BOOT_TEXT void cm4_fault_capture(const uint32_t *frame, uint32_t exc_return,
   s_record.exc_return = exc_return;
   s_record.magic = CM4_FAULT_MAGIC;
   s_record.check = record_check(&s_record);
-  cm4_dsb();
-  SCB->AIRCR = SCB_AIRCR_VECTKEY | SCB_AIRCR_SYSRESETREQ;
-  cm4_dsb();
-#ifndef CM4_HOST_TEST
-  for (;;) {
-  }
-#endif
+  cm4_system_reset();
 }
