@@ -427,7 +427,8 @@ static int selfcal_run(const sim_scenario_t *sc, const plant_cfg_t *pc,
   int rc = -1;
   if (p == NULL || a == NULL) {
     snprintf(err, err_len, "out of memory");
-  } else if (plant_init(p, pc, sc->seed ^ 0x5eedca1u) != 0 || plant_set_profiles(p, &held) != 0) {
+  } else if (plant_init(p, pc, sc->seed ^ 0x5eedca1u) != 0 ||
+             /* noise of its own */ plant_set_profiles(p, &held) != 0) {
     snprintf(err, err_len, "plant: %s", plant_error(p));
   } else {
     (void)hal_flash_host_configure(NULL);
