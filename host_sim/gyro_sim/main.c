@@ -4,7 +4,7 @@
  *
  *   gyro-sim --scenario FILE [--duration S] [--seed N] [--csv FILE] [--csv-rate HZ]
  *            [--json FILE] [--out DIR] [--set plant.KEY=V | firmware.NAME=V ...]
- *            [--no-analysis] [--quiet] [--uart-pty[=LINK]]
+ *            [--no-analysis] [--quiet] [--uart-pty[=LINK]] [--selfcal]
  *   gyro-sim --list-params
  */
 #define _XOPEN_SOURCE 700 /* nftw */
@@ -32,7 +32,7 @@ static void usage(FILE *f)
   fputs("usage: gyro-sim --scenario FILE [--duration S] [--seed N] [--csv FILE]\n"
         "                [--csv-rate HZ] [--json FILE] [--out DIR]\n"
         "                [--set plant.KEY=VALUE | --set firmware.NAME=VALUE ...]\n"
-        "                [--no-analysis] [--quiet] [--uart-pty[=LINK]]\n"
+        "                [--no-analysis] [--quiet] [--uart-pty[=LINK]] [--selfcal]\n"
         "       gyro-sim --list-params\n"
         "Runs a scenario (host_sim/scenarios/*.json) of the plant with the firmware in\n"
         "closed loop and prints its figures. --out keeps the analysis plots (PNG) and\n"
@@ -40,7 +40,14 @@ static void usage(FILE *f)
         "in real time with the tuning UART on a pseudo-terminal (path printed as\n"
         "'pty PATH'; optional symlink LINK) for gyroctl; SIGINT/SIGTERM end the run.\n"
         "--isr-figures adds the Cortex-M4F interrupt cost that tools/bench/run-bench\n"
-        "--json measured to the figures (isr_instructions_per_tick, ...).\n",
+        "--json measured to the figures (isr_instructions_per_tick, ...).\n"
+        "--selfcal (scenario key \"selfcal\": true; closed loop only) first runs the\n"
+        "firmware's own `sweep` at the scenario's initial conditions from the parameter\n"
+        "defaults and the scenario's firmware settings, saves what it identified (`save`),\n"
+        "puts the mechanics at rest (temperatures kept) and starts the timeline from\n"
+        "power-on with the stored values (t_s = 0 there; --duration counts the timeline).\n"
+        "Figures selfcal_f0_hz, selfcal_q, selfcal_s (the firmware's sweep time) and the\n"
+        "plant's selfcal_true_f0_hz, selfcal_true_q; a failed sweep says why, exit 1.\n",
         f);
 }
 
@@ -125,7 +132,7 @@ typedef struct {
   const char *scen_path, *csv_path, *json_path, *out_dir;
   double duration_s, csv_rate_hz; /* <= 0: the scenario's */
   long long seed;                 /* < 0: the scenario's */
-  int quiet, analysis, uart_pty;
+  int quiet, analysis, uart_pty, selfcal;
   const char *uart_pty_link;
   const char *isr_json;
   char sets[SIM_MAX_SETS][160];
@@ -136,21 +143,15 @@ typedef struct {
  * --list-params). */
 static int parse_args(int argc, char **argv, cli_args_t *a)
 {
-  static const struct option lo[] = {{"scenario", required_argument, 0, 's'},
-                                     {"duration", required_argument, 0, 'd'},
-                                     {"seed", required_argument, 0, 'S'},
-                                     {"csv", required_argument, 0, 'c'},
-                                     {"csv-rate", required_argument, 0, 'r'},
-                                     {"json", required_argument, 0, 'j'},
-                                     {"out", required_argument, 0, 'o'},
-                                     {"set", required_argument, 0, 'x'},
-                                     {"quiet", no_argument, 0, 'q'},
-                                     {"no-analysis", no_argument, 0, 'n'},
-                                     {"list-params", no_argument, 0, 'L'},
-                                     {"help", no_argument, 0, 'h'},
-                                     {"uart-pty", optional_argument, 0, 'u'},
-                                     {"isr-figures", required_argument, 0, 'i'},
-                                     {0, 0, 0, 0}};
+  static const struct option lo[] = {
+      {"scenario", required_argument, 0, 's'}, {"duration", required_argument, 0, 'd'},
+      {"seed", required_argument, 0, 'S'},     {"csv", required_argument, 0, 'c'},
+      {"csv-rate", required_argument, 0, 'r'}, {"json", required_argument, 0, 'j'},
+      {"out", required_argument, 0, 'o'},      {"set", required_argument, 0, 'x'},
+      {"quiet", no_argument, 0, 'q'},          {"no-analysis", no_argument, 0, 'n'},
+      {"list-params", no_argument, 0, 'L'},    {"help", no_argument, 0, 'h'},
+      {"uart-pty", optional_argument, 0, 'u'}, {"isr-figures", required_argument, 0, 'i'},
+      {"selfcal", no_argument, 0, 'C'},        {0, 0, 0, 0}};
   memset(a, 0, sizeof *a);
   a->duration_s = -1.0;
   a->csv_rate_hz = -1.0;
@@ -203,6 +204,7 @@ static int parse_args(int argc, char **argv, cli_args_t *a)
       break;
     case 'n': a->analysis = 0; break;
     case 'i': a->isr_json = optarg; break;
+    case 'C': a->selfcal = 1; break;
     case 'L': list_params(); return 0;
     case 'h': usage(stdout); return 0;
     default: usage(stderr); return 2;
@@ -234,6 +236,14 @@ static int load_scenario(const cli_args_t *a, sim_scenario_t *sc)
   if (a->duration_s > 0.0) sc->duration_s = a->duration_s;
   if (a->seed >= 0) sc->seed = (uint64_t)a->seed;
   if (a->csv_rate_hz > 0.0) sc->csv_rate_hz = a->csv_rate_hz;
+  if (a->selfcal) {
+    if (sc->loop != SIM_CLOSED_LOOP) {
+      fprintf(stderr, "gyro-sim: --selfcal needs a closed-loop scenario (the firmware runs "
+                      "the sweep)\n");
+      return 2;
+    }
+    sc->selfcal = 1;
+  }
   return 0;
 }
 
@@ -293,8 +303,11 @@ static void report_run(report_t *r, const char *isr_json, const bench_figs_t *is
   if (r->quiet) return;
   const sim_result_t *res = r->res;
   printf("scenario %s: %s\n", r->sc->name, r->sc->description);
-  printf("  simulated %.1f s in %.2f s wall (%.2f s CPU): %.0fx real time (%.0fx per CPU second)\n",
-         res->sim_s, res->wall_s, res->cpu_s, res->realtime_factor, res->realtime_factor_cpu);
+  if (res->sim_s > 0.0) {
+    printf("  simulated %.1f s in %.2f s wall (%.2f s CPU): %.0fx real time (%.0fx per CPU "
+           "second)\n",
+           res->sim_s, res->wall_s, res->cpu_s, res->realtime_factor, res->realtime_factor_cpu);
+  }
   if (isr_json != NULL) {
     printf("  Cortex-M4F sample interrupt (%s): %.0f instructions per tick (worst %.0f)",
            isr_json, isr->insns_mean, isr->insns_max);
@@ -302,6 +315,22 @@ static void report_run(report_t *r, const char *isr_json, const bench_figs_t *is
       printf(", about %.0f cycles (worst %.0f)", isr->cycles_mean, isr->cycles_max);
     printf("\n");
   }
+}
+
+/* The self-calibration before the timeline: the firmware's result and time, the plant's
+ * truth during it. */
+static void report_selfcal(report_t *r)
+{
+  const sim_selfcal_t *c = &r->res->selfcal;
+  add_num(r->fig, "selfcal_f0_hz", c->f0_hz);
+  add_num(r->fig, "selfcal_q", c->q);
+  add_num(r->fig, "selfcal_s", c->s);
+  add_num(r->fig, "selfcal_true_f0_hz", c->true_f0_hz);
+  add_num(r->fig, "selfcal_true_q", c->true_q);
+  if (r->quiet) return;
+  printf("  self-calibration (`sweep`) %s in %.2f s: f0 %.4f Hz, Q %.2f (plant %.4f Hz, Q %.2f)%s%s\n",
+         c->ok ? "saved" : "FAILED", c->s, c->f0_hz, c->q, c->true_f0_hz, c->true_q,
+         c->ok ? "" : ": ", c->ok ? "" : c->why);
 }
 
 static void report_startup(report_t *r)
@@ -588,6 +617,8 @@ static void report_figures(report_t *r, const cli_args_t *a, const bench_figs_t 
 {
   const sim_scenario_t *sc = r->sc;
   report_run(r, a->isr_json, isr);
+  if (r->res->selfcal.ran) report_selfcal(r);
+  if (r->res->selfcal.ran && !r->res->selfcal.ok) return; /* no timeline ran */
   if (sc->analyses & SIM_AN_STARTUP) report_startup(r);
   if (sc->loop == SIM_CLOSED_LOOP) report_closed_loop(r);
   add_num(r->fig, "adc_fraction_drive", r->res->adc_fraction[0]);
@@ -632,12 +663,14 @@ static int run(const cli_args_t *a, const sim_scenario_t *sc, const bench_figs_t
   else rc = sim_run_open_loop(sc, &so, &res, &sweep, &sq, err, sizeof err);
   if (rc != 0) {
     fprintf(stderr, "gyro-sim: %s\n", err);
-    return 1;
+    if (rc != -2) return 1; /* -2: the self-calibration failed, its figures are written */
   }
 
   cJSON *root = cJSON_CreateObject();
   cJSON_AddStringToObject(root, "scenario", sc->name);
-  add_params(root, sc, &pc, &fw);
+  if (res.selfcal.ran && !res.selfcal.ok)
+    cJSON_AddStringToObject(root, "selfcal_error", res.selfcal.why);
+  add_params(root, sc, &pc, res.selfcal.ok ? &res.selfcal.saved : &fw);
   report_t r = {.sc = sc,
                 .pc = &pc,
                 .res = &res,
@@ -650,7 +683,7 @@ static int run(const cli_args_t *a, const sim_scenario_t *sc, const bench_figs_t
   add_num(root, "realtime_factor_cpu", res.realtime_factor_cpu);
   if (a->json_path != NULL && write_json(root, a->json_path) != 0) r.failed = 1;
   cJSON_Delete(root);
-  return r.failed ? 1 : 0;
+  return (r.failed || rc != 0) ? 1 : 0;
 }
 
 int main(int argc, char **argv)

@@ -407,6 +407,9 @@ int scenario_parse(sim_scenario_t *out, const char *json, char *err, size_t len)
         sc->has_accel = 1;
       } else if (strcmp(k, "open_loop") == 0) {
         rc = parse_open_loop(it, &sc->ol, err, len);
+      } else if (strcmp(k, "selfcal") == 0) {
+        if (!cJSON_IsBool(it)) rc = fail(err, len, "selfcal: expected true or false");
+        else sc->selfcal = cJSON_IsTrue(it);
       } else if (strcmp(k, "notes") == 0) {
         if (!cJSON_IsObject(it)) rc = fail(err, len, "notes: expected an object of strings");
       } else {
@@ -415,6 +418,8 @@ int scenario_parse(sim_scenario_t *out, const char *json, char *err, size_t len)
       if (rc != 0) break;
     }
   }
+  if (rc == 0 && sc->selfcal && sc->loop != SIM_CLOSED_LOOP)
+    rc = fail(err, len, "selfcal: needs \"mode\": \"closed_loop\" (the firmware runs the sweep)");
   if (rc == 0) *out = *sc;
   free(sc);
   cJSON_Delete(root);

@@ -7,6 +7,9 @@
  *     "mode": "closed_loop" | "open_loop" | "open_loop_sweep",
  *     "analyses": ["startup", "rate_table", ...],
  *     "csv_rate_hz": 1000,
+ *     "selfcal": false,   (true: the firmware's own `sweep` first, at the initial
+ *                          conditions; the timeline then starts from power-on with
+ *                          what it identified, as if saved; closed loop only)
  *     "plant":    { "<plant parameter>": number, ... },       (plant.h descriptor table)
  *     "firmware": { "<firmware parameter>": number, ... },    (params/param_list.h)
  *     "rate_dps":  PROFILE, "ambient_c": PROFILE,             (input profiles)
@@ -85,6 +88,7 @@ typedef struct {
   profile_t ambient_c;
   accel_profile_t accel_g;
   sim_open_loop_t ol;
+  int selfcal; /* key "selfcal" / --selfcal: self-calibrate before the timeline */
 } sim_scenario_t;
 
 /* Defaults: closed loop, 1 s, seed 1, no analyses, CSV at 1 kHz. */

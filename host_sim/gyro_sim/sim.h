@@ -43,6 +43,19 @@ typedef struct {
   double amp_m[16]; /* true displacement amplitude */
 } sim_square_t;
 
+/* The self-calibration before the timeline (scenario key "selfcal"): what the firmware's
+ * own `sweep` identified and how long it took, against the plant's truth during it. */
+typedef struct {
+  int ran;              /* a sweep was run */
+  int ok;               /* it finished (DONE) and its values were saved */
+  char why[160];        /* the reason, when not ok */
+  double f0_hz, q;      /* identified (NAN before the fit) */
+  double s;             /* the firmware's sweep time: request to hand-over */
+  double true_f0_hz;    /* undamped drive resonance (2-32), mean over the sweep */
+  double true_q;        /* the drive resonance's Q at the same time */
+  param_values_t saved; /* the parameters the timeline starts from (the store's) */
+} sim_selfcal_t;
+
 typedef struct {
   double sim_s;
   double wall_s;
@@ -59,6 +72,7 @@ typedef struct {
   double mean_struct_k;
   double mean_drive_freq_hz;
   double mean_drive_amp_m;
+  sim_selfcal_t selfcal;
 } sim_result_t;
 
 typedef struct {
@@ -76,6 +90,9 @@ int sim_plant_cfg(const sim_scenario_t *sc, plant_cfg_t *cfg, plant_profiles_t *
 /* The firmware parameters from the scenario: defaults + overrides, each checked. */
 int sim_fw_params(const sim_scenario_t *sc, param_values_t *v, char *err, size_t err_len);
 
+/* Closed loop; with sc->selfcal the firmware's `sweep` first (res->selfcal). Returns 0,
+ * -1 with err (nothing run or a run error), or -2 with err when the self-calibration
+ * failed (res->selfcal says why; no timeline). */
 int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_result_t *res,
                         char *err, size_t err_len);
 int sim_run_open_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_result_t *res,

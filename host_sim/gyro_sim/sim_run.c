@@ -216,11 +216,26 @@ static int cl_open_pty(cl_run_t *r, const sim_opts_t *opt, char *err, size_t err
   return 0;
 }
 
+/* What a timeline after a self-calibration starts from: the structure's, circuit's and
+ * board's temperatures as the sweep left them (the mechanics start at rest). */
+typedef struct {
+  double t_k[THERMAL_NODES];
+} sim_warm_t;
+
+static int params_equal(const param_values_t *a, const param_values_t *b)
+{
+  for (unsigned i = 0; i < (unsigned)PARAM_COUNT; i++) {
+    const param_value_t x = param_get(a, (param_idx_t)i), y = param_get(b, (param_idx_t)i);
+    if (param_info((param_idx_t)i)->type == PARAM_T_F32 ? x.f != y.f : x.u != y.u) return 0;
+  }
+  return 1;
+}
+
 /* Allocates and starts the plant, the firmware behind the host HAL, the trace and the
  * pty. Returns 0, or -1 with err set (cl_release frees what was made). */
 static int cl_start(cl_run_t *r, const sim_scenario_t *sc, const sim_opts_t *opt,
-                    const plant_cfg_t *pc, const plant_profiles_t *prof,
-                    const param_values_t *fw, uint64_t n_ticks, char *err, size_t err_len)
+                    const plant_cfg_t *pc, const plant_profiles_t *prof, const param_values_t *fw,
+                    const sim_warm_t *warm, uint64_t n_ticks, char *err, size_t err_len)
 {
   memset(r, 0, sizeof *r);
   r->pty.master_fd = -1;
@@ -245,12 +260,18 @@ static int cl_start(cl_run_t *r, const sim_scenario_t *sc, const sim_opts_t *opt
     snprintf(err, err_len, "plant: %s", plant_error(r->plant));
     return -1;
   }
-  (void)hal_flash_host_configure(NULL);
+  if (warm != NULL) thermal_set(&r->plant->thermal, warm->t_k);
+  /* After a self-calibration the flash keeps what it saved: power-on loads it. */
+  if (warm == NULL) (void)hal_flash_host_configure(NULL);
   hal_uart_host_reset();
   hal_host_attach(plant_step_hal, r->plant);
-  if (app_init_with(r->app, fw) != 0 ||
+  if ((warm != NULL ? app_init(r->app) : app_init_with(r->app, fw)) != 0 ||
       hal_sample_timer_start(fw->sys_fs_hz, app_sample_isr, r->app) != 0) {
     snprintf(err, err_len, "firmware: application did not start");
+    return -1;
+  }
+  if (warm != NULL && !params_equal(params_current(&r->app->params), fw)) {
+    snprintf(err, err_len, "firmware: power-on did not load the values the sweep saved");
     return -1;
   }
   if (opt->csv_path != NULL && sim_csv_open(&r->csv, opt->csv_path, err, err_len) != 0)
@@ -298,6 +319,137 @@ static void cl_results(const cl_run_t *r, const cl_stats_t *st, const plant_cfg_
   res->mean_drive_amp_m = st->n_mean ? st->sum_drive_amp_m / n : NAN;
 }
 
+/* ------------------------------------------------------------ self-calibration -- */
+
+/* The longest sweep gyro-sim waits for (simulated): the sequencer's own timeouts end a
+ * stuck sweep long before (selfcal_watch); this only bounds a run that keeps going. */
+#define SELFCAL_MAX_S 600.0
+
+/* One command line into the application over its UART, the background loop run once,
+ * the reply out (as a user at the command line, or gyroctl, would send it). */
+static const char *sc_cmd(app_t *a, const char *line, char *reply, size_t n)
+{
+  hal_uart_host_rx_push((const uint8_t *)line, strlen(line));
+  app_poll(a);
+  const size_t got = hal_uart_host_tx_pop((uint8_t *)reply, n - 1u);
+  reply[got] = '\0';
+  return reply;
+}
+
+/* The scenario's inputs held at their values of t = 0: the initial conditions. */
+static void initial_profiles(const plant_profiles_t *prof, plant_profiles_t *held)
+{
+  memset(held, 0, sizeof *held);
+  profile_const(&held->rate_dps, profile_eval(&prof->rate_dps, 0.0, NULL));
+  profile_const(&held->ambient_k, profile_eval(&prof->ambient_k, 0.0, NULL));
+  double a_g[PROFILE_ACCEL_AXES];
+  accel_profile_eval(&prof->accel_g, 0.0, a_g);
+  accel_profile_zero(&held->accel_g);
+  for (int i = 0; i < PROFILE_ACCEL_AXES; i++) held->accel_g.const_g[i] = a_g[i];
+}
+
+/* The reply's first line without its line end, for a message. */
+static void first_line(const char *reply, char *out, size_t n)
+{
+  snprintf(out, n, "%.*s", (int)strcspn(reply, "\r\n"), reply);
+}
+
+/* `sweep` on the running application, then the background loop polled every
+ * millisecond until the sequencer is done or failed. Sums the plant's true drive
+ * resonance over the sweep. Returns 0 when it finished (DONE), else -1 with out->why. */
+static int selfcal_sweep(app_t *a, const plant_t *p, double fs, sim_selfcal_t *out)
+{
+  char reply[1024];
+  sc_cmd(a, "sweep\n", reply, sizeof reply);
+  if (strncmp(reply, "ok", 2) != 0) {
+    first_line(reply, out->why, sizeof out->why);
+    return -1;
+  }
+  const uint64_t poll = (uint64_t)llround(fs / 1000.0);
+  const uint64_t cap = (uint64_t)llround(SELFCAL_MAX_S * fs);
+  double sum_wn = 0.0;
+  uint64_t n = 0u;
+  const selfcal_t *s = &a->selfcal;
+  for (uint64_t k = 0; k < cap && s->state != SELFCAL_DONE && s->state != SELFCAL_FAILED;
+       k += poll) {
+    hal_host_run(poll);
+    app_poll(a);
+    sum_wn += plant_truth(p)->wn_drive_rad_s;
+    n++;
+  }
+  out->true_f0_hz = n ? sum_wn / (double)n / (2.0 * PLANT_PI) : NAN;
+  /* The plant's drive Q has no temperature law (mech.h): the configured one holds. */
+  out->true_q = p->mech.cfg.q1;
+  out->f0_hz = s->fit.q > 0.0 ? s->fit.f0_hz : NAN;
+  out->q = s->fit.q > 0.0 ? s->fit.q : NAN;
+  out->s = (double)(s->state == SELFCAL_DONE ? a->selfcal_ticks
+                                             : a->isr_ticks - a->selfcal_t0_ticks) /
+           fs;
+  if (s->state == SELFCAL_DONE) return 0;
+  if (s->state == SELFCAL_FAILED)
+    snprintf(out->why, sizeof out->why, "%s", s->why != NULL ? s->why : "failed");
+  else snprintf(out->why, sizeof out->why, "still running after %g s", SELFCAL_MAX_S);
+  return -1;
+}
+
+/* Keeps what the sweep identified as a user would: `drive off`, `save` (the parameter
+ * store in the host flash, read back at the timeline's power-on). */
+static int selfcal_save(app_t *a, sim_selfcal_t *out)
+{
+  char reply[1024];
+  sc_cmd(a, "drive off\nsave\n", reply, sizeof reply);
+  const char *sv = strstr(reply, "\r\n");
+  if (strncmp(reply, "ok", 2) != 0 || sv == NULL ||
+      (strncmp(sv + 2, "ok saved", 8) != 0 && strncmp(sv + 2, "ok unchanged", 12) != 0)) {
+    char line[128];
+    first_line(sv != NULL && strncmp(reply, "ok", 2) == 0 ? sv + 2 : reply, line, sizeof line);
+    snprintf(out->why, sizeof out->why, "saving the identified values: %s", line);
+    return -1;
+  }
+  out->saved = *params_current(&a->params);
+  return 0;
+}
+
+/* The scenario's self-calibration: a plant at the initial conditions (inputs held at
+ * their t = 0 values), the application from the scenario's parameters with an empty
+ * store, `sweep`, then `drive off` and `save`. warm receives the temperatures it left.
+ * Returns 0, -1 with err (could not run), -2 (the sweep failed: out->why). */
+static int selfcal_run(const sim_scenario_t *sc, const plant_cfg_t *pc,
+                       const plant_profiles_t *prof, const param_values_t *fw,
+                       sim_selfcal_t *out, sim_warm_t *warm, char *err, size_t err_len)
+{
+  out->ran = 1;
+  out->f0_hz = out->q = out->s = out->true_f0_hz = out->true_q = NAN;
+  plant_profiles_t held;
+  initial_profiles(prof, &held);
+  plant_t *p = calloc(1, sizeof *p);
+  app_t *a = calloc(1, sizeof *a);
+  int rc = -1;
+  if (p == NULL || a == NULL) {
+    snprintf(err, err_len, "out of memory");
+  } else if (plant_init(p, pc, sc->seed ^ 0x5eedca1u) != 0 ||
+             /* noise of its own */ plant_set_profiles(p, &held) != 0) {
+    snprintf(err, err_len, "plant: %s", plant_error(p));
+  } else {
+    (void)hal_flash_host_configure(NULL);
+    hal_uart_host_reset();
+    hal_host_attach(plant_step_hal, p);
+    if (app_init_with(a, fw) != 0 ||
+        hal_sample_timer_start(fw->sys_fs_hz, app_sample_isr, a) != 0) {
+      snprintf(err, err_len, "firmware: application did not start");
+    } else {
+      rc = (selfcal_sweep(a, p, pc->fs_hz, out) == 0 && selfcal_save(a, out) == 0) ? 0 : -2;
+      out->ok = rc == 0;
+      for (int i = 0; i < THERMAL_NODES; i++) warm->t_k[i] = thermal_temp(&p->thermal, i);
+    }
+    hal_sample_timer_stop();
+  }
+  if (rc == -2) snprintf(err, err_len, "self-calibration failed: %s", out->why);
+  free(p);
+  free(a);
+  return rc;
+}
+
 int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_result_t *res,
                         char *err, size_t err_len)
 {
@@ -312,10 +464,17 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
              fw.sys_fs_hz);
     return -1;
   }
+  sim_warm_t warm;
+  if (sc->selfcal) {
+    const int sc_rc = selfcal_run(sc, &pc, &prof, &fw, &res->selfcal, &warm, err, err_len);
+    if (sc_rc != 0) return sc_rc;
+    fw = res->selfcal.saved;
+  }
   const double fs = pc.fs_hz;
   uint64_t n_ticks = (uint64_t)llround(sc->duration_s * fs);
   cl_run_t r;
-  if (cl_start(&r, sc, opt, &pc, &prof, &fw, n_ticks, err, err_len) != 0) {
+  if (cl_start(&r, sc, opt, &pc, &prof, &fw, sc->selfcal ? &warm : NULL, n_ticks, err,
+               err_len) != 0) {
     cl_release(&r);
     return -1;
   }

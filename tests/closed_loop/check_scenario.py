@@ -2,11 +2,12 @@
 """Closed-loop acceptance test: run a gyro-sim scenario and check its JSON figures.
 
     check_scenario.py --sim PATH --scenario FILE [--set K=V ...] [--duration S]
-                      [--isr-figures BENCH_JSON]
+                      [--isr-figures BENCH_JSON] [--selfcal]
                       --expect 'lock_time_s<=0.2' --expect 'q~33.33:0.02' ...
 
 Expectations: NAME<=X, NAME>=X, NAME==X, or NAME~X:REL (within REL relative of X), or
-NAME~X:+ABS (within ABS of X). Prints every figure checked with its bound; exits 1 on
+NAME~X:+ABS (within ABS of X). X may be another figure's name (its value in the same
+run), e.g. 'selfcal_q~selfcal_true_q:0.02'. Prints every figure checked with its bound; exits 1 on
 the first run that misses any bound, 2 on a usage error.
 """
 import argparse
@@ -20,13 +21,22 @@ import tempfile
 
 
 def check(fig, expr):
-    m = re.fullmatch(r"([A-Za-z0-9_]+)\s*(<=|>=|==|~)\s*([-+0-9.eE]+)(?::(\+?)([0-9.eE+-]+))?", expr)
+    m = re.fullmatch(
+        r"([A-Za-z0-9_]+)\s*(<=|>=|==|~)\s*([-+0-9.eE]+|[A-Za-z_][A-Za-z0-9_]*)"
+        r"(?::(\+?)([0-9.eE+-]+))?",
+        expr,
+    )
     if not m:
         raise SystemExit(f"check_scenario: bad --expect '{expr}'")
     name, op, val, absflag, tol = m.groups()
-    if name not in fig or fig[name] is None:
-        return False, f"{name}: missing from the figures"
-    x, v = float(fig[name]), float(val)
+    ref = re.match(r"[A-Za-z_]", val) is not None  # another figure, not a number
+    for n in (name, val) if ref else (name,):
+        if n not in fig or fig[n] is None:
+            return False, f"{n}: missing from the figures"
+    x = float(fig[name])
+    v = float(fig[val]) if ref else float(val)
+    if ref:
+        val = f"{val} = {v:.9g}"
     if op == "<=":
         ok = x <= v
     elif op == ">=":
@@ -47,6 +57,7 @@ def main():
     p.add_argument("--set", action="append", default=[])
     p.add_argument("--duration", default=None)
     p.add_argument("--isr-figures", default=None)
+    p.add_argument("--selfcal", action="store_true")
     p.add_argument("--expect", action="append", default=[])
     a = p.parse_args()
     with tempfile.TemporaryDirectory() as d:
@@ -58,6 +69,8 @@ def main():
             cmd += ["--duration", a.duration]
         if a.isr_figures:
             cmd += ["--isr-figures", a.isr_figures]
+        if a.selfcal:
+            cmd += ["--selfcal"]
         print(" ".join(cmd), flush=True)
         r = subprocess.run(cmd, text=True)
         if r.returncode != 0:
