@@ -20,13 +20,16 @@ import tempfile
 
 
 def check(fig, expr):
-    m = re.fullmatch(r"([A-Za-z0-9_]+)\s*(<=|>=|==|~)\s*([-+0-9.eE]+)(?::(\+?)([0-9.eE+-]+))?", expr)
+    m = re.fullmatch(r"([A-Za-z0-9_.]+)\s*(<=|>=|==|~)\s*([-+0-9.eE]+)(?::(\+?)([0-9.eE+-]+))?", expr)
     if not m:
         raise SystemExit(f"check_scenario: bad --expect '{expr}'")
     name, op, val, absflag, tol = m.groups()
-    if name not in fig or fig[name] is None:
+    node = fig  # a dotted name walks into nested figures (plant_warnings.LAW.count)
+    for part in name.split("."):
+        node = node.get(part) if isinstance(node, dict) else None
+    if node is None or isinstance(node, dict):
         return False, f"{name}: missing from the figures"
-    x, v = float(fig[name]), float(val)
+    x, v = float(node), float(val)
     if op == "<=":
         ok = x <= v
     elif op == ">=":
