@@ -611,6 +611,26 @@ static int prepare_out_dir(const char **out_dir, char *tmpdir, int need_tools, i
   return 0;
 }
 
+/* plant_warnings: each plant law that left its range, its count and first time. */
+static void report_plant_warnings(report_t *r)
+{
+  cJSON *w = cJSON_AddObjectToObject(r->fig, "plant_warnings");
+  uint64_t total = 0;
+  for (int i = 0; i < PLANT_LAWS; i++) {
+    const plant_warning_t *pw = &r->res->plant_warnings[i];
+    total += pw->count;
+    if (pw->count == 0) continue;
+    cJSON *o = cJSON_AddObjectToObject(w, plant_law_name(i));
+    add_num(o, "count", (double)pw->count);
+    add_num(o, "first_t_s", pw->first_t_s);
+    if (!r->quiet)
+      fprintf(stderr,
+              "gyro-sim: warning: plant law %s outside its range %llu times from t = %g s\n",
+              plant_law_name(i), (unsigned long long)pw->count, pw->first_t_s);
+  }
+  add_num(r->fig, "plant_warnings_total", (double)total);
+}
+
 /* The figures of a finished run: printed unless quiet, and into the JSON root. */
 static void report_figures(report_t *r, const cli_args_t *a, const bench_figs_t *isr,
                            const sim_sweep_t *sweep, const sim_square_t *sq, int need_tools)
@@ -625,6 +645,7 @@ static void report_figures(report_t *r, const cli_args_t *a, const bench_figs_t 
   add_num(r->fig, "adc_fraction_sense", r->res->adc_fraction[1]);
   add_num(r->fig, "adc_clips_drive", (double)r->res->adc_clips[0]);
   add_num(r->fig, "adc_clips_sense", (double)r->res->adc_clips[1]);
+  report_plant_warnings(r);
   if (sc->loop == SIM_OPEN_LOOP_SWEEP && sweep->n > 0) report_sweep(r, sweep, a->analysis);
   if (sc->loop == SIM_OPEN_LOOP && sq->n > 1) {
     report_square_law(r, sq);

@@ -65,6 +65,7 @@ typedef struct {
   sim_startup_t startup;
   double adc_fraction[2]; /* worst-case budget from plant_adc_fraction */
   uint64_t adc_clips[2];
+  plant_warning_t plant_warnings[PLANT_LAWS]; /* plant laws outside their range */
   uint32_t faults;
   double rate_valid_fraction; /* of the run's ticks with the rate output valid */
   double rate_first_valid_s;  /* first tick with the rate valid; -1: never */

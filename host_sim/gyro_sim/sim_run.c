@@ -308,6 +308,7 @@ static void cl_results(const cl_run_t *r, const cl_stats_t *st, const plant_cfg_
   const plant_truth_t *tr = plant_truth(r->plant);
   res->adc_clips[0] = tr->adc_clip[0];
   res->adc_clips[1] = tr->adc_clip[1];
+  memcpy(res->plant_warnings, plant_warnings(r->plant), sizeof res->plant_warnings);
   (void)plant_adc_fraction(pc, res->adc_fraction);
   res->faults = r->app->gyro.sup.fault_count;
   res->rate_valid_fraction = n_ticks > 0u ? (double)st->valid_ticks / (double)n_ticks : 0.0;
@@ -652,6 +653,7 @@ int sim_run_open_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_resul
   res->realtime_factor_cpu = res->cpu_s > 0.0 ? res->sim_s / res->cpu_s : 0.0;
   res->adc_clips[0] = plant_truth(plant)->adc_clip[0];
   res->adc_clips[1] = plant_truth(plant)->adc_clip[1];
+  memcpy(res->plant_warnings, plant_warnings(plant), sizeof res->plant_warnings);
   (void)plant_adc_fraction(&pc, res->adc_fraction);
   sim_csv_close(&csv);
   hal_sample_timer_stop();

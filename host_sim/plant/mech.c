@@ -88,6 +88,25 @@ static int temp_ok(const mech_cfg_t *c, double temp_k)
          fabs(0.5 * c->ket_per_k * (temp_k - c->temp_ref_k)) < 0.2;
 }
 
+double mech_temp_clamp(const mech_cfg_t *c, double temp_k, int *outside)
+{
+  /* the edge of temp_ok's range, a hair inside: |0.5 kET dT| <= 0.199, 1..1999 K */
+  double lo = 1.0, hi = 1999.0;
+  if (c->ket_per_k != 0.0) {
+    const double span = 0.398 / fabs(c->ket_per_k);
+    if (c->temp_ref_k - span > lo) lo = c->temp_ref_k - span;
+    if (c->temp_ref_k + span < hi) hi = c->temp_ref_k + span;
+  }
+  int out = 1;
+  double v = temp_k;
+  if (!isfinite(v)) v = c->temp_ref_k;
+  else if (v < lo) v = lo;
+  else if (v > hi) v = hi;
+  else out = 0;
+  if (outside != NULL) *outside = out;
+  return v;
+}
+
 enum {
   MONO_1 = 0,
   MONO_E,

@@ -135,6 +135,10 @@ int mech_cfg_check(const mech_cfg_t *cfg, const char **key);
  * or -2 (matrix exponential failed). */
 int mech_init(mech_t *m, const mech_cfg_t *cfg, double temp_k, uint64_t seed);
 
+/* temp_k kept to the range of (2-32) in this model (|0.5 kET (T - T0)| < 0.2, 0..2000 K,
+ * where temp_ok accepts it); *outside (may be NULL) is 1 if it had to move. */
+double mech_temp_clamp(const mech_cfg_t *cfg, double temp_k, int *outside);
+
 /* New structure temperature (K). Cheap unless |e| passes refresh_eps. Non-finite or
  * non-positive temperatures are ignored (returns -1). */
 int mech_set_temp(mech_t *m, double temp_k);

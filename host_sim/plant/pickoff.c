@@ -120,10 +120,61 @@ static double phase_at(const pickoff_cfg_t *c, double temp_k)
   return c->phi0_rad + c->phi1_rad_per_k * dt + 0.5 * c->phi2_rad_per_k2 * dt * dt; /* (2-40) */
 }
 
-static int phase_ok(const pickoff_cfg_t *c, double phi)
+double pickoff_phi_clamp(pickoff_lag_kind_t kind, double phi_rad, int *outside)
 {
-  const double hi = (c->lag_kind == PICKOFF_LAG_ALLPASS) ? 2.8 : 1.4;
-  return isfinite(phi) && phi > 1e-4 && phi < hi;
+  const double lo = (kind == PICKOFF_LAG_ALLPASS) ? PICKOFF_LEAD_MIN_ALLPASS_RAD
+                                                  : PICKOFF_LEAD_MIN_LOWPASS_RAD;
+  const double hi = (kind == PICKOFF_LAG_ALLPASS) ? PICKOFF_LAG_MAX_ALLPASS_RAD
+                                                  : PICKOFF_LAG_MAX_LOWPASS_RAD;
+  int out = 1;
+  double v = phi_rad;
+  if (!isfinite(v)) v = 0.0;
+  else if (v < lo) v = lo;
+  else if (v > hi) v = hi;
+  else out = 0;
+  if (outside != NULL) *outside = out;
+  return v;
+}
+
+double pickoff_gain_factor(double tc_per_k, double dt_k, int *outside)
+{
+  const double g = 1.0 + tc_per_k * dt_k; /* (4-12): gain ~ Vc - V_D */
+  const int out = !(g >= PICKOFF_GAIN_MIN_FACTOR);
+  if (outside != NULL) *outside = out;
+  return out ? PICKOFF_GAIN_MIN_FACTOR : g;
+}
+
+void pickoff_lag_section(pickoff_lag_kind_t kind, double phi_rad, double *b0, double *b1_w,
+                         double *tp_w)
+{
+  const double pm = PICKOFF_PHI_POLE_MIN_RAD;
+  if (kind == PICKOFF_LAG_ALLPASS) {
+    /* (1 - s tau)/(1 + s tau), tau = tan(Phi/2)/w: phase -Phi, unit gain */
+    const double hm = 0.5 * (phi_rad >= pm ? phi_rad : pm);
+    *tp_w = tan(hm);
+    if (phi_rad >= pm) {
+      *b0 = 1.0;
+      *b1_w = -*tp_w;
+    } else {
+      /* continued below pm with the pole held: the numerator turns by Phi - pm, its
+       * size kept, so the gain at w stays 1 and the phase -Phi (a lead for Phi < 0) */
+      *b0 = cos(hm - phi_rad) / cos(hm);
+      *b1_w = sin(hm - phi_rad) / cos(hm);
+    }
+    return;
+  }
+  /* 1 / (1 + s tau), tau = tan(Phi)/w: phase -Phi, gain cos(Phi) at w */
+  *b0 = 1.0;
+  if (phi_rad >= pm) {
+    *tp_w = tan(phi_rad);
+    *b1_w = 0.0;
+  } else {
+    /* continued below pm as a lead-lag network (1 + s tz)/(1 + s tp) with the pole
+     * held at tan(pm)/w and the zero at tan(pm - Phi)/w: phase -Phi, gain
+     * cos(pm)/cos(pm - Phi); identical to the low-pass at Phi = pm */
+    *tp_w = tan(pm);
+    *b1_w = tan(pm - phi_rad);
+  }
 }
 
 /* Build the chain of c at phase phi and discretise it into p (n, phi, g, output rows,
@@ -134,21 +185,17 @@ static int discretise(pickoff_t *p, const pickoff_cfg_t *c, double phi)
   const double wref = 2.0 * k_pi * c->lag_ref_hz;
   ss_t chain, sec;
 
-  /* circuit lag (2-40) realised as a real filter */
+  /* circuit lag (2-40) realised as a real filter (b0 + s b1)/(1 + s tp) */
   memset(&chain, 0, sizeof chain);
   chain.n = 1;
-  if (c->lag_kind == PICKOFF_LAG_ALLPASS) {
-    const double tau = tan(0.5 * phi) / wref / T;
+  {
+    double b0, b1w, tpw;
+    pickoff_lag_section(c->lag_kind, phi, &b0, &b1w, &tpw);
+    const double tau = tpw / wref / T, r = b1w / tpw; /* r = b1 / tp */
     chain.a[0][0] = -1.0 / tau;
     chain.b[0] = 1.0 / tau;
-    chain.c[0] = 2.0;
-    chain.d = -1.0;
-  } else {
-    const double tau = tan(phi) / wref / T;
-    chain.a[0][0] = -1.0 / tau;
-    chain.b[0] = 1.0 / tau;
-    chain.c[0] = 1.0;
-    chain.d = 0.0;
+    chain.c[0] = b0 - r;
+    chain.d = r;
   }
   if (c->hp_hz > 0.0) {
     const double tau = 1.0 / (2.0 * k_pi * c->hp_hz) / T;
@@ -243,11 +290,23 @@ static int discretise(pickoff_t *p, const pickoff_cfg_t *c, double phi)
   return 0;
 }
 
+/* Phase and gain laws at temp_k, each kept to its range (flags: PICKOFF_OUT_*). */
+static double laws_at(const pickoff_cfg_t *c, double temp_k, double *gain, unsigned *flags)
+{
+  int out_phi = 0, out_gain = 0;
+  const double phi = pickoff_phi_clamp(c->lag_kind, phase_at(c, temp_k), &out_phi);
+  *gain = c->gain_v_per_m *
+          pickoff_gain_factor(c->gain_tc_per_k, temp_k - c->temp_ref_k, &out_gain);
+  *flags = (out_phi ? PICKOFF_OUT_PHASE : 0u) | (out_gain ? PICKOFF_OUT_GAIN : 0u);
+  return phi;
+}
+
 int pickoff_init(pickoff_t *p, const pickoff_cfg_t *cfg, double temp_k, uint64_t seed)
 {
   if (p == NULL || cfg == NULL || !cfg_ok(cfg) || !isfinite(temp_k)) return -1;
-  const double phi = phase_at(cfg, temp_k);
-  if (!phase_ok(cfg, phi)) return -1;
+  double gain;
+  unsigned flags;
+  const double phi = laws_at(cfg, temp_k, &gain, &flags);
   /* built in place: discretise fails (if ever) before it writes; cfg is copied first in
    * case it lives inside p */
   const pickoff_cfg_t c = *cfg;
@@ -257,7 +316,8 @@ int pickoff_init(pickoff_t *p, const pickoff_cfg_t *cfg, double temp_k, uint64_t
   p->inv_t = c.fs_hz;
   p->temp_k = temp_k;
   p->rediscretise_count = 0;
-  p->gain_now = c.gain_v_per_m * (1.0 + c.gain_tc_per_k * (temp_k - c.temp_ref_k));
+  p->gain_now = gain;
+  p->out_of_range = flags;
   memset(p->z, 0, sizeof p->z);
   p->s_prev = 0.0;
   p->m_prev = 0.0;
@@ -272,15 +332,17 @@ int pickoff_init(pickoff_t *p, const pickoff_cfg_t *cfg, double temp_k, uint64_t
 int pickoff_set_temp(pickoff_t *p, double temp_k)
 {
   if (p == NULL || !isfinite(temp_k)) return -1;
-  const double phi = phase_at(&p->cfg, temp_k);
-  if (!phase_ok(&p->cfg, phi)) return -1;
+  double gain;
+  unsigned flags;
+  const double phi = laws_at(&p->cfg, temp_k, &gain, &flags);
   if (fabs(phi - p->phi_rad) >= p->cfg.phase_step_rad) {
     if (discretise(p, &p->cfg, phi) != 0) return -1; /* p unchanged then */
     p->rediscretise_count++;
   }
   p->temp_k = temp_k;
-  p->gain_now = p->cfg.gain_v_per_m * (1.0 + p->cfg.gain_tc_per_k * (temp_k - p->cfg.temp_ref_k));
-  return 0;
+  p->gain_now = gain;
+  p->out_of_range = flags;
+  return (int)flags;
 }
 
 double pickoff_step(pickoff_t *p, double pos_m, double vel_mps, const dac_out_t *dac)

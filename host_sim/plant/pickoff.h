@@ -4,12 +4,24 @@
  * Signal chain (continuous time):
  *   s(t) = g(T) pos(t) + ft_u1 U1(t) + ft_u2 U2(t) + ft_spare U3(t)   ring-diode output
  *          g(T) = gain_v_per_m (1 + gain_tc_per_k (T - T0))          (4-12): gain ~ Vc - V_D
+ *          (the factor is held at PICKOFF_GAIN_MIN_FACTOR below it, flagged
+ *          PICKOFF_OUT_GAIN: the carrier no longer clears the diode drop)
  *          clipped at +-preamp_rail_v (preamp saturation, counted)
  *   -> circuit lag section, phase Phi_cir(T) at lag_ref_hz                  (2-40)
  *          Phi_cir(T) = phi0 + phi1 (T - T0) + 0.5 phi2 (T - T0)^2   (rad, lag positive)
  *          LAG_LOWPASS: 1 / (1 + s tau), tau = tan(Phi) / w_ref  (the ring diode's R//C
  *                       hold network, fig. 4-9: gain cos(Phi) at w_ref, drifts with it)
  *          LAG_ALLPASS: (1 - s tau) / (1 + s tau), tau = tan(Phi/2) / w_ref (pure phase)
+ *          Below Phi = pm (PICKOFF_PHI_POLE_MIN_RAD) the pole's time constant would go to
+ *          zero (and negative: unstable), so the law is continued with the pole held at
+ *          its value at pm and a zero taking the rest of the phase (pickoff_lag_section):
+ *          the lag passes through zero into a lead, phase -Phi exactly at w_ref, the
+ *          filter identical to the lag's at pm. Low-pass: the lead-lag network
+ *          (1 + s tz)/(1 + s tp), gain cos(pm)/cos(pm - Phi) at w_ref (about 1/cos(Phi),
+ *          the mirror of the lag's cos(Phi)); all-pass: unit gain at w_ref kept.
+ *          Range of the law: Phi in [pm - 1.4, 1.4] rad (low-pass), [pm/2 - 1.4, 2.8]
+ *          (all-pass), i.e. leads to about 80 deg; beyond it the phase is held at the edge
+ *          and flagged (PICKOFF_OUT_PHASE), which the plant counts as a warning.
  *   -> anti-alias band-pass (fig. 4-13): first-order high-pass at hp_hz (0: none)
  *      times second-order low-pass at lp_hz, quality lp_q.
  *          Why a band-pass: the useful band is 1-3 kHz; the low-pass keeps ~20 dB at
@@ -66,6 +78,17 @@
 #define PICKOFF_RNG_STREAM_JITTER 0x7011u /* + axis */
 #define PICKOFF_MAX_N 4
 
+/* Ranges of the temperature laws (see the top of this file). */
+#define PICKOFF_PHI_POLE_MIN_RAD 1e-4 /* smallest lag realised by the pole alone */
+#define PICKOFF_LAG_MAX_LOWPASS_RAD 1.4
+#define PICKOFF_LAG_MAX_ALLPASS_RAD 2.8
+#define PICKOFF_LEAD_MIN_LOWPASS_RAD (PICKOFF_PHI_POLE_MIN_RAD - 1.4)
+#define PICKOFF_LEAD_MIN_ALLPASS_RAD (0.5 * PICKOFF_PHI_POLE_MIN_RAD - 1.4)
+#define PICKOFF_GAIN_MIN_FACTOR 0.1
+/* flags of a law held at the edge of its range (pickoff_t.out_of_range) */
+#define PICKOFF_OUT_PHASE 1u
+#define PICKOFF_OUT_GAIN 2u
+
 typedef enum { PICKOFF_DRIVE = 0, PICKOFF_SENSE = 1 } pickoff_axis_t;
 typedef enum { PICKOFF_LAG_LOWPASS = 0, PICKOFF_LAG_ALLPASS = 1 } pickoff_lag_kind_t;
 
@@ -106,6 +129,7 @@ typedef struct {
   double phi_rad;              /* Phi_cir realised by the current discretisation */
   uint64_t rediscretise_count; /* re-discretisations by pickoff_set_temp */
   double gain_now;             /* g(temp_k) */
+  unsigned out_of_range;       /* PICKOFF_OUT_* of the laws at temp_k */
   double phi[PICKOFF_MAX_N][PICKOFF_MAX_N];
   double g[PICKOFF_MAX_N][4];
   double out_z[PICKOFF_MAX_N];  /* output at the nominal sampling instant: state row */
@@ -135,13 +159,27 @@ typedef struct {
 void pickoff_default_cfg(pickoff_cfg_t *cfg, pickoff_axis_t axis);
 
 /* Validates cfg, discretises at the circuit temperature temp_k, zero state, seeds the
- * noise and jitter sources. Returns 0, or -1 (bad cfg or temperature) with p unchanged. */
+ * noise and jitter sources. Returns 0, or -1 (bad cfg or non-finite temperature) with
+ * p unchanged. A law outside its range at temp_k is held at its edge and flagged in
+ * p->out_of_range. */
 int pickoff_init(pickoff_t *p, const pickoff_cfg_t *cfg, double temp_k, uint64_t seed);
 
 /* New circuit temperature (K): the gain follows at once, Phi_cir (2-40) to within
- * phase_step_rad. Returns 0, or -1 if temp_k is not finite or Phi_cir leaves
- * (1e-4, 1.4) rad (low-pass) or (1e-4, 2.8) rad (all-pass); p is then unchanged. */
+ * phase_step_rad. Returns the PICKOFF_OUT_* flags of the laws held at an edge (0 when
+ * both are in range), or -1 if temp_k is not finite (p then unchanged). */
 int pickoff_set_temp(pickoff_t *p, double temp_k);
+
+/* Phi kept to the range of the lag section of kind; *outside (may be NULL) is set to 1
+ * if it had to move (a non-finite Phi gives 0 rad). */
+double pickoff_phi_clamp(pickoff_lag_kind_t kind, double phi_rad, int *outside);
+
+/* Gain factor 1 + tc dT of (4-12), held at PICKOFF_GAIN_MIN_FACTOR below it (*outside). */
+double pickoff_gain_factor(double tc_per_k, double dt_k, int *outside);
+
+/* The lag section at phase phi_rad (in range) as (b0 + j x b1_w)/(1 + j x tp_w) with
+ * x = f / lag_ref_hz: its phase at x = 1 is -phi_rad. */
+void pickoff_lag_section(pickoff_lag_kind_t kind, double phi_rad, double *b0, double *b1_w,
+                         double *tp_w);
 
 /* Advance one sample to tick t_{k+1}: pos_m, vel_mps are the axis displacement and
  * velocity at t_{k+1}; dac the DAC output of the sample just finished (its end values

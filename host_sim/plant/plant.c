@@ -134,6 +134,36 @@ static void make_accel_cfg(const plant_cfg_t *c, accel_cfg_t *a)
 
 static int pick_node(const plant_cfg_t *c, int axis) { return PLANT_PICK(c, axis, temp_node); }
 
+/* ------------------------------------------------------------- warnings ------ */
+
+static const char *const kLawNames[PLANT_LAWS] = {"pick_drive_phase", "pick_sense_phase",
+                                                  "pick_drive_gain",  "pick_sense_gain",
+                                                  "resonance",        "ambient"};
+
+const char *plant_law_name(int law)
+{
+  return (law >= 0 && law < PLANT_LAWS) ? kLawNames[law] : NULL;
+}
+
+const plant_warning_t *plant_warnings(const plant_t *p) { return p->warn; }
+
+/* One evaluation of a law outside its range, at the plant's time now. */
+static void warn(plant_t *p, plant_law_t law)
+{
+  plant_warning_t *w = &p->warn[law];
+  if (w->count == 0) w->first_t_s = (double)p->k * p->T;
+  w->count++;
+}
+
+static void warn_pickoff(plant_t *p, int axis, int flags)
+{
+  if (flags <= 0) return;
+  if ((unsigned)flags & PICKOFF_OUT_PHASE)
+    warn(p, axis == 0 ? PLANT_LAW_PICK_DRIVE_PHASE : PLANT_LAW_PICK_SENSE_PHASE);
+  if ((unsigned)flags & PICKOFF_OUT_GAIN)
+    warn(p, axis == 0 ? PLANT_LAW_PICK_DRIVE_GAIN : PLANT_LAW_PICK_SENSE_GAIN);
+}
+
 /* ------------------------------------------------------------------ init ------ */
 
 static void accel_flags(plant_t *p)
@@ -192,9 +222,12 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   accel_cfg_t gc;
   make_accel_cfg(c, &gc);
 
+  int out_mech = 0;
   if (thermal_init(&p->thermal, &thc, c->temp_k) != 0)
     what = "thermal (tau_*, couple_*, rise_*)";
-  else if (mech_init(&p->mech, &mc, thermal_temp(&p->thermal, THERMAL_STRUCT), seed) != 0)
+  else if (mech_init(&p->mech, &mc,
+                     mech_temp_clamp(&mc, thermal_temp(&p->thermal, THERMAL_STRUCT), &out_mech),
+                     seed) != 0)
     what = "mechanics (f_*_hz, q_*, ket_per_k, temp_k)";
   else if (dac_init(&p->dac, &dc) != 0) what = "DAC (dac_*)";
   else if (actuator_init(&p->act, &ac, seed) != 0) what = "actuator (ks_*, *_noise_*, fb_*)";
@@ -202,8 +235,7 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   else if (accel_init(&p->accel, &gc) != 0) what = "g-sensitivity (gs_*)";
   for (int i = 0; what == NULL && i < 2; i++) {
     if (pickoff_init(&p->pick[i], &pc[i], thermal_temp(&p->thermal, pick_node(c, i)), seed) != 0)
-      what = i == 0 ? "drive pickoff (pick_drive_*: phase law at this temperature?)"
-                    : "sense pickoff (pick_sense_*: phase law at this temperature?)";
+      what = i == 0 ? "drive pickoff (pick_drive_*)" : "sense pickoff (pick_sense_*)";
   }
   if (what != NULL) {
     memset(p, 0, offsetof(plant_t, err));
@@ -229,6 +261,8 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   p->truth_countdown = c->truth_decim;
   p->fz_alpha = 1.0 - exp(-p->T / c->truth_force_tau_s);
   truth_temps(p, c->temp_k);
+  if (out_mech) warn(p, PLANT_LAW_RESONANCE);
+  for (int i = 0; i < 2; i++) warn_pickoff(p, i, p->pick[i].out_of_range);
   p->err[0] = '\0';
   return 0;
 }
@@ -263,13 +297,20 @@ static void thermal_update(plant_t *p, double t0)
 {
   const double dt = p->thermal_every * p->T;
   double amb = profile_eval(&p->prof.ambient_k, t0 + 0.5 * dt, NULL);
-  if (!(amb > 1.0 && amb < 2000.0)) amb = p->truth.ambient_k; /* keep the last sane one */
+  if (!(amb > 1.0 && amb < 2000.0)) {
+    amb = p->truth.ambient_k; /* keep the last sane one */
+    warn(p, PLANT_LAW_AMBIENT);
+  }
   thermal_step(&p->thermal, amb);
-  (void)mech_set_temp(&p->mech, thermal_temp(&p->thermal, THERMAL_STRUCT));
+  int out = 0;
+  (void)mech_set_temp(
+      &p->mech, mech_temp_clamp(&p->mech.cfg, thermal_temp(&p->thermal, THERMAL_STRUCT), &out));
+  if (out) warn(p, PLANT_LAW_RESONANCE);
   /* the gain follows at once; the phase re-discretises (microseconds) only when it moved
-   * by pick_phase_step_rad. A law driven out of its range keeps the last phase. */
+   * by pick_phase_step_rad. A law driven out of its range is held at its edge, counted. */
   for (int i = 0; i < 2; i++)
-    (void)pickoff_set_temp(&p->pick[i], thermal_temp(&p->thermal, pick_node(&p->cfg, i)));
+    warn_pickoff(
+        p, i, pickoff_set_temp(&p->pick[i], thermal_temp(&p->thermal, pick_node(&p->cfg, i))));
   truth_temps(p, amb);
 }
 

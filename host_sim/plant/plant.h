@@ -129,8 +129,8 @@
     "feedthrough of U2 into the drive pickoff") \
   X(double, pick_drive_ft_spare, DOUBLE, -1.0, 1.0, "V/V", \
     "feedthrough of the spare channel into the drive pickoff") \
-  X(double, pick_drive_phi0_deg, DOUBLE, 0.006, 80.0, "deg", \
-    "drive circuit lag at T0 and pick_lag_ref_hz (2-40)") \
+  X(double, pick_drive_phi0_deg, DOUBLE, -80.0, 80.0, "deg", \
+    "drive circuit lag at T0 and pick_lag_ref_hz (2-40), negative: a lead") \
   X(double, pick_drive_phi1_deg_per_k, DOUBLE, -1.0, 1.0, "deg/K", \
     "its first temperature derivative (2-40)") \
   X(double, pick_drive_phi2_deg_per_k2, DOUBLE, -0.1, 0.1, "deg/K^2", \
@@ -158,8 +158,8 @@
     "feedthrough of U2 into the sense pickoff") \
   X(double, pick_sense_ft_spare, DOUBLE, -1.0, 1.0, "V/V", \
     "feedthrough of the spare channel into the sense pickoff") \
-  X(double, pick_sense_phi0_deg, DOUBLE, 0.006, 80.0, "deg", \
-    "sense circuit lag at T0 and pick_lag_ref_hz (2-40)") \
+  X(double, pick_sense_phi0_deg, DOUBLE, -80.0, 80.0, "deg", \
+    "sense circuit lag at T0 and pick_lag_ref_hz (2-40), negative: a lead") \
   X(double, pick_sense_phi1_deg_per_k, DOUBLE, -1.0, 1.0, "deg/K", \
     "its first temperature derivative (2-40)") \
   X(double, pick_sense_phi2_deg_per_k2, DOUBLE, -0.1, 0.1, "deg/K^2", \
@@ -270,6 +270,29 @@ typedef struct {
   uint64_t mech_refreshes;
 } plant_truth_t;
 
+/* Temperature laws of the plant with a range (plant_law_name gives the JSON key):
+ *   PICK_*_PHASE  circuit phase (2-40), pickoff.h: [-80, 80] deg low-pass lag section
+ *                 ([-80, 160] all-pass), a lag passing through zero into a lead;
+ *   PICK_*_GAIN   ring-diode gain factor 1 + tc (T - T0) (4-12) >= 0.1;
+ *   RESONANCE     (2-32) at the structure temperature, |0.5 kET (T - T0)| < 0.2;
+ *   AMBIENT       the thermal network's input, 1..2000 K.
+ * Outside its range a law is held at the edge (the ambient at its last sane value) and
+ * each evaluation there (every thermal update, and once at plant_init) is counted. */
+typedef enum {
+  PLANT_LAW_PICK_DRIVE_PHASE = 0,
+  PLANT_LAW_PICK_SENSE_PHASE,
+  PLANT_LAW_PICK_DRIVE_GAIN,
+  PLANT_LAW_PICK_SENSE_GAIN,
+  PLANT_LAW_RESONANCE,
+  PLANT_LAW_AMBIENT,
+  PLANT_LAWS
+} plant_law_t;
+
+typedef struct {
+  uint64_t count;   /* evaluations outside the law's range */
+  double first_t_s; /* plant time of the first one (meaningful when count > 0) */
+} plant_warning_t;
+
 typedef struct {
   plant_cfg_t cfg;
   plant_profiles_t prof;
@@ -291,6 +314,7 @@ typedef struct {
   int thermal_countdown, truth_countdown; /* samples to the next update */
   double fz_re, fz_im, fz_alpha;          /* force phasor at mid-sample, rotating average */
   plant_truth_t truth;
+  plant_warning_t warn[PLANT_LAWS];
   char err[192];
 } plant_t;
 
@@ -333,6 +357,11 @@ void plant_step_hal(void *plant, const hal_dac_frame_t *dac, hal_adc_frame_t *ad
 
 /* The truth of the last completed sample. */
 const plant_truth_t *plant_truth(const plant_t *p);
+
+/* Warnings of the temperature laws, PLANT_LAWS entries in plant_law_t order. */
+const plant_warning_t *plant_warnings(const plant_t *p);
+/* "pick_drive_phase", ..., NULL past the end. */
+const char *plant_law_name(int law);
 
 /* ------------------------------------------------------------ budgets -------- */
 

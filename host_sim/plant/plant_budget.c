@@ -24,14 +24,14 @@ static double complex hp1(double f, double f0)
   return s / (1.0 + s);
 }
 
-/* circuit lag section of pickoff.h at f, its phase Phi at f_ref */
+/* circuit lag section of pickoff.h at f, its phase Phi at f_ref (kept to its range) */
 static double complex lag_section(double f, double f_ref, double phi, bool allpass)
 {
-  if (allpass) {
-    const double tau_w = tan(0.5 * phi) * f / f_ref;
-    return (1.0 - I * tau_w) / (1.0 + I * tau_w);
-  }
-  return 1.0 / (1.0 + I * tan(phi) * f / f_ref);
+  const pickoff_lag_kind_t kind = allpass ? PICKOFF_LAG_ALLPASS : PICKOFF_LAG_LOWPASS;
+  double b0, b1w, tpw;
+  pickoff_lag_section(kind, pickoff_phi_clamp(kind, phi, NULL), &b0, &b1w, &tpw);
+  const double x = f / f_ref;
+  return (b0 + I * b1w * x) / (1.0 + I * tpw * x);
 }
 
 static double circuit_phi(double phi0_deg, double phi1, double phi2, double dt)
@@ -46,7 +46,8 @@ static double complex pick_chain(const plant_cfg_t *c, int axis, double f, doubl
   const double phi = circuit_phi(PLANT_PICK(c, axis, phi0_deg),
                                  PLANT_PICK(c, axis, phi1_deg_per_k),
                                  PLANT_PICK(c, axis, phi2_deg_per_k2), dt);
-  return PLANT_PICK(c, axis, gain_v_per_m) * (1.0 + PLANT_PICK(c, axis, gain_tc_per_k) * dt) *
+  return PLANT_PICK(c, axis, gain_v_per_m) *
+         pickoff_gain_factor(PLANT_PICK(c, axis, gain_tc_per_k), dt, NULL) *
          lag_section(f, c->pick_lag_ref_hz, phi, PLANT_PICK(c, axis, lag_allpass)) *
          hp1(f, PLANT_PICK(c, axis, hp_hz)) *
          lp2(f, PLANT_PICK(c, axis, lp_hz), PLANT_PICK(c, axis, lp_q));

@@ -7,7 +7,8 @@
 
 Expectations: NAME<=X, NAME>=X, NAME==X, or NAME~X:REL (within REL relative of X), or
 NAME~X:+ABS (within ABS of X). X may be another figure's name (its value in the same
-run), e.g. 'selfcal_q~selfcal_true_q:0.02'. Prints every figure checked with its bound; exits 1 on
+run), e.g. 'selfcal_q~selfcal_true_q:0.02'. A dotted NAME reaches a nested figure
+(plant_warnings.pick_sense_phase.count). Prints every figure checked with its bound; exits 1 on
 the first run that misses any bound, 2 on a usage error.
 """
 import argparse
@@ -20,9 +21,18 @@ import sys
 import tempfile
 
 
+def figure(fig, name):
+    """A figure by name; a dotted name walks into nested figures (plant_warnings.LAW.count).
+    None when missing, null or not a number's place."""
+    node = fig
+    for part in name.split("."):
+        node = node.get(part) if isinstance(node, dict) else None
+    return None if isinstance(node, dict) else node
+
+
 def check(fig, expr):
     m = re.fullmatch(
-        r"([A-Za-z0-9_]+)\s*(<=|>=|==|~)\s*([-+0-9.eE]+|[A-Za-z_][A-Za-z0-9_]*)"
+        r"([A-Za-z0-9_.]+)\s*(<=|>=|==|~)\s*([-+0-9.eE]+|[A-Za-z_][A-Za-z0-9_.]*)"
         r"(?::(\+?)([0-9.eE+-]+))?",
         expr,
     )
@@ -31,10 +41,10 @@ def check(fig, expr):
     name, op, val, absflag, tol = m.groups()
     ref = re.match(r"[A-Za-z_]", val) is not None  # another figure, not a number
     for n in (name, val) if ref else (name,):
-        if n not in fig or fig[n] is None:
+        if figure(fig, n) is None:
             return False, f"{n}: missing from the figures"
-    x = float(fig[name])
-    v = float(fig[val]) if ref else float(val)
+    x = float(figure(fig, name))
+    v = float(figure(fig, val)) if ref else float(val)
     if ref:
         val = f"{val} = {v:.9g}"
     if op == "<=":

@@ -65,10 +65,10 @@ static void test_ambient_ramp(void **state)
   pc.tau_struct_s = 0.5; /* thermal nodes follow in a fraction of a second */
   pc.tau_circuit_s = 0.5;
   pc.tau_board_s = 0.5;
-  /* The sense circuit lag drifts 0.1 deg/K (table 7-4); centred so that it stays a lag
-   * over the whole range (the pickoff model needs 0 < phi < 80 deg). */
-  pc.pick_sense_phi0_deg = 15.0;
+  /* The default part: its sense circuit lag (3 deg at 25 degC, 0.1 deg/K, table 7-4)
+   * passes through zero into a 3.4 deg lead at -40 degC, (2-40) continued (pickoff.h). */
   start(&pc);
+  assert_true(plant.pick[1].phi_rad < 0.0);
   plant_profiles_t prof;
   memset(&prof, 0, sizeof prof);
   profile_const(&prof.rate_dps, 0.0);
@@ -86,6 +86,7 @@ static void test_ambient_ramp(void **state)
   }
   assert_int_equal(app.gyro.sup.fault_count, 0u);
   assert_true(plant_truth(&plant)->struct_k > 273.15 + 80.0);
+  for (int i = 0; i < PLANT_LAWS; i++) assert_true(plant_warnings(&plant)[i].count == 0);
   /* The resonance moved by about 125 K * 0.5 * 40 ppm/K * 1490 Hz = 3.7 Hz. */
   assert_true(worst < 0.01);
 }

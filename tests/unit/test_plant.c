@@ -483,6 +483,85 @@ static void test_temperature_plumbing(void **state)
   assert_true(plant_truth(&p)->dac_held_v[0] == 0.0); /* mid-scale */
 }
 
+static uint64_t warn_total(const plant_t *p)
+{
+  uint64_t n = 0;
+  for (int i = 0; i < PLANT_LAWS; i++) n += plant_warnings(p)[i].count;
+  return n;
+}
+
+/* The default part is built and runs at -40 and at 85 degC ambient (the sense circuit's
+ * lag of (2-40) has passed through zero into a 3.4 deg lead at -40 degC) with no law
+ * outside its range; an off-nominal part whose laws leave their ranges is not refused
+ * either: each evaluation there is counted, with the time of the first. */
+static void test_law_warnings(void **state)
+{
+  (void)state;
+  static plant_t p;
+  plant_cfg_t c;
+  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  const double ambients[2] = {233.15, 358.15};
+  for (int i = 0; i < 2; i++) {
+    plant_default_cfg(&c);
+    quiet(&c);
+    c.temp_k = ambients[i];
+    assert_int_equal(plant_init(&p, &c, 5u), 0);
+    for (long k = 0; k < 5000; k++) plant_step(&p, &fr, NULL);
+    assert_true(warn_total(&p) == 0);
+    const double tc = plant_truth(&p)->circuit_k;
+    const double law = (c.pick_sense_phi0_deg +
+                        c.pick_sense_phi1_deg_per_k * (tc - c.temp_ref_k)) *
+                       kDeg;
+    print_message("ambient %.2f K: circuit %.3f K, sense phase %+.4f deg\n", c.temp_k, tc,
+                  p.pick[1].phi_rad / kDeg);
+    assert_true(fabs(p.pick[1].phi_rad - law) <= c.pick_phase_step_rad);
+  }
+  assert_true(p.pick[1].phi_rad > 0.0);
+  /* off-nominal: 40 deg + 1 deg/K of sense lag passes 80 deg at 85 degC; the drive gain
+   * falls 9.9 %/K and is gone below -40 degC: both from the start */
+  plant_default_cfg(&c);
+  quiet(&c);
+  c.temp_k = 358.15;
+  c.pick_sense_phi0_deg = 40.0;
+  c.pick_sense_phi1_deg_per_k = 1.0;
+  assert_int_equal(plant_init(&p, &c, 5u), 0);
+  const plant_warning_t *w = plant_warnings(&p);
+  assert_true(w[PLANT_LAW_PICK_SENSE_PHASE].count == 1 &&
+              w[PLANT_LAW_PICK_SENSE_PHASE].first_t_s == 0.0);
+  for (long k = 0; k < 500; k++) plant_step(&p, &fr, NULL); /* 10 ms: 10 thermal updates */
+  assert_true(w[PLANT_LAW_PICK_SENSE_PHASE].count == 11);
+  assert_true(p.pick[1].phi_rad == PICKOFF_LAG_MAX_LOWPASS_RAD);
+  assert_true(warn_total(&p) == 11);
+  assert_string_equal(plant_law_name(PLANT_LAW_PICK_SENSE_PHASE), "pick_sense_phase");
+  assert_null(plant_law_name(PLANT_LAWS));
+  /* a law that leaves its range during the run: first time after the start */
+  plant_default_cfg(&c);
+  quiet(&c);
+  c.pick_drive_gain_tc_per_k = 0.099;
+  c.tau_circuit_s = 0.01;
+  assert_int_equal(plant_init(&p, &c, 5u), 0);
+  assert_true(warn_total(&p) == 0);
+  plant_profiles_t pr = p.prof;
+  profile_const(&pr.ambient_k, 233.15);
+  assert_int_equal(plant_set_profiles(&p, &pr), 0);
+  for (long k = 0; k < 50000; k++) plant_step(&p, &fr, NULL); /* 1 s */
+  w = plant_warnings(&p);
+  print_message("drive gain: %llu warnings from %.4f s\n",
+                (unsigned long long)w[PLANT_LAW_PICK_DRIVE_GAIN].count,
+                w[PLANT_LAW_PICK_DRIVE_GAIN].first_t_s);
+  assert_true(w[PLANT_LAW_PICK_DRIVE_GAIN].count > 900);
+  assert_true(w[PLANT_LAW_PICK_DRIVE_GAIN].first_t_s > 0.0 &&
+              w[PLANT_LAW_PICK_DRIVE_GAIN].first_t_s < 0.1);
+  assert_true(p.pick[0].gain_now == c.pick_drive_gain_v_per_m * PICKOFF_GAIN_MIN_FACTOR);
+  /* an ambient the thermal network cannot take: held, counted */
+  profile_const(&pr.ambient_k, 2500.0);
+  if (plant_set_profiles(&p, &pr) == 0) {
+    for (long k = 0; k < 100; k++) plant_step(&p, &fr, NULL);
+    assert_true(plant_warnings(&p)[PLANT_LAW_AMBIENT].count == 2);
+    assert_true(plant_truth(&p)->ambient_k == 233.15);
+  }
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -490,6 +569,7 @@ int main(void)
       cmocka_unit_test(test_init_validation),      cmocka_unit_test(test_open_loop_chain),
       cmocka_unit_test(test_table_7_1_square_law), cmocka_unit_test(test_table_7_4_slopes),
       cmocka_unit_test(test_adc_budget),           cmocka_unit_test(test_temperature_plumbing),
+      cmocka_unit_test(test_law_warnings),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
