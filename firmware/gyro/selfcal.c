@@ -135,6 +135,12 @@ static void post_chirp(selfcal_t *s, int up, selfcal_state_t next)
 static void post_steps(selfcal_t *s, double f_c, double hb, double tau_s, double gain)
 {
   const selfcal_cfg_t *c = &s->cfg;
+  /* The plan spans f_c +- 2 hb = f_c (1 +- 1/Q): below Q = 2 its lowest point would lie
+   * under half the centre (at or below 0 Hz for Q <= 1), which no drive part has. */
+  if (!(f_c - 2.0 * hb >= 0.5 * f_c) || !(f_c + 2.0 * hb < 0.25 * c->fs_hz)) {
+    fail(s, "Q below 2: no stepped plan around the resonance");
+    return;
+  }
   selfcal_job_t j;
   double f_cmd = c->amp_meas_v / gain;
   if (f_cmd > c->f_cmd_max_v2) f_cmd = c->f_cmd_max_v2;
