@@ -2,7 +2,8 @@
  * plant: the executive's jobs are completed by hand (done_seq = job_seq with a result).
  * A ring-down whose Q lies between 0.5 and 1 passed the ring-down check, and the step
  * plan then placed points below 0 Hz (f_d - 2 f_d / (2 Q) < 0): such a ring-down must
- * fail with its reason, and every posted step lie at a positive frequency. */
+ * fail with its reason, and every posted step lie at a positive frequency. The high-Q
+ * plan: a second, unexcited decay identifies the part (test_decay_*). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -11,6 +12,7 @@
 #include <string.h>
 #include <cmocka.h>
 
+#include "dsp/fastmath.h"
 #include "dsp/nco.h"
 #include "gyro/selfcal.h"
 
@@ -73,9 +75,10 @@ static selfcal_state_t ringdown(uint32_t tau_ticks)
 {
   selfcal_result_t r;
   memset(&r, 0, sizeof r);
-  r.rd_amp0_v = 0.6f;
+  r.rd_amp2_0_v2 = 0.36f;
   r.rd_f_cmd_v2 = 8.0f;
   r.rd_ticks = tau_ticks;
+  r.rd_amp2_end_v2 = 0.6f * 0.6f * 0.1353352832f;
   return complete(r, 1000u + tau_ticks);
 }
 
@@ -110,11 +113,68 @@ static void test_ringdown_q_thesis(void **state)
   assert_steps_positive();
 }
 
+/* High Q: a ring-down that ends on time (8 s) is followed by the unexcited decay job at
+ * the free frequency (nine means of Z); exact means of a decay of (f0, Q) 0.002 Hz above
+ * the NCO identify the part. Beyond the fixed drive's reach the sweep fails with the
+ * reason naming tracking; within it one point at f0 follows. */
+static void decay_case(double q, selfcal_state_t expect)
+{
+  const double f0 = 1489.8612;
+  to_ringdown(f0);
+  const double tau = q / (FM_PI * f0);
+  const uint32_t win = (uint32_t)(8.0 * FS_HZ);
+  selfcal_result_t r;
+  memset(&r, 0, sizeof r);
+  r.rd_amp2_0_v2 = 0.36f;
+  r.rd_f_cmd_v2 = 8.0f;
+  r.rd_ticks = win < (uint32_t)(tau * FS_HZ) ? win : (uint32_t)(tau * FS_HZ);
+  r.rd_amp2_end_v2 = (float)(0.36 * exp(-2.0 * (double)r.rd_ticks / FS_HZ / tau));
+  assert_int_equal(complete(r, 1000u + r.rd_ticks), SELFCAL_RINGDOWN);
+  assert_int_equal(x.job.kind, SELFCAL_JOB_STEPS);
+  assert_int_equal(x.job.n_pts, 9u);
+  assert_true(x.job.f_cmd_v2 == 0.0f);
+  const double f_nco = nco_freq_of(x.job.half_step[0], FS_HZ);
+  const double df = f0 * sqrt(1.0 - 0.25 / (q * q)) - f_nco;
+  memset(&r, 0, sizeof r);
+  for (uint32_t i = 0; i < 9u; i++) {
+    const double t = ((double)x.job.settle_ticks +
+                      (double)i * (double)(x.job.step_settle_ticks + x.job.avg_ticks) +
+                      0.5 * (double)x.job.avg_ticks) /
+                     FS_HZ;
+    const double a = 0.2 * exp(-t / tau), ph = 0.3 + 2.0 * FM_PI * df * t;
+    r.z_re[i] = (float)(a * cos(ph));
+    r.z_im[i] = (float)(a * sin(ph));
+  }
+  assert_int_equal(complete(r, 100000u), expect);
+  assert_true(fabs(s.fit.q / q - 1.0) < 1e-3);
+  assert_true(fabs(s.fit.f0_hz - f0) < 1e-4);
+}
+
+static void test_decay_beyond_reach(void **state)
+{
+  (void)state;
+  decay_case(1.0e5, SELFCAL_FAILED);
+  assert_string_equal(s.why, SELFCAL_BEYOND_FIXED);
+  assert_non_null(strstr(s.why, "tracking"));
+}
+
+static void test_decay_within_reach(void **state)
+{
+  (void)state;
+  decay_case(3000.0, SELFCAL_FINE);
+  assert_int_equal(x.job.kind, SELFCAL_JOB_STEPS);
+  assert_int_equal(x.job.n_pts, 1u);
+  assert_true(x.job.f_cmd_v2 > 0.0f);
+  assert_true(fabs(nco_freq_of(x.job.half_step[0], FS_HZ) - s.fit.f0_hz) < 1e-4);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_ringdown_q_below_one),
       cmocka_unit_test(test_ringdown_q_thesis),
+      cmocka_unit_test(test_decay_beyond_reach),
+      cmocka_unit_test(test_decay_within_reach),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
