@@ -116,9 +116,13 @@ static void put_selfcal(cli_t *cli, app_t *a)
   if (s->fit.q > 0.0) {
     cli_data_f32(cli, "selfcal_f0_hz", (float)s->fit.f0_hz);
     cli_data_f32(cli, "selfcal_q", (float)s->fit.q);
-    cli_data_f32(cli, "selfcal_gain_v_per_v2", (float)s->fit.gain_v_per_v2);
-    cli_data_f32(cli, "selfcal_p_init_deg", (float)(s->hold_p_rad * FM_DEG_PER_RAD));
-    cli_data_f32(cli, "selfcal_fit_rms_rel", (float)s->fit.rms_rel);
+    /* A high-Q sweep has no frequency-response fit, and one beyond the fixed drive's
+     * reach measures no |H(f0)| and plans no hold: those lines are left out. */
+    if (s->fit.gain_v_per_v2 > 0.0) {
+      cli_data_f32(cli, "selfcal_gain_v_per_v2", (float)s->fit.gain_v_per_v2);
+      cli_data_f32(cli, "selfcal_p_init_deg", (float)(s->hold_p_rad * FM_DEG_PER_RAD));
+    }
+    if (s->n_pts > 1u) cli_data_f32(cli, "selfcal_fit_rms_rel", (float)s->fit.rms_rel);
   }
 }
 

@@ -91,7 +91,9 @@ void app_selfcal_poll(app_t *a)
     if (selfcal_background(s, sweeping) == SELFCAL_READY) hand_over(a);
   }
   if (!selfcal_running(s) && a->sweep_owns_drive) {
-    /* A failed sweep leaves the electrodes off (safe mode); status says why. */
+    /* A failed sweep leaves the electrodes off (safe mode); status says why and how long
+     * it ran (selfcal_s). */
+    a->selfcal_ticks = a->isr_ticks - a->selfcal_t0_ticks;
     a->sweep_owns_drive = false;
     (void)app_request(a, APP_REQ_DRIVE_OFF);
   }

@@ -9,8 +9,21 @@
 
 #define SC_MIN_PEAK_V 0.02 /* chirp peak below this: not resolved from the noise */
 #define SC_MAX_RETRIES 6u
-#define SC_EXCITE_MAX_S 1.5 /* ring-down excitation, at most */
-#define SC_RING_MAX_S 2.0   /* Q up to pi f 2 s */
+#define SC_EXCITE_MAX_S 3.0 /* ring-down excitation, at most */
+/* The decay is followed to 1/e or for this long, whichever comes first: beyond Q = pi f
+ * 8 s (25,000 at 1 kHz) the log-amplitude slope over 8 s gives tau (6-12), at Q = 10^5
+ * an amplitude ratio of e^-0.37 at 1490 Hz. */
+#define SC_RING_MAX_S 8.0
+/* Nine settled steps while tau <= 0.25 s (Q <= 980 at 1250 Hz, 1170 at 1490 Hz): with
+ * the second placement they take at most 2 (8 + 8 x 7) tau + 1.6 s = 34 s. Beyond, the
+ * ring-down's own f0 and Q are the result and one point at the resonance, settled for
+ * SC_ONE_SETTLE_TAU, gives |H(wn)| and arg H(wn) for the hold. */
+#define SC_STEPS_MAX_TAU_S 0.25
+#define SC_ONE_SETTLE_TAU 6.0
+/* The second decay (post_decay): nine means, the first after the demodulator has
+ * settled on the new NCO frequency. */
+#define SC_DECAY_PTS 9u
+#define SC_DECAY_SETTLE_S 0.05
 #define SC_AVG_S 0.1
 #define SC_SETTLE_TAU 7.0
 #define SC_HOLD_TAU 6.0
@@ -135,6 +148,12 @@ static void post_chirp(selfcal_t *s, int up, selfcal_state_t next)
 static void post_steps(selfcal_t *s, double f_c, double hb, double tau_s, double gain)
 {
   const selfcal_cfg_t *c = &s->cfg;
+  /* The plan spans f_c +- 2 hb = f_c (1 +- 1/Q): below Q = 2 its lowest point would lie
+   * under half the centre (at or below 0 Hz for Q <= 1), which no drive part has. */
+  if (!(f_c - 2.0 * hb >= 0.5 * f_c) || !(f_c + 2.0 * hb < 0.25 * c->fs_hz)) {
+    fail(s, "Q below 2: no stepped plan around the resonance");
+    return;
+  }
   selfcal_job_t j;
   double f_cmd = c->amp_meas_v / gain;
   if (f_cmd > c->f_cmd_max_v2) f_cmd = c->f_cmd_max_v2;
@@ -151,6 +170,25 @@ static void post_steps(selfcal_t *s, double f_c, double hb, double tau_s, double
   j.avg_ticks = ticks_of(SC_AVG_S, c->fs_hz);
   s->plan_f_hz = f_c;
   s->plan_hb_hz = hb;
+  post(s, &j, SELFCAL_FINE);
+}
+
+/* One point at the ring-down's resonance (high Q), at a force that puts it at amp_meas. */
+static void post_one(selfcal_t *s, double tau_s)
+{
+  const selfcal_cfg_t *c = &s->cfg;
+  selfcal_job_t j;
+  double f_cmd = c->amp_meas_v / s->rd_gain;
+  if (f_cmd > c->f_cmd_max_v2) f_cmd = c->f_cmd_max_v2;
+  s->f_cmd_v2 = f_cmd;
+  base_job(s, &j, SELFCAL_JOB_STEPS);
+  j.n_pts = 1u;
+  j.half_step[0] = nco_half_step_of(s->fit.f0_hz, c->fs_hz);
+  j.settle_ticks = j.step_settle_ticks = ticks_of(SC_ONE_SETTLE_TAU * tau_s, c->fs_hz);
+  j.avg_ticks = ticks_of(SC_AVG_S, c->fs_hz);
+  s->plan_f_hz = s->fit.f0_hz;
+  s->plan_hb_hz = s->fit.f0_hz / (2.0 * s->fit.q);
+  s->one_point = 1u;
   post(s, &j, SELFCAL_FINE);
 }
 
@@ -204,16 +242,42 @@ static void on_chirp(selfcal_t *s, const selfcal_result_t *r, int up)
   base_job(s, &j, SELFCAL_JOB_RINGDOWN);
   j.half_step[0] = nco_half_step_of(s->f_coarse_hz, c->fs_hz);
   j.amp_target_v = (float)c->amp_meas_v;
-  j.avg_ticks = ticks_of(SC_EXCITE_MAX_S > SC_RING_MAX_S ? SC_EXCITE_MAX_S : SC_RING_MAX_S,
-                         c->fs_hz);
+  j.settle_ticks = ticks_of(SC_EXCITE_MAX_S, c->fs_hz);
+  j.avg_ticks = ticks_of(SC_RING_MAX_S, c->fs_hz);
+  post(s, &j, SELFCAL_RINGDOWN);
+}
+
+/* High Q: the decay excited at f_c, off the resonance by up to many bandwidths, was seen
+ * by the demodulator at that offset and through single samples. It is followed again,
+ * unexcited, with the NCO at the free frequency just found, as SC_DECAY_PTS means of Z
+ * over one tau (at most SC_RING_MAX_S) from where the first decay ended (on_decay). */
+static void post_decay(selfcal_t *s, double tau_s)
+{
+  const selfcal_cfg_t *c = &s->cfg;
+  const double win_s = tau_s < SC_RING_MAX_S ? tau_s : SC_RING_MAX_S;
+  const double gap_s = win_s / (double)(SC_DECAY_PTS - 1u);
+  const double avg_s = SC_AVG_S < 0.5 * gap_s ? SC_AVG_S : 0.5 * gap_s;
+  selfcal_job_t j;
+  base_job(s, &j, SELFCAL_JOB_STEPS);
+  j.f_cmd_v2 = 0.0f;
+  j.n_pts = SC_DECAY_PTS;
+  for (uint32_t i = 0; i < SC_DECAY_PTS; i++)
+    j.half_step[i] = nco_half_step_of(s->rd_f_hz, c->fs_hz);
+  j.settle_ticks = ticks_of(SC_DECAY_SETTLE_S, c->fs_hz);
+  j.avg_ticks = ticks_of(avg_s, c->fs_hz);
+  j.step_settle_ticks = ticks_of(gap_s, c->fs_hz) - j.avg_ticks;
+  s->rd_passes = 1u;
   post(s, &j, SELFCAL_RINGDOWN);
 }
 
 static void on_ringdown(selfcal_t *s, const selfcal_result_t *r)
 {
   const selfcal_cfg_t *c = &s->cfg;
-  if ((double)r->rd_amp0_v < SC_MIN_PEAK_V || r->rd_ticks < 8u) {
-    if (more_force(s, (double)r->rd_amp0_v) != 0) {
+  /* |Z0| from its square here: the interrupt's tick that stops the excitation stays
+   * without a square root. */
+  const double amp0_v = sqrt((double)(r->rd_amp2_0_v2 > 0.0f ? r->rd_amp2_0_v2 : 0.0f));
+  if (amp0_v < SC_MIN_PEAK_V || r->rd_ticks < 8u) {
+    if (more_force(s, amp0_v) != 0) {
       fail(s, "ring-down too small to measure");
       return;
     }
@@ -222,8 +286,18 @@ static void on_ringdown(selfcal_t *s, const selfcal_result_t *r)
     post(s, &j, SELFCAL_RINGDOWN);
     return;
   }
-  const double tau = (double)r->rd_ticks / c->fs_hz;
-  s->rd_f_hz = s->f_coarse_hz + (double)r->rd_phase_rad / (2.0 * FM_PI * tau);
+  /* Decay followed over t_ring from |Z0| to |Z_end|: tau = t_ring / ln(|Z0| / |Z_end|)
+   * (6-12); the free (damped) frequency from the rotation of Z over t_ring. */
+  const double t_ring = (double)r->rd_ticks / c->fs_hz;
+  const double a0_2 = amp0_v * amp0_v;
+  const double ln2 = (double)r->rd_amp2_end_v2 > 0.0 ? log(a0_2 / (double)r->rd_amp2_end_v2)
+                                                     : 0.0;
+  if (!(ln2 > 1e-3) || !isfinite(ln2)) {
+    fail(s, "ring-down did not decay");
+    return;
+  }
+  const double tau = 2.0 * t_ring / ln2;
+  s->rd_f_hz = s->f_coarse_hz + (double)r->rd_phase_rad / (2.0 * FM_PI * t_ring);
   s->rd_q = FM_PI * s->rd_f_hz * tau;
   /* Steady-state gain at the peak from the excitation phase: the amplitude grew as
    * 1 - e^{-t/tau} towards |H(f_c)| f_cmd, and |H(f_c)| is below the peak by the
@@ -231,14 +305,120 @@ static void on_ringdown(selfcal_t *s, const selfcal_result_t *r)
   const double t_ex = (double)(r->ticks - r->rd_ticks) / c->fs_hz;
   const double grown = 1.0 - exp(-t_ex / tau);
   const double det = 2.0 * s->rd_q * (s->f_coarse_hz - s->rd_f_hz) / s->rd_f_hz;
-  s->rd_gain = (double)r->rd_amp0_v / ((double)r->rd_f_cmd_v2 * (grown > 0.05 ? grown : 0.05)) *
-               sqrt(1.0 + det * det);
+  /* (The second, unexcited decay of high Q keeps the first's.) */
+  if (r->rd_f_cmd_v2 > 0.0f)
+    s->rd_gain = amp0_v / ((double)r->rd_f_cmd_v2 * (grown > 0.05 ? grown : 0.05)) *
+                 sqrt(1.0 + det * det);
   if (!(s->rd_q > 0.5) || !(s->rd_f_hz > c->f_lo_hz && s->rd_f_hz < c->f_hi_hz) ||
       !isfinite(s->rd_gain)) {
     fail(s, "ring-down not consistent with a resonance");
     return;
   }
-  post_steps(s, s->rd_f_hz, s->rd_f_hz / (2.0 * s->rd_q), tau, s->rd_gain);
+  if (tau <= SC_STEPS_MAX_TAU_S) {
+    post_steps(s, s->rd_f_hz, s->rd_f_hz / (2.0 * s->rd_q), tau, s->rd_gain);
+    return;
+  }
+  post_decay(s, tau);
+}
+
+/* High Q: the ring-down is the identification. The undamped resonance from the free
+ * frequency, wd = wn sqrt(1 - 1/(4 Q^2)); a Q beyond the fixed drive's reach ends the
+ * sweep with the reason, else one point at f0 for the hold. */
+static void high_q_result(selfcal_t *s, double tau)
+{
+  s->fit.f0_hz = s->rd_f_hz / sqrt(1.0 - 0.25 / (s->rd_q * s->rd_q));
+  s->fit.q = s->rd_q;
+  s->fit.gain_v_per_v2 = 0.0; /* measured at f0 by post_one, within the reach */
+  s->fit.rms_rel = 0.0;       /* no frequency-response fit */
+  s->delay_s = s->cfg.delay_s;
+  /* Within the identification's 2 % of the reach counts as within it. */
+  if (s->rd_q > 1.02 * SELFCAL_Q_FIXED_MAX) {
+    fail(s, SELFCAL_BEYOND_FIXED);
+    return;
+  }
+  post_one(s, tau);
+}
+
+/* The decay averaged at SC_DECAY_PTS times (the STEPS job, unexcited, at the free
+ * frequency): the mean of Z over avg_ticks at each. ln|Z| and arg Z are straight lines in
+ * t, of slopes -1/tau (6-12) and 2 pi (f_free - f_nco): least squares over the points.
+ * Point i's mean is centred at settle + i (step_settle + avg) + avg / 2 ticks. */
+static void on_decay(selfcal_t *s, const selfcal_result_t *r)
+{
+  const selfcal_job_t *j = &s->x->job;
+  const double fs = s->cfg.fs_hz;
+  double st = 0.0, sy = 0.0, sp = 0.0, stt = 0.0, sty = 0.0, stp = 0.0, ph = 0.0, ph_prev = 0.0;
+  const double n = (double)j->n_pts;
+  for (uint32_t i = 0; i < j->n_pts; i++) {
+    const double zr = (double)r->z_re[i], zi = (double)r->z_im[i], m2 = zr * zr + zi * zi;
+    if (!(m2 > 0.0) || !isfinite(m2)) {
+      fail(s, "ring-down too small to measure");
+      return;
+    }
+    const double p = atan2(zi, zr);
+    ph = i == 0u ? p : ph + remainder(p - ph_prev, 2.0 * FM_PI);
+    ph_prev = p;
+    const double t = ((double)j->settle_ticks +
+                      (double)i * (double)(j->step_settle_ticks + j->avg_ticks) +
+                      0.5 * (double)j->avg_ticks) /
+                     fs;
+    const double y = 0.5 * log(m2);
+    st += t;
+    sy += y;
+    sp += ph;
+    stt += t * t;
+    sty += t * y;
+    stp += t * ph;
+  }
+  const double den = n * stt - st * st;
+  const double slope_y = (n * sty - st * sy) / den, slope_p = (n * stp - st * sp) / den;
+  if (r->backoffs != 0u || !(slope_y < 0.0) || !isfinite(slope_p)) {
+    fail(s, "ring-down did not decay");
+    return;
+  }
+  const double tau = -1.0 / slope_y;
+  s->rd_f_hz = nco_freq_of(j->half_step[0], fs) + slope_p / (2.0 * FM_PI);
+  s->rd_q = FM_PI * s->rd_f_hz * tau;
+  high_q_result(s, tau);
+}
+
+/* Hold at the identified resonance s->fit, at the loop's set point, for SC_HOLD_TAU. */
+static void post_hold(selfcal_t *s)
+{
+  const selfcal_cfg_t *c = &s->cfg;
+  const double tau = 2.0 * s->fit.q / (2.0 * FM_PI * s->fit.f0_hz);
+  s->f0_hz_f = (float)s->fit.f0_hz;
+  s->hold_f_cmd_v2 = c->amp_set_v / s->fit.gain_v_per_v2;
+  s->hold_p_rad = remainder(c->phase_set_rad - s->fit.phase_rad, 2.0 * FM_PI);
+  if (!(s->hold_f_cmd_v2 < c->f_cmd_max_v2)) {
+    fail(s, "the amplitude set point needs more force than the drive has");
+    return;
+  }
+  selfcal_job_t h;
+  base_job(s, &h, SELFCAL_JOB_HOLD);
+  h.f_cmd_v2 = (float)s->hold_f_cmd_v2;
+  h.p_rad = (float)s->hold_p_rad;
+  h.half_step[0] = nco_half_step_of((double)s->f0_hz_f, c->fs_hz);
+  h.avg_ticks = ticks_of(SC_HOLD_TAU * tau > 0.02 ? SC_HOLD_TAU * tau : 0.02, c->fs_hz);
+  post(s, &h, SELFCAL_HOLD);
+}
+
+/* High Q, one point at f near wn with f0 and Q from the ring-down: H(wn) from H(f) by the
+ * model of selfcal_fit.h, H(wn) / H(w) = (wn^2 - w^2 + j w wn / Q) / (j wn^2 / Q) (2-24). */
+static void on_one_point(selfcal_t *s, const selfcal_point_t *p)
+{
+  const double wn = 2.0 * FM_PI * s->fit.f0_hz, w = 2.0 * FM_PI * p->f_hz, q = s->fit.q;
+  /* (a + j b) / (j c) = (b - j a) / c */
+  const double a = wn * wn - w * w, b = w * wn / q, cden = wn * wn / q;
+  const double kr = b / cden, ki = -a / cden;
+  const double hr = p->h_re * kr - p->h_im * ki, hi = p->h_re * ki + p->h_im * kr;
+  s->fit.gain_v_per_v2 = hypot(hr, hi);
+  s->fit.phase_rad = atan2(hi, hr);
+  if (!(s->fit.gain_v_per_v2 > 0.0) || !isfinite(s->fit.gain_v_per_v2)) {
+    fail(s, "no response at the resonance");
+    return;
+  }
+  post_hold(s);
 }
 
 static void on_steps(selfcal_t *s, const selfcal_result_t *r)
@@ -261,6 +441,10 @@ static void on_steps(selfcal_t *s, const selfcal_result_t *r)
     pts[i].h_re = (double)r->z_re[i] / f;
     pts[i].h_im = (double)r->z_im[i] / f;
   }
+  if (s->one_point != 0u) {
+    on_one_point(s, &pts[0]);
+    return;
+  }
   selfcal_fit_t fit;
   double delay_s = c->delay_s;
   /* The converter delay is known; what the analog chain adds (up to 8 samples) is
@@ -282,21 +466,7 @@ static void on_steps(selfcal_t *s, const selfcal_result_t *r)
     post_steps(s, fit.f0_hz, hb, tau, fit.gain_v_per_v2);
     return;
   }
-  /* Hold at the identified resonance, at the loop's set point. */
-  s->f0_hz_f = (float)fit.f0_hz;
-  s->hold_f_cmd_v2 = c->amp_set_v / fit.gain_v_per_v2;
-  s->hold_p_rad = remainder(c->phase_set_rad - fit.phase_rad, 2.0 * FM_PI);
-  if (!(s->hold_f_cmd_v2 < c->f_cmd_max_v2)) {
-    fail(s, "the amplitude set point needs more force than the drive has");
-    return;
-  }
-  selfcal_job_t h;
-  base_job(s, &h, SELFCAL_JOB_HOLD);
-  h.f_cmd_v2 = (float)s->hold_f_cmd_v2;
-  h.p_rad = (float)s->hold_p_rad;
-  h.half_step[0] = nco_half_step_of((double)s->f0_hz_f, c->fs_hz);
-  h.avg_ticks = ticks_of(SC_HOLD_TAU * tau > 0.02 ? SC_HOLD_TAU * tau : 0.02, c->fs_hz);
-  post(s, &h, SELFCAL_HOLD);
+  post_hold(s);
 }
 
 selfcal_state_t selfcal_background(selfcal_t *s, int sweeping)
@@ -320,7 +490,10 @@ selfcal_state_t selfcal_background(selfcal_t *s, int sweeping)
   case SELFCAL_QUIET_DOWN: post_chirp(s, 0, SELFCAL_CHIRP_DOWN); break;
   case SELFCAL_CHIRP_UP: on_chirp(s, &r, 1); break;
   case SELFCAL_CHIRP_DOWN: on_chirp(s, &r, 0); break;
-  case SELFCAL_RINGDOWN: on_ringdown(s, &r); break;
+  case SELFCAL_RINGDOWN:
+    if (s->rd_passes != 0u) on_decay(s, &r);
+    else on_ringdown(s, &r);
+    break;
   case SELFCAL_FINE: on_steps(s, &r); break;
   case SELFCAL_HOLD: s->state = SELFCAL_READY; break;
   case SELFCAL_IDLE:

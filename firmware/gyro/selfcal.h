@@ -11,6 +11,12 @@
  *   2. RINGDOWN at f_c: excite, stop, follow the free decay to 1/e: the time constant
  *      tau = 2Q/wn (6-12) gives Q_rd = pi f tau, the rotation of the LMSD phasor gives
  *      the free frequency f_d.
+ *      The decay is followed to 1/e or for at most 8 s; tau from the log-amplitude
+ *      slope. At high Q it is followed a second time, unexcited, with the NCO at the
+ *      free frequency found (the first was seen off frequency from f_c). Above tau = 0.25 s (high Q) the ring-down is the identification (f0 from
+ *      the free frequency, Q from tau), a Q beyond SELFCAL_Q_FIXED_MAX fails with the
+ *      reason, and else one point at f0 settled for 6 tau gives |H(wn)|, arg H(wn)
+ *      for step 4 (2Q/wn per step would be 21 s at Q = 10^5).
  *   3. STEPS: 9 points at f_d + {-2,-1.5,-1,-0.5,0,0.5,1,1.5,2} f_d/(2 Q_rd), each
  *      settled for 7 tau, averaged 0.1 s, at a force that puts the peak at amp_meas_v; the linear
  *      least-squares fit of selfcal_fit.h (known converter delay of 1.5 samples plus up
@@ -32,6 +38,18 @@
 
 #include "gyro/selfcal_exec.h"
 #include "gyro/selfcal_fit.h"
+
+/* The fixed-frequency drive's reach (the thesis's drive: fixed NCO frequency, phase PI
+ * on the force phase): its phase PI's proportional gain grows as Q and the drive phase
+ * keeps its temperature sensitivity only within about +-1/(Q kET) K, +-5 K at Q = 5000.
+ * Q = 5000 is the highest Q at which the self-calibrated fixed drive is shown to lock
+ * (tests/slow/test_integrity_selfcal.c); at Q = 10^4 it never locks. A sweep that
+ * identifies a higher Q identifies it, then fails with SELFCAL_BEYOND_FIXED (nothing
+ * committed, drive off) rather than hand over loops that cannot hold the part. */
+#define SELFCAL_Q_FIXED_MAX 5000.0
+#define SELFCAL_BEYOND_FIXED \
+  "Q beyond the fixed-frequency drive's reach (Q <= 5000): this part needs the tracking " \
+  "drive (drive.track)"
 
 typedef struct {
   double fs_hz;
@@ -90,7 +108,9 @@ typedef struct {
   float f0_hz_f;  /* wn/2pi as the float parameter value */
   uint32_t ticks; /* sweep length so far, samples */
   uint32_t retries, refits;
-  const char *why; /* reason of FAILED */
+  uint32_t rd_passes; /* ring-downs followed (high Q: a second one on frequency) */
+  uint32_t one_point; /* the high-Q plan: ring-down identification, one point */
+  const char *why;    /* reason of FAILED */
   /* selfcal_watch: the state last seen, since when (caller's ticks), and how long the
    * posted job may take (samples). */
   selfcal_state_t watch_state;

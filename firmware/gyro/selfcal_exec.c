@@ -17,7 +17,7 @@
 #define SC_GROWTH_EVERY 512u
 #define SC_GROWTH2 1.0201f
 
-enum { ST_SETTLE = 0u, ST_AVG = 1u, ST_EXCITE = 2u, ST_RING = 3u, ST_DONE = 4u };
+enum { ST_SETTLE = 0u, ST_AVG = 1u, ST_EXCITE = 2u, ST_STOP = 3u, ST_RING = 4u, ST_DONE = 5u };
 
 void selfcal_exec_reset(selfcal_exec_t *x, uint32_t half_step)
 {
@@ -126,23 +126,29 @@ GYRO_RAMFUNC static void tick_ringdown(selfcal_exec_t *x, float w_i, float w_q, 
       x->f_cmd_v2 *= 0.5f;
       x->res.backoffs++;
     }
-    int stop = amp2 >= j->amp_target_v * j->amp_target_v || x->check_ticks >= j->avg_ticks;
+    int stop = amp2 >= j->amp_target_v * j->amp_target_v || x->check_ticks >= j->settle_ticks;
     if ((x->check_ticks % SC_GROWTH_EVERY) == 0u) {
       /* Growth stalled: the response has settled as far as it usefully will. */
       if (x->check_ticks > SC_GROWTH_EVERY && amp2 < SC_GROWTH2 * x->amp_ref2) stop = 1;
       x->amp_ref2 = amp2;
     }
     if (stop) {
-      x->res.rd_amp0_v = fm_sqrtf(amp2);
+      /* The excitation stops here and the decay's reference is taken on the next tick:
+       * this tick already carries the excitation's checks (the interrupt's budget). */
       x->res.rd_f_cmd_v2 = x->f_cmd_v2;
       x->f_cmd_v2 = 0.0f;
-      x->amp_ref2 = amp2;
-      x->z_prev_re = w_i;
-      x->z_prev_im = w_q;
-      x->phase_acc = 0.0f;
-      x->check_ticks = 0u;
-      x->stage = ST_RING;
+      x->stage = ST_STOP;
     }
+    return;
+  }
+  if (x->stage == ST_STOP) {
+    x->res.rd_amp2_0_v2 = amp2;
+    x->amp_ref2 = amp2;
+    x->z_prev_re = w_i;
+    x->z_prev_im = w_q;
+    x->phase_acc = 0.0f;
+    x->check_ticks = 0u;
+    x->stage = ST_RING;
     return;
   }
   const int end = amp2 < SC_INV_E2 * x->amp_ref2 || x->check_ticks >= j->avg_ticks;
@@ -156,6 +162,7 @@ GYRO_RAMFUNC static void tick_ringdown(selfcal_exec_t *x, float w_i, float w_q, 
   }
   if (end) {
     x->res.rd_ticks = x->check_ticks;
+    x->res.rd_amp2_end_v2 = amp2;
     x->res.rd_phase_rad = x->phase_acc;
     finish(x);
   }
@@ -222,7 +229,8 @@ static int job_ok(const selfcal_job_t *j)
     return j->n_pts >= 1u && j->n_pts <= SELFCAL_MAX_PTS && j->avg_ticks >= 1u;
   case SELFCAL_JOB_CHIRP: return j->chirp_ticks >= 1u;
   case SELFCAL_JOB_RINGDOWN:
-    return j->avg_ticks >= 1u && j->amp_target_v > 0.0f && j->amp_target_v < j->amp_max_v;
+    return j->avg_ticks >= 1u && j->settle_ticks >= 1u && j->amp_target_v > 0.0f &&
+           j->amp_target_v < j->amp_max_v;
   case SELFCAL_JOB_HOLD:
   case SELFCAL_JOB_QUIET: return j->avg_ticks >= 1u;
   case SELFCAL_JOB_NONE:

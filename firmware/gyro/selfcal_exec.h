@@ -16,9 +16,11 @@
  *             |Z| and the half-step at which it occurred. Over-amplitude aborts the
  *             job (aborted = 1) and stops the excitation.
  *   RINGDOWN  excite at half_step[0] until |Z| >= amp_target_v, or |Z| grew by less
- *             than 1 % in the last 512 ticks, or avg_ticks passed; then f_cmd = 0 and
- *             the free oscillation is followed until |Z| < |Z0| / e: rd_ticks is the
- *             time constant tau = 2Q/wn in ticks (6-12), rd_phase_rad the unwrapped
+ *             than 1 % in the last 512 ticks, or settle_ticks passed; then f_cmd = 0 and,
+ *             from the next tick, the free oscillation is followed until |Z| < |Z0| / e or for avg_ticks,
+ *             whichever comes first: rd_ticks is the length of the decay followed,
+ *             rd_amp2_end_v2 the |Z|^2 it ended at (the time constant tau = 2Q/wn of
+ *             (6-12) from the log-amplitude slope), rd_phase_rad the unwrapped
  *             rotation of Z over it (the free frequency minus the NCO frequency).
  *   STEPS     for each point: settle (settle_ticks for the first, step_settle_ticks for
  *             the others), then average Z over avg_ticks. Over-amplitude halves f_cmd
@@ -69,13 +71,14 @@ typedef struct {
   float f_cmd_v2[SELFCAL_MAX_PTS];                    /* STEPS: excitation it had */
   float peak_amp_v;                                   /* CHIRP */
   uint32_t peak_half_step;                            /* CHIRP */
-  float rd_amp0_v;    /* RINGDOWN: |Z| when the excitation stopped */
-  float rd_f_cmd_v2;  /* RINGDOWN: the excitation it had */
-  uint32_t rd_ticks;  /* RINGDOWN: ticks to |Z0| / e */
-  float rd_phase_rad; /* RINGDOWN: rotation of Z over rd_ticks */
-  uint32_t aborted;   /* CHIRP: over-amplitude */
-  uint32_t backoffs;  /* halvings of f_cmd */
-  uint32_t ticks;     /* length of the job */
+  float rd_amp2_0_v2;   /* RINGDOWN: |Z|^2 when the excitation stopped */
+  float rd_f_cmd_v2;    /* RINGDOWN: the excitation it had */
+  uint32_t rd_ticks;    /* RINGDOWN: length of the decay followed, ticks */
+  float rd_amp2_end_v2; /* RINGDOWN: |Z|^2 at its end */
+  float rd_phase_rad;   /* RINGDOWN: rotation of Z over rd_ticks */
+  uint32_t aborted;     /* CHIRP: over-amplitude */
+  uint32_t backoffs;    /* halvings of f_cmd */
+  uint32_t ticks;       /* length of the job */
 } selfcal_result_t;
 
 typedef struct {

@@ -1,7 +1,8 @@
-/* Output integrity on a high-Q part calibrated by its own `sweep` (85 s of simulated
- * time at Q = 5000: label slow; test_cl_integrity runs the same case with the values
- * this sweep identifies): the structure 22.5 K warmer than at the sweep, beyond the
- * fixed-frequency drive's reach, and never a valid wrong rate (integrity_judge.h). */
+/* Output integrity on a high-Q part calibrated by its own `sweep` (22.6 s of simulated
+ * time at Q = 5000, then 3 s judged: label slow; test_cl_integrity runs the same case
+ * with the values this sweep identifies): the structure 22.5 K warmer than at the sweep,
+ * beyond the fixed-frequency drive's reach, and never a valid wrong rate
+ * (integrity_judge.h). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
