@@ -99,8 +99,8 @@ static void test_phase_setpoint_walk(void **state)
 }
 
 /* A high-Q part with the calibration its own sweep identifies (tests/slow/
- * test_integrity_selfcal.c runs that sweep, 69 s of simulated time: f0 1489.8613 Hz,
- * Q 4999, gain 0.81279 V/V^2, P 25.66 deg), then the structure 22.5 K warmer than at its
+ * test_integrity_selfcal.c runs that sweep, 22.6 s of simulated time: f0 1489.8612 Hz,
+ * Q 4999.7, gain 0.81028 V/V^2, P 25.66 deg), then the structure 22.5 K warmer than at its
  * sweep: beyond the fixed-frequency drive's reach (the drive phase slips towards 90 deg). */
 static void test_q5000_calibrated_warm(void **state)
 {
@@ -110,10 +110,10 @@ static void test_q5000_calibrated_warm(void **state)
   pc.q_drive = 5000.0;
   param_values_t v;
   param_values_defaults(&v);
-  v.drive_cal_f0_hz = 1489.8613f;
-  v.drive_freq_hz = 1489.8613f;
-  v.drive_cal_q = 4999.0f;
-  v.drive_cal_gain_v_per_v2 = 0.81279f;
+  v.drive_cal_f0_hz = 1489.8612f;
+  v.drive_freq_hz = 1489.8612f;
+  v.drive_cal_q = 4999.7f;
+  v.drive_cal_gain_v_per_v2 = 0.81028f;
   v.drive_p_init_deg = 25.66f;
   pc.temp_k += 22.5;
   run_case("Q 5000 calibrated, +22.5 K", &pc, &v, 3.0);
