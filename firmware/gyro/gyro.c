@@ -1,10 +1,8 @@
 #include "gyro/gyro.h"
 
-#include <math.h>
 #include <stddef.h>
 #include <string.h>
 
-#include "dsp/butter.h"
 #include "dsp/fastmath.h"
 #include "gyro/gyro_block.h"
 #include "dsp/ramfunc.h"
