@@ -42,6 +42,7 @@ BIT_MEANING = {
                              "sup.lost_phase_tol_deg for its hold time",
     "GYRO_FAULT_ACQ_TIMEOUT": "ACQUIRE took longer than the loops' design allows",
     "GYRO_FAULT_LOST_SAMPLE": "the HAL counted a lost sample (a converter frame overrun)",
+    "GYRO_FAULT_FREQ_WINDOW": "the tracking drive stayed at the edge of its frequency window (+-0.5 % of f0)",
 }
 # Telemetry fields whose gyro_out_t comment names a type rather than saying what it is.
 TLM_MEANING = {

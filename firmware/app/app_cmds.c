@@ -26,7 +26,8 @@ static const struct {
     {GYRO_FAULT_ADC_CLIP, "ADC_CLIP"},       {GYRO_FAULT_NAN, "NAN"},
     {GYRO_FAULT_LOST_LOCK, "LOST_LOCK"},     {GYRO_FAULT_DRIVE_SAT, "DRIVE_SAT"},
     {GYRO_FAULT_OVER_AMP, "OVER_AMP"},       {GYRO_FAULT_PHASE_LOST, "PHASE_LOST"},
-    {GYRO_FAULT_ACQ_TIMEOUT, "ACQ_TIMEOUT"}, {GYRO_FAULT_LOST_SAMPLE, "LOST_SAMPLE"}};
+    {GYRO_FAULT_ACQ_TIMEOUT, "ACQ_TIMEOUT"}, {GYRO_FAULT_LOST_SAMPLE, "LOST_SAMPLE"},
+    {GYRO_FAULT_FREQ_WINDOW, "FREQ_WINDOW"}};
 #define FAULT_NAMES (sizeof k_fault_names / sizeof k_fault_names[0])
 _Static_assert(FAULT_NAMES == GYRO_FAULT_KINDS, "a name for every fault kind");
 
@@ -179,6 +180,9 @@ static void put_design(cli_t *cli, app_t *a)
   cli_data_f32(cli, "design_amp_pm_deg", (float)d->amp_design.phase_margin_deg);
   cli_data_f32(cli, "design_phase_bw_hz", (float)d->phase_design.bw_hz);
   cli_data_f32(cli, "design_phase_pm_deg", (float)d->phase_design.phase_margin_deg);
+  cli_data_f32(cli, "design_track_bw_hz", (float)d->track_design.bw_hz);
+  cli_data_f32(cli, "design_track_acq_bw_hz", (float)d->track_design.acq_bw_hz);
+  cli_data_f32(cli, "design_track_pm_deg", (float)d->track_design.phase_margin_deg);
 }
 
 /* ---- status: one table of rows, in the order of the reply ---- */
@@ -210,6 +214,12 @@ static void put_drive(cli_t *cli, app_t *a)
   cli_data_f32(cli, "p_deg", o->p_deg);
   cli_data_f32(cli, "p_f_deg", o->p_f_deg);
   cli_data_f32(cli, "f_cmd_v2", o->f_cmd_v2);
+  /* The drive frequency (tracking: the tracked resonance), and its offset from the
+   * calibrated one to the NCO's resolution (a float at 1.5 kHz resolves 1.2e-4 Hz only). */
+  const gyro_design_t *d = a->gyro.design;
+  cli_data_u32(cli, "drive_track", d->track);
+  cli_data_f32(cli, "f_drive_hz", o->f_drive_hz);
+  cli_data_f32(cli, "f_offset_hz", (float)a->gyro.track.off_steps * d->hz_per_step);
 }
 
 static void put_store(cli_t *cli, app_t *a)

@@ -41,7 +41,8 @@
   X(fault,           U32, "-") \
   X(flags,           U32, "-") \
   X(tick,            U32, "-") \
-  X(rate_valid,      U32, "-")
+  X(rate_valid,      U32, "-") \
+  X(f_drive_hz,      F32, "Hz")
 /* clang-format on */
 
 typedef enum {

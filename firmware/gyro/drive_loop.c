@@ -119,6 +119,7 @@ GYRO_RAMFUNC void drive_loop_reset(const drive_loop_cfg_t *restrict c, drive_loo
   dl->phase_err_rad = 0.0f;
   dl->f_cmd_v2 = 0.0f;
   dl->p_rad = c->p_init_rad;
+  dl->p_eq_rad = c->p_init_rad;
   dl->p_turn_rad = 0.0f;
 }
 
@@ -152,6 +153,7 @@ GYRO_RAMFUNC void drive_loop_update_phase(const drive_loop_cfg_t *restrict c,
       dl->p_turn_rad -= turn;
     }
     dl->p_rad = p;
+    dl->p_eq_rad = p;
   } else {
     (void)pi_reset(&c->phase, &dl->phase_pi, dl->p_rad, dl->phase_err_rad);
   }

@@ -92,6 +92,8 @@ typedef struct {
   float p_rad;      /* force phase P */
   float p_turn_rad; /* whole turn taken off P at the latest update (0: none), for the
                      * caller to act on and clear */
+  float p_eq_rad;   /* the thermometer's phase: P in the fixed drive, the tracking drive's
+                     * equivalent of P from its frequency (drive_track.h) */
 } drive_loop_t;
 
 typedef struct {

@@ -31,6 +31,7 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
     return -2;
   }
   drive_loop_init(&d->drive, &t.drive);
+  drive_track_reset(&d->track_cfg, &t.track);
   supervisor_init(&t.sup);
   gyro_attach_lost_counter(&t, NULL);
   t.adc_v_per_code = HAL_ADC_V_PER_CODE;
@@ -71,12 +72,16 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
    * would own it): a design sets it only when the drive frequency changes. */
   if (d->nco_half_step != old->nco_half_step) {
     g->nco.half_step = d->nco_half_step;
+    drive_track_reset(&d->track_cfg, &g->track); /* it tracks from the new frequency */
   }
   /* The LMSDs' step sizes sit beside their weights (lmsd_t: the one coefficient the
    * per-sample step reads, within the same load). */
   (void)lmsd_set_mu(&g->lmsd_drive, d->lmsd_drive.mu);
   (void)lmsd_set_mu(&g->lmsd_sense, d->lmsd_sense.mu);
   drive_loop_reconfigure(&d->drive, &g->drive);
+  if (d->track != 0u) {
+    g->drive.p_rad = d->drive.p_init_rad; /* the tracking drive's force phase is p_init */
+  }
   selftest_reconfigure(&old->selftest, &d->selftest, &g->selftest);
   /* The drive scheme only changes with the drive off (drive.mode is not live); the
    * synthesiser keeps its own scheme and levels (drive_synth_t) until then. */
@@ -101,6 +106,9 @@ void gyro_stop(gyro_t *g)
 {
   supervisor_stop(&g->sup);
   drive_loop_reset(&g->design->drive, &g->drive);
+  /* The drive starts again from the calibrated frequency, whatever moved the NCO (the
+   * tracking drive, or a sweep that ended without its hand-over). */
+  gyro_track_restart(g);
 }
 
 void gyro_sweep_begin(gyro_t *g)
@@ -115,6 +123,7 @@ int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d)
   if (g->sup.mode != GYRO_MODE_SWEEP) {
     return -1;
   }
+  drive_track_reset(&d->track_cfg, &g->track);
   g->nco.half_step = d->nco_half_step;
   /* The sweep's last job held the vibration at the set point with (f_cmd, P): the
    * integrators continue from there instead of from zero force. */
@@ -122,6 +131,7 @@ int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d)
   (void)pi_reset(&d->drive.phase, &g->drive.phase_pi, g->cal.p_rad, 0.0f);
   g->drive.f_cmd_v2 = g->drive.amp_pi.u;
   g->drive.p_rad = g->drive.phase_pi.u;
+  g->drive.p_eq_rad = g->drive.p_rad;
   supervisor_stop(&g->sup);
   supervisor_start(&g->sup);
   return 0;

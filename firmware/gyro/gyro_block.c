@@ -42,6 +42,7 @@ GYRO_RAMFUNC void gyro_block_command(gyro_t *g)
   si->setpoint_moving = drive_loop_slewing(&g->design->drive, &g->drive);
   si->phase_err_rad = g->drive.phase_err_rad;
   si->drive_at_limit = drive_on && g->drive.f_cmd_v2 >= g->design->drive.f_cmd_max_v2;
+  si->freq_at_limit = (int)g->track.at_limit; /* 0 unless the tracking drive runs */
   if (si->drive_at_limit) g->flags_acc |= GYRO_FLAG_DRIVE_LIMIT;
   /* The drive loops' fault is a clipped drive channel. A clipped sense channel (too much
    * quadrature, rate or vibration for its gain) leaves the drive sound: the rate is not
@@ -62,12 +63,31 @@ GYRO_RAMFUNC void gyro_block_clear(gyro_t *g)
   lmsd_reset(&g->lmsd_drive);
   lmsd_reset(&g->lmsd_sense);
   drive_loop_reset(&g->design->drive, &g->drive);
+  gyro_track_restart(g);
   drive_synth_silence(&g->synth);
   g->rate_clear_due = 1u; /* the rate channel's half, on the next tick (its budget) */
 }
 
+/* The tracking drive's update (drive_track.h): the wrapped phase error moves the NCO's
+ * step from the next tick on; P stays at p_init, the thermometer gets p_eq. */
+GYRO_RAMFUNC static void gyro_block_track(gyro_t *g)
+{
+  const gyro_design_t *d = g->design;
+  drive_loop_t *dl = &g->drive;
+  const float e = fm_wrap_pi(d->drive.phase_set_rad - dl->phase_rad);
+  dl->phase_err_rad = e;
+  const int32_t off = drive_track_update(
+      &d->track_cfg, &g->track, e, dl->amp_v * dl->inv_amp_set, g->sup.mode == GYRO_MODE_LOCKED);
+  g->nco.half_step = d->nco_half_step + (uint32_t)off;
+  dl->p_eq_rad = g->track.p_eq_rad;
+}
+
 GYRO_RAMFUNC void gyro_block_phase(gyro_t *g)
 {
+  if (g->design->track != 0u) {
+    gyro_block_track(g);
+    return;
+  }
   drive_loop_update_phase(&g->design->drive, &g->drive);
   if (GYRO_UNLIKELY(g->drive.p_turn_rad != 0.0f)) {
     /* A whole turn of P is no change of temperature: the thermometer moves with it,
@@ -94,7 +114,7 @@ GYRO_RAMFUNC void gyro_block_quad(gyro_t *g)
 GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
 {
   rate_channel_project(&g->design->rate, &g->rate, g->lmsd_drive.w_i, g->lmsd_drive.w_q,
-                       g->drive.p_rad);
+                       g->drive.p_eq_rad);
   /* The continuous self-test's modulation, for the ticks from here on and for its notch
    * on this projection (GYRO_SLOT_RATE, GYRO_SLOT_QUAD): the force runs a fixed block
    * ahead of the reference, which the LMS's two weights absorb as a phase. */
@@ -112,7 +132,8 @@ GYRO_RAMFUNC void gyro_block_measure(gyro_t *g, int drive_on)
   gyro_out_t *o = &g->out;
   o->drive_amp_v = g->drive.amp_v;
   o->drive_phase_deg = g->drive.phase_rad * FM_DEG_PER_RAD_F;
-  o->p_deg = g->drive.p_rad * FM_DEG_PER_RAD_F;
+  o->p_deg = g->drive.p_eq_rad * FM_DEG_PER_RAD_F;
+  o->f_drive_hz = g->design->f_cal_hz + (float)g->track.off_steps * g->design->hz_per_step;
   o->f_cmd_v2 = g->drive.f_cmd_v2;
   o->sense_i_v = g->lmsd_sense.w_i;
   o->sense_q_v = g->lmsd_sense.w_q;
@@ -154,7 +175,7 @@ GYRO_RAMFUNC void gyro_block_p(gyro_t *g, int hold)
     rate_valid_slew(&d->valid, &g->valid, rc->quad_dps);
   }
   /* Last, as a tail call: its new P_f is flagged in rc->p_new. */
-  (void)rate_channel_update_p(&d->rate, rc, g->drive.p_rad);
+  (void)rate_channel_update_p(&d->rate, rc, g->drive.p_eq_rad);
 }
 
 GYRO_RAMFUNC void gyro_block_p_selftest(gyro_t *g)

@@ -20,6 +20,15 @@
 #include "dsp/fastmath.h"
 #include "gyro/gyro_state.h"
 
+/* The tracking drive from the calibrated frequency again (drive off, a fault's clear): its
+ * state reset and the NCO back on the design's step (in the fixed drive that is where
+ * the NCO already is, unless a sweep ended without its hand-over). */
+static inline void gyro_track_restart(gyro_t *g)
+{
+  drive_track_reset(&g->design->track_cfg, &g->track);
+  g->nco.half_step = g->design->nco_half_step;
+}
+
 /* GYRO_SLOT_AMP: the first half of the finiteness check (the LMSD weights), then |Z|
  * and, while the drive runs, the amplitude PI (with the drive off |Z| only, for the
  * over-amplitude trip) (gyro_block_amp_measure); the rate-valid drive-phase and
@@ -38,7 +47,8 @@ void gyro_block_clear(gyro_t *g);
  * on it), then the quadrature's output filter. */
 void gyro_block_quad(gyro_t *g);
 /* GYRO_SLOT_PHASE_PI: the phase loop's update; a whole turn of P it took is passed on to
- * the thermometer (rate_channel_shift_p). */
+ * the thermometer (rate_channel_shift_p). Tracking drive: the PLL's update instead (the
+ * NCO's step from the next tick on). */
 void gyro_block_phase(gyro_t *g);
 /* GYRO_SLOT_PHASE_MEAS: arg Z (drive on), the drive half of the output snapshot. */
 void gyro_block_measure(gyro_t *g, int drive_on);

@@ -29,7 +29,18 @@ static double acq_timeout_s(const param_values_t *v, double tau_s, const gyro_de
   const double bw_ph = (double)t->drive.phase_kp / (2.0 * FM_PI * tau_s);
   double bw = bw_amp < bw_ph ? bw_amp : bw_ph;
   if (!(bw > 1e-3)) bw = 1e-3; /* a loop of no gain: the hour below */
-  const double t_s = 0.1 + 10.0 * tau_s + 3.0 / (2.0 * FM_PI * bw) + (double)v->sup_lock_hold_s;
+  /* Tracking drive: the ring-up is force-limited, not tau-limited (at resonance the
+   * amplitude grows at K f_max / tau from rest: A_set tau / (K f_max), Q-independent),
+   * and the PLL's bandwidth is its own. */
+  double ring_s = 10.0 * tau_s;
+  if (v->drive_track != 0u) {
+    const double up = 10.0 * (double)v->drive_amp_set_v * tau_s /
+                      ((double)v->drive_cal_gain_v_per_v2 * (double)t->drive.f_cmd_max_v2);
+    if (up < ring_s) ring_s = up;
+    bw = bw_amp < t->track_design.bw_hz ? bw_amp : t->track_design.bw_hz;
+    if (!(bw > 1e-3)) bw = 1e-3;
+  }
+  const double t_s = 0.1 + ring_s + 3.0 / (2.0 * FM_PI * bw) + (double)v->sup_lock_hold_s;
   return t_s < 3600.0 ? t_s : 3600.0; /* an hour: beyond it the part is not acquiring */
 }
 
@@ -175,6 +186,37 @@ static double lag_samples(uint32_t slot)
   return (double)((GYRO_SLOT_COMMAND + GYRO_BLOCK - slot) % GYRO_BLOCK + 1u);
 }
 
+/* The fixed-frequency drive's reach in Q (selfcal.h: SELFCAL_Q_FIXED_MAX, where it is
+ * measured); the tracking drive has none. */
+#define GYRO_FIXED_Q_MAX 5000.0f
+/* Half-width of the tracking drive's frequency window, relative to f0 (drive_track.h):
+ * +-0.5 %, some 60 K of structure temperature at 40 ppm/K of Young's modulus either way. */
+#define GYRO_TRACK_WINDOW_REL 0.005
+/* The tracking loop's acquisition crossover, relative to the locked one (drive_track.h). */
+#define GYRO_TRACK_ACQ_BW_FACTOR 3.0
+
+/* The tracking drive (drive_track.h): a PLL on the NCO frequency, designed from the same
+ * identified model and bandwidth (drive.phase_bw_hz) as the phase loop, in either mode
+ * (status shows the design); the fixed drive's phase PI stops at GYRO_FIXED_Q_MAX. */
+static gyro_design_status_t design_track(const param_values_t *v, double demod_bw,
+                                         gyro_design_t *t)
+{
+  t->track = v->drive_track;
+  if (t->track == 0u && v->drive_cal_q > GYRO_FIXED_Q_MAX) return GYRO_DESIGN_FIXED_Q;
+  const double fs = (double)v->sys_fs_hz;
+  const drive_track_design_in_t in = {(double)v->drive_cal_q, (double)v->drive_cal_f0_hz,
+                                      (double)v->drive_phase_bw_hz, GYRO_TRACK_ACQ_BW_FACTOR,
+                                      demod_bw, fs, (double)GYRO_BLOCK,
+                                      /* the new step acts from the tick after its job */
+                                      (double)(GYRO_SLOT_PHASE_PI - GYRO_SLOT_PHASE_MEAS + 1u),
+                                      GYRO_TRACK_WINDOW_REL, (double)t->drive.p_init_rad, 0.1};
+  if (drive_track_design(&in, &t->track_cfg, &t->track_design) != 0)
+    return GYRO_DESIGN_PHASE_LOOP;
+  t->hz_per_step = (float)(fs / 2147483648.0);
+  t->f_cal_hz = (float)nco_freq_of(t->nco_half_step, fs);
+  return GYRO_DESIGN_OK;
+}
+
 /* Both drive loops (drive_loop.h), once per block; nonzero manual gains override the
  * designed ones. */
 static gyro_design_status_t design_drive_loops(const param_values_t *v, double tau_s,
@@ -205,7 +247,7 @@ static gyro_design_status_t design_drive_loops(const param_values_t *v, double t
    * parameter's range; within the parameters' ranges nothing else of theirs can fail. */
   drive_loop_cfg_t probe = t->drive;
   if (drive_loop_cfg_derive(&probe) != 0) return GYRO_DESIGN_P_INIT;
-  return GYRO_DESIGN_OK;
+  return design_track(v, demod_bw, t);
 }
 
 /* The rate channel (rate_channel.h): output filter, reference, scale, compensation. */
@@ -336,6 +378,8 @@ static const char *const k_reasons[GYRO_DESIGN_STATUS_COUNT] = {
                              "drive.amp_bw_hz must be positive for the amplitude loop's design",
     [GYRO_DESIGN_PHASE_LOOP] = "drive.cal_q, drive.cal_f0_hz and drive.phase_bw_hz must be "
                                "positive for the phase loop's design",
+    [GYRO_DESIGN_FIXED_Q] = "drive.cal_q above 5000 is beyond the fixed-frequency drive's reach: "
+                            "select the tracking drive first (set drive.track 1, drive off)",
     [GYRO_DESIGN_P_INIT] = "drive.p_init_deg must lie within +-360 deg (one turn)",
     [GYRO_DESIGN_RATE_LPF] = "rate.lpf_cutoff_hz must be below half the block rate "
                              "(sys.fs_hz / 20), rate.lpf_order even and at most 8",

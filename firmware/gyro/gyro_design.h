@@ -12,6 +12,7 @@
 #include "dsp/nco.h"
 #include "gyro/drive_loop.h"
 #include "gyro/drive_synth.h"
+#include "gyro/drive_track.h"
 #include "gyro/rate_channel.h"
 #include "gyro/rate_valid.h"
 #include "gyro/selftest.h"
@@ -33,6 +34,13 @@ typedef struct {
   lmsd_cfg_t lmsd_drive, lmsd_sense;
   drive_synth_cfg_t synth;
   drive_loop_design_out_t amp_design, phase_design; /* what the designer achieved */
+  /* The tracking drive (drive.track 1, drive_track.h); its design is made in either mode
+   * (status shows it), the sample path runs it only when track is 1. */
+  uint32_t track;
+  drive_track_cfg_t track_cfg;
+  drive_track_design_out_t track_design;
+  float f_cal_hz;    /* the calibrated drive frequency as the NCO realises it */
+  float hz_per_step; /* fs / 2^31: the NCO's frequency per half-step */
   uint32_t autostart;
 } gyro_design_t;
 
@@ -49,6 +57,7 @@ typedef enum {
   GYRO_DESIGN_MU_SENSE,       /* demod.mu_sense */
   GYRO_DESIGN_AMP_LOOP,       /* drive.cal_*, drive.amp_bw_hz */
   GYRO_DESIGN_PHASE_LOOP,     /* drive.cal_f0_hz, drive.cal_q, drive.phase_bw_hz */
+  GYRO_DESIGN_FIXED_Q,        /* drive.cal_q beyond the fixed-frequency drive's reach */
   GYRO_DESIGN_P_INIT,         /* drive.p_init_deg beyond one turn */
   GYRO_DESIGN_RATE_LPF,       /* rate.lpf_order, rate.lpf_cutoff_hz */
   GYRO_DESIGN_AMP_SET,        /* drive.amp_set_v against the ADC's range */

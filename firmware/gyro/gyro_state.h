@@ -13,6 +13,7 @@
 #include "dsp/nco.h"
 #include "gyro/drive_loop.h"
 #include "gyro/drive_synth.h"
+#include "gyro/drive_track.h"
 #include "gyro/gyro_dac.h"
 #include "gyro/gyro_design.h"
 #include "gyro/gyro_slots.h"
@@ -32,7 +33,7 @@ typedef struct {
   float quad_dps;             /* quadrature, equivalent rate */
   float drive_amp_v;          /* demodulated drive pickoff amplitude */
   float drive_phase_deg;      /* arg of the drive phasor */
-  float p_deg;                /* force phase P: the temperature signal */
+  float p_deg;                /* temperature signal: P, or its equivalent from f (tracking) */
   float p_f_deg;              /* P low-passed (what the compensation uses) */
   float f_cmd_v2;             /* drive force command */
   float u1_v, u2_v;           /* drive electrode voltages written this tick */
@@ -43,6 +44,7 @@ typedef struct {
   uint32_t rate_invalid;      /* RATE_INVALID_* reasons of this block (0: valid) */
   float rate_out_v;           /* voltage commanded on the analog rate output this block */
   uint32_t rate_valid; /* 1 when the rate output can be trusted (output integrity), else 0 */
+  float f_drive_hz;    /* drive (NCO) frequency: the tracked resonance in tracking mode */
 } gyro_out_t;
 
 #define GYRO_FLAG_LOCKED (1u << 0)
@@ -64,6 +66,7 @@ typedef struct {
                           * and when the drive frequency changes, moved by the sweep */
   lmsd_t lmsd_drive, lmsd_sense;
   drive_loop_t drive;
+  drive_track_t track; /* the tracking drive's PLL (design->track 1) */
   drive_synth_t synth;
   rate_channel_t rate;
   supervisor_t sup;

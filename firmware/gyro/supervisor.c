@@ -49,6 +49,7 @@ void supervisor_init(supervisor_t *sv)
   sv->last_fault = GYRO_FAULT_NONE;
   sv->last_fault_step = 0u;
   sv->in_tol_blocks = sv->out_tol_blocks = sv->out_phase_blocks = sv->sat_blocks = 0u;
+  sv->win_blocks = 0u;
   sv->fault_blocks = sv->mode_blocks = 0u;
   sv->clip_sum = sv->clip_pos = 0u;
   sv->steps = 0u;
@@ -63,6 +64,7 @@ GYRO_RAMFUNC static void set_mode(supervisor_t *restrict sv, gyro_mode_t m)
   sv->mode = m;
   sv->mode_blocks = 0u;
   sv->in_tol_blocks = sv->out_tol_blocks = sv->out_phase_blocks = sv->sat_blocks = 0u;
+  sv->win_blocks = 0u;
 }
 
 void supervisor_start(supervisor_t *sv)
@@ -152,6 +154,8 @@ GYRO_RAMFUNC static int step_driving(const supervisor_cfg_t *restrict c,
   sv->phase_err_f = ep;
   const float ae = fm_absf(ea);
   const float pe = fm_absf(ep);
+  sv->win_blocks = in->freq_at_limit ? sv->win_blocks + 1u : 0u;
+  if (sv->win_blocks >= c->sat_hold_blocks) return trip(sv, GYRO_FAULT_FREQ_WINDOW);
   if (mode == GYRO_MODE_LOCKED) {
     /* Amplitude and phase each have their own count: a drive that holds its amplitude
      * while its phase has run off (a phase loop at a dead end) is not locked either. */

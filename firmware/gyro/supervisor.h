@@ -8,6 +8,8 @@
  *   the designer derives from the drive resonance's time constant and the loop bandwidths: a part
  *   the loops cannot hold (resonance out of reach, drive pinned at its limit, a
  *   setpoint the drive cannot reach) faults instead of acquiring for ever.
+ *   ACQUIRE or LOCKED -> FAULT (FREQ_WINDOW) when the tracking drive's frequency stays at
+ *   the edge of its window (drive_track.h) for sat_hold_s: the resonance is outside it.
  *   any mode -> FAULT at once on: over-amplitude (above amp_trip_rel times the setpoint,
  *   or above amp_max_v, an absolute level the ADC can still measure: structure
  *   protection whatever the setpoint), drive ADC clipping (clip_max_count rail codes
@@ -46,9 +48,10 @@ typedef enum {
   GYRO_FAULT_OVER_AMP = 1u << 4,
   GYRO_FAULT_PHASE_LOST = 1u << 5,
   GYRO_FAULT_ACQ_TIMEOUT = 1u << 6,
-  GYRO_FAULT_LOST_SAMPLE = 1u << 7
+  GYRO_FAULT_LOST_SAMPLE = 1u << 7,
+  GYRO_FAULT_FREQ_WINDOW = 1u << 8
 } gyro_fault_t;
-#define GYRO_FAULT_KINDS 8u
+#define GYRO_FAULT_KINDS 9u
 
 /* Supervisor steps (blocks) over which rail codes are counted against clip_max_count:
  * 2 ms, about three carrier cycles, so that a waveform clipped only at its peaks (a
@@ -90,6 +93,7 @@ typedef struct {
   uint32_t out_tol_blocks;   /* consecutive steps outside lost tolerance while LOCKED */
   uint32_t out_phase_blocks; /* consecutive steps beyond the lost phase tolerance */
   uint32_t sat_blocks;       /* consecutive steps with the drive at its limit */
+  uint32_t win_blocks;       /* consecutive steps with the frequency at its window's edge */
   uint32_t fault_blocks;     /* steps spent in FAULT */
   uint32_t mode_blocks;      /* steps spent in the current mode (ACQUIRE: since the end of
                             * a setpoint move, the acquisition timeout's clock) */
@@ -105,6 +109,7 @@ typedef struct {
   float amp_rel;     /* A / A_set */
   float phase_err_rad;
   int drive_at_limit;  /* amplitude PI pinned at its maximum */
+  int freq_at_limit;   /* the tracking drive's frequency at its window's edge */
   uint32_t clip_count; /* drive-channel ADC rail codes since the last step */
   int state_finite;    /* every loop state value finite */
   int sample_lost;     /* a sample was lost since the last step */

@@ -33,7 +33,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 4u
+#define PARAM_LAYOUT_VERSION 5u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -87,7 +87,11 @@
     PF_PERSIST | PF_LIVE, "designed closed-loop bandwidth of the amplitude loop") \
   /* as the amplitude loop */ \
   X(drive_phase_bw_hz, 0x0110u, "drive.phase_bw_hz", F32, "Hz", 0.1f, 1000.0f, 30.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "designed closed-loop bandwidth of the phase loop") \
+    PF_PERSIST | PF_LIVE, "designed closed-loop bandwidth of the phase loop (tracking: of the PLL)") \
+  /* fixed by default: the air-damped default part (Q 33) is calibrated in it, and it \
+   * holds Q <= 5000; the sweep selects tracking beyond (gyro/drive_track.h) */ \
+  X(drive_track, 0x0111u, "drive.track", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
+    PF_PERSIST, "0 fixed frequency, phase PI on P (Q <= 5000); 1 tracking PLL on the frequency") \
   /* 5.4: mu = 0.034 at 50 kHz; |r| = 1 makes it a normalised step (5-5) */ \
   X(demod_mu_drive, 0x0201u, "demod.mu_drive", F32, "-", 0.0001f, 0.49f, 0.034f, 0u, \
     PF_PERSIST | PF_LIVE, "LMS demodulator step size, drive pickoff (sets its bandwidth)") \

@@ -52,6 +52,20 @@ static void test_new_frequency_retunes(void **state)
   assert_int_equal(g.nco.half_step, d2.nco_half_step);
 }
 
+/* A sweep that ends without a hand-over (failed, or stopped by `drive off`) left the NCO
+ * at its last excitation step, so the next `drive on` drove there, off the resonance (it
+ * did): stopping the drive puts the NCO back on the design's frequency. */
+static void test_stop_restores_frequency(void **state)
+{
+  (void)state;
+  design(&d1, NULL);
+  assert_int_equal(gyro_init_from_design(&g, &d1), 0);
+  gyro_sweep_begin(&g);
+  g.nco.half_step = d1.nco_half_step + 54321u;
+  gyro_stop(&g);
+  assert_int_equal(g.nco.half_step, d1.nco_half_step);
+}
+
 /* LOCKED, a new amplitude setpoint beyond the lock tolerance: ACQUIRE again. */
 static void test_amplitude_step_reacquires(void **state)
 {
@@ -69,6 +83,7 @@ int main(void)
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_sweep_step_kept),
       cmocka_unit_test(test_new_frequency_retunes),
+      cmocka_unit_test(test_stop_restores_frequency),
       cmocka_unit_test(test_amplitude_step_reacquires),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -50,6 +50,9 @@ static void mu_drive_high(param_values_t *v) { v->demod_mu_drive = 0.6f; }
 static void mu_sense_zero(param_values_t *v) { v->demod_mu_sense = 0.0f; }
 static void cal_gain_zero(param_values_t *v) { v->drive_cal_gain_v_per_v2 = 0.0f; }
 static void phase_bw_zero(param_values_t *v) { v->drive_phase_bw_hz = 0.0f; }
+/* Q = 10^4 in the fixed drive (drive.track 0): beyond its reach, refused with a pointer to
+ * the tracking drive; the same Q with drive.track 1 designs (test_tracking_designs). */
+static void fixed_q_beyond_reach(param_values_t *v) { v->drive_cal_q = 1.0e4f; }
 static void lpf_above_nyquist(param_values_t *v) { v->rate_lpf_cutoff_hz = 3000.0f; }
 static void lpf_odd_order(param_values_t *v) { v->rate_lpf_order = 3u; }
 static void amp_set_over_adc(param_values_t *v) { v->drive_amp_set_v = 4.9f; }
@@ -66,6 +69,7 @@ static const refusal_t k_refusals[] = {
     {GYRO_DESIGN_MU_SENSE, "demod.mu_sense", mu_sense_zero},
     {GYRO_DESIGN_AMP_LOOP, "drive.cal_gain_v_per_v2", cal_gain_zero},
     {GYRO_DESIGN_PHASE_LOOP, "drive.phase_bw_hz", phase_bw_zero},
+    {GYRO_DESIGN_FIXED_Q, "drive.track", fixed_q_beyond_reach},
     {GYRO_DESIGN_P_INIT, "drive.p_init_deg", p_init_beyond_reach},
     {GYRO_DESIGN_RATE_LPF, "rate.lpf_cutoff_hz", lpf_above_nyquist},
     {GYRO_DESIGN_RATE_LPF, "rate.lpf_order", lpf_odd_order},
