@@ -360,9 +360,11 @@ static void report_closed_loop(report_t *r)
   add_num(r->fig, "final_mode", res->final_mode);
   add_num(r->fig, "rate_valid_fraction", res->rate_valid_fraction);
   add_num(r->fig, "rate_first_valid_s", res->rate_first_valid_s);
+  add_num(r->fig, "phase_slips", res->phase_slips);
   if (!r->quiet) {
-    printf("  rate output valid from %.3f s, %.1f %% of the run (faults %u)\n",
-           res->rate_first_valid_s, 100.0 * res->rate_valid_fraction, (unsigned)res->faults);
+    printf("  rate output valid from %.3f s, %.1f %% of the run (faults %u, phase slips %u)\n",
+           res->rate_first_valid_s, 100.0 * res->rate_valid_fraction, (unsigned)res->faults,
+           (unsigned)res->phase_slips);
   }
   add_num(r->fig, "mean_drive_freq_hz", res->mean_drive_freq_hz);
   add_num(r->fig, "mean_drive_amp_m", res->mean_drive_amp_m);

@@ -22,7 +22,10 @@ typedef struct {
 } sim_csv_t;
 
 int sim_csv_open(sim_csv_t *c, const char *path, char *err, size_t err_len);
-void sim_csv_row(sim_csv_t *c, const plant_truth_t *tr, const gyro_out_t *o);
+/* One row; o NULL in open loop (the firmware's columns are 0). f_drive_hz: the drive
+ * frequency the firmware's NCO runs at (its step to full precision), or in open loop the
+ * frequency of the drive the simulator generates. */
+void sim_csv_row(sim_csv_t *c, const plant_truth_t *tr, const gyro_out_t *o, double f_drive_hz);
 void sim_csv_close(sim_csv_t *c);
 
 #endif /* SIM_OUT_H */

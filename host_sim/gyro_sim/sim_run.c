@@ -170,8 +170,41 @@ static void truth_sample(cl_truth_t *t, const app_t *app, const plant_truth_t *t
   t->n++;
 }
 
+/* Phase slips: the plant's true drive phase (displacement against the force's
+ * fundamental, plant_truth_t) leaving the value it had when the firmware locked by more
+ * than 90 deg, counted while the drive runs; each slip re-references (a drift counts
+ * again every 90 deg). */
+typedef struct {
+  int armed;
+  double ref, prev, unwrapped;
+  uint32_t count;
+} slip_t;
+
+static void slip_sample(slip_t *s, const app_t *app, const plant_truth_t *tr)
+{
+  const gyro_mode_t m = app->gyro.sup.mode;
+  if (m != GYRO_MODE_LOCKED && m != GYRO_MODE_ACQUIRE) {
+    s->armed = 0;
+    return;
+  }
+  const double p = tr->drive_phase_rad;
+  if (!s->armed) {
+    if (m != GYRO_MODE_LOCKED) return;
+    s->armed = 1;
+    s->prev = s->unwrapped = s->ref = p;
+    return;
+  }
+  s->unwrapped += remainder(p - s->prev, 2.0 * PLANT_PI);
+  s->prev = p;
+  if (fabs(s->unwrapped - s->ref) > 0.5 * PLANT_PI) {
+    s->count++;
+    s->ref = s->unwrapped;
+  }
+}
+
 /* Running sums of a closed-loop run for its figures. */
 typedef struct {
+  slip_t slip;
   double fw_lock_s, first_valid_s; /* -1: not yet */
   uint64_t valid_ticks;
   double sum_struct_k, sum_drive_freq_hz, sum_drive_amp_m;
@@ -313,6 +346,7 @@ static void cl_results(const cl_run_t *r, const cl_stats_t *st, const plant_cfg_
   res->faults = r->app->gyro.sup.fault_count;
   res->rate_valid_fraction = n_ticks > 0u ? (double)st->valid_ticks / (double)n_ticks : 0.0;
   res->rate_first_valid_s = st->first_valid_s;
+  res->phase_slips = st->slip.count;
   res->final_mode = (uint32_t)r->app->gyro.sup.mode;
   const double n = (double)st->n_mean;
   res->mean_struct_k = st->n_mean ? st->sum_struct_k / n : NAN;
@@ -493,10 +527,13 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
       st.valid_ticks++;
       if (st.first_valid_s < 0.0) st.first_valid_s = (double)(k + 1u) / fs;
     }
-    if ((k + 1u) % r.truth.decim == 0u && r.truth.n < r.truth.cap)
-      truth_sample(&r.truth, app, tr);
+    if ((k + 1u) % r.truth.decim == 0u) {
+      if (r.truth.n < r.truth.cap) truth_sample(&r.truth, app, tr);
+      slip_sample(&st.slip, app, tr);
+    }
     if (k % csv_every == 0u) {
-      if (r.csv.f != NULL) sim_csv_row(&r.csv, tr, &app->gyro.out);
+      if (r.csv.f != NULL)
+        sim_csv_row(&r.csv, tr, &app->gyro.out, nco_freq_of(app->gyro.nco.half_step, fs));
       st.sum_struct_k += tr->struct_k;
       st.sum_drive_freq_hz += tr->drive_freq_hz;
       st.sum_drive_amp_m += tr->drive_amp_m;
@@ -577,7 +614,8 @@ static void ol_point(ol_t *o, plant_t *plant, double fs, double f_hz, double u, 
     if (i == n_settle) o->measuring = 1;
     hal_host_run(1u);
     if (o->measuring) sum_am += plant_truth(plant)->drive_amp_m;
-    if (csv->f != NULL && (*k)++ % csv_every == 0u) sim_csv_row(csv, plant_truth(plant), NULL);
+    if (csv->f != NULL && (*k)++ % csv_every == 0u)
+      sim_csv_row(csv, plant_truth(plant), NULL, plant_truth(plant)->drive_freq_hz);
   }
   const double n = (double)o->acc_n;
   *amp_v = 2.0 * hypot(o->acc_i, o->acc_q) / n;

@@ -28,7 +28,8 @@ CSV_MEANING = {
     "quad_dps": "quadrature, as an equivalent rate (firmware)",
     "drive_amp": "demodulated drive pickoff amplitude (firmware; telemetry drive_amp_v)",
     "drive_phase_deg": "phase of the drive pickoff phasor (firmware)",
-    "p_deg": "force phase P, the temperature signal (firmware)",
+    "p_deg": "the temperature signal: force phase P (fixed drive), or its equivalent from the "
+             "tracked frequency, p_init - (2Q/f0)(f - f_cal) (tracking drive) (firmware)",
     "t_ambient_c": "ambient temperature (truth)",
     "t_struct_c": "sensor structure temperature (truth)",
     "t_board_c": "board temperature sensor (truth)",
@@ -46,6 +47,8 @@ CSV_MEANING = {
     "rate_valid": "1 when the rate output can be trusted, 0 when not (firmware, output integrity)",
     "rate_out_v": "voltage commanded on the analog rate output in the same tick: the rate "
                   "times rate.out_v_per_dps when valid, rate.fault_out_v when not (firmware)",
+    "f_drive_hz": "drive (NCO) frequency, from its integer step: the tracked resonance with "
+                  "drive.track 1 (firmware; telemetry f_drive_hz, a float)",
 }
 
 
