@@ -35,7 +35,8 @@ static int derive(void *ctx, const param_values_t *v, void *derived, const char 
 static bool loop_safe(void *ctx)
 {
   const app_t *a = ctx;
-  return app_mode_after_queue(a) == GYRO_MODE_OFF && !selfcal_running(&a->selfcal);
+  return a->handing_over ||
+         (app_mode_after_queue(a) == GYRO_MODE_OFF && !selfcal_running(&a->selfcal));
 }
 
 static void cli_write(void *ctx, const char *data, size_t len)

@@ -57,6 +57,8 @@ typedef struct {
   volatile uint32_t req_word[APP_REQ_QUEUE];
   volatile uint32_t req_head, req_tail;
   bool sweep_owns_drive;     /* the sequencer, not a command, decides the drive's next mode */
+  bool handing_over;         /* the sweep's hand-over commits its values: the loops are off
+                              * in SWEEP and start from them, so drive.track may change */
   app_tlm_t tlm;             /* telemetry stream and its commands (app_tlm.c) */
   selfcal_t selfcal;         /* self-calibration sequencer (background, app_selfcal.c) */
   uint32_t selfcal_t0_ticks; /* isr_ticks when the sweep was requested */

@@ -33,6 +33,7 @@ int app_selfcal_start(app_t *a)
   c.f_cmd_max_v2 = (double)a->gyro.design->drive.f_cmd_max_v2;
   c.amp_set_v = (double)v->drive_amp_set_v;
   c.phase_set_rad = (double)v->drive_phase_set_deg * FM_PI / 180.0;
+  c.track = v->drive_track;
   /* One sample of DAC latency plus half a sample of zero-order hold. */
   c.delay_s = 1.5 / c.fs_hz;
   if (selfcal_start(&a->selfcal, &c) != 0) return -1;
@@ -59,13 +60,21 @@ static void hand_over(app_t *a)
   if (st == PARAM_OK) st = stage_f(a, PARAM_drive_cal_q, s->fit.q);
   if (st == PARAM_OK) st = stage_f(a, PARAM_drive_cal_gain_v_per_v2, s->fit.gain_v_per_v2);
   if (st == PARAM_OK) st = stage_f(a, PARAM_drive_p_init_deg, s->hold_p_rad * 180.0 / FM_PI);
+  if (st == PARAM_OK) {
+    /* A Q beyond the fixed drive's reach: the tracking drive (selfcal.h). */
+    param_value_t tr;
+    tr.u = s->track;
+    st = params_stage(&a->params, PARAM_drive_track, tr);
+  }
   if (st != PARAM_OK) {
     params_discard(&a->params);
     selfcal_finish(s, 0, param_status_str(st));
     return;
   }
   params_err_t err;
+  a->handing_over = true;
   st = params_commit(&a->params, &err);
+  a->handing_over = false;
   if (st == PARAM_ERR_PENDING) return; /* the ISR has not taken the last change: retry */
   if (st != PARAM_OK) {
     selfcal_finish(s, 0, err.why != NULL ? err.why : param_status_str(st));

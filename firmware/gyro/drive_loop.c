@@ -90,6 +90,7 @@ void drive_loop_init(const drive_loop_cfg_t *cfg, drive_loop_t *dl)
 
 void drive_loop_reconfigure(const drive_loop_cfg_t *cfg, drive_loop_t *dl)
 {
+  dl->amp_int = fm_clampf(dl->amp_int, cfg->amp.u_min, cfg->amp.u_max);
   pi_limit(&cfg->amp, &dl->amp_pi);
   pi_limit(&cfg->phase, &dl->phase_pi);
 }
@@ -118,6 +119,8 @@ GYRO_RAMFUNC void drive_loop_reset(const drive_loop_cfg_t *restrict c, drive_loo
   dl->amp_err_v = 0.0f;
   dl->phase_err_rad = 0.0f;
   dl->f_cmd_v2 = 0.0f;
+  dl->amp_int = 0.0f;
+  dl->amp_n1 = dl->amp_n2 = 0.0f;
   dl->p_rad = c->p_init_rad;
   dl->p_eq_rad = c->p_init_rad;
   dl->p_turn_rad = 0.0f;
@@ -128,8 +131,25 @@ GYRO_RAMFUNC void drive_loop_step_amp(const drive_loop_cfg_t *restrict c,
 {
   if (drive_loop_slewing(c, dl)) slew_amp(c, dl);
   dl->amp_v = fm_sqrtf(w_i * w_i + w_q * w_q);
-  dl->amp_err_v = dl->amp_set_v - dl->amp_v;
-  dl->f_cmd_v2 = pi_step(&c->amp, &dl->amp_pi, dl->amp_err_v);
+  float e = dl->amp_set_v - dl->amp_v;
+  dl->amp_err_v = e;
+  if (c->amp_position == 0u) {
+    dl->f_cmd_v2 = pi_step(&c->amp, &dl->amp_pi, e);
+    return;
+  }
+  /* Position form (drive_loop_cfg_t.amp_position): the error of the notched amplitude
+   * (drive_track.h), the integral of (6-26b) on e(k-1). */
+  const float a = dl->amp_v;
+  e = dl->amp_set_v - c->notch_g * (a - c->notch_c2 * dl->amp_n1 + dl->amp_n2);
+  dl->amp_n2 = dl->amp_n1;
+  dl->amp_n1 = a;
+  const float i = fm_clampf(dl->amp_int + c->amp.ki_t * dl->amp_pi.e_prev, c->amp.u_min,
+                            c->amp.u_max);
+  dl->amp_int = i;
+  dl->amp_pi.e_prev = e;
+  const float u = fm_clampf(i + c->amp.kp * e, c->amp.u_min, c->amp.u_max);
+  dl->amp_pi.u = u;
+  dl->f_cmd_v2 = u;
 }
 
 GYRO_RAMFUNC void drive_loop_measure_phase(drive_loop_t *restrict dl, float w_i, float w_q)

@@ -67,6 +67,17 @@ typedef struct {
   float phase_kp, phase_ki; /* rad per rad; per rad*s */
   float f_cmd_max_v2;       /* force command limit (u_max^2 for half-frequency drive) */
   float p_init_rad;
+  /* Amplitude PI in position form (1) instead of the velocity form of pi.h (0): the
+   * tracking drive's. At high Q the holding force is small (A_set / K, 0.02 Ks V^2 at
+   * Q = 10^5) against the proportional term's response to the pickoff's ripple and noise
+   * (kp = wc tau / K does not fall with Q), so the command keeps touching its lower limit
+   * of zero force; the velocity form stores the clamped output as its integrator and so
+   * ratchets upwards on every touch (the mean force rises above the holding force and the
+   * amplitude creeps above its set point: +10 % in 0.3 s at Q = 10^4). The position form
+   * integrates the unclamped error, its integrator clamped to the limits on its own: the
+   * clipped command's mean then settles where the mean error is zero. */
+  uint32_t amp_position;
+  float notch_c2, notch_g; /* with amp_position: the ripple notch on |Z| (drive_track.h) */
   /* Derived (drive_loop_cfg_derive): */
   pi_coeffs_t amp, phase; /* the PIs' coefficients and limits */
   float inv_amp_set;      /* 1 / amp_set_v */
@@ -80,6 +91,8 @@ typedef struct {
 /* What the loops remember. */
 typedef struct {
   pi_t amp_pi;
+  float amp_int;        /* the position form's integrator (amp_position), Ks V^2 */
+  float amp_n1, amp_n2; /* the notch's last two inputs (amp_position) */
   pi_t phase_pi;
   float amp_set_v;   /* setpoint the loop uses now, slewing towards the cfg's */
   float inv_amp_set; /* 1 / amp_set_v: the supervisor's reference */

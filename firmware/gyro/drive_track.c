@@ -53,7 +53,8 @@ int drive_track_design(const drive_track_design_in_t *in, drive_track_cfg_t *cfg
   }
   const double tau = 2.0 * in->q / (2.0 * FM_PI * in->f0_hz); /* (6-12) */
   const double wd = 2.0 * FM_PI * in->demod_bw_hz;
-  const double delay_s = (in->lag_samples + 1.0 + 0.5 * in->loop_decim) / in->fs_hz;
+  /* + one update: the ripple notch's delay (header) */
+  const double delay_s = (in->lag_samples + 1.0 + 1.5 * in->loop_decim) / in->fs_hz;
   double pm_lock = 0.0, pm_acq = 0.0;
   const double wc = design_wc(in->bw_hz, tau, wd, delay_s, &pm_lock);
   const double wc_acq = design_wc(in->bw_hz * in->acq_bw_factor, tau, wd, delay_s, &pm_acq);
@@ -72,6 +73,7 @@ int drive_track_design(const drive_track_design_in_t *in, drive_track_cfg_t *cfg
   cfg->p_eq_per_step_rad = (float)(2.0 * in->q / in->f0_hz / k);
   cfg->p_init_rad = (float)in->p_init_rad;
   cfg->min_amp_rel = (float)in->min_amp_rel;
+  drive_track_notch(in->f0_hz, in->fs_hz, in->loop_decim, &cfg->notch_c2, &cfg->notch_g);
   out->bw_hz = wc / (2.0 * FM_PI);
   out->acq_bw_hz = wc_acq / (2.0 * FM_PI);
   out->phase_margin_deg = pm_lock;
@@ -80,8 +82,16 @@ int drive_track_design(const drive_track_design_in_t *in, drive_track_cfg_t *cfg
   return 0;
 }
 
+void drive_track_notch(double f0_hz, double fs_hz, double loop_decim, float *c2, float *g)
+{
+  const double c = 2.0 * cos(2.0 * FM_PI * f0_hz * loop_decim / fs_hz);
+  *c2 = (float)c;
+  *g = (float)(1.0 / (2.0 - c));
+}
+
 void drive_track_reset(const drive_track_cfg_t *cfg, drive_track_t *t)
 {
+  t->notch.x1 = t->notch.x2 = 0.0f;
   t->int_steps = 0;
   t->int_frac = 0.0f;
   t->off_steps = 0;
@@ -105,8 +115,13 @@ GYRO_RAMFUNC int32_t drive_track_update(const drive_track_cfg_t *restrict c,
                                         drive_track_t *restrict t, float e_rad, float amp_rel,
                                         int locked)
 {
-  /* While the amplitude is tiny its phase is noise: hold the frequency. */
-  if (amp_rel < c->min_amp_rel) return t->off_steps;
+  /* While the amplitude is tiny its phase is noise: hold the frequency (the notch starts
+   * afresh when there is a vibration to measure). */
+  if (amp_rel < c->min_amp_rel) {
+    t->notch.x1 = t->notch.x2 = e_rad;
+    return t->off_steps;
+  }
+  e_rad = drive_notch(c->notch_c2, c->notch_g, &t->notch, e_rad);
   const uint32_t lk = locked ? 1u : 0u;
   const float kp = lk ? c->kp_lock : c->kp_acq;
   float acc = t->int_frac - (lk ? c->ki_dt_lock : c->ki_dt_acq) * e_rad;

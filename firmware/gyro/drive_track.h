@@ -26,6 +26,14 @@
  * of steps plus a float remainder below one step, never a float frequency (a float32 at
  * 1490 Hz resolves 1.2e-4 Hz: 0.9 deg of drive phase at Q = 10^5).
  *
+ * Ripple. The drive LMSD's weights carry a ripple at the carrier wc (0.22 deg and 1.3 mV
+ * rms on the default part, from the pickoff's DC and harmonics): kp turns it into 0.11 Hz
+ * rms of frequency, and the amplitude loop's kp into force swings larger than the
+ * holding force at high Q. Both tracking-drive measurements (phase error, amplitude)
+ * pass a three-tap notch at wc at the block rate, H(z) = g (1 - c2 z^-1 + z^-2),
+ * c2 = 2 cos(wc T_block), g = 1 / (2 - c2) (unit gain at DC): linear phase, one block of
+ * delay in the loops' designs, 145x at the edge of the frequency window.
+ *
  * Window. The offset from the calibrated step is clamped to +-window (0.5 % of f0); a
  * loop that stays at the edge (the resonance is outside, or the loop ran off) is a
  * fault (supervisor FREQ_WINDOW).
@@ -53,16 +61,31 @@ typedef struct {
   float p_eq_per_step_rad;   /* (2Q/f0) fs / 2^31: p_eq's move per step of offset */
   float p_init_rad;          /* the force phase held, p_eq at the calibrated step */
   float min_amp_rel;         /* below this fraction of the set point arg Z is noise: hold */
+  float notch_c2, notch_g;   /* the ripple notch at wc (above) */
 } drive_track_cfg_t;
+
+/* The notch's memory: the last two inputs. */
+typedef struct {
+  float x1, x2;
+} drive_notch_t;
+
+static inline float drive_notch(float c2, float g, drive_notch_t *n, float x)
+{
+  const float y = g * (x - c2 * n->x1 + n->x2);
+  n->x2 = n->x1;
+  n->x1 = x;
+  return y;
+}
 
 /* What the tracker remembers. */
 typedef struct {
-  int32_t int_steps; /* integrator, whole steps off the calibrated one */
-  float int_frac;    /* its remainder, within +-1/2 step */
-  int32_t off_steps; /* offset in use (integrator + proportional, in the window) */
-  uint32_t locked;   /* the LOCKED gains are in use */
-  uint32_t at_limit; /* the offset sits at the window's edge */
-  float p_eq_rad;    /* thermometer phase (above) */
+  int32_t int_steps;   /* integrator, whole steps off the calibrated one */
+  float int_frac;      /* its remainder, within +-1/2 step */
+  int32_t off_steps;   /* offset in use (integrator + proportional, in the window) */
+  uint32_t locked;     /* the LOCKED gains are in use */
+  uint32_t at_limit;   /* the offset sits at the window's edge */
+  float p_eq_rad;      /* thermometer phase (above) */
+  drive_notch_t notch; /* on the phase error */
 } drive_track_t;
 
 typedef struct {
@@ -92,7 +115,11 @@ int drive_track_design(const drive_track_design_in_t *in, drive_track_cfg_t *cfg
 /* Offset 0 (the calibrated step), integrator cleared, acquisition gains. */
 void drive_track_reset(const drive_track_cfg_t *cfg, drive_track_t *t);
 
-/* One update (once per block) from the wrapped phase error e_rad and the relative
+/* The notch's coefficients for a carrier f0_hz at the loop rate fs_hz / loop_decim
+ * (background). */
+void drive_track_notch(double f0_hz, double fs_hz, double loop_decim, float *c2, float *g);
+
+/* One update (once per block) from the wrapped phase error e_rad (notched here) and the relative
  * amplitude amp_rel = |Z| / A_set; locked selects the gains. Returns the offset in steps
  * to add to the calibrated step. */
 int32_t drive_track_update(const drive_track_cfg_t *cfg, drive_track_t *t, float e_rad,

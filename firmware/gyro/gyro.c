@@ -130,6 +130,7 @@ int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d)
   (void)pi_reset(&d->drive.amp, &g->drive.amp_pi, g->cal.f_cmd_v2, 0.0f);
   (void)pi_reset(&d->drive.phase, &g->drive.phase_pi, g->cal.p_rad, 0.0f);
   g->drive.f_cmd_v2 = g->drive.amp_pi.u;
+  g->drive.amp_int = g->drive.amp_pi.u;
   g->drive.p_rad = g->drive.phase_pi.u;
   g->drive.p_eq_rad = g->drive.p_rad;
   supervisor_stop(&g->sup);

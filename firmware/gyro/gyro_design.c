@@ -227,7 +227,8 @@ static gyro_design_status_t design_drive_loops(const param_values_t *v, double t
   const double blk = (double)GYRO_BLOCK;
   const drive_loop_design_in_t amp_in = {
       (double)v->drive_cal_gain_v_per_v2, tau_s, (double)v->drive_amp_bw_hz, demod_bw, fs, blk,
-      lag_samples(GYRO_SLOT_AMP)};
+      /* the tracking drive's ripple notch delays the amplitude by a block (drive_track.h) */
+      lag_samples(GYRO_SLOT_AMP) + (v->drive_track != 0u ? blk : 0.0)};
   const drive_loop_design_in_t ph_in = {1.0, tau_s, (double)v->drive_phase_bw_hz,     demod_bw,
                                         fs,  blk,   lag_samples(GYRO_SLOT_PHASE_MEAS)};
   if (drive_loop_design(&amp_in, &t->amp_design) != 0) return GYRO_DESIGN_AMP_LOOP;
@@ -243,6 +244,8 @@ static gyro_design_status_t design_drive_loops(const param_values_t *v, double t
   t->drive.phase_kp = manual_ph ? v->drive_phase_kp : (float)t->phase_design.kp;
   t->drive.phase_ki = manual_ph ? v->drive_phase_ki : (float)t->phase_design.ki;
   t->drive.p_init_rad = v->drive_p_init_deg * FM_RAD_PER_DEG_F;
+  t->drive.amp_position = v->drive_track; /* drive_loop.h: the tracking drive's, any Q */
+  drive_track_notch((double)v->drive_freq_hz, fs, blk, &t->drive.notch_c2, &t->drive.notch_g);
   /* The loops accept P's start value within one turn either way (drive_loop.c), the
    * parameter's range; within the parameters' ranges nothing else of theirs can fail. */
   drive_loop_cfg_t probe = t->drive;

@@ -192,6 +192,35 @@ static void post_one(selfcal_t *s, double tau_s)
   post(s, &j, SELFCAL_FINE);
 }
 
+/* High Q, the tracking drive: |H(wn)| and arg H(wn) from a burst at f0 instead of a
+ * point settled for SC_ONE_SETTLE_TAU (128 s at Q = 10^5). From the decay's remains z0,
+ * the force F makes Z(t) = z_inf + (z0 - z_inf) e^{-t/tau} with z_inf = H(wn) F (6-12);
+ * SC_BURST_PTS means over SC_AVG_S after SC_DECAY_SETTLE_S give z_inf and z0 by least
+ * squares (on_burst). F is chosen for a rise of about amp_meas / 2 over the burst from
+ * the ring-down's gain. */
+#define SC_BURST_PTS 4u
+static void post_burst(selfcal_t *s, double tau_s)
+{
+  const selfcal_cfg_t *c = &s->cfg;
+  const double t_b = SC_DECAY_SETTLE_S + SC_BURST_PTS * SC_AVG_S;
+  double f_cmd = 0.5 * c->amp_meas_v * tau_s / (t_b * s->rd_gain);
+  if (f_cmd > c->f_cmd_max_v2) f_cmd = c->f_cmd_max_v2;
+  s->f_cmd_v2 = f_cmd;
+  selfcal_job_t j;
+  base_job(s, &j, SELFCAL_JOB_STEPS);
+  j.n_pts = SC_BURST_PTS;
+  for (uint32_t i = 0; i < SC_BURST_PTS; i++)
+    j.half_step[i] = nco_half_step_of(s->fit.f0_hz, c->fs_hz);
+  j.settle_ticks = ticks_of(SC_DECAY_SETTLE_S, c->fs_hz);
+  j.step_settle_ticks = 0u;
+  j.avg_ticks = ticks_of(SC_AVG_S, c->fs_hz);
+  s->plan_f_hz = s->fit.f0_hz;
+  s->plan_hb_hz = s->fit.f0_hz / (2.0 * s->fit.q);
+  s->one_point = 1u;
+  s->burst = 1u;
+  post(s, &j, SELFCAL_FINE);
+}
+
 static int more_force(selfcal_t *s, double peak_v)
 {
   if (s->f_cmd_v2 >= s->cfg.f_cmd_max_v2 || ++s->retries > SC_MAX_RETRIES) return -1;
@@ -331,9 +360,12 @@ static void high_q_result(selfcal_t *s, double tau)
   s->fit.gain_v_per_v2 = 0.0; /* measured at f0 by post_one, within the reach */
   s->fit.rms_rel = 0.0;       /* no frequency-response fit */
   s->delay_s = s->cfg.delay_s;
-  /* Within the identification's 2 % of the reach counts as within it. */
-  if (s->rd_q > 1.02 * SELFCAL_Q_FIXED_MAX) {
-    fail(s, SELFCAL_BEYOND_FIXED);
+  /* Within the identification's 2 % of the fixed drive's reach counts as within it;
+   * beyond, or with the tracking drive selected, the tracking drive takes over, and its
+   * point is a burst: it needs no settled vibration to start from. */
+  s->track = s->cfg.track != 0u || s->rd_q > 1.02 * SELFCAL_Q_FIXED_MAX ? 1u : 0u;
+  if (s->track != 0u) {
+    post_burst(s, tau);
     return;
   }
   post_one(s, tau);
@@ -399,7 +431,23 @@ static void post_hold(selfcal_t *s)
   h.f_cmd_v2 = (float)s->hold_f_cmd_v2;
   h.p_rad = (float)s->hold_p_rad;
   h.half_step[0] = nco_half_step_of((double)s->f0_hz_f, c->fs_hz);
-  h.avg_ticks = ticks_of(SC_HOLD_TAU * tau > 0.02 ? SC_HOLD_TAU * tau : 0.02, c->fs_hz);
+  /* The burst left the vibration above the set point, and at high Q it would take tau
+   * ln(A / A_set) to decay (seconds; force cannot pull, only push): brake it first with
+   * half the drive's force in anti-phase, at K F / tau per second (6-12), to 90 % of the
+   * set point, from where the amplitude loop brings it up. */
+  const double a_end = s->burst_end_v, a_to = 0.9 * c->amp_set_v;
+  if (s->track != 0u && s->braked == 0u && a_end > a_to) {
+    const double f_b = 0.5 * c->f_cmd_max_v2;
+    s->braked = 1u;
+    h.f_cmd_v2 = (float)f_b;
+    h.p_rad = (float)remainder(s->hold_p_rad + FM_PI, 2.0 * FM_PI);
+    h.avg_ticks = ticks_of((a_end - a_to) * tau / (s->fit.gain_v_per_v2 * f_b), c->fs_hz);
+    post(s, &h, SELFCAL_HOLD);
+    return;
+  }
+  /* The tracking drive needs no settled vibration: its hold only hands the command over. */
+  const double hold_s = s->track != 0u ? 0.02 : SC_HOLD_TAU * tau;
+  h.avg_ticks = ticks_of(hold_s > 0.02 ? hold_s : 0.02, c->fs_hz);
   post(s, &h, SELFCAL_HOLD);
 }
 
@@ -421,6 +469,46 @@ static void on_one_point(selfcal_t *s, const selfcal_point_t *p)
   post_hold(s);
 }
 
+/* The burst's means (post_burst): z_mean_i = z_inf (1 - c_i) + z0 c_i, c_i the mean of
+ * e^{-t/tau} over point i's window; least squares for z_inf and z0 (one real 2 x 2
+ * system for both parts), then H(f) = z_inf / F and the point at f0 as on_one_point. */
+static void on_burst(selfcal_t *s, const selfcal_result_t *r)
+{
+  const selfcal_job_t *j = &s->x->job;
+  const double fs = s->cfg.fs_hz, tau = 2.0 * s->fit.q / (2.0 * FM_PI * s->fit.f0_hz);
+  const double avg = (double)j->avg_ticks / fs;
+  double saa = 0.0, sab = 0.0, sbb = 0.0, sar = 0.0, sbr = 0.0, sai = 0.0, sbi = 0.0;
+  for (uint32_t i = 0; i < j->n_pts; i++) {
+    const double t0 = (double)j->settle_ticks / fs + (double)i * avg;
+    const double ci = tau * (exp(-t0 / tau) - exp(-(t0 + avg) / tau)) / avg;
+    const double a = 1.0 - ci, b = ci;
+    saa += a * a;
+    sab += a * b;
+    sbb += b * b;
+    sar += a * (double)r->z_re[i];
+    sbr += b * (double)r->z_re[i];
+    sai += a * (double)r->z_im[i];
+    sbi += b * (double)r->z_im[i];
+  }
+  const double det = saa * sbb - sab * sab;
+  const double f = (double)r->f_cmd_v2[0];
+  if (r->backoffs != 0u || !(fabs(det) > 1e-12) || !(f > 0.0)) {
+    fail(s, "no response at the resonance");
+    return;
+  }
+  selfcal_point_t p;
+  p.f_hz = nco_freq_of(j->half_step[0], fs);
+  p.h_re = (sbb * sar - sab * sbr) / det / f;
+  p.h_im = (sbb * sai - sab * sbi) / det / f;
+  /* Where the burst left the vibration (its end, t_b): the brake's start (post_hold). */
+  const double t_b = ((double)j->settle_ticks + (double)j->n_pts * (double)j->avg_ticks) / fs;
+  const double k = exp(-t_b / tau), zr = p.h_re * f, zi = p.h_im * f;
+  const double z0r = (saa * sbr - sab * sar) / det;
+  const double z0i = (saa * sbi - sab * sai) / det;
+  s->burst_end_v = hypot(zr + (z0r - zr) * k, zi + (z0i - zi) * k);
+  on_one_point(s, &p);
+}
+
 static void on_steps(selfcal_t *s, const selfcal_result_t *r)
 {
   const selfcal_cfg_t *c = &s->cfg;
@@ -440,6 +528,10 @@ static void on_steps(selfcal_t *s, const selfcal_result_t *r)
     pts[i].f_hz = nco_freq_of(j->half_step[i], c->fs_hz);
     pts[i].h_re = (double)r->z_re[i] / f;
     pts[i].h_im = (double)r->z_im[i] / f;
+  }
+  if (s->burst != 0u) {
+    on_burst(s, r);
+    return;
   }
   if (s->one_point != 0u) {
     on_one_point(s, &pts[0]);
@@ -495,7 +587,14 @@ selfcal_state_t selfcal_background(selfcal_t *s, int sweeping)
     else on_ringdown(s, &r);
     break;
   case SELFCAL_FINE: on_steps(s, &r); break;
-  case SELFCAL_HOLD: s->state = SELFCAL_READY; break;
+  case SELFCAL_HOLD:
+    if (s->braked == 1u) {
+      s->braked = 2u;
+      post_hold(s);
+    } else {
+      s->state = SELFCAL_READY;
+    }
+    break;
   case SELFCAL_IDLE:
   case SELFCAL_WAIT_SWEEP:
   case SELFCAL_READY:

@@ -44,12 +44,10 @@
  * keeps its temperature sensitivity only within about +-1/(Q kET) K, +-5 K at Q = 5000.
  * Q = 5000 is the highest Q at which the self-calibrated fixed drive is shown to lock
  * (tests/slow/test_integrity_selfcal.c); at Q = 10^4 it never locks. A sweep that
- * identifies a higher Q identifies it, then fails with SELFCAL_BEYOND_FIXED (nothing
- * committed, drive off) rather than hand over loops that cannot hold the part. */
+ * identifies a higher Q (or that runs with drive.track 1 and a tau beyond the stepped
+ * plan's) identifies |H(wn)| by a burst (selfcal.c: post_burst) instead of a settled
+ * point, hands over to the tracking drive and commits drive.track 1 (track). */
 #define SELFCAL_Q_FIXED_MAX 5000.0
-#define SELFCAL_BEYOND_FIXED \
-  "Q beyond the fixed-frequency drive's reach (Q <= 5000): this part needs the tracking " \
-  "drive (drive.track)"
 
 typedef struct {
   double fs_hz;
@@ -60,9 +58,11 @@ typedef struct {
   double amp_meas_v;     /* peak amplitude aimed at by the measurements */
   double f_cmd_start_v2; /* first chirp force (low) */
   double f_cmd_max_v2;   /* what the drive synthesis can deliver */
-  double amp_set_v;      /* the amplitude loop's set point */
-  double phase_set_rad;  /* the phase loop's set point */
-  double delay_s;        /* DAC latency + zero-order hold: 1.5 samples */
+  double amp_set_v;
+  uint32_t track;
+  /* drive.track at the start: 1 keeps the tracking drive at any Q */ /* the amplitude loop's set point */
+  double phase_set_rad; /* the phase loop's set point */
+  double delay_s;       /* DAC latency + zero-order hold: 1.5 samples */
 } selfcal_cfg_t;
 
 typedef enum {
@@ -110,6 +110,10 @@ typedef struct {
   uint32_t retries, refits;
   uint32_t rd_passes; /* ring-downs followed (high Q: a second one on frequency) */
   uint32_t one_point; /* the high-Q plan: ring-down identification, one point */
+  uint32_t burst;     /* ... that point by a burst (post_burst) */
+  uint32_t track;     /* hand over to the tracking drive (drive.track 1) */
+  uint32_t braked;    /* tracking hand-over: 1 braking the burst's vibration, 2 done */
+  double burst_end_v; /* |Z| where the burst left the vibration */
   const char *why;    /* reason of FAILED */
   /* selfcal_watch: the state last seen, since when (caller's ticks), and how long the
    * posted job may take (samples). */

@@ -155,7 +155,7 @@ GYRO_RAMFUNC static int step_driving(const supervisor_cfg_t *restrict c,
   const float ae = fm_absf(ea);
   const float pe = fm_absf(ep);
   sv->win_blocks = in->freq_at_limit ? sv->win_blocks + 1u : 0u;
-  if (sv->win_blocks >= c->sat_hold_blocks) return trip(sv, GYRO_FAULT_FREQ_WINDOW);
+  if (sv->win_blocks >= c->lost_hold_blocks) return trip(sv, GYRO_FAULT_FREQ_WINDOW);
   if (mode == GYRO_MODE_LOCKED) {
     /* Amplitude and phase each have their own count: a drive that holds its amplitude
      * while its phase has run off (a phase loop at a dead end) is not locked either. */

@@ -9,7 +9,7 @@
  *   the loops cannot hold (resonance out of reach, drive pinned at its limit, a
  *   setpoint the drive cannot reach) faults instead of acquiring for ever.
  *   ACQUIRE or LOCKED -> FAULT (FREQ_WINDOW) when the tracking drive's frequency stays at
- *   the edge of its window (drive_track.h) for sat_hold_s: the resonance is outside it.
+ *   the edge of its window (drive_track.h) for lost_hold_s: the resonance is outside it.
  *   any mode -> FAULT at once on: over-amplitude (above amp_trip_rel times the setpoint,
  *   or above amp_max_v, an absolute level the ADC can still measure: structure
  *   protection whatever the setpoint), drive ADC clipping (clip_max_count rail codes

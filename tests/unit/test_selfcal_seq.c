@@ -150,12 +150,17 @@ static void decay_case(double q, selfcal_state_t expect)
   assert_true(fabs(s.fit.f0_hz - f0) < 1e-4);
 }
 
+/* Beyond the fixed drive's reach: the tracking drive, and a burst of four contiguous
+ * means at f0 (post_burst) instead of a point settled for six tau. */
 static void test_decay_beyond_reach(void **state)
 {
   (void)state;
-  decay_case(1.0e5, SELFCAL_FAILED);
-  assert_string_equal(s.why, SELFCAL_BEYOND_FIXED);
-  assert_non_null(strstr(s.why, "tracking"));
+  decay_case(1.0e5, SELFCAL_FINE);
+  assert_int_equal(s.track, 1u);
+  assert_int_equal(s.burst, 1u);
+  assert_int_equal(x.job.n_pts, 4u);
+  assert_int_equal(x.job.step_settle_ticks, 0u);
+  assert_true(x.job.f_cmd_v2 > 0.0f);
 }
 
 static void test_decay_within_reach(void **state)
