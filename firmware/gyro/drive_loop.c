@@ -173,7 +173,6 @@ GYRO_RAMFUNC void drive_loop_update_phase(const drive_loop_cfg_t *restrict c,
       dl->p_turn_rad -= turn;
     }
     dl->p_rad = p;
-    dl->p_eq_rad = p;
   } else {
     (void)pi_reset(&c->phase, &dl->phase_pi, dl->p_rad, dl->phase_err_rad);
   }

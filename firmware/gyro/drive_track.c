@@ -89,7 +89,7 @@ void drive_track_notch(double f0_hz, double fs_hz, double loop_decim, float *c2,
   *g = (float)(1.0 / (2.0 - c));
 }
 
-void drive_track_reset(const drive_track_cfg_t *cfg, drive_track_t *t)
+GYRO_RAMFUNC void drive_track_reset(const drive_track_cfg_t *cfg, drive_track_t *t)
 {
   t->notch.x1 = t->notch.x2 = 0.0f;
   t->int_steps = 0;
@@ -98,6 +98,17 @@ void drive_track_reset(const drive_track_cfg_t *cfg, drive_track_t *t)
   t->locked = 0u;
   t->at_limit = 0u;
   t->p_eq_rad = cfg->p_init_rad;
+}
+
+GYRO_RAMFUNC float drive_track_error(const drive_track_cfg_t *restrict c,
+                                     drive_track_t *restrict t, float e_rad, float amp_rel)
+{
+  /* The notch starts afresh when there is a vibration to measure. */
+  if (amp_rel < c->min_amp_rel) {
+    t->notch.x1 = t->notch.x2 = e_rad;
+    return e_rad;
+  }
+  return drive_notch(c->notch_c2, c->notch_g, &t->notch, e_rad);
 }
 
 /* Round to the nearest whole step without libm (|x| well inside int32). */
@@ -115,13 +126,8 @@ GYRO_RAMFUNC int32_t drive_track_update(const drive_track_cfg_t *restrict c,
                                         drive_track_t *restrict t, float e_rad, float amp_rel,
                                         int locked)
 {
-  /* While the amplitude is tiny its phase is noise: hold the frequency (the notch starts
-   * afresh when there is a vibration to measure). */
-  if (amp_rel < c->min_amp_rel) {
-    t->notch.x1 = t->notch.x2 = e_rad;
-    return t->off_steps;
-  }
-  e_rad = drive_notch(c->notch_c2, c->notch_g, &t->notch, e_rad);
+  /* While the amplitude is tiny its phase is noise: hold the frequency. */
+  if (amp_rel < c->min_amp_rel) return t->off_steps;
   const uint32_t lk = locked ? 1u : 0u;
   const float kp = lk ? c->kp_lock : c->kp_acq;
   float acc = t->int_frac - (lk ? c->ki_dt_lock : c->ki_dt_acq) * e_rad;

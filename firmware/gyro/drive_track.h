@@ -119,7 +119,12 @@ void drive_track_reset(const drive_track_cfg_t *cfg, drive_track_t *t);
  * (background). */
 void drive_track_notch(double f0_hz, double fs_hz, double loop_decim, float *c2, float *g);
 
-/* One update (once per block) from the wrapped phase error e_rad (notched here) and the relative
+/* The loop's error from the wrapped phase error e_rad: notched, or (amp_rel below
+ * min_amp_rel: no vibration to measure) passed through with the notch re-seeded. */
+float drive_track_error(const drive_track_cfg_t *cfg, drive_track_t *t, float e_rad,
+                        float amp_rel);
+
+/* One update (once per block) from the error drive_track_error made and the relative
  * amplitude amp_rel = |Z| / A_set; locked selects the gains. Returns the offset in steps
  * to add to the calibrated step. */
 int32_t drive_track_update(const drive_track_cfg_t *cfg, drive_track_t *t, float e_rad,

@@ -55,6 +55,9 @@ GYRO_RAMFUNC void gyro_block_command(gyro_t *g)
   if (drive_on) {
     drive_synth_set(&g->synth, g->drive.f_cmd_v2, g->drive.p_rad);
   }
+  /* The thermometer's phase of this block's loops, for the rate channel (GYRO_SLOT_PROJECT,
+   * GYRO_SLOT_P) and the next snapshot: P, or the tracking drive's equivalent. */
+  g->drive.p_eq_rad = g->design->track != 0u ? g->track.p_eq_rad : g->drive.p_rad;
 }
 
 GYRO_RAMFUNC void gyro_block_clear(gyro_t *g)
@@ -63,31 +66,24 @@ GYRO_RAMFUNC void gyro_block_clear(gyro_t *g)
   lmsd_reset(&g->lmsd_drive);
   lmsd_reset(&g->lmsd_sense);
   drive_loop_reset(&g->design->drive, &g->drive);
-  gyro_track_restart(g);
   drive_synth_silence(&g->synth);
   g->rate_clear_due = 1u; /* the rate channel's half, on the next tick (its budget) */
 }
 
 /* The tracking drive's update (drive_track.h): the wrapped phase error moves the NCO's
  * step from the next tick on; P stays at p_init, the thermometer gets p_eq. */
-GYRO_RAMFUNC static void gyro_block_track(gyro_t *g)
+GYRO_RAMFUNC void gyro_block_track(gyro_t *g)
 {
   const gyro_design_t *d = g->design;
   drive_loop_t *dl = &g->drive;
-  const float e = fm_wrap_pi(d->drive.phase_set_rad - dl->phase_rad);
-  dl->phase_err_rad = e;
-  const int32_t off = drive_track_update(
-      &d->track_cfg, &g->track, e, dl->amp_v * dl->inv_amp_set, g->sup.mode == GYRO_MODE_LOCKED);
+  const int32_t off = drive_track_update(&d->track_cfg, &g->track, dl->phase_err_rad,
+                                         dl->amp_v * dl->inv_amp_set,
+                                         g->sup.mode == GYRO_MODE_LOCKED);
   g->nco.half_step = d->nco_half_step + (uint32_t)off;
-  dl->p_eq_rad = g->track.p_eq_rad;
 }
 
 GYRO_RAMFUNC void gyro_block_phase(gyro_t *g)
 {
-  if (g->design->track != 0u) {
-    gyro_block_track(g);
-    return;
-  }
   drive_loop_update_phase(&g->design->drive, &g->drive);
   if (GYRO_UNLIKELY(g->drive.p_turn_rad != 0.0f)) {
     /* A whole turn of P is no change of temperature: the thermometer moves with it,
@@ -123,7 +119,17 @@ GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_measure(gyro_t *g, int drive_on)
 {
-  if (drive_on) drive_loop_measure_phase(&g->drive, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
+  if (drive_on) {
+    drive_loop_measure_phase(&g->drive, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
+    /* The tracking drive's error and its notch here, its PI next tick (the budget). */
+    const gyro_design_t *d = g->design;
+    if (d->track != 0u) {
+      drive_loop_t *dl = &g->drive;
+      dl->phase_err_rad = drive_track_error(&d->track_cfg, &g->track,
+                                            fm_wrap_pi(d->drive.phase_set_rad - dl->phase_rad),
+                                            dl->amp_v * dl->inv_amp_set);
+    }
+  }
   /* The last verdict's onsets into the history, on this lighter tick. */
   if (GYRO_UNLIKELY(g->valid.onsets_pending != 0u)) {
     rate_valid_count_onsets(&g->valid, &g->valid_history);
@@ -133,7 +139,6 @@ GYRO_RAMFUNC void gyro_block_measure(gyro_t *g, int drive_on)
   o->drive_amp_v = g->drive.amp_v;
   o->drive_phase_deg = g->drive.phase_rad * FM_DEG_PER_RAD_F;
   o->p_deg = g->drive.p_eq_rad * FM_DEG_PER_RAD_F;
-  o->f_drive_hz = g->design->f_cal_hz + (float)g->track.off_steps * g->design->hz_per_step;
   o->f_cmd_v2 = g->drive.f_cmd_v2;
   o->sense_i_v = g->lmsd_sense.w_i;
   o->sense_q_v = g->lmsd_sense.w_q;
@@ -146,12 +151,20 @@ GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g, int drive_on)
                                      g->sup.mode == GYRO_MODE_LOCKED);
 }
 
+GYRO_RAMFUNC void gyro_block_track_judge(gyro_t *g, int drive_on)
+{
+  if (drive_on) gyro_block_track(g);
+  g->cont_fail = selftest_cont_judge(&g->design->selftest, &g->selftest,
+                                     g->sup.mode == GYRO_MODE_LOCKED);
+}
+
 GYRO_RAMFUNC void gyro_block_rate(gyro_t *g)
 {
   rate_channel_t *rc = &g->rate;
   if (GYRO_UNLIKELY(g->rate_clear_due != 0u)) {
     g->rate_clear_due = 0u;
     rate_channel_reset(&g->design->rate, rc, g->design->rate.p_ref_deg);
+    gyro_track_restart(g); /* the clear's tracking-drive half, within this tick's budget */
     return;
   }
   selftest_cont_notch(&g->design->selftest, &g->selftest, 0u, &rc->rate_raw);
@@ -214,6 +227,7 @@ GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
   o->rate_unc_dps = g->rate.rate_unc_dps;
   o->quad_dps = g->rate.quad_dps;
   o->p_f_deg = g->rate.p_f_deg;
+  o->f_drive_hz = d->f_cal_hz + (float)g->track.off_steps * d->hz_per_step;
   o->u1_v = u1_v;
   o->u2_v = u2_v;
   o->mode = (uint32_t)g->sup.mode;

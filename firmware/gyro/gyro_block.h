@@ -54,8 +54,10 @@ void gyro_block_phase(gyro_t *g);
 void gyro_block_measure(gyro_t *g, int drive_on);
 /* GYRO_SLOT_PROJECT: the block's projection and the continuous self-test's modulation. */
 void gyro_block_project(gyro_t *g);
-/* GYRO_SLOT_PHASE_PI: the phase loop (drive on, gyro_block_phase) and the continuous
- * self-test's verdict. */
+/* GYRO_SLOT_PHASE_PI: the phase loop (drive on, gyro_block_phase), or the tracking
+ * drive's PLL (gyro_block_track), and the continuous self-test's verdict. */
+void gyro_block_track(gyro_t *g);
+void gyro_block_track_judge(gyro_t *g, int drive_on);
 void gyro_block_phase_judge(gyro_t *g, int drive_on);
 /* GYRO_SLOT_RATE: the continuous self-test's notch on the rate axis, the rate's output
  * filter, scale and compensation, its range check. */
@@ -89,7 +91,13 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
   const int drive_on = supervisor_drive_enabled(&g->sup);
   switch (slot) {
   case GYRO_SLOT_PHASE_MEAS: gyro_block_measure(g, drive_on); break;
-  case GYRO_SLOT_PHASE_PI: gyro_block_phase_judge(g, drive_on); break;
+  case GYRO_SLOT_PHASE_PI:
+    if (g->design->track != 0u) {
+      gyro_block_track_judge(g, drive_on);
+    } else {
+      gyro_block_phase_judge(g, drive_on);
+    }
+    break;
   case GYRO_SLOT_AMP: gyro_block_amp(g); break;
   case GYRO_SLOT_COMMAND: gyro_block_command(g); break;
   case GYRO_SLOT_SUPERVISE:

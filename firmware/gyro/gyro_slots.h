@@ -18,14 +18,17 @@
  *   slot  job                                             uses (slot it comes from)
  *   0     arg Z (fm_atan2f: one divide); the drive half   drive LMSD
  *         of the output snapshot                          drive loop (1, 2, last block)
+ *         tracking drive: wrapped error and its notch     arg Z
  *   1     phase loop: wrapped error, PI -> P (P held      arg Z (0), |Z| (2, last block)
  *         while |Z| < 10 % of its setpoint; a whole
- *         turn of P passed on to the thermometer); the
- *         continuous self-test's verdict                  its LMS (6, 7, last block)
+ *         turn of P passed on to the thermometer);
+ *         tracking drive: its PI -> the NCO's step       its notched error (0)
+ *         the continuous self-test's verdict             its LMS (6, 7, last block)
  *   2     finiteness check, first half (LMSD weights);    drive LMSD
  *         |Z| (square root), amplitude PI -> f_cmd;
  *         rate-valid drive-phase and sense-range checks   phase error (4), quad (7), sense LMSD
- *   3     the supervisor's evidence (sup_in);             |Z|, f_cmd (2), phase error (1)
+ *   3     the supervisor's evidence (sup_in); the         |Z|, f_cmd (2), phase error (1)
+ *         thermometer's phase (P or its equivalent)      P (1)
  *         drive_synth_set(f_cmd, P): the waveform's       f_cmd (2), P (1)
  *         amplitude (square root) and phase offset
  *   4     supervisor (its clear request: slot 5)          evidence (3), finiteness (7, last block)

@@ -76,7 +76,7 @@ typedef struct {
   uint32_t clip_drive_count, clip_drive_block; /* the same, drive channel only */
   const volatile uint32_t *lost_count;         /* the HAL's count of lost samples */
   uint32_t lost_seen;                          /* its value at the last block */
-  uint32_t cont_fail;      /* the continuous self-test's verdict (GYRO_SLOT_P) */
+  uint32_t cont_fail;      /* the continuous self-test's verdict (GYRO_SLOT_PHASE_PI) */
   uint32_t rate_clear_due; /* the loop-state clear's rate-channel half is due (GYRO_SLOT_RATE) */
   uint32_t flags_acc;      /* GYRO_FLAG_* seen since the last snapshot */
   supervisor_in_t sup_in;  /* the supervisor's evidence, gathered by the jobs before

@@ -25,6 +25,9 @@
  * tools/bench/isr_trace.py turns into a per-function breakdown and a cycle estimate, in
  * this order (each an irq case, its interrupts in a row):
  *   isr_app_cb          LOCKED, BENCH_N_TRACE interrupts (the steady state)
+ *   isr_track           the same drive switched to the tracking drive (drive.track 1:
+ *                       its PLL, the position-form amplitude PI and their notches),
+ *                       BENCH_N_TRACE interrupts
  *   isr_fault           a NaN planted in the drive demodulator: the fault's tick, the
  *                       loop state's clear and the ticks after it
  *   isr_sweep_chirp     SWEEP: the self-calibration executive (selfcal_exec.h) on a
@@ -346,6 +349,22 @@ static void post_job(uint32_t kind)
   atomic_store(&x->job_seq, atomic_load(&x->job_seq) + 1u);
 }
 
+/* The tracking drive (drive.track 1) takes over the running drive, as a design change
+ * would hand it over; its own rarer ticks (the self-test's verdict, a slew window's end)
+ * are put inside the traced interrupts as for the fixed drive. */
+static gyro_design_t s_track_design;
+static void trace_tracking(void)
+{
+  param_values_t v = *params_current(&s_app.params);
+  v.drive_track = 1u;
+  if (gyro_design(&v, &s_track_design) != GYRO_DESIGN_OK) fail("track_design", -1);
+  gyro_apply(&s_app.gyro, &s_track_design);
+  s_app.gyro.selftest.cont_blocks = s_track_design.selftest.cont_settle_blocks;
+  s_app.gyro.valid.p_updates = RATE_VALID_SLEW_UPDATES - 1u;
+  put_state("isr_track");
+  irq_case_n("isr_track", bench_cb, BENCH_N_TRACE);
+}
+
 /* The rarer ticks (trace mode): a fault and its clear, then SWEEP's jobs. */
 static void trace_other_modes(void)
 {
@@ -404,6 +423,7 @@ static void bench_app(uint32_t settle, int trace)
     s_each = 1;
     put_state("isr_app_cb");
     irq_case("isr_app_cb", bench_cb);
+    trace_tracking();
     trace_other_modes();
     s_each = 0;
     direct_case("cb_wrap", bench_cb_empty);
