@@ -61,9 +61,10 @@ static void hand_over(app_t *a)
   if (st == PARAM_OK) st = stage_f(a, PARAM_drive_cal_gain_v_per_v2, s->fit.gain_v_per_v2);
   if (st == PARAM_OK) st = stage_f(a, PARAM_drive_p_init_deg, s->hold_p_rad * 180.0 / FM_PI);
   if (st == PARAM_OK) {
-    /* A Q beyond the fixed drive's reach: the tracking drive (selfcal.h). */
+    /* A Q beyond the fixed drive's reach: the tracking drive (selfcal.h); a tracking
+     * drive selected before the sweep stays selected at any Q. */
     param_value_t tr;
-    tr.u = s->track;
+    tr.u = s->track != 0u || s->cfg.track != 0u ? 1u : 0u;
     st = params_stage(&a->params, PARAM_drive_track, tr);
   }
   if (st != PARAM_OK) {
