@@ -50,6 +50,29 @@ static void test_default_plant(void **state)
   check_lock();
 }
 
+/* The tracking drive selected before the sweep stays selected when the sweep's own plan is
+ * the stepped sine (it committed drive.track 0 over it), and locks on another part
+ * (1700 Hz, Q 300, 20 K warmer). */
+static void test_tracking_kept(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  plant_default_cfg(&pc);
+  pc.f_drive_hz = 1700.0;
+  pc.q_drive = 300.0;
+  pc.temp_k += 20.0;
+  param_values_t v;
+  values_no_autostart(&v);
+  v.drive_track = 1u;
+  start(&pc, &v);
+  (void)sweep();
+  assert_int_equal(app.selfcal.state, SELFCAL_DONE);
+  check_identified(&pc);
+  assert_int_equal(params_current(&app.params)->drive_track, 1u);
+  check_lock();
+  assert_int_equal(app.gyro.design->track, 1u);
+}
+
 static void test_low_q_plant(void **state)
 {
   (void)state;
@@ -68,6 +91,7 @@ int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_default_plant),
+      cmocka_unit_test(test_tracking_kept),
       cmocka_unit_test(test_low_q_plant),
       cmocka_unit_test(test_high_q_plant),
   };
