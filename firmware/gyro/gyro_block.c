@@ -208,7 +208,8 @@ GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
   const uint32_t block_bits = (g->sup.mode == GYRO_MODE_LOCKED ? 0u : RATE_INVALID_MODE) |
                               (selftest_running(&g->selftest) ? RATE_INVALID_SELFTEST : 0u) |
                               (g->clip_block != 0u ? RATE_INVALID_CLIP : 0u) |
-                              (g->cont_fail != 0u ? RATE_INVALID_CONT_SELFTEST : 0u);
+                              (g->cont_fail != 0u ? RATE_INVALID_CONT_SELFTEST : 0u) |
+                              (g->design->track != 0u ? RATE_INVALID_TRACKING : 0u);
   const uint32_t invalid = rate_valid_verdict(&g->valid, block_bits);
   /* Never a valid-looking wrong rate: the analog output goes to the fault level in the
    * same sample as the verdict, without a slew. */

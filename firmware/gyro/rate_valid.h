@@ -30,6 +30,10 @@
  *                 error that makes as above
  *   CONT_SELFTEST the continuous self-test's response missing or out of its band
  *                 (selftest.h)
+ *   TRACKING      the tracking drive runs (drive.track 1): its rate channel has no
+ *                 calibration of its own yet (reference, scale and compensation are the
+ *                 fixed drive's, its thermometer an equivalent of P): measured valid, it
+ *                 read up to 28 deg/s wrong on a self-calibrated Q 10^3 part at rest
  * Each check is a few multiplies and compares per block; no divide, no libm. */
 #ifndef RATE_VALID_H
 #define RATE_VALID_H
@@ -47,7 +51,8 @@
 #define RATE_INVALID_THERMO_SLEW (1u << 8)
 #define RATE_INVALID_THERMO_SETTLE (1u << 9)
 #define RATE_INVALID_CONT_SELFTEST (1u << 10)
-#define RATE_INVALID_KINDS 11u
+#define RATE_INVALID_TRACKING (1u << 11)
+#define RATE_INVALID_KINDS 12u
 
 /* Blocks in a row inside the settling tolerance (2 ms): longer than the noise's
  * correlation time at the filters' 100 Hz, far shorter than their settling. */
