@@ -120,7 +120,7 @@ GYRO_RAMFUNC void drive_loop_reset(const drive_loop_cfg_t *restrict c, drive_loo
   dl->phase_err_rad = 0.0f;
   dl->f_cmd_v2 = 0.0f;
   dl->amp_int = 0.0f;
-  dl->amp_n1 = dl->amp_n2 = 0.0f;
+  dl->amp_notch.x1 = dl->amp_notch.x2 = 0.0f;
   dl->p_rad = c->p_init_rad;
   dl->p_eq_rad = c->p_init_rad;
   dl->p_turn_rad = 0.0f;
@@ -139,10 +139,7 @@ GYRO_RAMFUNC void drive_loop_step_amp(const drive_loop_cfg_t *restrict c,
   }
   /* Position form (drive_loop_cfg_t.amp_position): the error of the notched amplitude
    * (drive_track.h), the integral of (6-26b) on e(k-1). */
-  const float a = dl->amp_v;
-  e = dl->amp_set_v - c->notch_g * (a - c->notch_c2 * dl->amp_n1 + dl->amp_n2);
-  dl->amp_n2 = dl->amp_n1;
-  dl->amp_n1 = a;
+  e = dl->amp_set_v - drive_notch(c->notch_c2, c->notch_g, &dl->amp_notch, dl->amp_v);
   const float i = fm_clampf(dl->amp_int + c->amp.ki_t * dl->amp_pi.e_prev, c->amp.u_min,
                             c->amp.u_max);
   dl->amp_int = i;

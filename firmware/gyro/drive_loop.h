@@ -57,6 +57,7 @@
 #include <stdint.h>
 
 #include "dsp/pi.h"
+#include "gyro/drive_track.h" /* drive_notch */
 
 /* What the loops are told (the designer, gyro_design): constant while they run. */
 typedef struct {
@@ -91,8 +92,8 @@ typedef struct {
 /* What the loops remember. */
 typedef struct {
   pi_t amp_pi;
-  float amp_int;        /* the position form's integrator (amp_position), Ks V^2 */
-  float amp_n1, amp_n2; /* the notch's last two inputs (amp_position) */
+  float amp_int;           /* the position form's integrator (amp_position), Ks V^2 */
+  drive_notch_t amp_notch; /* the notch on |Z| (amp_position) */
   pi_t phase_pi;
   float amp_set_v;   /* setpoint the loop uses now, slewing towards the cfg's */
   float inv_amp_set; /* 1 / amp_set_v: the supervisor's reference */

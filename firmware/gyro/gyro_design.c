@@ -11,6 +11,7 @@
 #include "dsp/fastmath.h"
 #include "gyro/gyro_dac.h"
 #include "gyro/gyro_slots.h"
+#include "gyro/selfcal.h" /* SELFCAL_Q_FIXED_MAX */
 
 /* The absolute over-amplitude trip, as a fraction of the ADC's range: the highest
  * drive-pickoff amplitude the ADC still measures with headroom for the carrier's noise. */
@@ -186,9 +187,6 @@ static double lag_samples(uint32_t slot)
   return (double)((GYRO_SLOT_COMMAND + GYRO_BLOCK - slot) % GYRO_BLOCK + 1u);
 }
 
-/* The fixed-frequency drive's reach in Q (selfcal.h: SELFCAL_Q_FIXED_MAX, where it is
- * measured); the tracking drive has none. */
-#define GYRO_FIXED_Q_MAX 5000.0f
 /* Half-width of the tracking drive's frequency window, relative to f0 (drive_track.h):
  * +-0.5 %, some 60 K of structure temperature at 40 ppm/K of Young's modulus either way. */
 #define GYRO_TRACK_WINDOW_REL 0.005
@@ -202,7 +200,10 @@ static gyro_design_status_t design_track(const param_values_t *v, double demod_b
                                          gyro_design_t *t)
 {
   t->track = v->drive_track;
-  if (t->track == 0u && v->drive_cal_q > GYRO_FIXED_Q_MAX) return GYRO_DESIGN_FIXED_Q;
+  /* The fixed-frequency drive's reach in Q (selfcal.h, where it is measured); the
+   * tracking drive has none. */
+  if (t->track == 0u && (double)v->drive_cal_q > SELFCAL_Q_FIXED_MAX)
+    return GYRO_DESIGN_FIXED_Q;
   const double fs = (double)v->sys_fs_hz;
   const drive_track_design_in_t in = {(double)v->drive_cal_q, (double)v->drive_cal_f0_hz,
                                       (double)v->drive_phase_bw_hz, GYRO_TRACK_ACQ_BW_FACTOR,
