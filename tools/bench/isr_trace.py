@@ -31,9 +31,9 @@ from collections import Counter, OrderedDict
 HANDLER = "DMA2_Stream0_IRQHandler"
 RETURN_TO = "run_irq"                           # the bench loop that pends the interrupt
 SCAFFOLD = {"bench_cb", "bench_board_clear_tc"}  # not in the product's path
-# Kept although not in the product's path either: __app_sample_isr_veneer, the long
-# branch from bench_cb (flash) to app_sample_isr (SRAM); the product's handler calls it
-# through a pointer. One instruction per interrupt that the -icount counter also sees.
+# The scaffolding sits in SRAM beside the sample path (bench_main.c), so that bench_cb
+# calls app_sample_isr without a linker veneer, as the product's handler (a call through
+# a pointer) does.
 
 TRACE_RE = re.compile(rb"^Trace \d+: 0x[0-9a-f]+ \[[0-9a-f]+/([0-9a-f]+)/")
 DIS_RE = re.compile(r"^\s*([0-9a-f]+):\t([0-9a-f]{4})(?: ([0-9a-f]{4}))?\s*\t(\S+)\s*(.*)$")
@@ -153,10 +153,11 @@ class CycleModel:
     Each instruction is priced by where it sits: the image puts the sample path in SRAM
     (.ramfunc, linker/stm32f405_sections.ld), so "flash" below prices the flash model
     only for what is still fetched from flash. SRAM code has no wait states, but its
-    fetches share the S-bus with data accesses to SRAM: a stack access (sp-relative
-    load/store, PUSH/POP per register) or a literal-pool load from SRAM code costs one
-    cycle more. The state (app_t) and the sine table live in CCM on the D-bus (no
-    contention); the sine table is priced as flash data only when the image leaves it
+    fetches share the S-bus with data accesses to SRAM: a literal-pool load from SRAM
+    code costs one cycle more, and so does a stack access (sp-relative load/store,
+    PUSH/POP per register) when the image's main stack (_sstack) is in SRAM; the
+    product's is in CCM (D-bus), as are the state (app_t) and the sine table (no
+    contention). The sine table is priced as flash data only when the image leaves it
     in flash. "zero wait" ignores all of this (every access one cycle).
     The cache is fully associative LRU here (the ART's organisation is not documented
     in that detail), which flatters the warm case.
@@ -180,8 +181,9 @@ class CycleModel:
     COND = ("eq", "ne", "cs", "cc", "hs", "lo", "mi", "pl", "vs", "vc", "hi", "ls", "ge", "lt",
             "gt", "le", "al")
 
-    def __init__(self, insns):
+    def __init__(self, insns, stack_in_sram=True):
         self.insns = insns
+        self.stack_in_sram = stack_in_sram
 
     @classmethod
     def _root(cls, base):
@@ -261,12 +263,16 @@ class CycleModel:
                     a = ((pc + 4) & ~3) + int(lit.group(1))
                     if self.FLASH_LO <= a < self.FLASH_HI:
                         c += self._touch(dcache, a >> 4, 8) * (self.FLASH_LINE - 1)
-            # SRAM code: S-bus shared by the fetch and SRAM data (stack, literal pool)
+            # SRAM code: S-bus shared by the fetch and SRAM data (literal pool, the stack
+            # when it is in SRAM)
             if flash and self.SRAM_LO <= pc < self.SRAM_HI:
-                if root in self.MULTI and ("sp" in ops or root in ("push", "pop", "vpush", "vpop")):
-                    c += self._nregs(ops)
-                elif root in self.LDST1 | {"ldrd", "strd"} and re.search(r"\[(sp|pc)\b", ops):
+                stack_op = root in self.MULTI and ("sp" in ops or root in ("push", "pop", "vpush", "vpop"))
+                if stack_op:
+                    c += self._nregs(ops) if self.stack_in_sram else 0
+                elif root in self.LDST1 | {"ldrd", "strd"} and re.search(r"\[pc\b", ops):
                     c += 1
+                elif root in self.LDST1 | {"ldrd", "strd"} and re.search(r"\[sp\b", ops):
+                    c += 1 if self.stack_in_sram else 0
             if flash and root == "vldr" and self._in_sincos(pc):
                 c += 0 if sine_pair_hit else self.FLASH_LINE - 1
                 sine_pair_hit = not sine_pair_hit
@@ -341,7 +347,11 @@ def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm", 
     insns = disassemble(objdump, elf)
     funcs = symbols(nm, elf)
     fmap = FuncMap(funcs)
-    model = CycleModel(insns)
+    sstack = data_symbol(nm, elf, "_sstack")
+    if sstack is None:
+        raise RuntimeError("no _sstack in the image: where its stack sits sets its cost")
+    stack_in_sram = CycleModel.SRAM_LO <= sstack < CycleModel.SRAM_HI
+    model = CycleModel(insns, stack_in_sram)
     table = data_symbol(nm, elf, "sincos_table")
     table_in_flash = table is not None and CycleModel.FLASH_LO <= table < CycleModel.FLASH_HI
     for start, size, name in funcs:
@@ -403,6 +413,7 @@ def analyse(lines, elf, objdump="arm-none-eabi-objdump", nm="arm-none-eabi-nm", 
         "peripheral_extra": PERIPH_EXTRA,
         "cycles": res,
         "budget_cycles": 0.2 * 3360,
+        "stack_in_sram": stack_in_sram,
     }
 
 

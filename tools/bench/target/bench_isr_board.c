@@ -18,4 +18,5 @@ void bench_board_set_frame(const hal_adc_frame_t *frame)
 
 void bench_board_arm(void) { bench_fake_dma2.LISR = DMA_FLAG_TCIF; /* stream 0: shift 0 */ }
 
-void bench_board_clear_tc(void) { bench_fake_dma2.LISR = 0u; }
+/* In SRAM: bench_cb calls it from there (bench_main.c). */
+CM4_RAMFUNC void bench_board_clear_tc(void) { bench_fake_dma2.LISR = 0u; }

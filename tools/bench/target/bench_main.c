@@ -44,6 +44,7 @@
 #include "bench_kernels.h"
 #include "bench_now.h"
 #include "bench_plant.h"
+#include "dsp/ramfunc.h"
 #include "hal/hal_sample_timer.h"
 #include "stm32f4_board.h"
 #include "stm32f4_core.h"
@@ -201,22 +202,25 @@ static void calibrate(void)
 
 /* ---- the application and its sample interrupt ---- */
 
-static app_t s_app;
+/* Where the product keeps it (hal/boards/ref_f405/main/main_board.c). */
+static STM32F4_CCM_BSS app_t s_app;
 static bench_plant_t s_plant;
 static uint32_t s_n; /* iterations per case */
 static int s_each;   /* trace mode: print every interrupt's count */
 
 typedef void (*isr_fn)(void *);
 
-__attribute__((noipa)) static void bench_empty(void *ctx) { (void)ctx; }
+/* The wrappers sit in SRAM with the sample path, so that they call it as the product's
+ * handler does, without a linker veneer between flash and SRAM. */
+GYRO_RAMFUNC __attribute__((noipa)) static void bench_empty(void *ctx) { (void)ctx; }
 
-__attribute__((noipa)) static void bench_cb(void *ctx)
+GYRO_RAMFUNC __attribute__((noipa)) static void bench_cb(void *ctx)
 {
   app_sample_isr(ctx);
   bench_board_clear_tc();
 }
 
-__attribute__((noipa)) static void bench_cb_empty(void *ctx)
+GYRO_RAMFUNC __attribute__((noipa)) static void bench_cb_empty(void *ctx)
 {
   bench_empty(ctx);
   bench_board_clear_tc();
