@@ -1,6 +1,6 @@
 /* High-water mark of the main stack (the only stack: thread mode and every interrupt run
- * on MSP, linker/stm32f405.ld puts it at the bottom of SRAM, growing down from _estack
- * towards _sstack).
+ * on MSP, linker/stm32f405_sections.ld puts it at the bottom of CCM, growing down from
+ * _estack towards _sstack).
  *
  * Reset_Handler paints the stack from _sstack up to just below its own frame with
  * CM4_STACK_PAINT before anything else runs; a word that no longer holds the paint
