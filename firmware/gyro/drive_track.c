@@ -89,7 +89,7 @@ void drive_track_notch(double f0_hz, double fs_hz, double loop_decim, float *c2,
   *g = (float)(1.0 / (2.0 - c));
 }
 
-GYRO_RAMFUNC void drive_track_reset(const drive_track_cfg_t *cfg, drive_track_t *t)
+GYRO_RAMFUNC void drive_track_reset(drive_track_t *t)
 {
   t->notch.x1 = t->notch.x2 = 0.0f;
   t->int_steps = 0;
@@ -97,7 +97,6 @@ GYRO_RAMFUNC void drive_track_reset(const drive_track_cfg_t *cfg, drive_track_t 
   t->off_steps = 0;
   t->locked = 0u;
   t->at_limit = 0u;
-  t->p_eq_rad = cfg->p_init_rad;
 }
 
 GYRO_RAMFUNC float drive_track_error(const drive_track_cfg_t *restrict c,
@@ -144,6 +143,5 @@ GYRO_RAMFUNC int32_t drive_track_update(const drive_track_cfg_t *restrict c,
   const int32_t off = clamp_steps(want, w);
   t->at_limit = off != want || off == w || off == -w ? 1u : 0u;
   t->off_steps = off;
-  t->p_eq_rad = c->p_init_rad - c->p_eq_per_step_rad * (float)off;
   return off;
 }

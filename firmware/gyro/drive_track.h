@@ -84,9 +84,14 @@ typedef struct {
   int32_t off_steps;   /* offset in use (integrator + proportional, in the window) */
   uint32_t locked;     /* the LOCKED gains are in use */
   uint32_t at_limit;   /* the offset sits at the window's edge */
-  float p_eq_rad;      /* thermometer phase (above) */
   drive_notch_t notch; /* on the phase error */
 } drive_track_t;
+
+/* The thermometer's phase p_eq (above) of the offset in use. */
+static inline float drive_track_p_eq_rad(const drive_track_cfg_t *cfg, const drive_track_t *t)
+{
+  return cfg->p_init_rad - cfg->p_eq_per_step_rad * (float)t->off_steps;
+}
 
 typedef struct {
   double q, f0_hz;      /* identified drive resonance (drive.cal_*) */
@@ -113,7 +118,7 @@ int drive_track_design(const drive_track_design_in_t *in, drive_track_cfg_t *cfg
                        drive_track_design_out_t *out);
 
 /* Offset 0 (the calibrated step), integrator cleared, acquisition gains. */
-void drive_track_reset(const drive_track_cfg_t *cfg, drive_track_t *t);
+void drive_track_reset(drive_track_t *t);
 
 /* The notch's coefficients for a carrier f0_hz at the loop rate fs_hz / loop_decim
  * (background). */

@@ -31,7 +31,7 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
     return -2;
   }
   drive_loop_init(&d->drive, &t.drive);
-  drive_track_reset(&d->track_cfg, &t.track);
+  drive_track_reset(&t.track);
   supervisor_init(&t.sup);
   gyro_attach_lost_counter(&t, NULL);
   t.adc_v_per_code = HAL_ADC_V_PER_CODE;
@@ -72,7 +72,7 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
    * would own it): a design sets it only when the drive frequency changes. */
   if (d->nco_half_step != old->nco_half_step) {
     g->nco.half_step = d->nco_half_step;
-    drive_track_reset(&d->track_cfg, &g->track); /* it tracks from the new frequency */
+    drive_track_reset(&g->track); /* it tracks from the new frequency */
   }
   /* The LMSDs' step sizes sit beside their weights (lmsd_t: the one coefficient the
    * per-sample step reads, within the same load). */
@@ -123,7 +123,7 @@ int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d)
   if (g->sup.mode != GYRO_MODE_SWEEP) {
     return -1;
   }
-  drive_track_reset(&d->track_cfg, &g->track);
+  drive_track_reset(&g->track);
   g->nco.half_step = d->nco_half_step;
   /* The sweep's last job held the vibration at the set point with (f_cmd, P): the
    * integrators continue from there instead of from zero force. */

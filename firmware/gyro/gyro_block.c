@@ -57,7 +57,9 @@ GYRO_RAMFUNC void gyro_block_command(gyro_t *g)
   }
   /* The thermometer's phase of this block's loops, for the rate channel (GYRO_SLOT_PROJECT,
    * GYRO_SLOT_P) and the next snapshot: P, or the tracking drive's equivalent. */
-  g->drive.p_eq_rad = g->design->track != 0u ? g->track.p_eq_rad : g->drive.p_rad;
+  const gyro_design_t *d = g->design;
+  g->drive.p_eq_rad = d->track != 0u ? drive_track_p_eq_rad(&d->track_cfg, &g->track)
+                                     : g->drive.p_rad;
 }
 
 GYRO_RAMFUNC void gyro_block_clear(gyro_t *g)
@@ -130,10 +132,6 @@ GYRO_RAMFUNC void gyro_block_measure(gyro_t *g, int drive_on)
                                             dl->amp_v * dl->inv_amp_set);
     }
   }
-  /* The last verdict's onsets into the history, on this lighter tick. */
-  if (GYRO_UNLIKELY(g->valid.onsets_pending != 0u)) {
-    rate_valid_count_onsets(&g->valid, &g->valid_history);
-  }
   /* The drive half of the snapshot (gyro_block_output the rest): on this lighter tick. */
   gyro_out_t *o = &g->out;
   o->drive_amp_v = g->drive.amp_v;
@@ -142,6 +140,15 @@ GYRO_RAMFUNC void gyro_block_measure(gyro_t *g, int drive_on)
   o->f_cmd_v2 = g->drive.f_cmd_v2;
   o->sense_i_v = g->lmsd_sense.w_i;
   o->sense_q_v = g->lmsd_sense.w_q;
+}
+
+GYRO_RAMFUNC void gyro_block_supervise(gyro_t *g)
+{
+  /* The last verdict's onsets into the history, on this lighter tick. */
+  if (GYRO_UNLIKELY(g->valid.onsets_pending != 0u)) {
+    rate_valid_count_onsets(&g->valid, &g->valid_history);
+  }
+  (void)supervisor_step(&g->design->sup, &g->sup, &g->sup_in);
 }
 
 GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g, int drive_on)

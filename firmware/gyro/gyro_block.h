@@ -25,7 +25,7 @@
  * the NCO already is, unless a sweep ended without its hand-over). */
 static inline void gyro_track_restart(gyro_t *g)
 {
-  drive_track_reset(&g->design->track_cfg, &g->track);
+  drive_track_reset(&g->track);
   g->nco.half_step = g->design->nco_half_step;
 }
 
@@ -50,8 +50,12 @@ void gyro_block_quad(gyro_t *g);
  * the thermometer (rate_channel_shift_p). Tracking drive: the PLL's update instead (the
  * NCO's step from the next tick on). */
 void gyro_block_phase(gyro_t *g);
-/* GYRO_SLOT_PHASE_MEAS: arg Z (drive on), the drive half of the output snapshot. */
+/* GYRO_SLOT_PHASE_MEAS: arg Z (drive on; the tracking drive's notched error), the drive
+ * half of the output snapshot. */
 void gyro_block_measure(gyro_t *g, int drive_on);
+/* GYRO_SLOT_SUPERVISE, in every mode: the last verdict's onsets into the history (rare),
+ * then the supervisor. */
+void gyro_block_supervise(gyro_t *g);
 /* GYRO_SLOT_PROJECT: the block's projection and the continuous self-test's modulation. */
 void gyro_block_project(gyro_t *g);
 /* GYRO_SLOT_PHASE_PI: the phase loop (drive on, gyro_block_phase), or the tracking
@@ -102,7 +106,7 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
   case GYRO_SLOT_COMMAND: gyro_block_command(g); break;
   case GYRO_SLOT_SUPERVISE:
     /* Its request to clear the loop state (sup.clear_req) is acted on next tick. */
-    (void)supervisor_step(&g->design->sup, &g->sup, &g->sup_in);
+    gyro_block_supervise(g);
     break;
   case GYRO_SLOT_PROJECT:
     /* The clear resets the rate channel, whose projection waits for the next block. */
@@ -153,7 +157,7 @@ static inline void gyro_block_run_sweep(gyro_t *g, uint32_t slot, float u1_v, fl
   case GYRO_SLOT_PHASE_MEAS: gyro_block_measure(g, 0); break;
   case GYRO_SLOT_AMP: gyro_block_amp_measure(g); break;
   case GYRO_SLOT_COMMAND: gyro_block_command(g); break;
-  case GYRO_SLOT_SUPERVISE: (void)supervisor_step(&g->design->sup, &g->sup, &g->sup_in); break;
+  case GYRO_SLOT_SUPERVISE: gyro_block_supervise(g); break;
   case GYRO_SLOT_PROJECT:
     gyro_block_take_rails(g);
     if (g->sup.clear_req != 0u) gyro_block_clear(g);

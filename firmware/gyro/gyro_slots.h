@@ -28,10 +28,12 @@
  *         |Z| (square root), amplitude PI -> f_cmd;
  *         rate-valid drive-phase and sense-range checks   phase error (4), quad (7), sense LMSD
  *   3     the supervisor's evidence (sup_in); the         |Z|, f_cmd (2), phase error (1)
- *         thermometer's phase (P or its equivalent)      P (1)
+ *         thermometer's phase (P, or p_eq from the       P (1), the tracker's step (1)
+ *         tracking drive's step)
  *         drive_synth_set(f_cmd, P): the waveform's       f_cmd (2), P (1)
  *         amplitude (square root) and phase offset
- *   4     supervisor (its clear request: slot 5)          evidence (3), finiteness (7, last block)
+ *   4     the last verdict's onsets into the history      verdict (9, last block)
+ *         (rare); supervisor (its clear request: slot 5)  evidence (3), finiteness (7, last block)
  *   5     rate channel: block mean of S, projection       sense sum, P (1)
  *         (or, on request, the loop state cleared);
  *         the block's rail codes; the continuous

@@ -96,19 +96,6 @@ GYRO_RAMFUNC void rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid
   rv->slew_due = 0u;
 }
 
-GYRO_RAMFUNC void rate_valid_count_onsets(rate_valid_t *restrict rv, rate_valid_history_t *h)
-{
-  /* Only the bits that are set (usually one). */
-  uint32_t onsets = rv->onsets_pending;
-  rv->onsets_pending = 0u;
-  while (onsets != 0u) {
-    const uint32_t i = (uint32_t)__builtin_ctz(onsets);
-    h->count[i]++;
-    h->last_block[i] = rv->onset_block;
-    onsets &= onsets - 1u;
-  }
-}
-
 GYRO_RAMFUNC void rate_valid_drive(const rate_valid_cfg_t *restrict c, rate_valid_t *restrict rv,
                                    float phase_err_rad, float quad_dps, float sense_v2)
 {

@@ -155,8 +155,20 @@ static inline void rate_valid_range(const rate_valid_cfg_t *cfg, rate_valid_t *r
 }
 
 /* The onsets the verdict noted (onsets_pending) into the history, on a later, lighter
- * tick than the verdict's (rare: only when the set of reasons grew). */
-void rate_valid_count_onsets(rate_valid_t *rv, rate_valid_history_t *h);
+ * tick than the verdict's (the supervisor's; rare: only when the set of reasons grew).
+ * Inline: the call would cost that tick as much as the counting. */
+static inline void rate_valid_count_onsets(rate_valid_t *restrict rv, rate_valid_history_t *h)
+{
+  /* Only the bits that are set (usually one). */
+  uint32_t onsets = rv->onsets_pending;
+  rv->onsets_pending = 0u;
+  while (onsets != 0u) {
+    const uint32_t i = (uint32_t)__builtin_ctz(onsets);
+    h->count[i]++;
+    h->last_block[i] = rv->onset_block;
+    onsets &= onsets - 1u;
+  }
+}
 
 /* Once per block, last: the verdict (0: valid, else RATE_INVALID_* bits) from the
  * block's own evidence, block_bits (MODE, SELFTEST, CLIP, found by the caller), and what
