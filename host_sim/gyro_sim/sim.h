@@ -69,7 +69,7 @@ typedef struct {
   uint32_t faults;
   double rate_valid_fraction; /* of the run's ticks with the rate output valid */
   double rate_first_valid_s;  /* first tick with the rate valid; -1: never */
-  uint32_t phase_slips; /* true drive phase off its locked value by > 90 deg (sim_run.c) */
+  uint32_t phase_slips;       /* true drive phase off its locked value by > 90 deg (slip.h) */
   uint32_t final_mode;
   double mean_struct_k;
   double mean_drive_freq_hz;

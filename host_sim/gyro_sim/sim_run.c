@@ -14,6 +14,7 @@
 #include "hal_uart_host.h"
 #include "sim.h"
 #include "sim_out.h"
+#include "slip.h"
 #include "sim/uart_pty.h"
 
 #include <errno.h>
@@ -170,36 +171,12 @@ static void truth_sample(cl_truth_t *t, const app_t *app, const plant_truth_t *t
   t->n++;
 }
 
-/* Phase slips: the plant's true drive phase (displacement against the force's
- * fundamental, plant_truth_t) leaving the value it had when the firmware locked by more
- * than 90 deg, counted while the drive runs; each slip re-references (a drift counts
- * again every 90 deg). */
-typedef struct {
-  int armed;
-  double ref, prev, unwrapped;
-  uint32_t count;
-} slip_t;
-
-static void slip_sample(slip_t *s, const app_t *app, const plant_truth_t *tr)
+/* Phase slips (slip.h), judged on the truth's samples. */
+static void slip_take(slip_t *s, const app_t *app, const plant_truth_t *tr)
 {
   const gyro_mode_t m = app->gyro.sup.mode;
-  if (m != GYRO_MODE_LOCKED && m != GYRO_MODE_ACQUIRE) {
-    s->armed = 0;
-    return;
-  }
-  const double p = tr->drive_phase_rad;
-  if (!s->armed) {
-    if (m != GYRO_MODE_LOCKED) return;
-    s->armed = 1;
-    s->prev = s->unwrapped = s->ref = p;
-    return;
-  }
-  s->unwrapped += remainder(p - s->prev, 2.0 * PLANT_PI);
-  s->prev = p;
-  if (fabs(s->unwrapped - s->ref) > 0.5 * PLANT_PI) {
-    s->count++;
-    s->ref = s->unwrapped;
-  }
+  slip_sample(s, m == GYRO_MODE_LOCKED || m == GYRO_MODE_ACQUIRE, m == GYRO_MODE_LOCKED,
+              tr->drive_phase_rad, tr->drive_force_mps2);
 }
 
 /* Running sums of a closed-loop run for its figures. */
@@ -518,6 +495,7 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
   progress_t pr = {opt->progress && !opt->uart_pty, wall_now(), 0.0, sc->duration_s};
   const double t_wall0 = wall_now(), t_cpu0 = cpu_now();
   cl_stats_t st = {.fw_lock_s = -1.0, .first_valid_s = -1.0};
+  slip_init(&st.slip, (double)r.truth.decim / fs);
   for (uint64_t k = 0; k < n_ticks; k++) {
     hal_host_run(1u);
     const plant_truth_t *tr = plant_truth(r.plant);
@@ -529,7 +507,7 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
     }
     if ((k + 1u) % r.truth.decim == 0u) {
       if (r.truth.n < r.truth.cap) truth_sample(&r.truth, app, tr);
-      slip_sample(&st.slip, app, tr);
+      slip_take(&st.slip, app, tr);
     }
     if (k % csv_every == 0u) {
       if (r.csv.f != NULL)
