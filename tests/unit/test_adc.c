@@ -77,7 +77,9 @@ static void test_faults(void **state)
   assert_int_equal(adc_convert(&a, 2, 1.0), 0);
   assert_int_equal(adc_convert(&a, -1, 1.0), 0);
   assert_int_equal(a.fault_count[ADC_CH_SENSE], 0);
-  adc_cfg_t c = {0.0};
+  adc_cfg_t c;
+  adc_default_cfg(&c);
+  c.full_scale_v = 0.0;
   adc_t before = a;
   assert_int_equal(adc_init(&a, &c), -1);
   c.full_scale_v = NAN;
