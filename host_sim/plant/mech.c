@@ -452,16 +452,18 @@ static double cubic(double k3, double u, unsigned flag, unsigned *out)
   return k3 * u * u * u;
 }
 
-/* The held forces of mech.h (Duffing, coupling drift) per unit mass, from the state at
- * the start of the sample predicted to its middle. */
-static void held_forces(mech_t *m, double *fy, double *fx)
+/* The held forces of mech.h (Duffing, coupling drift) per unit mass, from the motion at
+ * the middle of the sample: the cubic Hermite interpolant of the states at its start (z0)
+ * and end without these forces (z1), scaled units (mech.h). */
+static void held_forces(mech_t *m, const double *z0, const double *z1, double *fy, double *fx)
 {
   const mech_cfg_t *c = &m->cfg;
-  const double h = 0.5 / c->fs_hz;
+  const double T = 1.0 / c->fs_hz, wr = m->wr;
   const double w1 = mech_wn1(m), w2 = mech_wn2(m);
-  const double y = m->z[0], vy = m->z[1] * m->wr, x = m->z[2], vx = m->z[3] * m->wr;
-  const double k = 1.0 - 0.5 * (w1 * h) * (w1 * h);
-  const double ym = y * k + vy * h, vym = vy * k - w1 * w1 * y * h, xm = x * k + vx * h;
+  /* p(1/2) = (p0 + p1)/2 + T (v0 - v1)/8,  p'(1/2) = 3 (p1 - p0) / (2T) - (v0 + v1)/4 */
+  const double ym = 0.5 * (z0[0] + z1[0]) + 0.125 * T * wr * (z0[1] - z1[1]);
+  const double vym = 1.5 * (z1[0] - z0[0]) / T - 0.25 * wr * (z0[1] + z1[1]);
+  const double xm = 0.5 * (z0[2] + z1[2]) + 0.125 * T * wr * (z0[3] - z1[3]);
   *fy = *fx = 0.0;
   if (c->k3_drive_per_m2 != 0.0)
     *fy -= w1 * w1 * cubic(c->k3_drive_per_m2, ym, MECH_OUT_DUFFING_DRIVE, &m->duffing_out);
@@ -490,12 +492,6 @@ void mech_step(mech_t *m, double f_drive_mps2, double f_sense_mps2, double rate_
   v[3] = m->z[3];
   v[4] = f_drive_mps2 * in_scale;
   v[5] = f_sense_mps2 * in_scale;
-  if (m->held) {
-    double fy, fx;
-    held_forces(m, &fy, &fx);
-    v[4] += fy * in_scale;
-    v[5] += fx * in_scale;
-  }
   if (m->cfg.brownian) {
     v[4] += m->noise_sd[0] * gauss_zig(&m->zig, &m->rng[0]);
     v[5] += m->noise_sd[1] * gauss_zig(&m->zig, &m->rng[1]);
@@ -504,6 +500,14 @@ void mech_step(mech_t *m, double f_drive_mps2, double f_sense_mps2, double rate_
     const double *kr = m->k[r];
     m->z[r] = kr[0] * v[0] + kr[1] * v[1] + kr[2] * v[2] + kr[3] * v[3] + kr[4] * v[4] +
               kr[5] * v[5];
+  }
+  if (m->held) {
+    /* the held forces from the sample's motion without them, then their share of the
+     * step (the step is linear in the inputs: Gamma's columns) */
+    double fy, fx;
+    held_forces(m, v, m->z, &fy, &fx);
+    for (int r = 0; r < MECH_NS; r++)
+      m->z[r] += m->k[r][4] * (fy * in_scale) + m->k[r][5] * (fx * in_scale);
   }
 }
 

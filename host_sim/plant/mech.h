@@ -46,12 +46,16 @@
  * like the other stiffness terms (exact).
  *
  * Held forces (not in the generator; added to the inputs f_y, f_x of the sample, only
- * when switched on), each evaluated at the middle of the sample from the state at its
- * start, predicted along the free motion at the drive frequency w1 = wn1(T):
- *   y_m = y (1 - (w1 T/2)^2 / 2) + y' T/2,   y'_m = y' (1 - (w1 T/2)^2 / 2) - w1^2 y T/2
- * (the value at mid-sample, held, has no phase error against the motion and a gain of
- * sinc(w T/2), 0.9985 at 1.5 kHz and 50 kHz: the lead of the mid-sample value cancels the
- * hold's lag, as for the rate in A and the DAC's per-sample means, dac.h):
+ * when switched on), each evaluated from the motion at the middle of the sample: the
+ * cubic Hermite interpolant between the state at its start and the state at its end
+ * without these forces (y_m = (y0 + y1)/2 + T (y0' - y1')/8, y'_m likewise; exact for a
+ * cubic, (w T)^4 / 384 = 3e-6 on a sine at 1.5 kHz, whatever its frequency), then their
+ * share of the step added through Gamma (the step is linear in its inputs); the forces'
+ * own effect within the sample is left out of the interpolant (second order in them).
+ * The mid-sample value, held, has no phase error against the motion and a gain of
+ * sinc(w T/2) on it, 0.99855 at 1.49 kHz and 0.99737 at 2 kHz (50 kHz): the lead of the
+ * mid-sample value cancels the hold's lag, as for the rate in A and the DAC's per-sample
+ * means (dac.h):
  *   - cubic suspension stiffness (Duffing): f_y -= wn1^2 k3_drive y_m^3, f_x -= wn2^2
  *     k3_sense x_m^3 with k3 = k3/k (1/m^2), restoring force k (y + (k3/k) y^3). A free
  *     oscillation of amplitude A then runs at f (1 + 3 (k3/k) A^2 / 8) to first order
