@@ -51,32 +51,6 @@ static void usage(FILE *f)
         f);
 }
 
-static void list_params(void)
-{
-  printf("# plant parameters (plant.KEY)\n");
-  plant_cfg_t c;
-  plant_default_cfg(&c);
-  for (size_t i = 0; i < plant_param_count(); i++) {
-    const plant_param_desc_t *d = plant_param_at(i);
-    printf("plant.%-34s %-12g [%g, %g] %s  %s\n", d->name, plant_param_get(&c, d), d->min,
-           d->max, d->unit, d->doc);
-  }
-  printf("# firmware parameters (firmware.NAME)\n");
-  param_values_t v;
-  param_values_defaults(&v);
-  for (unsigned i = 0; i < (unsigned)PARAM_COUNT; i++) {
-    const param_info_t *pi = param_info((param_idx_t)i);
-    const param_value_t x = param_get(&v, (param_idx_t)i);
-    if (pi->type == PARAM_T_F32) {
-      printf("firmware.%-31s %-12g [%g, %g] %s  %s\n", pi->name, (double)x.f, (double)pi->min.f,
-             (double)pi->max.f, pi->unit, pi->help);
-    } else {
-      printf("firmware.%-31s %-12u [%u, %u] %s  %s\n", pi->name, x.u, pi->min.u, pi->max.u,
-             pi->unit, pi->help);
-    }
-  }
-}
-
 /* Brownian floor of the rate (4-24) at the run's actual drive frequency, amplitude and
  * structure temperature: the white-rate coefficient N of the Allan deviation (IEEE,
  * two-sided; a one-sided spectrum shows sqrt(2) N), in deg/h/sqrt(Hz). */
@@ -205,7 +179,7 @@ static int parse_args(int argc, char **argv, cli_args_t *a)
     case 'n': a->analysis = 0; break;
     case 'i': a->isr_json = optarg; break;
     case 'C': a->selfcal = 1; break;
-    case 'L': list_params(); return 0;
+    case 'L': sim_list_params(stdout); return 0;
     case 'h': usage(stdout); return 0;
     default: usage(stderr); return 2;
     }

@@ -221,6 +221,119 @@ static int parse_vec3(const cJSON *j, const char *where, double lim, double out[
   return 0;
 }
 
+/* "axis": "drive" | "sense" | "normal" (accel.h's ACCEL_AXIS_* order). */
+static int parse_axis(const cJSON *j, const char *where, int *axis, char *err, size_t len)
+{
+  static const char *const names[3] = {"drive", "sense", "normal"};
+  for (int i = 0; cJSON_IsString(j) && i < 3; i++) {
+    if (strcmp(j->valuestring, names[i]) == 0) {
+      *axis = i;
+      return 0;
+    }
+  }
+  return fail(err, len, "%s: expected \"drive\", \"sense\" or \"normal\"", where);
+}
+
+/* Every key of the entry obj is one of allowed (n of them) and the required ones (the
+ * first n_req) are there. */
+static int entry_keys(const cJSON *obj, const char *where, const char *const *allowed, int n,
+                      int n_req, char *err, size_t len)
+{
+  if (!cJSON_IsObject(obj)) return fail(err, len, "%s: expected an object", where);
+  const cJSON *it;
+  cJSON_ArrayForEach(it, obj)
+  {
+    int known = 0;
+    for (int i = 0; i < n; i++) known |= strcmp(it->string, allowed[i]) == 0;
+    if (!known) return fail(err, len, "%s.%s: unknown key", where, it->string);
+  }
+  for (int i = 0; i < n_req; i++)
+    if (cJSON_GetObjectItemCaseSensitive(obj, allowed[i]) == NULL)
+      return fail(err, len, "%s.%s: missing", where, allowed[i]);
+  return 0;
+}
+
+/* accel_g.shocks: [{"t_s", "peak_g", "duration_ms", "axis"}, ...], half-sine shocks. */
+static int parse_shocks(const cJSON *arr, accel_profile_t *t, char *err, size_t len)
+{
+  static const char *const keys[] = {"t_s", "peak_g", "duration_ms", "axis"};
+  if (!cJSON_IsArray(arr) || cJSON_GetArraySize(arr) > PROFILE_MAX_SHOCKS)
+    return fail(err, len, "accel_g.shocks: expected a list of at most %d shocks",
+                PROFILE_MAX_SHOCKS);
+  const cJSON *e;
+  int j = 0;
+  cJSON_ArrayForEach(e, arr)
+  {
+    char w[64], k[96];
+    snprintf(w, sizeof w, "accel_g.shocks[%d]", j);
+    if (entry_keys(e, w, keys, 4, 4, err, len) != 0) return -1;
+    double ms = 0.0;
+    snprintf(k, sizeof k, "%s.t_s", w);
+    if (get_num(cJSON_GetObjectItemCaseSensitive(e, "t_s"), k, 0.0, 1e7, &t->shock_t_s[j], err,
+                len) != 0)
+      return -1;
+    snprintf(k, sizeof k, "%s.peak_g", w);
+    if (get_num(cJSON_GetObjectItemCaseSensitive(e, "peak_g"), k, -1e5, 1e5,
+                &t->shock_peak_g[j], err, len) != 0)
+      return -1;
+    snprintf(k, sizeof k, "%s.duration_ms", w);
+    if (get_num(cJSON_GetObjectItemCaseSensitive(e, "duration_ms"), k, 1e-3, 1e4, &ms, err,
+                len) != 0)
+      return -1;
+    t->shock_dur_s[j] = 1e-3 * ms;
+    snprintf(k, sizeof k, "%s.axis", w);
+    if (parse_axis(cJSON_GetObjectItemCaseSensitive(e, "axis"), k, &t->shock_axis[j], err,
+                   len) != 0)
+      return -1;
+    j++;
+  }
+  t->n_shocks = j;
+  return 0;
+}
+
+/* accel_g.random: [{"axis", "psd_g2_per_hz", "f_hi_hz", "f_lo_hz"}, ...], random
+ * vibration bands (f_lo_hz optional: 0, a flat spectrum from DC). */
+static int parse_random(const cJSON *arr, accel_profile_t *t, char *err, size_t len)
+{
+  static const char *const keys[] = {"axis", "psd_g2_per_hz", "f_hi_hz", "f_lo_hz"};
+  if (!cJSON_IsArray(arr) || cJSON_GetArraySize(arr) > PROFILE_MAX_VIB_BANDS)
+    return fail(err, len, "accel_g.random: expected a list of at most %d bands",
+                PROFILE_MAX_VIB_BANDS);
+  const cJSON *e;
+  int j = 0;
+  cJSON_ArrayForEach(e, arr)
+  {
+    char w[64], k[96];
+    snprintf(w, sizeof w, "accel_g.random[%d]", j);
+    if (entry_keys(e, w, keys, 4, 3, err, len) != 0) return -1;
+    snprintf(k, sizeof k, "%s.axis", w);
+    if (parse_axis(cJSON_GetObjectItemCaseSensitive(e, "axis"), k, &t->band_axis[j], err, len) !=
+        0)
+      return -1;
+    snprintf(k, sizeof k, "%s.psd_g2_per_hz", w);
+    if (get_num(cJSON_GetObjectItemCaseSensitive(e, "psd_g2_per_hz"), k, 1e-12, 1e3,
+                &t->band_psd_g2_per_hz[j], err, len) != 0)
+      return -1;
+    snprintf(k, sizeof k, "%s.f_hi_hz", w);
+    if (get_num(cJSON_GetObjectItemCaseSensitive(e, "f_hi_hz"), k, 0.2, 1e5,
+                &t->band_f_hi_hz[j], err, len) != 0)
+      return -1;
+    const cJSON *lo = cJSON_GetObjectItemCaseSensitive(e, "f_lo_hz");
+    t->band_f_lo_hz[j] = 0.0;
+    snprintf(k, sizeof k, "%s.f_lo_hz", w);
+    if (lo != NULL && get_num(lo, k, 0.0, 1e5, &t->band_f_lo_hz[j], err, len) != 0) return -1;
+    if (t->band_f_lo_hz[j] != 0.0 && t->band_f_lo_hz[j] < 0.1)
+      return fail(err, len, "%s: %g is neither 0 (from DC) nor at least 0.1 Hz", k,
+                  t->band_f_lo_hz[j]);
+    if (t->band_f_hi_hz[j] < 2.0 * t->band_f_lo_hz[j])
+      return fail(err, len,
+                  "%s.f_hi_hz: the band must span an octave at least (f_hi_hz >= 2 f_lo_hz)", w);
+    j++;
+  }
+  t->n_bands = j;
+  return 0;
+}
+
 static int parse_accel(const cJSON *obj, accel_profile_t *a, char *err, size_t len)
 {
   if (!cJSON_IsObject(obj)) return fail(err, len, "accel_g: expected an object");
@@ -238,8 +351,11 @@ static int parse_accel(const cJSON *obj, accel_profile_t *a, char *err, size_t l
       rc = parse_vec3(it, "accel_g.freq_hz", 1e4, t.freq_hz, err, len);
     else if (strcmp(it->string, "phase_rad") == 0)
       rc = parse_vec3(it, "accel_g.phase_rad", 1e3, t.phase_rad, err, len);
+    else if (strcmp(it->string, "shocks") == 0) rc = parse_shocks(it, &t, err, len);
+    else if (strcmp(it->string, "random") == 0) rc = parse_random(it, &t, err, len);
     else
-      return fail(err, len, "accel_g.%s: unknown key (const, amp, freq_hz, phase_rad)",
+      return fail(err, len,
+                  "accel_g.%s: unknown key (const, amp, freq_hz, phase_rad, shocks, random)",
                   it->string);
     if (rc != 0) return -1;
   }

@@ -13,7 +13,16 @@
  *     "plant":    { "<plant parameter>": number, ... },       (plant.h descriptor table)
  *     "firmware": { "<firmware parameter>": number, ... },    (params/param_list.h)
  *     "rate_dps":  PROFILE, "ambient_c": PROFILE,             (input profiles)
- *     "accel_g": { "const": [x,y,z], "amp": [x,y,z], "freq_hz": [x,y,z] },
+ *     "accel_g": { "const": [x,y,z], "amp": [x,y,z], "freq_hz": [x,y,z], "phase_rad": [x,y,z],
+ *                  "shocks": [ {"t_s": t, "peak_g": p, "duration_ms": d, "axis": AXIS}, ... ],
+ *                  "random": [ {"axis": AXIS, "psd_g2_per_hz": G, "f_lo_hz": lo,
+ *                               "f_hi_hz": hi}, ... ] },
+ *                 (x, y, z and AXIS "drive", "sense", "normal": accel.h's axes; up to 8
+ *                  half-sine shocks and 4 random-vibration bands, profile.h; f_lo_hz
+ *                  optional, 0: flat from DC; a band spans an octave at least and
+ *                  ends below 0.45 plant.fs_hz. The self-calibration's initial
+ *                  conditions hold the deterministic part's value at t = 0, no random
+ *                  vibration),
  *     "open_loop": { "u_amp_v": 8, "freq_hz": 1489.9,
  *                    "sweep": { "f_start_hz": 1400, "f_stop_hz": 1600, "points": 81,
  *                               "dwell_s": 0.2, "settle_s": 0.1 } },

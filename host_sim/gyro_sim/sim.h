@@ -52,7 +52,8 @@ typedef struct {
   double f0_hz, q;      /* identified (NAN before the fit) */
   double s;             /* the firmware's sweep time: request to hand-over */
   double true_f0_hz;    /* undamped drive resonance (2-32), mean over the sweep */
-  double true_q;        /* the drive resonance's Q at the same time */
+  double true_q;        /* the drive Q at the structure temperature (plant.q_temp_law),
+                           mean over the sweep */
   param_values_t saved; /* the parameters the timeline starts from (the store's) */
 } sim_selfcal_t;
 
@@ -84,6 +85,10 @@ typedef struct {
   int uart_pty;              /* expose the tuning UART as a pty, run paced in real time */
   const char *uart_pty_link; /* optional symlink to the pty */
 } sim_opts_t;
+
+/* Every parameter a scenario or --set takes, with its default, range, unit and doc:
+ * plant.KEY (the plant's table and plant.thermal_preset) and firmware.NAME. */
+void sim_list_params(FILE *f);
 
 /* Build the plant configuration and profiles from the scenario (defaults + overrides).
  * Returns 0, or -1 with the offending key in err. */

@@ -5,6 +5,39 @@
 
 #include "sim.h"
 
+/* The thermal presets by number, as plant.thermal_preset takes them. */
+static const char *const kThermalPresets[] = {"default", "tight", "loose"};
+
+void sim_list_params(FILE *f)
+{
+  fprintf(f, "# plant parameters (plant.KEY)\n");
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  for (size_t i = 0; i < plant_param_count(); i++) {
+    const plant_param_desc_t *d = plant_param_at(i);
+    fprintf(f, "plant.%-40s %-12g [%g, %g] %s  %s\n", d->name, plant_param_get(&c, d), d->min,
+            d->max, d->unit, d->doc);
+  }
+  /* not a field of the plant: a set of them (thermal.h), applied where it stands among
+   * the settings, so later tau_*, couple_*, rise_* settings override it */
+  fprintf(f, "plant.%-40s %-12g [%g, %g] %s  %s\n", "thermal_preset", 0.0, 0.0, 2.0, "",
+          "thermal network preset: 0 default, 1 tight, 2 loose (sets tau_*, couple_*, rise_*)");
+  fprintf(f, "# firmware parameters (firmware.NAME)\n");
+  param_values_t v;
+  param_values_defaults(&v);
+  for (unsigned i = 0; i < (unsigned)PARAM_COUNT; i++) {
+    const param_info_t *pi = param_info((param_idx_t)i);
+    const param_value_t x = param_get(&v, (param_idx_t)i);
+    if (pi->type == PARAM_T_F32) {
+      fprintf(f, "firmware.%-37s %-12g [%g, %g] %s  %s\n", pi->name, (double)x.f,
+              (double)pi->min.f, (double)pi->max.f, pi->unit, pi->help);
+    } else {
+      fprintf(f, "firmware.%-37s %-12u [%u, %u] %s  %s\n", pi->name, x.u, pi->min.u, pi->max.u,
+              pi->unit, pi->help);
+    }
+  }
+}
+
 int sim_plant_cfg(const sim_scenario_t *sc, plant_cfg_t *cfg, plant_profiles_t *prof, char *err,
                   size_t err_len)
 {
@@ -14,9 +47,9 @@ int sim_plant_cfg(const sim_scenario_t *sc, plant_cfg_t *cfg, plant_profiles_t *
     const sim_set_t *s = &sc->plant_set[i];
     /* "thermal_preset" selects a coupling preset (tight/loose/default) by number. */
     if (strcmp(s->key, "thermal_preset") == 0) {
-      static const char *const names[] = {"default", "tight", "loose"};
-      const int k = (int)s->value;
-      if (s->value != (double)k || k < 0 || k > 2 || plant_thermal_preset(&c, names[k]) != 0) {
+      const double v = s->value;
+      const int k = (v >= 0.0 && v <= 2.0) ? (int)v : -1;
+      if (k < 0 || v != (double)k || plant_thermal_preset(&c, kThermalPresets[k]) != 0) {
         snprintf(err, err_len,
                  "plant.thermal_preset: %g is not 0 (default), 1 (tight) or 2 (loose)", s->value);
         return -1;
@@ -33,6 +66,16 @@ int sim_plant_cfg(const sim_scenario_t *sc, plant_cfg_t *cfg, plant_profiles_t *
   if (plant_cfg_check(&c, why, sizeof why) != 0) {
     snprintf(err, err_len, "plant: %s", why);
     return -1;
+  }
+  /* every band ends below 0.45 fs (vib.h), fs_hz being a parameter too */
+  const accel_profile_t *acc = &sc->accel_g;
+  for (int j = 0; sc->has_accel && j < acc->n_bands; j++) {
+    if (!(acc->band_f_hi_hz[j] < 0.45 * c.fs_hz)) {
+      snprintf(err, err_len,
+               "accel_g.random[%d].f_hi_hz: %g Hz must be below 0.45 plant.fs_hz (%g Hz)", j,
+               acc->band_f_hi_hz[j], 0.45 * c.fs_hz);
+      return -1;
+    }
   }
   memset(prof, 0, sizeof *prof);
   if (sc->has_rate) prof->rate_dps = sc->rate_dps;

@@ -368,7 +368,8 @@ static void first_line(const char *reply, char *out, size_t n)
 
 /* `sweep` on the running application, then the background loop polled every
  * millisecond until the sequencer is done or failed. Sums the plant's true drive
- * resonance over the sweep. Returns 0 when it finished (DONE), else -1 with out->why. */
+ * resonance and Q (both at the structure temperature) over the sweep. Returns 0 when it
+ * finished (DONE), else -1 with out->why. */
 static int selfcal_sweep(app_t *a, const plant_t *p, double fs, sim_selfcal_t *out)
 {
   char reply[1024];
@@ -379,7 +380,10 @@ static int selfcal_sweep(app_t *a, const plant_t *p, double fs, sim_selfcal_t *o
   }
   const uint64_t poll = (uint64_t)llround(fs / 1000.0);
   const uint64_t cap = (uint64_t)llround(SELFCAL_MAX_S * fs);
-  double sum_wn = 0.0;
+  /* the Q as its first value plus the mean deviation: exactly the plant's Q when its
+   * law keeps it constant */
+  const double q0 = plant_truth(p)->q_drive;
+  double sum_wn = 0.0, sum_dq = 0.0;
   uint64_t n = 0u;
   const selfcal_t *s = &a->selfcal;
   for (uint64_t k = 0; k < cap && s->state != SELFCAL_DONE && s->state != SELFCAL_FAILED;
@@ -387,11 +391,13 @@ static int selfcal_sweep(app_t *a, const plant_t *p, double fs, sim_selfcal_t *o
     hal_host_run(poll);
     app_poll(a);
     sum_wn += plant_truth(p)->wn_drive_rad_s;
+    sum_dq += plant_truth(p)->q_drive - q0;
     n++;
   }
   out->true_f0_hz = n ? sum_wn / (double)n / (2.0 * PLANT_PI) : NAN;
-  /* The plant's drive Q has no temperature law (mech.h): the configured one holds. */
-  out->true_q = p->mech.cfg.q1;
+  /* the drive Q at the structure temperature (its law, plant.q_temp_law), mean over the
+   * sweep */
+  out->true_q = n ? q0 + sum_dq / (double)n : NAN;
   out->f0_hz = s->fit.q > 0.0 ? s->fit.f0_hz : NAN;
   out->q = s->fit.q > 0.0 ? s->fit.q : NAN;
   out->s = (double)(s->state == SELFCAL_DONE ? a->selfcal_ticks

@@ -26,8 +26,11 @@
  * with the noise voltage w taken constant over the sample (one value of the noise
  * sequence per sample; its spectrum is defined up to fs/2). See dac.h for the size of
  * the remaining zero-order-hold approximation (sinc^2(wT/2), no phase error).
- * Not modelled: electrostatic spring softening (6-3) of parallel-plate feedback
- * electrodes (|Ke| << K2, (6-4)); fringe-field variation of comb forces with stroke.
+ * The electrostatic spring softening (6-3) of the parallel-plate feedback electrodes by
+ * their DC bias is a stiffness of the mechanics (plant.fb_gap_m, plant_fb_softening,
+ * mech.h). Not modelled: the forces' own dependence on the displacement (Ks(x) of
+ * parallel plates; |Ke| << K2, (6-4)), the parametric stiffness of the AC part of the
+ * electrode voltages, fringe-field variation of comb forces with stroke.
  *
  * Noise streams: rng_seed(seed, ACTUATOR_RNG_STREAM_U1 + i), i = 0..3 for U1, U2, U3,
  * U4; a source with zero density draws nothing.

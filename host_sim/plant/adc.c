@@ -3,17 +3,45 @@
 #include <math.h>
 #include <string.h>
 
-void adc_default_cfg(adc_cfg_t *cfg) { cfg->full_scale_v = (double)HAL_ADC_FULL_SCALE_V; }
+void adc_default_cfg(adc_cfg_t *cfg)
+{
+  memset(cfg, 0, sizeof *cfg);
+  cfg->full_scale_v = (double)HAL_ADC_FULL_SCALE_V;
+}
 
 int adc_init(adc_t *a, const adc_cfg_t *cfg)
 {
   if (a == NULL || cfg == NULL) return -1;
   if (!(isfinite(cfg->full_scale_v) && cfg->full_scale_v > 0.0 && cfg->full_scale_v <= 100.0))
     return -1;
+  if (!(isfinite(cfg->aperture_jitter_s) && cfg->aperture_jitter_s >= 0.0 &&
+        cfg->aperture_jitter_s <= 1e-3))
+    return -1;
+  if (inl_check(&cfg->inl, ADC_BITS) != 0) return -1;
   memset(a, 0, sizeof *a);
   a->cfg = *cfg;
   a->inv_lsb = 32768.0 / cfg->full_scale_v;
+  (void)inl_init(&a->inl, &cfg->inl, ADC_BITS, cfg->seed, ADC_RNG_STREAM_INL);
+  rng_seed(&a->rng_aperture, cfg->seed, ADC_RNG_STREAM_APERTURE);
   return 0;
+}
+
+void adc_set_ref(adc_t *a, double ref_rel) { a->ref_rel = ref_rel; }
+
+double adc_aperture_draw(adc_t *a)
+{
+  if (!(a->cfg.aperture_jitter_s > 0.0)) return 0.0;
+  return a->cfg.aperture_jitter_s * rng_gauss(&a->rng_aperture);
+}
+
+/* INL (inl.h) at the code x would ideally give, in offset binary. */
+static double inl_at(const adc_t *a, double x)
+{
+  const double r = round(x);
+  long c = 0;
+  if (r > (double)HAL_ADC_CODE_MAX) c = 65535;
+  else if (r >= (double)HAL_ADC_CODE_MIN) c = (long)r + 32768;
+  return inl_lsb(&a->inl, c);
 }
 
 int16_t adc_convert(adc_t *a, int ch, double v)
@@ -23,7 +51,10 @@ int16_t adc_convert(adc_t *a, int ch, double v)
     a->fault_count[ch]++;
     return 0;
   }
-  const double x = round(v * a->inv_lsb);
+  double xv = v * a->inv_lsb;
+  if (a->ref_rel != 0.0) xv /= 1.0 + a->ref_rel;
+  if (a->inl.active) xv += inl_at(a, xv);
+  const double x = round(xv);
   if (x > (double)HAL_ADC_CODE_MAX) {
     a->clip_count[ch]++;
     return (int16_t)HAL_ADC_CODE_MAX;

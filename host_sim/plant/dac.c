@@ -56,13 +56,21 @@ static int cfg_ok(const dac_cfg_t *c)
       return 0;
     if (c->initial_code[i] > HAL_DAC_CODE_MAX) return 0;
   }
-  return 1;
+  return inl_check(&c->inl, DAC_BITS) == 0;
 }
 
 static double held_level(const dac_t *d, int c, uint16_t code)
 {
-  return d->scale[c] * (double)code + d->zero[c];
+  double u = d->scale[c] * (double)code + d->zero[c];
+  if (d->inl[c].active) u += d->scale[c] * inl_lsb(&d->inl[c], (long)code);
+  if (d->ref_rel != 0.0) {
+    const double off = d->cfg.offset_v[c];
+    u = off + (u - off) * (1.0 + d->ref_rel);
+  }
+  return u;
 }
+
+void dac_set_ref(dac_t *d, double ref_rel) { d->ref_rel = ref_rel; }
 
 /* Exact forms of the filter over one sample, in normalised time s = t / T. */
 static int discretise(dac_t *d)
@@ -136,6 +144,9 @@ int dac_init(dac_t *d, const dac_cfg_t *cfg)
     t.scale[c] = cfg->gain[c] * lsb;
     t.zero[c] = cfg->offset_v[c] - cfg->gain[c] * lsb * (double)HAL_DAC_CODE_MID;
   }
+  for (int c = 0; c < DAC_NCH; c++)
+    (void)inl_init(&t.inl[c], &cfg->inl, DAC_BITS, cfg->inl_seed,
+                   DAC_RNG_STREAM_INL + (uint64_t)c);
   for (int c = 0; c < DAC_NCH; c++) {
     t.latched[c] = cfg->initial_code[c];
     t.pending[c] = cfg->initial_code[c];

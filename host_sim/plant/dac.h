@@ -44,6 +44,12 @@
  * Voltages at the end of the sample (end_v, end_dvdt_v_per_s) are for the pickoff's
  * electrical feedthrough, which interpolates between ticks.
  *
+ * Imperfections, each off at zero: the INL of each channel's 14-bit ladder (cfg.inl,
+ * inl.h: the bow and a per-code pattern of its own per channel), the level of code c
+ * being gain (c + INL(c) - 8192) lsb + offset; and the shared reference's relative
+ * error r (dac_set_ref, vref.h), which scales the converter's part of the level:
+ * offset + (level - offset) (1 + r).
+ *
  * Channels (hal/include/hal/hal_dac.h): 0 drive U1, 1 drive U2, 2 analog rate output, 3 spare.
  *
  * One plant sample [t_k, t_k+1) with the electrical modules (the top level's order):
@@ -67,8 +73,11 @@
 #include <stdint.h>
 
 #include "hal/hal_dac.h"
+#include "plant/inl.h"
 
 #define DAC_NCH HAL_DAC_NUM_CHANNELS
+#define DAC_BITS 14
+#define DAC_RNG_STREAM_INL 0x7501u /* + channel */
 
 typedef struct {
   double fs_hz;                   /* latch (sample) rate, Hz */
@@ -77,6 +86,8 @@ typedef struct {
   double gain[DAC_NCH];           /* output amplifier gain, 1 = ideal */
   double offset_v[DAC_NCH];       /* output offset, V */
   uint16_t initial_code[DAC_NCH]; /* held before the first latched frame */
+  inl_cfg_t inl;                  /* integral nonlinearity of every channel, LSB */
+  uint64_t inl_seed;              /* the part's INL patterns */
 } dac_cfg_t;
 
 typedef struct {
@@ -104,15 +115,20 @@ typedef struct {
   double x[DAC_NCH][2];      /* filter states [v, v'/w0] */
   uint16_t latched[DAC_NCH]; /* code held over the current sample */
   uint16_t pending[DAC_NCH]; /* code latched at the end of the current sample */
+  double ref_rel;            /* reference error r (dac_set_ref) */
+  inl_t inl[DAC_NCH];
 } dac_t;
 
 /* fs 50 kHz, 2nd-order Butterworth at 20 kHz, ideal gain, no offset, mid-scale codes. */
 void dac_default_cfg(dac_cfg_t *cfg);
 
 /* Validates cfg (fs > 0; cutoff 0 or in (0, fs]; Q in [0.1, 10]; |gain| in (0, 2];
- * |offset| <= 15 V; codes <= 16383). Returns 0, or -1 with d unchanged. The filters
- * start settled at the initial codes. */
+ * |offset| <= 15 V; codes <= 16383; inl_check). Returns 0, or -1 with d unchanged. The
+ * filters start settled at the initial codes. */
 int dac_init(dac_t *d, const dac_cfg_t *cfg);
+
+/* The reference's relative error r for the samples that follow (0: exact). */
+void dac_set_ref(dac_t *d, double ref_rel);
 
 /* Queue a frame for the next latch. Any code > HAL_DAC_CODE_MAX: returns -1 and keeps
  * the previously queued frame. */

@@ -4,6 +4,7 @@
 #include <stddef.h>
 #include <string.h>
 #include "plant/plant_const.h"
+#include "plant/qlaw.h"
 #include "board.h"
 
 static const double kPi = PLANT_PI;
@@ -47,6 +48,7 @@ void mech_default_cfg(mech_cfg_t *cfg)
   cfg->refresh_eps = 1e-3;
   cfg->full_kinematics = 1;
   cfg->brownian = 1;
+  /* Q constant, no cubic stiffness, no electrostatic softening (memset) */
 }
 
 static int finite_in(double v, double lo, double hi)
@@ -69,6 +71,12 @@ int mech_cfg_check(const mech_cfg_t *c, const char **key)
   else if (!finite_in(c->dq_per_s, -1e4, 1e4)) bad = "dq_per_s";
   else if (!finite_in(c->mass_kg, 1e-12, 1.0)) bad = "mass_kg";
   else if (!finite_in(c->refresh_eps, 1e-9, 1e-2)) bad = "refresh_eps";
+  else if (!finite_in(c->k3_drive_per_m2, -1e12, 1e12)) bad = "k3_drive_per_m2";
+  else if (!finite_in(c->k3_sense_per_m2, -1e12, 1e12)) bad = "k3_sense_per_m2";
+  /* softening below half the sense stiffness at T0: far from pull-in over (2-32)'s range */
+  else if (!finite_in(c->ke2_per_s2, 0.0, 0.5 * (2.0 * kPi * c->f2_hz) * (2.0 * kPi * c->f2_hz)))
+    bad = "ke2_per_s2";
+  else if (c->q_law < 0 || c->q_law >= QLAW_NLAWS) bad = "q_law";
   else if (c->full_kinematics != 0 && c->full_kinematics != 1) bad = "full_kinematics";
   else if (c->brownian != 0 && c->brownian != 1) bad = "brownian";
   if (key != NULL) *key = bad;
@@ -122,15 +130,28 @@ enum {
   MONO_AE
 };
 
+/* Q of resonance i (0 drive, 1 sense) at temp_k by the law; *out set when the law was
+ * held at its edge. QLAW_CONST gives the configured Q itself. */
+static double q_at(const mech_cfg_t *c, int i, double temp_k, int *out)
+{
+  const double q0 = i == 0 ? c->q1 : c->q2;
+  *out = 0;
+  if (c->q_law == QLAW_CONST) return q0;
+  const double wn_ratio = 1.0 - 0.5 * c->ket_per_k * (temp_k - c->temp_ref_k); /* (2-32) */
+  return q0 * qlaw_factor(c->q_law, temp_k, c->temp_ref_k, wn_ratio, out);
+}
+
 /* Continuous generator in scaled coordinates, one block per monomial: A(w,a,e) =
  * wr * sum_m Ahat_m * mono_m, augmented with the input columns. Only the four state
  * rows are stored: the input rows of [A B; 0 0] are zero. The generator is exactly
- * polynomial in (w, a, e): stiffness r^2 (1+e)^2, damping r (1+e), Coriolis and Euler
- * linear, centrifugal quadratic. */
+ * polynomial in (w, a, e): stiffness r^2 (1+e)^2, damping r (1+e) / Q (Q of the
+ * temperature the blocks are made at), Coriolis and Euler linear, centrifugal quadratic;
+ * the electrostatic softening is a constant stiffness. */
 static void build_generator(const mech_cfg_t *c, double wr, double wn1, double wn2,
-                            double ahat[MECH_NMONO][MECH_NS][NA])
+                            const double q[2], double ahat[MECH_NMONO][MECH_NS][NA])
 {
   const double r1 = wn1 / wr, r2 = wn2 / wr;
+  const double q1 = q[0], q2 = q[1];
   /* cross couplings follow the structure temperature like the resonances: stiffness with
    * wn^2, damping with wn (Q constant) */
   const double s = wn1 / wn_at(c, c->f1_hz, c->temp_ref_k);
@@ -140,21 +161,22 @@ static void build_generator(const mech_cfg_t *c, double wr, double wn1, double w
   double(*a0)[NA] = ahat[MONO_1];
   a0[0][1] = 1.0;
   a0[1][0] = -r1 * r1;
-  a0[1][1] = -r1 / c->q1;
+  a0[1][1] = -r1 / q1;
   a0[1][4] = 1.0;
   a0[2][3] = 1.0;
   a0[3][0] = -kq;
   a0[3][1] = -dq;
   a0[3][2] = -r2 * r2;
-  a0[3][3] = -r2 / c->q2;
+  if (c->ke2_per_s2 != 0.0) a0[3][2] += c->ke2_per_s2 / (wr * wr); /* (6-3): softening */
+  a0[3][3] = -r2 / q2;
   a0[3][5] = 1.0;
   /* e: wn -> wn (1 + e) */
   ahat[MONO_E][1][0] = -2.0 * r1 * r1;
-  ahat[MONO_E][1][1] = -r1 / c->q1;
+  ahat[MONO_E][1][1] = -r1 / q1;
   ahat[MONO_E][3][0] = -2.0 * kq;
   ahat[MONO_E][3][1] = -dq;
   ahat[MONO_E][3][2] = -2.0 * r2 * r2;
-  ahat[MONO_E][3][3] = -r2 / c->q2;
+  ahat[MONO_E][3][3] = -r2 / q2;
   ahat[MONO_E2][1][0] = -r1 * r1;
   ahat[MONO_E2][3][0] = -kq;
   ahat[MONO_E2][3][2] = -r2 * r2;
@@ -254,27 +276,30 @@ static int alg_exp(alg_t b, alg_t e)
   return 0;
 }
 
-/* Taylor blocks at structure temperature temp_k (e = 0 there): exp(h A) in the
- * truncated algebra is sum_i mono_i P_i, the P_i being the blocks [Phi Gamma].
- * Returns -2 (blk untouched) for a non-finite generator. */
-static int discretise_blocks(const mech_cfg_t *c, double wr, double temp_k, alg_t blk)
+/* Taylor blocks at structure temperature temp_k (e = 0 there) and quality factors q:
+ * exp(h A) in the truncated algebra is sum_i mono_i P_i, the P_i being the blocks
+ * [Phi Gamma]. Returns -2 (blk untouched) for a non-finite generator. */
+static int discretise_blocks(const mech_cfg_t *c, double wr, double temp_k,
+                             const double qual[2], alg_t blk)
 {
   const double wn1 = wn_at(c, c->f1_hz, temp_k), wn2 = wn_at(c, c->f2_hz, temp_k);
   const double h = wr / c->fs_hz;
 
   alg_t ahat; /* 2.3 kB: the only scratch */
-  build_generator(c, wr, wn1, wn2, ahat);
+  build_generator(c, wr, wn1, wn2, qual, ahat);
   for (int i = 0; i < MECH_NMONO; i++)
     for (int r = 0; r < MECH_NS; r++)
       for (int q = 0; q < NA; q++) ahat[i][r][q] *= h;
   return alg_exp(ahat, blk) != 0 ? -2 : 0;
 }
 
-/* Re-discretise at temp_k; m unchanged on failure. */
+/* Re-discretise at temp_k with the Q of m->q_now; m unchanged on failure. */
 static int discretise(mech_t *m, double temp_k)
 {
-  if (discretise_blocks(&m->cfg, m->wr, temp_k, m->blk) != 0) return -2;
+  if (discretise_blocks(&m->cfg, m->wr, temp_k, m->q_now, m->blk) != 0) return -2;
   m->temp_disc_k = temp_k;
+  m->q_disc[0] = m->q_now[0];
+  m->q_disc[1] = m->q_now[1];
   m->eps = 0.0;
   m->q_valid = 0;
   m->refresh_count++;
@@ -298,8 +323,15 @@ int mech_init(mech_t *m, const mech_cfg_t *cfg, double temp_k, uint64_t seed)
    * and only on success; cfg is copied first in case it lives inside m */
   const mech_cfg_t c = *cfg;
   const double wr = 2.0 * kPi * c.f1_hz;
-  if (discretise_blocks(&c, wr, temp_k, m->blk) != 0) return -2;
+  int out[2];
+  const double q[2] = {q_at(&c, 0, temp_k, &out[0]), q_at(&c, 1, temp_k, &out[1])};
+  if (discretise_blocks(&c, wr, temp_k, q, m->blk) != 0) return -2;
   m->cfg = c;
+  for (int i = 0; i < 2; i++) m->q_now[i] = m->q_disc[i] = q[i];
+  m->q_out = (out[0] || out[1]) ? MECH_OUT_Q : 0u;
+  m->duffing_out = 0u;
+  m->drift_kq_per_s2 = m->drift_dq_per_s = 0.0;
+  m->held = c.k3_drive_per_m2 != 0.0 || c.k3_sense_per_m2 != 0.0;
   m->wr = wr;
   m->temp_k = temp_k;
   m->temp_disc_k = temp_k;
@@ -319,13 +351,25 @@ int mech_init(mech_t *m, const mech_cfg_t *cfg, double temp_k, uint64_t seed)
   return 0;
 }
 
+/* The Q law at temp_k into m->q_now; 1 when either moved by refresh_eps from the blocks'. */
+static int update_q(mech_t *m, double temp_k)
+{
+  if (m->cfg.q_law == QLAW_CONST) return 0;
+  int out[2];
+  for (int i = 0; i < 2; i++) m->q_now[i] = q_at(&m->cfg, i, temp_k, &out[i]);
+  m->q_out = (out[0] || out[1]) ? MECH_OUT_Q : 0u;
+  return fabs(m->q_now[0] / m->q_disc[0] - 1.0) > m->cfg.refresh_eps ||
+         fabs(m->q_now[1] / m->q_disc[1] - 1.0) > m->cfg.refresh_eps;
+}
+
 int mech_set_temp(mech_t *m, double temp_k)
 {
   if (!temp_ok(&m->cfg, temp_k)) return -1;
   if (temp_k == m->temp_k) return 0;
   m->temp_k = temp_k;
+  const int q_moved = update_q(m, temp_k);
   const double e = wn_at(&m->cfg, 1.0, temp_k) / wn_at(&m->cfg, 1.0, m->temp_disc_k) - 1.0;
-  if (fabs(e) > m->cfg.refresh_eps) {
+  if (fabs(e) > m->cfg.refresh_eps || q_moved) {
     if (discretise(m, temp_k) != 0) {
       /* cannot happen for a validated cfg (discretise fails before it writes
        * anything); stay on the old blocks */
@@ -396,6 +440,41 @@ static void build_k(mech_t *m, double w, double a)
   m->k_valid = 1;
 }
 
+/* The cubic term k3 u^3 of a restoring force, u held to |k3| u^2 <= MECH_DUFFING_MAX
+ * (flag set then). */
+static double cubic(double k3, double u, unsigned flag, unsigned *out)
+{
+  const double lim2 = MECH_DUFFING_MAX / fabs(k3);
+  if (u * u > lim2) {
+    u = u > 0.0 ? sqrt(lim2) : -sqrt(lim2);
+    *out |= flag;
+  }
+  return k3 * u * u * u;
+}
+
+/* The held forces of mech.h (Duffing, coupling drift) per unit mass, from the motion at
+ * the middle of the sample: the cubic Hermite interpolant of the states at its start (z0)
+ * and end without these forces (z1), scaled units (mech.h). */
+static void held_forces(mech_t *m, const double *z0, const double *z1, double *fy, double *fx)
+{
+  const mech_cfg_t *c = &m->cfg;
+  const double T = 1.0 / c->fs_hz, wr = m->wr;
+  const double w1 = mech_wn1(m), w2 = mech_wn2(m);
+  /* p(1/2) = (p0 + p1)/2 + T (v0 - v1)/8,  p'(1/2) = 3 (p1 - p0) / (2T) - (v0 + v1)/4 */
+  const double ym = 0.5 * (z0[0] + z1[0]) + 0.125 * T * wr * (z0[1] - z1[1]);
+  const double vym = 1.5 * (z1[0] - z0[0]) / T - 0.25 * wr * (z0[1] + z1[1]);
+  const double xm = 0.5 * (z0[2] + z1[2]) + 0.125 * T * wr * (z0[3] - z1[3]);
+  *fy = *fx = 0.0;
+  if (c->k3_drive_per_m2 != 0.0)
+    *fy -= w1 * w1 * cubic(c->k3_drive_per_m2, ym, MECH_OUT_DUFFING_DRIVE, &m->duffing_out);
+  if (c->k3_sense_per_m2 != 0.0)
+    *fx -= w2 * w2 * cubic(c->k3_sense_per_m2, xm, MECH_OUT_DUFFING_SENSE, &m->duffing_out);
+  if (m->drift_kq_per_s2 != 0.0 || m->drift_dq_per_s != 0.0) {
+    const double s = w1 / wn_at(c, c->f1_hz, c->temp_ref_k); /* as build_generator */
+    *fx -= m->drift_kq_per_s2 * s * s * ym + m->drift_dq_per_s * s * vym;
+  }
+}
+
 void mech_step(mech_t *m, double f_drive_mps2, double f_sense_mps2, double rate_rad_s,
                double rate_dot_rad_s2)
 {
@@ -422,6 +501,14 @@ void mech_step(mech_t *m, double f_drive_mps2, double f_sense_mps2, double rate_
     m->z[r] = kr[0] * v[0] + kr[1] * v[1] + kr[2] * v[2] + kr[3] * v[3] + kr[4] * v[4] +
               kr[5] * v[5];
   }
+  if (m->held) {
+    /* the held forces from the sample's motion without them, then their share of the
+     * step (the step is linear in the inputs: Gamma's columns) */
+    double fy, fx;
+    held_forces(m, v, m->z, &fy, &fx);
+    for (int r = 0; r < MECH_NS; r++)
+      m->z[r] += m->k[r][4] * (fy * in_scale) + m->k[r][5] * (fx * in_scale);
+  }
 }
 
 mech_state_t mech_state(const mech_t *m)
@@ -445,10 +532,30 @@ void mech_set_state(mech_t *m, const mech_state_t *s)
 double mech_wn1(const mech_t *m) { return wn_at(&m->cfg, m->cfg.f1_hz, m->temp_k); }
 double mech_wn2(const mech_t *m) { return wn_at(&m->cfg, m->cfg.f2_hz, m->temp_k); }
 
+double mech_q1(const mech_t *m) { return m->q_now[0]; }
+double mech_q2(const mech_t *m) { return m->q_now[1]; }
+
+int mech_set_coupling_drift(mech_t *m, double dkq_per_s2, double ddq_per_s)
+{
+  if (!(isfinite(dkq_per_s2) && isfinite(ddq_per_s))) return -1;
+  m->drift_kq_per_s2 = dkq_per_s2;
+  m->drift_dq_per_s = ddq_per_s;
+  m->held = m->cfg.k3_drive_per_m2 != 0.0 || m->cfg.k3_sense_per_m2 != 0.0 ||
+            dkq_per_s2 != 0.0 || ddq_per_s != 0.0;
+  return 0;
+}
+
+unsigned mech_laws_out(mech_t *m)
+{
+  const unsigned f = m->q_out | m->duffing_out;
+  m->duffing_out = 0u;
+  return f;
+}
+
 double mech_noise_psd(const mech_t *m, int resonance)
 {
   const double wn = resonance == 1 ? mech_wn1(m) : mech_wn2(m);
-  const double q = resonance == 1 ? m->cfg.q1 : m->cfg.q2;
+  const double q = resonance == 1 ? m->q_now[0] : m->q_now[1];
   /* (4-20): force PSD 4 kB T D, D = m wn / Q; divided by m^2 */
   return 4.0 * MECH_KB_J_PER_K * m->temp_k * wn / (q * m->cfg.mass_kg);
 }

@@ -28,8 +28,46 @@
  *            response by 0.3 % (drive, 1.49 kHz) and 0.5 % (sense, 2 kHz) at 50 kHz.
  *
  * Temperature (2-29..2-32): wn_i(T) = wn_i(T0) (1 - 0.5 kET (T - T0)) for both resonances
- * (the structure temperature); Q constant, so every damping term scales with wn and
- * every stiffness term (including k_q) with wn^2.
+ * (the structure temperature); every stiffness term (including k_q) scales with wn^2,
+ * every damping term with wn / Q(T), Q(T) = Q(T0) times the law cfg.q_law (qlaw.h;
+ * QLAW_CONST: Q constant, the damping scales with wn alone). The blocks below hold one
+ * Q: they are recomputed when Q(T) has moved by refresh_eps relative since they were
+ * made, so the damping follows its law to within refresh_eps (1e-3 by default: every
+ * 0.4 K under the gas law, 0.07 K under the thermoelastic law).
+ *
+ * Electrostatic spring softening (thesis (6-3); Senturia, Microsystem Design, Kluwer
+ * 2001, §6.4.3): a parallel-plate electrode pair of gap d at DC voltages V_j pulls with
+ * F = eps A V^2 / (2 (d -+ x)^2), whose stiffness -dF/dx at x = 0 is -eps A V^2 / d^3 per
+ * electrode: a negative spring k_e that lowers the sense resonance,
+ *     wn2_eff^2 = wn2^2 - k_e / m,   df = -f2 k_e / (2 k) to first order.
+ * cfg.ke2_per_s2 is k_e / m (the plant derives it from the feedback electrodes' bias,
+ * plant.fb_gap_m); it is not a property of the silicon, so it does not scale with
+ * (2-32), and it leaves the damping (c = m wn2 / Q2) alone. It sits in the generator
+ * like the other stiffness terms (exact).
+ *
+ * Held forces (not in the generator; added to the inputs f_y, f_x of the sample, only
+ * when switched on), each evaluated from the motion at the middle of the sample: the
+ * cubic Hermite interpolant between the state at its start and the state at its end
+ * without these forces (y_m = (y0 + y1)/2 + T (y0' - y1')/8, y'_m likewise; exact for a
+ * cubic, (w T)^4 / 384 = 3e-6 on a sine at 1.5 kHz, whatever its frequency), then their
+ * share of the step added through Gamma (the step is linear in its inputs); the forces'
+ * own effect within the sample is left out of the interpolant (second order in them).
+ * The mid-sample value, held, has no phase error against the motion and a gain of
+ * sinc(w T/2) on it, 0.99855 at 1.49 kHz and 0.99737 at 2 kHz (50 kHz): the lead of the
+ * mid-sample value cancels the hold's lag, as for the rate in A and the DAC's per-sample
+ * means (dac.h):
+ *   - cubic suspension stiffness (Duffing): f_y -= wn1^2 k3_drive y_m^3, f_x -= wn2^2
+ *     k3_sense x_m^3 with k3 = k3/k (1/m^2), restoring force k (y + (k3/k) y^3). A free
+ *     oscillation of amplitude A then runs at f (1 + 3 (k3/k) A^2 / 8) to first order
+ *     (Lindstedt-Poincare, A. H. Nayfeh & D. T. Mook, Nonlinear Oscillations, Wiley 1979,
+ *     §4.1.1; for silicon flexures V. Kaajakari et al., J. Microelectromech. Syst. 13
+ *     (2004) 715). k3/k follows E like k, so it has no temperature law. Range of the
+ *     expansion: |k3/k| y^2 <= MECH_DUFFING_MAX (the cubic term at most a tenth of the
+ *     linear one); beyond it the cubic term is held at its edge and flagged.
+ *   - slow drift of the couplings (drift.h; set by mech_set_coupling_drift):
+ *     f_x -= dk_q y_m + dd_q y'_m, scaled with the structure temperature like k_q, d_q.
+ *     They act as the configured couplings do; held rather than in the generator so
+ *     that a drift needs no re-discretisation.
  *
  * Discretisation. State s = [y, y', x, x'] (m, m/s); inputs u = [f_y, f_x] (forces
  * per unit mass, m/s^2) held over the sample (zero-order hold). Over one sample
@@ -81,21 +119,31 @@
 #define MECH_RNG_STREAM_SENSE 0x6d02u
 
 #define MECH_KB_J_PER_K 1.380649e-23 /* Boltzmann constant (SI 2019, exact) */
+#define MECH_DUFFING_MAX 0.1         /* largest |k3/k| y^2 of the cubic expansion */
+
+/* Laws held at an edge (mech_laws_out). */
+#define MECH_OUT_Q 1u             /* Q(T) outside its law's temperature range, now */
+#define MECH_OUT_DUFFING_DRIVE 2u /* drive cubic term beyond MECH_DUFFING_MAX, since last */
+#define MECH_OUT_DUFFING_SENSE 4u /* sense cubic term beyond MECH_DUFFING_MAX, since last */
 
 typedef struct {
-  double f1_hz;        /* drive resonance at temp_ref_k */
-  double q1;           /* drive quality factor (temperature independent) */
-  double f2_hz;        /* sense resonance at temp_ref_k */
-  double q2;           /* sense quality factor */
-  double temp_ref_k;   /* T0 of (2-32) */
-  double ket_per_k;    /* kET, temperature coefficient of Young's modulus (2-29) */
-  double kq_per_s2;    /* k_q at T0: quadrature stiffness coupling per unit mass */
-  double dq_per_s;     /* d_q at T0: damping coupling per unit mass */
-  double mass_kg;      /* proof mass m: sets the Brownian noise (4-20) */
-  double fs_hz;        /* sample rate */
-  double refresh_eps;  /* |wn(T)/wn(T_d) - 1| that triggers a re-discretisation */
-  int full_kinematics; /* 1: reciprocal Coriolis, centrifugal and Euler terms (2-20) */
-  int brownian;        /* 1: Brownian force noise on both axes */
+  double f1_hz;           /* drive resonance at temp_ref_k */
+  double q1;              /* drive quality factor (temperature independent) */
+  double f2_hz;           /* sense resonance at temp_ref_k */
+  double q2;              /* sense quality factor */
+  double temp_ref_k;      /* T0 of (2-32) */
+  double ket_per_k;       /* kET, temperature coefficient of Young's modulus (2-29) */
+  double kq_per_s2;       /* k_q at T0: quadrature stiffness coupling per unit mass */
+  double dq_per_s;        /* d_q at T0: damping coupling per unit mass */
+  double mass_kg;         /* proof mass m: sets the Brownian noise (4-20) */
+  double fs_hz;           /* sample rate */
+  double refresh_eps;     /* |wn(T)/wn(T_d) - 1| (or of Q) that triggers a re-discretisation */
+  double k3_drive_per_m2; /* Duffing k3/k of the drive suspension, 1/m^2; 0: linear */
+  double k3_sense_per_m2; /* ... of the sense suspension */
+  double ke2_per_s2;      /* electrostatic softening k_e/m of the sense axis, >= 0 */
+  int q_law;              /* qlaw_kind_t of both Q; QLAW_CONST (0): constant */
+  int full_kinematics;    /* 1: reciprocal Coriolis, centrifugal and Euler terms (2-20) */
+  int brownian;           /* 1: Brownian force noise on both axes */
 } mech_cfg_t;
 
 typedef struct {
@@ -120,6 +168,13 @@ typedef struct {
   rng_t rng[MECH_NU];       /* one source per axis */
   gauss_zig_t zig;          /* normal deviates from them (gauss_zig.h) */
   uint64_t refresh_count;
+  double q_now[2];        /* Q of drive, sense at temp_k (the law) */
+  double q_disc[2];       /* ... of the current Taylor blocks */
+  double drift_kq_per_s2; /* coupling drift at T0 (mech_set_coupling_drift) */
+  double drift_dq_per_s;
+  int held;             /* a held force of the header is on */
+  unsigned q_out;       /* MECH_OUT_Q at temp_k */
+  unsigned duffing_out; /* MECH_OUT_DUFFING_* since the last mech_laws_out */
 } mech_t;
 
 /* Defaults: the thesis linear gyro (fn1 1489.9 Hz, Q1 33.33, fn2 2000 Hz, Q2 3,
@@ -152,9 +207,22 @@ void mech_step(mech_t *m, double f_drive_mps2, double f_sense_mps2, double rate_
 mech_state_t mech_state(const mech_t *m);
 void mech_set_state(mech_t *m, const mech_state_t *s);
 
-/* Resonances at the current structure temperature (2-32), rad/s. */
+/* Resonances at the current structure temperature (2-32), rad/s (mechanical: without
+ * the electrostatic softening). */
 double mech_wn1(const mech_t *m);
 double mech_wn2(const mech_t *m);
+
+/* Quality factors at the current structure temperature (the law cfg.q_law). */
+double mech_q1(const mech_t *m);
+double mech_q2(const mech_t *m);
+
+/* The drifts of the couplings k_q (1/s^2) and d_q (1/s) on top of the configured ones,
+ * at T0 (held until the next call). Non-finite values are ignored (returns -1). */
+int mech_set_coupling_drift(mech_t *m, double dkq_per_s2, double ddq_per_s);
+
+/* MECH_OUT_* of the laws held at an edge: the Q law at the present temperature, the
+ * cubic terms since the last call (cleared). */
+unsigned mech_laws_out(mech_t *m);
 
 /* One-sided acceleration noise PSD of resonance 1 (drive) or 2 (sense) at the current temperature,
  * (m/s^2)^2/Hz (4-20): 4 kB T wn / (Q m). */

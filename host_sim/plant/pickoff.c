@@ -59,6 +59,7 @@ void pickoff_default_cfg(pickoff_cfg_t *cfg, pickoff_axis_t axis)
   cfg->noise_v_rthz = 2e-6;
   cfg->jitter_rms_s = 0.0;
   cfg->phase_step_rad = 1e-6;
+  cfg->flicker_fmin_hz = 1e-3; /* the flicker itself is off (zero density) */
   if (axis == PICKOFF_SENSE) {
     cfg->gain_v_per_m = 6.18e7;
     cfg->ft_u1 = 1e-4;
@@ -83,6 +84,31 @@ static int finite_all(const double *v, int n)
   for (int i = 0; i < n; i++)
     if (!isfinite(v[i])) return 0;
   return 1;
+}
+
+/* The flicker specs of the gain (relative) and the phase (rad). */
+static void flicker_specs(const pickoff_cfg_t *c, flicker_spec_t *gain, flicker_spec_t *phase)
+{
+  gain->white_rthz = phase->white_rthz = 0.0;
+  gain->flicker_1hz_rthz = c->gain_flicker_1hz_rthz;
+  phase->flicker_1hz_rthz = c->phase_flicker_1hz_rad_rthz;
+  gain->fmin_hz = phase->fmin_hz = c->flicker_fmin_hz;
+}
+
+/* The imperfections' fields (pickoff.h). */
+static int imperfections_ok(const pickoff_cfg_t *c)
+{
+  const double vals[] = {c->gap_m, c->gap_asym, c->gain_flicker_1hz_rthz,
+                         c->phase_flicker_1hz_rad_rthz, c->flicker_fmin_hz};
+  if (!finite_all(vals, (int)(sizeof vals / sizeof vals[0]))) return 0;
+  if (!(c->gap_m >= 0.0 && c->gap_m <= 1.0 && c->gap_asym >= 0.0 && c->gap_asym <= 1.0))
+    return 0;
+  if (!(c->gain_flicker_1hz_rthz >= 0.0 && c->gain_flicker_1hz_rthz <= 0.1 &&
+        c->phase_flicker_1hz_rad_rthz >= 0.0 && c->phase_flicker_1hz_rad_rthz <= 0.1))
+    return 0;
+  flicker_spec_t g, ph;
+  flicker_specs(c, &g, &ph);
+  return flicker_check(&g, c->fs_hz) == 0 && flicker_check(&ph, c->fs_hz) == 0;
 }
 
 static int cfg_ok(const pickoff_cfg_t *c)
@@ -111,7 +137,7 @@ static int cfg_ok(const pickoff_cfg_t *c)
   if (!(fabs(c->sample_delay_s) <= 0.5 * T && c->jitter_rms_s >= 0.0 &&
         c->jitter_rms_s <= 0.05 * T))
     return 0;
-  return 1;
+  return imperfections_ok(c);
 }
 
 static double phase_at(const pickoff_cfg_t *c, double temp_k)
@@ -326,7 +352,42 @@ int pickoff_init(pickoff_t *p, const pickoff_cfg_t *cfg, double temp_k, uint64_t
   rng_seed(&p->rng_jitter, seed, PICKOFF_RNG_STREAM_JITTER + (uint64_t)c.axis);
   gauss_zig_init(&p->zig);
   p->preamp_clip_count = 0;
+  /* imperfections (checked by cfg_ok, so the flicker inits cannot fail) */
+  p->gap_on = c.gap_m > 0.0;
+  p->inv_gap = p->gap_on ? 1.0 / c.gap_m : 0.0;
+  p->inv_wref = 1.0 / (2.0 * k_pi * c.lag_ref_hz);
+  p->gain_fl_on = c.gain_flicker_1hz_rthz > 0.0;
+  p->phase_fl_on = c.phase_flicker_1hz_rad_rthz > 0.0;
+  p->gain_noise = p->phase_noise_rad = 0.0;
+  p->gap_out = 0u;
+  flicker_spec_t g, ph;
+  flicker_specs(&c, &g, &ph);
+  (void)flicker_init(&p->gain_fl, &g, c.fs_hz, seed,
+                     PICKOFF_RNG_STREAM_GAIN_FLICKER + (uint64_t)c.axis);
+  (void)flicker_init(&p->phase_fl, &ph, c.fs_hz, seed,
+                     PICKOFF_RNG_STREAM_PHASE_FLICKER + (uint64_t)c.axis);
   return 0;
+}
+
+unsigned pickoff_gap_out(pickoff_t *p)
+{
+  const unsigned f = p->gap_out;
+  p->gap_out = 0u;
+  return f;
+}
+
+/* The capacitive law of pickoff.h: x_read = x (1 + beta u + u^2), u = x / d held to
+ * PICKOFF_GAP_MAX_U, and its time derivative (1 + 2 beta u + 3 u^2) x'. */
+static void gap_law(pickoff_t *p, double *pos, double *vel)
+{
+  double u = *pos * p->inv_gap;
+  if (u > PICKOFF_GAP_MAX_U || u < -PICKOFF_GAP_MAX_U) {
+    u = u > 0.0 ? PICKOFF_GAP_MAX_U : -PICKOFF_GAP_MAX_U;
+    p->gap_out |= PICKOFF_OUT_GAP;
+  }
+  const double b = p->cfg.gap_asym;
+  *vel *= 1.0 + u * (2.0 * b + 3.0 * u);
+  *pos *= 1.0 + u * (b + u);
 }
 
 int pickoff_set_temp(pickoff_t *p, double temp_k)
@@ -347,10 +408,22 @@ int pickoff_set_temp(pickoff_t *p, double temp_k)
 
 double pickoff_step(pickoff_t *p, double pos_m, double vel_mps, const dac_out_t *dac)
 {
+  return pickoff_step_at(p, pos_m, vel_mps, dac, 0.0);
+}
+
+double pickoff_step_at(pickoff_t *p, double pos_m, double vel_mps, const dac_out_t *dac,
+                       double dt_s)
+{
   const pickoff_cfg_t *c = &p->cfg;
+  if (p->gap_on) gap_law(p, &pos_m, &vel_mps);
+  double g = p->gain_now;
+  if (p->gain_fl_on) {
+    p->gain_noise = flicker_step(&p->gain_fl);
+    g *= 1.0 + p->gain_noise;
+  }
   /* ring-diode output (4-12) plus feedthrough, and its slope */
-  double s1 = p->gain_now * pos_m;
-  double ds1 = p->gain_now * vel_mps;
+  double s1 = g * pos_m;
+  double ds1 = g * vel_mps;
   if (dac != NULL) {
     const dac_chan_out_t *u1 = &dac->ch[HAL_DAC_DRIVE_U1], *u2 = &dac->ch[HAL_DAC_DRIVE_U2];
     const dac_chan_out_t *u3 = &dac->ch[HAL_DAC_SPARE];
@@ -384,11 +457,19 @@ double pickoff_step(pickoff_t *p, double pos_m, double vel_mps, const dac_out_t 
   double v = 0.0;
   for (int i = 0; i < PICKOFF_MAX_N; i++) v += p->out_z[i] * zn[i];
   for (int i = 0; i < 4; i++) v += p->out_u[i] * u[i];
-  if (c->jitter_rms_s > 0.0) {
+  /* the ADC's timing error and the phase flicker's delay (pickoff.h) */
+  double te = dt_s;
+  if (p->phase_fl_on) {
+    p->phase_noise_rad = flicker_step(&p->phase_fl);
+    te -= p->phase_noise_rad * p->inv_wref;
+  }
+  if (c->jitter_rms_s > 0.0 || te != 0.0) {
     double dy = 0.0;
     for (int i = 0; i < PICKOFF_MAX_N; i++) dy += p->dout_z[i] * zn[i];
     for (int i = 0; i < 4; i++) dy += p->dout_u[i] * u[i];
-    v += c->jitter_rms_s * p->inv_t * gauss_zig(&p->zig, &p->rng_jitter) * dy;
+    if (c->jitter_rms_s > 0.0)
+      v += c->jitter_rms_s * p->inv_t * gauss_zig(&p->zig, &p->rng_jitter) * dy;
+    if (te != 0.0) v += te * p->inv_t * dy;
   }
   v += c->offset_v;
   if (p->noise_sd > 0.0) v += p->noise_sd * gauss_zig(&p->zig, &p->rng_noise);

@@ -56,14 +56,44 @@
  * (first order; the neglected e^2 y''/2 is (w sigma)^2/2 = 4e-5 relative at the largest
  * allowed sigma, T/20): on a sine of amplitude a, noise of rms a w sigma / sqrt(2).
  *
+ * Imperfections of the front end, each off at zero:
+ *   Capacitive nonlinearity (gap_m > 0). The ring diode demodulates the difference of
+ *   the two sense capacitances (§4.3.2). Parallel plates at gap d: C+- = C0 d / (d -+ x),
+ *   so dC+ = C0 u / (1 - u), dC- = -C0 u / (1 + u), u = x / d (Senturia, Microsystem
+ *   Design, Kluwer 2001, §6.4; Kaajakari et al., J. Microelectromech. Syst. 13 (2004)
+ *   715, the capacitive nonlinearity of a resonator's readout). A perfectly balanced pair
+ *   reads (dC+ - dC-) / 2 = C0 (u + u^3 + ...), odd orders only; an imbalance beta
+ *   between the two sides (1: one-sided) adds beta (dC+ + dC-) / 2 = C0 beta (u^2 + ...).
+ *   To third order the displacement read is
+ *       x_read = x (1 + beta u + u^2),   u = x / d,   beta = gap_asym,
+ *   within 1 % of the parallel-plate law for |u| <= PICKOFF_GAP_MAX_U; beyond, u is held
+ *   at the edge and flagged (PICKOFF_OUT_GAP). On a sine of amplitude A: second harmonic
+ *   beta A^2 / (2 d) (and as much DC), third A^3 / (4 d^2), fundamental up 3 A^2 / (4 d^2).
+ *   Gain flicker (gain_flicker_1hz_rthz > 0): the ring diode's gain follows Vc - V_D
+ *   (4-12), and the carrier amplitude and the diodes' drop carry 1/f noise (diode and
+ *   resistor flicker, F. N. Hooge, Phys. Lett. 29A (1969) 139): g(t) = g (1 + n_g(t)),
+ *   n_g relative with one-sided PSD K^2 / f from flicker_fmin_hz up (white above fs/20),
+ *   applied to the displacement term (not to the feedthrough).
+ *   Phase flicker (phase_flicker_1hz_rad_rthz > 0): the lag network's R and C carry the
+ *   same 1/f fluctuation, so Phi_cir wanders by n_p(t) rad (PSD K^2 / f). Realised as a
+ *   fluctuation of the chain's delay, n_p / w_ref at the reference frequency (lag_ref_hz:
+ *   the drive frequency, where both channels' signals are): the output sampled at
+ *   t - n_p / w_ref, to first order y - (n_p / w_ref) y' (the jitter's derivative row),
+ *   without re-discretising; error (n_p)^2 / 2 relative, 2e-6 at 0.1 deg.
+ *   These two are the low-frequency gain and phase noise that turn into scale-factor
+ *   and bias instability (the sense phase through the quadrature, §2.4.2 B).
+ *   Timing: pickoff_step_at() samples the output dt_s later (the ADC's aperture jitter,
+ *   common to both channels; adc.h), to first order through the slope as the jitter.
+ *
  * Temperature: pickoff_set_temp() updates the gain at once and re-discretises the chain
  * (about 5-10 us) only when Phi_cir has moved by phase_step_rad or more since the last
  * discretisation; it may be called every sample. The default step, 1e-6 rad, is a bias
  * step of 1.5e-3 deg/s on 1500 deg/s of quadrature (0.57 mK at 0.1 deg/K); a 10 K/min
  * ramp then re-discretises about 300 times per simulated second.
  *
- * Noise streams: rng_seed(seed, PICKOFF_RNG_STREAM_NOISE + axis) for the white noise and
- * rng_seed(seed, PICKOFF_RNG_STREAM_JITTER + axis) for the jitter.
+ * Noise streams: rng_seed(seed, PICKOFF_RNG_STREAM_NOISE + axis) for the white noise,
+ * rng_seed(seed, PICKOFF_RNG_STREAM_JITTER + axis) for the jitter, _GAIN_FLICKER + axis
+ * and _PHASE_FLICKER + axis for the flicker (drawn only when on).
  */
 #ifndef PLANT_PICKOFF_H
 #define PLANT_PICKOFF_H
@@ -71,11 +101,14 @@
 #include <stdint.h>
 
 #include "plant/dac.h"
+#include "plant/flicker.h"
 #include "plant/gauss_zig.h"
 #include "plant/rng.h"
 
-#define PICKOFF_RNG_STREAM_NOISE 0x7001u  /* + axis */
-#define PICKOFF_RNG_STREAM_JITTER 0x7011u /* + axis */
+#define PICKOFF_RNG_STREAM_NOISE 0x7001u         /* + axis */
+#define PICKOFF_RNG_STREAM_JITTER 0x7011u        /* + axis */
+#define PICKOFF_RNG_STREAM_GAIN_FLICKER 0x7021u  /* + axis */
+#define PICKOFF_RNG_STREAM_PHASE_FLICKER 0x7031u /* + axis */
 #define PICKOFF_MAX_N 4
 
 /* Ranges of the temperature laws (see the top of this file). */
@@ -85,9 +118,11 @@
 #define PICKOFF_LEAD_MIN_LOWPASS_RAD (PICKOFF_PHI_POLE_MIN_RAD - 1.4)
 #define PICKOFF_LEAD_MIN_ALLPASS_RAD (0.5 * PICKOFF_PHI_POLE_MIN_RAD - 1.4)
 #define PICKOFF_GAIN_MIN_FACTOR 0.1
+#define PICKOFF_GAP_MAX_U 0.3 /* |x| / d of the third-order capacitive law */
 /* flags of a law held at the edge of its range (pickoff_t.out_of_range) */
 #define PICKOFF_OUT_PHASE 1u
 #define PICKOFF_OUT_GAIN 2u
+#define PICKOFF_OUT_GAP 4u /* since the last pickoff_gap_out */
 
 typedef enum { PICKOFF_DRIVE = 0, PICKOFF_SENSE = 1 } pickoff_axis_t;
 typedef enum { PICKOFF_LAG_LOWPASS = 0, PICKOFF_LAG_ALLPASS = 1 } pickoff_lag_kind_t;
@@ -119,6 +154,12 @@ typedef struct {
   double sample_delay_s; /* fixed sampling instant after the tick, |.| <= T/2 */
   double jitter_rms_s;   /* rms random timing error, <= T/20 */
   double phase_step_rad; /* Phi_cir change that triggers a re-discretisation, >= 0 */
+  /* imperfections (see the top), 0: off */
+  double gap_m;                      /* parallel-plate gap d of the capacitive pickoff */
+  double gap_asym;                   /* imbalance beta of the pair, 0..1 */
+  double gain_flicker_1hz_rthz;      /* relative gain 1/f density at 1 Hz, 1/sqrt(Hz) */
+  double phase_flicker_1hz_rad_rthz; /* circuit phase 1/f density at 1 Hz, rad/sqrt(Hz) */
+  double flicker_fmin_hz;            /* both flicker spectra flatten below this */
 } pickoff_cfg_t;
 
 typedef struct {
@@ -142,6 +183,14 @@ typedef struct {
   rng_t rng_noise, rng_jitter;
   gauss_zig_t zig; /* normal deviates by the ziggurat: no log per sample (gauss_zig.h) */
   uint64_t preamp_clip_count;
+  /* imperfections */
+  int gap_on, gain_fl_on, phase_fl_on;
+  double inv_gap;         /* 1 / d */
+  double inv_wref;        /* 1 / (2 pi lag_ref_hz), s/rad */
+  double gain_noise;      /* n_g of the last sample */
+  double phase_noise_rad; /* n_p of the last sample */
+  unsigned gap_out;       /* PICKOFF_OUT_GAP since the last pickoff_gap_out */
+  flicker_t gain_fl, phase_fl;
 } pickoff_t;
 
 /* Defaults for one axis (thesis linear gyro, 1489.9 Hz drive, 50 kHz):
@@ -186,5 +235,12 @@ void pickoff_lag_section(pickoff_lag_kind_t kind, double phi_rad, double *b0, do
  * are the electrode voltages at t_{k+1}), or NULL for no feedthrough. Returns the
  * voltage at the ADC input sampled at t_{k+1} + delay + jitter. */
 double pickoff_step(pickoff_t *p, double pos_m, double vel_mps, const dac_out_t *dac);
+
+/* The same, the output sampled dt_s later (|dt_s| well below T/2; first order). */
+double pickoff_step_at(pickoff_t *p, double pos_m, double vel_mps, const dac_out_t *dac,
+                       double dt_s);
+
+/* PICKOFF_OUT_GAP if the capacitive law was held at its edge since the last call (cleared). */
+unsigned pickoff_gap_out(pickoff_t *p);
 
 #endif /* PLANT_PICKOFF_H */

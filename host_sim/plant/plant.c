@@ -40,6 +40,19 @@ static void make_mech_cfg(const plant_cfg_t *c, mech_cfg_t *m)
   m->refresh_eps = c->mech_refresh_eps;
   m->full_kinematics = c->full_kinematics ? 1 : 0;
   m->brownian = c->brownian ? 1 : 0;
+  m->q_law = c->q_temp_law;
+  m->k3_drive_per_m2 = c->k3_drive_per_m2;
+  m->k3_sense_per_m2 = c->k3_sense_per_m2;
+  m->ke2_per_s2 = plant_fb_softening(c);
+}
+
+double plant_fb_softening(const plant_cfg_t *c)
+{
+  /* (6-3) per electrode: k_e = eps A V^2 / d^3 = 2 (Ks m) V^2 / d, with Ks m = eps A / (2 d^2)
+   * the force constant of F = Ks V^2 at x = 0; both electrodes of the differential pair
+   * sit at the DC bias Vb: k_e / m = 4 Ks Vb^2 / d. The single electrode has no DC. */
+  if (c->fb_mode != 2 || !(c->fb_gap_m > 0.0)) return 0.0;
+  return 4.0 * c->ks_fb_mps2_per_v2 * c->fb_bias_v * c->fb_bias_v / c->fb_gap_m;
 }
 
 static int thermal_every(const plant_cfg_t *c)
@@ -63,9 +76,12 @@ static void make_thermal_cfg(const plant_cfg_t *c, thermal_cfg_t *t)
   t->dt_s = thermal_every(c) / c->fs_hz;
 }
 
-static void make_dac_cfg(const plant_cfg_t *c, dac_cfg_t *d)
+static void make_dac_cfg(const plant_cfg_t *c, uint64_t seed, dac_cfg_t *d)
 {
   dac_default_cfg(d);
+  d->inl.bow_lsb = c->dac_inl_bow_lsb;
+  d->inl.code_lsb = c->dac_inl_code_lsb;
+  d->inl_seed = seed;
   d->fs_hz = c->fs_hz;
   d->recon_cutoff_hz = c->dac_recon_hz;
   d->recon_q = c->dac_recon_q;
@@ -119,6 +135,43 @@ static void make_pickoff_cfg(const plant_cfg_t *c, int axis, pickoff_cfg_t *q)
   q->noise_v_rthz = PLANT_PICK(c, axis, noise_v_rthz);
   q->sample_delay_s = PLANT_PICK(c, axis, delay_s);
   q->jitter_rms_s = PLANT_PICK(c, axis, jitter_s);
+  q->gap_m = PLANT_PICK(c, axis, gap_m);
+  q->gap_asym = PLANT_PICK(c, axis, gap_asym);
+  q->gain_flicker_1hz_rthz = PLANT_PICK(c, axis, gain_flicker_1hz_rthz);
+  q->phase_flicker_1hz_rad_rthz = PLANT_PICK(c, axis, phase_flicker_1hz_deg_rthz) * kDeg;
+  q->flicker_fmin_hz = c->pick_flicker_fmin_hz;
+}
+
+static void make_adc_cfg(const plant_cfg_t *c, uint64_t seed, adc_cfg_t *a)
+{
+  adc_default_cfg(a);
+  a->full_scale_v = c->adc_full_scale_v;
+  a->inl.bow_lsb = c->adc_inl_bow_lsb;
+  a->inl.code_lsb = c->adc_inl_code_lsb;
+  a->aperture_jitter_s = c->adc_aperture_jitter_s;
+  a->seed = seed;
+}
+
+static void make_vref_cfg(const plant_cfg_t *c, vref_cfg_t *v)
+{
+  v->noise.white_rthz = c->vref_noise_white_rthz;
+  v->noise.flicker_1hz_rthz = c->vref_noise_1hz_rthz;
+  v->noise.fmin_hz = c->vref_noise_fmin_hz;
+}
+
+/* The two coupling drifts (drift.h), stepped at the thermal updates, in deg/s of
+ * equivalent rate; with the scales to k_q and d_q of make_mech_cfg. */
+static int init_drifts(plant_t *p, uint64_t seed)
+{
+  const plant_cfg_t *c = &p->cfg;
+  const double dt = p->thermal_every * p->T;
+  const drift_cfg_t dc[2] = {{c->quad_drift_dps, c->quad_drift_tau_s, dt},
+                             {c->inphase_drift_dps, c->inphase_drift_tau_s, dt}};
+  p->drift_kq_per_s2 = 2.0 * (2.0 * kPi * c->f_drive_hz) * kDeg;
+  p->drift_dq_per_s = 2.0 * kDeg;
+  p->drift_on = c->quad_drift_dps > 0.0 || c->inphase_drift_dps > 0.0;
+  if (drift_init(&p->drift[0], &dc[0], seed, PLANT_RNG_STREAM_QUAD_DRIFT) != 0) return -1;
+  return drift_init(&p->drift[1], &dc[1], seed, PLANT_RNG_STREAM_INPHASE_DRIFT);
 }
 
 static void make_accel_cfg(const plant_cfg_t *c, accel_cfg_t *a)
@@ -136,9 +189,10 @@ static int pick_node(const plant_cfg_t *c, int axis) { return PLANT_PICK(c, axis
 
 /* ------------------------------------------------------------- warnings ------ */
 
-static const char *const kLawNames[PLANT_LAWS] = {"pick_drive_phase", "pick_sense_phase",
-                                                  "pick_drive_gain",  "pick_sense_gain",
-                                                  "resonance",        "ambient"};
+static const char *const kLawNames[PLANT_LAWS] = {
+    "pick_drive_phase", "pick_sense_phase", "pick_drive_gain", "pick_sense_gain",
+    "resonance",        "ambient",          "q_temp",          "duffing_drive",
+    "duffing_sense",    "pick_drive_gap",   "pick_sense_gap"};
 
 const char *plant_law_name(int law)
 {
@@ -162,6 +216,18 @@ static void warn_pickoff(plant_t *p, int axis, int flags)
     warn(p, axis == 0 ? PLANT_LAW_PICK_DRIVE_PHASE : PLANT_LAW_PICK_SENSE_PHASE);
   if ((unsigned)flags & PICKOFF_OUT_GAIN)
     warn(p, axis == 0 ? PLANT_LAW_PICK_DRIVE_GAIN : PLANT_LAW_PICK_SENSE_GAIN);
+  if ((unsigned)flags & PICKOFF_OUT_GAP)
+    warn(p, axis == 0 ? PLANT_LAW_PICK_DRIVE_GAP : PLANT_LAW_PICK_SENSE_GAP);
+}
+
+/* The mechanics' laws (mech_laws_out) and the pickoffs' capacitive laws. */
+static void warn_amplitude_laws(plant_t *p)
+{
+  const unsigned m = mech_laws_out(&p->mech);
+  if (m & MECH_OUT_Q) warn(p, PLANT_LAW_Q_TEMP);
+  if (m & MECH_OUT_DUFFING_DRIVE) warn(p, PLANT_LAW_DUFFING_DRIVE);
+  if (m & MECH_OUT_DUFFING_SENSE) warn(p, PLANT_LAW_DUFFING_SENSE);
+  for (int i = 0; i < 2; i++) warn_pickoff(p, i, (int)pickoff_gap_out(&p->pick[i]));
 }
 
 /* ------------------------------------------------------------------ init ------ */
@@ -169,12 +235,14 @@ static void warn_pickoff(plant_t *p, int axis, int flags)
 static void accel_flags(plant_t *p)
 {
   const accel_profile_t *a = &p->prof.accel_g;
-  p->accel_dynamic = 0;
+  p->accel_dynamic = a->n_shocks > 0;
   p->accel_any = 0;
   for (int i = 0; i < PROFILE_ACCEL_AXES; i++) {
     if (a->amp_g[i] != 0.0) p->accel_dynamic = 1;
     if (a->amp_g[i] != 0.0 || a->const_g[i] != 0.0) p->accel_any = 1;
   }
+  p->vib_on = a->n_bands > 0;
+  if (p->accel_dynamic || p->vib_on) p->accel_any = 1;
 }
 
 static void truth_temps(plant_t *p, double ambient_k)
@@ -185,6 +253,7 @@ static void truth_temps(plant_t *p, double ambient_k)
   t->circuit_k = thermal_temp(&p->thermal, THERMAL_CIRCUIT);
   t->board_k = thermal_temp(&p->thermal, THERMAL_BOARD);
   t->wn_drive_rad_s = mech_wn1(&p->mech);
+  t->q_drive = mech_q1(&p->mech);
 }
 
 int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
@@ -210,17 +279,18 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   mech_cfg_t mc;
   make_mech_cfg(c, &mc);
   dac_cfg_t dc;
-  make_dac_cfg(c, &dc);
+  make_dac_cfg(c, seed, &dc);
   actuator_cfg_t ac;
   make_actuator_cfg(c, &ac);
   pickoff_cfg_t pc[2];
   make_pickoff_cfg(c, 0, &pc[0]);
   make_pickoff_cfg(c, 1, &pc[1]);
   adc_cfg_t adcc;
-  adc_default_cfg(&adcc);
-  adcc.full_scale_v = c->adc_full_scale_v;
+  make_adc_cfg(c, seed, &adcc);
   accel_cfg_t gc;
   make_accel_cfg(c, &gc);
+  vref_cfg_t vc;
+  make_vref_cfg(c, &vc);
 
   int out_mech = 0;
   if (thermal_init(&p->thermal, &thc, c->temp_k) != 0)
@@ -231,8 +301,10 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
     what = "mechanics (f_*_hz, q_*, ket_per_k, temp_k)";
   else if (dac_init(&p->dac, &dc) != 0) what = "DAC (dac_*)";
   else if (actuator_init(&p->act, &ac, seed) != 0) what = "actuator (ks_*, *_noise_*, fb_*)";
-  else if (adc_init(&p->adc, &adcc) != 0) what = "ADC (adc_full_scale_v)";
+  else if (adc_init(&p->adc, &adcc) != 0) what = "ADC (adc_*)";
   else if (accel_init(&p->accel, &gc) != 0) what = "g-sensitivity (gs_*)";
+  else if (vref_init(&p->vref, &vc, c->fs_hz, seed) != 0) what = "reference (vref_noise_*)";
+  else if (init_drifts(p, seed) != 0) what = "coupling drift (*_drift_*)";
   for (int i = 0; what == NULL && i < 2; i++) {
     if (pickoff_init(&p->pick[i], &pc[i], thermal_temp(&p->thermal, pick_node(c, i)), seed) != 0)
       what = i == 0 ? "drive pickoff (pick_drive_*)" : "sense pickoff (pick_sense_*)";
@@ -247,6 +319,7 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   profile_const(&p->prof.ambient_k, c->temp_k);
   accel_profile_zero(&p->prof.accel_g);
   accel_flags(p);
+  p->seed = seed;
 
   /* truth at t = 0 */
   p->est_alpha = 1.0 - exp(-p->T / c->truth_tau_s);
@@ -263,7 +336,20 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   truth_temps(p, c->temp_k);
   if (out_mech) warn(p, PLANT_LAW_RESONANCE);
   for (int i = 0; i < 2; i++) warn_pickoff(p, i, p->pick[i].out_of_range);
+  warn_amplitude_laws(p);
   p->err[0] = '\0';
+  return 0;
+}
+
+/* 1 when the random vibration bands of a and b differ. */
+static int bands_differ(const accel_profile_t *a, const accel_profile_t *b)
+{
+  if (a->n_bands != b->n_bands) return 1;
+  for (int j = 0; j < a->n_bands; j++)
+    if (a->band_axis[j] != b->band_axis[j] ||
+        a->band_psd_g2_per_hz[j] != b->band_psd_g2_per_hz[j] ||
+        a->band_f_lo_hz[j] != b->band_f_lo_hz[j] || a->band_f_hi_hz[j] != b->band_f_hi_hz[j])
+      return 1;
   return 0;
 }
 
@@ -279,10 +365,14 @@ int plant_set_profiles(plant_t *p, const plant_profiles_t *prof)
     set_err(p, "ambient profile: %s invalid", key);
     return -1;
   }
-  if (accel_profile_check(&prof->accel_g, &key) != 0) {
+  if (accel_profile_check(&prof->accel_g, &key) != 0 ||
+      vib_check(&prof->accel_g, p->cfg.fs_hz, &key) != 0) {
     set_err(p, "acceleration profile: %s invalid", key);
     return -1;
   }
+  /* the generators keep running unless the bands changed (vib.h: they start at rest) */
+  if (bands_differ(&prof->accel_g, &p->prof.accel_g))
+    (void)vib_init(&p->vib, &prof->accel_g, p->cfg.fs_hz, p->seed);
   p->prof = *prof;
   accel_flags(p);
   return 0;
@@ -311,6 +401,10 @@ static void thermal_update(plant_t *p, double t0)
   for (int i = 0; i < 2; i++)
     warn_pickoff(
         p, i, pickoff_set_temp(&p->pick[i], thermal_temp(&p->thermal, pick_node(&p->cfg, i))));
+  warn_amplitude_laws(p);
+  if (p->drift_on)
+    (void)mech_set_coupling_drift(&p->mech, p->drift_kq_per_s2 * drift_step(&p->drift[0]),
+                                  p->drift_dq_per_s * drift_step(&p->drift[1]));
   truth_temps(p, amb);
 }
 
@@ -387,6 +481,11 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
       memcpy(p->dac.latched, p->dac.pending, sizeof p->dac.latched);
     else t->dac_rejects++;
   }
+  if (p->vref.active) {
+    const double r = vref_step(&p->vref); /* one reference for both converters */
+    dac_set_ref(&p->dac, r);
+    adc_set_ref(&p->adc, r);
+  }
   dac_out_t dout;
   dac_step(&p->dac, &dout);
   actuator_out_t aout;
@@ -395,6 +494,7 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
   if (p->accel_any) {
     if (p->accel_dynamic) accel_profile_mean(&p->prof.accel_g, t0, t0 + T, t->accel_g);
     else memcpy(t->accel_g, p->prof.accel_g.const_g, sizeof t->accel_g);
+    if (p->vib_on) vib_step(&p->vib, t->accel_g);
     accel_out_t gout;
     accel_step(&p->accel, t->accel_g, &gout);
     fd += gout.f_drive_mps2;
@@ -406,8 +506,9 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
   mech_step(&p->mech, fd, fsn, rate_dps * kDeg, slope_dps * kDeg);
   const mech_state_t s = mech_state(&p->mech);
 
-  const double vd = pickoff_step(&p->pick[0], s.y_m, s.vy_mps, &dout);
-  const double vs = pickoff_step(&p->pick[1], s.x_m, s.vx_mps, &dout);
+  const double ta = adc_aperture_draw(&p->adc); /* common to both channels (adc.h) */
+  const double vd = pickoff_step_at(&p->pick[0], s.y_m, s.vy_mps, &dout, ta);
+  const double vs = pickoff_step_at(&p->pick[1], s.x_m, s.vx_mps, &dout, ta);
   adc_convert_frame(&p->adc, vd, vs, &t->adc);
   if (adc_out != NULL) *adc_out = t->adc;
   p->k++;

@@ -5,22 +5,34 @@
  * One sample, plant_step(p, dac, adc), covering [t_k, t_k+1), t_k = k / fs:
  *   1. thermal network (every thermal_dt_s): ambient profile at mid-interval ->
  *      structure / circuit / board-sensor temperatures (thermal.h); the structure
- *      temperature moves the resonances (2-32) (mech.h), the circuit temperature (of
- *      the node chosen by pick_*_temp_node) the pickoff phases and gains (2-40)
- *      (pickoff.h, re-discretised when the phase moved by pick_phase_step_rad);
+ *      temperature moves the resonances (2-32) and the quality factors (q_temp_law,
+ *      qlaw.h) (mech.h), the circuit temperature (of the node chosen by
+ *      pick_*_temp_node) the pickoff phases and gains (2-40) (pickoff.h, re-discretised
+ *      when the phase moved by pick_phase_step_rad); the slow drifts of the couplings
+ *      (drift.h) take their next value;
  *   2. DAC (dac.h): the frame passed in is the one on the converter outputs during
  *      this interval (the host HAL stub applies the board's one-sample latency: it
  *      passes the frame the firmware wrote at the previous tick); zero-order hold,
- *      output amplifier, reconstruction low-pass;
+ *      INL, output amplifier, reconstruction low-pass; the shared reference's noise
+ *      (vref.h) on it and on the ADC;
  *   3. actuator (actuator.h): F = Ks (U1^2 - U2^2) (6-7) with 1/f electrode-voltage
  *      noise, mean over the sample, per unit mass; plus the inertial and g-sensitivity
- *      forces of the acceleration profile (accel.h, exact mean over the sample);
+ *      forces of the acceleration profile (accel.h, exact mean over the sample of the
+ *      constant, sine and half-sine shock parts; random vibration from vib.h);
  *   4. mechanics (mech.h): exact discretisation of (2-22)/(2-20) with the rate profile
- *      at mid-sample inside the transition matrix, Brownian force noise (4-20);
- *   5. pickoffs (pickoff.h): ring-diode front end, feedthrough, circuit phase,
- *      anti-alias band-pass, offset, noise, sampled at t_k+1 (+ delay, jitter);
- *   6. ADC (adc.h): 16-bit quantiser, clip and fault counters -> the frame returned,
- *      which the firmware reads at tick k+1.
+ *      at mid-sample inside the transition matrix, Brownian force noise (4-20), the
+ *      electrostatic softening of the biased feedback electrodes (6-3); held cubic
+ *      stiffness and coupling drift forces;
+ *   5. pickoffs (pickoff.h): ring-diode front end (capacitive nonlinearity, gain and
+ *      phase flicker), feedthrough, circuit phase, anti-alias band-pass, offset, noise,
+ *      sampled at t_k+1 (+ delay, jitter, the ADC's aperture jitter);
+ *   6. ADC (adc.h): 16-bit quantiser (INL), clip and fault counters -> the frame
+ *      returned, which the firmware reads at tick k+1.
+ *
+ * Every imperfection beyond the thesis's linear gyro (the q_temp_law, k3_*, *_drift_*,
+ * fb_gap_m, pick_*_gap_*, pick_*_flicker_*, adc_inl_*, dac_inl_*, adc_aperture_jitter_s,
+ * vref_noise_* parameters, the shocks and random vibration of the acceleration profile)
+ * is off at zero, its default: the default part's run is the same, sample for sample.
  *
  * Units and signs: rates in deg/s at the API (rad/s inside the mechanics), positive
  * rate gives a Coriolis force +2 Omega y' on the sense axis (thesis (2-22)); the
@@ -48,10 +60,16 @@
 #include "plant/actuator.h"
 #include "plant/adc.h"
 #include "plant/dac.h"
+#include "plant/drift.h"
 #include "plant/mech.h"
 #include "plant/pickoff.h"
 #include "plant/profile.h"
 #include "plant/thermal.h"
+#include "plant/vib.h"
+#include "plant/vref.h"
+
+#define PLANT_RNG_STREAM_QUAD_DRIFT 0x7601u
+#define PLANT_RNG_STREAM_INPHASE_DRIFT 0x7602u
 
 /* The parameter list: X(c_type, name, kind, min, max, unit, doc). It generates the
  * fields of plant_cfg_t and the descriptor table, so every field is a parameter.
@@ -86,6 +104,16 @@
     "quadrature (stiffness coupling k_q) as an equivalent rate k_q/(2 wc)") \
   X(double, inphase_bias_dps, DOUBLE, -1e4, 1e4, "deg/s", \
     "damping coupling d_q as an equivalent rate d_q/2") \
+  X(double, quad_drift_dps, DOUBLE, 0.0, 1e4, "deg/s", \
+    "rms of the quadrature's slow drift (first-order Gauss-Markov, drift.h), 0 = none") \
+  X(double, quad_drift_tau_s, DOUBLE, 1e-2, 1e9, "s", "correlation time of that drift") \
+  X(double, inphase_drift_dps, DOUBLE, 0.0, 1e4, "deg/s", \
+    "rms of the damping coupling's slow drift (Gauss-Markov), 0 = none") \
+  X(double, inphase_drift_tau_s, DOUBLE, 1e-2, 1e9, "s", "correlation time of that drift") \
+  X(double, k3_drive_per_m2, DOUBLE, -1e12, 1e12, "1/m^2", \
+    "cubic stiffness k3/k of the drive suspension (Duffing), 0 = linear") \
+  X(double, k3_sense_per_m2, DOUBLE, -1e12, 1e12, "1/m^2", \
+    "cubic stiffness k3/k of the sense suspension (Duffing), 0 = linear") \
   X(double, mech_refresh_eps, DOUBLE, 1e-9, 1e-2, "", \
     "relative resonance shift that re-discretises the mechanics") \
   /* actuators (actuator.h) */ \
@@ -104,6 +132,9 @@
     "1/f noise at 1 Hz on each feedback electrode") \
   X(double, fb_noise_fmin_hz, DOUBLE, 1e-7, 1.0, "Hz", \
     "feedback 1/f spectrum flattens below this") \
+  X(double, fb_gap_m, DOUBLE, 0.0, 1e-3, "m", \
+    "parallel-plate gap of the feedback electrodes: their bias softens the sense spring " \
+    "(6-3), 0 = none") \
   /* DAC (dac.h) */ \
   X(double, dac_recon_hz, DOUBLE, 0.0, 1e7, "Hz", \
     "reconstruction low-pass natural frequency, 0 = none") \
@@ -117,6 +148,10 @@
   X(double, dac_offset_u2_v, DOUBLE, -15.0, 15.0, "V", "output offset, U2") \
   X(double, dac_offset_rate_v, DOUBLE, -15.0, 15.0, "V", "output offset, rate output") \
   X(double, dac_offset_spare_v, DOUBLE, -15.0, 15.0, "V", "output offset, spare") \
+  X(double, dac_inl_bow_lsb, DOUBLE, -64.0, 64.0, "LSB", \
+    "DAC INL bow at mid-scale, zero at the ends (inl.h), 0 = none") \
+  X(double, dac_inl_code_lsb, DOUBLE, 0.0, 64.0, "LSB", \
+    "DAC per-code INL: rms weight error of the MSB (inl.h), 0 = none") \
   /* drive pickoff (pickoff.h) */ \
   X(double, pick_drive_gain_v_per_m, DOUBLE, 1.0, 1e12, "V/m", \
     "drive ring-diode gain at T0 (4-12)") \
@@ -146,6 +181,14 @@
   X(double, pick_drive_delay_s, DOUBLE, -1e-3, 1e-3, "s", \
     "drive sampling instant after the tick (|.| <= T/2)") \
   X(double, pick_drive_jitter_s, DOUBLE, 0.0, 1e-3, "s", "drive sampling jitter rms (<= T/20)") \
+  X(double, pick_drive_gap_m, DOUBLE, 0.0, 1e-3, "m", \
+    "drive pickoff parallel-plate gap: capacitive nonlinearity, 0 = linear") \
+  X(double, pick_drive_gap_asym, DOUBLE, 0.0, 1.0, "", \
+    "imbalance of the drive pickoff pair (0 balanced: odd orders only, 1 one-sided)") \
+  X(double, pick_drive_gain_flicker_1hz_rthz, DOUBLE, 0.0, 1e-2, "1/rtHz", \
+    "relative 1/f noise of the drive pickoff gain at 1 Hz, 0 = none") \
+  X(double, pick_drive_phase_flicker_1hz_deg_rthz, DOUBLE, 0.0, 1.0, "deg/rtHz", \
+    "1/f noise of the drive circuit phase at 1 Hz, 0 = none") \
   /* sense pickoff */ \
   X(double, pick_sense_gain_v_per_m, DOUBLE, 1.0, 1e12, "V/m", \
     "sense ring-diode gain at T0 (4-12)") \
@@ -175,12 +218,34 @@
   X(double, pick_sense_delay_s, DOUBLE, -1e-3, 1e-3, "s", \
     "sense sampling instant after the tick (|.| <= T/2)") \
   X(double, pick_sense_jitter_s, DOUBLE, 0.0, 1e-3, "s", "sense sampling jitter rms (<= T/20)") \
+  X(double, pick_sense_gap_m, DOUBLE, 0.0, 1e-3, "m", \
+    "sense pickoff parallel-plate gap: capacitive nonlinearity, 0 = linear") \
+  X(double, pick_sense_gap_asym, DOUBLE, 0.0, 1.0, "", \
+    "imbalance of the sense pickoff pair (0 balanced: odd orders only, 1 one-sided)") \
+  X(double, pick_sense_gain_flicker_1hz_rthz, DOUBLE, 0.0, 1e-2, "1/rtHz", \
+    "relative 1/f noise of the sense pickoff gain at 1 Hz, 0 = none") \
+  X(double, pick_sense_phase_flicker_1hz_deg_rthz, DOUBLE, 0.0, 1.0, "deg/rtHz", \
+    "1/f noise of the sense circuit phase at 1 Hz, 0 = none") \
   X(double, pick_lag_ref_hz, DOUBLE, 1.0, 1e6, "Hz", \
     "frequency at which the circuit lags equal phi (< fs/2)") \
   X(double, pick_phase_step_rad, DOUBLE, 0.0, 0.01, "rad", \
     "circuit phase change that re-discretises a pickoff") \
-  /* ADC (adc.h) */ \
+  X(double, pick_flicker_fmin_hz, DOUBLE, 1e-7, 1.0, "Hz", \
+    "the pickoff gain and phase 1/f spectra flatten below this") \
+  /* ADC (adc.h) and the shared reference (vref.h) */ \
   X(double, adc_full_scale_v, DOUBLE, 0.01, 100.0, "V", "ADC full scale, +-") \
+  X(double, adc_inl_bow_lsb, DOUBLE, -64.0, 64.0, "LSB", \
+    "ADC INL bow at mid-scale, zero at the ends (inl.h), 0 = none") \
+  X(double, adc_inl_code_lsb, DOUBLE, 0.0, 64.0, "LSB", \
+    "ADC per-code INL: rms weight error of the MSB (inl.h), 0 = none") \
+  X(double, adc_aperture_jitter_s, DOUBLE, 0.0, 1e-3, "s", \
+    "ADC aperture jitter rms, common to both channels (<= T/20), 0 = none") \
+  X(double, vref_noise_white_rthz, DOUBLE, 0.0, 1e-3, "1/rtHz", \
+    "relative white noise of the reference shared by ADC and DAC, 0 = none") \
+  X(double, vref_noise_1hz_rthz, DOUBLE, 0.0, 1e-2, "1/rtHz", \
+    "relative 1/f noise of that reference at 1 Hz, 0 = none") \
+  X(double, vref_noise_fmin_hz, DOUBLE, 1e-7, 1.0, "Hz", \
+    "reference 1/f spectrum flattens below this") \
   /* acceleration (accel.h): force per unit mass per g */ \
   X(double, gs_drive_from_drive_mps2_per_g, DOUBLE, -1e3, 1e3, "(m/s^2)/g", \
     "drive-axis force per g along the drive axis") \
@@ -216,6 +281,9 @@
     "thermal node of the drive circuit laws: 0 structure, 1 circuit, 2 board") \
   X(int, pick_sense_temp_node, INT, 0, 2, "", \
     "thermal node of the sense circuit laws: 0 structure, 1 circuit, 2 board") \
+  X(int, q_temp_law, INT, 0, 2, "", \
+    "Q against structure temperature: 0 constant, 1 gas damping (air), 2 thermoelastic " \
+    "(vacuum) (qlaw.h)") \
   X(bool, full_kinematics, BOOL, 0, 1, "", \
     "reciprocal Coriolis, centrifugal and Euler terms of (2-20)") \
   X(bool, brownian, BOOL, 0, 1, "", "Brownian force noise on both axes (4-20)") \
@@ -250,6 +318,7 @@ typedef struct {
   /* temperatures */
   double ambient_k, struct_k, circuit_k, board_k;
   double wn_drive_rad_s; /* drive resonance now (2-32) */
+  double q_drive;        /* drive quality factor now (q_temp_law) */
   /* motion (state at t_s) */
   double y_m, vy_mps, x_m, vx_mps;
   /* phasors at the drive frequency (every truth_decim samples): */
@@ -270,14 +339,21 @@ typedef struct {
   uint64_t mech_refreshes;
 } plant_truth_t;
 
-/* Temperature laws of the plant with a range (plant_law_name gives the JSON key):
+/* Laws of the plant with a range (plant_law_name gives the JSON key):
  *   PICK_*_PHASE  circuit phase (2-40), pickoff.h: [-80, 80] deg low-pass lag section
  *                 ([-80, 160] all-pass), a lag passing through zero into a lead;
  *   PICK_*_GAIN   ring-diode gain factor 1 + tc (T - T0) (4-12) >= 0.1;
  *   RESONANCE     (2-32) at the structure temperature, |0.5 kET (T - T0)| < 0.2;
- *   AMBIENT       the thermal network's input, 1..2000 K.
- * Outside its range a law is held at the edge (the ambient at its last sane value) and
- * each evaluation there (every thermal update, and once at plant_init) is counted. */
+ *   AMBIENT       the thermal network's input, 1..2000 K;
+ *   Q_TEMP        the Q law (qlaw.h) at the structure temperature: 170..1900 K (gas),
+ *                 200..500 K (thermoelastic);
+ *   DUFFING_*     the cubic suspension term, |k3/k| x^2 <= 0.1 (mech.h);
+ *   PICK_*_GAP    the capacitive pickoff law, |x| / gap <= 0.3 (pickoff.h).
+ * Every law holds over the -40..85 degC ambient of the default part and of the ranges
+ * of the parameters' defaults. Outside its range a law is held at the edge (the ambient
+ * at its last sane value) and each evaluation there (every thermal update, and once at
+ * plant_init; the amplitude laws DUFFING_* and PICK_*_GAP once per thermal update in
+ * which a sample left the range) is counted, never refused. */
 typedef enum {
   PLANT_LAW_PICK_DRIVE_PHASE = 0,
   PLANT_LAW_PICK_SENSE_PHASE,
@@ -285,6 +361,11 @@ typedef enum {
   PLANT_LAW_PICK_SENSE_GAIN,
   PLANT_LAW_RESONANCE,
   PLANT_LAW_AMBIENT,
+  PLANT_LAW_Q_TEMP,
+  PLANT_LAW_DUFFING_DRIVE,
+  PLANT_LAW_DUFFING_SENSE,
+  PLANT_LAW_PICK_DRIVE_GAP,
+  PLANT_LAW_PICK_SENSE_GAP,
   PLANT_LAWS
 } plant_law_t;
 
@@ -303,10 +384,16 @@ typedef struct {
   pickoff_t pick[2];
   adc_t adc;
   accel_t accel;
+  vref_t vref;                            /* the converters' shared reference */
+  vib_t vib;                              /* random vibration of the acceleration profile */
+  drift_t drift[2];                       /* slow drift of k_q and d_q */
+  double drift_kq_per_s2, drift_dq_per_s; /* per unit of the drifts' values (deg/s) */
+  uint64_t seed;
   double T;                     /* sample period */
   uint64_t k;                   /* samples done */
   int thermal_every;            /* samples per thermal update */
-  int accel_any, accel_dynamic; /* acceleration profile non-zero / has a sine */
+  int accel_any, accel_dynamic; /* acceleration profile non-zero / has a sine or a shock */
+  int vib_on, drift_on;         /* random vibration / a coupling drift is on */
   /* truth: drive-frequency estimate from the force samples */
   double f_prev[2]; /* F_{k-1}, F_{k-2} */
   double est_num, est_den, est_alpha;
@@ -362,6 +449,12 @@ const plant_truth_t *plant_truth(const plant_t *p);
 const plant_warning_t *plant_warnings(const plant_t *p);
 /* "pick_drive_phase", ..., NULL past the end. */
 const char *plant_law_name(int law);
+
+/* k_e / m (1/s^2) of the electrostatic spring softening of the sense axis by the DC
+ * bias of the feedback electrodes (thesis (6-3), parallel plates of gap fb_gap_m):
+ * 4 ks_fb_mps2_per_v2 fb_bias_v^2 / fb_gap_m in differential mode (fb_mode 2), 0 in
+ * the other modes (no DC on the electrodes) or with fb_gap_m = 0. */
+double plant_fb_softening(const plant_cfg_t *cfg);
 
 /* ------------------------------------------------------------ budgets -------- */
 

@@ -158,6 +158,14 @@ void plant_default_cfg(plant_cfg_t *c)
   c->ket_per_k = 40e-6;
   c->quad_dps = 1500.0;      /* §7.2.2: quadrature about 1500 deg/s, table */
   c->inphase_bias_dps = 0.0; /* damping coupling: not in the thesis model */
+  /* Beyond the thesis's linear gyro, every imperfection is off (zero, by the memset):
+   * quad_drift_dps, inphase_drift_dps, k3_*_per_m2, fb_gap_m, pick_*_gap_m,
+   * pick_*_flicker_*, adc_inl_*, dac_inl_*, adc_aperture_jitter_s, vref_noise_*,
+   * q_temp_law. Their shape parameters get values that make sense once one is on: */
+  c->quad_drift_tau_s = 600.0; /* minutes: a package-stress relaxation's time scale */
+  c->inphase_drift_tau_s = 600.0;
+  c->pick_flicker_fmin_hz = 1e-3; /* as the electrode-voltage noise below */
+  c->vref_noise_fmin_hz = 1e-3;
   c->full_kinematics = true;
   c->brownian = true;
   c->mech_refresh_eps = 1e-3; /* mech.c: < 1e-9 error, one refresh per 50 K */
@@ -273,6 +281,38 @@ int plant_thermal_preset(plant_cfg_t *c, const char *name)
   return 0;
 }
 
+/* Cross-field limits of the imperfections (plant.h), each named by its parameter. */
+static int check_imperfections(const plant_cfg_t *c, char *buf, size_t n)
+{
+  const double fmax = c->fs_hz / 1000.0, T = 1.0 / c->fs_hz;
+  const int pick_fl = c->pick_drive_gain_flicker_1hz_rthz > 0.0 ||
+                      c->pick_drive_phase_flicker_1hz_deg_rthz > 0.0 ||
+                      c->pick_sense_gain_flicker_1hz_rthz > 0.0 ||
+                      c->pick_sense_phase_flicker_1hz_deg_rthz > 0.0;
+  if (pick_fl && c->pick_flicker_fmin_hz > fmax) {
+    errf(buf, n, "%s: must not exceed fs_hz/1000 (%g Hz)", "pick_flicker_fmin_hz", fmax);
+    return -1;
+  }
+  if (c->vref_noise_1hz_rthz > 0.0 && c->vref_noise_fmin_hz > fmax) {
+    errf(buf, n, "%s: must not exceed fs_hz/1000 (%g Hz)", "vref_noise_fmin_hz", fmax);
+    return -1;
+  }
+  if (c->adc_aperture_jitter_s > T / 20.0) {
+    errf(buf, n, "%s: must not exceed T/20 (%g s)", "adc_aperture_jitter_s", T / 20.0);
+    return -1;
+  }
+  /* the bias's softening must stay well short of the sense stiffness (pull-in, (6-4)) */
+  const double ke = plant_fb_softening(c), w2 = 2.0 * PLANT_PI * c->f_sense_hz;
+  if (ke >= 0.5 * w2 * w2) {
+    errf(buf, n,
+         "%s: the bias's spring softening 4 ks_fb Vb^2/gap (%g 1/s^2) reaches half the "
+         "sense stiffness (%g 1/s^2): pull-in",
+         "fb_gap_m", ke, 0.5 * w2 * w2);
+    return -1;
+  }
+  return 0;
+}
+
 int plant_cfg_check(const plant_cfg_t *c, char *buf, size_t n)
 {
   if (c == NULL) {
@@ -343,6 +383,7 @@ int plant_cfg_check(const plant_cfg_t *c, char *buf, size_t n)
     errf(buf, n, "%s: must not exceed fs_hz/1000 (%g Hz)", "fb_noise_fmin_hz", c->fs_hz / 1000.0);
     return -1;
   }
+  if (check_imperfections(c, buf, n) != 0) return -1;
   const struct {
     const char *key;
     double v;

@@ -242,6 +242,47 @@ double profile_eval(const profile_t *p, double t, double *slope)
 
 void accel_profile_zero(accel_profile_t *a) { memset(a, 0, sizeof(*a)); }
 
+/* The shocks' and bands' fields, checked after the constant and sine parts. */
+static const char *shocks_bands_bad(const accel_profile_t *a)
+{
+  static const char *const sk[4][PROFILE_MAX_SHOCKS] = {
+      {"shock_axis[0]", "shock_axis[1]", "shock_axis[2]", "shock_axis[3]", "shock_axis[4]",
+       "shock_axis[5]", "shock_axis[6]", "shock_axis[7]"},
+      {"shock_t_s[0]", "shock_t_s[1]", "shock_t_s[2]", "shock_t_s[3]", "shock_t_s[4]",
+       "shock_t_s[5]", "shock_t_s[6]", "shock_t_s[7]"},
+      {"shock_peak_g[0]", "shock_peak_g[1]", "shock_peak_g[2]", "shock_peak_g[3]",
+       "shock_peak_g[4]", "shock_peak_g[5]", "shock_peak_g[6]", "shock_peak_g[7]"},
+      {"shock_dur_s[0]", "shock_dur_s[1]", "shock_dur_s[2]", "shock_dur_s[3]", "shock_dur_s[4]",
+       "shock_dur_s[5]", "shock_dur_s[6]", "shock_dur_s[7]"}};
+  static const char *const bk[4][PROFILE_MAX_VIB_BANDS] = {
+      {"band_axis[0]", "band_axis[1]", "band_axis[2]", "band_axis[3]"},
+      {"band_psd_g2_per_hz[0]", "band_psd_g2_per_hz[1]", "band_psd_g2_per_hz[2]",
+       "band_psd_g2_per_hz[3]"},
+      {"band_f_lo_hz[0]", "band_f_lo_hz[1]", "band_f_lo_hz[2]", "band_f_lo_hz[3]"},
+      {"band_f_hi_hz[0]", "band_f_hi_hz[1]", "band_f_hi_hz[2]", "band_f_hi_hz[3]"}};
+  if (a->n_shocks < 0 || a->n_shocks > PROFILE_MAX_SHOCKS) return "n_shocks";
+  for (int j = 0; j < a->n_shocks; j++) {
+    if (a->shock_axis[j] < 0 || a->shock_axis[j] >= PROFILE_ACCEL_AXES) return sk[0][j];
+    if (!(isfinite(a->shock_t_s[j]) && a->shock_t_s[j] >= 0.0 && a->shock_t_s[j] <= kMaxAbs))
+      return sk[1][j];
+    if (!(isfinite(a->shock_peak_g[j]) && fabs(a->shock_peak_g[j]) <= 1e5)) return sk[2][j];
+    if (!(isfinite(a->shock_dur_s[j]) && a->shock_dur_s[j] >= 1e-6 && a->shock_dur_s[j] <= 10.0))
+      return sk[3][j];
+  }
+  if (a->n_bands < 0 || a->n_bands > PROFILE_MAX_VIB_BANDS) return "n_bands";
+  for (int j = 0; j < a->n_bands; j++) {
+    const double lo = a->band_f_lo_hz[j], hi = a->band_f_hi_hz[j];
+    if (a->band_axis[j] < 0 || a->band_axis[j] >= PROFILE_ACCEL_AXES) return bk[0][j];
+    if (!(isfinite(a->band_psd_g2_per_hz[j]) && a->band_psd_g2_per_hz[j] > 0.0 &&
+          a->band_psd_g2_per_hz[j] <= 1e3))
+      return bk[1][j];
+    if (!(isfinite(lo) && (lo == 0.0 || lo >= 0.1))) return bk[2][j];
+    /* an octave at least, so that the band is flat in its middle (vib.h) */
+    if (!(isfinite(hi) && hi > 0.0 && hi <= 1e6 && hi >= 2.0 * lo)) return bk[3][j];
+  }
+  return NULL;
+}
+
 int accel_profile_check(const accel_profile_t *a, const char **key)
 {
   static const char *const keys[4][PROFILE_ACCEL_AXES] = {
@@ -258,14 +299,45 @@ int accel_profile_check(const accel_profile_t *a, const char **key)
       bad = keys[2][i];
     else if (!(isfinite(a->phase_rad[i]) && fabs(a->phase_rad[i]) <= 1e3)) bad = keys[3][i];
   }
+  if (bad == NULL) bad = shocks_bands_bad(a);
   if (key != NULL) *key = bad;
   return bad == NULL ? 0 : -1;
+}
+
+int accel_profile_dynamic(const accel_profile_t *a)
+{
+  for (int i = 0; i < PROFILE_ACCEL_AXES; i++)
+    if (a->amp_g[i] != 0.0) return 1;
+  return a->n_shocks > 0 || a->n_bands > 0;
+}
+
+/* Half-sine shock j at t (0 outside it). */
+static double shock_at(const accel_profile_t *a, int j, double t)
+{
+  const double u = (t - a->shock_t_s[j]) / a->shock_dur_s[j];
+  if (!(u >= 0.0 && u <= 1.0)) return 0.0;
+  return a->shock_peak_g[j] * sin(PLANT_PI * u);
+}
+
+/* Integral of half-sine shock j over [t0, t1]: peak dur / pi (cos(pi u0) - cos(pi u1))
+ * over the part of the interval inside the pulse (exact), written as
+ * 2 sin(pi (u0 + u1) / 2) sin(pi (u1 - u0) / 2) so that a sample deep inside a long pulse
+ * loses no digits to the difference. */
+static double shock_integral(const accel_profile_t *a, int j, double t0, double t1)
+{
+  const double ts = a->shock_t_s[j], d = a->shock_dur_s[j];
+  const double lo = t0 > ts ? t0 : ts, hi = t1 < ts + d ? t1 : ts + d;
+  if (!(hi > lo)) return 0.0;
+  const double u0 = (lo - ts) / d, u1 = (hi - ts) / d;
+  return a->shock_peak_g[j] * d / PLANT_PI * 2.0 * sin(0.5 * PLANT_PI * (u0 + u1)) *
+         sin(0.5 * PLANT_PI * (u1 - u0));
 }
 
 void accel_profile_eval(const accel_profile_t *a, double t, double a_g[PROFILE_ACCEL_AXES])
 {
   for (int i = 0; i < PROFILE_ACCEL_AXES; i++)
     a_g[i] = a->const_g[i] + a->amp_g[i] * sin(kTwoPi * a->freq_hz[i] * t + a->phase_rad[i]);
+  for (int j = 0; j < a->n_shocks; j++) a_g[a->shock_axis[j]] += shock_at(a, j, t);
 }
 
 void accel_profile_mean(const accel_profile_t *a, double t0, double t1,
@@ -290,10 +362,14 @@ void accel_profile_mean(const accel_profile_t *a, double t0, double t1,
     }
     a_g[i] = a->const_g[i] + a->amp_g[i] * m;
   }
+  if (dt > 0.0)
+    for (int j = 0; j < a->n_shocks; j++)
+      a_g[a->shock_axis[j]] += shock_integral(a, j, t0, t1) / dt;
 }
 
 void accel_profile_peak(const accel_profile_t *a, double peak_g[PROFILE_ACCEL_AXES])
 {
   for (int i = 0; i < PROFILE_ACCEL_AXES; i++)
     peak_g[i] = fabs(a->const_g[i]) + fabs(a->amp_g[i]);
+  for (int j = 0; j < a->n_shocks; j++) peak_g[a->shock_axis[j]] += fabs(a->shock_peak_g[j]);
 }

@@ -77,7 +77,9 @@ static void test_faults(void **state)
   assert_int_equal(adc_convert(&a, 2, 1.0), 0);
   assert_int_equal(adc_convert(&a, -1, 1.0), 0);
   assert_int_equal(a.fault_count[ADC_CH_SENSE], 0);
-  adc_cfg_t c = {0.0};
+  adc_cfg_t c;
+  adc_default_cfg(&c);
+  c.full_scale_v = 0.0;
   adc_t before = a;
   assert_int_equal(adc_init(&a, &c), -1);
   c.full_scale_v = NAN;
@@ -104,6 +106,82 @@ static void test_quantisation_noise(void **state)
   assert_true(fabs(s2 / n / want - 1.0) < 5.0 * sqrt(0.8 / n)); /* var of e^2 = 0.8 want^2 */
 }
 
+/* INL (inl.h): a bow of 4 LSB moves the code of mid-scale inputs by 4 and of inputs at a
+ * quarter of the range by 3 (4 (1 - 1/4)), none at the ends; with the per-code pattern
+ * the codes follow round(x + INL(c)) for the part's own pattern. Both channels alike. */
+static void test_inl(void **state)
+{
+  (void)state;
+  adc_cfg_t c;
+  adc_default_cfg(&c);
+  c.inl.bow_lsb = 4.0;
+  adc_t a;
+  assert_int_equal(adc_init(&a, &c), 0);
+  assert_int_equal(adc_convert(&a, ADC_CH_DRIVE, 0.0), 4);
+  assert_int_equal(adc_convert(&a, ADC_CH_SENSE, 0.0), 4);
+  assert_int_equal(adc_convert(&a, ADC_CH_DRIVE, -16384 * LSB), -16384 + 3);
+  assert_int_equal(adc_convert(&a, ADC_CH_DRIVE, 32767 * LSB), 32767);
+  assert_int_equal(adc_convert(&a, ADC_CH_DRIVE, -32768 * LSB), -32768);
+  c.inl.bow_lsb = 0.0;
+  c.inl.code_lsb = 3.0;
+  c.seed = 12u;
+  assert_int_equal(adc_init(&a, &c), 0);
+  int moved = 0;
+  for (int x = -32000; x <= 32000; x += 250) {
+    const int want = (int)lround((double)x + inl_lsb(&a.inl, x + 32768L));
+    assert_int_equal(adc_convert(&a, ADC_CH_DRIVE, x * LSB), want);
+    moved |= want != x;
+  }
+  assert_true(moved);
+}
+
+/* The shared reference r (vref.h): the converter reads v / (lsb (1 + r)). */
+static void test_reference_error(void **state)
+{
+  (void)state;
+  adc_t a = make();
+  adc_set_ref(&a, 1e-3);
+  assert_int_equal(adc_convert(&a, ADC_CH_DRIVE, 20000 * LSB), 19980); /* 20000 / 1.001 */
+  adc_set_ref(&a, -1e-3);
+  assert_int_equal(adc_convert(&a, ADC_CH_SENSE, -20000 * LSB), -20020);
+  adc_set_ref(&a, 0.0);
+  assert_int_equal(adc_convert(&a, ADC_CH_DRIVE, 20000 * LSB), 20000);
+}
+
+/* Aperture jitter: draws of rms sigma from the seeded stream (the pickoffs apply them,
+ * test_pickoff_effects); none without it, and 0 returned. Bad values refused. */
+static void test_aperture_jitter(void **state)
+{
+  (void)state;
+  adc_t a = make();
+  const rng_t r0 = a.rng_aperture;
+  assert_true(adc_aperture_draw(&a) == 0.0);
+  assert_memory_equal(&a.rng_aperture, &r0, sizeof r0); /* nothing drawn */
+  adc_cfg_t c;
+  adc_default_cfg(&c);
+  c.aperture_jitter_s = 5e-9;
+  c.seed = 3u;
+  assert_int_equal(adc_init(&a, &c), 0);
+  const int n = 100000;
+  double s2 = 0.0;
+  for (int i = 0; i < n; i++) {
+    const double d = adc_aperture_draw(&a);
+    s2 += d * d;
+  }
+  assert_true(fabs(sqrt(s2 / n) / 5e-9 - 1.0) < 5.0 / sqrt(2.0 * n));
+  const adc_t before = a;
+  const double bad[3] = {-1e-9, NAN, 2e-3};
+  for (int i = 0; i < 3; i++) {
+    c.aperture_jitter_s = bad[i];
+    assert_int_equal(adc_init(&a, &c), -1);
+    assert_memory_equal(&a, &before, sizeof a);
+  }
+  adc_default_cfg(&c);
+  c.inl.code_lsb = -1.0;
+  assert_int_equal(adc_init(&a, &c), -1);
+  assert_memory_equal(&a, &before, sizeof a);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -111,6 +189,9 @@ int main(void)
       cmocka_unit_test(test_clipping_per_channel),
       cmocka_unit_test(test_faults),
       cmocka_unit_test(test_quantisation_noise),
+      cmocka_unit_test(test_inl),
+      cmocka_unit_test(test_reference_error),
+      cmocka_unit_test(test_aperture_jitter),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -218,12 +218,105 @@ static void test_channels_independent(void **state)
   }
 }
 
+/* Held level of every channel after one latched frame of code (no filter). */
+static void held_levels(const dac_cfg_t *cfg, uint16_t code, double ref, double out[DAC_NCH])
+{
+  dac_t d;
+  assert_int_equal(dac_init(&d, cfg), 0);
+  dac_set_ref(&d, ref);
+  hal_dac_frame_t f = frame_all(code);
+  assert_int_equal(dac_write(&d, &f), 0);
+  dac_out_t o;
+  dac_step(&d, &o);
+  dac_step(&d, &o);
+  for (int c = 0; c < DAC_NCH; c++) out[c] = o.ch[c].held_v;
+}
+
+/* INL (inl.h): a bow of 2 LSB raises the mid-scale level by 2 LSB times the channel's
+ * gain, a quarter-scale code by 1.5 LSB, the end codes not at all; the per-code pattern
+ * is each channel's own (its own weight errors), zero at the ends. */
+static void test_inl(void **state)
+{
+  (void)state;
+  dac_cfg_t cfg;
+  dac_default_cfg(&cfg);
+  cfg.recon_cutoff_hz = 0.0;
+  cfg.gain[1] = 1.5;
+  cfg.offset_v[1] = 0.2;
+  double ideal[DAC_NCH], v[DAC_NCH];
+  const uint16_t codes[3] = {8192, 4096, 0};
+  const double bow[3] = {2.0, 1.5, 0.0};
+  for (int i = 0; i < 3; i++) {
+    held_levels(&cfg, codes[i], 0.0, ideal);
+    dac_cfg_t b = cfg;
+    b.inl.bow_lsb = 2.0;
+    held_levels(&b, codes[i], 0.0, v);
+    for (int c = 0; c < DAC_NCH; c++)
+      assert_true(fabs(v[c] - ideal[c] - bow[i] * LSB_V * cfg.gain[c]) < 1e-12);
+  }
+  dac_cfg_t p = cfg;
+  p.inl.code_lsb = 1.0;
+  p.inl_seed = 4u;
+  held_levels(&p, 8192, 0.0, v);
+  held_levels(&cfg, 8192, 0.0, ideal);
+  assert_true(v[0] != v[2] || v[2] != v[3]); /* each channel its own ladder */
+  for (int c = 0; c < DAC_NCH; c++) {
+    dac_t d;
+    assert_int_equal(dac_init(&d, &p), 0);
+    assert_true(fabs(v[c] - ideal[c] - inl_lsb(&d.inl[c], 8192) * LSB_V * p.gain[c]) < 1e-12);
+    assert_true(fabs(inl_lsb(&d.inl[c], 0)) < 1e-12 && fabs(inl_lsb(&d.inl[c], 16383)) < 1e-12);
+  }
+}
+
+/* The shared reference r (vref.h) scales the converter's part of the level, not the
+ * amplifier's offset: offset + (level - offset) (1 + r). */
+static void test_reference_error(void **state)
+{
+  (void)state;
+  dac_cfg_t cfg;
+  dac_default_cfg(&cfg);
+  cfg.recon_cutoff_hz = 0.0;
+  cfg.offset_v[2] = 0.5;
+  double ideal[DAC_NCH], v[DAC_NCH];
+  held_levels(&cfg, 12000, 0.0, ideal);
+  held_levels(&cfg, 12000, 2e-3, v);
+  for (int c = 0; c < DAC_NCH; c++) {
+    const double off = cfg.offset_v[c];
+    assert_true(fabs(v[c] - (off + (ideal[c] - off) * 1.002)) < 1e-12);
+  }
+}
+
+/* Off by default (zero INL, no draws); a bad INL is refused and changes nothing. */
+static void test_inl_off_and_bad(void **state)
+{
+  (void)state;
+  dac_cfg_t cfg;
+  dac_default_cfg(&cfg);
+  assert_true(cfg.inl.bow_lsb == 0.0 && cfg.inl.code_lsb == 0.0);
+  dac_t d, before;
+  assert_int_equal(dac_init(&d, &cfg), 0);
+  for (int c = 0; c < DAC_NCH; c++) assert_false(d.inl[c].active);
+  before = d;
+  cfg.inl.bow_lsb = NAN;
+  assert_int_equal(dac_init(&d, &cfg), -1);
+  cfg.inl.bow_lsb = 0.0;
+  cfg.inl.code_lsb = -0.5;
+  assert_int_equal(dac_init(&d, &cfg), -1);
+  assert_memory_equal(&d, &before, sizeof d);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_code_to_volts),      cmocka_unit_test(test_latency_and_hold),
-      cmocka_unit_test(test_bad_write),          cmocka_unit_test(test_bad_cfg),
-      cmocka_unit_test(test_filtered_staircase), cmocka_unit_test(test_channels_independent),
+      cmocka_unit_test(test_code_to_volts),
+      cmocka_unit_test(test_latency_and_hold),
+      cmocka_unit_test(test_bad_write),
+      cmocka_unit_test(test_bad_cfg),
+      cmocka_unit_test(test_filtered_staircase),
+      cmocka_unit_test(test_channels_independent),
+      cmocka_unit_test(test_inl),
+      cmocka_unit_test(test_reference_error),
+      cmocka_unit_test(test_inl_off_and_bad),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -201,12 +201,112 @@ static void test_accel(void **state)
   assert_string_equal(key, "amp_g[0]");
 }
 
+/* Half-sine shocks (IEC 60068-2-27): the per-sample means over a run sum to the pulse's
+ * velocity change 2 peak dur / pi (g s) exactly (to rounding), for pulses of many
+ * samples and of less than one; each mean against Simpson's rule; nothing outside the
+ * pulse; the shocks add to the other parts of their axis. */
+static void test_half_sine_shocks(void **state)
+{
+  (void)state;
+  accel_profile_t a;
+  accel_profile_zero(&a);
+  assert_false(accel_profile_dynamic(&a));
+  a.n_shocks = 3;
+  const double t_s[3] = {0.01003, 0.02, 0.03}, peak[3] = {50.0, -200.0, 1000.0};
+  const double dur[3] = {0.5e-3, 7e-6, 1e-4};
+  const int axis[3] = {0, 1, 0};
+  for (int j = 0; j < 3; j++) {
+    a.shock_t_s[j] = t_s[j];
+    a.shock_peak_g[j] = peak[j];
+    a.shock_dur_s[j] = dur[j];
+    a.shock_axis[j] = axis[j];
+  }
+  a.const_g[1] = 0.25;
+  assert_int_equal(accel_profile_check(&a, NULL), 0);
+  assert_true(accel_profile_dynamic(&a));
+  const double fs = 50e3;
+  double dv[3] = {0, 0, 0};
+  for (int k = 0; k < 2000; k++) {
+    const double t0 = k / fs, t1 = (k + 1) / fs;
+    double m[3];
+    accel_profile_mean(&a, t0, t1, m);
+    for (int i = 0; i < 3; i++) dv[i] += m[i] / fs;
+    if (k % 13 == 0 || (t1 > 0.01 && t0 < 0.0106) || (t1 > 0.02 && t0 < 0.0201)) {
+      double v[3], sum[3] = {0, 0, 0};
+      const int np = 20000;
+      for (int j = 0; j <= np; j++) {
+        const double w = (j == 0 || j == np) ? 1.0 : ((j & 1) ? 4.0 : 2.0);
+        accel_profile_eval(&a, t0 + (t1 - t0) * j / np, v);
+        for (int i = 0; i < 3; i++) sum[i] += w * v[i];
+      }
+      /* Simpson on the kinks at a pulse's ends: 1e-6 of the peak */
+      for (int i = 0; i < 3; i++) assert_true(fabs(m[i] - sum[i] / (3.0 * np)) < 1e-3);
+    }
+  }
+  const double want0 = 2.0 * (peak[0] * dur[0] + peak[2] * dur[2]) / (0.5 * kTwoPi);
+  const double want1 = 2.0 * peak[1] * dur[1] / (0.5 * kTwoPi) + 0.25 * 2000 / fs;
+  print_message("shock velocity change: %.9e g s (2 peak dur / pi: %.9e)\n", dv[0], want0);
+  assert_true(fabs(dv[0] / want0 - 1.0) < 1e-12);
+  assert_true(fabs(dv[1] / want1 - 1.0) < 1e-12);
+  assert_true(dv[2] == 0.0);
+  double v[3];
+  accel_profile_eval(&a, t_s[0] + 0.5 * dur[0], v);
+  assert_true(fabs(v[0] - peak[0]) < 1e-12);
+  accel_profile_eval(&a, t_s[0] - 1e-9, v);
+  assert_true(v[0] == 0.0);
+  double pk[3];
+  accel_profile_peak(&a, pk);
+  assert_true(pk[0] == 1050.0 && pk[1] == 200.25 && pk[2] == 0.0);
+}
+
+/* Every field of the shocks and the random bands is checked and named. */
+static void test_shock_band_validation(void **state)
+{
+  (void)state;
+  accel_profile_t good;
+  accel_profile_zero(&good);
+  good.n_shocks = 1;
+  good.shock_dur_s[0] = 1e-3;
+  good.shock_peak_g[0] = 10.0;
+  good.n_bands = 1;
+  good.band_psd_g2_per_hz[0] = 1e-3;
+  good.band_f_lo_hz[0] = 20.0;
+  good.band_f_hi_hz[0] = 40.0;
+  assert_int_equal(accel_profile_check(&good, NULL), 0);
+  assert_true(accel_profile_dynamic(&good));
+  struct {
+    const char *key;
+    accel_profile_t a;
+  } cases[11];
+  for (int i = 0; i < 11; i++) cases[i].a = good;
+  cases[0].key = "n_shocks", cases[0].a.n_shocks = PROFILE_MAX_SHOCKS + 1;
+  cases[1].key = "shock_axis[0]", cases[1].a.shock_axis[0] = 3;
+  cases[2].key = "shock_t_s[0]", cases[2].a.shock_t_s[0] = -1.0;
+  cases[3].key = "shock_peak_g[0]", cases[3].a.shock_peak_g[0] = NAN;
+  cases[4].key = "shock_dur_s[0]", cases[4].a.shock_dur_s[0] = 0.0;
+  cases[5].key = "n_bands", cases[5].a.n_bands = -1;
+  cases[6].key = "band_axis[0]", cases[6].a.band_axis[0] = -1;
+  cases[7].key = "band_psd_g2_per_hz[0]", cases[7].a.band_psd_g2_per_hz[0] = 0.0;
+  cases[8].key = "band_f_lo_hz[0]", cases[8].a.band_f_lo_hz[0] = 0.05;
+  cases[9].key = "band_f_hi_hz[0]", cases[9].a.band_f_hi_hz[0] = 39.0; /* < an octave */
+  cases[10].key = "band_f_hi_hz[0]", cases[10].a.band_f_hi_hz[0] = INFINITY;
+  for (int i = 0; i < 11; i++) {
+    const char *key = NULL;
+    assert_true(accel_profile_check(&cases[i].a, &key) < 0);
+    assert_string_equal(key, cases[i].key);
+  }
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_const_sine_ramp), cmocka_unit_test(test_heat_cool),
-      cmocka_unit_test(test_steps),           cmocka_unit_test(test_validation),
+      cmocka_unit_test(test_const_sine_ramp),
+      cmocka_unit_test(test_heat_cool),
+      cmocka_unit_test(test_steps),
+      cmocka_unit_test(test_validation),
       cmocka_unit_test(test_accel),
+      cmocka_unit_test(test_half_sine_shocks),
+      cmocka_unit_test(test_shock_band_validation),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,56 @@
+/* Converter integral nonlinearity: the bow and the per-code pattern of inl.h. */
+#include "plant/inl.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "plant/rng.h"
+
+int inl_check(const inl_cfg_t *cfg, int bits)
+{
+  if (cfg == NULL || bits < 1 || bits > INL_MAX_BITS) return -1;
+  const double span = ldexp(1.0, bits);
+  if (!(isfinite(cfg->bow_lsb) && fabs(cfg->bow_lsb) <= span)) return -1;
+  if (!(isfinite(cfg->code_lsb) && cfg->code_lsb >= 0.0 && cfg->code_lsb <= span)) return -1;
+  return 0;
+}
+
+int inl_init(inl_t *n, const inl_cfg_t *cfg, int bits, uint64_t seed, uint64_t stream)
+{
+  if (n == NULL || inl_check(cfg, bits) != 0) return -1;
+  memset(n, 0, sizeof *n);
+  n->bits = bits;
+  n->bow_lsb = cfg->bow_lsb;
+  n->mid = ldexp(1.0, bits - 1);
+  n->active = cfg->bow_lsb != 0.0 || cfg->code_lsb > 0.0;
+  n->pattern = cfg->code_lsb > 0.0;
+  if (n->pattern) {
+    rng_t r;
+    rng_seed(&r, seed, stream);
+    double sum = 0.0;
+    for (int i = 0; i < bits; i++) {
+      /* sigma of bit i: code_lsb 2^((i - (bits-1)) / 2) */
+      n->err_lsb[i] = cfg->code_lsb * sqrt(ldexp(1.0, i - (bits - 1))) * rng_gauss(&r);
+      sum += n->err_lsb[i];
+    }
+    n->slope_lsb = sum / (ldexp(1.0, bits) - 1.0);
+  }
+  return 0;
+}
+
+double inl_lsb(const inl_t *n, long code)
+{
+  if (!n->active) return 0.0;
+  const long top = (1L << n->bits) - 1L;
+  if (code < 0) code = 0;
+  if (code > top) code = top;
+  const double u = ((double)code - n->mid) / n->mid;
+  double e = n->bow_lsb * (1.0 - u * u);
+  if (n->pattern) {
+    double s = 0.0;
+    for (int i = 0; i < n->bits; i++)
+      if (((unsigned long)code >> i) & 1u) s += n->err_lsb[i];
+    e += s - (double)code * n->slope_lsb;
+  }
+  return e;
+}

@@ -1,0 +1,503 @@
+/* The plant's imperfections beyond the linear gyro, through the whole plant (host_sim/
+ * plant/plant.h): every one off by default (the default part runs bit for bit as with
+ * them explicitly off), each switched on by its parameter and reaching its module with
+ * the expected size, the converters' shared reference and the ADC's common aperture
+ * jitter, shocks and random vibration through the g-sensitivity, Q(T) in the truth, the
+ * laws' warnings over -40..85 degC and beyond, and the cross-field refusals. The physics
+ * of each effect is tested on its module (test_mech_effects, test_pickoff_effects,
+ * test_qlaw, test_inl, test_vref, test_drift, test_vib, test_profile, test_adc,
+ * test_dac). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+#include <cmocka.h>
+
+#include "plant/plant.h"
+#include "plant/qlaw.h"
+
+static const double kTwoPi = 6.28318530717958647692;
+static const double kDeg = 6.28318530717958647692 / 360.0;
+
+/* Every switch of an imperfection: zero in the default part. */
+static const char *const kSwitches[] = {"quad_drift_dps",
+                                        "inphase_drift_dps",
+                                        "k3_drive_per_m2",
+                                        "k3_sense_per_m2",
+                                        "fb_gap_m",
+                                        "dac_inl_bow_lsb",
+                                        "dac_inl_code_lsb",
+                                        "pick_drive_gap_m",
+                                        "pick_drive_gain_flicker_1hz_rthz",
+                                        "pick_drive_phase_flicker_1hz_deg_rthz",
+                                        "pick_sense_gap_m",
+                                        "pick_sense_gain_flicker_1hz_rthz",
+                                        "pick_sense_phase_flicker_1hz_deg_rthz",
+                                        "adc_inl_bow_lsb",
+                                        "adc_inl_code_lsb",
+                                        "adc_aperture_jitter_s",
+                                        "vref_noise_white_rthz",
+                                        "vref_noise_1hz_rthz",
+                                        "q_temp_law"};
+#define NSWITCH (sizeof kSwitches / sizeof kSwitches[0])
+
+/* Half-frequency drive at the default resonance, 8 V (the square law's test point). */
+static void drive_frame(long k, double fs, hal_dac_frame_t *fr)
+{
+  const double ph = 0.5 * kTwoPi * 1489.9 * (double)k / fs;
+  fr->code[HAL_DAC_DRIVE_U1] = dac_v_to_code(8.0 * cos(ph));
+  fr->code[HAL_DAC_DRIVE_U2] = dac_v_to_code(8.0 * sin(ph));
+  fr->code[HAL_DAC_RATE_OUT] = (uint16_t)HAL_DAC_CODE_MID;
+  fr->code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID;
+}
+
+/* n samples of p under the drive; ADC frames into out (may be NULL). */
+static void run(plant_t *p, long n, hal_adc_frame_t *out)
+{
+  for (long k = 0; k < n; k++) {
+    hal_dac_frame_t fr;
+    drive_frame((long)p->k, p->cfg.fs_hz, &fr);
+    hal_adc_frame_t a;
+    plant_step(p, &fr, &a);
+    if (out != NULL) out[k] = a;
+  }
+}
+
+/* Off by default: every switch is 0 in the default part, and a part whose shape
+ * parameters (correlation times, 1/f floors, imbalances) are changed while the switches
+ * stay 0, with empty shock and band lists in its profile, gives the same ADC frames and
+ * truth bit for bit. */
+static void test_off_by_default(void **state)
+{
+  (void)state;
+  plant_cfg_t c, d;
+  plant_default_cfg(&c);
+  for (size_t i = 0; i < NSWITCH; i++) {
+    const plant_param_desc_t *pd = plant_param_find(kSwitches[i]);
+    assert_non_null(pd);
+    if (plant_param_get(&c, pd) != 0.0) fail_msg("%s is on in the default part", pd->name);
+  }
+  d = c;
+  d.quad_drift_tau_s = d.inphase_drift_tau_s = 5.0;
+  d.pick_flicker_fmin_hz = d.vref_noise_fmin_hz = 0.01;
+  d.pick_drive_gap_asym = d.pick_sense_gap_asym = 0.5;
+  static plant_t a, b;
+  assert_int_equal(plant_init(&a, &c, 3u), 0);
+  assert_int_equal(plant_init(&b, &d, 3u), 0);
+  plant_profiles_t pr = b.prof;
+  pr.accel_g.n_shocks = 0;
+  pr.accel_g.n_bands = 0;
+  assert_int_equal(plant_set_profiles(&b, &pr), 0);
+  const long n = 30000;
+  hal_adc_frame_t *fa = malloc(sizeof *fa * (size_t)n), *fb = malloc(sizeof *fb * (size_t)n);
+  assert_non_null(fa);
+  assert_non_null(fb);
+  run(&a, n, fa);
+  run(&b, n, fb);
+  assert_memory_equal(fa, fb, sizeof *fa * (size_t)n);
+  assert_memory_equal(&a.truth, &b.truth, sizeof a.truth);
+  free(fa);
+  free(fb);
+}
+
+/* Each switch on alone changes what the ADC reads within 0.3 s of the same drive (its
+ * size is its module's test); none of them leaves a law's range at these values. */
+static void test_each_switch_acts(void **state)
+{
+  (void)state;
+  static const struct {
+    const char *key;
+    double v;
+  } on[] = {{"quad_drift_dps", 20.0},
+            {"inphase_drift_dps", 20.0},
+            {"k3_drive_per_m2", 1e8},
+            {"k3_sense_per_m2", 1e12},
+            {"fb_gap_m", 2e-6},
+            {"dac_inl_bow_lsb", 2.0},
+            {"dac_inl_code_lsb", 1.0},
+            {"pick_drive_gap_m", 100e-6},
+            {"pick_drive_gain_flicker_1hz_rthz", 1e-4},
+            {"pick_drive_phase_flicker_1hz_deg_rthz", 0.01},
+            {"pick_sense_gap_m", 2e-6},
+            {"pick_sense_gain_flicker_1hz_rthz", 1e-4},
+            {"pick_sense_phase_flicker_1hz_deg_rthz", 0.01},
+            {"adc_inl_bow_lsb", 2.0},
+            {"adc_inl_code_lsb", 1.0},
+            {"adc_aperture_jitter_s", 1e-8},
+            {"vref_noise_white_rthz", 1e-6},
+            {"vref_noise_1hz_rthz", 1e-5},
+            {"q_temp_law", 2.0}};
+  assert_int_equal(sizeof on / sizeof on[0], NSWITCH);
+  const long n = 15000;
+  hal_adc_frame_t *ref = malloc(sizeof *ref * (size_t)n), *x = malloc(sizeof *x * (size_t)n);
+  assert_non_null(ref);
+  assert_non_null(x);
+  static plant_t p;
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  assert_int_equal(plant_init(&p, &c, 4u), 0);
+  run(&p, n, ref);
+  for (size_t i = 0; i < NSWITCH; i++) {
+    plant_default_cfg(&c);
+    char err[200];
+    assert_int_equal(plant_param_set(&c, on[i].key, on[i].v, err, sizeof err), 0);
+    assert_int_equal(plant_init(&p, &c, 4u), 0);
+    run(&p, n, x);
+    long differ = 0;
+    for (long k = 0; k < n; k++) differ += memcmp(&x[k], &ref[k], sizeof x[k]) != 0;
+    uint64_t warnings = 0;
+    for (int l = 0; l < PLANT_LAWS; l++) warnings += plant_warnings(&p)[l].count;
+    print_message("%-40s %-8g: %ld of %ld frames differ\n", on[i].key, on[i].v, differ, n);
+    assert_true(differ > 0);
+    assert_true(warnings == 0);
+  }
+  free(ref);
+  free(x);
+}
+
+/* The feedback electrodes' bias softens the sense spring by 4 ks Vb^2 / gap (6-3) in
+ * differential mode, not at all in the others; the coupling drifts reach the mechanics
+ * with the scales of quad_dps and inphase_bias_dps (k_q = 2 wc quad, d_q = 2 inphase),
+ * their rms within 20 % of the configured one after many correlation times (tau 20 ms,
+ * 3 s: the estimate's sd about sqrt(tau / t) = 8 %). */
+static void test_softening_and_drift_wiring(void **state)
+{
+  (void)state;
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  c.fb_gap_m = 2e-6;
+  static plant_t p;
+  assert_int_equal(plant_init(&p, &c, 5u), 0);
+  const double ke = 4.0 * c.ks_fb_mps2_per_v2 * c.fb_bias_v * c.fb_bias_v / c.fb_gap_m;
+  assert_true(fabs(p.mech.cfg.ke2_per_s2 / ke - 1.0) < 1e-15);
+  assert_true(plant_fb_softening(&c) == p.mech.cfg.ke2_per_s2);
+  c.fb_mode = 1;
+  assert_true(plant_fb_softening(&c) == 0.0);
+  plant_default_cfg(&c);
+  c.quad_drift_dps = 10.0;
+  c.inphase_drift_dps = 2.0;
+  c.quad_drift_tau_s = c.inphase_drift_tau_s = 0.02;
+  assert_int_equal(plant_init(&p, &c, 5u), 0);
+  assert_true(p.mech.drift_kq_per_s2 == 0.0); /* starts at the configured values */
+  double skq = 0.0, sdq = 0.0;
+  int cnt = 0;
+  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  for (long k = 0; k < 150000; k++) {
+    plant_step(&p, &fr, NULL);
+    if (k % 50 == 0) {
+      skq += p.mech.drift_kq_per_s2 * p.mech.drift_kq_per_s2;
+      sdq += p.mech.drift_dq_per_s * p.mech.drift_dq_per_s;
+      cnt++;
+    }
+  }
+  const double kq = 2.0 * kTwoPi * c.f_drive_hz * c.quad_drift_dps * kDeg;
+  const double dq = 2.0 * c.inphase_drift_dps * kDeg;
+  print_message("drift: k_q rms %.4g (%.4g), d_q rms %.4g (%.4g)\n", sqrt(skq / cnt), kq,
+                sqrt(sdq / cnt), dq);
+  assert_true(fabs(sqrt(skq / cnt) / kq - 1.0) < 0.2);
+  assert_true(fabs(sqrt(sdq / cnt) / dq - 1.0) < 0.2);
+}
+
+/* One reference for both converters: with white reference noise W the DAC's held levels
+ * move by r = (held - ideal) / ideal of rms W sqrt(fs/2), the same r each sample for the
+ * two drive channels; the ADC reads through the same r (test_adc: v / (1 + r)). */
+static void test_shared_reference(void **state)
+{
+  (void)state;
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  c.vref_noise_white_rthz = 1e-6;
+  static plant_t a, b;
+  plant_cfg_t d;
+  plant_default_cfg(&d);
+  assert_int_equal(plant_init(&a, &d, 6u), 0);
+  assert_int_equal(plant_init(&b, &c, 6u), 0);
+  double s2 = 0.0;
+  int cnt = 0;
+  for (long k = 0; k < 20000; k++) {
+    hal_dac_frame_t fr;
+    drive_frame(k, c.fs_hz, &fr);
+    plant_step(&a, &fr, NULL);
+    plant_step(&b, &fr, NULL);
+    const double *u0 = a.truth.dac_held_v, *u1 = b.truth.dac_held_v;
+    if (fabs(u0[0]) > 1.0 && fabs(u0[1]) > 1.0) {
+      const double r0 = u1[0] / u0[0] - 1.0, r1 = u1[1] / u0[1] - 1.0;
+      assert_true(fabs(r0 - r1) < 1e-12 + 1e-9 * fabs(r0));
+      assert_true(fabs(r0 - b.vref.rel) < 1e-12); /* the frame held this sample */
+      s2 += r0 * r0;
+      cnt++;
+    }
+  }
+  const double want = 1e-6 * sqrt(c.fs_hz / 2.0);
+  print_message("reference: r rms %.4e (W sqrt(fs/2) %.4e)\n", sqrt(s2 / cnt), want);
+  assert_true(fabs(sqrt(s2 / cnt) / want - 1.0) < 0.05);
+}
+
+/* The ADC's aperture jitter is one timing error per frame for both channels: the
+ * analog values at the ADC move by dt y' on each, so the ratio of the two channels'
+ * differences to their slopes is the same dt; its rms on the drive channel is
+ * 2 pi f A sigma / sqrt(2) (within 3 %). */
+static void test_common_aperture_jitter(void **state)
+{
+  (void)state;
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  c.brownian = false;
+  c.pick_drive_noise_v_rthz = c.pick_sense_noise_v_rthz = 0.0;
+  c.drive_noise_white_v_rthz = c.drive_noise_1hz_v_rthz = 0.0;
+  c.fb_noise_white_v_rthz = c.fb_noise_1hz_v_rthz = 0.0;
+  static plant_t a, b;
+  assert_int_equal(plant_init(&a, &c, 7u), 0);
+  c.adc_aperture_jitter_s = 20e-9;
+  assert_int_equal(plant_init(&b, &c, 7u), 0);
+  const double T = 1.0 / c.fs_hz, w = kTwoPi * 1489.9;
+  double s2 = 0.0, amp2 = 0.0, prev[2] = {0, 0};
+  long cnt = 0, same = 0, both = 0;
+  for (long k = 0; k < 60000; k++) {
+    hal_dac_frame_t fr;
+    drive_frame(k, c.fs_hz, &fr);
+    plant_step(&a, &fr, NULL);
+    plant_step(&b, &fr, NULL);
+    const double d0 = b.truth.adc_v[0] - a.truth.adc_v[0];
+    const double d1 = b.truth.adc_v[1] - a.truth.adc_v[1];
+    /* slopes from the jitter-free run's samples (central difference one step late) */
+    const double s0 = (a.truth.adc_v[0] - prev[0]) / T, s1 = (a.truth.adc_v[1] - prev[1]) / T;
+    prev[0] = a.truth.adc_v[0];
+    prev[1] = a.truth.adc_v[1];
+    if (k < 20000) continue;
+    s2 += d0 * d0;
+    amp2 += 2.0 * a.truth.adc_v[0] * a.truth.adc_v[0];
+    cnt++;
+    if (fabs(s0) > 0.5 * w * 0.3 && fabs(s1) > 0.5 * w * 0.5) {
+      both++;
+      same += (d0 / s0 > 0.0) == (d1 / s1 > 0.0);
+    }
+  }
+  const double want = w * sqrt(amp2 / cnt) * 20e-9 / sqrt(2.0);
+  print_message("aperture jitter: drive %.4e V rms (%.4e), same sign on both channels %ld of %ld\n",
+                sqrt(s2 / cnt), want, same, both);
+  assert_true(fabs(sqrt(s2 / cnt) / want - 1.0) < 0.03);
+  assert_true(both > 1000 && same > 0.95 * both);
+}
+
+/* A half-sine shock of 100 g, 0.1 ms along the drive axis (velocity change
+ * 2 peak g0 dur / pi = 0.0624 m/s) leaves the free drive mode (Q 1e5, at rest, no drive)
+ * ringing at (dv / wn) cos(wn dur / 2) / (1 - (wn dur / pi)^2) (the half-sine's spectrum
+ * at wn, Harris & Piersol ch. 8) times the held means' sinc^2(wn T / 2) = 0.9971
+ * (dac.h): within 0.3 %. The acceleration truth holds the pulse's per-sample means. */
+static void test_shock_response(void **state)
+{
+  (void)state;
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  c.brownian = false;
+  c.q_drive = 1e5;
+  c.drive_noise_white_v_rthz = c.drive_noise_1hz_v_rthz = 0.0;
+  c.fb_noise_white_v_rthz = c.fb_noise_1hz_v_rthz = 0.0;
+  static plant_t p;
+  assert_int_equal(plant_init(&p, &c, 8u), 0);
+  plant_profiles_t pr = p.prof;
+  pr.accel_g.n_shocks = 1;
+  pr.accel_g.shock_axis[0] = 0;
+  pr.accel_g.shock_t_s[0] = 0.01;
+  pr.accel_g.shock_peak_g[0] = 100.0;
+  pr.accel_g.shock_dur_s[0] = 1e-4;
+  assert_int_equal(plant_set_profiles(&p, &pr), 0);
+  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  double sum_a = 0.0;
+  for (long k = 0; k < 1000; k++) {
+    plant_step(&p, &fr, NULL);
+    sum_a += p.truth.accel_g[0] / c.fs_hz;
+  }
+  const double dv = 2.0 * 100.0 * ACCEL_G0_MPS2 * 1e-4 / (0.5 * kTwoPi);
+  assert_true(fabs(sum_a * ACCEL_G0_MPS2 / dv - 1.0) < 1e-12);
+  const double wn = p.truth.wn_drive_rad_s, x = 0.5 * wn / c.fs_hz;
+  const double sinc = sin(x) / x;
+  const double want = dv / wn * cos(0.5 * wn * 1e-4) /
+                      (1.0 - pow(wn * 1e-4 / (0.5 * kTwoPi), 2)) * sinc * sinc;
+  const double amp = hypot(p.truth.y_m, p.truth.vy_mps / wn);
+  print_message("shock: drive rings at %.5e m (half-sine spectrum %.5e m)\n", amp, want);
+  assert_true(fabs(amp / want - 1.0) < 3e-3);
+}
+
+/* Random vibration through the acceleration truth: rms sqrt of the band's design
+ * variance (test_vib) on its axis; a band beyond 0.45 fs and a bad shock are refused by
+ * plant_set_profiles with the profiles unchanged. */
+static void test_random_vibration_and_refusals(void **state)
+{
+  (void)state;
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  static plant_t p;
+  assert_int_equal(plant_init(&p, &c, 9u), 0);
+  plant_profiles_t pr = p.prof;
+  pr.accel_g.n_bands = 1;
+  pr.accel_g.band_axis[0] = 1;
+  pr.accel_g.band_psd_g2_per_hz[0] = 1e-6;
+  pr.accel_g.band_f_lo_hz[0] = 20.0;
+  pr.accel_g.band_f_hi_hz[0] = 500.0;
+  assert_int_equal(plant_set_profiles(&p, &pr), 0);
+  assert_true(p.vib_on && p.accel_any && !p.accel_dynamic);
+  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  double s2 = 0.0;
+  const long n = 200000;
+  for (long k = 0; k < n; k++) {
+    plant_step(&p, &fr, NULL);
+    assert_true(p.truth.accel_g[0] == 0.0 && p.truth.accel_g[2] == 0.0);
+    if (k >= 10000) s2 += p.truth.accel_g[1] * p.truth.accel_g[1];
+  }
+  double design = 0.0;
+  for (double f = 0.125; f < 25000.0; f += 0.25)
+    design += vib_band_psd(&p.vib, 0, c.fs_hz, f) * 0.25;
+  const double rms = sqrt(s2 / (double)(n - 10000));
+  print_message("random vibration: %.4e g rms (design %.4e)\n", rms, sqrt(design));
+  assert_true(fabs(rms / sqrt(design) - 1.0) < 0.05);
+  const plant_profiles_t before = p.prof;
+  plant_profiles_t bad = pr;
+  bad.accel_g.band_f_hi_hz[0] = 0.45 * c.fs_hz;
+  assert_int_equal(plant_set_profiles(&p, &bad), -1);
+  assert_non_null(strstr(plant_error(&p), "band_f_hi_hz[0]"));
+  bad = pr;
+  bad.accel_g.n_shocks = 1;
+  bad.accel_g.shock_dur_s[0] = -1.0;
+  assert_int_equal(plant_set_profiles(&p, &bad), -1);
+  assert_non_null(strstr(plant_error(&p), "shock_dur_s[0]"));
+  assert_memory_equal(&p.prof, &before, sizeof before);
+}
+
+/* The truth's drive Q follows the law at the structure temperature (the figure
+ * selfcal_true_q of gyro-sim is its mean over the sweep); the constant law keeps it. */
+static void test_truth_q(void **state)
+{
+  (void)state;
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  static plant_t p;
+  assert_int_equal(plant_init(&p, &c, 10u), 0);
+  assert_true(plant_truth(&p)->q_drive == c.q_drive);
+  c.q_temp_law = QLAW_GAS;
+  c.temp_k = 358.15;
+  assert_int_equal(plant_init(&p, &c, 10u), 0);
+  run(&p, 100, NULL);
+  const plant_truth_t *t = plant_truth(&p);
+  const double r = 1.0 - 0.5 * c.ket_per_k * (t->struct_k - c.temp_ref_k);
+  const double want = c.q_drive * qlaw_factor(QLAW_GAS, t->struct_k, c.temp_ref_k, r, NULL);
+  print_message("gas damping at %.2f K: Q %.4f (33.33 at 25 degC)\n", t->struct_k, t->q_drive);
+  assert_true(fabs(t->q_drive / want - 1.0) < 1e-14);
+  assert_true(t->q_drive < 0.9 * c.q_drive);
+}
+
+static uint64_t warn_total(const plant_t *p)
+{
+  uint64_t n = 0;
+  for (int i = 0; i < PLANT_LAWS; i++) n += plant_warnings(p)[i].count;
+  return n;
+}
+
+/* Every law holds over -40..85 degC ambient with the effects on; outside its range a law
+ * is counted (each thermal update), never refused: the thermoelastic law below 200 K, the
+ * cubic spring beyond |k3/k| y^2 = 0.1, the capacitive pickoff beyond |x| = 0.3 gap. */
+static void test_law_warnings(void **state)
+{
+  (void)state;
+  static plant_t p;
+  plant_cfg_t c;
+  const double ambients[2] = {233.15, 358.15};
+  for (int law = QLAW_GAS; law <= QLAW_TED; law++)
+    for (int i = 0; i < 2; i++) {
+      plant_default_cfg(&c);
+      c.temp_k = ambients[i];
+      c.q_temp_law = law;
+      c.k3_drive_per_m2 = 1e8;
+      c.pick_drive_gap_m = 100e-6;
+      c.pick_sense_gap_m = 2e-6;
+      assert_int_equal(plant_init(&p, &c, 11u), 0);
+      run(&p, 5000, NULL);
+      assert_true(warn_total(&p) == 0);
+    }
+  plant_default_cfg(&c);
+  c.temp_k = 150.0;
+  c.q_temp_law = QLAW_TED;
+  assert_int_equal(plant_init(&p, &c, 11u), 0);
+  run(&p, 500, NULL); /* 10 ms: 10 thermal updates */
+  assert_true(plant_warnings(&p)[PLANT_LAW_Q_TEMP].count == 11);
+  assert_string_equal(plant_law_name(PLANT_LAW_Q_TEMP), "q_temp");
+  /* a free 10 um drive oscillation (Q 1e5, no drive: a strong cubic term would detune a
+   * driven one) past the edge of each amplitude law: counted once per thermal update
+   * from the first one after the start */
+  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  for (int which = 0; which < 2; which++) {
+    plant_default_cfg(&c);
+    c.q_drive = 1e5;
+    if (which == 0) c.k3_drive_per_m2 = 4e9; /* 0.1 / 4e9: the edge at 5 um */
+    else c.pick_drive_gap_m = 20e-6;         /* 0.3 gap = 6 um */
+    assert_int_equal(plant_init(&p, &c, 11u), 0);
+    const mech_state_t s0 = {10e-6, 0.0, 0.0, 0.0};
+    mech_set_state(&p.mech, &s0);
+    for (long k = 0; k < 5000; k++) plant_step(&p, &fr, NULL); /* 100 thermal updates */
+    const plant_law_t law = which == 0 ? PLANT_LAW_DUFFING_DRIVE : PLANT_LAW_PICK_DRIVE_GAP;
+    const plant_warning_t *w = plant_warnings(&p);
+    print_message("%s: %llu warnings from %.4f s\n", plant_law_name(law),
+                  (unsigned long long)w[law].count, w[law].first_t_s);
+    assert_true(w[law].count == 99 && fabs(w[law].first_t_s - 1e-3) < 1e-12);
+    assert_true(warn_total(&p) == w[law].count);
+  }
+  assert_string_equal(plant_law_name(PLANT_LAW_DUFFING_DRIVE), "duffing_drive");
+  assert_string_equal(plant_law_name(PLANT_LAW_PICK_SENSE_GAP), "pick_sense_gap");
+  assert_null(plant_law_name(PLANT_LAWS));
+}
+
+/* Cross-field limits of the imperfections: refused by plant_cfg_check and plant_init,
+ * naming the parameter, the plant unchanged: the aperture jitter beyond T/20 (the first
+ * order of pickoff_step_at), and the feedback bias's softening at half the sense
+ * stiffness (pull-in). (The 1/f floors' fs/1000 limits cannot bind within their ranges.) */
+static void test_cross_checks(void **state)
+{
+  (void)state;
+  static plant_t p, before;
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  assert_int_equal(plant_init(&p, &c, 12u), 0);
+  before = p;
+  struct {
+    const char *key, *on;
+    double v, on_v;
+  } cases[] = {{"adc_aperture_jitter_s", NULL, 1.01e-6, 0.0}, /* T/20 = 1 us */
+               {"fb_gap_m", "fb_bias_v", 1e-7, 100.0}};
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    plant_cfg_t b = c;
+    char err[200];
+    assert_int_equal(plant_param_set(&b, cases[i].key, cases[i].v, err, sizeof err), 0);
+    if (cases[i].on != NULL) {
+      assert_int_equal(plant_cfg_check(&b, err, sizeof err), 0); /* fine while off */
+      assert_int_equal(plant_param_set(&b, cases[i].on, cases[i].on_v, err, sizeof err), 0);
+    }
+    assert_int_equal(plant_cfg_check(&b, err, sizeof err), -1);
+    print_message("%s\n", err);
+    assert_non_null(strstr(err, cases[i].key));
+    assert_int_equal(plant_init(&p, &b, 12u), -1);
+    assert_non_null(strstr(plant_error(&p), cases[i].key));
+    assert_memory_equal(&p, &before, offsetof(plant_t, err));
+  }
+}
+
+int main(void)
+{
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_off_by_default),
+      cmocka_unit_test(test_each_switch_acts),
+      cmocka_unit_test(test_softening_and_drift_wiring),
+      cmocka_unit_test(test_shared_reference),
+      cmocka_unit_test(test_common_aperture_jitter),
+      cmocka_unit_test(test_shock_response),
+      cmocka_unit_test(test_random_vibration_and_refusals),
+      cmocka_unit_test(test_truth_q),
+      cmocka_unit_test(test_law_warnings),
+      cmocka_unit_test(test_cross_checks),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,196 @@
+/* gyro-sim's scenario files and settings (host_sim/gyro_sim/scenario.h, sim_cfg.c) for the
+ * plant's inputs and parameters: half-sine shocks and random-vibration bands in
+ * "accel_g", each field validated with the key named and nothing changed on error;
+ * plant.thermal_preset and the new plant parameters through --set; --list-params naming
+ * every plant parameter and plant.thermal_preset. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+#include <cmocka.h>
+
+#include "scenario.h"
+#include "sim.h"
+
+static sim_scenario_t *fresh(void)
+{
+  static sim_scenario_t sc;
+  scenario_defaults(&sc);
+  return &sc;
+}
+
+/* Shocks and bands as written in a scenario, in the profile's units (duration in s). */
+static void test_shocks_and_random_parsed(void **state)
+{
+  (void)state;
+  sim_scenario_t *sc = fresh();
+  char err[400];
+  const char *json =
+      "{\"accel_g\": {\"const\": [0, 0, -1],"
+      " \"shocks\": [{\"t_s\": 0.5, \"peak_g\": 50, \"duration_ms\": 0.5, \"axis\": \"drive\"},"
+      "              {\"t_s\": 1.5, \"peak_g\": -2, \"duration_ms\": 11, \"axis\": \"normal\"}],"
+      " \"random\": [{\"axis\": \"sense\", \"psd_g2_per_hz\": 1e-5, \"f_lo_hz\": 20,"
+      " \"f_hi_hz\": 2000}, {\"axis\": \"drive\", \"psd_g2_per_hz\": 0.01, \"f_hi_hz\": 100}]}}";
+  assert_int_equal(scenario_parse(sc, json, err, sizeof err), 0);
+  const accel_profile_t *a = &sc->accel_g;
+  assert_true(sc->has_accel && a->const_g[2] == -1.0);
+  assert_int_equal(a->n_shocks, 2);
+  assert_true(a->shock_t_s[0] == 0.5 && a->shock_peak_g[0] == 50.0 && a->shock_axis[0] == 0);
+  assert_true(fabs(a->shock_dur_s[0] - 0.5e-3) < 1e-18 && fabs(a->shock_dur_s[1] - 11e-3) < 1e-18);
+  assert_true(a->shock_axis[1] == 2 && a->shock_peak_g[1] == -2.0);
+  assert_int_equal(a->n_bands, 2);
+  assert_true(a->band_axis[0] == 1 && a->band_psd_g2_per_hz[0] == 1e-5);
+  assert_true(a->band_f_lo_hz[0] == 20.0 && a->band_f_hi_hz[0] == 2000.0);
+  assert_true(a->band_axis[1] == 0 && a->band_f_lo_hz[1] == 0.0 && a->band_f_hi_hz[1] == 100.0);
+  assert_int_equal(accel_profile_check(a, NULL), 0);
+  plant_cfg_t c;
+  plant_profiles_t pr;
+  assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), 0);
+  assert_memory_equal(&pr.accel_g, a, sizeof *a);
+}
+
+/* Every bad entry is refused with its key and leaves the scenario as it was. */
+static void test_bad_entries_refused(void **state)
+{
+  (void)state;
+  static const struct {
+    const char *json, *msg;
+  } bad[] = {
+      {"{\"accel_g\": {\"shocks\": [{\"t_s\": 1, \"peak_g\": 5, \"duration_ms\": 1, \"axis\": "
+       "\"drive\", \"shape\": 1}]}}",
+       "accel_g.shocks[0].shape: unknown key"},
+      {"{\"accel_g\": {\"shocks\": [{\"t_s\": 1, \"peak_g\": 5, \"axis\": \"drive\"}]}}",
+       "accel_g.shocks[0].duration_ms: missing"},
+      {"{\"accel_g\": {\"shocks\": [{\"t_s\": 1, \"peak_g\": 5, \"duration_ms\": 1, \"axis\": "
+       "\"x\"}]}}",
+       "accel_g.shocks[0].axis: expected \"drive\", \"sense\" or \"normal\""},
+      {"{\"accel_g\": {\"shocks\": [{\"t_s\": -1, \"peak_g\": 5, \"duration_ms\": 1, \"axis\": "
+       "\"sense\"}]}}",
+       "accel_g.shocks[0].t_s: -1 is out of range"},
+      {"{\"accel_g\": {\"shocks\": [{\"t_s\": 1, \"peak_g\": 5, \"duration_ms\": 0, \"axis\": "
+       "\"sense\"}]}}",
+       "accel_g.shocks[0].duration_ms: 0 is out of range"},
+      {"{\"accel_g\": {\"shocks\": [{\"t_s\": 1, \"peak_g\": 2e5, \"duration_ms\": 1, \"axis\": "
+       "\"sense\"}]}}",
+       "accel_g.shocks[0].peak_g: 200000 is out of range"},
+      {"{\"accel_g\": {\"shocks\": [{}, {}, {}, {}, {}, {}, {}, {}, {}]}}",
+       "accel_g.shocks: expected a list of at most 8 shocks"},
+      {"{\"accel_g\": {\"random\": [{\"axis\": \"sense\", \"psd_g2_per_hz\": 0, \"f_hi_hz\": "
+       "100}]}}",
+       "accel_g.random[0].psd_g2_per_hz: 0 is out of range"},
+      {"{\"accel_g\": {\"random\": [{\"axis\": \"sense\", \"psd_g2_per_hz\": 1e-3, \"f_lo_hz\": "
+       "0.05, \"f_hi_hz\": 100}]}}",
+       "accel_g.random[0].f_lo_hz: 0.05 is neither 0"},
+      {"{\"accel_g\": {\"random\": [{\"axis\": \"sense\", \"psd_g2_per_hz\": 1e-3, \"f_lo_hz\": "
+       "80, \"f_hi_hz\": 100}]}}",
+       "accel_g.random[0].f_hi_hz: the band must span an octave"},
+      {"{\"accel_g\": {\"random\": [{\"axis\": \"sense\", \"f_hi_hz\": 100}]}}",
+       "accel_g.random[0].psd_g2_per_hz: missing"},
+      {"{\"accel_g\": {\"random\": {}}}", "accel_g.random: expected a list of at most 4 bands"},
+      {"{\"accel_g\": {\"bump\": []}}", "accel_g.bump: unknown key"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    sim_scenario_t *sc = fresh();
+    static sim_scenario_t before;
+    before = *sc;
+    char err[400] = "";
+    assert_int_equal(scenario_parse(sc, bad[i].json, err, sizeof err), -1);
+    if (strstr(err, bad[i].msg) == NULL) fail_msg("'%s' does not say '%s'", err, bad[i].msg);
+    assert_memory_equal(sc, &before, sizeof before);
+  }
+}
+
+/* A band must end below 0.45 plant.fs_hz: refused by sim_plant_cfg naming the band and
+ * the rate, accepted at a rate that allows it. */
+static void test_band_against_sample_rate(void **state)
+{
+  (void)state;
+  sim_scenario_t *sc = fresh();
+  char err[400];
+  assert_int_equal(scenario_parse(sc,
+                                  "{\"accel_g\": {\"random\": [{\"axis\": \"drive\", "
+                                  "\"psd_g2_per_hz\": 1e-6, \"f_hi_hz\": 30000}]}}",
+                                  err, sizeof err),
+                   0);
+  plant_cfg_t c;
+  plant_profiles_t pr;
+  assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), -1);
+  assert_non_null(
+      strstr(err, "accel_g.random[0].f_hi_hz: 30000 Hz must be below 0.45 plant.fs_hz"));
+  assert_int_equal(scenario_add_override(sc, "plant.fs_hz=100000", err, sizeof err), 0);
+  assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), 0);
+}
+
+/* plant.thermal_preset takes 0, 1, 2; anything else is refused with the choices. The
+ * imperfections' parameters go through --set like any other, with their ranges. */
+static void test_settings(void **state)
+{
+  (void)state;
+  char err[400], arg[64];
+  plant_cfg_t c, d;
+  plant_profiles_t pr;
+  plant_default_cfg(&d);
+  static const double ok[3] = {0, 1, 2}, bad[4] = {3, 1.5, -1, 1e300};
+  for (int i = 0; i < 3; i++) {
+    sim_scenario_t *sc = fresh();
+    snprintf(arg, sizeof arg, "plant.thermal_preset=%g", ok[i]);
+    assert_int_equal(scenario_add_override(sc, arg, err, sizeof err), 0);
+    assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), 0);
+    assert_true((i == 0) == (c.couple_sc_per_s == d.couple_sc_per_s));
+  }
+  for (int i = 0; i < 4; i++) {
+    sim_scenario_t *sc = fresh();
+    snprintf(arg, sizeof arg, "plant.thermal_preset=%g", bad[i]);
+    assert_int_equal(scenario_add_override(sc, arg, err, sizeof err), 0);
+    assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), -1);
+    assert_non_null(strstr(err, "plant.thermal_preset: "));
+    assert_non_null(strstr(err, "is not 0 (default), 1 (tight) or 2 (loose)"));
+  }
+  sim_scenario_t *sc = fresh();
+  assert_int_equal(scenario_add_override(sc, "plant.q_temp_law=3", err, sizeof err), 0);
+  assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), -1);
+  assert_string_equal(err, "plant.q_temp_law: out of range (allowed 0 .. 2)");
+  sc = fresh();
+  assert_int_equal(scenario_add_override(sc, "plant.k3_drive_per_m2=2e7", err, sizeof err), 0);
+  assert_int_equal(scenario_add_override(sc, "plant.fb_gap_m=3e-6", err, sizeof err), 0);
+  assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), 0);
+  assert_true(c.k3_drive_per_m2 == 2e7 && c.fb_gap_m == 3e-6);
+}
+
+/* --list-params: every plant parameter of the table and plant.thermal_preset, each on a
+ * line of its own with its default and range. */
+static void test_list_params(void **state)
+{
+  (void)state;
+  char *buf = NULL;
+  size_t len = 0;
+  FILE *f = open_memstream(&buf, &len);
+  assert_non_null(f);
+  sim_list_params(f);
+  fclose(f);
+  for (size_t i = 0; i < plant_param_count(); i++) {
+    char key[96];
+    snprintf(key, sizeof key, "\nplant.%s ", plant_param_at(i)->name);
+    if (strstr(buf, key) == NULL) fail_msg("--list-params misses %s", key + 1);
+  }
+  assert_non_null(strstr(buf, "\nplant.thermal_preset "));
+  assert_non_null(strstr(buf, "[0, 2]"));
+  assert_non_null(strstr(buf, "\nfirmware.drive.amp_set_v "));
+  free(buf);
+}
+
+int main(void)
+{
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_shocks_and_random_parsed),
+      cmocka_unit_test(test_bad_entries_refused),
+      cmocka_unit_test(test_band_against_sample_rate),
+      cmocka_unit_test(test_settings),
+      cmocka_unit_test(test_list_params),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
