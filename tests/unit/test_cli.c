@@ -534,7 +534,9 @@ static void test_putf(void **state)
   cli_put_f32(&g.cli, 333.33334f);
   cli_put(&g.cli, " Hz");
   char want[64];
-  snprintf(want, sizeof want, "%s", putf_line());
+  const char *line = putf_line();
+  assert_true(strlen(line) < sizeof want);
+  memcpy(want, line, strlen(line) + 1u);
   cli_putf(&g.cli, "stream %u %f Hz", 3u, 333.33334f);
   assert_string_equal(putf_line(), want);
   /* bounded: a long argument is cut at CLI_OUT_MAX like any append, and counted */
