@@ -11,7 +11,7 @@ for f in "$ROOT"/host_sim/plant/*.c; do
   arm-none-eabi-gcc -std=c11 -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -O2 \
     -ffunction-sections -fdata-sections -fno-common -Wall -Wextra -Werror -Wshadow -Wundef \
     -Wpointer-arith -Wcast-qual -Wformat=2 -Wstrict-prototypes -Wvla -D_DEFAULT_SOURCE \
-    -fstack-usage -fcallgraph-info=su -I"$ROOT"/host_sim -I"$ROOT"/hal/include \
+    -fstack-usage -fcallgraph-info=su -I"$ROOT"/host_sim -I"$ROOT"/hal/include -I"$ROOT"/hal/boards/ref_f405/include \
     -c "$f" -o "$(basename "$f" .c).o"
 done
 echo "largest frames (bytes):"
