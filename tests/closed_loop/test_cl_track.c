@@ -121,13 +121,13 @@ static void test_q_1e5_hot(void **state)
   check_startup(1.0e5, 85.0);
 }
 
-/* +-27 K steps of the whole structure at Q = 10^4 (the resonance jumps by about 0.8 Hz,
- * 5 bandwidths): no phase slip, no loss of lock, the amplitude back within 1 % in 0.2 s. */
-static void test_temperature_steps(void **state)
+/* +-27 K steps of the whole structure (the resonance jumps by about 0.8 Hz: 5 bandwidths
+ * at Q = 10^4, 54 at 10^5): no loss of lock, no fault, the amplitude back within 1 % in
+ * 0.2 s and the frequency on the new resonance. */
+static void check_steps(double q)
 {
-  (void)state;
   plant_cfg_t pc;
-  start_part(1.0e4, 25.0, 0.0, &pc);
+  start_part(q, 25.0, 0.0, &pc);
   run_s(0.3);
   const double steps_k[] = {+27.0, -27.0, -27.0, +27.0};
   for (size_t k = 0; k < 4; k++) {
@@ -145,12 +145,44 @@ static void test_temperature_steps(void **state)
       assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
     }
     const double f = nco_freq_of(app.gyro.nco.half_step, 50000.0);
-    printf("# step %+.0f K: f0 %.4f Hz tracked %.4f Hz, 0.2..0.5 s amplitude %.4f..%.4f um\n",
-           steps_k[k], true_f0(&pc), f, lo * 1e6, hi * 1e6);
+    printf("# Q %g, step %+.0f K: f0 %.4f Hz tracked %.4f Hz, 0.2..0.5 s amplitude "
+           "%.4f..%.4f um\n",
+           q, steps_k[k], true_f0(&pc), f, lo * 1e6, hi * 1e6);
     assert_true(fabs(lo / 10.0e-6 - 1.0) < 0.01 && fabs(hi / 10.0e-6 - 1.0) < 0.01);
-    assert_true(fabs(f - true_f0(&pc)) < 0.25 * true_f0(&pc) / 1.0e4 + 5e-4);
+    assert_true(fabs(f - true_f0(&pc)) < 0.25 * true_f0(&pc) / q + 5e-4);
   }
   assert_int_equal(app.gyro.sup.fault_count, 0u);
+}
+
+static void test_steps_q33(void **state)
+{
+  (void)state;
+  check_steps(33.0);
+}
+
+static void test_steps_q1e3(void **state)
+{
+  (void)state;
+  check_steps(1.0e3);
+}
+
+static void test_steps_q1e4(void **state)
+{
+  (void)state;
+  check_steps(1.0e4);
+}
+
+static void test_steps_q1e5(void **state)
+{
+  (void)state;
+  check_steps(1.0e5);
+}
+
+/* The lowest Q the drive is specified for. */
+static void test_q_20(void **state)
+{
+  (void)state;
+  check_startup(20.0, 25.0);
 }
 
 /* Calibrated 1 % above the resonance: outside the window, the frequency stops at its
@@ -179,7 +211,9 @@ int main(void)
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_q_1e3),          cmocka_unit_test(test_q_1e4),
       cmocka_unit_test(test_q_1e5),          cmocka_unit_test(test_q_1e5_cold),
-      cmocka_unit_test(test_q_1e5_hot),      cmocka_unit_test(test_temperature_steps),
+      cmocka_unit_test(test_q_1e5_hot),      cmocka_unit_test(test_steps_q33),
+      cmocka_unit_test(test_steps_q1e3),     cmocka_unit_test(test_steps_q1e4),
+      cmocka_unit_test(test_steps_q1e5),     cmocka_unit_test(test_q_20),
       cmocka_unit_test(test_outside_window),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
