@@ -360,10 +360,10 @@ static void high_q_result(selfcal_t *s, double tau)
   s->fit.gain_v_per_v2 = 0.0; /* measured at f0 by post_one, within the reach */
   s->fit.rms_rel = 0.0;       /* no frequency-response fit */
   s->delay_s = s->cfg.delay_s;
-  /* Within the identification's 2 % of the fixed drive's reach counts as within it;
-   * beyond, or with the tracking drive selected, the tracking drive takes over, and its
-   * point is a burst: it needs no settled vibration to start from. */
-  s->track = s->cfg.track != 0u || s->rd_q > 1.02 * SELFCAL_Q_FIXED_MAX ? 1u : 0u;
+  /* Beyond the fixed drive's reach (the limit the design refuses beyond, whatever the
+   * identification's scatter), or with the tracking drive selected, the tracking drive
+   * takes over, and its point is a burst: it needs no settled vibration to start from. */
+  s->track = s->cfg.track != 0u || s->rd_q > SELFCAL_Q_FIXED_MAX ? 1u : 0u;
   if (s->track != 0u) {
     post_burst(s, tau);
     return;
