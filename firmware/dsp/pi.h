@@ -79,6 +79,27 @@ static inline float pi_step(const pi_coeffs_t *restrict c, pi_t *restrict pi, fl
   return u;
 }
 
+/* One sample of (6-26b) in position form: the integral *integ (its own state, clamped to
+ * the limits on its own) takes Ki T e(k-1), the output is integral + Kp e(k), clamped.
+ * Unlike the velocity form the output's clamp does not stop the integral where the
+ * proportional part pushed it: a noisy error on a limit (a holding force of a few codes
+ * near u_min = 0) cannot ratchet the integral up. pi->u and pi->e_prev are kept as in
+ * pi_step, so either form can take over. Returns u(k). */
+static inline float pi_step_position(const pi_coeffs_t *restrict c, pi_t *restrict pi,
+                                     float *restrict integ, float e)
+{
+  float i = *integ + c->ki_t * pi->e_prev;
+  i = (i > c->u_max) ? c->u_max : i;
+  i = (i < c->u_min) ? c->u_min : i;
+  *integ = i;
+  float u = i + c->kp * e;
+  u = (u > c->u_max) ? c->u_max : u;
+  u = (u < c->u_min) ? c->u_min : u;
+  pi->e_prev = e;
+  pi->u = u;
+  return u;
+}
+
 static inline float pi_output(const pi_t *pi) { return pi->u; }
 
 #endif /* PI_H */

@@ -137,16 +137,10 @@ GYRO_RAMFUNC void drive_loop_step_amp(const drive_loop_cfg_t *restrict c,
     dl->f_cmd_v2 = pi_step(&c->amp, &dl->amp_pi, e);
     return;
   }
-  /* Position form (drive_loop_cfg_t.amp_position): the error of the notched amplitude
-   * (drive_track.h), the integral of (6-26b) on e(k-1). */
+  /* Position form (drive_loop_cfg_t.amp_position) on the error of the notched amplitude
+   * (drive_track.h). */
   e = dl->amp_set_v - drive_notch(c->notch_c2, c->notch_g, &dl->amp_notch, dl->amp_v);
-  const float i = fm_clampf(dl->amp_int + c->amp.ki_t * dl->amp_pi.e_prev, c->amp.u_min,
-                            c->amp.u_max);
-  dl->amp_int = i;
-  dl->amp_pi.e_prev = e;
-  const float u = fm_clampf(i + c->amp.kp * e, c->amp.u_min, c->amp.u_max);
-  dl->amp_pi.u = u;
-  dl->f_cmd_v2 = u;
+  dl->f_cmd_v2 = pi_step_position(&c->amp, &dl->amp_pi, &dl->amp_int, e);
 }
 
 GYRO_RAMFUNC void drive_loop_measure_phase(drive_loop_t *restrict dl, float w_i, float w_q)

@@ -190,6 +190,30 @@ static void test_anti_windup_recovery_independent_of_saturation_time(void **stat
   assert_true(r_long < p_long);
 }
 
+/* Position form on a limit: a zero-mean error alternating around an output held near
+ * u_min = 0 leaves the integral where it was (its clamp is its own), where the velocity
+ * form ratchets up (its clamp cuts the proportional kick's negative half away). */
+static void test_position_form_does_not_ratchet(void **state)
+{
+  (void)state;
+  const pi_cfg_t cfg = {1.0f, 1.0f, 1e-3f, 0.0f, 10.0f, 0.0f};
+  pi_coeffs_t c;
+  pi_t vel, pos;
+  assert_int_equal(pi_init(&cfg, &c, &vel), 0);
+  assert_int_equal(pi_init(&cfg, &c, &pos), 0);
+  float integ = 0.01f;
+  for (int k = 0; k < 1000; k++) {
+    const float e = (k & 1) ? 0.5f : -0.5f;
+    (void)pi_step(&c, &vel, e);
+    (void)pi_step_position(&c, &pos, &integ, e);
+  }
+  print_message("after 1000 alternating errors: velocity form u %.4f, position integral %.4f\n",
+                (double)vel.u, (double)integ);
+  assert_true(vel.u > 0.2f);                      /* ratcheted */
+  assert_float_equal(integ, 0.01f, 1e-3f);        /* Ki T sums +-0.5 to zero */
+  assert_float_equal(pos.u, 0.01f + 0.5f, 1e-3f); /* last error +0.5: integral + Kp e */
+}
+
 /* Changing Kp and Ki mid-run makes no step: with a constant error the increment at the
  * change is the new integral term alone (Kp acts on e(k) - e(k-1) = 0). */
 static void test_gain_change_is_bumpless(void **state)
@@ -306,6 +330,7 @@ int main(void)
       cmocka_unit_test(test_thesis_example_coefficients),
       cmocka_unit_test(test_anti_windup_recovery_independent_of_saturation_time),
       cmocka_unit_test(test_gain_change_is_bumpless),
+      cmocka_unit_test(test_position_form_does_not_ratchet),
       cmocka_unit_test(test_reset_to_output),
       cmocka_unit_test(test_limits_hold_and_change),
       cmocka_unit_test(test_bad_config_rejected_unchanged),
