@@ -31,6 +31,8 @@ static inline float fm_clampf(float x, float lo, float hi)
   return x < lo ? lo : (x > hi ? hi : x);
 }
 
+static inline float fm_maxf(float a, float b) { return a > b ? a : b; }
+
 /* atan(t) for t in [-1, 1]: odd polynomial in t, minimax coefficients for
  * atan(t)/t on t^2 in [0, 1], fitted by iteratively reweighted least squares
  * (max abs error 1.7e-6 rad). */

@@ -112,7 +112,7 @@ GYRO_RAMFUNC void gyro_block_quad(gyro_t *g)
 GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
 {
   rate_channel_project(&g->design->rate, &g->rate, g->lmsd_drive.w_i, g->lmsd_drive.w_q,
-                       g->drive.p_eq_rad);
+                       g->drive.p_eq_rad, g->drive.phase_err_rad);
   /* The continuous self-test's modulation, for the ticks from here on and for its notch
    * on this projection (GYRO_SLOT_RATE, GYRO_SLOT_QUAD): the force runs a fixed block
    * ahead of the reference, which the LMS's two weights absorb as a phase. */
@@ -216,7 +216,10 @@ GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
                               (selftest_running(&g->selftest) ? RATE_INVALID_SELFTEST : 0u) |
                               (g->clip_block != 0u ? RATE_INVALID_CLIP : 0u) |
                               (g->cont_fail != 0u ? RATE_INVALID_CONT_SELFTEST : 0u) |
-                              (g->design->track != 0u ? RATE_INVALID_TRACKING : 0u);
+                              (g->design->track != 0u ? RATE_INVALID_TRACKING : 0u) |
+                              /* the reference's wide start (rate_channel.h): it passes
+                               * the acquisition's tail of the measured phase */
+                              (g->rate.ref_wide_left != 0u ? RATE_INVALID_SETTLING : 0u);
   const uint32_t invalid = rate_valid_verdict(&g->valid, block_bits);
   /* Never a valid-looking wrong rate: the analog output goes to the fault level in the
    * same sample as the verdict, without a slew. */

@@ -280,6 +280,19 @@ static gyro_design_status_t design_rate(const param_values_t *v, double tau_s, g
   t->rate.p_lpf_alpha = (float)(1.0 - exp(-2.0 * FM_PI * (double)v->rate_p_lpf_hz *
                                           RATE_P_DECIM / fs));
   t->rate.p_mode_k = (float)(1.0 - exp(-(double)GYRO_BLOCK / (fs * tau_s))); /* per block */
+  /* The reference's type-2 low-pass (rate_channel.h), per block: a PI tracker whose
+   * closed loop is wn^2 + 2 zeta wn s over s^2 + 2 zeta wn s + wn^2. */
+  const double ref_wn_t = 2.0 * FM_PI * RATE_REF_LP_HZ * (double)GYRO_BLOCK / fs;
+  t->rate.ref_lp_kp = (float)(2.0 * RATE_REF_LP_ZETA * ref_wn_t);
+  t->rate.ref_lp_ki = (float)(ref_wn_t * ref_wn_t);
+  const double wide_wn_t = 2.0 * FM_PI * RATE_REF_WIDE_HZ * (double)GYRO_BLOCK / fs;
+  t->rate.ref_wide_kp = (float)(2.0 * RATE_REF_LP_ZETA * wide_wn_t);
+  t->rate.ref_wide_ki = (float)(wide_wn_t * wide_wn_t);
+  const double blk_s = (double)GYRO_BLOCK / fs;
+  t->rate.ref_wide_blocks = (uint32_t)(fmax(RATE_REF_WIDE_TAUS * tau_s, RATE_REF_WIDE_MIN_S) /
+                                       blk_s);
+  t->rate.ref_narrow_k = (float)pow(RATE_REF_LP_HZ / RATE_REF_WIDE_HZ,
+                                    blk_s / RATE_REF_NARROW_S); /* per block */
   t->rate.lpf_sections = (uint32_t)n;
   t->rate.min_drive_v = 0.05f * v->drive_amp_set_v;
   t->rate_out_v_per_dps = v->rate_out_v_per_dps;

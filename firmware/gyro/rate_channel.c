@@ -24,7 +24,10 @@ int rate_channel_cfg_ok(const rate_channel_cfg_t *cfg)
          fm_isfinite(cfg->scale_dps) && finite4(cfg->bias_c_dps) && finite4(cfg->sf_c) &&
          cfg->p_lpf_alpha > 0.0f && cfg->p_lpf_alpha <= 1.0f && cfg->min_drive_v > 0.0f &&
          fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg) && cfg->p_mode_k > 0.0f &&
-         cfg->p_mode_k <= 1.0f;
+         cfg->p_mode_k <= 1.0f && cfg->ref_lp_kp > 0.0f && cfg->ref_lp_kp < 1.0f &&
+         cfg->ref_lp_ki > 0.0f && cfg->ref_lp_ki < cfg->ref_lp_kp && cfg->ref_wide_kp > 0.0f &&
+         cfg->ref_wide_kp < 1.0f && cfg->ref_wide_ki > 0.0f &&
+         cfg->ref_wide_ki < cfg->ref_wide_kp;
 }
 
 int rate_channel_init(const rate_channel_cfg_t *cfg, rate_channel_t *rc)
@@ -83,7 +86,13 @@ GYRO_RAMFUNC void rate_channel_reset(const rate_channel_cfg_t *restrict cfg,
   rc->p_dev_deg = p_deg - cfg->p_ref_deg;
   rc->p_held_dev_deg = rc->p_dev_deg;
   rc->p_held_w = 0.0f;
-  rc->p_mode_rad = rc->p_dev_deg * FM_RAD_PER_DEG_F;
+  rc->p_last_rad = p_deg * FM_RAD_PER_DEG_F;
+  rc->p_lag_rad = 0.0f;
+  rc->ref_dev_rad = 0.0f;
+  rc->ref_slope_rad = 0.0f;
+  rc->ref_wide_left = cfg->ref_wide_blocks;
+  rc->ref_kp = cfg->ref_wide_kp;
+  rc->ref_ki = cfg->ref_wide_ki;
   rc->p_f_deg = p_deg;
   rc->rate_dps = 0.0f;
 }
@@ -95,17 +104,46 @@ _Static_assert(RATE_P_DECIM % RATE_DECIM == 0u && RATE_P_BLOCKS >= 2u,
 
 GYRO_RAMFUNC void rate_channel_project(const rate_channel_cfg_t *restrict cfg,
                                        rate_channel_t *restrict rc, float w_i, float w_q,
-                                       float p_rad)
+                                       float p_rad, float e_rad)
 {
   const float k = 1.0f / (float)RATE_DECIM;
   const float s_s = rc->acc_re * k, s_c = rc->acc_im * k;
   rc->acc_re = 0.0f;
   rc->acc_im = 0.0f;
-  /* (6-17): the true drive phase follows P through the resonance's lag. Work on P - p_ref
-   * (small) so the float low-pass has no dead band. */
-  const float p_dev_rad = p_rad - cfg->p_ref_deg * FM_RAD_PER_DEG_F;
-  rc->p_mode_rad += cfg->p_mode_k * (p_dev_rad - rc->p_mode_rad);
-  const float delta = rc->p_mode_rad - rc->p_dev_deg * FM_RAD_PER_DEG_F;
+  /* (6-17): the true drive phase follows P through the resonance's lag. Every state is a
+   * small difference (P's step since the last block, P - LP(P), the correction), so that
+   * no float low-pass of a large P has a dead band (at Q = 10^4 the lag's factor is 1e-4). */
+  const float lag_in = rc->p_lag_rad + (p_rad - rc->p_last_rad);
+  rc->p_last_rad = p_rad;
+  const float lag_step = cfg->p_mode_k * lag_in; /* LP(P) moves by this */
+  rc->p_lag_rad = lag_in - lag_step;
+  float delta = rc->ref_dev_rad + lag_step;
+  if (rc->p_hold != 0u) {
+    /* Acquisition: the lag model holds only for small motions about the set point, so
+     * the mode is taken as settled on P, and the reference follows the measured phase. */
+    rc->p_lag_rad = 0.0f;
+    delta = fm_clampf(-e_rad, -RATE_REF_DEV_MAX_RAD, RATE_REF_DEV_MAX_RAD);
+    rc->ref_slope_rad = 0.0f;
+    rc->ref_wide_left = cfg->ref_wide_blocks;
+    rc->ref_kp = cfg->ref_wide_kp;
+    rc->ref_ki = cfg->ref_wide_ki;
+  } else {
+    /* The type-2 low-pass's error: LP(P) + e (the static phase's estimate) less its
+     * low-passed value; its slope state follows a temperature ramp without a lag. Wide
+     * at first, while the model's start (settled on P at the release) is still wrong. */
+    if (rc->ref_wide_left != 0u) {
+      rc->ref_wide_left--;
+    } else if (rc->ref_kp > cfg->ref_lp_kp) {
+      /* Narrowing geometrically rather than in one step: a step would leave the wide
+       * filter's slope state to the narrow one, a bias bump lasting its settling. */
+      rc->ref_kp = fm_maxf(rc->ref_kp * cfg->ref_narrow_k, cfg->ref_lp_kp);
+      rc->ref_ki = fm_maxf(rc->ref_ki * (cfg->ref_narrow_k * cfg->ref_narrow_k), cfg->ref_lp_ki);
+    }
+    const float r = delta + e_rad;
+    rc->ref_slope_rad += rc->ref_ki * r;
+    delta -= rc->ref_slope_rad + rc->ref_kp * r;
+  }
+  rc->ref_dev_rad = delta;
   float re = 0.0f, im = 0.0f;
   if (w_i * w_i + w_q * w_q > cfg->min_drive_v * cfg->min_drive_v) {
     /* S conj(e^{j psi} / A_set), then turned by -delta (small angle: e^{-j delta} ~ 1 - j delta) */
@@ -142,9 +180,9 @@ GYRO_RAMFUNC void rate_channel_filter_quad(const rate_channel_cfg_t *restrict cf
 }
 
 void rate_channel_update(const rate_channel_cfg_t *cfg, rate_channel_t *rc, float w_i,
-                         float w_q, float p_rad)
+                         float w_q, float p_rad, float e_rad)
 {
-  rate_channel_project(cfg, rc, w_i, w_q, p_rad);
+  rate_channel_project(cfg, rc, w_i, w_q, p_rad, e_rad);
   rate_channel_filter_rate(cfg, rc);
   rate_channel_filter_quad(cfg, rc);
 }
@@ -155,7 +193,7 @@ GYRO_RAMFUNC void rate_channel_shift_p(rate_channel_t *restrict rc, float shift_
   rc->p_f_deg += shift_deg;
   rc->p_held_dev_deg += shift_deg;
   rc->p_acc_deg += shift_deg * (float)rc->p_count;
-  rc->p_mode_rad += shift_deg * FM_RAD_PER_DEG_F;
+  rc->p_last_rad += shift_deg * FM_RAD_PER_DEG_F; /* the lag does not see the turn */
 }
 
 GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,

@@ -7,12 +7,26 @@
  *     R = S e^{-j psi} / A_set,     psi = phase_set + phi_dm
  * puts the Coriolis part on the real axis and the quadrature on the imaginary axis once
  * phi_dm (the demodulation phase: sense-resonance and pickoff phase differences, calibrated)
- * is right. The drive motion is referenced through the phase loop's setpoint, not
- * through the measured drive phasor D: the loop holds the true drive phase at the
- * setpoint to a few thousandths of a degree, while D carries the drive pickoff's noise,
- * and every radian of reference phase noise multiplies the 1500 deg/s quadrature (2
- * uV/rtHz on a 0.35 V pickoff is 5.7e-6 rad/rtHz, 31 deg/h/rtHz of rate noise: more
- * than the Brownian floor). Likewise A_set (held by the amplitude loop) normalises the
+ * is right. Every radian of error in the reference's phase multiplies the 1500 deg/s
+ * quadrature, so the reference must follow the true drive phase theta, and neither
+ * the setpoint nor the measured phasor D is it: below the phase loop's bandwidth the
+ * loop writes the drive pickoff's noise n onto theta (theta - set ~ -n), and D carries n
+ * itself (2 uV/rtHz on a 0.35 V pickoff is 8e-6 rad/rtHz, 44 deg/h/rtHz of rate
+ * noise: more than the Brownian floor). What does know theta without n is the loop's
+ * own force phase P: the mode turns it into theta through its lag (6-17),
+ *     theta = LP_tau(P) + const,   tau = 2Q/wn
+ * (the tracking drive's p_eq the same way, drive_track.h). The constant (the resonance's
+ * phase at the drive frequency) moves with temperature, so the reference is a
+ * complementary filter: the model's high frequencies, the measurement's low ones,
+ *     delta = theta - set = LP_tau(P) - LP2(LP_tau(P) + e),   e = set - arg D,
+ * LP2 a type-2 low-pass of RATE_REF_LP_HZ (the estimate of the static phase: it follows
+ * a temperature ramp of the resonance without a lag; at Q = 10^4 a 10 K/min ramp moves
+ * that phase by 0.07 rad/s, which a first-order 1 Hz low-pass would trail by 0.01 rad:
+ * 16 deg/s of rate). What is left is q LP2(n): n over LP2's 3.3 Hz of noise bandwidth
+ * instead of the loop's tens of Hz, and no rise with Q (at Q = 5000 the loop moves P by
+ * 200 times theta's own swing at 30 Hz: a reference built on a 1 Hz low-pass of P, as
+ * before, left 6 times the error of no correction at all).
+ * Likewise A_set (held by the amplitude loop) normalises the
  * Coriolis signal, which is proportional to the drive amplitude (2-28).
  * A demodulation-phase error d_phi leaks quadrature into rate as Q sin(d_phi): with
  * 1500 deg/s of quadrature, 0.01 deg is 0.26 deg/s of bias (thesis §2.4.2 B).
@@ -47,6 +61,28 @@
  * low-pass of P - p_ref has no dead band worth mentioning (at 50 kHz a 1 Hz first-order
  * update is smaller than half an ulp of P and the filter would stick). */
 #define RATE_P_DECIM 100u
+/* The reference's complementary low-pass (above): natural frequency and damping of
+ * LP2. Low enough that little of the pickoff's phase noise reaches the reference, high
+ * enough that a change of the resonance's own phase (a thermal transient) is followed
+ * within a second. */
+#define RATE_REF_LP_HZ 1.0
+#define RATE_REF_LP_ZETA 0.7071
+/* After each lock the model starts from the mode settled on P, which is off by P's
+ * own swing at that moment (its noise: 0.035 rad at Q = 5000, 0.07 rad on the tracking
+ * drive's p_eq at 10^4); that error decays with tau, and LP2 passes (w tau / wn)^2 of it
+ * ... 1/40 at 1 Hz and tau = 1 s. So LP2 is wide for RATE_REF_WIDE_TAUS tau after the
+ * release (1/4000 of the error), then narrow: more of the pickoff's phase noise for that
+ * while (as much as the loop writes on the true phase), no bias. */
+#define RATE_REF_WIDE_HZ 10.0
+#define RATE_REF_WIDE_TAUS 4.0
+/* ... and at least this long (a few of its own time constants: the acquisition's tail
+ * it took in has left), then narrowed to RATE_REF_LP_HZ geometrically over
+ * RATE_REF_NARROW_S. */
+#define RATE_REF_WIDE_MIN_S 0.1
+#define RATE_REF_NARROW_S 0.25
+/* Before lock the reference follows the measured phase (the model's constant is not
+ * known yet), limited to the small angles its rotation is formed for. */
+#define RATE_REF_DEV_MAX_RAD 0.05f
 
 /* What the channel is told (the designer, gyro_design): constant while it runs. The
  * rate and the quadrature filters share the one set of output low-pass sections. */
@@ -58,7 +94,12 @@ typedef struct {
   float p_ref_deg;   /* P around which its low-pass works (the start value) */
   float p_lpf_alpha; /* first-order low-pass of P at fs / RATE_P_DECIM */
   float p_mode_k;    /* per-block factor of the resonance's lag: 1 - exp(-T_block / (2Q/wn)) */
-  float min_drive_v; /* below this measured drive amplitude no rate is formed */
+  float ref_lp_kp;   /* LP2 per block: 2 zeta wn T_block ... */
+  float ref_lp_ki;   /* ... and (wn T_block)^2 */
+  float ref_wide_kp, ref_wide_ki; /* the same at RATE_REF_WIDE_HZ ... */
+  uint32_t ref_wide_blocks;       /* ... for this many blocks after a release, */
+  float ref_narrow_k;             /* then kp x this per block (ki x its square) */
+  float min_drive_v;              /* below this measured drive amplitude no rate is formed */
   uint32_t lpf_sections;
   biquad_coeffs_t lpf[BIQUAD_MAX_SECTIONS]; /* output low-pass, designed for fs / RATE_DECIM */
 } rate_channel_cfg_t;
@@ -67,15 +108,20 @@ typedef struct {
 typedef struct {
   float p_acc_deg; /* sum of (P - p_ref), one sample per block, over RATE_P_DECIM ticks */
   uint32_t p_count;
-  float p_dev_deg;      /* low-passed P - p_ref */
-  float p_held_dev_deg; /* P_f - p_ref while held: where the fast start began */
-  float p_held_w;       /* weight the held value still has in P_f (1 while held) */
-  float p_mode_rad;     /* P - p_ref through the resonance's lag, rad */
-  uint32_t p_hold;      /* nonzero: P is not the temperature yet, P_f holds */
-  uint32_t p_n;         /* P means since the last hold (fast start) */
-  float p_a_mean;       /* 1 / (p_n + 1 + prior): the fast start's next weight */
-  float acc_re, acc_im; /* sense phasor summed over the current block */
-  uint32_t p_new;       /* set with each new P_f (rate_channel_update_p), for the
+  float p_dev_deg;        /* low-passed P - p_ref */
+  float p_held_dev_deg;   /* P_f - p_ref while held: where the fast start began */
+  float p_held_w;         /* weight the held value still has in P_f (1 while held) */
+  float p_last_rad;       /* P at the last projection */
+  float p_lag_rad;        /* P - LP_tau(P): the resonance's lag still to come */
+  float ref_dev_rad;      /* the reference's correction delta = theta - set */
+  float ref_slope_rad;    /* LP2's slope state, per block */
+  uint32_t ref_wide_left; /* blocks LP2 is still wide */
+  float ref_kp, ref_ki;   /* LP2's gains now (wide, narrowing, narrow) */
+  uint32_t p_hold;        /* nonzero: P is not the temperature yet, P_f holds */
+  uint32_t p_n;           /* P means since the last hold (fast start) */
+  float p_a_mean;         /* 1 / (p_n + 1 + prior): the fast start's next weight */
+  float acc_re, acc_im;   /* sense phasor summed over the current block */
+  uint32_t p_new;         /* set with each new P_f (rate_channel_update_p), for the
                                * caller's checks of it; the caller clears it */
   biquad_state_t lpf_rate[BIQUAD_MAX_SECTIONS];
   biquad_state_t lpf_quad[BIQUAD_MAX_SECTIONS];
@@ -128,11 +174,12 @@ static inline void rate_channel_hold_p(rate_channel_t *rc, int hold)
 
 /* Once per RATE_DECIM ticks, after the block's last accumulate. (w_i, w_q): the drive
  * LMSD's weights (only to tell that the drive runs); p_rad: force phase (the phase loop
- * holds it over the block), for the reference's correction; the compensation uses P_f
+ * holds it over the block) and e_rad: the phase loop's error set - arg D, for the
+ * reference's correction; the compensation uses P_f
  * as rate_channel_update_p last left it. Rate and quadrature outputs. The same as
  * rate_channel_project, rate_channel_filter_rate and rate_channel_filter_quad in a row. */
 void rate_channel_update(const rate_channel_cfg_t *cfg, rate_channel_t *rc, float w_i,
-                         float w_q, float p_rad);
+                         float w_q, float p_rad, float e_rad);
 
 /* The parts of the block update, for a caller that spreads them over the ticks of the
  * block (gyro_state.h), each once per block:
@@ -144,7 +191,7 @@ void rate_channel_update(const rate_channel_cfg_t *cfg, rate_channel_t *rc, floa
  *   rate_channel_update_p     any time: P's block sum, its low-pass every RATE_P_DECIM
  *                             ticks -> P_f (the compensation's from then on) */
 void rate_channel_project(const rate_channel_cfg_t *cfg, rate_channel_t *rc, float w_i,
-                          float w_q, float p_rad);
+                          float w_q, float p_rad, float e_rad);
 void rate_channel_filter_rate(const rate_channel_cfg_t *cfg, rate_channel_t *rc);
 void rate_channel_filter_quad(const rate_channel_cfg_t *cfg, rate_channel_t *rc);
 /* Returns 1 when it made a new P_f (every RATE_P_DECIM ticks while not held; p_new is

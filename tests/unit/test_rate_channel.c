@@ -23,6 +23,13 @@ static rate_channel_cfg_t base_cfg(biquad_coeffs_t *sec, float phi_dm)
                           .p_ref_deg = 0.0f,
                           .p_lpf_alpha = 0.5f,
                           .p_mode_k = 2.7658e-2f, /* 1 - (1 - 2.8e-3)^10 per block */
+                          /* 1 Hz, zeta 0.707 per 0.2 ms block (gyro_design.c) */
+                          .ref_lp_kp = 1.7772e-3f,
+                          .ref_lp_ki = 1.5791e-6f,
+                          .ref_wide_kp = 1.7772e-2f, /* 10 Hz */
+                          .ref_wide_ki = 1.5791e-4f,
+                          .ref_wide_blocks = 0u,
+                          .ref_narrow_k = 0.5f, /* narrow within a few blocks */
                           .lpf_sections = (uint32_t)n,
                           .min_drive_v = 0.1f};
   memcpy(c.lpf, sec, (size_t)n * sizeof sec[0]);
@@ -44,7 +51,7 @@ static int rc_init(rate_channel_t *rc, const rate_channel_cfg_t *c)
 static void block(rate_channel_t *rc, float d_s, float d_c, float s_s, float s_c, float p_rad)
 {
   for (uint32_t i = 0; i < RATE_DECIM; i++) rate_channel_accumulate(rc, s_s, s_c);
-  rate_channel_update(s_cfg, rc, d_s, d_c, p_rad);
+  rate_channel_update(s_cfg, rc, d_s, d_c, p_rad, 0.0f);
   rate_channel_update_p(s_cfg, rc, p_rad);
 }
 
@@ -99,7 +106,9 @@ static void test_compensation_polynomials(void **state)
   assert_int_equal(rc_init(&rc, &c), 0);
   rate_channel_reset(s_cfg, &rc, -1.5f);
   const double p_deg = -1.7, r = 0.2, q = -0.05;
-  for (int n = 0; n < 5000; n++) {
+  /* 5 s: P's step reaches the reference's correction through its 1 Hz low-pass as well
+   * (the block passes no loop error), which must have settled to 1e-5 as well. */
+  for (int n = 0; n < 25000; n++) {
     block(&rc, 1.0f, 0.0f, (float)r, (float)q, (float)(p_deg * M_PI / 180.0));
   }
   const double sf = 1.0 + 1e-3 * p_deg - 2e-6 * p_deg * p_deg * p_deg;
@@ -150,7 +159,7 @@ static void test_dc_linearity(void **state)
       const double noise = 1e-3 * ((double)(lcg >> 8) / 16777216.0 - 0.5);
       rate_channel_accumulate(&rc, (float)(levels[i] + noise), 0.0f);
       if (n % RATE_DECIM == RATE_DECIM - 1) {
-        rate_channel_update(s_cfg, &rc, 1.0f, 0.0f, 0.0f);
+        rate_channel_update(s_cfg, &rc, 1.0f, 0.0f, 0.0f, 0.0f);
         rate_channel_update_p(s_cfg, &rc, 0.0f);
       }
       if (n >= 50000 && n % RATE_DECIM == RATE_DECIM - 1) {
@@ -185,13 +194,69 @@ static void test_reference_follows_drive_jitter(void **state)
     const double sr = -q * sin(lag), si = q * cos(lag); /* quadrature turned by the true phase */
     rate_channel_accumulate(&rc, (float)sr, (float)si);
     if (n % RATE_DECIM != RATE_DECIM - 1) continue;
-    rate_channel_update(s_cfg, &rc, 1.0f, 0.0f, (float)p);
+    rate_channel_update(s_cfg, &rc, 1.0f, 0.0f, (float)p, (float)-lag);
     rate_channel_update_p(s_cfg, &rc, (float)p);
     if (n > 100 && fabs((double)rc.rate_raw) > worst) worst = fabs((double)rc.rate_raw);
   }
   /* Left: P's 1 Hz low-pass moving over 50 ms (2 pi 1 Hz 0.05 s ~ 0.3 of dp at most). */
   assert_true(worst < 0.35 * q * dp);
   assert_true(worst < q * dp); /* uncorrected it would be q * dp */
+}
+
+/* A part of Q = 5000 (tau = 2Q/wn = 1.07 s) in its phase loop (30 Hz, the PI zero on the
+ * mode's pole, drive_loop.h), with the drive pickoff's white phase noise n on the
+ * measurement (8e-6 rad/rtHz: 2 uV/rtHz on 0.35 V). Below the loop's bandwidth the loop
+ * writes -n onto the true drive phase; to hold it there P moves by tens of times as much
+ * (tau s at 30 Hz is 200), and the quadrature turns with the true phase. The reference's
+ * correction must follow the true phase, not P's wander: what is left is the phase
+ * noise its complementary low-pass passes, q * LP(n), LP of about 3.3 Hz of noise
+ * bandwidth: 1.5e-5 rad rms, against 5.5e-5 rad rms of true phase (n over the loop's
+ * 30 Hz, times pi/2 for its first-order roll-off) that an uncorrected reference leaves.
+ * Asserted: below half the uncorrected error, and below twice the prediction. */
+static void test_reference_high_q_loop(void **state)
+{
+  (void)state;
+  biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
+  rate_channel_cfg_t c = base_cfg(sec, 0.0f);
+  const double t_blk = RATE_DECIM / 50000.0, tau = 2.0 * 5000.0 / (2.0 * M_PI * 1489.9);
+  const double k = 1.0 - exp(-t_blk / tau), kp = 2.0 * M_PI * 30.0 * tau, ki = kp / tau;
+  c.p_mode_k = (float)k;
+  c.p_lpf_alpha = 1.25e-2f; /* 1 Hz at fs / RATE_P_DECIM */
+  rate_channel_t rc;
+  assert_int_equal(rc_init(&rc, &c), 0);
+  const double q = 0.5, sigma_n = 8e-6 * sqrt(0.5 / t_blk), p_static = 0.3;
+  double theta = 0.0, integ = p_static, p = p_static;
+  uint32_t seed = 12345u;
+  double sum_res2 = 0.0, sum_th2 = 0.0;
+  int count = 0;
+  const int n_blocks = (int)(20.0 / t_blk);
+  for (int b = 0; b < n_blocks; b++) {
+    /* Gaussian by the sum of 12 uniforms (the test needs only its variance). */
+    double u = 0.0;
+    for (int i = 0; i < 12; i++) {
+      seed = seed * 1664525u + 1013904223u;
+      u += (double)(seed >> 8) / 16777216.0;
+    }
+    const double n = sigma_n * (u - 6.0);
+    theta += k * ((p - p_static) - theta); /* the structure's phase (6-17) */
+    const double e = -(theta + n);         /* the loop's measured error */
+    for (uint32_t i = 0; i < RATE_DECIM; i++) {
+      rate_channel_accumulate(&rc, (float)(-q * sin(theta)), (float)(q * cos(theta)));
+    }
+    rate_channel_update(s_cfg, &rc, 1.0f, 0.0f, (float)p, (float)e);
+    rate_channel_update_p(s_cfg, &rc, (float)p);
+    integ += ki * t_blk * e;
+    p = integ + kp * e;
+    if (b > n_blocks / 2) {
+      sum_res2 += (double)rc.rate_raw * (double)rc.rate_raw;
+      sum_th2 += q * q * theta * theta;
+      count++;
+    }
+  }
+  const double res = sqrt(sum_res2 / count), unc = sqrt(sum_th2 / count);
+  printf("high-Q loop: residual %.3g, uncorrected %.3g (q rad)\n", res / q, unc / q);
+  assert_true(res < 0.5 * unc);
+  assert_true(res < 2.0 * q * 1.5e-5);
 }
 
 /* While held (acquisition), P's swings do not reach P_f; after the release P_f starts
@@ -256,6 +321,7 @@ int main(void)
       cmocka_unit_test(test_p_lowpass_resolution),
       cmocka_unit_test(test_dc_linearity),
       cmocka_unit_test(test_reference_follows_drive_jitter),
+      cmocka_unit_test(test_reference_high_q_loop),
       cmocka_unit_test(test_p_hold_and_fast_start),
       cmocka_unit_test(test_no_drive),
   };
