@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "plant/plant.h"
+
 static const struct {
   sim_analysis_t bit;
   const char *name;
@@ -91,6 +93,18 @@ static int add_set(sim_set_t *arr, int *n, const char *key, double v, const char
   return 0;
 }
 
+/* The part preset by name into sc (checked against plant_preset's names). */
+static int set_preset(sim_scenario_t *sc, const char *name, const char *where, char *err,
+                      size_t len)
+{
+  plant_cfg_t probe;
+  if (name == NULL || strlen(name) >= SIM_NAME_MAX || plant_preset(&probe, name) != 0)
+    return fail(err, len, "%s: '%s' is not a plant preset: %s", where, name ? name : "",
+                PLANT_PRESET_NAMES);
+  snprintf(sc->plant_preset, SIM_NAME_MAX, "%s", name);
+  return 0;
+}
+
 static int parse_sets(const cJSON *obj, const char *where, sim_set_t *arr, int *n, char *err,
                       size_t len)
 {
@@ -101,6 +115,11 @@ static int parse_sets(const cJSON *obj, const char *where, sim_set_t *arr, int *
   {
     char key[160];
     snprintf(key, sizeof key, "%s.%s", where, it->string);
+    if (strcmp(key, "plant.preset") == 0) {
+      if (!cJSON_IsString(it))
+        return fail(err, len, "plant.preset: expected a name: %s", PLANT_PRESET_NAMES);
+      continue; /* applied by scenario_parse (parse_sets has no scenario) */
+    }
     double v = 0.0;
     if (cJSON_IsBool(it)) {
       v = cJSON_IsTrue(it) ? 1.0 : 0.0;
@@ -510,6 +529,9 @@ int scenario_parse(sim_scenario_t *out, const char *json, char *err, size_t len)
         }
       } else if (strcmp(k, "plant") == 0) {
         rc = parse_sets(it, "plant", sc->plant_set, &sc->n_plant_set, err, len);
+        const cJSON *pre = cJSON_GetObjectItemCaseSensitive(it, "preset");
+        if (rc == 0 && pre != NULL)
+          rc = set_preset(sc, pre->valuestring, "plant.preset", err, len);
       } else if (strcmp(k, "firmware") == 0) {
         rc = parse_sets(it, "firmware", sc->fw_set, &sc->n_fw_set, err, len);
       } else if (strcmp(k, "rate_dps") == 0) {
@@ -587,6 +609,8 @@ int scenario_add_override(sim_scenario_t *sc, const char *arg, char *err, size_t
   if (eq == NULL)
     return fail(err, len, "--set %s: expected plant.KEY=VALUE or firmware.KEY=VALUE", arg);
   const char *val = eq + 1;
+  if ((size_t)(eq - arg) == strlen("plant.preset") && strncmp(arg, "plant.preset", 12) == 0)
+    return set_preset(sc, val, "--set plant.preset", err, len);
   char *end = NULL;
   errno = 0;
   const double v = strtod(val, &end);

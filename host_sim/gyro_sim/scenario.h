@@ -11,6 +11,9 @@
  *                          conditions; the timeline then starts from power-on with
  *                          what it identified, as if saved; closed loop only)
  *     "plant":    { "<plant parameter>": number, ... },       (plant.h descriptor table)
+ *                 ("preset": "thesis" | "ideal" there selects the part the other plant
+ *                  settings start from, wherever it stands: plant_preset; the default is
+ *                  "thesis"; "thermal_preset": 0..2 a thermal network, applied in order)
  *     "firmware": { "<firmware parameter>": number, ... },    (params/param_list.h)
  *     "rate_dps":  PROFILE, "ambient_c": PROFILE,             (input profiles)
  *     "accel_g": { "const": [x,y,z], "amp": [x,y,z], "freq_hz": [x,y,z], "phase_rad": [x,y,z],
@@ -88,6 +91,7 @@ typedef struct {
   sim_loop_t loop;
   uint32_t analyses;
   double csv_rate_hz;
+  char plant_preset[SIM_NAME_MAX]; /* "": the default part; else a plant_preset name */
   sim_set_t plant_set[SIM_MAX_SETS];
   int n_plant_set;
   sim_set_t fw_set[SIM_MAX_SETS];
@@ -110,7 +114,8 @@ int scenario_load(sim_scenario_t *sc, const char *path, char *err, size_t err_le
 
 /* A command-line override "plant.KEY=VALUE" or "firmware.KEY=VALUE" (the firmware key
  * is the parameter's own dotted name, e.g. firmware.drive.amp_bw_hz=20). Only the
- * syntax and the number are checked here; the key and range when applied. */
+ * syntax and the number are checked here; the key and range when applied. The one
+ * value that is a name, "plant.preset=NAME", is checked here (plant_preset's names). */
 int scenario_add_override(sim_scenario_t *sc, const char *arg, char *err, size_t err_len);
 
 const char *scenario_analysis_name(sim_analysis_t a);

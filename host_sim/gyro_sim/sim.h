@@ -87,7 +87,7 @@ typedef struct {
 } sim_opts_t;
 
 /* Every parameter a scenario or --set takes, with its default, range, unit and doc:
- * plant.KEY (the plant's table and plant.thermal_preset) and firmware.NAME. */
+ * plant.KEY (the plant's table, plant.thermal_preset and plant.preset) and firmware.NAME. */
 void sim_list_params(FILE *f);
 
 /* Build the plant configuration and profiles from the scenario (defaults + overrides).

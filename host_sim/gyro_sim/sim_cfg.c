@@ -22,6 +22,11 @@ void sim_list_params(FILE *f)
    * the settings, so later tau_*, couple_*, rise_* settings override it */
   fprintf(f, "plant.%-40s %-12g [%g, %g] %s  %s\n", "thermal_preset", 0.0, 0.0, 2.0, "",
           "thermal network preset: 0 default, 1 tight, 2 loose (sets tau_*, couple_*, rise_*)");
+  /* a name, not a number: the part the other plant settings start from (applied first,
+   * wherever it stands among them) */
+  fprintf(f, "plant.%-40s %-12s [%s] %s  %s\n", "preset", "thesis", "thesis, ideal", "",
+          "part preset: thesis (the default part, with the thesis's measured imperfections) or "
+          "ideal (every imperfection off); applied first, other plant settings override it");
   fprintf(f, "# firmware parameters (firmware.NAME)\n");
   param_values_t v;
   param_values_defaults(&v);
@@ -42,7 +47,15 @@ int sim_plant_cfg(const sim_scenario_t *sc, plant_cfg_t *cfg, plant_profiles_t *
                   size_t err_len)
 {
   plant_cfg_t c;
-  plant_default_cfg(&c);
+  /* the part preset first, whatever its place among the settings: the scenario's and
+   * the command line's other plant settings then override it */
+  if (sc->plant_preset[0] == '\0') {
+    plant_default_cfg(&c);
+  } else if (plant_preset(&c, sc->plant_preset) != 0) {
+    snprintf(err, err_len, "plant.preset: '%s' is not a plant preset: %s", sc->plant_preset,
+             PLANT_PRESET_NAMES);
+    return -1;
+  }
   for (int i = 0; i < sc->n_plant_set; i++) {
     const sim_set_t *s = &sc->plant_set[i];
     /* "thermal_preset" selects a coupling preset (tight/loose/default) by number. */

@@ -73,6 +73,7 @@ int mech_cfg_check(const mech_cfg_t *c, const char **key)
   else if (!finite_in(c->refresh_eps, 1e-9, 1e-2)) bad = "refresh_eps";
   else if (!finite_in(c->k3_drive_per_m2, -1e12, 1e12)) bad = "k3_drive_per_m2";
   else if (!finite_in(c->k3_sense_per_m2, -1e12, 1e12)) bad = "k3_sense_per_m2";
+  else if (!finite_in(c->nl_damp_drive_per_m2, 0.0, 1e12)) bad = "nl_damp_drive_per_m2";
   /* softening below half the sense stiffness at T0: far from pull-in over (2-32)'s range */
   else if (!finite_in(c->ke2_per_s2, 0.0, 0.5 * (2.0 * kPi * c->f2_hz) * (2.0 * kPi * c->f2_hz)))
     bad = "ke2_per_s2";
@@ -331,7 +332,7 @@ int mech_init(mech_t *m, const mech_cfg_t *cfg, double temp_k, uint64_t seed)
   m->q_out = (out[0] || out[1]) ? MECH_OUT_Q : 0u;
   m->duffing_out = 0u;
   m->drift_kq_per_s2 = m->drift_dq_per_s = 0.0;
-  m->held = c.k3_drive_per_m2 != 0.0 || c.k3_sense_per_m2 != 0.0;
+  m->held = c.k3_drive_per_m2 != 0.0 || c.k3_sense_per_m2 != 0.0 || c.nl_damp_drive_per_m2 != 0.0;
   m->wr = wr;
   m->temp_k = temp_k;
   m->temp_disc_k = temp_k;
@@ -452,7 +453,7 @@ static double cubic(double k3, double u, unsigned flag, unsigned *out)
   return k3 * u * u * u;
 }
 
-/* The held forces of mech.h (Duffing, coupling drift) per unit mass, from the motion at
+/* The held forces of mech.h (Duffing, nonlinear drive damping, coupling drift) per unit mass, from the motion at
  * the middle of the sample: the cubic Hermite interpolant of the states at its start (z0)
  * and end without these forces (z1), scaled units (mech.h). */
 static void held_forces(mech_t *m, const double *z0, const double *z1, double *fy, double *fx)
@@ -469,6 +470,8 @@ static void held_forces(mech_t *m, const double *z0, const double *z1, double *f
     *fy -= w1 * w1 * cubic(c->k3_drive_per_m2, ym, MECH_OUT_DUFFING_DRIVE, &m->duffing_out);
   if (c->k3_sense_per_m2 != 0.0)
     *fx -= w2 * w2 * cubic(c->k3_sense_per_m2, xm, MECH_OUT_DUFFING_SENSE, &m->duffing_out);
+  if (c->nl_damp_drive_per_m2 != 0.0) /* (wn1/Q1) c y^2 y' (mech.h) */
+    *fy -= w1 / m->q_now[0] * c->nl_damp_drive_per_m2 * ym * ym * vym;
   if (m->drift_kq_per_s2 != 0.0 || m->drift_dq_per_s != 0.0) {
     const double s = w1 / wn_at(c, c->f1_hz, c->temp_ref_k); /* as build_generator */
     *fx -= m->drift_kq_per_s2 * s * s * ym + m->drift_dq_per_s * s * vym;
@@ -541,7 +544,7 @@ int mech_set_coupling_drift(mech_t *m, double dkq_per_s2, double ddq_per_s)
   m->drift_kq_per_s2 = dkq_per_s2;
   m->drift_dq_per_s = ddq_per_s;
   m->held = m->cfg.k3_drive_per_m2 != 0.0 || m->cfg.k3_sense_per_m2 != 0.0 ||
-            dkq_per_s2 != 0.0 || ddq_per_s != 0.0;
+            m->cfg.nl_damp_drive_per_m2 != 0.0 || dkq_per_s2 != 0.0 || ddq_per_s != 0.0;
   return 0;
 }
 

@@ -64,6 +64,17 @@
  *     (2004) 715). k3/k follows E like k, so it has no temperature law. Range of the
  *     expansion: |k3/k| y^2 <= MECH_DUFFING_MAX (the cubic term at most a tenth of the
  *     linear one); beyond it the cubic term is held at its edge and flagged.
+ *   - amplitude-dependent drive damping (nonlinear damping of the van der Pol kind):
+ *     f_y -= (wn1 / Q1) c y_m^2 y'_m with c = nl_damp_drive_per_m2 (1/m^2), the drive's
+ *     damping force growing as (1 + c y^2). Its fundamental on y = A sin(w t) is
+ *     (wn1/Q1) (c A^2 / 4) y': the drive's effective Q is Q1 / (1 + c A^2 / 4), with no
+ *     shift of the resonance (unlike the Duffing term), so the amplitude at a fixed
+ *     frequency grows more slowly than the force at large amplitudes. Air damping of a
+ *     comb-driven proof mass grows with the stroke when the fingers' overlap and the
+ *     squeeze-film regions change over it (S. Zaitsev et al., Nonlinear Dyn. 67 (2012)
+ *     859; A. Eichler et al., Nature Nanotech. 6 (2011) 339 for the model); the thesis's
+ *     table 7-1 shows the compression (docs/honest-part.md). No temperature law beyond
+ *     Q1's own; no range law (c A^2 / 4 is a few % at the largest strokes);
  *   - slow drift of the couplings (drift.h; set by mech_set_coupling_drift):
  *     f_x -= dk_q y_m + dd_q y'_m, scaled with the structure temperature like k_q, d_q.
  *     They act as the configured couplings do; held rather than in the generator so
@@ -140,10 +151,11 @@ typedef struct {
   double refresh_eps;     /* |wn(T)/wn(T_d) - 1| (or of Q) that triggers a re-discretisation */
   double k3_drive_per_m2; /* Duffing k3/k of the drive suspension, 1/m^2; 0: linear */
   double k3_sense_per_m2; /* ... of the sense suspension */
-  double ke2_per_s2;      /* electrostatic softening k_e/m of the sense axis, >= 0 */
-  int q_law;              /* qlaw_kind_t of both Q; QLAW_CONST (0): constant */
-  int full_kinematics;    /* 1: reciprocal Coriolis, centrifugal and Euler terms (2-20) */
-  int brownian;           /* 1: Brownian force noise on both axes */
+  double nl_damp_drive_per_m2; /* amplitude-dependent drive damping: (1 + c y^2), 1/m^2 */
+  double ke2_per_s2;           /* electrostatic softening k_e/m of the sense axis, >= 0 */
+  int q_law;                   /* qlaw_kind_t of both Q; QLAW_CONST (0): constant */
+  int full_kinematics;         /* 1: reciprocal Coriolis, centrifugal and Euler terms (2-20) */
+  int brownian;                /* 1: Brownian force noise on both axes */
 } mech_cfg_t;
 
 typedef struct {

@@ -43,6 +43,7 @@ static void make_mech_cfg(const plant_cfg_t *c, mech_cfg_t *m)
   m->q_law = c->q_temp_law;
   m->k3_drive_per_m2 = c->k3_drive_per_m2;
   m->k3_sense_per_m2 = c->k3_sense_per_m2;
+  m->nl_damp_drive_per_m2 = c->nl_damp_drive_per_m2;
   m->ke2_per_s2 = plant_fb_softening(c);
 }
 

@@ -29,10 +29,13 @@
  *   6. ADC (adc.h): 16-bit quantiser (INL), clip and fault counters -> the frame
  *      returned, which the firmware reads at tick k+1.
  *
- * Every imperfection beyond the thesis's linear gyro (the q_temp_law, k3_*, *_drift_*,
- * fb_gap_m, pick_*_gap_*, pick_*_flicker_*, adc_inl_*, dac_inl_*, adc_aperture_jitter_s,
- * vref_noise_* parameters, the shocks and random vibration of the acceleration profile)
- * is off at zero, its default: the default part's run is the same, sample for sample.
+ * Every imperfection beyond the thesis's linear gyro (the q_temp_law, k3_*,
+ * nl_damp_drive_per_m2, *_drift_*, fb_gap_m, pick_*_gap_*, pick_*_flicker_*, adc_inl_*,
+ * dac_inl_*, adc_aperture_jitter_s, vref_noise_* parameters, the shocks and random
+ * vibration of the acceleration profile) is off at zero. The ideal part
+ * (plant_ideal_cfg) has every one off; the default part (plant_default_cfg) has the
+ * circuit phases' flicker and the amplitude-dependent drive damping on, set to reproduce
+ * the thesis's measured bias stability and square law (docs/honest-part.md).
  *
  * Units and signs: rates in deg/s at the API (rad/s inside the mechanics), positive
  * rate gives a Coriolis force +2 Omega y' on the sense axis (thesis (2-22)); the
@@ -114,6 +117,9 @@
     "cubic stiffness k3/k of the drive suspension (Duffing), 0 = linear") \
   X(double, k3_sense_per_m2, DOUBLE, -1e12, 1e12, "1/m^2", \
     "cubic stiffness k3/k of the sense suspension (Duffing), 0 = linear") \
+  X(double, nl_damp_drive_per_m2, DOUBLE, 0.0, 1e12, "1/m^2", \
+    "amplitude-dependent drive damping c: damping grows as (1 + c y^2), Q1 / (1 + c A^2 / 4) " \
+    "at amplitude A (mech.h), 0 = linear") \
   X(double, mech_refresh_eps, DOUBLE, 1e-9, 1e-2, "", \
     "relative resonance shift that re-discretises the mechanics") \
   /* actuators (actuator.h) */ \
@@ -407,8 +413,23 @@ typedef struct {
 
 /* ----------------------------------------------------------------- life cycle -- */
 
-/* The table "thesis linear gyro, air package" (system spec §2); sources in plant_cfg.c. */
+/* The default part, preset "thesis": the table "thesis linear gyro, air package"
+ * (system spec §2) plus the imperfections that reproduce the thesis's measured figures
+ * (bias stability, square law; plant_cfg.c and docs/honest-part.md give each value's
+ * source). */
 void plant_default_cfg(plant_cfg_t *cfg);
+
+/* Preset "ideal": the same table with every imperfection beyond the thesis's linear gyro
+ * off (the q_temp_law, k3_*, *_drift_*, fb_gap_m, pick_*_gap_*, pick_*_flicker_*,
+ * adc_inl_*, dac_inl_*, adc_aperture_jitter_s, vref_noise_* parameters at zero): the
+ * part the simulator modelled before the imperfections existed. */
+void plant_ideal_cfg(plant_cfg_t *cfg);
+
+/* Part presets by name into cfg (the whole configuration replaced): "thesis" (=
+ * plant_default_cfg) or "ideal" (plant_ideal_cfg). 0, or -1 if the name is unknown
+ * (cfg unchanged). PLANT_PRESET_NAMES lists them for messages. */
+int plant_preset(plant_cfg_t *cfg, const char *name);
+#define PLANT_PRESET_NAMES "thesis (the default) or ideal"
 
 /* Thermal presets "default", "tight", "loose" (thermal.h) into cfg; -1 if unknown. */
 int plant_thermal_preset(plant_cfg_t *cfg, const char *name);

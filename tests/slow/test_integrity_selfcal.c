@@ -18,7 +18,7 @@ static void test_q5000_selfcal_warm(void **state)
 {
   (void)state;
   plant_cfg_t pc;
-  plant_default_cfg(&pc);
+  plant_ideal_cfg(&pc);
   pc.q_drive = 5000.0;
   param_values_t v;
   param_values_defaults(&v);

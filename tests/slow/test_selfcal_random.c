@@ -52,7 +52,7 @@ static void test_too_weak_plant(void **state)
 {
   (void)state;
   plant_cfg_t pc;
-  plant_default_cfg(&pc);
+  plant_ideal_cfg(&pc);
   pc.f_drive_hz = 2000.0;
   pc.q_drive = 20.0;
   param_values_t v;

@@ -246,12 +246,14 @@ static double complex hp1(double f, double f0)
 
 /* Drive at resonance with 8 V, rate 100 deg/s and 1500 deg/s of quadrature: amplitude
  * and phase of both ADC channels against the closed form of every stage; the truth's
- * phasors against the same. */
+ * phasors against the same. The closed form is the linear chain's, so the part is the
+ * ideal preset (the default part's stroke-dependent drive damping lowers the drive
+ * amplitude by 0.3 % at 10 um, beyond the 0.2 % tolerance). */
 static void test_open_loop_chain(void **state)
 {
   (void)state;
   plant_cfg_t c;
-  plant_default_cfg(&c);
+  plant_ideal_cfg(&c);
   quiet(&c);
   c.full_kinematics = false; /* (2-22) exactly, so (2-25) below is exact */
   c.rate_dps = 100.0;
@@ -336,12 +338,14 @@ static void test_open_loop_chain(void **state)
 }
 
 /* Table 7-1: demodulated drive amplitude against the half-frequency voltage amplitude,
- * at 1490 Hz: linear in U^2, 0.8754 V at 12.75 V. */
+ * at 1490 Hz: linear in U^2, 0.8754 V at 12.75 V, on the ideal preset (the linear law the
+ * drive pickoff gain was derived from; the default part's compression, set to the
+ * thesis's 0.25 %, is cl_square_law's). */
 static void test_table_7_1_square_law(void **state)
 {
   (void)state;
   plant_cfg_t c;
-  plant_default_cfg(&c);
+  plant_ideal_cfg(&c);
   quiet(&c);
   static plant_t p;
   const double u[3] = {3.0, 7.5, 12.75}, thesis[3] = {0.04957, 0.3080, 0.8754};

@@ -1,6 +1,6 @@
 /* The plant's imperfections beyond the linear gyro, through the whole plant (host_sim/
- * plant/plant.h): every one off by default (the default part runs bit for bit as with
- * them explicitly off), each switched on by its parameter and reaching its module with
+ * plant/plant.h), on the ideal part (plant_ideal_cfg) so that each is seen alone: every
+ * one off there (the ideal part runs bit for bit as with them explicitly off), each switched on by its parameter and reaching its module with
  * the expected size, the converters' shared reference and the ADC's common aperture
  * jitter, shocks and random vibration through the g-sensitivity, Q(T) in the truth, the
  * laws' warnings over -40..85 degC and beyond, and the cross-field refusals. The physics
@@ -28,6 +28,7 @@ static const char *const kSwitches[] = {"quad_drift_dps",
                                         "inphase_drift_dps",
                                         "k3_drive_per_m2",
                                         "k3_sense_per_m2",
+                                        "nl_damp_drive_per_m2",
                                         "fb_gap_m",
                                         "dac_inl_bow_lsb",
                                         "dac_inl_code_lsb",
@@ -67,7 +68,7 @@ static void run(plant_t *p, long n, hal_adc_frame_t *out)
   }
 }
 
-/* Off by default: every switch is 0 in the default part, and a part whose shape
+/* Off in the ideal part: every switch is 0 there, and a part whose shape
  * parameters (correlation times, 1/f floors, imbalances) are changed while the switches
  * stay 0, with empty shock and band lists in its profile, gives the same ADC frames and
  * truth bit for bit. */
@@ -75,7 +76,7 @@ static void test_off_by_default(void **state)
 {
   (void)state;
   plant_cfg_t c, d;
-  plant_default_cfg(&c);
+  plant_ideal_cfg(&c);
   for (size_t i = 0; i < NSWITCH; i++) {
     const plant_param_desc_t *pd = plant_param_find(kSwitches[i]);
     assert_non_null(pd);
@@ -116,6 +117,7 @@ static void test_each_switch_acts(void **state)
             {"inphase_drift_dps", 20.0},
             {"k3_drive_per_m2", 1e8},
             {"k3_sense_per_m2", 1e12},
+            {"nl_damp_drive_per_m2", 1e9},
             {"fb_gap_m", 2e-6},
             {"dac_inl_bow_lsb", 2.0},
             {"dac_inl_code_lsb", 1.0},
@@ -138,11 +140,11 @@ static void test_each_switch_acts(void **state)
   assert_non_null(x);
   static plant_t p;
   plant_cfg_t c;
-  plant_default_cfg(&c);
+  plant_ideal_cfg(&c);
   assert_int_equal(plant_init(&p, &c, 4u), 0);
   run(&p, n, ref);
   for (size_t i = 0; i < NSWITCH; i++) {
-    plant_default_cfg(&c);
+    plant_ideal_cfg(&c);
     char err[200];
     assert_int_equal(plant_param_set(&c, on[i].key, on[i].v, err, sizeof err), 0);
     assert_int_equal(plant_init(&p, &c, 4u), 0);
@@ -168,7 +170,7 @@ static void test_softening_and_drift_wiring(void **state)
 {
   (void)state;
   plant_cfg_t c;
-  plant_default_cfg(&c);
+  plant_ideal_cfg(&c);
   c.fb_gap_m = 2e-6;
   static plant_t p;
   assert_int_equal(plant_init(&p, &c, 5u), 0);
@@ -177,7 +179,7 @@ static void test_softening_and_drift_wiring(void **state)
   assert_true(plant_fb_softening(&c) == p.mech.cfg.ke2_per_s2);
   c.fb_mode = 1;
   assert_true(plant_fb_softening(&c) == 0.0);
-  plant_default_cfg(&c);
+  plant_ideal_cfg(&c);
   c.quad_drift_dps = 10.0;
   c.inphase_drift_dps = 2.0;
   c.quad_drift_tau_s = c.inphase_drift_tau_s = 0.02;
@@ -209,11 +211,11 @@ static void test_shared_reference(void **state)
 {
   (void)state;
   plant_cfg_t c;
-  plant_default_cfg(&c);
+  plant_ideal_cfg(&c);
   c.vref_noise_white_rthz = 1e-6;
   static plant_t a, b;
   plant_cfg_t d;
-  plant_default_cfg(&d);
+  plant_ideal_cfg(&d);
   assert_int_equal(plant_init(&a, &d, 6u), 0);
   assert_int_equal(plant_init(&b, &c, 6u), 0);
   double s2 = 0.0;
@@ -245,7 +247,7 @@ static void test_common_aperture_jitter(void **state)
 {
   (void)state;
   plant_cfg_t c;
-  plant_default_cfg(&c);
+  plant_ideal_cfg(&c);
   c.brownian = false;
   c.pick_drive_noise_v_rthz = c.pick_sense_noise_v_rthz = 0.0;
   c.drive_noise_white_v_rthz = c.drive_noise_1hz_v_rthz = 0.0;
@@ -293,7 +295,7 @@ static void test_shock_response(void **state)
 {
   (void)state;
   plant_cfg_t c;
-  plant_default_cfg(&c);
+  plant_ideal_cfg(&c);
   c.brownian = false;
   c.q_drive = 1e5;
   c.drive_noise_white_v_rthz = c.drive_noise_1hz_v_rthz = 0.0;
@@ -331,7 +333,7 @@ static void test_random_vibration_and_refusals(void **state)
 {
   (void)state;
   plant_cfg_t c;
-  plant_default_cfg(&c);
+  plant_ideal_cfg(&c);
   static plant_t p;
   assert_int_equal(plant_init(&p, &c, 9u), 0);
   plant_profiles_t pr = p.prof;
@@ -375,7 +377,7 @@ static void test_truth_q(void **state)
 {
   (void)state;
   plant_cfg_t c;
-  plant_default_cfg(&c);
+  plant_ideal_cfg(&c);
   static plant_t p;
   assert_int_equal(plant_init(&p, &c, 10u), 0);
   assert_true(plant_truth(&p)->q_drive == c.q_drive);
@@ -409,7 +411,7 @@ static void test_law_warnings(void **state)
   const double ambients[2] = {233.15, 358.15};
   for (int law = QLAW_GAS; law <= QLAW_TED; law++)
     for (int i = 0; i < 2; i++) {
-      plant_default_cfg(&c);
+      plant_ideal_cfg(&c);
       c.temp_k = ambients[i];
       c.q_temp_law = law;
       c.k3_drive_per_m2 = 1e8;
@@ -419,7 +421,7 @@ static void test_law_warnings(void **state)
       run(&p, 5000, NULL);
       assert_true(warn_total(&p) == 0);
     }
-  plant_default_cfg(&c);
+  plant_ideal_cfg(&c);
   c.temp_k = 150.0;
   c.q_temp_law = QLAW_TED;
   assert_int_equal(plant_init(&p, &c, 11u), 0);
@@ -431,7 +433,7 @@ static void test_law_warnings(void **state)
    * from the first one after the start */
   hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
   for (int which = 0; which < 2; which++) {
-    plant_default_cfg(&c);
+    plant_ideal_cfg(&c);
     c.q_drive = 1e5;
     if (which == 0) c.k3_drive_per_m2 = 4e9; /* 0.1 / 4e9: the edge at 5 um */
     else c.pick_drive_gap_m = 20e-6;         /* 0.3 gap = 6 um */
@@ -460,7 +462,7 @@ static void test_cross_checks(void **state)
   (void)state;
   static plant_t p, before;
   plant_cfg_t c;
-  plant_default_cfg(&c);
+  plant_ideal_cfg(&c);
   assert_int_equal(plant_init(&p, &c, 12u), 0);
   before = p;
   struct {

@@ -1,8 +1,8 @@
 /* gyro-sim's scenario files and settings (host_sim/gyro_sim/scenario.h, sim_cfg.c) for the
  * plant's inputs and parameters: half-sine shocks and random-vibration bands in
  * "accel_g", each field validated with the key named and nothing changed on error;
- * plant.thermal_preset and the new plant parameters through --set; --list-params naming
- * every plant parameter and plant.thermal_preset. */
+ * plant.thermal_preset, plant.preset and the new plant parameters through --set and in a
+ * file; --list-params naming every plant parameter, plant.thermal_preset and plant.preset. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -161,6 +161,76 @@ static void test_settings(void **state)
   assert_true(c.k3_drive_per_m2 == 2e7 && c.fb_gap_m == 3e-6);
 }
 
+/* plant.preset: "ideal" gives plant_ideal_cfg, "thesis" (and no preset) the default part;
+ * the preset is applied first wherever it stands, so the other plant settings override it
+ * whether they come before or after it, on the command line or in the file. */
+static void test_preset(void **state)
+{
+  (void)state;
+  char err[400];
+  plant_cfg_t c, want;
+  plant_profiles_t pr;
+  sim_scenario_t *sc = fresh();
+  assert_int_equal(scenario_add_override(sc, "plant.pick_sense_phase_flicker_1hz_deg_rthz=1e-3",
+                                         err, sizeof err),
+                   0);
+  assert_int_equal(scenario_add_override(sc, "plant.preset=ideal", err, sizeof err), 0);
+  assert_int_equal(scenario_add_override(sc, "plant.k3_drive_per_m2=2e7", err, sizeof err), 0);
+  assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), 0);
+  plant_ideal_cfg(&want);
+  want.pick_sense_phase_flicker_1hz_deg_rthz = 1e-3;
+  want.k3_drive_per_m2 = 2e7;
+  assert_memory_equal(&c, &want, sizeof c);
+  /* in a file: the preset after the setting it must not undo */
+  sc = fresh();
+  assert_int_equal(scenario_parse(sc,
+                                  "{\"plant\": {\"pick_drive_phase_flicker_1hz_deg_rthz\": 0,"
+                                  " \"preset\": \"thesis\"}}",
+                                  err, sizeof err),
+                   0);
+  assert_string_equal(sc->plant_preset, "thesis");
+  assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), 0);
+  plant_default_cfg(&want);
+  assert_true(want.pick_drive_phase_flicker_1hz_deg_rthz > 0.0);
+  want.pick_drive_phase_flicker_1hz_deg_rthz = 0.0;
+  assert_memory_equal(&c, &want, sizeof c);
+  /* no preset: the default part, which is "thesis" and not "ideal" */
+  sc = fresh();
+  assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), 0);
+  plant_default_cfg(&want);
+  assert_memory_equal(&c, &want, sizeof c);
+  assert_int_equal(plant_preset(&want, "thesis"), 0);
+  assert_memory_equal(&c, &want, sizeof c);
+  plant_ideal_cfg(&want);
+  assert_true(memcmp(&c, &want, sizeof c) != 0);
+}
+
+/* A preset that is not a name of plant_preset is refused, with the choices, and leaves the
+ * scenario as it was. */
+static void test_preset_refused(void **state)
+{
+  (void)state;
+  char err[400];
+  static const char *const bad_set[] = {"plant.preset=nope", "plant.preset=1",
+                                        "plant.preset=", "plant.preset=IDEAL"};
+  for (size_t i = 0; i < sizeof bad_set / sizeof bad_set[0]; i++) {
+    sim_scenario_t *sc = fresh();
+    assert_int_equal(scenario_add_override(sc, bad_set[i], err, sizeof err), -1);
+    assert_non_null(strstr(err, "--set plant.preset: '"));
+    assert_non_null(strstr(err, "is not a plant preset: thesis (the default) or ideal"));
+    assert_string_equal(sc->plant_preset, "");
+  }
+  static const char *const bad_json[] = {"{\"plant\": {\"preset\": 1}}",
+                                         "{\"plant\": {\"preset\": \"bogus\"}}",
+                                         "{\"plant\": {\"preset\": null}}"};
+  for (size_t i = 0; i < sizeof bad_json / sizeof bad_json[0]; i++) {
+    sim_scenario_t *sc = fresh();
+    assert_int_equal(scenario_parse(sc, bad_json[i], err, sizeof err), -1);
+    assert_non_null(strstr(err, "plant.preset: "));
+    assert_string_equal(sc->plant_preset, "");
+  }
+}
+
 /* --list-params: every plant parameter of the table and plant.thermal_preset, each on a
  * line of its own with its default and range. */
 static void test_list_params(void **state)
@@ -178,6 +248,8 @@ static void test_list_params(void **state)
     if (strstr(buf, key) == NULL) fail_msg("--list-params misses %s", key + 1);
   }
   assert_non_null(strstr(buf, "\nplant.thermal_preset "));
+  assert_non_null(strstr(buf, "\nplant.preset "));
+  assert_non_null(strstr(buf, "[thesis, ideal]"));
   assert_non_null(strstr(buf, "[0, 2]"));
   assert_non_null(strstr(buf, "\nfirmware.drive.amp_set_v "));
   free(buf);
@@ -190,6 +262,8 @@ int main(void)
       cmocka_unit_test(test_bad_entries_refused),
       cmocka_unit_test(test_band_against_sample_rate),
       cmocka_unit_test(test_settings),
+      cmocka_unit_test(test_preset),
+      cmocka_unit_test(test_preset_refused),
       cmocka_unit_test(test_list_params),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,5 +1,5 @@
 """The firmware's sweep exported for gyro-freqresp, end to end: gyro-sim --uart-pty runs
-the real application on the default plant (thesis part: drive resonance 1489.9 Hz at
+the real application on the ideal preset of the plant (drive resonance 1489.9 Hz at
 the 25 degC reference, Q 33.33) in real time; `gyroctl sweep-csv --run` runs the
 self-calibration sweep through the serial port, waits for it and writes the CSV;
 gyro-freqresp fits it. The fit on the firmware's own points must find the plant's
