@@ -2,7 +2,7 @@
  * noise onto the true drive phase, and the 1500 deg/s quadrature turns with it; the
  * reference must follow that motion so that a higher drive Q does not raise the rate
  * noise (the Brownian floor (4-24) is set by the sense mode and the drive amplitude).
- * Each part runs twice with the same seed, with the plant's quadrature at 1500 deg/s and
+ * Each part (the ideal preset) runs twice with the same seed, with the plant's quadrature at 1500 deg/s and
  * at 0, calibrated in flash as the self-calibration identifies it
  * (tests/closed_loop/test_cl_selfcal_highq.c), at constant temperature. Asserted: the rate
  * output's noise (standard deviation over 2 s, 1 ms samples, after the reference's wide
@@ -31,6 +31,9 @@ static double rate_noise_dps(double q, double quad_dps, int track, double settle
 {
   plant_cfg_t pc;
   plant_default_cfg(&pc);
+  /* The ideal part: the default part's circuit-phase flicker would turn the quadrature
+   * into a rate drift of its own, the part's and not the channel's. */
+  assert_int_equal(plant_preset(&pc, "ideal"), 0);
   pc.q_drive = q;
   pc.quad_dps = quad_dps;
   param_values_t v;
