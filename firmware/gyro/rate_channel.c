@@ -102,14 +102,11 @@ GYRO_RAMFUNC void rate_channel_reset(const rate_channel_cfg_t *restrict cfg,
 _Static_assert(RATE_P_DECIM % RATE_DECIM == 0u && RATE_P_BLOCKS >= 2u,
                "P's average spans whole blocks, at least two");
 
-GYRO_RAMFUNC void rate_channel_project(const rate_channel_cfg_t *restrict cfg,
-                                       rate_channel_t *restrict rc, float w_i, float w_q,
-                                       float p_rad, float e_rad)
+/* The reference's correction delta = theta - set for this block (rate_channel.h): the
+ * mode's lag of P, made complementary with the measured phase error e_rad. */
+static inline float ref_update(const rate_channel_cfg_t *restrict cfg,
+                               rate_channel_t *restrict rc, float p_rad, float e_rad)
 {
-  const float k = 1.0f / (float)RATE_DECIM;
-  const float s_s = rc->acc_re * k, s_c = rc->acc_im * k;
-  rc->acc_re = 0.0f;
-  rc->acc_im = 0.0f;
   /* (6-17): the true drive phase follows P through the resonance's lag. Every state is a
    * small difference (P's step since the last block, P - LP(P), the correction), so that
    * no float low-pass of a large P has a dead band (at Q = 10^4 the lag's factor is 1e-4). */
@@ -144,6 +141,18 @@ GYRO_RAMFUNC void rate_channel_project(const rate_channel_cfg_t *restrict cfg,
     delta -= rc->ref_slope_rad + rc->ref_kp * r;
   }
   rc->ref_dev_rad = delta;
+  return delta;
+}
+
+GYRO_RAMFUNC void rate_channel_project(const rate_channel_cfg_t *restrict cfg,
+                                       rate_channel_t *restrict rc, float w_i, float w_q,
+                                       float p_rad, float e_rad)
+{
+  const float k = 1.0f / (float)RATE_DECIM;
+  const float s_s = rc->acc_re * k, s_c = rc->acc_im * k;
+  rc->acc_re = 0.0f;
+  rc->acc_im = 0.0f;
+  const float delta = ref_update(cfg, rc, p_rad, e_rad);
   float re = 0.0f, im = 0.0f;
   if (w_i * w_i + w_q * w_q > cfg->min_drive_v * cfg->min_drive_v) {
     /* S conj(e^{j psi} / A_set), then turned by -delta (small angle: e^{-j delta} ~ 1 - j delta) */

@@ -435,11 +435,12 @@ static void report_square_law(report_t *r, const sim_square_t *sq)
   }
   add_num(r->fig, "square_law_k_v_per_v2", k);
   add_num(r->fig, "square_law_nonlinearity_pct", 100.0 * dmax / amax);
-  add_num(r->fig, "square_law_nonlinearity_rms_pct", 100.0 * square_law_rms(sq) / amax);
+  const double rms_pct = 100.0 * square_law_rms(sq) / amax;
+  add_num(r->fig, "square_law_nonlinearity_rms_pct", rms_pct);
   if (!r->quiet)
     printf("  k = %.6g V/V^2, largest deviation %.3f %% of the largest amplitude; RMS residual "
            "of a line with intercept %.3f %% (the thesis's figure)\n",
-           k, 100.0 * dmax / amax, 100.0 * square_law_rms(sq) / amax);
+           k, 100.0 * dmax / amax, rms_pct);
 }
 
 static void analyse_rate_table(report_t *r)

@@ -609,7 +609,9 @@ int scenario_add_override(sim_scenario_t *sc, const char *arg, char *err, size_t
   if (eq == NULL)
     return fail(err, len, "--set %s: expected plant.KEY=VALUE or firmware.KEY=VALUE", arg);
   const char *val = eq + 1;
-  if ((size_t)(eq - arg) == strlen("plant.preset") && strncmp(arg, "plant.preset", 12) == 0)
+  static const char k_preset[] = "plant.preset";
+  if ((size_t)(eq - arg) == sizeof k_preset - 1u &&
+      strncmp(arg, k_preset, sizeof k_preset - 1u) == 0)
     return set_preset(sc, val, "--set plant.preset", err, len);
   char *end = NULL;
   errno = 0;

@@ -30,21 +30,13 @@
 static double rate_noise_dps(double q, double quad_dps, int track, double settle_s)
 {
   plant_cfg_t pc;
-  plant_default_cfg(&pc);
   /* The ideal part: the default part's circuit-phase flicker would turn the quadrature
    * into a rate drift of its own, the part's and not the channel's. */
   assert_int_equal(plant_preset(&pc, "ideal"), 0);
   pc.q_drive = q;
   pc.quad_dps = quad_dps;
-  param_values_t v;
-  param_values_defaults(&v);
-  v.drive_track = track ? 1u : 0u;
-  v.drive_cal_q = (float)q;
-  /* |H(wn)| grows as Q (6-12): the default part's gain at Q = 33.33, scaled. */
-  v.drive_cal_gain_v_per_v2 = (float)(0.00546 * q / 33.33);
-  /* The undamped resonance at the structure's temperature (2-32), as the sweep finds it. */
-  const double f0 = pc.f_drive_hz * (1.0 - 0.5 * pc.ket_per_k * (pc.temp_k - pc.temp_ref_k));
-  v.drive_freq_hz = v.drive_cal_f0_hz = (float)f0;
+  param_values_t v; /* calibrated at the structure's temperature, the reference one */
+  app_plant_cal_values(&pc, q, track, 0.0, &v);
   app_plant_start(&pc, 7u, &v);
   run_s(settle_s);
   assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);

@@ -44,12 +44,7 @@ static void start_part(double q, double temp_c, double f_offset_rel, plant_cfg_t
   pc->q_drive = q;
   pc->temp_k = 273.15 + temp_c;
   param_values_t v;
-  param_values_defaults(&v);
-  v.drive_track = 1u;
-  v.drive_cal_q = (float)q;
-  /* |H(wn)| grows as Q (6-12): the default part's gain at Q = 33.33, scaled. */
-  v.drive_cal_gain_v_per_v2 = (float)(0.00546 * q / 33.33);
-  v.drive_freq_hz = v.drive_cal_f0_hz = (float)(pc->f_drive_hz * (1.0 + f_offset_rel));
+  app_plant_cal_values(pc, q, 1, f_offset_rel, &v);
   app_plant_start(pc, 5u, &v);
 }
 

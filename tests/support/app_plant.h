@@ -29,6 +29,20 @@ static inline void app_plant_start(const plant_cfg_t *pc, uint64_t seed, const p
   assert_int_equal(hal_sample_timer_start(50000u, app_sample_isr, &app), 0);
 }
 
+/* The parameter values of a part at quality factor q calibrated at the reference
+ * temperature as the self-calibration would leave them in flash (drive.track as given):
+ * its resonance f_drive_hz times (1 + f_offset_rel), its Q, and its gain, which grows as
+ * Q (6-12): the default part's 0.00546 V/V^2 at Q = 33.33, scaled. */
+static inline void app_plant_cal_values(const plant_cfg_t *pc, double q, int track,
+                                        double f_offset_rel, param_values_t *v)
+{
+  param_values_defaults(v);
+  v->drive_track = track ? 1u : 0u;
+  v->drive_cal_q = (float)q;
+  v->drive_cal_gain_v_per_v2 = (float)(0.00546 * q / 33.33);
+  v->drive_freq_hz = v->drive_cal_f0_hz = (float)(pc->f_drive_hz * (1.0 + f_offset_rel));
+}
+
 /* One command line in, the whole reply out (the background loop runs once). */
 static inline const char *cmd(const char *line) { return app_cmd_line(&app, line); }
 
