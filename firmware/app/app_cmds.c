@@ -222,6 +222,19 @@ static void put_drive(cli_t *cli, app_t *a)
   cli_data_f32(cli, "f_offset_hz", (float)a->gyro.track.off_steps * d->hz_per_step);
 }
 
+/* The calibration record (gyro_design.h): `calibrated yes|no|stale`; with a record,
+ * the drive frequency it was made at, the part and the date. */
+static void put_calibration(cli_t *cli, app_t *a)
+{
+  cli_putf(cli, "calibrated %s", gyro_cal_state_name(a->gyro.design->cal_state));
+  cli_emit_data(cli);
+  const param_values_t *v = params_current(&a->params);
+  if (a->gyro.design->cal_state == GYRO_CAL_NONE) return;
+  cli_data_f32(cli, "cal_ref_freq_hz", v->cal_ref_freq_hz);
+  cli_data_u32(cli, "cal_part_id", v->cal_part_id);
+  cli_data_u32(cli, "cal_date", v->cal_date);
+}
+
 static void put_store(cli_t *cli, app_t *a)
 {
   cli_putf(cli, "store %s", param_store_status_str(a->store_status));
@@ -284,6 +297,7 @@ static const status_row_t k_status_rows[] = {
     {"last_fault", NULL, put_last_fault},
     {"rate_dps", NULL, put_rate},
     {"rate_valid", NULL, put_integrity},
+    {"calibrated", NULL, put_calibration},
     {"drive", NULL, put_drive},
     {"design", NULL, put_design},
     {"ticks", isr_ticks, NULL},

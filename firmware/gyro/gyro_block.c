@@ -217,6 +217,8 @@ GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
                               (g->clip_block != 0u ? RATE_INVALID_CLIP : 0u) |
                               (g->cont_fail != 0u ? RATE_INVALID_CONT_SELFTEST : 0u) |
                               (g->design->track != 0u ? RATE_INVALID_TRACKING : 0u) |
+                              (g->design->cal_state != GYRO_CAL_OK ? RATE_INVALID_UNCALIBRATED
+                                                                   : 0u) |
                               /* the reference's wide start (rate_channel.h): it passes
                                * the acquisition's tail of the measured phase */
                               (g->rate.ref_wide_left != 0u ? RATE_INVALID_SETTLING : 0u);

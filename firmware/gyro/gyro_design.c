@@ -332,6 +332,22 @@ static gyro_design_status_t design_supervisor(const param_values_t *v, double ta
 }
 
 /* Each part in turn; the first that fails names the reason. */
+/* The demodulation phase, the scale and the compensation are measured at one drive
+ * frequency: at another, the phase of the drive against its resonance, and with it P
+ * and the sense phasor's angle, are another (2Q df/f rad, 2-33). */
+static uint32_t cal_state(const param_values_t *v)
+{
+  const double ref = (double)v->cal_ref_freq_hz;
+  if (!(ref > 0.0)) return GYRO_CAL_NONE;
+  return fabs((double)v->drive_freq_hz - ref) <= GYRO_CAL_FREQ_REL * ref ? GYRO_CAL_OK
+                                                                         : GYRO_CAL_STALE;
+}
+
+const char *gyro_cal_state_name(uint32_t s)
+{
+  return s == GYRO_CAL_OK ? "yes" : s == GYRO_CAL_STALE ? "stale" : "no";
+}
+
 static gyro_design_status_t design_parts(const param_values_t *v, gyro_design_t *t)
 {
   gyro_design_status_t s = design_nco(v, t);
@@ -344,6 +360,7 @@ static gyro_design_status_t design_parts(const param_values_t *v, gyro_design_t 
   if (s == GYRO_DESIGN_OK) s = design_validity(v, t);
   if (s == GYRO_DESIGN_OK) s = design_selftest(v, t);
   t->autostart = v->sys_autostart;
+  t->cal_state = cal_state(v);
   return s;
 }
 

@@ -42,7 +42,21 @@ typedef struct {
   float f_cal_hz;    /* the calibrated drive frequency as the NCO realises it */
   float hz_per_step; /* fs / 2^31: the NCO's frequency per half-step */
   uint32_t autostart;
+  /* The calibration record (cal.ref_freq_hz) against the drive frequency: GYRO_CAL_*;
+   * anything but OK makes the rate not valid (rate_valid.h, UNCALIBRATED). */
+  uint32_t cal_state;
 } gyro_design_t;
+
+/* gyro_design_t.cal_state */
+#define GYRO_CAL_NONE 0u  /* no calibration: cal.ref_freq_hz 0 */
+#define GYRO_CAL_OK 1u    /* made at drive.freq_hz */
+#define GYRO_CAL_STALE 2u /* made at another drive frequency */
+/* cal.ref_freq_hz and drive.freq_hz agree within this, relative: two steps of a float,
+ * so that a value printed and set again through the command line still matches. */
+#define GYRO_CAL_FREQ_REL 2.0e-7
+
+/* "no", "yes", "stale" for `status` */
+const char *gyro_cal_state_name(uint32_t cal_state);
 
 /* Why gyro_design refused a set of values: one status per check, each with a reason
  * (gyro_design_reason) that names the parameters at fault by their user-visible names.

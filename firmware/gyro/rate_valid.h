@@ -34,6 +34,11 @@
  *                 calibration of its own yet (reference, scale and compensation are the
  *                 fixed drive's, its thermometer an equivalent of P): measured valid, it
  *                 read up to 28 deg/s wrong on a self-calibrated Q 10^3 part at rest
+ *   UNCALIBRATED  the part has no calibration (cal.ref_freq_hz 0), or its calibration is
+ *                 stale: made at another drive frequency than drive.freq_hz (a sweep, a
+ *                 hand change). The demodulation phase and scale are a part's own;
+ *                 measured valid without them, a 1300 Hz part read its rate with the
+ *                 sign inverted
  * Each check is a few multiplies and compares per block; no divide, no libm. */
 #ifndef RATE_VALID_H
 #define RATE_VALID_H
@@ -52,7 +57,8 @@
 #define RATE_INVALID_THERMO_SETTLE (1u << 9)
 #define RATE_INVALID_CONT_SELFTEST (1u << 10)
 #define RATE_INVALID_TRACKING (1u << 11)
-#define RATE_INVALID_KINDS 12u
+#define RATE_INVALID_UNCALIBRATED (1u << 12)
+#define RATE_INVALID_KINDS 13u
 
 /* Blocks in a row inside the settling tolerance (2 ms): longer than the noise's
  * correlation time at the filters' 100 Hz, far shorter than their settling. */

@@ -25,22 +25,29 @@
  * The drive loops are designed by the firmware (gyro/drive_loop.h) from the identified
  * drive-resonance model (drive.cal_*: resonance, Q, gain, found by the self-calibration
  * sweep) for the bandwidths drive.amp_bw_hz / drive.phase_bw_hz; nonzero manual gains
- * drive.amp_kp ... override the design. Defaults: the thesis part, drive resonance
- * 1489.9 Hz, Q1 = 33.33 (7.2.2), in the default simulator plant.
+ * drive.amp_kp ... override the design.
+ *
+ * Defaults are generic: the part family's design values (thesis §2: drive 1750 Hz,
+ * Q1 50), never values identified on a part. A part's own values (the sweep's drive
+ * model, the rate table's demodulation phase and scale, the self-test expectations,
+ * the temperature compensation) come from its calibration (tools/calibrate, loaded with
+ * gyroctl load-params), which records the drive frequency it was made at in
+ * cal.ref_freq_hz: without it the part says `calibrated no` and its rate is never valid
+ * (rate_valid.h, UNCALIBRATED).
  */
 #ifndef PARAM_LIST_H
 #define PARAM_LIST_H
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 5u
+#define PARAM_LAYOUT_VERSION 6u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
 /* clang-format off */
 #define PARAM_LIST(X) \
-  /* 7.2.2: measured drive resonance of the thesis part */ \
-  X(drive_freq_hz, 0x0101u, "drive.freq_hz", F32, "Hz", 500.0f, 5000.0f, 1489.9f, 0u, \
+  /* the family's design resonance (thesis §2: 1750 Hz); the sweep finds the part's */ \
+  X(drive_freq_hz, 0x0101u, "drive.freq_hz", F32, "Hz", 500.0f, 5000.0f, 1750.0f, 0u, \
     PF_PERSIST | PF_LIVE, "drive frequency, fixed near the drive resonance found by the sweep") \
   /* half-frequency by default: 1/f voltage noise lands at wc/2, not wc (6-21, 6-23) */ \
   X(drive_mode, 0x0102u, "drive.mode", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
@@ -69,18 +76,19 @@
   /* DC+AC only: force = 4 Ks D A (6-21); 5 V leaves headroom under u_max for A */ \
   X(drive_dc_bias_v, 0x010Au, "drive.dc_bias_v", F32, "V", 0.0f, 15.0f, 5.0f, 0u, \
     PF_PERSIST | PF_LIVE, "DC bias D of the DC+AC drive (unused in half-frequency mode)") \
-  /* the force phase P at lock on the default plant at 25 degC ambient (its low-pass reads
-   * 25.747..25.751 in the startup scenario); acquisition starts there */ \
-  X(drive_p_init_deg, 0x010Bu, "drive.p_init_deg", F32, "deg", -360.0f, 360.0f, 25.75f, 0u, \
+  /* P at lock is the circuits' lags at resonance, unknown before the sweep measures it
+   * (its hold phase); acquisition pulls in from 0 */ \
+  X(drive_p_init_deg, 0x010Bu, "drive.p_init_deg", F32, "deg", -360.0f, 360.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "force phase P the phase loop starts from, and the reference of P's low-pass") \
-  /* 7.2.2 sweep */ \
-  X(drive_cal_f0_hz, 0x010Cu, "drive.cal_f0_hz", F32, "Hz", 100.0f, 20000.0f, 1489.9f, 0u, \
+  /* the design resonance until the sweep identifies the part's */ \
+  X(drive_cal_f0_hz, 0x010Cu, "drive.cal_f0_hz", F32, "Hz", 100.0f, 20000.0f, 1750.0f, 0u, \
     PF_PERSIST | PF_LIVE, "identified undamped drive resonance (self-calibration)") \
-  /* 7.2.2: Q from the -3 dB points, air package */ \
-  X(drive_cal_q, 0x010Du, "drive.cal_q", F32, "-", 1.0f, 1.0e6f, 33.33f, 0u, \
+  /* the design Q of the air package (thesis §2: 50) until the sweep identifies it */ \
+  X(drive_cal_q, 0x010Du, "drive.cal_q", F32, "-", 1.0f, 1.0e6f, 50.0f, 0u, \
     PF_PERSIST | PF_LIVE, "identified drive-mode quality factor") \
-  /* the default plant: 0.349 V of pickoff for 64 Ks V^2 of force at resonance (table 7-1: 8 V) */ \
-  X(drive_cal_gain_v_per_v2, 0x010Eu, "drive.cal_gain_v_per_v2", F32, "V/V^2", 1.0e-6f, 100.0f, 0.00546f, 0u, \
+  /* the design transducers (table 7-1: 8 V of drive for 10 um, 3.49e4 V/m of pickoff) at
+   * the design Q 50: the gain grows as Q (6-12); the sweep measures the part's */ \
+  X(drive_cal_gain_v_per_v2, 0x010Eu, "drive.cal_gain_v_per_v2", F32, "V/V^2", 1.0e-6f, 100.0f, 0.0082f, 0u, \
     PF_PERSIST | PF_LIVE, "identified drive gain at resonance, pickoff volts per Ks V^2 of force") \
   /* 30 Hz: 1 % in about 25 ms after the drive comes off its limit, 80 deg of margin */ \
   X(drive_amp_bw_hz, 0x010Fu, "drive.amp_bw_hz", F32, "Hz", 0.1f, 1000.0f, 30.0f, 0u, \
@@ -98,8 +106,9 @@
   /* same bandwidth as the drive channel */ \
   X(demod_mu_sense, 0x0202u, "demod.mu_sense", F32, "-", 0.0001f, 0.49f, 0.034f, 0u, \
     PF_PERSIST | PF_LIVE, "LMS demodulator step size, sense pickoff") \
-  /* calibrated per part with tools/gyro-demodcal; this is the default simulator plant's */ \
-  X(rate_demod_phase_deg, 0x0301u, "rate.demod_phase_deg", F32, "deg", -180.0f, 180.0f, 63.16f, 0u, \
+  /* a part's own (sense resonance and pickoff lags): its rate table measures it
+   * (tools/gyro-demodcal); 0 until then */ \
+  X(rate_demod_phase_deg, 0x0301u, "rate.demod_phase_deg", F32, "deg", -180.0f, 180.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "angle of the Coriolis phasor against the drive phasor (separates rate from quadrature)") \
   /* 5.4.3: 100 Hz output low-pass */ \
   X(rate_lpf_cutoff_hz, 0x0302u, "rate.lpf_cutoff_hz", F32, "Hz", 1.0f, 1000.0f, 100.0f, 0u, \
@@ -108,8 +117,9 @@
   X(rate_lpf_order, 0x0303u, "rate.lpf_order", ENUM, "-", 2u, 8u, 4u, \
     PARAM_CHOICE(2) | PARAM_CHOICE(4) | PARAM_CHOICE(6) | PARAM_CHOICE(8), \
     PF_PERSIST | PF_LIVE, "rate output low-pass order (2 per biquad section)") \
-  /* calibrated with tools/gyro-demodcal; the default simulator plant's */ \
-  X(rate_scale_dps, 0x0310u, "rate.scale_dps", F32, "deg/s", -1.0e7f, 1.0e7f, 139.23f, 0u, \
+  /* a part's own: its rate table measures it (tools/gyro-demodcal); 100 only sizes the
+   * monitors' quadrature until then (the rate is not valid without a calibration) */ \
+  X(rate_scale_dps, 0x0310u, "rate.scale_dps", F32, "deg/s", -1.0e7f, 1.0e7f, 100.0f, 0u, \
     PF_PERSIST | PF_LIVE, "scale factor: deg/s per unit of the sense/drive phasor ratio") \
   /* uncalibrated: 0 (the thesis part's fit was B = 34.59 P + 58.533, 7.3.2) */ \
   X(rate_bias_c0_dps, 0x0305u, "rate.bias_c0_dps", F32, "deg/s", -2000.0f, 2000.0f, 0.0f, 0u, \
@@ -191,9 +201,8 @@
   /* 0.1 V on the differential sense electrodes (5 V bias): about 5.5 deg/s equivalent */ \
   X(selftest_amp_v, 0x0701u, "selftest.amp_v", F32, "V", 0.0f, 5.0f, 0.1f, 0u, \
     PF_PERSIST | PF_LIVE, "self-test force: voltage amplitude on the sense feedback electrodes") \
-  /* calibrated on the part: 5.49 deg/s measured on the default simulator plant
-   * (test_cl_selftest; 0.017 deg/s with the electrodes dead, feedthrough only) */ \
-  X(selftest_expect_dps, 0x0702u, "selftest.expect_dps", F32, "deg/s", -1000.0f, 1000.0f, 5.49f, 0u, \
+  /* a part's own, measured when it is calibrated; 0: none, the test cannot pass */ \
+  X(selftest_expect_dps, 0x0702u, "selftest.expect_dps", F32, "deg/s", -1000.0f, 1000.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "self-test: expected rate-axis response to the test force") \
   /* 10 %: well outside the test's own noise, well inside a broken channel */ \
   X(selftest_tol_rel, 0x0703u, "selftest.tol_rel", F32, "-", 0.001f, 1.0f, 0.1f, 0u, \
@@ -208,13 +217,25 @@
   /* 2.5 x the 100 Hz output cut-off, inside the sense demodulator's few hundred Hz */ \
   X(selftest_cont_freq_hz, 0x0706u, "selftest.cont_freq_hz", F32, "Hz", 50.0f, 1250.0f, 250.0f, 0u, \
     PF_PERSIST | PF_LIVE, "continuous self-test: modulation frequency (above the rate output band)") \
-  /* calibrated on the part: 4.24 measured on the default simulator plant (test_cl_selftest;
-   * 0.018 with the electrodes dead: the feedthrough lands on the quadrature axis) */ \
-  X(selftest_cont_expect_dps, 0x0707u, "selftest.cont_expect_dps", F32, "deg/s", 0.0f, 1000.0f, 4.24f, 0u, \
+  /* a part's own, measured when it is calibrated; 0: none (the continuous test cannot be
+   * switched on without it) */ \
+  X(selftest_cont_expect_dps, 0x0707u, "selftest.cont_expect_dps", F32, "deg/s", 0.0f, 1000.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "continuous self-test: expected amplitude of the response tone") \
   /* the default setpoint, at which the expectations above were measured */ \
   X(selftest_ref_amp_v, 0x0708u, "selftest.ref_amp_v", F32, "V", 0.01f, 4.5f, 0.349f, 0u, \
     PF_PERSIST | PF_LIVE, "drive amplitude setpoint at which the self-test expectations were measured") \
+  /* 0: no calibration. The compensation, the demodulation phase and the scale hold at
+   * the drive frequency they were measured at: another one (a sweep, a hand change)
+   * makes them stale. Equal within 2e-7 (two float steps), so that a value that went
+   * through the command line's text still matches */ \
+  X(cal_ref_freq_hz, 0x0801u, "cal.ref_freq_hz", F32, "Hz", 0.0f, 20000.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "drive.freq_hz the calibration was made at; 0 none: the rate is valid only at it") \
+  /* written by the calibration flow; 0: none */ \
+  X(cal_part_id, 0x0802u, "cal.part_id", U32, "-", 0u, 0xFFFFFFFFu, 0u, 0u, \
+    PF_PERSIST | PF_LIVE, "id of the part the calibration was made on") \
+  /* written by the calibration flow, as yyyymmdd; 0: none */ \
+  X(cal_date, 0x0803u, "cal.date", U32, "-", 0u, 99991231u, 0u, 0u, \
+    PF_PERSIST | PF_LIVE, "date of the calibration, yyyymmdd") \
   /* start the drive at power-on */ \
   X(sys_autostart, 0x0602u, "sys.autostart", ENUM, "-", 0u, 1u, 1u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
     PF_PERSIST | PF_RESTART, "start acquiring at power-on") \

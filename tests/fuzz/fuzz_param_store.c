@@ -13,7 +13,7 @@
 #include "hal_flash_host.h"
 #include "params/param_store.h"
 
-#define SECTOR 512u
+#define SECTOR 1024u
 
 static uint32_t le32(const uint8_t *p)
 {

@@ -53,7 +53,7 @@ static void test_set_applies_at_tick(void **state)
   assert_int_equal(app.gyro.sup.fault_count, 0u);
   /* Designed gains follow a new model: doubling the identified gain halves Kp. */
   const float kp = app.gyro.design->drive.amp.kp;
-  assert_true(strncmp(cmd("set drive.cal_gain_v_per_v2 0.01092\n"), "ok", 2) == 0);
+  assert_true(strncmp(cmd("set drive.cal_gain_v_per_v2 0.0164\n"), "ok", 2) == 0);
   hal_host_run(1u);
   assert_true(fabsf(app.gyro.design->drive.amp.kp - 0.5f * kp) < 1e-6f * kp);
 }

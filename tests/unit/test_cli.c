@@ -127,7 +127,7 @@ static const param_values_t *cur(void) { return params_current(&g.bank); }
 static void test_get_set(void **state)
 {
   (void)state;
-  expect("get drive.freq_hz\n", "ok drive.freq_hz 1489.9 Hz\r\n");
+  expect("get drive.freq_hz\n", "ok drive.freq_hz 1750 Hz\r\n");
   expect("set drive.freq_hz 1500.5\n", "ok drive.freq_hz 1500.5\r\n");
   assert_true(cur()->drive_freq_hz == 1500.5f);
   expect("get drive.freq_hz\n", "ok drive.freq_hz 1500.5 Hz\r\n");
@@ -217,7 +217,7 @@ static void test_save_load_defaults_diff(void **state)
          "ok drive.freq_hz 1500 rate.bias_c1_dps_per_deg 34.59\r\n");
   expect(
       "diff\n",
-      "- drive.freq_hz 1500 default 1489.9\r\n- rate.bias_c1_dps_per_deg 34.59 default 0\r\nok 2 differ\r\n");
+      "- drive.freq_hz 1500 default 1750\r\n- rate.bias_c1_dps_per_deg 34.59 default 0\r\nok 2 differ\r\n");
   expect("save\n", "ok saved slot A seq 1\r\n");
   expect("save\n", "ok unchanged slot A seq 1\r\n");
   expect("defaults\n", "ok defaults applied (not saved)\r\n");
@@ -315,7 +315,7 @@ static void test_list(void **state)
   assert_string_equal(out + strlen(out) - strlen(tail), tail);
   assert_int_equal(g.cli.truncated, 0u);
   assert_non_null(
-      strstr(out, "- drive.freq_hz 1489.9 Hz [500,5000] def=1489.9 flags=PL drive frequency"));
+      strstr(out, "- drive.freq_hz 1750 Hz [500,5000] def=1750 flags=PL drive frequency"));
   assert_non_null(strstr(out, "- drive.mode 0 - {0,1} def=0 flags=P "));
   assert_non_null(strstr(out, "- sys.fs_hz 50000 Hz [50000,50000] def=50000 flags=R "));
   out = run("list rate.bias\n");

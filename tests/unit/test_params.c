@@ -78,7 +78,7 @@ static void test_typed_and_generic_agree(void **state)
   (void)state;
   param_values_t v;
   param_values_defaults(&v);
-  assert_true(v.drive_freq_hz == 1489.9f);
+  assert_true(v.drive_freq_hz == 1750.0f);
   assert_int_equal(v.sys_fs_hz, 50000u);
   assert_int_equal(v.rate_lpf_order, 4u);
   param_value_t x = {.f = 1234.5f};
