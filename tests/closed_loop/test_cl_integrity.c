@@ -109,12 +109,13 @@ static void test_q5000_calibrated_warm(void **state)
   default_part(&pc);
   pc.q_drive = 5000.0;
   param_values_t v;
-  param_values_defaults(&v);
+  default_part_values(&v);
   v.drive_cal_f0_hz = 1489.8612f;
   v.drive_freq_hz = 1489.8612f;
   v.drive_cal_q = 4999.7f;
   v.drive_cal_gain_v_per_v2 = 0.81028f;
   v.drive_p_init_deg = 25.66f;
+  v.cal_ref_freq_hz = v.drive_freq_hz;
   pc.temp_k += 22.5;
   run_case("Q 5000 calibrated, +22.5 K", &pc, &v, 3.0);
 }
@@ -153,7 +154,7 @@ static void test_amplitude_setpoint_at_limit(void **state)
   plant_cfg_t pc;
   default_part(&pc);
   param_values_t v;
-  param_values_defaults(&v);
+  default_part_values(&v);
   set_value(&v, "drive.amp_set_v", 4.5f);
   run_case("drive.amp_set_v 4.5", &pc, &v, 2.0);
 }
@@ -164,7 +165,7 @@ static void test_drive_frequency_5000(void **state)
   plant_cfg_t pc;
   default_part(&pc);
   param_values_t v;
-  param_values_defaults(&v);
+  default_part_values(&v);
   set_value(&v, "drive.freq_hz", 5000.0f);
   run_case("drive.freq_hz 5000", &pc, &v, 2.0);
 }
@@ -177,7 +178,7 @@ static void test_subnormal_gain(void **state)
   plant_cfg_t pc;
   default_part(&pc);
   param_values_t v;
-  param_values_defaults(&v);
+  default_part_values(&v);
   set_value(&v, "drive.amp_kp", 1e-45f);
   assert_int_equal(plant_init(&plant, &pc, 31u), 0);
   assert_int_equal(hal_flash_host_configure(NULL), 0);

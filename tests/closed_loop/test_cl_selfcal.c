@@ -21,7 +21,7 @@ static void test_default_plant(void **state)
   plant_cfg_t pc;
   plant_ideal_cfg(&pc); /* the firmware identifies the linear Q: selfcal_harness.h */
   param_values_t v;
-  param_values_defaults(&v);
+  default_part_values(&v);
   start(&pc, &v);
   /* The sweep is commanded while the drive runs locked with the stored design. */
   run_polled_s(0.3);
@@ -83,7 +83,7 @@ static void test_high_q_plant(void **state)
 {
   (void)state;
   random_plant_case(1342.8, 571.0);
-  /* Negative control: the default (thesis part) design does not lock on this part. */
+  /* Negative control: the default part's calibration does not lock on this part. */
   assert_true(fixed_design_fails(1342.8, 571.0));
 }
 

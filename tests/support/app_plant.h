@@ -8,6 +8,7 @@
 
 #include "app/app.h"
 #include "app_cmd.h"
+#include "default_part.h"
 #include "hal/hal_sample_timer.h"
 #include "hal_flash_host.h"
 #include "hal_host.h"
@@ -18,29 +19,38 @@ static plant_t plant;
 static app_t app;
 
 /* Plant pc (seed) on the host HAL, an empty flash store, the application with the
- * values v (NULL: from the store, that is the defaults), the 50 kHz clock running. */
+ * values v (NULL: the default part's calibration, default_part.h), the 50 kHz clock
+ * running. */
 static inline void app_plant_start(const plant_cfg_t *pc, uint64_t seed, const param_values_t *v)
 {
   if (plant_init(&plant, pc, seed) != 0) fail_msg("plant: %s", plant_error(&plant));
   assert_int_equal(hal_flash_host_configure(NULL), 0);
   hal_uart_host_reset();
   hal_host_attach(plant_step_hal, &plant);
-  assert_int_equal(v != NULL ? app_init_with(&app, v) : app_init(&app), 0);
+  param_values_t def;
+  if (v == NULL) {
+    default_part_values(&def);
+    v = &def;
+  }
+  assert_int_equal(app_init_with(&app, v), 0);
   assert_int_equal(hal_sample_timer_start(50000u, app_sample_isr, &app), 0);
 }
 
-/* The parameter values of a part at quality factor q calibrated at the reference
- * temperature as the self-calibration would leave them in flash (drive.track as given):
- * its resonance f_drive_hz times (1 + f_offset_rel), its Q, and its gain, which grows as
- * Q (6-12): the default part's 0.00546 V/V^2 at Q = 33.33, scaled. */
+/* The parameter values of the default part at quality factor q calibrated at the
+ * reference temperature as its calibration would leave them in flash (drive.track as
+ * given): its resonance f_drive_hz times (1 + f_offset_rel), its Q, and its gain, which
+ * grows as Q (6-12): the default part's calibrated gain and Q, scaled; the rate channel's
+ * calibration the default part's, its record at the new drive frequency. */
 static inline void app_plant_cal_values(const plant_cfg_t *pc, double q, int track,
                                         double f_offset_rel, param_values_t *v)
 {
-  param_values_defaults(v);
+  default_part_values(v);
   v->drive_track = track ? 1u : 0u;
+  v->drive_cal_gain_v_per_v2 = (float)((double)v->drive_cal_gain_v_per_v2 * q /
+                                       (double)v->drive_cal_q);
   v->drive_cal_q = (float)q;
-  v->drive_cal_gain_v_per_v2 = (float)(0.00546 * q / 33.33);
   v->drive_freq_hz = v->drive_cal_f0_hz = (float)(pc->f_drive_hz * (1.0 + f_offset_rel));
+  v->cal_ref_freq_hz = v->drive_freq_hz;
 }
 
 /* One command line in, the whole reply out (the background loop runs once). */

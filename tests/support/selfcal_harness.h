@@ -294,7 +294,7 @@ static inline int fixed_design_fails(double f_hz, double q)
   pc.f_drive_hz = f_hz;
   pc.q_drive = q;
   param_values_t v;
-  param_values_defaults(&v);
+  default_part_values(&v);
   start(&pc, &v);
   run_polled_s(1.2);
   const double a = amp_m();
