@@ -3,7 +3,6 @@
 
 #include <cJSON.h>
 #include <errno.h>
-#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdbool.h>
@@ -14,6 +13,10 @@
 #include "gyro/gyro_design.h"
 #include "params/crc32.h"
 #include "params/fw_version.h"
+
+/* From here on a double rounds to float32 infinity: 2^128 - 2^103, half an ulp above
+ * FLT_MAX (so "3.40282347e38", the nine-digit FLT_MAX, is a float). */
+#define PS_F32_LIMIT 0x1.ffffffp127
 
 /* One checked entry of "params". */
 typedef struct {
@@ -97,7 +100,7 @@ static int parse_value(const cJSON *j, param_idx_t idx, const char *where, param
   if (!isfinite(d)) return fail(err, len, "%s: value: not a finite number", where);
   param_value_t val;
   if (pi->type == PARAM_T_F32) {
-    if (fabs(d) > (double)FLT_MAX) {
+    if (fabs(d) >= PS_F32_LIMIT) {
       return fail(err, len, "%s: value %g is out of range %s", where, d, rng);
     }
     val.f = (float)d;
@@ -356,19 +359,20 @@ static void put(ps_buf_t *b, const char *fmt, ...)
 }
 
 /* The shortest decimal that reads back as exactly f (at most 9 significant digits), as
- * a JSON number that looks like a float: positional below 1e17 ("30.0", not "3e+01"),
- * with an exponent below 1e-4 and from 1e17 (as printf's %g and Python's repr). */
+ * a JSON number that looks like a float: positional below 1e16 ("30.0", not "3e+01"),
+ * with an exponent below 1e-4 and from 1e16 (as Python's repr). */
 static void format_f32(float f, char out[40])
 {
   int p = 1;
   for (; p < 9; p++) {
     snprintf(out, 40, "%.*e", p - 1, (double)f);
-    const float back = (float)strtod(out, NULL);
-    if (memcmp(&back, &f, sizeof f) == 0) break;
+    const double d = strtod(out, NULL);
+    const float back = fabs(d) < PS_F32_LIMIT ? (float)d : 0.0f; /* 3.403e38: no float */
+    if (fabs(d) < PS_F32_LIMIT && memcmp(&back, &f, sizeof f) == 0) break;
   }
   snprintf(out, 40, "%.*e", p - 1, (double)f);
   const int x = atoi(strchr(out, 'e') + 1); /* the decimal exponent */
-  snprintf(out, 40, "%.*g", (x >= p && x < 17) ? x + 1 : p, (double)f);
+  snprintf(out, 40, "%.*g", (x >= p && x < 16) ? x + 1 : p, (double)f);
   if (strpbrk(out, ".e") == NULL) strcat(out, ".0");
 }
 
