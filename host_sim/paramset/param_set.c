@@ -235,7 +235,7 @@ static int apply_entries(const cJSON *root, param_values_t *v, unsigned *count, 
   const cJSON *e;
   cJSON_ArrayForEach(e, arr)
   {
-    ps_entry_t ent;
+    ps_entry_t ent = {PARAM_COUNT, {.u = 0u}};
     if (parse_entry(e, k, seen, &ent, err, len) != 0) return -1;
     crc = crc_add(crc, ent.idx, ent.val);
     param_put(&t, ent.idx, ent.val);
