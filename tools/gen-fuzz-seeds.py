@@ -2,11 +2,13 @@
 """Write the seed inputs of the fuzz harnesses into tests/fuzz/corpus/<harness>/.
 
 Seeds give libFuzzer a start inside the interesting grammar (commands, numbers, valid
-parameter images built from the layout in firmware/params/param_store.h); crash inputs
+parameter images built from the layout in firmware/params/param_store.h, parameter-set
+files written by tools/gyrotools/paramset.py); crash inputs
 found later are kept beside them as regression inputs (tools/run-fuzz)."""
 import binascii
 import os
 import struct
+import sys
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "fuzz", "corpus")
 
@@ -66,3 +68,28 @@ put("fuzz_param_store", "two-valid", b"\x00" + slots(image(1, recs_a), image(2, 
 put("fuzz_param_store", "one-valid", b"\x02" + slots(image(7, recs_b), b""))
 put("fuzz_param_store", "repair", b"\x01" + slots(image(1, recs_a)[:-8], image(3, recs_b)[:-8]))
 put("fuzz_param_store", "wrap", b"\x00" + slots(image(0xFFFFFFF0, recs_a), image(3, recs_b)))
+
+# Parameter sets (docs/param-set.md), written by gyrotools.paramset from the table: a
+# complete set at the defaults, a partial one with meta, and the same broken in the ways
+# the reader refuses (checksum, duplicate, kinds of number).
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gyrotools import paramset  # noqa: E402
+
+TABLE = paramset.load_table()
+SETTABLE = [d for d in TABLE.values() if d.settable]
+complete = paramset.from_values([(d.name, d.default) for d in SETTABLE])
+put("fuzz_param_set", "complete", paramset.dumps(complete).encode())
+first_f32 = next(d for d in SETTABLE if d.type == "F32")
+first_u32 = next(d for d in SETTABLE if d.type == "U32")
+partial = paramset.from_values([(first_u32.name, int(first_u32.default)), (first_f32.name, first_f32.default)],
+                               meta={"part": "SN 17", "notes": ["seed", {"\u00b5": 1.5e-3}], "date": None},
+                               firmware="0.1.0")
+text = paramset.dumps(partial)
+put("fuzz_param_set", "partial", text.encode())
+crc = text.split('"crc32": "')[1][:10]
+put("fuzz_param_set", "bad-crc", text.replace(crc, "0x%08x" % (int(crc, 16) ^ 0x80)).encode())
+line = text.split("\n")[text.split("\n").index('  "params": [') + 1]
+put("fuzz_param_set", "duplicate", text.replace(line, line + "\n" + line).encode())
+numbers = text.replace(f'"value": {int(first_u32.default)}', '"value": 1.5e0').replace(
+    paramset.format_f32(first_f32.default), "-0.0e-0")
+put("fuzz_param_set", "numbers", numbers.encode())

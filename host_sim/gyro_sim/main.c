@@ -5,6 +5,7 @@
  *   gyro-sim --scenario FILE [--duration S] [--seed N] [--csv FILE] [--csv-rate HZ]
  *            [--json FILE] [--out DIR] [--set plant.KEY=V | firmware.NAME=V ...]
  *            [--no-analysis] [--quiet] [--uart-pty[=LINK]] [--selfcal]
+ *            [--firmware-params FILE] [--save-params FILE]
  *   gyro-sim --list-params
  */
 #define _XOPEN_SOURCE 700 /* nftw */
@@ -17,9 +18,11 @@
 #include <string.h>
 #include <ftw.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "bench_figs.h"
+#include "paramset/param_set.h"
 #include "post.h"
 #include "scenario.h"
 #include "sim.h"
@@ -33,6 +36,7 @@ static void usage(FILE *f)
         "                [--csv-rate HZ] [--json FILE] [--out DIR]\n"
         "                [--set plant.KEY=VALUE | --set firmware.NAME=VALUE ...]\n"
         "                [--no-analysis] [--quiet] [--uart-pty[=LINK]] [--selfcal]\n"
+        "                [--firmware-params FILE] [--save-params FILE]\n"
         "       gyro-sim --list-params\n"
         "Runs a scenario (host_sim/scenarios/*.json) of the plant with the firmware in\n"
         "closed loop and prints its figures. --out keeps the analysis plots (PNG) and\n"
@@ -47,7 +51,14 @@ static void usage(FILE *f)
         "puts the mechanics at rest (temperatures kept) and starts the timeline from\n"
         "power-on with the stored values (t_s = 0 there; --duration counts the timeline).\n"
         "Figures selfcal_f0_hz, selfcal_q, selfcal_s (the firmware's sweep time) and the\n"
-        "plant's selfcal_true_f0_hz, selfcal_true_q; a failed sweep says why, exit 1.\n",
+        "plant's selfcal_true_f0_hz, selfcal_true_q; a failed sweep says why, exit 1.\n"
+        "--firmware-params FILE (scenario key \"firmware_params\", relative to the\n"
+        "scenario's folder; the option wins) loads a firmware parameter set\n"
+        "(docs/param-set.md) onto the defaults, as if from flash, before the scenario's\n"
+        "firmware settings and --set; --selfcal then sweeps from it. A bad set is refused\n"
+        "with the entry and why (exit 2, nothing run). --save-params FILE (closed loop)\n"
+        "writes the firmware's values at the end of the run as a parameter set: with\n"
+        "--selfcal those the self-calibration saved, else those the firmware holds.\n",
         f);
 }
 
@@ -109,24 +120,39 @@ typedef struct {
   int quiet, analysis, uart_pty, selfcal;
   const char *uart_pty_link;
   const char *isr_json;
+  const char *fw_params;   /* --firmware-params */
+  const char *save_params; /* --save-params */
   char sets[SIM_MAX_SETS][160];
   int n_sets;
+  int argc;
+  char **argv; /* the command line, for the saved set's meta */
 } cli_args_t;
 
 /* Parses the options into a. Returns -1 to go on, else the exit code (usage, --help,
  * --list-params). */
 static int parse_args(int argc, char **argv, cli_args_t *a)
 {
-  static const struct option lo[] = {
-      {"scenario", required_argument, 0, 's'}, {"duration", required_argument, 0, 'd'},
-      {"seed", required_argument, 0, 'S'},     {"csv", required_argument, 0, 'c'},
-      {"csv-rate", required_argument, 0, 'r'}, {"json", required_argument, 0, 'j'},
-      {"out", required_argument, 0, 'o'},      {"set", required_argument, 0, 'x'},
-      {"quiet", no_argument, 0, 'q'},          {"no-analysis", no_argument, 0, 'n'},
-      {"list-params", no_argument, 0, 'L'},    {"help", no_argument, 0, 'h'},
-      {"uart-pty", optional_argument, 0, 'u'}, {"isr-figures", required_argument, 0, 'i'},
-      {"selfcal", no_argument, 0, 'C'},        {0, 0, 0, 0}};
+  static const struct option lo[] = {{"scenario", required_argument, 0, 's'},
+                                     {"duration", required_argument, 0, 'd'},
+                                     {"seed", required_argument, 0, 'S'},
+                                     {"csv", required_argument, 0, 'c'},
+                                     {"csv-rate", required_argument, 0, 'r'},
+                                     {"json", required_argument, 0, 'j'},
+                                     {"out", required_argument, 0, 'o'},
+                                     {"set", required_argument, 0, 'x'},
+                                     {"quiet", no_argument, 0, 'q'},
+                                     {"no-analysis", no_argument, 0, 'n'},
+                                     {"list-params", no_argument, 0, 'L'},
+                                     {"help", no_argument, 0, 'h'},
+                                     {"uart-pty", optional_argument, 0, 'u'},
+                                     {"isr-figures", required_argument, 0, 'i'},
+                                     {"selfcal", no_argument, 0, 'C'},
+                                     {"firmware-params", required_argument, 0, 'P'},
+                                     {"save-params", required_argument, 0, 'W'},
+                                     {0, 0, 0, 0}};
   memset(a, 0, sizeof *a);
+  a->argc = argc;
+  a->argv = argv;
   a->duration_s = -1.0;
   a->csv_rate_hz = -1.0;
   a->seed = -1;
@@ -179,6 +205,8 @@ static int parse_args(int argc, char **argv, cli_args_t *a)
     case 'n': a->analysis = 0; break;
     case 'i': a->isr_json = optarg; break;
     case 'C': a->selfcal = 1; break;
+    case 'P': a->fw_params = optarg; break;
+    case 'W': a->save_params = optarg; break;
     case 'L': sim_list_params(stdout); return 0;
     case 'h': usage(stdout); return 0;
     default: usage(stderr); return 2;
@@ -206,6 +234,18 @@ static int load_scenario(const cli_args_t *a, sim_scenario_t *sc)
       fprintf(stderr, "gyro-sim: %s\n", err);
       return 2;
     }
+  }
+  if (a->fw_params != NULL) {
+    if (a->fw_params[0] == '\0' || strlen(a->fw_params) >= sizeof sc->fw_params_path) {
+      fprintf(stderr, "gyro-sim: --firmware-params: expected the path of a parameter set\n");
+      return 2;
+    }
+    snprintf(sc->fw_params_path, sizeof sc->fw_params_path, "%s", a->fw_params);
+  }
+  if (a->save_params != NULL && sc->loop != SIM_CLOSED_LOOP) {
+    fprintf(stderr, "gyro-sim: --save-params needs a closed-loop scenario (the firmware's "
+                    "values)\n");
+    return 2;
   }
   if (a->duration_s > 0.0) sc->duration_s = a->duration_s;
   if (a->seed >= 0) sc->seed = (uint64_t)a->seed;
@@ -664,6 +704,77 @@ static void report_figures(report_t *r, const cli_args_t *a, const bench_figs_t 
   if (need_tools && sc->loop == SIM_CLOSED_LOOP) analyse_trace(r);
 }
 
+/* The command line as one string a shell reads back (words with other than
+ * [A-Za-z0-9_./=+:,@%-] single-quoted). */
+static char *command_line(int argc, char **argv)
+{
+  size_t cap = 1;
+  for (int i = 0; i < argc; i++) cap += 4u * strlen(argv[i]) + 3u;
+  char *out = malloc(cap);
+  if (out == NULL) return NULL;
+  size_t n = 0;
+  for (int i = 0; i < argc; i++) {
+    const char *w = argv[i];
+    const int plain = w[0] != '\0' &&
+                      strspn(w, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                                "0123456789_./=+:,@%-") == strlen(w);
+    if (i > 0) out[n++] = ' ';
+    if (!plain) out[n++] = '\'';
+    for (const char *c = w; *c != '\0'; c++) {
+      if (!plain && *c == '\'') {
+        memcpy(out + n, "'\\''", 4); /* close, escaped quote, reopen */
+        n += 4;
+      } else {
+        out[n++] = *c;
+      }
+    }
+    if (!plain) out[n++] = '\'';
+  }
+  out[n] = '\0';
+  return out;
+}
+
+/* --save-params: the firmware's values (after a self-calibration: what it saved; else
+ * what the application holds at the end) as a parameter set. Returns 0, or -1 after the
+ * message. */
+static int save_params(const cli_args_t *a, const sim_scenario_t *sc, const sim_result_t *res)
+{
+  const sim_selfcal_t *c = &res->selfcal;
+  if (c->ran && !c->ok) {
+    fprintf(stderr, "gyro-sim: --save-params %s: not written: the self-calibration failed\n",
+            a->save_params);
+    return -1;
+  }
+  cJSON *meta = cJSON_CreateObject();
+  char *cmd = command_line(a->argc, a->argv);
+  char date[32] = "";
+  const time_t now = time(NULL);
+  struct tm tm_utc;
+  if (gmtime_r(&now, &tm_utc) != NULL)
+    strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &tm_utc);
+  cJSON_AddStringToObject(meta, "made_by", "gyro-sim");
+  cJSON_AddStringToObject(meta, "command", cmd != NULL ? cmd : "");
+  cJSON_AddStringToObject(meta, "date", date);
+  cJSON_AddStringToObject(meta, "scenario", sc->name);
+  cJSON_AddStringToObject(meta, "values",
+                          c->ran ? "saved by the self-calibration (drive off, save)"
+                                 : "held by the firmware at the end of the run");
+  if (c->ran) {
+    add_num(meta, "selfcal_f0_hz", c->f0_hz);
+    add_num(meta, "selfcal_q", c->q);
+  }
+  char *mtxt = cJSON_PrintUnformatted(meta);
+  char err[512];
+  const int rc = param_set_write_file(a->save_params, c->ran ? &c->saved : &res->final_params,
+                                      mtxt, err, sizeof err);
+  if (rc != 0) fprintf(stderr, "gyro-sim: --save-params %s\n", err);
+  else if (!a->quiet) printf("  firmware parameters saved to %s\n", a->save_params);
+  free(mtxt);
+  free(cmd);
+  cJSON_Delete(meta);
+  return rc;
+}
+
 /* Runs the loaded scenario and reports it. Returns the exit code. */
 static int run(const cli_args_t *a, const sim_scenario_t *sc, const bench_figs_t *isr,
                const char *out_dir, const char *csv_path, int need_tools)
@@ -697,6 +808,9 @@ static int run(const cli_args_t *a, const sim_scenario_t *sc, const bench_figs_t
 
   cJSON *root = cJSON_CreateObject();
   cJSON_AddStringToObject(root, "scenario", sc->name);
+  if (sc->fw_params_path[0] != '\0')
+    cJSON_AddStringToObject(root, "firmware_params", sc->fw_params_path);
+  else cJSON_AddNullToObject(root, "firmware_params");
   if (res.selfcal.ran && !res.selfcal.ok)
     cJSON_AddStringToObject(root, "selfcal_error", res.selfcal.why);
   add_params(root, sc, &pc, res.selfcal.ok ? &res.selfcal.saved : &fw);
@@ -708,6 +822,7 @@ static int run(const cli_args_t *a, const sim_scenario_t *sc, const bench_figs_t
                 .quiet = a->quiet,
                 .fig = cJSON_AddObjectToObject(root, "figures")};
   report_figures(&r, a, isr, &sweep, &sq, need_tools);
+  if (a->save_params != NULL && save_params(a, sc, &res) != 0) r.failed = 1;
   add_num(root, "realtime_factor", res.realtime_factor);
   add_num(root, "realtime_factor_cpu", res.realtime_factor_cpu);
   if (a->json_path != NULL && write_json(root, a->json_path) != 0) r.failed = 1;

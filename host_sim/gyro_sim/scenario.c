@@ -548,6 +548,11 @@ int scenario_parse(sim_scenario_t *out, const char *json, char *err, size_t len)
       } else if (strcmp(k, "selfcal") == 0) {
         if (!cJSON_IsBool(it)) rc = fail(err, len, "selfcal: expected true or false");
         else sc->selfcal = cJSON_IsTrue(it);
+      } else if (strcmp(k, "firmware_params") == 0) {
+        if (!cJSON_IsString(it) || it->valuestring[0] == '\0' ||
+            strlen(it->valuestring) >= SIM_PATH_MAX)
+          rc = fail(err, len, "firmware_params: expected the path of a parameter set file");
+        else snprintf(sc->fw_params_path, SIM_PATH_MAX, "%s", it->valuestring);
       } else if (strcmp(k, "notes") == 0) {
         if (!cJSON_IsObject(it)) rc = fail(err, len, "notes: expected an object of strings");
       } else {
@@ -562,6 +567,25 @@ int scenario_parse(sim_scenario_t *out, const char *json, char *err, size_t len)
   free(sc);
   cJSON_Delete(root);
   return rc;
+}
+
+/* A "firmware_params" this file gave with a relative path: from the file's folder. */
+static int resolve_fw_params(sim_scenario_t *sc, const char *before, const char *path,
+                             char *err, size_t len)
+{
+  const char *rel = sc->fw_params_path;
+  if (strcmp(rel, before) == 0 || rel[0] == '/') return 0;
+  const char *slash = strrchr(path, '/');
+  if (slash == NULL) return 0; /* the scenario is in the working folder */
+  char full[2 * SIM_PATH_MAX];
+  snprintf(full, sizeof full, "%.*s/%s", (int)(slash - path), path, rel);
+  const size_t n = strlen(full);
+  if (n >= SIM_PATH_MAX) {
+    snprintf(sc->fw_params_path, SIM_PATH_MAX, "%s", before);
+    return fail(err, len, "%s: firmware_params: path too long", path);
+  }
+  memcpy(sc->fw_params_path, full, n + 1u);
+  return 0;
 }
 
 int scenario_load(sim_scenario_t *sc, const char *path, char *err, size_t len)
@@ -597,10 +621,12 @@ int scenario_load(sim_scenario_t *sc, const char *path, char *err, size_t len)
     return fail(err, len, "%s: contains a NUL byte", path);
   }
   char inner[400];
+  char before[SIM_PATH_MAX];
+  snprintf(before, sizeof before, "%s", sc->fw_params_path);
   const int rc = scenario_parse(sc, buf, inner, sizeof inner);
   free(buf);
   if (rc != 0) return fail(err, len, "%s: %s", path, inner);
-  return 0;
+  return resolve_fw_params(sc, before, path, err, len);
 }
 
 int scenario_add_override(sim_scenario_t *sc, const char *arg, char *err, size_t len)

@@ -14,6 +14,9 @@
  *                 ("preset": "thesis" | "ideal" there selects the part the other plant
  *                  settings start from, wherever it stands: plant_preset; the default is
  *                  "thesis"; "thermal_preset": 0..2 a thermal network, applied in order)
+ *     "firmware_params": "part.json",  (a firmware parameter set, docs/param-set.md,
+ *                          loaded onto the defaults before the "firmware" settings; a
+ *                          relative path is taken from the scenario file's folder)
  *     "firmware": { "<firmware parameter>": number, ... },    (params/param_list.h)
  *     "rate_dps":  PROFILE, "ambient_c": PROFILE,             (input profiles)
  *     "accel_g": { "const": [x,y,z], "amp": [x,y,z], "freq_hz": [x,y,z], "phase_rad": [x,y,z],
@@ -50,6 +53,7 @@
 
 #define SIM_MAX_SETS 160
 #define SIM_NAME_MAX 64
+#define SIM_PATH_MAX 1024
 
 typedef enum {
   SIM_CLOSED_LOOP = 0,
@@ -102,13 +106,17 @@ typedef struct {
   accel_profile_t accel_g;
   sim_open_loop_t ol;
   int selfcal; /* key "selfcal" / --selfcal: self-calibrate before the timeline */
+  /* key "firmware_params" / --firmware-params: a parameter set (param_set.h) under the
+   * firmware settings; "" none */
+  char fw_params_path[SIM_PATH_MAX];
 } sim_scenario_t;
 
 /* Defaults: closed loop, 1 s, seed 1, no analyses, CSV at 1 kHz. */
 void scenario_defaults(sim_scenario_t *sc);
 
 /* Parse a JSON scenario into sc (on top of its current content). Returns 0, or -1 with
- * a one-line message in err naming the key. */
+ * a one-line message in err naming the key. A relative "firmware_params" path is kept as
+ * written here; scenario_load makes it relative to the file's folder. */
 int scenario_parse(sim_scenario_t *sc, const char *json, char *err, size_t err_len);
 int scenario_load(sim_scenario_t *sc, const char *path, char *err, size_t err_len);
 

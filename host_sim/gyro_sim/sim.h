@@ -76,6 +76,7 @@ typedef struct {
   double mean_drive_freq_hz;
   double mean_drive_amp_m;
   sim_selfcal_t selfcal;
+  param_values_t final_params; /* closed loop: the values the application holds at the end */
 } sim_result_t;
 
 typedef struct {
@@ -94,7 +95,8 @@ void sim_list_params(FILE *f);
  * Returns 0, or -1 with the offending key in err. */
 int sim_plant_cfg(const sim_scenario_t *sc, plant_cfg_t *cfg, plant_profiles_t *prof, char *err,
                   size_t err_len);
-/* The firmware parameters from the scenario: defaults + overrides, each checked. */
+/* The firmware parameters from the scenario: defaults, the parameter set of
+ * "firmware_params" (--firmware-params) over them, then the settings, each checked. */
 int sim_fw_params(const sim_scenario_t *sc, param_values_t *v, char *err, size_t err_len);
 
 /* Closed loop; with sc->selfcal the firmware's `sweep` first (res->selfcal). Returns 0,

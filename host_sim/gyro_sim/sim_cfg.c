@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "paramset/param_set.h"
 #include "sim.h"
 
 /* The thermal presets by number, as plant.thermal_preset takes them. */
@@ -107,6 +108,14 @@ int sim_fw_params(const sim_scenario_t *sc, param_values_t *v, char *err, size_t
 {
   param_values_t t;
   param_values_defaults(&t);
+  /* the parameter set first (as flash would hold it), then the settings over it */
+  if (sc->fw_params_path[0] != '\0') {
+    char why[480];
+    if (param_set_load_file(sc->fw_params_path, &t, NULL, why, sizeof why) != 0) {
+      snprintf(err, err_len, "firmware parameter set %s", why);
+      return -1;
+    }
+  }
   for (int i = 0; i < sc->n_fw_set; i++) {
     const sim_set_t *s = &sc->fw_set[i];
     const param_idx_t idx = param_lookup(s->key, strlen(s->key));

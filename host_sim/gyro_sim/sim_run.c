@@ -325,6 +325,7 @@ static void cl_results(const cl_run_t *r, const cl_stats_t *st, const plant_cfg_
   res->rate_first_valid_s = st->first_valid_s;
   res->phase_slips = st->slip.count;
   res->final_mode = (uint32_t)r->app->gyro.sup.mode;
+  res->final_params = *params_current(&r->app->params);
   const double n = (double)st->n_mean;
   res->mean_struct_k = st->n_mean ? st->sum_struct_k / n : NAN;
   res->mean_drive_freq_hz = st->n_mean ? st->sum_drive_freq_hz / n : NAN;

@@ -2,7 +2,8 @@
  * plant's inputs and parameters: half-sine shocks and random-vibration bands in
  * "accel_g", each field validated with the key named and nothing changed on error;
  * plant.thermal_preset, plant.preset and the new plant parameters through --set and in a
- * file; --list-params naming every plant parameter, plant.thermal_preset and plant.preset. */
+ * file; --list-params naming every plant parameter, plant.thermal_preset and plant.preset;
+ * "firmware_params", a parameter set under the firmware settings. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -13,6 +14,7 @@
 #include <math.h>
 #include <cmocka.h>
 
+#include "paramset/param_set.h"
 #include "scenario.h"
 #include "sim.h"
 
@@ -255,6 +257,65 @@ static void test_list_params(void **state)
   free(buf);
 }
 
+/* "firmware_params" (--firmware-params): a parameter set loaded onto the defaults, a
+ * relative path taken from the scenario file's folder, the scenario's firmware settings
+ * over it; a bad set refused with its path and the entry. */
+static void test_firmware_params(void **state)
+{
+  (void)state;
+  param_idx_t a = PARAM_COUNT, b = PARAM_COUNT; /* two writable persistent floats */
+  for (unsigned i = 0; i < (unsigned)PARAM_COUNT && b == PARAM_COUNT; i++) {
+    const param_info_t *pi = param_info((param_idx_t)i);
+    if (pi->type != PARAM_T_F32 || (pi->flags & PF_PERSIST) == 0u ||
+        (pi->flags & PF_READONLY) != 0u || pi->def.f == pi->max.f)
+      continue;
+    if (a == PARAM_COUNT) a = (param_idx_t)i;
+    else b = (param_idx_t)i;
+  }
+  assert_true(b < PARAM_COUNT);
+  char dir[] = "/tmp/test_scenario_XXXXXX", path[160], scen[160], err[512];
+  assert_non_null(mkdtemp(dir));
+  snprintf(path, sizeof path, "%s/part.json", dir);
+  snprintf(scen, sizeof scen, "%s/scen.json", dir);
+  param_values_t set, v;
+  param_values_defaults(&set);
+  const param_value_t xa = {.f = nextafterf(param_info(a)->def.f, param_info(a)->max.f)};
+  const param_value_t xb = {.f = nextafterf(param_info(b)->def.f, param_info(b)->max.f)};
+  param_put(&set, a, xa);
+  param_put(&set, b, xb);
+  assert_int_equal(param_set_write_file(path, &set, NULL, err, sizeof err), 0);
+  FILE *f = fopen(scen, "w");
+  assert_non_null(f);
+  fprintf(f, "{\"firmware_params\": \"part.json\", \"firmware\": {\"%s\": %.9g}}",
+          param_info(b)->name, (double)param_info(b)->def.f);
+  fclose(f);
+  sim_scenario_t *sc = fresh();
+  assert_int_equal(scenario_load(sc, scen, err, sizeof err), 0);
+  assert_string_equal(sc->fw_params_path, path);
+  assert_int_equal(sim_fw_params(sc, &v, err, sizeof err), 0);
+  assert_int_equal(param_get(&v, a).u, xa.u);                 /* from the set */
+  assert_int_equal(param_get(&v, b).u, param_info(b)->def.u); /* the setting over it */
+  /* a bad set: nothing loaded, the file and the entry named */
+  f = fopen(path, "w");
+  assert_non_null(f);
+  fputs("{\"format\": \"gyro-param-set\", \"format_version\": 1, \"params\": "
+        "[{\"id\": \"0xffff\", \"name\": \"x\", \"value\": 1}], \"crc32\": \"0x0\"}",
+        f);
+  fclose(f);
+  assert_int_equal(sim_fw_params(sc, &v, err, sizeof err), -1);
+  assert_non_null(strstr(err, path));
+  assert_non_null(strstr(err, "params[0]"));
+  sc = fresh();
+  assert_int_equal(scenario_parse(sc, "{\"firmware_params\": 3}", err, sizeof err), -1);
+  assert_string_equal(err, "firmware_params: expected the path of a parameter set file");
+  assert_int_equal(scenario_parse(sc, "{\"firmware_params\": \"/abs/p.json\"}", err, sizeof err),
+                   0);
+  assert_string_equal(sc->fw_params_path, "/abs/p.json");
+  remove(path);
+  remove(scen);
+  remove(dir);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -265,6 +326,7 @@ int main(void)
       cmocka_unit_test(test_preset),
       cmocka_unit_test(test_preset_refused),
       cmocka_unit_test(test_list_params),
+      cmocka_unit_test(test_firmware_params),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

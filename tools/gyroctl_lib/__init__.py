@@ -7,5 +7,6 @@ Modules
     logger   `log`: a telemetry stream to CSV
     plot     `plot`: a CSV log to PNG
     shell    `shell`: interactive command line with tab completion
+    load_params  `load-params`: a parameter set file (docs/param-set.md) into flash
     cli      the `gyroctl` command (tools/gyroctl)
 """

@@ -11,6 +11,9 @@
                                                  a new sweep's, --run) as the CSV of
                                                  gyro-freqresp
     gyroctl --port PORT log FIELD... [--rate HZ] --duration S --out FILE.csv
+    gyroctl --port PORT load-params FILE [--merge]   a parameter set file (docs/param-set.md)
+                                                 into flash: checked first, then drive
+                                                 off, defaults, set, save, drive on again
     gyroctl plot FILE.csv [--columns A,B] [--t-start S] [--t-end S] [--out FILE.png]
 
 --timeout S is how long every command waits for its reply, and how long `log` waits
@@ -21,8 +24,9 @@ PORT: a serial device, a pty (gyro-sim, fw_pty_host) or a pyserial URL
 (socket://127.0.0.1:PORT); default $GYROCTL_PORT.
 
 Exit status: 0 the gyro answered ok; 1 it answered err (the err line is on stderr);
-2 usage; 3 the port cannot be opened or the gyro does not answer; 4 a log, plot or sweep
-export failed (the sweep failed or did not finish).
+2 usage, or a bad parameter-set file (nothing sent); 3 the port cannot be opened or the
+gyro does not answer; 4 a log, plot or sweep export failed (the sweep failed or did not
+finish).
 Data lines of a reply are printed without their "- " prefix, then the ok text.
 """
 
@@ -32,7 +36,9 @@ import argparse
 import os
 import sys
 
-from . import logger, shell
+from gyrotools import paramset
+
+from . import load_params, logger, shell
 from . import plot as plot_mod
 from . import sweep as sweep_mod
 from .client import Client
@@ -79,6 +85,21 @@ def _parser():
                         "its loops redesigned, as with `sweep`)")
     p.add_argument("--sweep-timeout", type=float, default=120.0, metavar="S",
                    help="with --run: wall-clock seconds to wait for the sweep (default 120)")
+    p = sub.add_parser(
+        "load-params", help="load a parameter set file into the gyro's flash",
+        description="Check a firmware parameter set (docs/param-set.md; gyro-sim --save-params "
+                    "writes them), then on the gyro: status, drive off, defaults (what the set "
+                    "does not list takes its default, as from flash; not with --merge), set "
+                    "the entries, save, and drive on if the drive was running. A bad file "
+                    "sends nothing (exit 2). A refused command stops the sequence (exit 1, the "
+                    "command and the gyro's answer on stderr): the board may then hold part of "
+                    "the set in RAM, unsaved, with the drive off; `gyroctl load` restores the "
+                    "values in flash and `gyroctl drive on` restarts the drive.")
+    p.add_argument("file", help="parameter set (JSON)")
+    p.add_argument("--merge", action="store_true",
+                   help="keep the gyro's values of the parameters the set does not list "
+                        "(default: they take their defaults)")
+    p.add_argument("--verbose", action="store_true", help="print each command and its answer")
     p = sub.add_parser("plot", help="draw a CSV log to PNG")
     p.add_argument("csv")
     p.add_argument("--out", default=None, help="PNG file (default: the CSV's name with .png)")
@@ -125,9 +146,18 @@ def main(argv=None) -> int:
         ap.error("set takes NAME VALUE pairs")
     if not args.timeout > 0:
         ap.error("--timeout must be > 0")
+    pset = None
+    if args.cmd == "load-params":
+        try:
+            pset = paramset.read(args.file)
+        except paramset.ParamSetError as e:
+            print(f"gyroctl: load-params: {e} (nothing sent)", file=sys.stderr)
+            return 2
     try:
         with Link(args.port, timeout_s=args.timeout) as link:
             link.sync()
+            if pset is not None:
+                return _load_params(args, link, pset)
             return _run(args, link)
     except CommandError as e:
         _print_err(e.reply)
@@ -138,6 +168,19 @@ def main(argv=None) -> int:
     except (logger.LogError, sweep_mod.SweepError, OSError) as e:
         print(f"gyroctl: {e}", file=sys.stderr)
         return 4
+
+
+def _load_params(args, link, pset) -> int:
+    say = (lambda m: print(f"gyroctl: {m}", file=sys.stderr)) if args.verbose else None
+    try:
+        res = load_params.load(link, pset, merge=args.merge, progress=say)
+    except load_params.LoadError as e:
+        print(f"gyroctl: load-params: {e}; the gyro may hold part of the set unsaved, with the "
+              "drive off (`gyroctl load` restores flash, `gyroctl drive on` the drive)", file=sys.stderr)
+        return 1
+    again = "; drive on again" if res["was_running"] else ""
+    print(f"{len(pset.entries)} parameters from {args.file}: {res['saved']}{again}")
+    return 0
 
 
 def _run(args, link) -> int:

@@ -10,6 +10,7 @@ freqresp        second-order resonance fit of a frequency sweep (fig. 7-3, 7-5)
 tempcomp        bias (and scale factor) against the drive phase P and a temperature,
                 polynomial order by blocked cross-validation (7.3)
 gyroctl_bridge  writes fitted coefficients to the gyro through the `gyroctl` tool
+paramset        firmware parameter sets (docs/param-set.md): read, check, write
 plotting        shared matplotlib helpers (Agg backend, no display needed)
 cli             what every command-line script shares: errors, output, JSON
 
