@@ -1,6 +1,7 @@
 /* fw_qemu_twin: the host twin of the emulator image gyro-fw-qemu, for the equivalence
- * test (tests/qemu/test_fw_qemu.py equiv). The same application (app_init with an empty
- * parameter store, hence the defaults; app_sample_isr) and the same plant configuration
+ * test (tests/qemu/test_fw_qemu.py equiv). The same application (app_init_with the
+ * default part's calibration, which the image holds as its factory parameter store,
+ * stm32f4_qemu_flash.c; app_sample_isr) and the same plant configuration
  * (qemu_plant_setup: default plant, seed, rate step) with the same converter timing,
  * here through the host HAL stub (hal/host/hal_host.h), whose tick order is that of the
  * emulator's SysTick handler (ISR, then the plant step with the previous tick's DAC
@@ -15,6 +16,7 @@
 #include "app/app.h"
 #include "hal/hal_sample_timer.h"
 #include "hal_host.h"
+#include "paramset/param_set.h"
 #include "plant/plant.h"
 #include "qemu_plant_setup.h"
 
@@ -29,7 +31,14 @@ int main(void)
     return 1;
   }
   hal_host_attach(plant_step_hal, &plant);
-  if (app_init(&app) != 0) {
+  param_values_t v;
+  param_values_defaults(&v);
+  char err[256];
+  if (param_set_load_file(GYRO_DEFAULT_PART_CAL, &v, NULL, err, sizeof err) != 0) {
+    fprintf(stderr, "fw_qemu_twin: %s\n", err);
+    return 1;
+  }
+  if (app_init_with(&app, &v) != 0) {
     fprintf(stderr, "fw_qemu_twin: app_init failed\n");
     return 1;
   }

@@ -52,8 +52,13 @@ int stm32f4_qemu_set_stretch(uint32_t stretch);
 void stm32f4_qemu_idle(void);
 
 /* With STM32F4_QEMU_FLASH_MODEL: the parameter sectors modelled in SRAM
- * (stm32f4_qemu_flash.c) set blank; called by stm32f4_board_init before the store is
+ * (stm32f4_qemu_flash.c) set to the factory image; called by stm32f4_board_init before the store is
  * read. */
 void stm32f4_qemu_flash_init(void);
+/* The parameter-store image the emulated part left the factory with: the default part's
+ * calibration (host_sim/parts/default/calibration.json, made by tools/calibrate), encoded
+ * at build time by tools/gen_factory_store.py. */
+extern const uint8_t stm32f4_qemu_factory_store[];
+extern const uint32_t stm32f4_qemu_factory_store_len;
 
 #endif /* STM32F4_QEMU_H */

@@ -6,7 +6,10 @@
  * sector to 0xFF at once (the chip takes a few hundred ms, RM0090 / datasheet: the
  * model does not stall); programming is the driver's own store into the array. The
  * contents live as long as the emulator runs: a save survives `load` and `defaults`,
- * not a restart of QEMU (the store then reads empty, as on a blank part). */
+ * not a restart of QEMU (the store then reads the factory image again). The factory
+ * image is the default part's calibration, as a calibrated part leaves the factory: the
+ * emulated part is the default one (qemu_plant_setup.c), and without its calibration
+ * it would say `calibrated no` and never give a valid rate. */
 #include <stdint.h>
 
 #include "stm32f4_core.h"
@@ -28,6 +31,10 @@ void stm32f4_qemu_flash_init(void)
 {
   /* A blank part (the .bss zeroes would read as programmed bits). */
   for (uint32_t s = 0u; s < STM32F4_PARAM_NUM_SECTORS; ++s) erase_sector(s);
+  const uint32_t n = stm32f4_qemu_factory_store_len <= STM32F4_PARAM_SECTOR_BYTES
+                         ? stm32f4_qemu_factory_store_len
+                         : 0u; /* too long: a blank part, which says so */
+  for (uint32_t i = 0u; i < n; ++i) stm32f4_qemu_param_flash[i] = stm32f4_qemu_factory_store[i];
   stm32f4_qemu_flash_regs.CR = FLASH_CR_LOCK;
 }
 
