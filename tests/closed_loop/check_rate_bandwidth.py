@@ -23,6 +23,11 @@ def fit(t, y, f):
     return c[0] + 1j * c[1]
 
 
+# The default part's calibration (tools/calibrate): the firmware's defaults are generic.
+PART = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "host_sim", "parts",
+                    "default", "calibration.json")
+
+
 def main():
     exe = sys.argv[1]
     extra = sys.argv[2:]
@@ -36,8 +41,8 @@ def main():
                        "rate_dps": {"kind": "sine", "value": 0, "amp": 10, "freq_hz": f}},
                       open(scen, "w"))
             csv = os.path.join(d, "t.csv")
-            subprocess.run([exe, "--scenario", scen, "--quiet", "--no-analysis", "--csv", csv]
-                           + extra, check=True)
+            subprocess.run([exe, "--scenario", scen, "--firmware-params", PART, "--quiet",
+                            "--no-analysis", "--csv", csv] + extra, check=True)
             t = np.genfromtxt(csv, delimiter=",", names=True)
             m = t["t_s"] >= 0.5
             h = fit(t["t_s"][m], t["rate_dps"][m], f) / fit(t["t_s"][m], t["rate_true_dps"][m], f)

@@ -102,7 +102,9 @@ def case_boot(emu, args):
           f"ticks {st['ticks']})")
     if st["mode"] != "LOCKED":
         return
-    check(st["store"] == "no valid parameter image", f"defaults in use (store: {st['store']})")
+    check(st["store"] == "ok" and st.get("calibrated") == "yes",
+          f"the factory calibration in use (store: {st['store']}, "
+          f"calibrated: {st.get('calibrated')})")
     check(st.get("isr_cycles_kind") == "emulated_instructions_x_stretch",
           f"status names its ISR figures for what they are ({st.get('isr_cycles_kind')})")
     t = int(st["ticks"])

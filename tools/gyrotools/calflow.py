@@ -87,12 +87,24 @@ def _run(part, args, what):
     return cmd
 
 
+def _scenario(part, name, doc):
+    """A scenario of the flow's own, in the work folder: the shipped scenarios name the
+    default part's calibration, and a fresh part has none."""
+    path = os.path.join(part.work, name + "_scenario.json")
+    with open(path, "w", encoding="utf-8") as fh:
+        json.dump(dict(doc, name=name, mode="closed_loop", seed=part.seed, analyses=[]), fh,
+                  indent=1)
+    return path
+
+
 def selfcal(part):
     """Stage 1: the firmware's sweep from its generic defaults -> a param set."""
     out = os.path.join(part.work, "selfcal_params.json")
     figs = os.path.join(part.work, "selfcal.json")
-    cmd = _run(part, ["--scenario", os.path.join(part.scenarios, "startup.json"), "--selfcal",
-                      "--duration", "0.2", "--seed", str(part.seed), "--no-analysis", "--quiet",
+    scen = _scenario(part, "calibrate_selfcal", {
+        "description": "a fresh part's self-calibration from the firmware's generic defaults",
+        "duration_s": 0.2, "selfcal": True})
+    cmd = _run(part, ["--scenario", scen, "--seed", str(part.seed), "--no-analysis", "--quiet",
                       "--save-params", out, "--json", figs], "self-calibration")
     with open(figs, encoding="utf-8") as fh:
         f = json.load(fh)["figures"]
@@ -154,23 +166,14 @@ def record(values, sets, date=None):
     return v
 
 
-def verify_scenario(path, seed):
-    """The verification's rate schedule as a scenario file of its own."""
-    steps = [[2.0, 0]] + [[VERIFY_DWELL_S, r] for r in VERIFY_RATES_DPS] + [[1.0, 0]]
-    doc = {"name": "calibrate_verify", "description":
-           "verification of a calibration: rates and dwell the fit never saw",
-           "duration_s": sum(s[0] for s in steps), "seed": seed, "mode": "closed_loop",
-           "analyses": [], "csv_rate_hz": 200,
-           "rate_dps": {"kind": "steps", "edge_s": 0.1, "steps": steps}}
-    with open(path, "w", encoding="utf-8") as fh:
-        json.dump(doc, fh, indent=1)
-    return path
-
-
 def verify(part, cal_path):
     """Stage 4: the calibrated part on a profile and noise the fit never saw."""
     seed = part.seed + VERIFY_SEED_OFFSET
-    scen = verify_scenario(os.path.join(part.work, "verify_scenario.json"), seed)
+    steps = [[2.0, 0]] + [[VERIFY_DWELL_S, r] for r in VERIFY_RATES_DPS] + [[1.0, 0]]
+    scen = _scenario(part, "calibrate_verify", {
+        "description": "verification of a calibration: rates and dwell the fit never saw",
+        "duration_s": sum(st[0] for st in steps), "csv_rate_hz": 200,
+        "rate_dps": {"kind": "steps", "edge_s": 0.1, "steps": steps}})
     log, cmd = _rate_log(part, cal_path, scen, seed, "verify")
     t, out, truth = log["t_s"], log["rate_dps"], log["rate_true_dps"]
     valid = log["rate_valid"] > 0.5

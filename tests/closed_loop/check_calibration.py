@@ -1,0 +1,81 @@
+#!/usr/bin/env python3
+"""tools/calibrate against gyro-sim.
+
+  check_calibration.py regen GYRO_SIM   the default part's flow run again reproduces the
+                                        committed host_sim/parts/default/calibration.json
+                                        (every value but cal.date, to 1e-6 relative) and
+                                        its verification passes (exit 0)
+  check_calibration.py usage GYRO_SIM   bad input is refused with exit 2 and a message,
+                                        nothing written
+"""
+import os
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+from gyrotools import paramset  # noqa: E402
+
+CAL = os.path.join(ROOT, "host_sim", "parts", "default", "calibration.json")
+TOOL = os.path.join(ROOT, "tools", "calibrate")
+
+
+def run(args):
+    return subprocess.run([sys.executable, TOOL] + args, capture_output=True, text=True)
+
+
+def regen(sim):
+    committed = paramset.read(CAL)
+    with tempfile.TemporaryDirectory() as d:
+        # The committed file's own command, with this build's simulator.
+        cmd = committed.meta["command"].split()[1:]
+        out = cmd.index("--out")
+        cmd[out + 1] = d
+        r = run(cmd + ["--gyro-sim", sim])
+        print(r.stdout + r.stderr)
+        if r.returncode != 0:
+            print(f"FAIL: exit {r.returncode}")
+            return 1
+        new = paramset.read(os.path.join(d, "calibration.json")).values()
+    bad = 0
+    for name, want in committed.values().items():
+        if name == "cal.date":
+            continue
+        got = new[name]
+        if abs(got - want) > 1e-6 * max(abs(want), 1e-30):
+            print(f"FAIL: {name} {got!r}, committed {want!r}")
+            bad += 1
+    print("ok: the flow reproduces the committed calibration" if bad == 0 else "")
+    return 1 if bad else 0
+
+
+def usage(sim):
+    cases = [
+        (["--sim", "--set", "firmware.rate.scale_dps=1", "--out", "X"], "only plant.KEY=V"),
+        (["--sim", "--set", "plant.q_drive", "--out", "X"], "only plant.KEY=V"),
+        (["--sim", "--out", "X", "--gyro-sim", "/nonexistent/gyro-sim"], "no simulator"),
+        (["--sim", "--seed", "-1", "--out", "X"], "--seed"),
+        (["--out", "X"], "--sim"),
+    ]
+    bad = 0
+    with tempfile.TemporaryDirectory() as d:
+        for args, want in cases:
+            args = [a if a != "X" else os.path.join(d, "out") for a in args]
+            if "--gyro-sim" not in args:
+                args += ["--gyro-sim", sim]
+            r = run(args)
+            ok = r.returncode == 2 and want in r.stderr and "Traceback" not in r.stderr \
+                and not os.path.exists(os.path.join(d, "out", "calibration.json"))
+            print(f"{'ok  ' if ok else 'FAIL'} {' '.join(args)} -> {r.returncode}: "
+                  f"{r.stderr.strip()[:120]}")
+            bad += not ok
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3 or sys.argv[1] not in ("regen", "usage"):
+        print(__doc__, file=sys.stderr)
+        sys.exit(2)
+    sys.exit({"regen": regen, "usage": usage}[sys.argv[1]](sys.argv[2]))
