@@ -250,7 +250,8 @@ GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
              (g->sup.mode == GYRO_MODE_FAULT ? GYRO_FLAG_FAULT : 0u) |
              (invalid == 0u ? GYRO_FLAG_RATE_VALID : 0u) |
              ((invalid & RATE_INVALID_OVER_RANGE) != 0u ? GYRO_FLAG_OVER_RANGE : 0u) |
-             ((invalid & RATE_INVALID_SENSE_RANGE) != 0u ? GYRO_FLAG_SENSE_RANGE : 0u);
+             ((invalid & RATE_INVALID_SENSE_RANGE) != 0u ? GYRO_FLAG_SENSE_RANGE : 0u) |
+             ((invalid & RATE_INVALID_UNCALIBRATED) != 0u ? GYRO_FLAG_UNCALIBRATED : 0u);
   g->flags_acc = 0u;
 }
 
@@ -269,7 +270,8 @@ GYRO_RAMFUNC void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v)
   o->mode = (uint32_t)g->sup.mode;
   o->fault = g->sup.fault;
   o->flags = g->flags_acc |
-             ((o->rate_invalid & RATE_INVALID_SENSE_RANGE) != 0u ? GYRO_FLAG_SENSE_RANGE : 0u);
+             ((o->rate_invalid & RATE_INVALID_SENSE_RANGE) != 0u ? GYRO_FLAG_SENSE_RANGE : 0u) |
+             (g->design->cal_state != GYRO_CAL_OK ? GYRO_FLAG_UNCALIBRATED : 0u);
   g->flags_acc = 0u;
 }
 

@@ -55,6 +55,8 @@ typedef struct {
 #define GYRO_FLAG_RATE_VALID (1u << 5)  /* the rate output can be trusted (rate_valid.h) */
 #define GYRO_FLAG_OVER_RANGE (1u << 6)  /* rate magnitude above rate.full_scale_dps */
 #define GYRO_FLAG_SENSE_RANGE (1u << 7) /* sense pickoff near the ADC's range (warning) */
+#define GYRO_FLAG_UNCALIBRATED \
+  (1u << 8) /* no calibration, or a stale one: status `calibrated` */
 
 typedef struct {
   /* The design the sample path runs with: the parameter bank's published block, whole

@@ -118,9 +118,43 @@ static void test_fresh_part_not_valid(void **state)
          locked_ms, valid_ms, worst_dps);
   assert_true(locked_ms > 2000u); /* the drive is identified: it runs */
   assert_int_equal(valid_ms, 0u);
+  assert_true((app.gyro.out.flags & GYRO_FLAG_UNCALIBRATED) != 0u);
   const char *r = cmd("status\n");
   assert_non_null(strstr(r, "calibrated no"));
   assert_non_null(strstr(r, "UNCALIBRATED"));
+}
+
+/* The calibration record: the default part with its calibration says `calibrated yes`
+ * and gives a valid rate; at another drive frequency (a hand change) the calibration is
+ * stale and the rate not valid; back at the calibration's frequency, as the command line
+ * prints it, it holds again. */
+static void test_calibration_record(void **state)
+{
+  (void)state;
+  plant_cfg_t pc;
+  plant_default_cfg(&pc);
+  param_values_t v;
+  default_part_values(&v);
+  start(&pc, &v);
+  run_polled_s(0.5);
+  assert_non_null(strstr(cmd("status\n"), "- calibrated yes\r\n"));
+  assert_int_equal(app.gyro.out.rate_valid, 1u);
+  /* "ok drive.freq_hz VALUE Hz": the value as the command line prints it */
+  char printed[32];
+  assert_int_equal(sscanf(cmd("get drive.freq_hz\n"), "ok drive.freq_hz %31s", printed), 1);
+  char line[64];
+  (void)snprintf(line, sizeof line, "set drive.freq_hz %.9g\n", (double)v.drive_freq_hz + 0.01);
+  assert_true(strncmp(cmd(line), "ok", 2) == 0);
+  run_polled_s(0.05);
+  assert_non_null(strstr(cmd("status\n"), "- calibrated stale\r\n"));
+  assert_int_equal(app.gyro.out.rate_valid, 0u);
+  assert_true((app.gyro.out.rate_invalid & RATE_INVALID_UNCALIBRATED) != 0u);
+  assert_true((app.gyro.out.flags & GYRO_FLAG_UNCALIBRATED) != 0u);
+  (void)snprintf(line, sizeof line, "set drive.freq_hz %s\n", printed);
+  assert_true(strncmp(cmd(line), "ok", 2) == 0);
+  run_polled_s(0.5);
+  assert_non_null(strstr(cmd("status\n"), "- calibrated yes\r\n"));
+  assert_int_equal(app.gyro.out.rate_valid, 1u);
 }
 
 int main(void)
@@ -128,7 +162,7 @@ int main(void)
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_default_plant),        cmocka_unit_test(test_tracking_kept),
       cmocka_unit_test(test_low_q_plant),          cmocka_unit_test(test_high_q_plant),
-      cmocka_unit_test(test_fresh_part_not_valid),
+      cmocka_unit_test(test_fresh_part_not_valid), cmocka_unit_test(test_calibration_record),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
