@@ -141,6 +141,10 @@ def fit(rate_in_dps, mean_out, segments=None):
     (bias, sf), *_ = np.linalg.lstsq(a, y, rcond=None)
     if sf == 0:
         raise InputError("the output does not change with the table rate (slope 0)")
+    if sf < 0:
+        raise InputError(f"the fitted scale factor is negative ({sf:.4g}): the table's "
+                         "schedule is probably misaligned with the log (--t0), or the "
+                         "output's sign is reversed")
     res_in = (y - (bias + sf * x)) / sf
     fs = float(np.max(np.abs(x)))
     if fs == 0:

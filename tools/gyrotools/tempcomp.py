@@ -51,6 +51,9 @@ from .errors import InputError
 
 MAX_ORDER = 3
 MAD_TO_SIGMA = 1.4826
+# Least span of the thermometer, in its bin-to-bin scatter, for a fit against it: noise
+# alone spans about 6 scatters over a few hundred bins.
+MIN_SPAN_PER_SCATTER = 20.0
 
 
 def bin_average(t_s, columns, bin_s):
@@ -143,6 +146,16 @@ def fit_bias(x, y, variable, k=10, max_order=MAX_ORDER, despike=None):
                          f"{need} (use a longer log or a shorter --bin)")
     if np.ptp(x) == 0:
         raise InputError(f"{variable} does not change over the log: nothing to fit against")
+    # The thermometer's span against its own bin-to-bin scatter (the spread of its first
+    # differences, which a trend does not have): an isothermal log's P is its noise, and a
+    # fit of the bias against it is noise against noise.
+    scatter = float(np.std(np.diff(x))) / math.sqrt(2.0)
+    if np.ptp(x) < MIN_SPAN_PER_SCATTER * scatter:
+        raise InputError(f"{variable} spans {np.ptp(x):.3g} over the log, "
+                         f"{np.ptp(x) / scatter:.1f} times its bin-to-bin scatter "
+                         f"({scatter:.3g}): no temperature change to fit against (an "
+                         "isothermal log?); need at least "
+                         f"{MIN_SPAN_PER_SCATTER:g} times")
     kept = np.ones(n, dtype=bool)
     mse, se = blocked_cv(x, y, k=k, max_order=max_order)
     order = choose_order(mse, se)

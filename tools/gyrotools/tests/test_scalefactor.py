@@ -112,3 +112,12 @@ def test_too_few_segments_and_no_segmentation():
         scalefactor.analyse(t, np.zeros(500))
     with pytest.raises(InputError, match="does not overlap"):
         scalefactor.analyse(t, np.zeros(500), table=[(10.0, 5.0)] * 3, t0_s=1000.0)
+
+
+def test_negative_scale_factor_is_refused():
+    """A log misaligned with its table schedule can fit a negative slope (it once
+    reported -0.47 with exit 0): implausible for the product's output, refused."""
+    rates = [20, -20, 40, -40, 60, -60, 80, -80]
+    out = [-0.47 * r + 0.1 for r in rates]
+    with pytest.raises(InputError, match="negative"):
+        scalefactor.fit(rates, out)

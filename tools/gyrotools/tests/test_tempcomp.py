@@ -115,3 +115,23 @@ def test_bad_input():
         tempcomp.fit_bias(np.ones(100), np.arange(100.0), "p_deg")
     with pytest.raises(InputError, match="> 0"):
         tempcomp.bin_average(np.arange(5.0), {}, 0.0)
+
+
+def test_isothermal_log_is_refused():
+    """A log without a temperature change: P is only its noise, and a 'fit' of the bias
+    against it is noise against noise (it once gave a slope of -14.8). Refused loudly."""
+    rng = np.random.default_rng(3)
+    p = 25.7 + 0.002 * rng.standard_normal(600)
+    b = 0.1 * rng.standard_normal(600)
+    with pytest.raises(InputError, match="temperature change"):
+        tempcomp.fit_bias(p, b, "P")
+
+
+def test_a_slow_ramp_is_not_taken_for_noise():
+    """The refusal compares P's span with its bin-to-bin scatter, which a trend has none
+    of: a small, clean ramp still fits."""
+    rng = np.random.default_rng(4)
+    p = np.linspace(25.0, 25.05, 600) + 0.0005 * rng.standard_normal(600)
+    b = 30.0 * (p - 25.0) + 0.01 * rng.standard_normal(600)
+    fit = tempcomp.fit_bias(p, b, "P")
+    assert fit is not None
