@@ -1,20 +1,20 @@
 """Write calibration coefficients to the gyro through the `gyroctl` command-line tool.
 
-Contract with gyroctl (the UART tuning client, tools/gyroctl), one process per command:
+Contract with gyroctl (the UART tuning client, tools/gyroctl): the values go as a
+parameter set (docs/param-set.md, written to a temporary file) in one command,
 
-    gyroctl --port PORT set rate.bias_c0_dps VALUE
-    gyroctl --port PORT set rate.bias_c1_dps_per_deg VALUE
-    gyroctl --port PORT set rate.bias_c2_dps_per_deg2 VALUE
-    gyroctl --port PORT set rate.bias_c3_dps_per_deg3 VALUE
-    gyroctl --port PORT save
+    gyroctl --port PORT load-params FILE --merge
 
-Exit status 0 means the gyro accepted the command; anything else is a failure whose
-reason is on stderr. The parameter names are those of the firmware's parameter list
-(bias polynomial B(P) = c0 + c1 P + c2 P^2 + c3 P^3, deg/s, P = drive phase in deg,
-thesis 7.3.2). All four terms are always written, unused orders as 0, so a term of an
-earlier, higher-order calibration cannot linger. `save` is sent only after every `set`
-succeeded; on a failure the gyro keeps the values already set live (not saved to flash:
-a power cycle restores the stored ones) and the error says which.
+which stops the drive, sets every value (each echo compared with the file), saves them
+to flash and starts the drive again if it ran (tools/gyroctl_lib/load_params.py): safe
+on a running gyro, whose firmware refuses `save` while the drive runs. Exit status 0
+means the gyro holds the values in flash; anything else is a failure whose reason is on
+stderr (the board may then hold part of them in RAM, unsaved, with the drive off:
+`gyroctl load` restores flash). The parameter names are those of the firmware's
+parameter list (bias polynomial B(P) = c0 + c1 P + c2 P^2 + c3 P^3, deg/s, P = drive
+phase in deg, thesis 7.3.2); a name or value the list refuses is refused before
+anything is sent. All four bias terms are always written, unused orders as 0, so a term
+of an earlier, higher-order calibration cannot linger.
 
 gyroctl is looked up as $GYROCTL, then `gyroctl` on PATH, then tools/gyroctl next to
 this package.
@@ -26,7 +26,9 @@ import math
 import os
 import shutil
 import subprocess
+import tempfile
 
+from . import paramset
 from .errors import InputError
 
 BIAS_PARAMS = ("rate.bias_c0_dps", "rate.bias_c1_dps_per_deg",
@@ -73,12 +75,12 @@ def _run(cmd, timeout_s):
     return p
 
 
-def write_params(port, values, gyroctl=None, timeout_s=30.0):
-    """Set each parameter of values ({name: number}, in order) with gyroctl, then save.
+def write_params(port, values, gyroctl=None, timeout_s=60.0):
+    """Write values ({name: number}) into the gyro's flash with gyroctl load-params.
 
-    Returns the list of commands run. Raises GyroctlError (an InputError) before running
-    anything if the input is invalid, and on the first command that fails (naming what
-    was already set live but not saved).
+    Returns the list of commands run (one). Raises GyroctlError (an InputError) before
+    running anything if the input is invalid (no port, nothing to write, a value that
+    is not finite, a name or value the parameter list refuses), and when gyroctl fails.
     """
     if not isinstance(port, str) or not port.strip():
         raise GyroctlError("no serial port given")
@@ -88,23 +90,20 @@ def write_params(port, values, gyroctl=None, timeout_s=30.0):
     bad = [k for k, v in items if not math.isfinite(v)]
     if bad:
         raise GyroctlError(f"non-finite value for {', '.join(bad)}")
+    try:
+        ps = paramset.from_values(items, meta={"made_by": "gyrotools.gyroctl_bridge"})
+    except paramset.ParamSetError as e:
+        raise GyroctlError(str(e)) from None
     exe = gyroctl or find_gyroctl()
-    done = []
-    for name, value in items:
-        cmd = [exe, "--port", port, "set", name, format_value(value)]
-        try:
-            _run(cmd, timeout_s)
-        except GyroctlError as e:
-            live = ", ".join(c[4] for c in done) or "none"
-            raise GyroctlError(f"{e}; already set live (not saved): {live}") from None
-        done.append(cmd)
-    cmd = [exe, "--port", port, "save"]
-    _run(cmd, timeout_s)
-    done.append(cmd)
-    return done
+    with tempfile.TemporaryDirectory() as d:
+        path = os.path.join(d, "params.json")
+        paramset.write(path, ps)
+        cmd = [exe, "--port", port, "load-params", path, "--merge"]
+        _run(cmd, timeout_s)
+    return [cmd]
 
 
-def write_bias_coeffs(port, coeffs, gyroctl=None, timeout_s=30.0):
+def write_bias_coeffs(port, coeffs, gyroctl=None, timeout_s=60.0):
     """Set rate.bias_c0..c3 to coeffs (ascending, 1 to 4 values, rest 0), then save."""
     coeffs = [float(c) for c in coeffs]
     if not 1 <= len(coeffs) <= len(BIAS_PARAMS):

@@ -134,3 +134,26 @@ def test_refused_value_stops(host, tmp_path, capsys, monkeypatch):
     assert "refused: err REJECTED" in err and d.name in err
     assert "`gyroctl load` restores flash" in err
     assert (flash.read_bytes() if flash.exists() else None) == before  # never saved
+
+
+def test_calibration_tools_write_on_a_running_gyro(host, fw_pty_host, tmp_path, capsys,
+                                                   monkeypatch):
+    """gyro-tempcomp/gyro-demodcal --write (gyrotools.gyroctl_bridge) on a gyro whose drive
+    runs: the values end in flash and the drive runs again. (It once set them live, then
+    `save` was refused with the drive running: exit 2, the gyro on unsaved values.)"""
+    from gyrotools import gyroctl_bridge
+    monkeypatch.delenv("GYROCTL", raising=False)
+    g = InProcess(capsys, monkeypatch, host.port)
+    assert g("status")[1].splitlines()[-1] != "OFF"
+    gyroctl_bridge.write_bias_coeffs(host.port, [0.5, 0.0125])
+    assert value_of(g, "rate.bias_c0_dps") == P.f32(0.5)
+    assert g("status")[1].splitlines()[-1] != "OFF"
+    host.stop()
+    h2 = Host(fw_pty_host, tmp_path / "flash.bin")
+    try:
+        g2 = InProcess(capsys, monkeypatch, h2.port)
+        assert value_of(g2, "rate.bias_c0_dps") == P.f32(0.5)
+        assert value_of(g2, "rate.bias_c1_dps_per_deg") == P.f32(0.0125)
+        assert value_of(g2, "rate.bias_c3_dps_per_deg3") == 0.0
+    finally:
+        h2.stop()

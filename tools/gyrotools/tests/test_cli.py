@@ -14,6 +14,8 @@ from test_gyroctl_bridge import FAKE
 from test_scalefactor import DWELL, RATES, table_log
 from test_tempcomp import cooldown
 
+from gyrotools import paramset
+
 TRUTH = ("rate_true_dps", "t_ambient_c", "t_struct_c")
 SCRIPTS = ("gyro-allan", "gyro-psd", "gyro-scalefactor", "gyro-freqresp", "gyro-tempcomp")
 
@@ -143,9 +145,10 @@ def test_gyro_tempcomp_and_write(run_script, logs, tmp_path, monkeypatch):
     assert set(j["firmware_bias_params"]) == {"rate.bias_c0_dps", "rate.bias_c1_dps_per_deg",
                                               "rate.bias_c2_dps_per_deg2",
                                               "rate.bias_c3_dps_per_deg3"}
-    sent = [json.loads(x) for x in calls.read_text().splitlines()]
-    assert [c[3] for c in sent[:4]] == list(j["firmware_bias_params"])
-    assert sent[-1] == ["--port", "/dev/ttyACM0", "save"]
+    (sent,) = [json.loads(x) for x in calls.read_text().splitlines()]
+    assert sent[:3] == ["--port", "/dev/ttyACM0", "load-params"] and sent[4:] == ["--merge"]
+    written = paramset.read(str(calls) + ".set").values()
+    assert list(written) == list(j["firmware_bias_params"])
     assert j["written_to_gyro"]["port"] == "/dev/ttyACM0"
     for png in ("tempcomp_bias_vs_p.png", "tempcomp_bias_vs_t.png", "tempcomp_residual.png"):
         assert os.path.isfile(out_dir / png)
