@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "app/app_selfcal.h"
+#include "dsp/fastmath.h"
 #include "dsp/math_const.h"
 #include "hal/hal_sample_timer.h"
 
@@ -246,6 +247,13 @@ static void put_selftest(cli_t *cli, app_t *a)
   cli_putf(cli, "selftest %s", selftest_state_name(a->gyro.selftest.state));
   cli_emit_data(cli);
   cli_data_f32(cli, "selftest_dps", a->gyro.selftest.result_dps);
+  /* The continuous test's response on the rate axis, as it is judged (selftest.h): what
+   * a calibration takes as selftest.cont_expect_dps. */
+  if (a->gyro.design->selftest.cont_on != 0u) {
+    const float *w = a->gyro.selftest.w_avg;
+    cli_data_f32(cli, "selftest_cont_dps",
+                 fm_sqrtf(w[0] * w[0] + w[1] * w[1]) * fm_absf(a->gyro.design->rate.scale_dps));
+  }
 }
 
 static void put_board(cli_t *cli, app_t *a)

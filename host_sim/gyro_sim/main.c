@@ -737,6 +737,22 @@ static char *command_line(int argc, char **argv)
 /* --save-params: the firmware's values (after a self-calibration: what it saved; else
  * what the application holds at the end) as a parameter set. Returns 0, or -1 after the
  * message. */
+/* "commands": the scenario's command lines with their replies (null: the run ended
+ * before the line was due). */
+static void add_commands(cJSON *root, const sim_scenario_t *sc, const sim_result_t *res)
+{
+  if (sc->n_cmds == 0) return;
+  cJSON *arr = cJSON_AddArrayToObject(root, "commands");
+  for (int i = 0; i < sc->n_cmds; i++) {
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "t_s", sc->cmds[i].t_s);
+    cJSON_AddStringToObject(o, "line", sc->cmds[i].line);
+    if (i < res->n_cmds_run) cJSON_AddStringToObject(o, "reply", res->cmd_reply[i]);
+    else cJSON_AddNullToObject(o, "reply");
+    cJSON_AddItemToArray(arr, o);
+  }
+}
+
 static int save_params(const cli_args_t *a, const sim_scenario_t *sc, const sim_result_t *res)
 {
   const sim_selfcal_t *c = &res->selfcal;
@@ -792,6 +808,11 @@ static int run(const cli_args_t *a, const sim_scenario_t *sc, const bench_figs_t
     fprintf(stderr, "gyro-sim: --uart-pty needs a closed-loop scenario\n");
     return 2;
   }
+  if (a->uart_pty && sc->n_cmds > 0) {
+    fprintf(stderr, "gyro-sim: --uart-pty and the scenario's \"commands\" would both type "
+                    "into the command line: one or the other\n");
+    return 2;
+  }
   const sim_opts_t so = {csv_path, sc->csv_rate_hz,
                          !a->quiet && isatty(2) && sc->duration_s > 2.0, a->uart_pty,
                          a->uart_pty_link};
@@ -814,6 +835,7 @@ static int run(const cli_args_t *a, const sim_scenario_t *sc, const bench_figs_t
   if (res.selfcal.ran && !res.selfcal.ok)
     cJSON_AddStringToObject(root, "selfcal_error", res.selfcal.why);
   add_params(root, sc, &pc, res.selfcal.ok ? &res.selfcal.saved : &fw);
+  add_commands(root, sc, &res);
   report_t r = {.sc = sc,
                 .pc = &pc,
                 .res = &res,

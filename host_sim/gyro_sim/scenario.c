@@ -448,6 +448,41 @@ static int parse_open_loop(const cJSON *obj, sim_open_loop_t *ol, char *err, siz
   return 0;
 }
 
+/* "commands": [[t_s, "line"], ...]: times from 0 and not decreasing, printable lines
+ * without a line end (gyro-sim adds it). */
+static int parse_commands(const cJSON *arr, sim_scenario_t *sc, char *err, size_t len)
+{
+  const int n = cJSON_IsArray(arr) ? cJSON_GetArraySize(arr) : -1;
+  if (n < 0 || n > SIM_CMDS_MAX)
+    return fail(err, len, "commands: expected a list of at most %d [t_s, \"line\"] pairs",
+                SIM_CMDS_MAX);
+  double t_last = 0.0;
+  for (int j = 0; j < n; j++) {
+    const cJSON *e = cJSON_GetArrayItem(arr, j);
+    const cJSON *t = cJSON_GetArrayItem(e, 0), *l = cJSON_GetArrayItem(e, 1);
+    if (!cJSON_IsArray(e) || cJSON_GetArraySize(e) != 2 || !cJSON_IsString(l))
+      return fail(err, len, "commands[%d]: expected [t_s, \"line\"]", j);
+    char w[32];
+    snprintf(w, sizeof w, "commands[%d]", j);
+    double t_s = 0.0;
+    if (get_num(t, w, t_last, 1e6, &t_s, err, len) != 0) return -1;
+    const size_t m = strlen(l->valuestring);
+    if (m == 0u || m >= SIM_CMD_LINE_MAX)
+      return fail(err, len, "commands[%d]: a line of 1 to %d characters", j,
+                  SIM_CMD_LINE_MAX - 1);
+    for (size_t i = 0; i < m; i++) {
+      const unsigned char c = (unsigned char)l->valuestring[i];
+      if (c < 0x20u || c > 0x7Eu)
+        return fail(err, len, "commands[%d]: printable ASCII only, no line end", j);
+    }
+    sc->cmds[j].t_s = t_s;
+    memcpy(sc->cmds[j].line, l->valuestring, m + 1u);
+    t_last = t_s;
+  }
+  sc->n_cmds = n;
+  return 0;
+}
+
 int scenario_parse(sim_scenario_t *out, const char *json, char *err, size_t len)
 {
   cJSON *root = cJSON_Parse(json);
@@ -553,6 +588,8 @@ int scenario_parse(sim_scenario_t *out, const char *json, char *err, size_t len)
             strlen(it->valuestring) >= SIM_PATH_MAX)
           rc = fail(err, len, "firmware_params: expected the path of a parameter set file");
         else snprintf(sc->fw_params_path, SIM_PATH_MAX, "%s", it->valuestring);
+      } else if (strcmp(k, "commands") == 0) {
+        rc = parse_commands(it, sc, err, len);
       } else if (strcmp(k, "notes") == 0) {
         if (!cJSON_IsObject(it)) rc = fail(err, len, "notes: expected an object of strings");
       } else {
@@ -563,6 +600,8 @@ int scenario_parse(sim_scenario_t *out, const char *json, char *err, size_t len)
   }
   if (rc == 0 && sc->selfcal && sc->loop != SIM_CLOSED_LOOP)
     rc = fail(err, len, "selfcal: needs \"mode\": \"closed_loop\" (the firmware runs the sweep)");
+  if (rc == 0 && sc->n_cmds > 0 && sc->loop != SIM_CLOSED_LOOP)
+    rc = fail(err, len, "commands: needs \"mode\": \"closed_loop\" (the firmware reads them)");
   if (rc == 0) *out = *sc;
   free(sc);
   cJSON_Delete(root);

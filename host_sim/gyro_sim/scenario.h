@@ -32,6 +32,9 @@
  *     "open_loop": { "u_amp_v": 8, "freq_hz": 1489.9,
  *                    "sweep": { "f_start_hz": 1400, "f_stop_hz": 1600, "points": 81,
  *                               "dwell_s": 0.2, "settle_s": 0.1 } },
+ *     "commands": [ [t_s, "command line"], ... ],   (closed loop: up to SIM_CMDS_MAX lines
+ *                 typed into the firmware's command line at simulated times t_s, in
+ *                 order; each reply is kept whole for the JSON output, "commands")
  *     "notes": { "<parameter>": "how its value was chosen", ... }  (documentation only)
  *   }
  *   PROFILE: { "kind": "const", "value": v }
@@ -54,6 +57,8 @@
 #define SIM_MAX_SETS 160
 #define SIM_NAME_MAX 64
 #define SIM_PATH_MAX 1024
+#define SIM_CMDS_MAX 16
+#define SIM_CMD_LINE_MAX 120 /* the firmware's line (CLI_LINE_MAX) with room to spare */
 
 typedef enum {
   SIM_CLOSED_LOOP = 0,
@@ -109,6 +114,12 @@ typedef struct {
   /* key "firmware_params" / --firmware-params: a parameter set (param_set.h) under the
    * firmware settings; "" none */
   char fw_params_path[SIM_PATH_MAX];
+  /* key "commands": lines typed into the command line at simulated times, in order */
+  struct {
+    double t_s;
+    char line[SIM_CMD_LINE_MAX];
+  } cmds[SIM_CMDS_MAX];
+  int n_cmds;
 } sim_scenario_t;
 
 /* Defaults: closed loop, 1 s, seed 1, no analyses, CSV at 1 kHz. */

@@ -57,6 +57,9 @@ typedef struct {
   param_values_t saved; /* the parameters the timeline starts from (the store's) */
 } sim_selfcal_t;
 
+/* Longest reply kept of a scenario command (the host UART stub holds less). */
+#define SIM_CMD_REPLY_MAX 8192
+
 typedef struct {
   double sim_s;
   double wall_s;
@@ -77,6 +80,8 @@ typedef struct {
   double mean_drive_amp_m;
   sim_selfcal_t selfcal;
   param_values_t final_params; /* closed loop: the values the application holds at the end */
+  int n_cmds_run;              /* scenario "commands" typed (those within the run) */
+  char cmd_reply[SIM_CMDS_MAX][SIM_CMD_REPLY_MAX]; /* their replies, whole */
 } sim_result_t;
 
 typedef struct {

@@ -349,6 +349,18 @@ static const char *sc_cmd(app_t *a, const char *line, char *reply, size_t n)
   return reply;
 }
 
+/* The scenario's "commands" due by t_s, typed in order between two ticks, each reply kept
+ * whole (a line end added: the command line reads lines). */
+static void cl_commands(app_t *a, const sim_scenario_t *sc, double t_s, sim_result_t *res)
+{
+  while (res->n_cmds_run < sc->n_cmds && sc->cmds[res->n_cmds_run].t_s <= t_s) {
+    char line[SIM_CMD_LINE_MAX + 2];
+    snprintf(line, sizeof line, "%s\n", sc->cmds[res->n_cmds_run].line);
+    (void)sc_cmd(a, line, res->cmd_reply[res->n_cmds_run], SIM_CMD_REPLY_MAX);
+    res->n_cmds_run++;
+  }
+}
+
 /* The scenario's inputs held at their values of t = 0: the initial conditions. */
 static void initial_profiles(const plant_profiles_t *prof, plant_profiles_t *held)
 {
@@ -503,8 +515,10 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
   const double t_wall0 = wall_now(), t_cpu0 = cpu_now();
   cl_stats_t st = {.fw_lock_s = -1.0, .first_valid_s = -1.0};
   slip_init(&st.slip, (double)r.truth.decim / fs);
+  res->n_cmds_run = 0;
   for (uint64_t k = 0; k < n_ticks; k++) {
     hal_host_run(1u);
+    cl_commands(r.app, sc, (double)(k + 1u) / fs, res);
     const plant_truth_t *tr = plant_truth(r.plant);
     if (st.fw_lock_s < 0.0 && app->gyro.sup.mode == GYRO_MODE_LOCKED)
       st.fw_lock_s = (double)(k + 1u) / fs;

@@ -7,7 +7,11 @@
                                         its verification passes (exit 0)
   check_calibration.py usage GYRO_SIM   bad input is refused with exit 2 and a message,
                                         nothing written
+  check_calibration.py commands GYRO_SIM  a scenario's "commands" (what the flow's
+                                        self-test stage uses) reach the command line at
+                                        their times; one due after the run has no reply
 """
+import json
 import os
 import subprocess
 import sys
@@ -74,8 +78,30 @@ def usage(sim):
     return 1 if bad else 0
 
 
+def commands(sim):
+    scen = os.path.join(ROOT, "tests", "vectors", "scenario_commands.json")
+    freq = paramset.read(CAL).values()["drive.freq_hz"]
+    with tempfile.TemporaryDirectory() as d:
+        js = os.path.join(d, "r.json")
+        r = subprocess.run([sim, "--scenario", scen, "--quiet", "--no-analysis", "--json", js],
+                           capture_output=True, text=True)
+        if r.returncode != 0:
+            print(f"FAIL: exit {r.returncode}: {r.stderr}")
+            return 1
+        with open(js, encoding="utf-8") as fh:
+            got = json.load(fh)["commands"]
+    for c in got:
+        print(f"{c['t_s']:g} {c['line']!r} -> {c['reply']!r}")
+    ok = (len(got) == 3 and "- calibrated yes\r\n" in got[0]["reply"]
+          and got[1]["reply"].startswith(f"ok drive.freq_hz {paramset.format_f32(freq)} Hz")
+          and got[2]["reply"] is None)
+    print("ok" if ok else "FAIL")
+    return 0 if ok else 1
+
+
 if __name__ == "__main__":
-    if len(sys.argv) != 3 or sys.argv[1] not in ("regen", "usage"):
+    modes = {"regen": regen, "usage": usage, "commands": commands}
+    if len(sys.argv) != 3 or sys.argv[1] not in modes:
         print(__doc__, file=sys.stderr)
         sys.exit(2)
-    sys.exit({"regen": regen, "usage": usage}[sys.argv[1]](sys.argv[2]))
+    sys.exit(modes[sys.argv[1]](sys.argv[2]))

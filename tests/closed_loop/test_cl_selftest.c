@@ -17,46 +17,18 @@
 #include "app_plant.h"
 
 
-/* The self-test expectations of the default part, measured on it as its calibration
- * measures them (the calibration flow has no self-test stage yet, so the part's
- * calibration file leaves them 0: no test can pass): the on-demand test's response and
- * the continuous test's amplitude on the healthy part at rest, once per program. */
-static float g_expect_dps, g_cont_expect_dps;
-
 static double cont_avg_dps(void)
 {
   return hypot((double)app.gyro.selftest.w_avg[0], (double)app.gyro.selftest.w_avg[1]) *
          fabs((double)app.gyro.design->rate.scale_dps);
 }
 
-static void measure_expectations(void)
-{
-  if (g_expect_dps != 0.0f) return;
-  plant_cfg_t pc;
-  plant_default_cfg(&pc);
-  param_values_t v;
-  default_part_values(&v);
-  v.selftest_cont_expect_dps = 1.0f; /* any nonzero value lets the continuous test run */
-  app_plant_start(&pc, 31u, &v);
-  run_s(0.3);
-  assert_true(strncmp(cmd("selftest\n"), "ok", 2) == 0);
-  run_s(0.6);
-  g_expect_dps = app.gyro.selftest.result_dps;
-  assert_true(strncmp(cmd("set selftest.continuous 1\n"), "ok", 2) == 0);
-  run_s(3.0);
-  g_cont_expect_dps = (float)cont_avg_dps();
-  printf("# measured expectations: on-demand %.4f deg/s, continuous %.4f deg/s\n",
-         (double)g_expect_dps, (double)g_cont_expect_dps);
-  assert_true(g_expect_dps > 1.0f && g_cont_expect_dps > 1.0f);
-}
-
-/* The default part with its self-test expectations. */
+/* The default part with its calibration, whose self-test expectations the calibration
+ * flow measured (tools/calibrate, on its own noise seed). */
 static void part_values(param_values_t *v)
 {
-  measure_expectations();
   default_part_values(v);
-  v->selftest_expect_dps = g_expect_dps;
-  v->selftest_cont_expect_dps = g_cont_expect_dps;
+  assert_true(v->selftest_expect_dps > 1.0f && v->selftest_cont_expect_dps > 1.0f);
 }
 
 static void start_part(const plant_cfg_t *pc)
@@ -173,7 +145,8 @@ static void test_continuous_keeps_scale(void **state)
   printf("# at 100 deg/s: output %.5f off / %.5f on, judged response %.4f deg/s\n", m[0], m[1],
          resp[1]);
   assert_true(fabs(m[1] / m[0] - 1.0) < 1e-4);
-  assert_true(fabs(resp[1] / (double)g_cont_expect_dps - 1.0) < 0.02);
+  assert_true(fabs(resp[1] / (double)params_current(&app.params)->selftest_cont_expect_dps -
+                   1.0) < 0.02);
   assert_int_equal(app.gyro.cont_fail, 0u);
 }
 

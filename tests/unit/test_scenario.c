@@ -94,6 +94,16 @@ static void test_bad_entries_refused(void **state)
        "accel_g.random[0].psd_g2_per_hz: missing"},
       {"{\"accel_g\": {\"random\": {}}}", "accel_g.random: expected a list of at most 4 bands"},
       {"{\"accel_g\": {\"bump\": []}}", "accel_g.bump: unknown key"},
+      {"{\"commands\": {}}", "commands: expected a list of at most 16"},
+      {"{\"commands\": [[1, \"status\"], [0.5, \"status\"]]}",
+       "commands[1]: 0.5 is out of range [1,"},
+      {"{\"commands\": [[1]]}", "commands[0]: expected [t_s, \"line\"]"},
+      {"{\"commands\": [[1, 2]]}", "commands[0]: expected [t_s, \"line\"]"},
+      {"{\"commands\": [[-1, \"status\"]]}", "commands[0]: -1 is out of range"},
+      {"{\"commands\": [[1, \"\"]]}", "commands[0]: a line of 1 to 119 characters"},
+      {"{\"commands\": [[1, \"status\\nsave\"]]}", "commands[0]: printable ASCII only"},
+      {"{\"mode\": \"open_loop\", \"commands\": [[1, \"status\"]]}",
+       "commands: needs \"mode\": \"closed_loop\""},
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     sim_scenario_t *sc = fresh();
@@ -104,6 +114,22 @@ static void test_bad_entries_refused(void **state)
     if (strstr(err, bad[i].msg) == NULL) fail_msg("'%s' does not say '%s'", err, bad[i].msg);
     assert_memory_equal(sc, &before, sizeof before);
   }
+}
+
+/* "commands": kept in order, whole. */
+static void test_commands_parsed(void **state)
+{
+  (void)state;
+  sim_scenario_t *sc = fresh();
+  char err[400] = "";
+  assert_int_equal(scenario_parse(sc,
+                                  "{\"commands\": [[0.5, \"selftest\"], [0.5, \"status\"], "
+                                  "[2, \"set rate.lpf_cutoff_hz 50\"]]}",
+                                  err, sizeof err),
+                   0);
+  assert_int_equal(sc->n_cmds, 3);
+  assert_true(sc->cmds[1].t_s == 0.5 && sc->cmds[2].t_s == 2.0);
+  assert_string_equal(sc->cmds[2].line, "set rate.lpf_cutoff_hz 50");
 }
 
 /* A band must end below 0.45 plant.fs_hz: refused by sim_plant_cfg naming the band and
@@ -321,6 +347,7 @@ int main(void)
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_shocks_and_random_parsed),
       cmocka_unit_test(test_bad_entries_refused),
+      cmocka_unit_test(test_commands_parsed),
       cmocka_unit_test(test_band_against_sample_rate),
       cmocka_unit_test(test_settings),
       cmocka_unit_test(test_preset),

@@ -9,18 +9,20 @@ firmware's generic defaults:
    thesis's table 7-2): the response's direction and length in the output frame give
    the demodulation phase and the scale factor (gyrotools.demodcal); repeated with the
    corrected values until the response lies on the rate axis with unit gain;
-3. the calibration record: every value the firmware holds for this part, with
+3. self-test expectations: the on-demand test's response and the continuous test's
+   amplitude on the calibrated part at rest (scenario "commands": `selftest`, `status`),
+   at the drive setpoint (selftest.ref_amp_v);
+4. the calibration record: every value the firmware holds for this part, with
    cal.ref_freq_hz (the drive frequency it was made at), cal.part_id and cal.date,
    written as a param set (gyrotools.paramset);
-4. verification on a profile the fit never saw: another noise seed and another rate
+5. verification on a profile the fit never saw: another noise seed and another rate
    schedule (+-30..150 deg/s, other dwell), judged on the rate output the firmware marks
-   valid where the input is held: scale factor, bias at rest, and never a valid rate off
-   by more than VERIFY_MAX_ERR_DPS.
+   valid where the input is held: scale factor, bias at rest, never a valid rate off by
+   more than VERIFY_MAX_ERR_DPS; then the on-demand self-test at rest passes.
 
-Not yet in the flow (the firmware keeps its generic values for them, and says what it
-lacks): thermal calibration (bias and scale-factor polynomials over temperature; the
-rate is valid only within rate.p_range_deg of the calibration temperature) and the
-self-test expectations (selftest.expect_dps 0: the on-demand test cannot pass).
+Not yet in the flow (the firmware keeps its generic values for them): thermal
+calibration (bias and scale-factor polynomials over temperature; the rate is valid only
+within rate.p_range_deg of the calibration temperature).
 """
 
 from __future__ import annotations
@@ -56,6 +58,9 @@ VERIFY_VALID_FRAC = 0.9
 # scenario reports is measured on the noise a calibration was fitted to.
 RATE_TABLE_SEED_OFFSET = 100
 VERIFY_SEED_OFFSET = 1000
+# The self-test's response below this is no working self-test (the design's electrodes
+# give about 5.5 deg/s at selftest.amp_v 0.1 V; dead ones, their feedthrough, 0.05).
+SELFTEST_MIN_DPS = 1.0
 VERIFY_RATES_DPS = (30, -30, 70, -70, 110, -110, 150, -150)
 VERIFY_DWELL_S = 1.25
 SETTLE_S = 0.5
@@ -113,12 +118,17 @@ def selfcal(part):
                  "true_f0_hz": f.get("selfcal_true_f0_hz"), "true_q": f.get("selfcal_true_q")}
 
 
-def _rate_log(part, params, scenario, seed, name):
+def _rate_log(part, params, scenario, seed, name, replies=None):
+    """The run's CSV log; its command replies appended to `replies` if given."""
     csv = os.path.join(part.work, name + ".csv")
+    js = os.path.join(part.work, name + ".json")
     cmd = _run(part, ["--scenario", scenario, "--firmware-params", params, "--seed", str(seed),
-                      "--no-analysis", "--quiet", "--csv", csv], name)
+                      "--no-analysis", "--quiet", "--csv", csv, "--json", js], name)
     log = csvlog.read_log(csv, need=["rate_dps", "quad_dps", "rate_true_dps", "rate_valid"],
                           purpose=name)
+    if replies is not None:
+        with open(js, encoding="utf-8") as fh:
+            replies += [c["reply"] for c in json.load(fh).get("commands", [])]
     return log, " ".join(cmd)
 
 
@@ -151,6 +161,51 @@ def rate_table(part, params_path):
     return values, passes
 
 
+def _status_value(reply, key):
+    """The value of `- KEY VALUE` in a status reply, or None."""
+    for ln in (reply or "").splitlines():
+        f = ln.split()
+        if len(f) >= 3 and f[0] == "-" and f[1] == key:
+            return f[2]
+    return None
+
+
+def _commands(part, params, name, doc, what):
+    """Run a scenario of the flow's own with "commands"; their replies."""
+    scen = _scenario(part, name, doc)
+    js = os.path.join(part.work, name + ".json")
+    cmd = _run(part, ["--scenario", scen, "--firmware-params", params, "--no-analysis",
+                      "--quiet", "--json", js], what)
+    with open(js, encoding="utf-8") as fh:
+        return [c["reply"] for c in json.load(fh).get("commands", [])], " ".join(cmd)
+
+
+def selftest(part, values):
+    """Stage 3: the self-test expectations, measured on the calibrated part at rest."""
+    path = os.path.join(part.work, "selftest_params.json")
+    paramset.write(path, paramset.from_values(values, meta={"stage": "self-test"}))
+    replies, cmd = _commands(part, path, "calibrate_selftest", {
+        "description": "the self-test's responses on the calibrated part at rest",
+        "duration_s": 6.0, "commands": [
+            [1.0, "selftest"], [2.0, "status"],
+            [2.1, "set selftest.cont_expect_dps 1 selftest.continuous 1"], [5.9, "status"]]},
+        "self-test")
+    on_demand = _status_value(replies[1] if len(replies) > 1 else None, "selftest_dps")
+    cont = _status_value(replies[3] if len(replies) > 3 else None, "selftest_cont_dps")
+    if on_demand is None or cont is None:
+        raise FlowError(f"self-test: no response in the status replies ({cmd})")
+    on_demand, cont = float(on_demand), float(cont)
+    if not (abs(on_demand) >= SELFTEST_MIN_DPS and cont >= SELFTEST_MIN_DPS):
+        raise FlowError(f"self-test: response {on_demand:.3g} deg/s on demand, {cont:.3g} "
+                        f"continuous, below {SELFTEST_MIN_DPS:g}: the self-test electrodes do "
+                        "not act on this part")
+    v = dict(values)
+    v["selftest.expect_dps"] = on_demand
+    v["selftest.cont_expect_dps"] = cont
+    v["selftest.ref_amp_v"] = v["drive.amp_set_v"]
+    return v, {"command": cmd, "expect_dps": on_demand, "cont_expect_dps": cont}
+
+
 def part_id(sets):
     """A stable id of the simulated part: CRC-32 of its settings (not of the noise)."""
     return zlib.crc32(("\n".join(sorted(sets)) + "\n").encode())
@@ -169,12 +224,18 @@ def record(values, sets, date=None):
 def verify(part, cal_path):
     """Stage 4: the calibrated part on a profile and noise the fit never saw."""
     seed = part.seed + VERIFY_SEED_OFFSET
-    steps = [[2.0, 0]] + [[VERIFY_DWELL_S, r] for r in VERIFY_RATES_DPS] + [[1.0, 0]]
+    steps = [[2.0, 0]] + [[VERIFY_DWELL_S, r] for r in VERIFY_RATES_DPS] + [[2.5, 0]]
+    duration = sum(st[0] for st in steps)
+    # The on-demand self-test in the last 1.2 s, at rest; the rate is judged before it.
+    t_selftest = duration - 1.2
     scen = _scenario(part, "calibrate_verify", {
         "description": "verification of a calibration: rates and dwell the fit never saw",
-        "duration_s": sum(st[0] for st in steps), "csv_rate_hz": 200,
-        "rate_dps": {"kind": "steps", "edge_s": 0.1, "steps": steps}})
-    log, cmd = _rate_log(part, cal_path, scen, seed, "verify")
+        "duration_s": duration, "csv_rate_hz": 200,
+        "rate_dps": {"kind": "steps", "edge_s": 0.1, "steps": steps},
+        "commands": [[t_selftest, "selftest"], [duration - 0.05, "status"]]})
+    replies = []
+    log, cmd = _rate_log(part, cal_path, scen, seed, "verify", replies)
+    st_state = _status_value(replies[-1] if replies else None, "selftest")
     t, out, truth = log["t_s"], log["rate_dps"], log["rate_true_dps"]
     valid = log["rate_valid"] > 0.5
     res = scalefactor.analyse(t, out, rate_true_dps=truth, settle_s=SETTLE_S,
@@ -183,6 +244,7 @@ def verify(part, cal_path):
     in_dwell = np.zeros(t.size, dtype=bool)
     for _, i0, i1 in win:
         in_dwell[i0:i1] = True
+    in_dwell &= t < t_selftest
     err = np.abs(out - truth)
     valid_frac = float(np.mean(valid[in_dwell])) if np.any(in_dwell) else 0.0
     # Judged where the input is held (after SETTLE_S): during a table's ramp the 100 Hz
@@ -198,11 +260,13 @@ def verify(part, cal_path):
         "bias_at_rest": bool(np.isfinite(bias) and abs(bias) <= VERIFY_BIAS_DPS),
         "valid_fraction": valid_frac >= VERIFY_VALID_FRAC,
         "no_valid_wrong_rate": worst <= VERIFY_MAX_ERR_DPS,
+        "selftest": st_state == "PASS",
     }
     return {"command": cmd, "seed": seed, "rates_dps": list(VERIFY_RATES_DPS),
             "dwell_s": VERIFY_DWELL_S, "scale_factor": res.sf, "scale_factor_ppm": sf_ppm,
             "nonlinearity_fs": res.nonlinearity, "bias_at_rest_dps": bias,
             "valid_fraction_in_dwell": valid_frac, "worst_valid_error_dps": worst,
+            "selftest": st_state,
             "limits": {"scale_factor_ppm": VERIFY_SF_PPM, "bias_dps": VERIFY_BIAS_DPS,
                        "valid_fraction": VERIFY_VALID_FRAC,
                        "worst_valid_error_dps": VERIFY_MAX_ERR_DPS},
