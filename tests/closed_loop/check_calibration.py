@@ -7,6 +7,9 @@
                                         its verification passes (exit 0)
   check_calibration.py usage GYRO_SIM   bad input is refused with exit 2 and a message,
                                         nothing written
+  check_calibration.py defaults GYRO_SIM  gyro-scalefactor and gyro-demodcal, run with
+                                        their defaults on the shipped rate table's log,
+                                        give the default part's calibrated values back
   check_calibration.py commands GYRO_SIM  a scenario's "commands" (what the flow's
                                         self-test stage uses) reach the command line at
                                         their times; one due after the run has no reply
@@ -78,6 +81,40 @@ def usage(sim):
     return 1 if bad else 0
 
 
+def tool_defaults(sim):
+    scen = os.path.join(ROOT, "host_sim", "scenarios", "rate_table.json")
+    cal = paramset.read(CAL).values()
+    bad = 0
+    with tempfile.TemporaryDirectory() as d:
+        csv = os.path.join(d, "rt.csv")
+        r = subprocess.run([sim, "--scenario", scen, "--quiet", "--no-analysis", "--csv", csv],
+                           capture_output=True, text=True)
+        if r.returncode != 0:
+            print(f"FAIL: gyro-sim exit {r.returncode}: {r.stderr}")
+            return 1
+        runs = [("gyro-scalefactor", [csv]),
+                ("gyro-demodcal", [csv, "--phase-deg", repr(cal["rate.demod_phase_deg"]),
+                                   "--scale", repr(cal["rate.scale_dps"])])]
+        for tool, args in runs:
+            out = os.path.join(d, tool)
+            r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", tool)] + args
+                               + ["--out", out], capture_output=True, text=True)
+            print(f"{tool} (defaults): exit {r.returncode}: "
+                  f"{(r.stdout + r.stderr).strip().splitlines()[-2:]}")
+            if r.returncode != 0:
+                bad += 1
+                continue
+            js = os.path.join(out, tool.replace("gyro-", "") + ".json")
+            with open(js, encoding="utf-8") as fh:
+                j = json.load(fh)
+            gain = j["scale_factor_out_per_dps"] if tool == "gyro-scalefactor" else j["gain"]
+            if abs(gain - 1.0) > 500e-6:
+                print(f"FAIL: {tool}: gain {gain}, not within 500 ppm of the calibration's")
+                bad += 1
+    print("ok" if bad == 0 else "FAIL")
+    return 1 if bad else 0
+
+
 def commands(sim):
     scen = os.path.join(ROOT, "tests", "vectors", "scenario_commands.json")
     freq = paramset.read(CAL).values()["drive.freq_hz"]
@@ -100,7 +137,7 @@ def commands(sim):
 
 
 if __name__ == "__main__":
-    modes = {"regen": regen, "usage": usage, "commands": commands}
+    modes = {"regen": regen, "usage": usage, "commands": commands, "defaults": tool_defaults}
     if len(sys.argv) != 3 or sys.argv[1] not in modes:
         print(__doc__, file=sys.stderr)
         sys.exit(2)

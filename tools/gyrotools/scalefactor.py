@@ -33,6 +33,13 @@ from .errors import InputError
 MIN_SEGMENTS = 3
 
 
+# Default segmentation of a rate table: 0.5 s excluded after each step (the 100 Hz output
+# settles in 20 ms, a table's acceleration, the project's 0.1 s edges, well within it),
+# then at least 0.5 s averaged: fits the project's own rate tables (1.5 s dwell, as the
+# thesis's 7.2.4) and longer ones.
+SETTLE_S_DEFAULT = 0.5
+MIN_AVG_S_DEFAULT = 0.5
+
 @dataclasses.dataclass
 class Segment:
     rate_in_dps: float
