@@ -5,10 +5,13 @@ Seeds give libFuzzer a start inside the interesting grammar (commands, numbers, 
 parameter images built from the layout in firmware/params/param_store.h, parameter-set
 files written by tools/gyrotools/paramset.py); crash inputs
 found later are kept beside them as regression inputs (tools/run-fuzz)."""
-import binascii
 import os
 import struct
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gyrotools import paramset  # noqa: E402
+from gyrotools.paramstore import image  # noqa: E402
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "fuzz", "corpus")
 
@@ -42,12 +45,6 @@ for i, s in enumerate([b"1489.9", b"-1.5e-7", b"3.4028235e38", b"1e999", b"1e-39
     put("fuzz_numparse", "%02d" % i, s)
 
 
-def image(seq, records, fmt=1, layout=1):
-    hdr = struct.pack("<IHHIII", 0x4D524750, fmt, layout, 0x000100, seq, len(records))
-    body = hdr + b"".join(struct.pack("<HBBI", rid, typ, 0, val) for rid, typ, val in records)
-    return body + struct.pack("<II", binascii.crc32(body) & 0xFFFFFFFF, 0x5AFEC0DE)
-
-
 def f32(x):
     return struct.unpack("<I", struct.pack("<f", x))[0]
 
@@ -72,8 +69,6 @@ put("fuzz_param_store", "wrap", b"\x00" + slots(image(0xFFFFFFF0, recs_a), image
 # Parameter sets (docs/param-set.md), written by gyrotools.paramset from the table: a
 # complete set at the defaults, a partial one with meta, and the same broken in the ways
 # the reader refuses (checksum, duplicate, kinds of number).
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gyrotools import paramset  # noqa: E402
 
 TABLE = paramset.load_table()
 SETTABLE = [d for d in TABLE.values() if d.settable]
