@@ -81,16 +81,22 @@ def usage(sim):
     return 1 if bad else 0
 
 
+def run_sim(sim, scen, extra):
+    """gyro-sim on a scenario, quietly; False (and why, printed) if it failed."""
+    r = subprocess.run([sim, "--scenario", scen, "--quiet", "--no-analysis"] + extra,
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        print(f"FAIL: gyro-sim exit {r.returncode}: {r.stderr}")
+    return r.returncode == 0
+
+
 def tool_defaults(sim):
     scen = os.path.join(ROOT, "host_sim", "scenarios", "rate_table.json")
     cal = paramset.read(CAL).values()
     bad = 0
     with tempfile.TemporaryDirectory() as d:
         csv = os.path.join(d, "rt.csv")
-        r = subprocess.run([sim, "--scenario", scen, "--quiet", "--no-analysis", "--csv", csv],
-                           capture_output=True, text=True)
-        if r.returncode != 0:
-            print(f"FAIL: gyro-sim exit {r.returncode}: {r.stderr}")
+        if not run_sim(sim, scen, ["--csv", csv]):
             return 1
         runs = [("gyro-scalefactor", [csv]),
                 ("gyro-demodcal", [csv, "--phase-deg", repr(cal["rate.demod_phase_deg"]),
@@ -120,10 +126,7 @@ def commands(sim):
     freq = paramset.read(CAL).values()["drive.freq_hz"]
     with tempfile.TemporaryDirectory() as d:
         js = os.path.join(d, "r.json")
-        r = subprocess.run([sim, "--scenario", scen, "--quiet", "--no-analysis", "--json", js],
-                           capture_output=True, text=True)
-        if r.returncode != 0:
-            print(f"FAIL: exit {r.returncode}: {r.stderr}")
+        if not run_sim(sim, scen, ["--json", js]):
             return 1
         with open(js, encoding="utf-8") as fh:
             got = json.load(fh)["commands"]

@@ -118,18 +118,19 @@ def selfcal(part):
                  "true_f0_hz": f.get("selfcal_true_f0_hz"), "true_q": f.get("selfcal_true_q")}
 
 
-def _rate_log(part, params, scenario, seed, name, replies=None):
-    """The run's CSV log; its command replies appended to `replies` if given."""
-    csv = os.path.join(part.work, name + ".csv")
+def _sim(part, params, scenario, seed, name, csv=False):
+    """One gyro-sim run from the param set `params`: (its CSV log or None, the replies to
+    the scenario's "commands", the command line)."""
     js = os.path.join(part.work, name + ".json")
-    cmd = _run(part, ["--scenario", scenario, "--firmware-params", params, "--seed", str(seed),
-                      "--no-analysis", "--quiet", "--csv", csv, "--json", js], name)
-    log = csvlog.read_log(csv, need=["rate_dps", "quad_dps", "rate_true_dps", "rate_valid"],
-                          purpose=name)
-    if replies is not None:
-        with open(js, encoding="utf-8") as fh:
-            replies += [c["reply"] for c in json.load(fh).get("commands", [])]
-    return log, " ".join(cmd)
+    args = ["--scenario", scenario, "--firmware-params", params, "--seed", str(seed),
+            "--no-analysis", "--quiet", "--json", js]
+    log_path = os.path.join(part.work, name + ".csv")
+    cmd = _run(part, args + (["--csv", log_path] if csv else []), name)
+    log = csvlog.read_log(log_path, need=["rate_dps", "quad_dps", "rate_true_dps", "rate_valid"],
+                          purpose=name) if csv else None
+    with open(js, encoding="utf-8") as fh:
+        replies = [c["reply"] for c in json.load(fh).get("commands", [])]
+    return log, replies, " ".join(cmd)
 
 
 def rate_table(part, params_path):
@@ -141,8 +142,8 @@ def rate_table(part, params_path):
     for k in range(MAX_PASSES):
         cur = os.path.join(part.work, f"rate_table_{k}_params.json")
         paramset.write(cur, paramset.from_values(values, meta={"stage": f"rate table pass {k}"}))
-        log, cmd = _rate_log(part, cur, scen, part.seed + RATE_TABLE_SEED_OFFSET + k,
-                            f"rate_table_{k}")
+        log, _, cmd = _sim(part, cur, scen, part.seed + RATE_TABLE_SEED_OFFSET + k,
+                           f"rate_table_{k}", csv=True)
         res = demodcal.analyse(log["t_s"], log["rate_dps"], log["quad_dps"],
                                values["rate.demod_phase_deg"], values["rate.scale_dps"],
                                rate_true_dps=log["rate_true_dps"], settle_s=SETTLE_S,
@@ -170,26 +171,16 @@ def _status_value(reply, key):
     return None
 
 
-def _commands(part, params, name, doc, what):
-    """Run a scenario of the flow's own with "commands"; their replies."""
-    scen = _scenario(part, name, doc)
-    js = os.path.join(part.work, name + ".json")
-    cmd = _run(part, ["--scenario", scen, "--firmware-params", params, "--no-analysis",
-                      "--quiet", "--json", js], what)
-    with open(js, encoding="utf-8") as fh:
-        return [c["reply"] for c in json.load(fh).get("commands", [])], " ".join(cmd)
-
-
 def selftest(part, values):
     """Stage 3: the self-test expectations, measured on the calibrated part at rest."""
     path = os.path.join(part.work, "selftest_params.json")
     paramset.write(path, paramset.from_values(values, meta={"stage": "self-test"}))
-    replies, cmd = _commands(part, path, "calibrate_selftest", {
+    scen = _scenario(part, "calibrate_selftest", {
         "description": "the self-test's responses on the calibrated part at rest",
         "duration_s": 6.0, "commands": [
             [1.0, "selftest"], [2.0, "status"],
-            [2.1, "set selftest.cont_expect_dps 1 selftest.continuous 1"], [5.9, "status"]]},
-        "self-test")
+            [2.1, "set selftest.cont_expect_dps 1 selftest.continuous 1"], [5.9, "status"]]})
+    _, replies, cmd = _sim(part, path, scen, part.seed, "self-test")
     on_demand = _status_value(replies[1] if len(replies) > 1 else None, "selftest_dps")
     cont = _status_value(replies[3] if len(replies) > 3 else None, "selftest_cont_dps")
     if on_demand is None or cont is None:
@@ -233,8 +224,7 @@ def verify(part, cal_path):
         "duration_s": duration, "csv_rate_hz": 200,
         "rate_dps": {"kind": "steps", "edge_s": 0.1, "steps": steps},
         "commands": [[t_selftest, "selftest"], [duration - 0.05, "status"]]})
-    replies = []
-    log, cmd = _rate_log(part, cal_path, scen, seed, "verify", replies)
+    log, replies, cmd = _sim(part, cal_path, scen, seed, "verify", csv=True)
     st_state = _status_value(replies[-1] if replies else None, "selftest")
     t, out, truth = log["t_s"], log["rate_dps"], log["rate_true_dps"]
     valid = log["rate_valid"] > 0.5
