@@ -202,6 +202,13 @@ const char *plant_law_name(int law)
 
 const plant_warning_t *plant_warnings(const plant_t *p) { return p->warn; }
 
+uint64_t plant_warning_total(const plant_t *p)
+{
+  uint64_t n = 0;
+  for (int i = 0; i < PLANT_LAWS; i++) n += p->warn[i].count;
+  return n;
+}
+
 /* One evaluation of a law outside its range, at the plant's time now. */
 static void warn(plant_t *p, plant_law_t law)
 {

@@ -468,6 +468,8 @@ const plant_truth_t *plant_truth(const plant_t *p);
 
 /* Warnings of the temperature laws, PLANT_LAWS entries in plant_law_t order. */
 const plant_warning_t *plant_warnings(const plant_t *p);
+/* Evaluations outside their range, all laws together. */
+uint64_t plant_warning_total(const plant_t *p);
 /* "pick_drive_phase", ..., NULL past the end. */
 const char *plant_law_name(int law);
 

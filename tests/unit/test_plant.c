@@ -487,13 +487,6 @@ static void test_temperature_plumbing(void **state)
   assert_true(plant_truth(&p)->dac_held_v[0] == 0.0); /* mid-scale */
 }
 
-static uint64_t warn_total(const plant_t *p)
-{
-  uint64_t n = 0;
-  for (int i = 0; i < PLANT_LAWS; i++) n += plant_warnings(p)[i].count;
-  return n;
-}
-
 /* The default part is built and runs at -40 and at 85 degC ambient (the sense circuit's
  * lag of (2-40) has passed through zero into a 3.4 deg lead at -40 degC) with no law
  * outside its range; an off-nominal part whose laws leave their ranges is not refused
@@ -511,7 +504,7 @@ static void test_law_warnings(void **state)
     c.temp_k = ambients[i];
     assert_int_equal(plant_init(&p, &c, 5u), 0);
     for (long k = 0; k < 5000; k++) plant_step(&p, &fr, NULL);
-    assert_true(warn_total(&p) == 0);
+    assert_true(plant_warning_total(&p) == 0);
     const double tc = plant_truth(&p)->circuit_k;
     const double law = (c.pick_sense_phi0_deg +
                         c.pick_sense_phi1_deg_per_k * (tc - c.temp_ref_k)) *
@@ -535,7 +528,7 @@ static void test_law_warnings(void **state)
   for (long k = 0; k < 500; k++) plant_step(&p, &fr, NULL); /* 10 ms: 10 thermal updates */
   assert_true(w[PLANT_LAW_PICK_SENSE_PHASE].count == 11);
   assert_true(p.pick[1].phi_rad == PICKOFF_LAG_MAX_LOWPASS_RAD);
-  assert_true(warn_total(&p) == 11);
+  assert_true(plant_warning_total(&p) == 11);
   assert_string_equal(plant_law_name(PLANT_LAW_PICK_SENSE_PHASE), "pick_sense_phase");
   assert_null(plant_law_name(PLANT_LAWS));
   /* a law that leaves its range during the run: first time after the start */
@@ -544,7 +537,7 @@ static void test_law_warnings(void **state)
   c.pick_drive_gain_tc_per_k = 0.099;
   c.tau_circuit_s = 0.01;
   assert_int_equal(plant_init(&p, &c, 5u), 0);
-  assert_true(warn_total(&p) == 0);
+  assert_true(plant_warning_total(&p) == 0);
   plant_profiles_t pr = p.prof;
   profile_const(&pr.ambient_k, 233.15);
   assert_int_equal(plant_set_profiles(&p, &pr), 0);

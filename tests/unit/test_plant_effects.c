@@ -393,13 +393,6 @@ static void test_truth_q(void **state)
   assert_true(t->q_drive < 0.9 * c.q_drive);
 }
 
-static uint64_t warn_total(const plant_t *p)
-{
-  uint64_t n = 0;
-  for (int i = 0; i < PLANT_LAWS; i++) n += plant_warnings(p)[i].count;
-  return n;
-}
-
 /* Every law holds over -40..85 degC ambient with the effects on; outside its range a law
  * is counted (each thermal update), never refused: the thermoelastic law below 200 K, the
  * cubic spring beyond |k3/k| y^2 = 0.1, the capacitive pickoff beyond |x| = 0.3 gap. */
@@ -419,7 +412,7 @@ static void test_law_warnings(void **state)
       c.pick_sense_gap_m = 2e-6;
       assert_int_equal(plant_init(&p, &c, 11u), 0);
       run(&p, 5000, NULL);
-      assert_true(warn_total(&p) == 0);
+      assert_true(plant_warning_total(&p) == 0);
     }
   plant_ideal_cfg(&c);
   c.temp_k = 150.0;
@@ -446,7 +439,7 @@ static void test_law_warnings(void **state)
     print_message("%s: %llu warnings from %.4f s\n", plant_law_name(law),
                   (unsigned long long)w[law].count, w[law].first_t_s);
     assert_true(w[law].count == 99 && fabs(w[law].first_t_s - 1e-3) < 1e-12);
-    assert_true(warn_total(&p) == w[law].count);
+    assert_true(plant_warning_total(&p) == w[law].count);
   }
   assert_string_equal(plant_law_name(PLANT_LAW_DUFFING_DRIVE), "duffing_drive");
   assert_string_equal(plant_law_name(PLANT_LAW_PICK_SENSE_GAP), "pick_sense_gap");
