@@ -34,11 +34,11 @@
  * stream (tlm_plan) is computed against. */
 #define APP_TLM_BAUD BOARD_UART_BAUD
 /* TX-ring bytes telemetry leaves free for command replies, so that the longest (list,
- * about 6.5 KB; status with the self-calibration and output-integrity lines about
+ * about 7.7 KB; status with the self-calibration and output-integrity lines about
  * 1.5 KB) comes out whole while a stream runs (test_app: every reply fits). The rings
- * are 8 KB on the board and the host, which leaves telemetry 1 KB (11 ms of the line)
+ * are 16 KB on the board and the host, which leaves telemetry 2 KB (22 ms of the line)
  * of backlog. */
-#define APP_TLM_TX_RESERVE 7168u
+#define APP_TLM_TX_RESERVE 14336u
 
 typedef struct {
   tlm_t stream;

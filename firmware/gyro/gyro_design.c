@@ -45,9 +45,9 @@ static double acq_timeout_s(const param_values_t *v, double tau_s, const gyro_de
   return t_s < 3600.0 ? t_s : 3600.0; /* an hour: beyond it the part is not acquiring */
 }
 
-/* Largest |dB/dP| of the bias polynomial (absolute P, rate_channel.h) over the
- * thermometer's range around p_ref, from nine points: how far a lag of P_f moves the
- * compensation. */
+/* Largest |dB/dP| of the bias polynomial (in x, rate_channel.h) over
+ * the thermometer's range around that reference, from nine points: how far a lag of
+ * P_f moves the compensation. */
 static double bias_slope_max(const param_values_t *v)
 {
   const double c1 = (double)v->rate_bias_c1_dps_per_deg;
@@ -55,11 +55,21 @@ static double bias_slope_max(const param_values_t *v)
   const double c3 = (double)v->rate_bias_c3_dps_per_deg3;
   double m = 0.0;
   for (int i = -4; i <= 4; i++) {
-    const double p = (double)v->drive_p_init_deg + 0.25 * i * (double)v->rate_p_range_deg;
+    const double p = 0.25 * i * (double)v->rate_p_range_deg;
     const double d = fabs(c1 + 2.0 * c2 * p + 3.0 * c3 * p * p);
     if (d > m) m = d;
   }
+  /* Not the gradient term's |k|: it acts on P_c - LP_tau(P_c), whose lag behind P in a
+   * transient is what the calibration fitted it to (rate_channel.c). */
   return m;
+}
+
+/* P_f's low-pass works around drive.p_init_deg (rate_channel.h), the compensation
+ * around cal.ref_p_deg: the offset between them, formed in double so that a reference
+ * equal to the start value gives exactly 0. */
+static float p_poly_off_deg(const param_values_t *v)
+{
+  return (float)((double)v->drive_p_init_deg - (double)v->cal_ref_p_deg);
 }
 
 /* The rate-valid monitors (rate_valid.h) and the analog fault level. The fault level
@@ -80,7 +90,8 @@ static gyro_design_status_t design_validity(const param_values_t *v, gyro_design
                               (float)(1.0 / (2.0 * FM_PI * (double)v->rate_p_lpf_hz)) / window_s,
                               sense_max_v * sense_max_v,
                               v->sup_lock_phase_tol_deg * FM_RAD_PER_DEG_F,
-                              (float)slope};
+                              (float)slope,
+                              p_poly_off_deg(v)};
   t->valid = c;
   t->rate_fault_out_v = v->rate_fault_out_v;
   return GYRO_DESIGN_OK;
@@ -275,7 +286,16 @@ static gyro_design_status_t design_rate(const param_values_t *v, double tau_s, g
   t->rate.sf_c[1] = v->rate_sf_c1_per_deg;
   t->rate.sf_c[2] = v->rate_sf_c2_per_deg2;
   t->rate.sf_c[3] = v->rate_sf_c3_per_deg3;
+  t->rate.sf_c[4] = v->rate_sf_c4_per_deg4;
   t->rate.p_ref_deg = v->drive_p_init_deg;
+  t->rate.p_poly_off_deg = p_poly_off_deg(v);
+  t->rate.grad_k_dps_per_deg = v->rate_bias_grad_dps_per_deg;
+  t->rate.p_rate_deg_per_dps = v->rate_p_rate_deg_per_dps;
+  t->rate.comp_a = v->rate_comp_tau_s > 0.0f
+                       ? (float)(1.0 -
+                                 exp(-(double)RATE_P_DECIM / (fs * (double)v->rate_comp_tau_s)))
+                       : 1.0f;
+  t->rate.grad_a = (float)(1.0 - exp(-(double)RATE_P_DECIM / (fs * (double)v->rate_grad_tau_s)));
   /* First-order low-pass of P at the decimated rate fs / RATE_P_DECIM. */
   t->rate.p_lpf_alpha = (float)(1.0 - exp(-2.0 * FM_PI * (double)v->rate_p_lpf_hz *
                                           RATE_P_DECIM / fs));
@@ -339,8 +359,14 @@ static uint32_t cal_state(const param_values_t *v)
 {
   const double ref = (double)v->cal_ref_freq_hz;
   if (!(ref > 0.0)) return GYRO_CAL_NONE;
-  return fabs((double)v->drive_freq_hz - ref) <= GYRO_CAL_FREQ_REL * ref ? GYRO_CAL_OK
-                                                                         : GYRO_CAL_STALE;
+  /* So is the phase setpoint: the loop holds the drive's phase there, so P is the set
+   * point plus the lags at the part's temperature (a new set point moves the
+   * thermometer by itself), and the drive's phase against the Coriolis force's moves. */
+  const int same_phase = fabs((double)v->drive_phase_set_deg -
+                              (double)v->cal_ref_phase_set_deg) <= GYRO_CAL_PHASE_DEG;
+  return same_phase && fabs((double)v->drive_freq_hz - ref) <= GYRO_CAL_FREQ_REL * ref
+             ? GYRO_CAL_OK
+             : GYRO_CAL_STALE;
 }
 
 const char *gyro_cal_state_name(uint32_t s)

@@ -49,11 +49,14 @@ typedef struct {
 
 /* gyro_design_t.cal_state */
 #define GYRO_CAL_NONE 0u  /* no calibration: cal.ref_freq_hz 0 */
-#define GYRO_CAL_OK 1u    /* made at drive.freq_hz */
-#define GYRO_CAL_STALE 2u /* made at another drive frequency */
+#define GYRO_CAL_OK 1u    /* made at drive.freq_hz and drive.phase_set_deg */
+#define GYRO_CAL_STALE 2u /* made at another drive frequency or phase setpoint */
 /* cal.ref_freq_hz and drive.freq_hz agree within this, relative: two steps of a float,
  * so that a value printed and set again through the command line still matches. */
 #define GYRO_CAL_FREQ_REL 2.0e-7
+/* cal.ref_phase_set_deg and drive.phase_set_deg agree within this (two float steps at
+ * 180 deg): 0.0001 deg turns the 1500 deg/s quadrature by 0.003 deg/s. */
+#define GYRO_CAL_PHASE_DEG 3.1e-5
 
 /* "no", "yes", "stale" for `status` */
 const char *gyro_cal_state_name(uint32_t cal_state);

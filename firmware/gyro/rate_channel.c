@@ -10,6 +10,9 @@
  * as RATE_P_PRIOR means; the running mean ends after RATE_P_FAST_MAX means at most. */
 #define RATE_P_PRIOR 4u
 #define RATE_P_FAST_MAX 1000u
+/* 1e-4: a restart 5 deg of P from the held value (a part that cooled by 60 K while off)
+ * leaves 5e-4 deg of it to the gradient term, 0.005 deg/s at 10 (deg/s)/deg. */
+#define RATE_P_HP_W_MAX 1e-4f
 
 static int finite4(const float *c)
 {
@@ -22,11 +25,13 @@ int rate_channel_cfg_ok(const rate_channel_cfg_t *cfg)
          fm_isfinite(cfg->ref_re) && fm_isfinite(cfg->ref_im) &&
          cfg->ref_re * cfg->ref_re + cfg->ref_im * cfg->ref_im > 0.0f &&
          fm_isfinite(cfg->scale_dps) && finite4(cfg->bias_c_dps) && finite4(cfg->sf_c) &&
-         cfg->p_lpf_alpha > 0.0f && cfg->p_lpf_alpha <= 1.0f && cfg->min_drive_v > 0.0f &&
-         fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg) && cfg->p_mode_k > 0.0f &&
-         cfg->p_mode_k <= 1.0f && cfg->ref_lp_kp > 0.0f && cfg->ref_lp_kp < 1.0f &&
-         cfg->ref_lp_ki > 0.0f && cfg->ref_lp_ki < cfg->ref_lp_kp && cfg->ref_wide_kp > 0.0f &&
-         cfg->ref_wide_kp < 1.0f && cfg->ref_wide_ki > 0.0f &&
+         fm_isfinite(cfg->sf_c[4]) && cfg->p_lpf_alpha > 0.0f && cfg->p_lpf_alpha <= 1.0f &&
+         cfg->min_drive_v > 0.0f && fm_isfinite(cfg->grad_k_dps_per_deg) && cfg->grad_a > 0.0f &&
+         cfg->grad_a <= 1.0f && fm_isfinite(cfg->p_rate_deg_per_dps) && cfg->comp_a > 0.0f &&
+         cfg->comp_a <= 1.0f && fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg) &&
+         cfg->p_mode_k > 0.0f && cfg->p_mode_k <= 1.0f && cfg->ref_lp_kp > 0.0f &&
+         cfg->ref_lp_kp < 1.0f && cfg->ref_lp_ki > 0.0f && cfg->ref_lp_ki < cfg->ref_lp_kp &&
+         cfg->ref_wide_kp > 0.0f && cfg->ref_wide_kp < 1.0f && cfg->ref_wide_ki > 0.0f &&
          cfg->ref_wide_ki < cfg->ref_wide_kp;
 }
 
@@ -59,10 +64,14 @@ void rate_channel_rebase(const rate_channel_cfg_t *old, const rate_channel_cfg_t
 int rate_channel_same_path(const rate_channel_cfg_t *a, const rate_channel_cfg_t *b)
 {
   int same = a->ref_re == b->ref_re && a->ref_im == b->ref_im && a->scale_dps == b->scale_dps &&
-             a->p_ref_deg == b->p_ref_deg && a->lpf_sections == b->lpf_sections;
+             a->p_ref_deg == b->p_ref_deg && a->p_poly_off_deg == b->p_poly_off_deg &&
+             a->grad_k_dps_per_deg == b->grad_k_dps_per_deg && a->grad_a == b->grad_a &&
+             a->p_rate_deg_per_dps == b->p_rate_deg_per_dps && a->comp_a == b->comp_a &&
+             a->lpf_sections == b->lpf_sections;
   for (int i = 0; i < 4; i++) {
     same = same && a->bias_c_dps[i] == b->bias_c_dps[i] && a->sf_c[i] == b->sf_c[i];
   }
+  same = same && a->sf_c[4] == b->sf_c[4];
   return same && memcmp(a->lpf, b->lpf, b->lpf_sections * sizeof b->lpf[0]) == 0;
 }
 
@@ -86,6 +95,8 @@ GYRO_RAMFUNC void rate_channel_reset(const rate_channel_cfg_t *restrict cfg,
   rc->p_dev_deg = p_deg - cfg->p_ref_deg;
   rc->p_held_dev_deg = rc->p_dev_deg;
   rc->p_held_w = 0.0f;
+  rc->p_hp_deg = 0.0f;
+  rc->p_comp_lag_deg = 0.0f;
   rc->p_last_rad = p_deg * FM_RAD_PER_DEG_F;
   rc->p_lag_rad = 0.0f;
   rc->ref_dev_rad = 0.0f;
@@ -168,12 +179,20 @@ GYRO_RAMFUNC void rate_channel_project(const rate_channel_cfg_t *restrict cfg,
 GYRO_RAMFUNC void rate_channel_filter_rate(const rate_channel_cfg_t *restrict cfg,
                                            rate_channel_t *restrict rc)
 {
-  /* Temperature compensation in P_f (the thesis fits the bias linear in P, 7.3.2),
-   * formed before the filter so that the configuration is not needed after it. */
-  const float p = rc->p_f_deg;
+  /* Temperature compensation in P_c (P_f low-passed again, rate.comp_tau_s; the thesis
+   * fits the bias linear in P, 7.3.2), in its deviation from the calibration's
+   * reference (x = P_c - cal.ref_p_deg); formed before the filter so that the
+   * configuration is
+   * not needed after it. */
+  const float p = rc->p_dev_deg - rc->p_comp_lag_deg + cfg->p_poly_off_deg;
   const float *b3 = cfg->bias_c_dps, *s3 = cfg->sf_c;
-  const float bias = b3[0] + p * (b3[1] + p * (b3[2] + p * b3[3]));
-  const float sf = 1.0f + p * (s3[1] + p * (s3[2] + p * s3[3]));
+  /* The gradient term: in a thermal transient the structure and the pickoff circuit part,
+   * and P (which weighs them otherwise than the bias does) reads a temperature the bias
+   * does not have; their difference follows P's recent change, which P - LP_tau(P)
+   * measures without a derivative's noise (rate.grad_tau_s). */
+  const float bias = b3[0] + p * (b3[1] + p * (b3[2] + p * b3[3])) +
+                     cfg->grad_k_dps_per_deg * rc->p_hp_deg;
+  const float sf = 1.0f + p * (s3[1] + p * (s3[2] + p * (s3[3] + p * s3[4])));
   const float scale = cfg->scale_dps;
   const float unc = scale * biquad_sections_step(cfg->lpf, rc->lpf_rate, cfg->lpf_sections,
                                                  rc->rate_raw);
@@ -205,6 +224,26 @@ GYRO_RAMFUNC void rate_channel_shift_p(rate_channel_t *restrict rc, float shift_
   rc->p_last_rad += shift_deg * FM_RAD_PER_DEG_F; /* the lag does not see the turn */
 }
 
+/* The compensation's filters of P_f, from its step: P_f - P_c (P_c the compensation's
+ * thermometer, P_f low-passed over rate.comp_tau_s) and P_c - LP_tau(P_c) (the gradient
+ * term's input). Each kept as a high-pass x - LP(x) = (1 - a)(its last value + x's
+ * step): the states stay small, so that no float low-pass of minutes has a dead band. */
+GYRO_RAMFUNC static inline void comp_filters_step(const rate_channel_cfg_t *restrict cfg,
+                                                  rate_channel_t *restrict rc, float step)
+{
+  if (rc->p_held_w > RATE_P_HP_W_MAX) {
+    /* P_f's way from a held value to P is no temperature change: the filters start once
+     * that value weighs less than RATE_P_HP_W_MAX in P_f. */
+    rc->p_comp_lag_deg = 0.0f;
+    rc->p_hp_deg = 0.0f;
+    return;
+  }
+  const float d = rc->p_comp_lag_deg + step;
+  const float step_c = cfg->comp_a * d; /* P_c's step */
+  rc->p_comp_lag_deg = d - step_c;
+  rc->p_hp_deg = (1.0f - cfg->grad_a) * (rc->p_hp_deg + step_c);
+}
+
 GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
                                        rate_channel_t *restrict rc, float p_rad)
 {
@@ -214,6 +253,8 @@ GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
     rc->p_n = 0u;
     rc->p_held_dev_deg = rc->p_dev_deg;
     rc->p_held_w = 1.0f;
+    rc->p_hp_deg = 0.0f;
+    rc->p_comp_lag_deg = 0.0f;
   } else {
     rc->p_acc_deg += p_rad * FM_DEG_PER_RAD_F - cfg->p_ref_deg;
     if (++rc->p_count == 1u && rc->p_n < RATE_P_FAST_MAX) {
@@ -223,7 +264,11 @@ GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
       rc->p_a_mean = 1.0f / (float)(rc->p_n + 1u + RATE_P_PRIOR);
     }
     if (rc->p_count == RATE_P_BLOCKS) {
-      const float mean = rc->p_acc_deg * (1.0f / (float)RATE_P_BLOCKS);
+      /* The thermometer is P less the rate's own turn of it (the reciprocal Coriolis force
+       * on the drive mode), from the latest output: 1 % of rate error is 1 % of a turn
+       * of thousandths of a degree. */
+      const float mean = rc->p_acc_deg * (1.0f / (float)RATE_P_BLOCKS) -
+                         cfg->p_rate_deg_per_dps * rc->rate_unc_dps;
       /* Fast start after a hold: the running mean of the means seen since the release
        * (the held value weighing as RATE_P_PRIOR of them) until its weight falls to the
        * low-pass's own, then the low-pass. */
@@ -240,7 +285,11 @@ GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
       /* Both the running mean and the low-pass scale what the held value still weighs
        * by (1 - a): it tells how far P_f may still be from P (rate_valid_thermo). */
       rc->p_held_w *= 1.0f - a;
-      rc->p_dev_deg += a * (mean - rc->p_dev_deg);
+      const float before = rc->p_dev_deg;
+      rc->p_dev_deg += a * (mean - before);
+      /* The step P_f took (exact, Sterbenz), not a * (mean - P_f): within P_f's own dead
+       * band the latter is a constant the compensation's filters would integrate. */
+      comp_filters_step(cfg, rc, rc->p_dev_deg - before);
       rc->p_f_deg = cfg->p_ref_deg + rc->p_dev_deg;
       rc->p_acc_deg = 0.0f;
       rc->p_count = 0u;

@@ -90,12 +90,18 @@ typedef struct {
   float ref_re, ref_im; /* e^{j psi} / A_set */
   float scale_dps;      /* deg/s per unit of Re(R) */
   float bias_c_dps[4];
-  float sf_c[4];
-  float p_ref_deg;   /* P around which its low-pass works (the start value) */
-  float p_lpf_alpha; /* first-order low-pass of P at fs / RATE_P_DECIM */
-  float p_mode_k;    /* per-block factor of the resonance's lag: 1 - exp(-T_block / (2Q/wn)) */
-  float ref_lp_kp;   /* LP2 per block: 2 zeta wn T_block ... */
-  float ref_lp_ki;   /* ... and (wn T_block)^2 */
+  float sf_c[5];            /* [0] unused: SF(x) = 1 + c1 x + .. + c4 x^4 */
+  float p_ref_deg;          /* P around which its low-pass works (the start value) */
+  float p_poly_off_deg;     /* p_ref - cal.ref_p_deg: x = p_dev + this at P_f, the
+                             * compensation polynomials' variable */
+  float p_lpf_alpha;        /* first-order low-pass of P at fs / RATE_P_DECIM */
+  float grad_k_dps_per_deg; /* bias per degree of P_f's high-pass: the thermal gradient */
+  float grad_a;             /* that high-pass's 1 - exp(-T / tau) per new P_f */
+  float p_rate_deg_per_dps; /* P's turn per deg/s of rate, taken out of the thermometer */
+  float comp_a;             /* P_c's low-pass of P_f: 1 - exp(-T / comp_tau) per new P_f */
+  float p_mode_k;  /* per-block factor of the resonance's lag: 1 - exp(-T_block / (2Q/wn)) */
+  float ref_lp_kp; /* LP2 per block: 2 zeta wn T_block ... */
+  float ref_lp_ki; /* ... and (wn T_block)^2 */
   float ref_wide_kp, ref_wide_ki; /* the same at RATE_REF_WIDE_HZ ... */
   uint32_t ref_wide_blocks;       /* ... for this many blocks after a release, */
   float ref_narrow_k;             /* then kp x this per block (ki x its square) */
@@ -111,6 +117,8 @@ typedef struct {
   float p_dev_deg;        /* low-passed P - p_ref */
   float p_held_dev_deg;   /* P_f - p_ref while held: where the fast start began */
   float p_held_w;         /* weight the held value still has in P_f (1 while held) */
+  float p_hp_deg;         /* P_c - LP_tau(P_c): the gradient term's input */
+  float p_comp_lag_deg;   /* P_f - P_c: P_c the compensation's thermometer */
   float p_last_rad;       /* P at the last projection */
   float p_lag_rad;        /* P - LP_tau(P): the resonance's lag still to come */
   float ref_dev_rad;      /* the reference's correction delta = theta - set */
@@ -170,6 +178,16 @@ static inline void rate_channel_accumulate(rate_channel_t *rc, float w_i, float 
 static inline void rate_channel_hold_p(rate_channel_t *rc, int hold)
 {
   rc->p_hold = hold ? 1u : 0u;
+}
+
+/* P_f moved faster than any temperature (THERMO_SLEW: a setpoint change, a fault): the
+ * compensation's own thermometer P_c and the gradient term's high-pass would carry that
+ * move for their time constants (seconds, minutes) after P_f has settled, where no
+ * monitor sees it; they restart from P_f instead. */
+static inline void rate_channel_comp_restart(rate_channel_t *rc)
+{
+  rc->p_comp_lag_deg = 0.0f;
+  rc->p_hp_deg = 0.0f;
 }
 
 /* Once per RATE_DECIM ticks, after the block's last accumulate. (w_i, w_q): the drive

@@ -78,7 +78,8 @@ GYRO_RAMFUNC void rate_valid_thermo(const rate_valid_cfg_t *restrict c,
   /* The reasons after the window's bookkeeping (which leaves slew alone): fewer values
    * live at once, no register to save. */
   uint32_t r = rv->slew;
-  if (!(fm_absf(p_dev_deg) <= c->p_range_deg)) r |= RATE_INVALID_THERMO_RANGE;
+  if (!(fm_absf(p_dev_deg + c->p_range_off_deg) <= c->p_range_deg))
+    r |= RATE_INVALID_THERMO_RANGE;
   /* |P_f - P| <= w / (1 - w) |P_held - P_f|, compared without the divide. */
   const float gap = lag_error_dps(c, p_held_w * fm_absf(p_held_dev_deg - p_dev_deg), quad_dps);
   if (!(gap <= c->tol_dps * (1.0f - p_held_w))) r |= RATE_INVALID_THERMO_SETTLE;

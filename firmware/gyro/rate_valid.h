@@ -83,13 +83,14 @@
 typedef struct {
   float tol_dps; /* the largest rate error each source may leave */
   float full_scale_dps;
-  float p_range_deg;            /* |P_f - p_ref| the compensation holds for */
+  float p_range_deg;            /* |x| the compensation holds for (rate_channel.h) */
   float p_window_max_deg;       /* largest change of P_f over RATE_VALID_SLEW_UPDATES updates */
   float p_lag_per_deg;          /* P_f's lag per degree of change over that window:
                              * its time constant / the window's length */
   float sense_max_v2;           /* (RATE_VALID_SENSE_FRAC x ADC full scale)^2 */
   float phase_tol_rad;          /* the lock tolerance of the drive phase */
-  float bias_slope_dps_per_deg; /* |dB/dP| of the compensation near p_ref */
+  float bias_slope_dps_per_deg; /* |dB/dP| of the compensation over its range */
+  float p_range_off_deg;        /* x = p_dev + this at P_f (rate_channel.h) */
 } rate_valid_cfg_t;
 
 typedef struct {

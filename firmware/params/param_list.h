@@ -40,7 +40,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 6u
+#define PARAM_LAYOUT_VERSION 7u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -123,10 +123,10 @@
     PF_PERSIST | PF_LIVE, "scale factor: deg/s per unit of the sense/drive phasor ratio") \
   /* uncalibrated: 0 (the thesis part's fit was B = 34.59 P + 58.533, 7.3.2) */ \
   X(rate_bias_c0_dps, 0x0305u, "rate.bias_c0_dps", F32, "deg/s", -2000.0f, 2000.0f, 0.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "bias polynomial B(P) = c0 + c1 P + c2 P^2 + c3 P^3, constant term") \
+    PF_PERSIST | PF_LIVE, "bias polynomial B(x) = c0 + c1 x + c2 x^2 + c3 x^3 in x = P_c - cal.ref_p_deg, constant term") \
   /* uncalibrated: 0 */ \
   X(rate_bias_c1_dps_per_deg, 0x0306u, "rate.bias_c1_dps_per_deg", F32, "deg/s/deg", -10000.0f, 10000.0f, 0.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "bias polynomial, linear term in the drive phase P (deg)") \
+    PF_PERSIST | PF_LIVE, "bias polynomial, linear term in x (deg)") \
   /* uncalibrated: 0 */ \
   X(rate_bias_c2_dps_per_deg2, 0x0307u, "rate.bias_c2_dps_per_deg2", F32, "deg/s/deg^2", -10000.0f, 10000.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "bias polynomial, quadratic term") \
@@ -135,13 +135,17 @@
     PF_PERSIST | PF_LIVE, "bias polynomial, cubic term") \
   /* uncalibrated: 0, scale factor independent of temperature */ \
   X(rate_sf_c1_per_deg, 0x0309u, "rate.sf_c1_per_deg", F32, "1/deg", -1.0f, 1.0f, 0.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "scale-factor polynomial SF(P) = 1 + c1 P + c2 P^2 + c3 P^3, linear term") \
+    PF_PERSIST | PF_LIVE, "scale-factor polynomial SF(x) = 1 + c1 x + .. + c4 x^4, linear term") \
   /* uncalibrated: 0 */ \
   X(rate_sf_c2_per_deg2, 0x030Au, "rate.sf_c2_per_deg2", F32, "1/deg^2", -1.0f, 1.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "scale-factor polynomial, quadratic term") \
   /* uncalibrated: 0 */ \
   X(rate_sf_c3_per_deg3, 0x030Bu, "rate.sf_c3_per_deg3", F32, "1/deg^3", -1.0f, 1.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "scale-factor polynomial, cubic term") \
+  /* uncalibrated: 0. The default part's scale factor peaks near room temperature and
+   * falls 0.8 % at -40 and 1.2 % at 85 degC: a cubic in x leaves 390 ppm, a quartic 110 */ \
+  X(rate_sf_c4_per_deg4, 0x0318u, "rate.sf_c4_per_deg4", F32, "1/deg^4", -1.0f, 1.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "scale-factor polynomial, quartic term") \
   /* temperature is slow; 1 Hz keeps the phase loop's noise out of the bias correction */ \
   X(rate_p_lpf_hz, 0x030Cu, "rate.p_lpf_hz", F32, "Hz", 0.01f, 50.0f, 1.0f, 0u, \
     PF_PERSIST | PF_LIVE, "low-pass of P before it is used as the temperature") \
@@ -160,13 +164,33 @@
     PF_PERSIST | PF_LIVE, "largest rate error a monitored source (phase, thermometer, settling) may leave while valid") \
   /* the shipped values carry no temperature compensation: on the default plant the bias
    * moves 34.9 (deg/s)/deg of P (0.0765 deg/K), so they hold within 1 deg/s only for
-   * 0.025 deg of P (+-0.33 K) around P at lock; a temperature calibration widens it to
-   * the range it was fitted over */ \
+   * 0.025 deg of P (+-0.33 K) around the thermometer's reference; a temperature
+   * calibration widens it to the range it was fitted over */ \
   X(rate_p_range_deg, 0x0312u, "rate.p_range_deg", F32, "deg", 0.001f, 180.0f, 0.025f, 0u, \
-    PF_PERSIST | PF_LIVE, "thermometer range: largest |P_f - drive.p_init_deg| the compensation holds for") \
+    PF_PERSIST | PF_LIVE, "thermometer range: largest |P_f - cal.ref_p_deg| the compensation holds for") \
   /* 0.05 deg/s of P: 0.65 K/s on the air part, far above any thermal ramp it was run on */ \
   X(rate_p_slew_max_deg_s, 0x0313u, "rate.p_slew_max_deg_s", F32, "deg/s", 0.001f, 100.0f, 0.05f, 0u, \
     PF_PERSIST | PF_LIVE, "thermometer slew: P_f moving faster than this makes the rate not valid") \
+  /* uncalibrated: 0, no gradient term. The calibration flow fits it on its chamber run's
+   * transitions, where the structure and the pickoff circuit part (tools/calibrate) */ \
+  X(rate_bias_grad_dps_per_deg, 0x0314u, "rate.bias_grad_dps_per_deg", F32, "deg/s/deg", -10000.0f, 10000.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "bias gradient term: deg/s per degree of P_f above its low-pass over rate.grad_tau_s") \
+  /* a minute: of the order of the structure-to-circuit heat exchange (the flow picks the \
+   * part's own) */ \
+  X(rate_grad_tau_s, 0x0315u, "rate.grad_tau_s", F32, "s", 1.0f, 100000.0f, 60.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "time constant of the gradient term's low-pass of P_f") \
+  /* uncalibrated: 0. The reciprocal Coriolis force of the sense motion (the quadrature's,
+   * 1500 deg/s on the default design) on the drive mode turns the drive phase in
+   * proportion to the rate; read as temperature it would move the compensation with the
+   * rate (a scale-factor error of slope x this). The flow measures it on its rate table */ \
+  X(rate_p_rate_deg_per_dps, 0x0316u, "rate.p_rate_deg_per_dps", F32, "deg/(deg/s)", -0.01f, 0.01f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "drive phase P per deg/s of rate, taken out of P before it is the thermometer") \
+  /* 0: the compensation reads P_f itself. The thermometer's own noise (the drive loop's
+   * phase noise) goes into the output at the bias slope; a slower thermometer for the
+   * compensation alone (the monitors keep P_f) takes it out, and its lag is the
+   * calibration's to model: the flow fits the gradient term with it in place */ \
+  X(rate_comp_tau_s, 0x0317u, "rate.comp_tau_s", F32, "s", 0.0f, 1000.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "low-pass time constant of P_f for the compensation's polynomials (0: P_f itself)") \
   /* 50 % over the setpoint: beyond any PI overshoot, short of the stops */ \
   X(sup_amp_trip_rel, 0x0401u, "sup.amp_trip_rel", F32, "-", 1.2f, 5.0f, 1.5f, 0u, \
     PF_PERSIST | PF_LIVE, "over-amplitude trip, as a multiple of drive.amp_set_v") \
@@ -236,6 +260,15 @@
   /* written by the calibration flow, as yyyymmdd; 0: none */ \
   X(cal_date, 0x0803u, "cal.date", U32, "-", 0u, 99991231u, 0u, 0u, \
     PF_PERSIST | PF_LIVE, "date of the calibration, yyyymmdd") \
+  /* The thermometer's reference: the compensation is in the deviation of P from it, so
+   * that it stays what was fitted whatever P's absolute value (a hand-set
+   * drive.p_init_deg moves the loop's start, not the compensation). Written by the
+   * calibration flow (the centre of the P span it fitted over); 0 until then */ \
+  X(cal_ref_p_deg, 0x0804u, "cal.ref_p_deg", F32, "deg", -360.0f, 360.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "thermometer reference: the compensation is in x = P_c - cal.ref_p_deg") \
+  /* Written by the calibration flow; 0, the default setpoint, until then */ \
+  X(cal_ref_phase_set_deg, 0x0805u, "cal.ref_phase_set_deg", F32, "deg", -180.0f, 180.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "drive.phase_set_deg the calibration was made at: at another it is stale") \
   /* start the drive at power-on */ \
   X(sys_autostart, 0x0602u, "sys.autostart", ENUM, "-", 0u, 1u, 1u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
     PF_PERSIST | PF_RESTART, "start acquiring at power-on") \

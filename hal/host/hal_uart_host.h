@@ -7,7 +7,7 @@
 #include <stdint.h>
 
 #define HAL_UART_HOST_RX_SIZE 1024u
-#define HAL_UART_HOST_TX_SIZE 8192u
+#define HAL_UART_HOST_TX_SIZE 16384u
 
 /* Bytes "received on the wire": queued for hal_uart_read. Returns the number accepted
  * (the rest is dropped and counted, as the board's RX interrupt does; after a drop

@@ -85,11 +85,13 @@ static void test_phase_setpoint_walk(void **state)
   judge_run(&j, 2.0);
   judge_print("phase set -179 then 2", &j);
   judge_assert(&j);
-  /* Locked on the new setpoint; P, which moved with it, is now 2 deg from the
-   * thermometer's reference, beyond the range the (uncompensated) shipped values hold
-   * for: not valid. */
+  /* Locked on the new setpoint; P, which moved with it, is 2 deg from the thermometer's
+   * reference, and the demodulation phase was measured at the old one: the calibration
+   * is stale, not valid (with a calibrated range of +-5 deg of P, the set point's 2 deg
+   * were once read as temperature: a valid rate 68 deg/s wrong). */
   assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
   assert_false(rate_valid_now());
+  assert_non_null(strstr(cmd("status\n"), "- calibrated stale\r\n"));
   /* Not a dead end: back on the setpoint the values were taken at, valid again. */
   assert_true(strncmp(cmd("set drive.phase_set_deg 0\n"), "ok", 2) == 0);
   judge_run(&j, 2.0);

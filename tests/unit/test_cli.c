@@ -320,7 +320,7 @@ static void test_list(void **state)
   assert_non_null(strstr(out, "- sys.fs_hz 50000 Hz [50000,50000] def=50000 flags=R "));
   out = run("list rate.bias\n");
   assert_int_equal(check_grammar(out), 1);
-  assert_non_null(strstr(out, "ok 4 parameters\r\n"));
+  assert_non_null(strstr(out, "ok 5 parameters\r\n")); /* c0..c3 and the gradient term */
   expect("list zzz\n", "ok 0 parameters\r\n");
   expect("list a b\n", "err ARGS usage: list [PREFIX]\r\n");
 }

@@ -19,9 +19,11 @@ static rate_channel_cfg_t base_cfg(biquad_coeffs_t *sec, float phi_dm)
                           .ref_im = sinf(phi_dm),
                           .scale_dps = 250.0f,
                           .bias_c_dps = {0, 0, 0, 0},
-                          .sf_c = {0, 0, 0, 0},
+                          .sf_c = {0, 0, 0, 0, 0},
                           .p_ref_deg = 0.0f,
                           .p_lpf_alpha = 0.5f,
+                          .grad_a = 1.0f,         /* no gradient term unless a test sets one */
+                          .comp_a = 1.0f,         /* the compensation reads P_f */
                           .p_mode_k = 2.7658e-2f, /* 1 - (1 - 2.8e-3)^10 per block */
                           /* 1 Hz, zeta 0.707 per 0.2 ms block (gyro_design.c) */
                           .ref_lp_kp = 1.7772e-3f,
@@ -90,7 +92,9 @@ static void test_phase_error_leakage(void **state)
   assert_true(fabs((double)rc.rate_raw - sin(0.01)) < 1e-6);
 }
 
-/* After the Butterworth settles: rate = scale * r * sf(P) - bias(P), with P low-passed. */
+/* After the Butterworth settles: rate = scale * r * sf(x) - bias(x), with x = P_f - the
+ * calibration's reference (cal.ref_p_deg) and P low-passed around another working point
+ * (drive.p_init_deg). */
 static void test_compensation_polynomials(void **state)
 {
   (void)state;
@@ -101,7 +105,10 @@ static void test_compensation_polynomials(void **state)
   c.bias_c_dps[2] = 0.1f;
   c.sf_c[1] = 1e-3f;
   c.sf_c[3] = -2e-6f;
+  c.sf_c[4] = 3e-7f;
   c.p_ref_deg = -1.5f;
+  const double ref_p_deg = -1.0;
+  c.p_poly_off_deg = (float)(c.p_ref_deg - ref_p_deg);
   rate_channel_t rc;
   assert_int_equal(rc_init(&rc, &c), 0);
   rate_channel_reset(s_cfg, &rc, -1.5f);
@@ -111,8 +118,9 @@ static void test_compensation_polynomials(void **state)
   for (int n = 0; n < 25000; n++) {
     block(&rc, 1.0f, 0.0f, (float)r, (float)q, (float)(p_deg * M_PI / 180.0));
   }
-  const double sf = 1.0 + 1e-3 * p_deg - 2e-6 * p_deg * p_deg * p_deg;
-  const double bias = 58.533 + 34.59 * p_deg + 0.1 * p_deg * p_deg;
+  const double x = p_deg - ref_p_deg;
+  const double sf = 1.0 + 1e-3 * x - 2e-6 * x * x * x + 3e-7 * x * x * x * x;
+  const double bias = 58.533 + 34.59 * x + 0.1 * x * x;
   assert_true(fabs((double)rc.p_f_deg - p_deg) < 1e-5);
   assert_true(fabs((double)rc.rate_unc_dps - 250.0 * r) < 250.0 * r * 1e-5);
   assert_true(fabs((double)rc.quad_dps - 250.0 * q) < 250.0 * fabs(q) * 1e-5); /* not compensated */
@@ -136,6 +144,97 @@ static void test_p_lowpass_resolution(void **state)
     block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, (float)(p_deg * M_PI / 180.0));
   }
   assert_true(fabs((double)rc.p_f_deg - p_deg) < 2e-5);
+}
+
+/* The gradient term: on a steady ramp of P at r the high-pass P_f - LP_tau(P_f) settles
+ * to r tau, and the bias it adds to k r tau; when P stops it decays to nothing. A jump
+ * of P across a hold (the restart of a part that cooled meanwhile) is no gradient. */
+static void test_gradient_term(void **state)
+{
+  (void)state;
+  biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
+  rate_channel_cfg_t c = base_cfg(sec, 0.0f);
+  const double tau_s = 2.0, k = 10.0, r_deg_s = 0.01, t_upd_s = RATE_P_DECIM / 50000.0;
+  c.p_lpf_alpha = 1.25e-2f; /* 1 Hz at fs / RATE_P_DECIM */
+  c.grad_k_dps_per_deg = (float)k;
+  c.grad_a = (float)(1.0 - exp(-t_upd_s / tau_s));
+  rate_channel_t rc;
+  assert_int_equal(rc_init(&rc, &c), 0);
+  rate_channel_reset(s_cfg, &rc, 0.0f);
+  const long blocks_per_s = 50000 / RATE_DECIM;
+  double p_deg = 0.0;
+  for (long n = 0; n < 20 * blocks_per_s; n++) { /* 10 tau */
+    p_deg += r_deg_s / (double)blocks_per_s;
+    block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, (float)(p_deg * M_PI / 180.0));
+  }
+  assert_true(fabs((double)rc.p_hp_deg - r_deg_s * tau_s) < 0.01 * r_deg_s * tau_s);
+  assert_true(fabs((double)rc.rate_dps + k * r_deg_s * tau_s) < 0.01 * k * r_deg_s * tau_s);
+  for (long n = 0; n < 20 * blocks_per_s; n++) {
+    block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, (float)(p_deg * M_PI / 180.0));
+  }
+  assert_true(fabs((double)rc.p_hp_deg) < 1e-4 * r_deg_s * tau_s);
+  /* Held, P moves by 0.5 deg, released: the fast start carries P_f there, no gradient. */
+  rate_channel_hold_p(&rc, 1);
+  block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, (float)(p_deg * M_PI / 180.0));
+  rate_channel_hold_p(&rc, 0);
+  p_deg += 0.5;
+  double hp_max = 0.0;
+  for (long n = 0; n < 2 * blocks_per_s; n++) {
+    block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, (float)(p_deg * M_PI / 180.0));
+    hp_max = fmax(hp_max, fabs((double)rc.p_hp_deg));
+  }
+  assert_true(fabs((double)rc.p_f_deg - p_deg) < 1e-3);
+  assert_true(hp_max < 2e-4); /* 0.5 deg x RATE_P_HP_W_MAX, and the lag of P_f */
+}
+
+/* The compensation's own thermometer P_c (rate.comp_tau_s): after a step of P it follows
+ * P_f with its time constant, so the bias polynomial moves 1 - 1/e of the way in one. */
+static void test_compensation_thermometer_lowpass(void **state)
+{
+  (void)state;
+  biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
+  rate_channel_cfg_t c = base_cfg(sec, 0.0f);
+  const double tau_s = 1.0, c1 = 10.0, dp_deg = 0.1;
+  c.p_lpf_alpha = 1.25e-2f;
+  c.bias_c_dps[1] = (float)c1;
+  c.comp_a = (float)(1.0 - exp(-(RATE_P_DECIM / 50000.0) / tau_s));
+  rate_channel_t rc;
+  assert_int_equal(rc_init(&rc, &c), 0);
+  rate_channel_reset(s_cfg, &rc, 0.0f);
+  const long blocks_per_s = 50000 / RATE_DECIM;
+  for (long n = 0; n < 2 * blocks_per_s; n++) block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f);
+  assert_true(fabs((double)rc.rate_dps) < 1e-6);
+  const float p_rad = (float)(dp_deg * M_PI / 180.0);
+  for (long n = 0; n < blocks_per_s; n++) block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, p_rad);
+  /* P_f's own 1 Hz low-pass (0.16 s) delays P_c a little more: 0.55 .. 0.632 of the way */
+  const double frac = -(double)rc.rate_dps / (c1 * dp_deg);
+  assert_true(frac > 0.55 && frac < 0.64);
+  for (long n = 0; n < 12 * blocks_per_s; n++) block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, p_rad);
+  assert_true(fabs((double)rc.rate_dps + c1 * dp_deg) < 1e-4);
+}
+
+/* The rate's own turn of P (the reciprocal Coriolis force on the drive mode) is no
+ * temperature: with rate.p_rate_deg_per_dps set, P_f stays where it was while the rate
+ * steps to 100 deg/s and P turns by 0.002 deg with it; without, it follows P. */
+static void test_rate_taken_out_of_p(void **state)
+{
+  (void)state;
+  biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
+  const double beta = 2e-5, p0_deg = 0.3, r = 0.4; /* 250 x 0.4 = 100 deg/s */
+  for (int with = 0; with < 2; with++) {
+    rate_channel_cfg_t c = base_cfg(sec, 0.0f);
+    c.p_lpf_alpha = 1.25e-2f;
+    c.p_rate_deg_per_dps = with ? (float)beta : 0.0f;
+    rate_channel_t rc;
+    assert_int_equal(rc_init(&rc, &c), 0);
+    rate_channel_reset(s_cfg, &rc, (float)p0_deg);
+    const double p_deg = p0_deg + beta * 250.0 * r;
+    for (int n = 0; n < 25000; n++) { /* 5 s */
+      block(&rc, 1.0f, 0.0f, (float)r, 0.0f, (float)(p_deg * M_PI / 180.0));
+    }
+    const double want = with ? p0_deg : p_deg;
+    assert_true(fabs((double)rc.p_f_deg - want) < 2e-5);
+  }
 }
 
 /* Scale-factor linearity through the decimated output filter: the mean output over a
@@ -319,6 +418,9 @@ int main(void)
       cmocka_unit_test(test_phase_error_leakage),
       cmocka_unit_test(test_compensation_polynomials),
       cmocka_unit_test(test_p_lowpass_resolution),
+      cmocka_unit_test(test_gradient_term),
+      cmocka_unit_test(test_rate_taken_out_of_p),
+      cmocka_unit_test(test_compensation_thermometer_lowpass),
       cmocka_unit_test(test_dc_linearity),
       cmocka_unit_test(test_reference_follows_drive_jitter),
       cmocka_unit_test(test_reference_high_q_loop),

@@ -127,6 +127,22 @@ static void test_thermo_settle_bound(void **state)
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_RANGE);
 }
 
+/* The calibrated range is centred on the thermometer's reference (cal.ref_p_deg), not on
+ * P_f's working point: with the reference 3 deg above it, p_dev from -5 to +11 is in. */
+static void test_thermo_range_about_reference(void **state)
+{
+  (void)state;
+  assert_int_equal(settle(), 0u);
+  s_cfg.p_range_off_deg = -3.0f;
+  const float in_deg[] = {-4.9f, 3.0f, 10.9f}, out_deg[] = {-5.1f, 11.1f, -9.0f};
+  for (int i = 0; i < 3; i++) {
+    rate_valid_thermo(&s_cfg, &rv, in_deg[i], in_deg[i], 0.0f, 1500.0f);
+    assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
+    rate_valid_thermo(&s_cfg, &rv, out_deg[i], out_deg[i], 0.0f, 1500.0f);
+    assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_RANGE);
+  }
+}
+
 /* A slew of P_f is judged over RATE_VALID_SLEW_UPDATES updates, against the cap and the
  * lag it leaves in P_f's low-pass. */
 static void test_thermo_slew(void **state)
@@ -177,6 +193,7 @@ int main(void)
       cmocka_unit_test(test_over_range_and_sense),
       cmocka_unit_test(test_phase_leak),
       cmocka_unit_test(test_thermo_settle_bound),
+      cmocka_unit_test(test_thermo_range_about_reference),
       cmocka_unit_test(test_thermo_slew),
       cmocka_unit_test(test_onsets_counted),
   };
