@@ -10,6 +10,11 @@
   check_calibration.py defaults GYRO_SIM  gyro-scalefactor and gyro-demodcal, run with
                                         their defaults on the shipped rate table's log,
                                         give the default part's calibrated values back
+  check_calibration.py tempcomp GYRO_SIM  the default part's committed compensation out
+                                        of sample: at ambients the thermal calibration
+                                        never used (-25 and 50 degC, the part starting
+                                        there), the rate valid, at rest within 0.2 deg/s,
+                                        and the scale factor (+-100 deg/s) within 500 ppm
   check_calibration.py commands GYRO_SIM  a scenario's "commands" (what the flow's
                                         self-test stage uses) reach the command line at
                                         their times; one due after the run has no reply
@@ -19,6 +24,8 @@ import os
 import subprocess
 import sys
 import tempfile
+
+import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
@@ -121,6 +128,45 @@ def tool_defaults(sim):
     return 1 if bad else 0
 
 
+# tempcomp: the part starts at the ambient (the plant's thermal nodes at rest there); the
+# table rests, turns at +R, -R, +R (as the flow's plateaus). Judged windows (s): rest,
+# +R, -R, +R.
+TC_AMBIENTS_C = (-25.0, 50.0)
+TC_RATE_DPS = 100.0
+TC_STEPS = [[3.0, 0.0], [3.0, TC_RATE_DPS], [3.0, -TC_RATE_DPS], [3.0, TC_RATE_DPS], [0.5, 0.0]]
+TC_WINDOWS = ((1.0, 3.0), (4.0, 6.0), (7.0, 9.0), (10.0, 12.0))
+TC_BIAS_DPS, TC_SF_PPM = 0.2, 500.0
+
+
+def tempcomp_out_of_sample(sim):
+    bad = 0
+    with tempfile.TemporaryDirectory() as d:
+        for amb in TC_AMBIENTS_C:
+            scen = os.path.join(d, "tc.json")
+            with open(scen, "w", encoding="utf-8") as fh:
+                json.dump({"name": "tempcomp_oos", "description": "out-of-sample plateau",
+                           "mode": "closed_loop", "seed": 4242, "analyses": [],
+                           "duration_s": sum(s[0] for s in TC_STEPS), "csv_rate_hz": 200,
+                           "firmware_params": CAL, "ambient_c": {"kind": "const", "value": amb},
+                           "rate_dps": {"kind": "steps", "edge_s": 0.2, "steps": TC_STEPS}}, fh)
+            csv = os.path.join(d, "tc.csv")
+            if not run_sim(sim, scen, ["--csv", csv]):
+                return 1
+            x = np.genfromtxt(csv, delimiter=",", names=True)
+            w = [(x["t_s"] >= a) & (x["t_s"] < b) for a, b in TC_WINDOWS]
+            valid = [float(np.mean(x["rate_valid"][m])) for m in w]
+            bias = float(np.mean(x["rate_dps"][w[0]]))
+            pos = 0.5 * (np.mean(x["rate_dps"][w[1]]) + np.mean(x["rate_dps"][w[3]]))
+            sf_ppm = ((pos - np.mean(x["rate_dps"][w[2]])) / (2 * TC_RATE_DPS) - 1.0) * 1e6
+            ok = min(valid) == 1.0 and abs(bias) <= TC_BIAS_DPS and abs(sf_ppm) <= TC_SF_PPM
+            print(f"{'ok  ' if ok else 'FAIL'} {amb:g} degC (structure "
+                  f"{np.mean(x['t_struct_c'][w[0]]):.2f} degC): bias {bias:+.4f} deg/s, scale "
+                  f"factor {sf_ppm:+.1f} ppm, valid in the windows (%): "
+                  + " ".join(f"{100 * v:.0f}" for v in valid))
+            bad += not ok
+    return 1 if bad else 0
+
+
 def commands(sim):
     scen = os.path.join(ROOT, "tests", "vectors", "scenario_commands.json")
     freq = paramset.read(CAL).values()["drive.freq_hz"]
@@ -140,7 +186,8 @@ def commands(sim):
 
 
 if __name__ == "__main__":
-    modes = {"regen": regen, "usage": usage, "commands": commands, "defaults": tool_defaults}
+    modes = {"regen": regen, "usage": usage, "commands": commands, "defaults": tool_defaults,
+             "tempcomp": tempcomp_out_of_sample}
     if len(sys.argv) != 3 or sys.argv[1] not in modes:
         print(__doc__, file=sys.stderr)
         sys.exit(2)

@@ -9,24 +9,27 @@ firmware's generic defaults:
    thesis's table 7-2): the response's direction and length in the output frame give
    the demodulation phase and the scale factor (gyrotools.demodcal); repeated with the
    corrected values until the response lies on the rate axis with unit gain;
-3. self-test expectations: the on-demand test's response and the continuous test's
+3. thermal calibration (gyrotools.thermcal): chamber plateaus over -40..85 degC with rate
+   steps at each plateau's end; bias and scale-factor cubics in the thermometer's
+   deviation from its reference (cal.ref_p_deg), the gradient term of the transients,
+   the thermometer's range;
+4. self-test expectations: the on-demand test's response and the continuous test's
    amplitude on the calibrated part at rest (scenario "commands": `selftest`, `status`),
    at the drive setpoint (selftest.ref_amp_v);
-4. the calibration record: every value the firmware holds for this part, with
+5. the calibration record: every value the firmware holds for this part, with
    cal.ref_freq_hz (the drive frequency it was made at), cal.part_id and cal.date,
    written as a param set (gyrotools.paramset);
-5. verification on a profile the fit never saw: another noise seed and another rate
-   schedule (+-30..150 deg/s, other dwell), judged on the rate output the firmware marks
-   valid where the input is held: scale factor, bias at rest, never a valid rate off by
-   more than VERIFY_MAX_ERR_DPS; then the on-demand self-test at rest passes.
-
-Not yet in the flow (the firmware keeps its generic values for them): thermal
-calibration (bias and scale-factor polynomials over temperature; the rate is valid only
-within rate.p_range_deg of the calibration temperature).
+6. verification on profiles the fit never saw, each with its own noise seed, run side by
+   side: another rate schedule (+-30..150 deg/s, other dwell), judged on the rate output
+   the firmware marks valid where the input is held: scale factor, bias at rest, never a
+   valid rate off by more than VERIFY_MAX_ERR_DPS, then the on-demand self-test at rest
+   passes; other chamber plateaus, a heating ramp and the noise with the compensation
+   (thermcal: limits in thermcal.LIMITS).
 """
 
 from __future__ import annotations
 
+import concurrent.futures
 import dataclasses
 import datetime
 import json
@@ -36,7 +39,7 @@ import zlib
 
 import numpy as np
 
-from . import csvlog, demodcal, paramset, scalefactor
+from . import csvlog, demodcal, paramset, scalefactor, thermcal
 from .errors import InputError
 
 # Rate-table iterations: the demodulation is linear in the phasors, so one pass is exact
@@ -57,7 +60,11 @@ VERIFY_VALID_FRAC = 0.9
 # verification +1000; none is a seed a shipped scenario uses, so that no figure a
 # scenario reports is measured on the noise a calibration was fitted to.
 RATE_TABLE_SEED_OFFSET = 100
+THERMAL_SEED_OFFSET = 200
+# --quick: three structure time constants of the default part per plateau.
+QUICK_DWELL_S = 1200.0
 VERIFY_SEED_OFFSET = 1000
+# The thermal verification's runs: plateaus, ramp, noise at +1001, +1002, +1003.
 # The self-test's response below this is no working self-test (the design's electrodes
 # give about 5.5 deg/s at selftest.amp_v 0.1 V; dead ones, their feedthrough, 0.05).
 SELFTEST_MIN_DPS = 1.0
@@ -78,6 +85,7 @@ class SimPart:
     sets: list      # ["plant.KEY=V", ...]
     seed: int
     work: str       # folder for the stages' files
+    thermal_dwell_s: float = thermcal.CAL_DWELL_S  # per chamber plateau (--quick: shorter)
 
 
 def _run(part, args, what):
@@ -118,7 +126,11 @@ def selfcal(part):
                  "true_f0_hz": f.get("selfcal_true_f0_hz"), "true_q": f.get("selfcal_true_q")}
 
 
-def _sim(part, params, scenario, seed, name, csv=False):
+LOG_COLUMNS = ["rate_dps", "quad_dps", "rate_true_dps", "rate_valid"]
+THERMAL_COLUMNS = LOG_COLUMNS + ["rate_unc_dps", "p_f_deg", "t_struct_c"]
+
+
+def _sim(part, params, scenario, seed, name, csv=False, columns=None):
     """One gyro-sim run from the param set `params`: (its CSV log or None, the replies to
     the scenario's "commands", the command line)."""
     js = os.path.join(part.work, name + ".json")
@@ -126,8 +138,7 @@ def _sim(part, params, scenario, seed, name, csv=False):
             "--no-analysis", "--quiet", "--json", js]
     log_path = os.path.join(part.work, name + ".csv")
     cmd = _run(part, args + (["--csv", log_path] if csv else []), name)
-    log = csvlog.read_log(log_path, need=["rate_dps", "quad_dps", "rate_true_dps", "rate_valid"],
-                          purpose=name) if csv else None
+    log = csvlog.read_log(log_path, need=columns or LOG_COLUMNS, purpose=name) if csv else None
     with open(js, encoding="utf-8") as fh:
         replies = [c["reply"] for c in json.load(fh).get("commands", [])]
     return log, replies, " ".join(cmd)
@@ -143,7 +154,7 @@ def rate_table(part, params_path):
         cur = os.path.join(part.work, f"rate_table_{k}_params.json")
         paramset.write(cur, paramset.from_values(values, meta={"stage": f"rate table pass {k}"}))
         log, _, cmd = _sim(part, cur, scen, part.seed + RATE_TABLE_SEED_OFFSET + k,
-                           f"rate_table_{k}", csv=True)
+                           f"rate_table_{k}", csv=True, columns=LOG_COLUMNS + ["p_f_deg"])
         res = demodcal.analyse(log["t_s"], log["rate_dps"], log["quad_dps"],
                                values["rate.demod_phase_deg"], values["rate.scale_dps"],
                                rate_true_dps=log["rate_true_dps"], settle_s=SETTLE_S,
@@ -157,9 +168,48 @@ def rate_table(part, params_path):
                        "quad_dps": res.quad_dps, "segments": res.n_segments})
         values["rate.demod_phase_deg"] = res.phase_deg
         values["rate.scale_dps"] = res.scale_dps
+        # The thermometer's reading of the rate (rate.p_rate_deg_per_dps), on top of what
+        # the firmware already took out: P's slope against the table's rate.
+        beta = p_rate_slope(log)
+        values["rate.p_rate_deg_per_dps"] += beta
+        passes[-1]["p_rate_deg_per_dps"] = beta
         if abs(res.alpha_deg) <= ALPHA_TOL_DEG and abs(res.gain - 1.0) <= GAIN_TOL:
             break
     return values, passes
+
+
+def thermal(part, values):
+    """Stage 3: the temperature compensation from a chamber run (gyrotools.thermcal)."""
+    path = os.path.join(part.work, "thermal_params.json")
+    values = dict(values, **{"rate.comp_tau_s": thermcal.COMP_TAU_S})
+    paramset.write(path, paramset.from_values(values, meta={"stage": "thermal"}))
+    temps = thermcal.CAL_PLATEAUS_C
+    scen = _scenario(part, "calibrate_thermal", thermcal.plateau_scenario(
+        temps, part.thermal_dwell_s,
+        {"description": "thermal calibration: chamber plateaus with rate steps at their ends"}))
+    log, _, cmd = _sim(part, path, scen, part.seed + THERMAL_SEED_OFFSET, "thermal", csv=True,
+                       columns=THERMAL_COLUMNS)
+    comp, s0, figs = thermcal.fit(log, len(temps), part.thermal_dwell_s)
+    if not (np.isfinite(s0) and s0 > 0.0) or not all(np.isfinite(v) for v in comp.values()):
+        raise FlowError(f"thermal calibration: implausible fit (scale {s0:.6g}) ({cmd})")
+    v = dict(values)
+    v.update(comp)
+    v["rate.scale_dps"] = values["rate.scale_dps"] * s0
+    figs["command"] = cmd
+    figs["seed"] = part.seed + THERMAL_SEED_OFFSET
+    return v, figs
+
+
+def p_rate_slope(log):
+    """Slope of the mean P_f against the table's rate over its held windows (deg per
+    deg/s): the drive phase the rate itself turns (the reciprocal Coriolis force)."""
+    win = scalefactor.windows_from_truth(log["t_s"], log["rate_true_dps"], SETTLE_S, MIN_AVG_S)
+    segs = scalefactor.segment_means(log["t_s"], log["rate_dps"], win, p_deg=log["p_f_deg"])
+    r = np.array([s.rate_in_dps for s in segs])
+    p = np.array([s.mean_p_deg for s in segs])
+    if r.size < 3 or np.ptp(r) <= 0.0:
+        raise FlowError("rate table: too few held rates to measure P against the rate")
+    return float(np.polyfit(r, p, 1)[0])
 
 
 def _status_value(reply, key):
@@ -206,6 +256,7 @@ def record(values, sets, date=None):
     """Stage 3: the calibration record on top of the identified values."""
     v = dict(values)
     v["cal.ref_freq_hz"] = v["drive.freq_hz"]
+    v["cal.ref_phase_set_deg"] = v["drive.phase_set_deg"]
     v["cal.part_id"] = part_id(sets)
     d = date or datetime.date.today()
     v["cal.date"] = d.year * 10000 + d.month * 100 + d.day
@@ -261,6 +312,52 @@ def verify(part, cal_path):
                        "valid_fraction": VERIFY_VALID_FRAC,
                        "worst_valid_error_dps": VERIFY_MAX_ERR_DPS},
             "checks": checks, "passed": all(checks.values())}
+
+
+def _thermal_runs(part, cal_path):
+    """The thermal verification's runs, as (name, function of nothing -> figures)."""
+    seed = part.seed + VERIFY_SEED_OFFSET
+    temps = thermcal.VERIFY_PLATEAUS_C
+    doc = {"description": "verification of a thermal calibration: plateaus it never saw"}
+
+    def plateaus():
+        scen = _scenario(part, "calibrate_verify_plateaus",
+                         thermcal.plateau_scenario(temps, part.thermal_dwell_s, doc))
+        log, _, cmd = _sim(part, cal_path, scen, seed + 1, "verify_plateaus", csv=True,
+                           columns=THERMAL_COLUMNS)
+        rows = thermcal.verify_plateaus(log, temps, part.thermal_dwell_s)
+        return {"command": cmd, "seed": seed + 1, "plateaus": rows,
+                "ok": all(r["ok"] for r in rows)}
+
+    def ramp():
+        scen = _scenario(part, "calibrate_verify_ramp", thermcal.ramp_scenario(
+            {"description": "verification of a thermal calibration: a heating ramp"}))
+        log, _, cmd = _sim(part, cal_path, scen, seed + 2, "verify_ramp", csv=True,
+                           columns=THERMAL_COLUMNS)
+        return dict(thermcal.verify_ramp(log), command=cmd, seed=seed + 2)
+
+    def noise():
+        scen = _scenario(part, "calibrate_verify_noise", thermcal.noise_scenario(
+            {"description": "output noise with and without the temperature compensation"}))
+        log, _, cmd = _sim(part, cal_path, scen, seed + 3, "verify_noise", csv=True,
+                           columns=THERMAL_COLUMNS)
+        return dict(thermcal.verify_noise(log), command=cmd, seed=seed + 3)
+
+    return [("thermal_plateaus", plateaus), ("thermal_ramp", ramp), ("noise", noise)]
+
+
+def verify_all(part, cal_path, workers=None):
+    """Every verification run side by side (one gyro-sim process each): a dict of their
+    figures, each with "ok" or "passed"."""
+    jobs = [("rate", lambda: verify(part, cal_path))] + _thermal_runs(part, cal_path)
+    n = workers or os.cpu_count() or 1
+    with concurrent.futures.ThreadPoolExecutor(max_workers=n) as pool:
+        futs = {name: pool.submit(fn) for name, fn in jobs}
+        return {name: f.result() for name, f in futs.items()}
+
+
+def verify_passed(res):
+    return all(v.get("passed", v.get("ok", False)) for v in res.values())
 
 
 def check_sets(sets):

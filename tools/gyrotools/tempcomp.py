@@ -83,6 +83,22 @@ def poly_eval(c, x):
     return Polynomial(c)(np.asarray(x, dtype=float))
 
 
+def firmware_bias(fit):
+    """The firmware's values for a bias fit in absolute P: the polynomial in the deviation
+    x = P - ref from the middle of the fitted span (cal.ref_p_deg, rate_channel.c), the
+    thermometer range half that span (rate.p_range_deg: the rate is valid only where the
+    fit had data), and no gradient term (a fit of its own, tools/calibrate)."""
+    lo, hi = fit.x_range
+    ref = 0.5 * (lo + hi)
+    c = padded(Polynomial(fit.coeffs)(Polynomial([ref, 1.0])).coef)
+    names = ("rate.bias_c0_dps", "rate.bias_c1_dps_per_deg", "rate.bias_c2_dps_per_deg2",
+             "rate.bias_c3_dps_per_deg3")
+    v = dict(zip(names, (float(x) for x in c)))
+    v.update({"cal.ref_p_deg": float(ref), "rate.p_range_deg": float(max(0.5 * (hi - lo), 1e-3)),
+              "rate.bias_grad_dps_per_deg": 0.0})
+    return v
+
+
 def blocks(n, k):
     """k contiguous index blocks covering 0..n-1."""
     edges = np.linspace(0, n, k + 1).round().astype(int)

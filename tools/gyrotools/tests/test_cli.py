@@ -142,9 +142,12 @@ def test_gyro_tempcomp_and_write(run_script, logs, tmp_path, monkeypatch):
     assert j["t_fit"]["residual_std_dps"] > 5 * j["p_fit"]["residual_std_dps"]
     for k in ("cv_rmse_dps_by_order", "residual_std_dps", "residual_p2p_dps"):
         assert k in j["p_fit"]
+    # In the deviation from the middle of the log's P span, with the range it covers
+    # and no gradient term (tempcomp.firmware_bias).
     assert set(j["firmware_bias_params"]) == {"rate.bias_c0_dps", "rate.bias_c1_dps_per_deg",
                                               "rate.bias_c2_dps_per_deg2",
-                                              "rate.bias_c3_dps_per_deg3"}
+                                              "rate.bias_c3_dps_per_deg3", "cal.ref_p_deg",
+                                              "rate.p_range_deg", "rate.bias_grad_dps_per_deg"}
     (sent,) = [json.loads(x) for x in calls.read_text().splitlines()]
     assert sent[:3] == ["--port", "/dev/ttyACM0", "load-params"] and sent[4:] == ["--merge"]
     written = paramset.read(str(calls) + ".set").values()

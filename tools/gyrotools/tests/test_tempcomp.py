@@ -135,3 +135,20 @@ def test_a_slow_ramp_is_not_taken_for_noise():
     b = 30.0 * (p - 25.0) + 0.01 * rng.standard_normal(600)
     fit = tempcomp.fit_bias(p, b, "P")
     assert fit is not None
+
+
+def test_firmware_values_are_in_deviation_from_the_span_middle():
+    # A fit in absolute P near 26 deg: the firmware's polynomial in x = P - ref gives the
+    # same bias, ref is the middle of the span, the range half of it, no gradient term.
+    p = np.linspace(24.0, 28.0, 400)
+    y = 58.533 + 34.59 * p - 0.2 * p ** 2 + 0.003 * p ** 3
+    fit = tempcomp.fit_bias(p, y + 1e-6 * np.sin(p * 37.0), "p_deg", max_order=3)
+    v = tempcomp.firmware_bias(fit)
+    assert v["cal.ref_p_deg"] == pytest.approx(26.0, abs=1e-9)
+    assert v["rate.p_range_deg"] == pytest.approx(2.0, abs=1e-9)
+    assert v["rate.bias_grad_dps_per_deg"] == 0.0
+    c = [v["rate.bias_c0_dps"], v["rate.bias_c1_dps_per_deg"], v["rate.bias_c2_dps_per_deg2"],
+         v["rate.bias_c3_dps_per_deg3"]]
+    x = p - 26.0
+    got = c[0] + c[1] * x + c[2] * x ** 2 + c[3] * x ** 3
+    assert np.max(np.abs(got - tempcomp.poly_eval(fit.coeffs, p))) < 1e-9

@@ -1,0 +1,264 @@
+"""Thermal calibration and its verification (stages of tools/calibrate, gyrotools/calflow).
+
+The thermometer is the drive phase P (thesis 7.3: "sensorless"); the firmware compensates
+
+    rate = u SF(x) - B(x) - k_g h,    x = P_c - cal.ref_p_deg,  h = P_c - LP_tau(P_c)
+
+(u the uncompensated output, P_c the thermometer P_f low-passed over rate.comp_tau_s,
+rate_channel.c). B is a cubic in x, SF a quartic; the gradient term
+k_g h stands for the structure-to-circuit temperature difference of a transient: P and the
+bias weigh the two nodes differently, so during a ramp the bias is off the plateaus' B(x)
+by an amount that follows P's recent change, which h measures (rate.grad_tau_s).
+
+Calibration run (one gyro-sim run, the part at rest but for short rate steps): chamber
+plateaus over -40..85 degC (CAL_PLATEAUS_C, CAL_DWELL_S each, the chamber's 60 s edges);
+near each plateau's end the rate steps +R, -R, +R (SF at that temperature), after a rest
+window (the bias there). P is the thermometer less the rate's own turn of it
+(rate.p_rate_deg_per_dps, measured on the rate table before). From the log:
+- SF(x): 2R / (u(+R) - u(-R)) per plateau against the plateau's mean x, cubic, its
+  constant folded into rate.scale_dps so that SF(0) = 1;
+- B(x) and k_g (with tau from TAU_GRID_S, the smallest residual): least squares over the
+  1 s means of the whole run at rest, plateaus and transitions alike, on y = u SF(x);
+- cal.ref_p_deg: the middle of the plateaus' P span; rate.p_range_deg: half that span
+  plus P_RANGE_MARGIN (the rate is valid only where the fit had data).
+
+Verification on profiles the fit never saw, each with its own noise seed: other plateaus
+(VERIFY_PLATEAUS_C, with rate steps: bias and SF there), a heating ramp 25 -> 65 degC at
+2 K/min (the 1 s means of the bias), and the output noise at constant temperature with
+the compensation against without it (Allan deviation at 1 s of rate_dps and rate_unc_dps
+of the same run).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.signal import lfilter
+
+from . import allan, tempcomp
+
+CAL_PLATEAUS_C = (25.0, -40.0, -10.0, 10.0, 40.0, 60.0, 85.0)
+VERIFY_PLATEAUS_C = (-25.0, 0.0, 20.0, 50.0, 70.0)
+# 2400 s: six structure time constants of the default part (400 s), its 65 K steps
+# settle to 0.2 % (the fit does not need them settled: the gradient term takes the rest).
+CAL_DWELL_S = 2400.0
+CHAMBER_EDGE_S = 60.0
+# The rate steps at a plateau's end: at rest (its last REST_AVG_S judged), then +R, -R, +R
+# for STEP_S each (their last STEP_AVG_S judged; the two +R around the -R take out a
+# drift of the bias that is still settling), then rest again.
+STEP_RATE_DPS = 100.0
+STEP_S = 60.0
+STEP_AVG_S = 45.0
+REST_AVG_S = 300.0
+TAIL_S = 20.0
+TABLE_EDGE_S = 0.5
+# The gradient term's time constants tried; the part's own is the one that fits best.
+TAU_GRID_S = (10.0, 15.0, 20.0, 30.0, 40.0, 60.0, 90.0, 120.0, 180.0, 300.0, 600.0)
+P_RANGE_MARGIN = 0.05  # of the span, each side
+# The scale factor against x: a quartic (rate.sf_c4_per_deg4); the default part's peaks
+# near room temperature, and a cubic through the seven plateaus leaves 390 ppm.
+SF_ORDER = 4
+# The compensation's thermometer P_c: P_f low-passed over 5 s (rate.comp_tau_s). At 1 s
+# the phase thermometer's noise at the bias slope (35 (deg/s)/deg on the default part)
+# nearly doubled the output's Allan deviation through P_f (1 Hz); the run is made with
+# it in place, so the gradient term's fit takes its lag in a ramp.
+COMP_TAU_S = 5.0
+START_S = 30.0         # the start-up (lock, P's fast start) is left out of every fit
+BIN_S = 1.0
+# The ramp of the verification (issue: 25 -> 65 degC at 2 K/min), then the part settles.
+RAMP_FROM_C, RAMP_TO_C, RAMP_K_PER_MIN = 25.0, 65.0, 2.0
+RAMP_LEAD_S, RAMP_TAIL_S = 120.0, 600.0
+NOISE_S = 300.0
+# The firmware's P update period (RATE_P_DECIM / fs, rate_channel.h).
+P_UPDATE_S = 100.0 / 50000.0
+LIMITS = {"ramp_bias_std_dps": 0.2, "plateau_bias_dps": 0.2, "sf_ppm": 500.0,
+          "noise_ratio": 1.1, "valid_fraction": 0.9}
+
+
+def _plateau_profiles(temps_c, dwell_s):
+    """(ambient steps, rate steps, duration): the rate steps at each plateau's end."""
+    amb = [[dwell_s, t] for t in temps_c]
+    rate = []
+    lead = dwell_s - TAIL_S - 3 * STEP_S
+    for _ in temps_c:
+        rate += [[lead, 0.0], [STEP_S, STEP_RATE_DPS], [STEP_S, -STEP_RATE_DPS],
+                 [STEP_S, STEP_RATE_DPS], [TAIL_S, 0.0]]
+    return amb, rate, dwell_s * len(temps_c)
+
+
+def plateau_scenario(temps_c, dwell_s, doc):
+    amb, rate, dur = _plateau_profiles(temps_c, dwell_s)
+    return dict(doc, duration_s=dur, csv_rate_hz=10,
+                ambient_c={"kind": "steps", "edge_s": CHAMBER_EDGE_S, "steps": amb},
+                rate_dps={"kind": "steps", "edge_s": TABLE_EDGE_S, "steps": rate})
+
+
+def ramp_scenario(doc):
+    dur_ramp = (RAMP_TO_C - RAMP_FROM_C) / RAMP_K_PER_MIN * 60.0
+    return dict(doc, duration_s=RAMP_LEAD_S + dur_ramp + RAMP_TAIL_S, csv_rate_hz=10,
+                ambient_c={"kind": "ramp", "value": RAMP_FROM_C,
+                           "slope_per_s": RAMP_K_PER_MIN / 60.0, "t_start_s": RAMP_LEAD_S,
+                           "t_end_s": RAMP_LEAD_S + dur_ramp})
+
+
+def noise_scenario(doc):
+    return dict(doc, duration_s=NOISE_S + START_S, csv_rate_hz=100)
+
+
+def _window(t, t0, t1):
+    return (t >= t0) & (t < t1)
+
+
+def plateau_windows(t, k, dwell_s):
+    """Index masks of plateau k: (rest, first +R, -R, second +R), at their steps' ends."""
+    end = (k + 1) * dwell_s
+    t_pos2_end = end - TAIL_S
+    t_neg_end = t_pos2_end - STEP_S
+    t_pos_end = t_neg_end - STEP_S
+    t_rest_end = t_pos_end - STEP_S - TABLE_EDGE_S
+    return (_window(t, t_rest_end - REST_AVG_S, t_rest_end),
+            _window(t, t_pos_end - STEP_AVG_S, t_pos_end),
+            _window(t, t_neg_end - STEP_AVG_S, t_neg_end),
+            _window(t, t_pos2_end - STEP_AVG_S, t_pos2_end))
+
+
+def plateau_points(log, n, dwell_s, out="rate_unc_dps"):
+    """Per plateau: mean P_f, output at rest, gain (u(+R) - u(-R)) / 2R, valid fraction."""
+    t = log["t_s"]
+    rows = []
+    for k in range(n):
+        rest, pos, neg, pos2 = plateau_windows(t, k, dwell_s)
+        u = log[out]
+        u_pos = 0.5 * (np.mean(u[pos]) + np.mean(u[pos2]))
+        rows.append({"p_deg": float(np.mean(log["p_f_deg"][rest])),
+                     "t_struct_c": float(np.mean(log["t_struct_c"][rest])),
+                     "bias_dps": float(np.mean(u[rest])),
+                     "gain": float((u_pos - np.mean(u[neg])) / (2 * STEP_RATE_DPS)),
+                     "valid": float(np.mean(log["rate_valid"][rest | pos | neg | pos2]))})
+    return rows
+
+
+def gradient_hp(t_s, p_deg, tau_s, t0_s=START_S):
+    """P_f - LP_tau(P_f) as the firmware forms it (rate_channel_update_p), on a log's P_f:
+    per firmware update the high-pass keeps 1 - a of (its value + P_f's step); the log's
+    rows are coarser (evenly spaced), a row's keep the product of its updates',
+    exp(-dt / tau). Zero before t0_s, as the firmware's is until P_f has settled."""
+    t = np.asarray(t_s, dtype=float)
+    step = np.diff(np.asarray(p_deg, dtype=float), prepend=float(p_deg[0]))
+    step[t < t0_s] = 0.0
+    keep = float(np.exp(-float(np.median(np.diff(t))) / tau_s))
+    return lfilter([keep], [1.0, -keep], step)
+
+
+def comp_thermometer(t_s, p_deg, tau_s=COMP_TAU_S):
+    """P_c, the compensation's thermometer: P_f low-passed over tau_s as the firmware does
+    (rate.comp_tau_s; 0: P_f itself), from the log's first row."""
+    p = np.asarray(p_deg, dtype=float)
+    if tau_s <= 0.0:
+        return p
+    keep = float(np.exp(-float(np.median(np.diff(t_s))) / tau_s))
+    return p[0] + lfilter([1.0 - keep], [1.0, -keep], p - p[0])
+
+
+def _lstsq(cols, y):
+    a = np.column_stack(cols)
+    c, *_ = np.linalg.lstsq(a, y, rcond=None)
+    return c, y - a @ c
+
+
+def fit(log, n_plateaus, dwell_s):
+    """The compensation from the calibration run: a dict of firmware values and figures."""
+    pts = plateau_points(log, n_plateaus, dwell_s)
+    p = np.array([r["p_deg"] for r in pts])
+    ref = 0.5 * (p.min() + p.max())
+    half = 0.5 * (p.max() - p.min())
+    x_pl = p - ref
+    inv_gain = 1.0 / np.array([r["gain"] for r in pts])
+    s = tempcomp.poly_fit(x_pl, inv_gain, min(SF_ORDER, n_plateaus - 2))
+    s0 = s[0]
+    sf_c = tempcomp.padded(s / s0, SF_ORDER + 1)
+    t = log["t_s"]
+    rest = (np.abs(log["rate_true_dps"]) < 1e-9) & (t >= START_S)
+    p_c = comp_thermometer(t, log["p_f_deg"])
+    best = None
+    for tau in TAU_GRID_S:
+        h = gradient_hp(t, p_c, tau)
+        x = p_c - ref
+        y = log["rate_unc_dps"] * tempcomp.poly_eval(s, x)
+        b = tempcomp.bin_average(t[rest], {"x": x[rest], "y": y[rest], "h": h[rest]}, BIN_S)
+        c, r = _lstsq([np.ones_like(b["x"]), b["x"], b["x"] ** 2, b["x"] ** 3, b["h"]], b["y"])
+        rms = float(np.sqrt(np.mean(r ** 2)))
+        if best is None or rms < best["rms"]:
+            best = {"tau": tau, "c": c, "rms": rms}
+    c = best["c"]
+    # The bias in the units of the rescaled output (u s0 -> the SF(x)/s0 of the firmware):
+    # rate = u s0 (SF/s0) - B - k h, the same B and k.
+    bias_pl = np.array([r["bias_dps"] for r in pts]) * tempcomp.poly_eval(s, x_pl)
+    resid_pl = bias_pl - tempcomp.poly_eval(c[:4], x_pl)
+    values = {"cal.ref_p_deg": float(ref), "rate.p_range_deg": float(half * (1 + 2 * P_RANGE_MARGIN)),
+              "rate.bias_c0_dps": float(c[0]), "rate.bias_c1_dps_per_deg": float(c[1]),
+              "rate.bias_c2_dps_per_deg2": float(c[2]), "rate.bias_c3_dps_per_deg3": float(c[3]),
+              "rate.sf_c1_per_deg": float(sf_c[1]), "rate.sf_c2_per_deg2": float(sf_c[2]),
+              "rate.sf_c3_per_deg3": float(sf_c[3]), "rate.sf_c4_per_deg4": float(sf_c[4]),
+              "rate.bias_grad_dps_per_deg": float(c[4]), "rate.grad_tau_s": float(best["tau"])}
+    figures = {"plateaus_c": list(CAL_PLATEAUS_C[:n_plateaus]), "dwell_s": dwell_s,
+               "p_deg": p.tolist(), "p_span_deg": float(2 * half),
+               "raw_bias_dps": [r["bias_dps"] for r in pts],
+               "raw_gain": [r["gain"] for r in pts], "scale_factor_s0": float(s0),
+               "plateau_residual_dps": resid_pl.tolist(),
+               "fit_rms_1s_dps": best["rms"], "grad_tau_s": best["tau"]}
+    return values, s0, figures
+
+
+def bias_means(log, t0, t1, out="rate_dps"):
+    """1 s means of the output at rest between t0 and t1, valid samples only."""
+    t = log["t_s"]
+    m = _window(t, t0, t1) & (np.abs(log["rate_true_dps"]) < 1e-9) & (log["rate_valid"] > 0.5)
+    valid = float(np.mean(log["rate_valid"][_window(t, t0, t1)] > 0.5))
+    if not np.any(m):
+        return np.zeros(0), valid
+    return tempcomp.bin_average(t[m], {"y": log[out][m]}, BIN_S)["y"], valid
+
+
+def verify_plateaus(log, temps_c, dwell_s):
+    pts = plateau_points(log, len(temps_c), dwell_s, out="rate_dps")
+    rows = []
+    for tc, r in zip(temps_c, pts):
+        sf_ppm = (r["gain"] - 1.0) * 1e6
+        rows.append({"ambient_c": tc, "t_struct_c": r["t_struct_c"], "p_deg": r["p_deg"],
+                     "bias_dps": r["bias_dps"], "sf_ppm": sf_ppm, "valid": r["valid"],
+                     "ok": bool(abs(r["bias_dps"]) <= LIMITS["plateau_bias_dps"] and
+                                abs(sf_ppm) <= LIMITS["sf_ppm"] and
+                                r["valid"] >= LIMITS["valid_fraction"])})
+    return rows
+
+
+def verify_ramp(log):
+    t_end = log["t_s"][-1]
+    means, valid = bias_means(log, RAMP_LEAD_S, t_end)
+    std = float(np.std(means)) if means.size else float("nan")
+    return {"from_c": RAMP_FROM_C, "to_c": RAMP_TO_C, "k_per_min": RAMP_K_PER_MIN,
+            "bias_1s_std_dps": std,
+            "bias_1s_max_abs_dps": float(np.max(np.abs(means))) if means.size else float("nan"),
+            "valid_fraction": valid,
+            "ok": bool(np.isfinite(std) and std <= LIMITS["ramp_bias_std_dps"] and
+                       valid >= LIMITS["valid_fraction"])}
+
+
+def verify_noise(log):
+    t = log["t_s"]
+    m = t >= START_S
+    fs = 1.0 / float(np.median(np.diff(t)))
+    comp = allan.adev_curve(log["rate_dps"][m], fs)
+    unc = allan.adev_curve(log["rate_unc_dps"][m], fs)
+    def at(curve, tau):
+        return float(np.interp(tau, curve.tau_s, curve.adev_dph))
+
+    a_c, a_u = at(comp, 1.0), at(unc, 1.0)
+    # Judged at 1 s (the thermometer's white noise); at 10 s reported: there the
+    # thermometer's own slow wander (not the bias's) comes through the compensation.
+    return {"adev_1s_compensated_dph": a_c, "adev_1s_uncompensated_dph": a_u,
+            "ratio": a_c / a_u, "ok": bool(a_c / a_u <= LIMITS["noise_ratio"]),
+            "adev_10s_compensated_dph": at(comp, 10.0), "adev_10s_uncompensated_dph": at(unc, 10.0),
+            "ratio_10s": at(comp, 10.0) / at(unc, 10.0),
+            "how": "Allan deviation at 1 s (judged) and 10 s (reported) of rate_dps and "
+                   f"rate_unc_dps of the same {NOISE_S:g} s run at 25 degC, csv at {fs:g} Hz"}
