@@ -193,7 +193,9 @@ GYRO_RAMFUNC void gyro_block_p(gyro_t *g, int hold)
                       rc->quad_dps);
   } else if (g->valid.slew_due != 0u) {
     rate_valid_slew(&d->valid, &g->valid, rc->quad_dps);
-    if (g->valid.slew != 0u) rate_channel_comp_restart(rc);
+    /* Beyond the cap only: P_f's noise trips the lag test now and then in a ramp, and a
+     * restart there drops the gradient term (1 deg/s at 2 K/min) for its time constant */
+    if (g->valid.slew_cap != 0u) rate_channel_comp_restart(rc);
   }
   /* Last, as a tail call: its new P_f is flagged in rc->p_new. */
   (void)rate_channel_update_p(&d->rate, rc, g->drive.p_eq_rad);

@@ -28,7 +28,7 @@ int rate_valid_init(const rate_valid_cfg_t *cfg, rate_valid_t *rv)
   rv->x_rate = rv->x_quad = 0.0f;
   rv->p_dev_window_deg = 0.0f;
   rv->p_updates = 0u;
-  rv->slew = rv->slew_due = 0u;
+  rv->slew = rv->slew_due = rv->slew_cap = 0u;
   rv->p_window_change_deg = 0.0f;
   rv->phase_err_lp_rad = 0.0f;
   rv->blocks = 0u;
@@ -90,8 +90,10 @@ GYRO_RAMFUNC void rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid
                                   float quad_dps)
 {
   const float change = rv->p_window_change_deg;
-  const int slewing = !(change <= c->p_window_max_deg) ||
+  const int over_cap = !(change <= c->p_window_max_deg);
+  const int slewing = over_cap ||
                       !(lag_error_dps(c, change * c->p_lag_per_deg, quad_dps) <= c->tol_dps);
+  rv->slew_cap = (uint32_t)over_cap;
   rv->slew = slewing ? RATE_INVALID_THERMO_SLEW : 0u;
   rv->thermo = (rv->thermo & ~RATE_INVALID_THERMO_SLEW) | rv->slew;
   rv->slew_due = 0u;

@@ -105,6 +105,7 @@ typedef struct {
   float p_dev_window_deg;    /* P_f - p_ref at the start of the slew window */
   uint32_t p_updates;        /* P_f updates into the slew window */
   uint32_t slew;             /* RATE_INVALID_THERMO_SLEW of the latest window */
+  uint32_t slew_cap;         /* that window beyond the cap (p_window_max_deg) itself */
   uint32_t slew_due;         /* a window ended: rate_valid_slew judges it */
   float p_window_change_deg; /* |change of P_f| over the window that ended */
   float phase_err_lp_rad;    /* the drive phase error through RATE_VALID_PHASE_K */

@@ -589,15 +589,16 @@ static void analyse_drive_noise(report_t *r)
 static void analyse_temp(report_t *r)
 {
   const sim_scenario_t *sc = r->sc;
-  /* Fit against the firmware's own low-passed P (what its compensation uses; the
-   * instantaneous P carries the phase loop's ripple) and, for a heat-gun run, on
-   * the cool-down only, as the thesis does (7.3.2). */
+  /* Fit the uncompensated output (the part's calibration may compensate already)
+   * against the firmware's own low-passed P (the instantaneous P carries the phase
+   * loop's ripple) and, for a heat-gun run, on the cool-down only, as the thesis does
+   * (7.3.2). */
   char t0[32] = "0";
   if (sc->has_ambient && sc->ambient_c.kind == PROFILE_HEAT_COOL) {
     snprintf(t0, sizeof t0, "%.3f", sc->ambient_c.t_start_s + sc->ambient_c.heat_s);
   }
-  const char *args[] = {r->csv_path,     "--column",  "rate_dps",  "--p-column", "p_f_deg",
-                        "--temp-column", "t_board_c", "--t-start", t0,           NULL};
+  const char *args[] = {r->csv_path,     "--column",  "rate_unc_dps", "--p-column", "p_f_deg",
+                        "--temp-column", "t_board_c", "--t-start",    t0,           NULL};
   cJSON *j = run_tool(r, "gyro-tempcomp", args, "tempcomp.json");
   if (j == NULL) return;
   add_num(r->fig, "residual_bias_p_dps", post_num(j, "p_fit.residual_std_dps"));

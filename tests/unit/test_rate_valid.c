@@ -164,6 +164,15 @@ static void test_thermo_slew(void **state)
     if (rv.slew_due) rate_valid_slew(&s_cfg, &rv, 3000.0f);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
+  /* Under the cap: not a move that restarts the compensation's filters (slew_cap) */
+  assert_int_equal(rv.slew_cap, 0u);
+  for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
+    p += 0.006f / (float)RATE_VALID_SLEW_UPDATES; /* 0.06 deg/s: beyond the cap */
+    rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f, 0.0f);
+    if (rv.slew_due) rate_valid_slew(&s_cfg, &rv, 0.0f);
+  }
+  assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
+  assert_int_equal(rv.slew_cap, 1u);
 }
 
 static void test_onsets_counted(void **state)
