@@ -318,32 +318,29 @@ def _thermal_runs(part, cal_path):
     """The thermal verification's runs, as (name, function of nothing -> figures)."""
     seed = part.seed + VERIFY_SEED_OFFSET
     temps = thermcal.VERIFY_PLATEAUS_C
-    doc = {"description": "verification of a thermal calibration: plateaus it never saw"}
 
-    def plateaus():
-        scen = _scenario(part, "calibrate_verify_plateaus",
-                         thermcal.plateau_scenario(temps, part.thermal_dwell_s, doc))
-        log, _, cmd = _sim(part, cal_path, scen, seed + 1, "verify_plateaus", csv=True,
+    def run(name, doc, k, judge):
+        scen = _scenario(part, "calibrate_" + name, doc)
+        log, _, cmd = _sim(part, cal_path, scen, seed + k, name, csv=True,
                            columns=THERMAL_COLUMNS)
+        return dict(judge(log), command=cmd, seed=seed + k)
+
+    def judge_plateaus(log):
         rows = thermcal.verify_plateaus(log, temps, part.thermal_dwell_s)
-        return {"command": cmd, "seed": seed + 1, "plateaus": rows,
-                "ok": all(r["ok"] for r in rows)}
+        return {"plateaus": rows, "ok": all(r["ok"] for r in rows)}
 
-    def ramp():
-        scen = _scenario(part, "calibrate_verify_ramp", thermcal.ramp_scenario(
-            {"description": "verification of a thermal calibration: a heating ramp"}))
-        log, _, cmd = _sim(part, cal_path, scen, seed + 2, "verify_ramp", csv=True,
-                           columns=THERMAL_COLUMNS)
-        return dict(thermcal.verify_ramp(log), command=cmd, seed=seed + 2)
-
-    def noise():
-        scen = _scenario(part, "calibrate_verify_noise", thermcal.noise_scenario(
-            {"description": "output noise with and without the temperature compensation"}))
-        log, _, cmd = _sim(part, cal_path, scen, seed + 3, "verify_noise", csv=True,
-                           columns=THERMAL_COLUMNS)
-        return dict(thermcal.verify_noise(log), command=cmd, seed=seed + 3)
-
-    return [("thermal_plateaus", plateaus), ("thermal_ramp", ramp), ("noise", noise)]
+    return [
+        ("thermal_plateaus", lambda: run("verify_plateaus", thermcal.plateau_scenario(
+            temps, part.thermal_dwell_s,
+            {"description": "verification of a thermal calibration: plateaus it never saw"}),
+            1, judge_plateaus)),
+        ("thermal_ramp", lambda: run("verify_ramp", thermcal.ramp_scenario(
+            {"description": "verification of a thermal calibration: a heating ramp"}),
+            2, thermcal.verify_ramp)),
+        ("noise", lambda: run("verify_noise", thermcal.noise_scenario(
+            {"description": "output noise with and without the temperature compensation"}),
+            3, thermcal.verify_noise)),
+    ]
 
 
 def verify_all(part, cal_path, workers=None):
