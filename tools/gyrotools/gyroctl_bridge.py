@@ -28,11 +28,10 @@ import shutil
 import subprocess
 import tempfile
 
-from . import paramset
+from . import paramset, tempcomp
 from .errors import InputError
 
-BIAS_PARAMS = ("rate.bias_c0_dps", "rate.bias_c1_dps_per_deg",
-               "rate.bias_c2_dps_per_deg2", "rate.bias_c3_dps_per_deg3")
+BIAS_PARAMS = tempcomp.BIAS_PARAMS
 
 
 class GyroctlError(InputError):

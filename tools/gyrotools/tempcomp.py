@@ -83,6 +83,11 @@ def poly_eval(c, x):
     return Polynomial(c)(np.asarray(x, dtype=float))
 
 
+# The firmware's bias polynomial, c0..c3 (firmware/params/param_list.h).
+BIAS_PARAMS = ("rate.bias_c0_dps", "rate.bias_c1_dps_per_deg", "rate.bias_c2_dps_per_deg2",
+               "rate.bias_c3_dps_per_deg3")
+
+
 def firmware_bias(fit):
     """The firmware's values for a bias fit in absolute P: the polynomial in the deviation
     x = P - ref from the middle of the fitted span (cal.ref_p_deg, rate_channel.c), the
@@ -91,9 +96,7 @@ def firmware_bias(fit):
     lo, hi = fit.x_range
     ref = 0.5 * (lo + hi)
     c = padded(Polynomial(fit.coeffs)(Polynomial([ref, 1.0])).coef)
-    names = ("rate.bias_c0_dps", "rate.bias_c1_dps_per_deg", "rate.bias_c2_dps_per_deg2",
-             "rate.bias_c3_dps_per_deg3")
-    v = dict(zip(names, (float(x) for x in c)))
+    v = dict(zip(BIAS_PARAMS, (float(x) for x in c)))
     v.update({"cal.ref_p_deg": float(ref), "rate.p_range_deg": float(max(0.5 * (hi - lo), 1e-3)),
               "rate.bias_grad_dps_per_deg": 0.0})
     return v

@@ -68,8 +68,6 @@ BIN_S = 1.0
 RAMP_FROM_C, RAMP_TO_C, RAMP_K_PER_MIN = 25.0, 65.0, 2.0
 RAMP_LEAD_S, RAMP_TAIL_S = 120.0, 600.0
 NOISE_S = 300.0
-# The firmware's P update period (RATE_P_DECIM / fs, rate_channel.h).
-P_UPDATE_S = 100.0 / 50000.0
 LIMITS = {"ramp_bias_std_dps": 0.2, "plateau_bias_dps": 0.2, "sf_ppm": 500.0,
           "noise_ratio": 1.1, "valid_fraction": 0.9}
 
@@ -194,12 +192,13 @@ def fit(log, n_plateaus, dwell_s):
     # rate = u s0 (SF/s0) - B - k h, the same B and k.
     bias_pl = np.array([r["bias_dps"] for r in pts]) * tempcomp.poly_eval(s, x_pl)
     resid_pl = bias_pl - tempcomp.poly_eval(c[:4], x_pl)
-    values = {"cal.ref_p_deg": float(ref), "rate.p_range_deg": float(half * (1 + 2 * P_RANGE_MARGIN)),
-              "rate.bias_c0_dps": float(c[0]), "rate.bias_c1_dps_per_deg": float(c[1]),
-              "rate.bias_c2_dps_per_deg2": float(c[2]), "rate.bias_c3_dps_per_deg3": float(c[3]),
-              "rate.sf_c1_per_deg": float(sf_c[1]), "rate.sf_c2_per_deg2": float(sf_c[2]),
-              "rate.sf_c3_per_deg3": float(sf_c[3]), "rate.sf_c4_per_deg4": float(sf_c[4]),
-              "rate.bias_grad_dps_per_deg": float(c[4]), "rate.grad_tau_s": float(best["tau"])}
+    values = dict(zip(tempcomp.BIAS_PARAMS, (float(x) for x in c[:4])))
+    values.update({"cal.ref_p_deg": float(ref),
+                   "rate.p_range_deg": float(half * (1 + 2 * P_RANGE_MARGIN)),
+                   "rate.sf_c1_per_deg": float(sf_c[1]), "rate.sf_c2_per_deg2": float(sf_c[2]),
+                   "rate.sf_c3_per_deg3": float(sf_c[3]), "rate.sf_c4_per_deg4": float(sf_c[4]),
+                   "rate.bias_grad_dps_per_deg": float(c[4]),
+                   "rate.grad_tau_s": float(best["tau"])})
     figures = {"plateaus_c": list(CAL_PLATEAUS_C[:n_plateaus]), "dwell_s": dwell_s,
                "p_deg": p.tolist(), "p_span_deg": float(2 * half),
                "raw_bias_dps": [r["bias_dps"] for r in pts],
