@@ -1,0 +1,52 @@
+"""tools/calibrate's outputs by verdict: a verified calibration is DIR/calibration.json; one
+whose verification failed is left as DIR/calibration_unverified.json only (the 1300 Hz,
+Q 200 part's gave valid rates 1.27 deg/s wrong in its ramp: it must not be loaded by
+mistake), and an earlier run's calibration.json in the same folder does not survive it.
+The flow's stages are replaced by doubles (the real ones take minutes of simulation)."""
+
+import importlib.machinery
+import importlib.util
+import os
+
+import pytest
+
+from gyrotools import calflow, paramset
+
+TOOL = os.path.join(os.path.dirname(__file__), "..", "..", "calibrate")
+
+
+def load_tool():
+    loader = importlib.machinery.SourceFileLoader("calibrate_tool", TOOL)
+    spec = importlib.util.spec_from_loader("calibrate_tool", loader)
+    mod = importlib.util.module_from_spec(spec)
+    loader.exec_module(mod)
+    return mod
+
+
+@pytest.mark.parametrize("passed", [True, False])
+def test_only_a_verified_calibration_is_calibration_json(tmp_path, monkeypatch, passed):
+    tool = load_tool()
+    values = {d.name: d.default for d in paramset.load_table().values()
+              if "persist" in d.flags and "read-only" not in d.flags}
+    values["drive.freq_hz"] = 1489.9
+    monkeypatch.setattr(calflow, "selfcal", lambda part: ("x", {"f0_hz": 1489.9, "q": 33.0}))
+    monkeypatch.setattr(calflow, "rate_table", lambda part, path: (dict(values), [
+        {"alpha_deg": 0.0, "gain": 1.0}]))
+    monkeypatch.setattr(calflow, "thermal", lambda part, v: (v, {
+        "plateaus_c": [-40.0, 85.0], "p_span_deg": 1.0, "fit_rms_1s_dps": 0.1}))
+    monkeypatch.setattr(calflow, "selftest", lambda part, v: (v, {
+        "expect_dps": 5.5, "cont_expect_dps": 4.2}))
+    monkeypatch.setattr(calflow, "verify_all", lambda part, cal: {"stub": {"ok": passed}})
+    monkeypatch.setattr(tool, "summarise", lambda res: None)
+    sim = tmp_path / "gyro-sim"
+    sim.write_text("#!/bin/sh\n")
+    sim.chmod(0o755)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "calibration.json").write_text("an earlier run's")
+    code = tool.main(["--sim", "--out", str(out), "--gyro-sim", str(sim)])
+    assert code == (0 if passed else tool.EXIT_VERIFY_FAILED)
+    assert (out / "calibration.json").exists() == passed
+    assert (out / "calibration_unverified.json").exists() == (not passed)
+    kept = out / ("calibration.json" if passed else "calibration_unverified.json")
+    assert paramset.read(str(kept)).values()["cal.ref_freq_hz"] == pytest.approx(1489.9)
