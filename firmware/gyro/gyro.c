@@ -67,6 +67,7 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   const float dphase_rad = d->drive.phase_set_rad - old->drive.phase_set_rad;
   if (dphase_rad != 0.0f && driving) {
     rate_channel_shift_p(&g->rate, dphase_rad * FM_DEG_PER_RAD_F);
+    rate_valid_shift_p(&g->valid, dphase_rad * FM_DEG_PER_RAD_F);
   }
   /* The NCO's step is the drive's own (the sweep moves it every tick, a tracking drive
    * would own it): a design sets it only when the drive frequency changes. */

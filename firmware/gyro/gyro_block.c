@@ -91,6 +91,7 @@ GYRO_RAMFUNC void gyro_block_phase(gyro_t *g)
     /* A whole turn of P is no change of temperature: the thermometer moves with it,
      * and the filters settle again after the jump of the rate reference's correction. */
     rate_channel_shift_p(&g->rate, g->drive.p_turn_rad * FM_DEG_PER_RAD_F);
+    rate_valid_shift_p(&g->valid, g->drive.p_turn_rad * FM_DEG_PER_RAD_F);
     g->drive.p_turn_rad = 0.0f;
     rate_valid_disturb(&g->valid);
   }
@@ -192,10 +193,8 @@ GYRO_RAMFUNC void gyro_block_p(gyro_t *g, int hold)
     rate_valid_thermo(&d->valid, &g->valid, rc->p_dev_deg, rc->p_held_dev_deg, rc->p_held_w,
                       rc->quad_dps);
   } else if (g->valid.slew_due != 0u) {
-    rate_valid_slew(&d->valid, &g->valid, rc->quad_dps);
-    /* Beyond the cap only: P_f's noise trips the lag test now and then in a ramp, and a
-     * restart there drops the gradient term (1 deg/s at 2 K/min) for its time constant */
-    if (g->valid.slew_cap != 0u) rate_channel_comp_restart(rc);
+    if (rate_valid_slew(&d->valid, &g->valid, rc->quad_dps, rc->p_comp_lag_deg, rc->p_hp_deg))
+      rate_channel_comp_restart(rc);
   }
   /* Last, as a tail call: its new P_f is flagged in rc->p_new. */
   (void)rate_channel_update_p(&d->rate, rc, g->drive.p_eq_rad);

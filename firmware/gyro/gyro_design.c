@@ -72,7 +72,8 @@ static float p_poly_off_deg(const param_values_t *v)
   return (float)((double)v->drive_p_init_deg - (double)v->cal_ref_p_deg);
 }
 
-/* The rate-valid monitors (rate_valid.h) and the analog fault level. The fault level
+/* The rate-valid monitors (rate_valid.h; after design_rate, whose compensation filters
+ * THERMO_SLEW's shadow mirrors) and the analog fault level. The fault level
  * must lie outside the span full scale x out_v_per_dps (with 10 % for the output
  * stage's gain and offset), or a failed gyro could read as a rate. */
 static gyro_design_status_t design_validity(const param_values_t *v, gyro_design_t *t)
@@ -91,8 +92,11 @@ static gyro_design_status_t design_validity(const param_values_t *v, gyro_design
                               sense_max_v * sense_max_v,
                               v->sup_lock_phase_tol_deg * FM_RAD_PER_DEG_F,
                               (float)slope,
-                              p_poly_off_deg(v)};
+                              p_poly_off_deg(v),
+                              fm_absf(v->rate_bias_grad_dps_per_deg),
+                              {0.0f}};
   t->valid = c;
+  rate_valid_spur_matrix(t->rate.comp_a, t->rate.grad_a, t->valid.spur_m);
   t->rate_fault_out_v = v->rate_fault_out_v;
   return GYRO_DESIGN_OK;
 }

@@ -5,14 +5,12 @@
 
 #include "dsp/fastmath.h"
 #include "dsp/ramfunc.h"
+#include "gyro/comp_filters.h"
 
 /* Fast start of P's low-pass after a hold (rate_channel_hold_p): the held value counts
  * as RATE_P_PRIOR means; the running mean ends after RATE_P_FAST_MAX means at most. */
 #define RATE_P_PRIOR 4u
 #define RATE_P_FAST_MAX 1000u
-/* 1e-4: a restart 5 deg of P from the held value (a part that cooled by 60 K while off)
- * leaves 5e-4 deg of it to the gradient term, 0.005 deg/s at 10 (deg/s)/deg. */
-#define RATE_P_HP_W_MAX 1e-4f
 
 static int finite4(const float *c)
 {
@@ -224,24 +222,18 @@ GYRO_RAMFUNC void rate_channel_shift_p(rate_channel_t *restrict rc, float shift_
   rc->p_last_rad += shift_deg * FM_RAD_PER_DEG_F; /* the lag does not see the turn */
 }
 
-/* The compensation's filters of P_f, from its step: P_f - P_c (P_c the compensation's
- * thermometer, P_f low-passed over rate.comp_tau_s) and P_c - LP_tau(P_c) (the gradient
- * term's input). Each kept as a high-pass x - LP(x) = (1 - a)(its last value + x's
- * step): the states stay small, so that no float low-pass of minutes has a dead band. */
-GYRO_RAMFUNC static inline void comp_filters_step(const rate_channel_cfg_t *restrict cfg,
-                                                  rate_channel_t *restrict rc, float step)
+/* The compensation's filters (comp_filters.h) take P_f's step. */
+GYRO_RAMFUNC static inline void comp_filters_update(const rate_channel_cfg_t *restrict cfg,
+                                                    rate_channel_t *restrict rc, float step)
 {
-  if (rc->p_held_w > RATE_P_HP_W_MAX) {
+  if (rc->p_held_w > COMP_FILTERS_HELD_W_MAX) {
     /* P_f's way from a held value to P is no temperature change: the filters start once
-     * that value weighs less than RATE_P_HP_W_MAX in P_f. */
+     * that value weighs less than COMP_FILTERS_HELD_W_MAX in P_f. */
     rc->p_comp_lag_deg = 0.0f;
     rc->p_hp_deg = 0.0f;
     return;
   }
-  const float d = rc->p_comp_lag_deg + step;
-  const float step_c = cfg->comp_a * d; /* P_c's step */
-  rc->p_comp_lag_deg = d - step_c;
-  rc->p_hp_deg = (1.0f - cfg->grad_a) * (rc->p_hp_deg + step_c);
+  comp_filters_step(&rc->p_comp_lag_deg, &rc->p_hp_deg, step, cfg->comp_a, cfg->grad_a);
 }
 
 GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
@@ -289,7 +281,7 @@ GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
       rc->p_dev_deg += a * (mean - before);
       /* The step P_f took (exact, Sterbenz), not a * (mean - P_f): within P_f's own dead
        * band the latter is a constant the compensation's filters would integrate. */
-      comp_filters_step(cfg, rc, rc->p_dev_deg - before);
+      comp_filters_update(cfg, rc, rc->p_dev_deg - before);
       rc->p_f_deg = cfg->p_ref_deg + rc->p_dev_deg;
       rc->p_acc_deg = 0.0f;
       rc->p_count = 0u;

@@ -180,10 +180,9 @@ static inline void rate_channel_hold_p(rate_channel_t *rc, int hold)
   rc->p_hold = hold ? 1u : 0u;
 }
 
-/* P_f moved faster than any temperature (THERMO_SLEW beyond its cap: a setpoint change, a fault): the
- * compensation's own thermometer P_c and the gradient term's high-pass would carry that
- * move for their time constants (seconds, minutes) after P_f has settled, where no
- * monitor sees it; they restart from P_f instead. */
+/* P_f moved by far more than any temperature (rate_valid.h, RATE_VALID_RESTART_CAPS):
+ * the compensation's own thermometer P_c and the gradient term's high-pass restart from
+ * P_f rather than carry that move for their time constants. */
 static inline void rate_channel_comp_restart(rate_channel_t *rc)
 {
   rc->p_comp_lag_deg = 0.0f;

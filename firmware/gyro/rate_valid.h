@@ -23,7 +23,21 @@
  *                 (p_slew_max), or so fast that P_f's low-pass lags it by more than
  *                 tol_dps of rate: a lag of P_f rotates the quadrature into the rate
  *                 (the reference's correction, rate_channel.h: Q x lag) and shifts the
- *                 bias polynomial (slope x lag)
+ *                 bias polynomial (slope x lag); and afterwards, while what such a move
+ *                 left in the compensation's filters (comp_filters.h: P_c's lag, the
+ *                 gradient term's high-pass) could still make more than tol_dps. A
+ *                 shadow of those filters holds their error: it runs on the moves beyond
+ *                 p_slew_max alone (a shock on the drive phase, not a temperature), so
+ *                 the rate is invalid for as long as the move's own trace lasts: seconds
+ *                 for a kick of a few tenths of a degree, nothing for a window P_f's
+ *                 noise tipped over the cap in a ramp. After a move beyond
+ *                 RATE_VALID_RESTART_CAPS caps (the loop pulling in after a setpoint
+ *                 change) the filters restart instead, once P_f has come to rest (the
+ *                 first window under the cap), and the shadow takes on what the restart
+ *                 drops: the filters' content at the last P update with the checks
+ *                 passed before the move (the gradient of a ramp in progress). (A
+ *                 restart on any move beyond the cap, as before, left the rate valid
+ *                 and 1 deg/s wrong for the gradient term's time constant.)
  *   THERMO_SETTLE P_f not yet at P after a hold (acquisition, a fault): how far it may
  *                 still be is known without noise from the weight w the held value
  *                 keeps in P_f, |P_f - P| = w / (1 - w) |P_held - P_f|, and the rate
@@ -77,6 +91,9 @@
  * constant of 5 blocks (1 ms, a corner of about 160 Hz), faster than the 100 Hz
  * output filter it checks. */
 #define RATE_VALID_INPUT_K 0.2f
+/* A window's move of P_f beyond this many caps restarts the compensation's filters:
+ * what they would carry of it outweighs the gradient the restart drops. */
+#define RATE_VALID_RESTART_CAPS 10.0f
 /* Fraction of the ADC range the sense amplitude may use. */
 #define RATE_VALID_SENSE_FRAC 0.8f
 
@@ -91,6 +108,8 @@ typedef struct {
   float phase_tol_rad;          /* the lock tolerance of the drive phase */
   float bias_slope_dps_per_deg; /* |dB/dP| of the compensation over its range */
   float p_range_off_deg;        /* x = p_dev + this at P_f (rate_channel.h) */
+  float grad_k_abs_dps_per_deg; /* |k| of the gradient term */
+  float spur_m[6]; /* the shadow's transition over a slew window (rate_valid_spur_matrix) */
 } rate_valid_cfg_t;
 
 typedef struct {
@@ -105,13 +124,20 @@ typedef struct {
   float p_dev_window_deg;    /* P_f - p_ref at the start of the slew window */
   uint32_t p_updates;        /* P_f updates into the slew window */
   uint32_t slew;             /* RATE_INVALID_THERMO_SLEW of the latest window */
-  uint32_t slew_cap;         /* that window beyond the cap (p_window_max_deg) itself */
   uint32_t slew_due;         /* a window ended: rate_valid_slew judges it */
-  float p_window_change_deg; /* |change of P_f| over the window that ended */
-  float phase_err_lp_rad;    /* the drive phase error through RATE_VALID_PHASE_K */
-  uint32_t blocks;           /* verdicts since power-on */
-  uint32_t onsets_pending;   /* reasons that set in, not yet in the history */
-  uint32_t onset_block;      /* the verdict that saw the latest of them */
+  float p_window_change_deg; /* change of P_f over the window that ended */
+  float spur_deg[3];         /* the shadow: the moves beyond the cap in P_f, and in the
+                              * compensation's filters (P_f - P_c, the gradient term's
+                              * input; comp_filters.h), at the next window's end */
+  uint32_t restart_armed;    /* a window's move beyond RATE_VALID_RESTART_CAPS caps */
+  float snap_lag_deg;        /* the compensation's filters at the latest window's end */
+  float snap_hp_deg;         /* with the checks passed and no restart armed */
+  uint32_t spur;           /* RATE_INVALID_THERMO_SLEW while the shadow's error is beyond tol */
+  uint32_t filters_held;   /* the compensation's filters wait for P_f (comp_filters.h) */
+  float phase_err_lp_rad;  /* the drive phase error through RATE_VALID_PHASE_K */
+  uint32_t blocks;         /* verdicts since power-on */
+  uint32_t onsets_pending; /* reasons that set in, not yet in the history */
+  uint32_t onset_block;    /* the verdict that saw the latest of them */
 } rate_valid_t;
 
 /* The history of the reasons for `status`: written only when a reason sets in, so it
@@ -145,14 +171,28 @@ void rate_valid_settling(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float ra
 void rate_valid_thermo(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float p_dev_deg,
                        float p_held_dev_deg, float p_held_w, float quad_dps);
 /* On a tick after rate_valid_thermo ended a slew window (slew_due): THERMO_SLEW from the
- * window's change of P_f (apart, so that no tick carries both). */
-void rate_valid_slew(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float quad_dps);
+ * window's change of P_f and from the shadow (apart, so that no tick carries both).
+ * (comp_lag_deg, comp_hp_deg): the compensation's filters' content (rate_channel_t).
+ * Returns 1 when the filters must restart now (rate_channel_comp_restart). */
+int rate_valid_slew(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float quad_dps,
+                    float comp_lag_deg, float comp_hp_deg);
+/* The shadow's transition over RATE_VALID_SLEW_UPDATES P updates for the compensation's
+ * filter weights comp_a, grad_a (rate_channel_cfg_t): m = (s<-s, lag<-s, lag<-lag,
+ * hp<-s, hp<-lag, hp<-hp). Design time (double). */
+void rate_valid_spur_matrix(float comp_a, float grad_a, float m[6]);
 
 /* Once per block, after the quadrature filter: the drive phase error as the supervisor
  * low-passed it, the quadrature output and the squared sense pickoff amplitude ->
  * PHASE, SENSE_RANGE. */
 void rate_valid_drive(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float phase_err_rad,
                       float quad_dps, float sense_v2);
+
+/* P_f jumped by shift_deg without a change of temperature (rate_channel_shift_p): the
+ * slew window's start moves with it, or the jump would read as a slew. */
+static inline void rate_valid_shift_p(rate_valid_t *rv, float shift_deg)
+{
+  rv->p_dev_window_deg += shift_deg;
+}
 
 /* Once per block, after the rate's output filter: OVER_RANGE. */
 static inline void rate_valid_range(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float rate_dps)

@@ -184,7 +184,7 @@ static void test_gradient_term(void **state)
     hp_max = fmax(hp_max, fabs((double)rc.p_hp_deg));
   }
   assert_true(fabs((double)rc.p_f_deg - p_deg) < 1e-3);
-  assert_true(hp_max < 2e-4); /* 0.5 deg x RATE_P_HP_W_MAX, and the lag of P_f */
+  assert_true(hp_max < 2e-4); /* 0.5 deg x COMP_FILTERS_HELD_W_MAX, and the lag of P_f */
 }
 
 /* The compensation's own thermometer P_c (rate.comp_tau_s): after a step of P it follows

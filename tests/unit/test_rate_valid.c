@@ -12,14 +12,17 @@
 
 static rate_valid_cfg_t cfg(void)
 {
-  const rate_valid_cfg_t c = {.tol_dps = 0.25f,
-                              .full_scale_dps = 300.0f,
-                              .p_range_deg = 8.0f,
-                              .p_window_max_deg = 0.005f,     /* 0.05 deg/s over 0.1 s */
-                              .p_lag_per_deg = 0.159f / 0.1f, /* 1 Hz low-pass, 0.1 s window */
-                              .sense_max_v2 = 16.0f,
-                              .phase_tol_rad = 0.01745f,
-                              .bias_slope_dps_per_deg = 0.0f};
+  rate_valid_cfg_t c = {.tol_dps = 0.25f,
+                        .full_scale_dps = 300.0f,
+                        .p_range_deg = 8.0f,
+                        .p_window_max_deg = 0.005f,     /* 0.05 deg/s over 0.1 s */
+                        .p_lag_per_deg = 0.159f / 0.1f, /* 1 Hz low-pass, 0.1 s window */
+                        .sense_max_v2 = 16.0f,
+                        .phase_tol_rad = 0.01745f,
+                        .bias_slope_dps_per_deg = 0.0f,
+                        .grad_k_abs_dps_per_deg = 0.0f,
+                        .spur_m = {0.0f}};
+  rate_valid_spur_matrix(4e-4f, 1e-4f, c.spur_m); /* P_c over 5 s, the gradient over 20 s */
   return c;
 }
 
@@ -61,6 +64,9 @@ static void test_bad_cfg(void **state)
   assert_int_equal(rv_init(&rv, &c), -1);
   c = cfg();
   c.full_scale_dps = NAN;
+  assert_int_equal(rv_init(&rv, &c), -1);
+  c = cfg();
+  c.spur_m[5] = 1.0f; /* a shadow that never fades */
   assert_int_equal(rv_init(&rv, &c), -1);
 }
 
@@ -153,7 +159,7 @@ static void test_thermo_slew(void **state)
   for (uint32_t i = 0; i < 3u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.004f / (float)RATE_VALID_SLEW_UPDATES; /* 0.04 deg/s, under the cap */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f, 0.0f);
-    if (rv.slew_due) rate_valid_slew(&s_cfg, &rv, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, 0.0f, 0.0f);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
@@ -161,18 +167,19 @@ static void test_thermo_slew(void **state)
     /* 0.004 deg per 0.1 s leaves P_f 0.0064 deg behind: 0.33 deg/s of 3000 deg/s of
      * quadrature rotated into the rate, beyond the tolerance though under the cap. */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f, 3000.0f);
-    if (rv.slew_due) rate_valid_slew(&s_cfg, &rv, 3000.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 3000.0f, 0.0f, 0.0f);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
-  /* Under the cap: not a move that restarts the compensation's filters (slew_cap) */
-  assert_int_equal(rv.slew_cap, 0u);
+  /* Under the cap: a temperature's move, none of it into the shadow of the compensation */
+  assert_true(rv.spur_deg[0] == 0.0f && rv.spur_deg[1] == 0.0f && rv.spur_deg[2] == 0.0f);
   for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.006f / (float)RATE_VALID_SLEW_UPDATES; /* 0.06 deg/s: beyond the cap */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f, 0.0f);
-    if (rv.slew_due) rate_valid_slew(&s_cfg, &rv, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, 0.0f, 0.0f);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
-  assert_int_equal(rv.slew_cap, 1u);
+  /* Beyond it: into the shadow (P_f carries 0.006 deg per window of it) */
+  assert_true(rv.spur_deg[0] > 0.005f);
 }
 
 static void test_onsets_counted(void **state)
