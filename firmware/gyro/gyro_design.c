@@ -291,6 +291,8 @@ static gyro_design_status_t design_rate(const param_values_t *v, double tau_s, g
   t->rate.sf_c[2] = v->rate_sf_c2_per_deg2;
   t->rate.sf_c[3] = v->rate_sf_c3_per_deg3;
   t->rate.sf_c[4] = v->rate_sf_c4_per_deg4;
+  t->rate.lin_c2_per_dps = v->rate_lin_c2_per_dps;
+  t->rate.lin_c3_per_dps2 = v->rate_lin_c3_per_dps2;
   t->rate.p_ref_deg = v->drive_p_init_deg;
   t->rate.p_poly_off_deg = p_poly_off_deg(v);
   t->rate.grad_k_dps_per_deg = v->rate_bias_grad_dps_per_deg;

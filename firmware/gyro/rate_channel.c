@@ -23,13 +23,15 @@ int rate_channel_cfg_ok(const rate_channel_cfg_t *cfg)
          fm_isfinite(cfg->ref_re) && fm_isfinite(cfg->ref_im) &&
          cfg->ref_re * cfg->ref_re + cfg->ref_im * cfg->ref_im > 0.0f &&
          fm_isfinite(cfg->scale_dps) && finite4(cfg->bias_c_dps) && finite4(cfg->sf_c) &&
-         fm_isfinite(cfg->sf_c[4]) && cfg->p_lpf_alpha > 0.0f && cfg->p_lpf_alpha <= 1.0f &&
-         cfg->min_drive_v > 0.0f && fm_isfinite(cfg->grad_k_dps_per_deg) && cfg->grad_a > 0.0f &&
-         cfg->grad_a <= 1.0f && fm_isfinite(cfg->p_rate_deg_per_dps) && cfg->comp_a > 0.0f &&
-         cfg->comp_a <= 1.0f && fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg) &&
-         cfg->p_mode_k > 0.0f && cfg->p_mode_k <= 1.0f && cfg->ref_lp_kp > 0.0f &&
-         cfg->ref_lp_kp < 1.0f && cfg->ref_lp_ki > 0.0f && cfg->ref_lp_ki < cfg->ref_lp_kp &&
-         cfg->ref_wide_kp > 0.0f && cfg->ref_wide_kp < 1.0f && cfg->ref_wide_ki > 0.0f &&
+         fm_isfinite(cfg->sf_c[4]) && fm_isfinite(cfg->lin_c2_per_dps) &&
+         fm_isfinite(cfg->lin_c3_per_dps2) && cfg->p_lpf_alpha > 0.0f &&
+         cfg->p_lpf_alpha <= 1.0f && cfg->min_drive_v > 0.0f &&
+         fm_isfinite(cfg->grad_k_dps_per_deg) && cfg->grad_a > 0.0f && cfg->grad_a <= 1.0f &&
+         fm_isfinite(cfg->p_rate_deg_per_dps) && cfg->comp_a > 0.0f && cfg->comp_a <= 1.0f &&
+         fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg) && cfg->p_mode_k > 0.0f &&
+         cfg->p_mode_k <= 1.0f && cfg->ref_lp_kp > 0.0f && cfg->ref_lp_kp < 1.0f &&
+         cfg->ref_lp_ki > 0.0f && cfg->ref_lp_ki < cfg->ref_lp_kp && cfg->ref_wide_kp > 0.0f &&
+         cfg->ref_wide_kp < 1.0f && cfg->ref_wide_ki > 0.0f &&
          cfg->ref_wide_ki < cfg->ref_wide_kp;
 }
 
@@ -69,7 +71,8 @@ int rate_channel_same_path(const rate_channel_cfg_t *a, const rate_channel_cfg_t
   for (int i = 0; i < 4; i++) {
     same = same && a->bias_c_dps[i] == b->bias_c_dps[i] && a->sf_c[i] == b->sf_c[i];
   }
-  same = same && a->sf_c[4] == b->sf_c[4];
+  same = same && a->sf_c[4] == b->sf_c[4] && a->lin_c2_per_dps == b->lin_c2_per_dps &&
+         a->lin_c3_per_dps2 == b->lin_c3_per_dps2;
   return same && memcmp(a->lpf, b->lpf, b->lpf_sections * sizeof b->lpf[0]) == 0;
 }
 
@@ -195,7 +198,10 @@ GYRO_RAMFUNC void rate_channel_filter_rate(const rate_channel_cfg_t *restrict cf
   const float unc = scale * biquad_sections_step(cfg->lpf, rc->lpf_rate, cfg->lpf_sections,
                                                  rc->rate_raw);
   rc->rate_unc_dps = unc;
-  rc->rate_dps = unc * sf - bias;
+  /* The linearisation acts on the whole in-phase signal (rate and raw bias), as the
+   * pickoff's nonlinearity does (rate_channel.h). */
+  const float lin = unc + unc * unc * (cfg->lin_c2_per_dps + unc * cfg->lin_c3_per_dps2);
+  rc->rate_dps = lin * sf - bias;
 }
 
 GYRO_RAMFUNC void rate_channel_filter_quad(const rate_channel_cfg_t *restrict cfg,

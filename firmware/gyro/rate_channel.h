@@ -31,11 +31,15 @@
  * A demodulation-phase error d_phi leaks quadrature into rate as Q sin(d_phi): with
  * 1500 deg/s of quadrature, 0.01 deg is 0.26 deg/s of bias (thesis §2.4.2 B).
  *
- * Output: rate = scale * Re(R_f) * sf(P_f) - bias(P_f), R_f the Butterworth-filtered R,
- * P_f the low-passed force phase in degrees (temperature is slow: a 1 Hz low-pass keeps
- * the phase loop's noise out of the bias correction, whose slope is tens of (deg/s)/deg); bias(P) =
- * c0 + c1 P + c2 P^2 + c3 P^3 and sf(P) = 1 + c1 P + c2 P^2 + c3 P^3 (the thesis fits bias linear
- * in P, 7.3.2).
+ * Output: rate = L(u) * sf(x) - bias(x) - k h, u = scale * Re(R_f) the uncompensated rate
+ * (R_f the Butterworth-filtered R), L(u) = u + c2 u^2 + c3 u^3 its linearisation (the
+ * sense pickoff's gain falls with the square of the whole sense amplitude, quadrature
+ * and bias included, so its rate nonlinearity is a polynomial in u, fitted by the
+ * calibration flow over the full scale), x = P_c - cal.ref_p_deg the thermometer's
+ * deviation from the calibration's reference (P_c: the force phase P low-passed at 1 Hz,
+ * P_f, and again over rate.comp_tau_s; temperature is slow and the bias slope is tens of
+ * (deg/s)/deg), bias(x) a cubic and sf(x) = 1 + c1 x + .. + c4 x^4 (the thesis fits the
+ * bias linear in P, 7.3.2), k h the gradient term (rate_channel.c).
  */
 #ifndef RATE_CHANNEL_H
 #define RATE_CHANNEL_H
@@ -90,7 +94,9 @@ typedef struct {
   float ref_re, ref_im; /* e^{j psi} / A_set */
   float scale_dps;      /* deg/s per unit of Re(R) */
   float bias_c_dps[4];
-  float sf_c[5];            /* [0] unused: SF(x) = 1 + c1 x + .. + c4 x^4 */
+  float sf_c[5];        /* [0] unused: SF(x) = 1 + c1 x + .. + c4 x^4 */
+  float lin_c2_per_dps; /* L(u) = u + c2 u^2 + c3 u^3 */
+  float lin_c3_per_dps2;
   float p_ref_deg;          /* P around which its low-pass works (the start value) */
   float p_poly_off_deg;     /* p_ref - cal.ref_p_deg: x = p_dev + this at P_f, the
                              * compensation polynomials' variable */

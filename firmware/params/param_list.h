@@ -40,7 +40,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 7u
+#define PARAM_LAYOUT_VERSION 8u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -146,6 +146,12 @@
    * falls 0.8 % at -40 and 1.2 % at 85 degC: a cubic in x leaves 390 ppm, a quartic 110 */ \
   X(rate_sf_c4_per_deg4, 0x0318u, "rate.sf_c4_per_deg4", F32, "1/deg^4", -1.0f, 1.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "scale-factor polynomial, quartic term") \
+  /* uncalibrated: 0, the output linear in the sense pickoff's in-phase signal */ \
+  X(rate_lin_c2_per_dps, 0x0319u, "rate.lin_c2_per_dps", F32, "1/(deg/s)", -1.0f, 1.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "linearisation u + c2 u^2 + c3 u^3 of the uncompensated rate u, quadratic term") \
+  /* uncalibrated: 0 */ \
+  X(rate_lin_c3_per_dps2, 0x031Au, "rate.lin_c3_per_dps2", F32, "1/(deg/s)^2", -1.0f, 1.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "linearisation, cubic term") \
   /* temperature is slow; 1 Hz keeps the phase loop's noise out of the bias correction */ \
   X(rate_p_lpf_hz, 0x030Cu, "rate.p_lpf_hz", F32, "Hz", 0.01f, 50.0f, 1.0f, 0u, \
     PF_PERSIST | PF_LIVE, "low-pass of P before it is used as the temperature") \

@@ -92,9 +92,9 @@ static void test_phase_error_leakage(void **state)
   assert_true(fabs((double)rc.rate_raw - sin(0.01)) < 1e-6);
 }
 
-/* After the Butterworth settles: rate = scale * r * sf(x) - bias(x), with x = P_f - the
- * calibration's reference (cal.ref_p_deg) and P low-passed around another working point
- * (drive.p_init_deg). */
+/* After the Butterworth settles: rate = L(scale * r) * sf(x) - bias(x), with L the
+ * linearisation of the uncompensated rate, x = P_f - the calibration's reference
+ * (cal.ref_p_deg) and P low-passed around another working point (drive.p_init_deg). */
 static void test_compensation_polynomials(void **state)
 {
   (void)state;
@@ -106,6 +106,8 @@ static void test_compensation_polynomials(void **state)
   c.sf_c[1] = 1e-3f;
   c.sf_c[3] = -2e-6f;
   c.sf_c[4] = 3e-7f;
+  c.lin_c2_per_dps = 2e-5f;   /* 0.1 % at 50 deg/s */
+  c.lin_c3_per_dps2 = -4e-8f; /* -0.01 % */
   c.p_ref_deg = -1.5f;
   const double ref_p_deg = -1.0;
   c.p_poly_off_deg = (float)(c.p_ref_deg - ref_p_deg);
@@ -124,7 +126,9 @@ static void test_compensation_polynomials(void **state)
   assert_true(fabs((double)rc.p_f_deg - p_deg) < 1e-5);
   assert_true(fabs((double)rc.rate_unc_dps - 250.0 * r) < 250.0 * r * 1e-5);
   assert_true(fabs((double)rc.quad_dps - 250.0 * q) < 250.0 * fabs(q) * 1e-5); /* not compensated */
-  assert_true(fabs((double)rc.rate_dps - (250.0 * r * sf - bias)) < 1e-3);
+  const double u = 250.0 * r, lin = u + 2e-5 * u * u - 4e-8 * u * u * u;
+  assert_true(fabs((double)rc.rate_dps - (lin * sf - bias)) < 1e-3);
+  assert_true(fabs((lin - u) * sf) > 0.04); /* the linearisation is seen */
 }
 
 /* The low-pass of P tracks a slow change without a dead band: a 1e-4 deg change of P

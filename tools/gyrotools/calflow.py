@@ -9,21 +9,25 @@ firmware's generic defaults:
    thesis's table 7-2): the response's direction and length in the output frame give
    the demodulation phase and the scale factor (gyrotools.demodcal); repeated with the
    corrected values until the response lies on the rate axis with unit gain;
-3. thermal calibration (gyrotools.thermcal): chamber plateaus over -40..85 degC with rate
+3. linearity (gyrotools.lincal): a rate table over the full scale, CW and CCW; the
+   output's linearisation, a cubic in the uncompensated rate, with its slope folded into
+   the scale so that the slope over the thesis's table stays 1;
+4. thermal calibration (gyrotools.thermcal): chamber plateaus over -40..85 degC with rate
    steps at each plateau's end; bias and scale-factor cubics in the thermometer's
    deviation from its reference (cal.ref_p_deg), the gradient term of the transients,
    the thermometer's range;
-4. self-test expectations: the on-demand test's response and the continuous test's
+5. self-test expectations: the on-demand test's response and the continuous test's
    amplitude on the calibrated part at rest (scenario "commands": `selftest`, `status`),
    at the drive setpoint (selftest.ref_amp_v);
-5. the calibration record: every value the firmware holds for this part, with
+6. the calibration record: every value the firmware holds for this part, with
    cal.ref_freq_hz (the drive frequency it was made at), cal.part_id and cal.date,
    written as a param set (gyrotools.paramset);
-6. verification on profiles the fit never saw, each with its own noise seed, run side by
-   side: another rate schedule (+-30..150 deg/s, other dwell), judged on the rate output
-   the firmware marks valid where the input is held: scale factor, bias at rest, never a
-   valid rate off by more than VERIFY_MAX_ERR_DPS, then the on-demand self-test at rest
-   passes; other chamber plateaus, a heating ramp and the noise with the compensation
+7. verification on profiles the fit never saw, each with its own noise seed, run side by
+   side: another rate schedule (+-30..270 deg/s, other dwell), judged on the rate output
+   the firmware marks valid where the input is held: scale factor over the thesis's
+   range, the slope over every sub-range of at least lincal.SUBRANGE_MIN_DPS, bias at
+   rest, never a valid rate off by more than VERIFY_MAX_ERR_DPS, then the on-demand
+   self-test at rest passes; other chamber plateaus, a heating ramp and the noise with the compensation
    (thermcal: limits in thermcal.LIMITS).
 """
 
@@ -39,7 +43,7 @@ import zlib
 
 import numpy as np
 
-from . import csvlog, demodcal, paramset, scalefactor, thermcal
+from . import csvlog, demodcal, lincal, paramset, scalefactor, thermcal
 from .errors import InputError
 
 # Rate-table iterations: the demodulation is linear in the phasors, so one pass is exact
@@ -68,8 +72,15 @@ VERIFY_SEED_OFFSET = 1000
 # The self-test's response below this is no working self-test (the design's electrodes
 # give about 5.5 deg/s at selftest.amp_v 0.1 V; dead ones, their feedthrough, 0.05).
 SELFTEST_MIN_DPS = 1.0
-VERIFY_RATES_DPS = (30, -30, 70, -70, 110, -110, 150, -150)
-VERIFY_DWELL_S = 1.25
+VERIFY_RATES_DPS = (30, -30, 70, -70, 110, -110, 150, -150, 190, -190, 230, -230, 270, -270)
+# The sub-range slopes are judged between the means of ~50 pairs, so their noise must
+# be a fraction of the limit; the part's bias wanders (flicker, drifts) by hundredths of
+# a deg/s over minutes, so each rate is measured against the rests on either side of it
+# (IEEE 1431's rate transfer test): with 4 s dwells and no rests the default part,
+# linear, read 508 ppm over 150..230 deg/s, with 15 s dwells 463.
+VERIFY_DWELL_S = 10.0
+VERIFY_REST_S = 5.0
+LINEARITY_SEED_OFFSET = 150
 SETTLE_S = scalefactor.SETTLE_S_DEFAULT
 MIN_AVG_S = scalefactor.MIN_AVG_S_DEFAULT
 
@@ -178,6 +189,63 @@ def rate_table(part, params_path):
     return values, passes
 
 
+def _held_means(log, column, t_end_s=np.inf):
+    """The held windows' means of a column, up to t_end_s: (rates, means, standard
+    errors). The error from the spread of eight sub-window means (the samples are
+    correlated)."""
+    win = scalefactor.windows_from_truth(log["t_s"], log["rate_true_dps"], SETTLE_S, MIN_AVG_S)
+    r, m, se = [], [], []
+    for rate, i0, i1 in win:
+        i1 = min(i1, int(np.searchsorted(log["t_s"], t_end_s)))
+        if i1 - i0 < 8:
+            continue
+        y = log[column][i0:i1]
+        parts = [np.mean(c) for c in np.array_split(y, 8) if c.size]
+        r.append(rate)
+        m.append(float(np.mean(y)))
+        se.append(float(np.std(parts, ddof=1) / np.sqrt(len(parts))) if len(parts) > 1
+                  else float("nan"))
+    return np.array(r), np.array(m), np.array(se)
+
+
+def linearity(part, values):
+    """Stage 3: the output's linearisation from a full-scale rate table (lincal)."""
+    path = os.path.join(part.work, "linearity_params.json")
+    paramset.write(path, paramset.from_values(values, meta={"stage": "linearity"}))
+    steps = lincal.table_steps(lincal.FIT_RATES_DPS, lincal.FIT_DWELL_S, lincal.FIT_REST_S)
+    scen = _scenario(part, "calibrate_linearity", {
+        "description": "linearity: a rate table over the full scale, CW and CCW",
+        "duration_s": sum(st[0] for st in steps), "csv_rate_hz": 200,
+        "rate_dps": {"kind": "steps", "edge_s": 0.1, "steps": steps}})
+    log, _, cmd = _sim(part, path, scen, part.seed + LINEARITY_SEED_OFFSET, "linearity",
+                       csv=True, columns=LOG_COLUMNS + ["rate_unc_dps"])
+    r, u, _ = _held_means(log, "rate_unc_dps")
+    held = np.abs(r) > 0.0
+    # The bias's wander out, its level kept (the linearisation acts on u, bias and all).
+    b_near = lincal.bias_between_rests(r, u)
+    u = u - np.where(held, b_near - np.mean(u[~held]), 0.0)
+    try:
+        s, b, c2, c3 = lincal.fit(r[held], u[held])
+    except ValueError as e:
+        raise FlowError(f"{e} ({cmd})") from None
+    fs = values["rate.full_scale_dps"]
+    if not (np.isfinite(s) and s > 0.0 and lincal.plausible(c2, c3, fs)):
+        raise FlowError(f"linearity: implausible fit (slope {s:.6g}, c2 {c2:.3g}, c3 {c3:.3g}: "
+                        f"more than {100 * lincal.MAX_CORRECTION_FS:g} % at full scale) ({cmd})")
+    lin = lincal.linearise(u[held], c2, c3)
+    resid_before = u[held] - np.polyval(np.polyfit(r[held], u[held], 1), r[held])
+    resid_after = lin - (s * r[held] + b)
+    v = lincal.rescaled(values, s, c2, c3)
+    return v, {"command": cmd, "seed": part.seed + LINEARITY_SEED_OFFSET,
+               "rates_dps": list(lincal.FIT_RATES_DPS), "dwell_s": lincal.FIT_DWELL_S,
+               "slope": s, "offset_dps": b, "c2_per_dps": v["rate.lin_c2_per_dps"],
+               "c3_per_dps2": v["rate.lin_c3_per_dps2"],
+               "correction_at_fs": [lincal.correction_at(c2, c3, fs),
+                                    lincal.correction_at(c2, c3, -fs)],
+               "residual_rms_dps_linear": float(np.sqrt(np.mean(resid_before ** 2))),
+               "residual_rms_dps_linearised": float(np.sqrt(np.mean(resid_after ** 2)))}
+
+
 def thermal(part, values):
     """Stage 3: the temperature compensation from a chamber run (gyrotools.thermcal)."""
     path = os.path.join(part.work, "thermal_params.json")
@@ -189,6 +257,10 @@ def thermal(part, values):
         {"description": "thermal calibration: chamber plateaus with rate steps at their ends"}))
     log, _, cmd = _sim(part, path, scen, part.seed + THERMAL_SEED_OFFSET, "thermal", csv=True,
                        columns=THERMAL_COLUMNS)
+    # The compensation acts on the linearised output L(u) (rate_channel.h).
+    log.data["rate_unc_dps"] = lincal.linearise(log["rate_unc_dps"],
+                                                values.get("rate.lin_c2_per_dps", 0.0),
+                                                values.get("rate.lin_c3_per_dps2", 0.0))
     comp, s0, figs = thermcal.fit(log, len(temps), part.thermal_dwell_s)
     if not (np.isfinite(s0) and s0 > 0.0) or not all(np.isfinite(v) for v in comp.values()):
         raise FlowError(f"thermal calibration: implausible fit (scale {s0:.6g}) ({cmd})")
@@ -266,7 +338,7 @@ def record(values, sets, date=None):
 def verify(part, cal_path):
     """Stage 4: the calibrated part on a profile and noise the fit never saw."""
     seed = part.seed + VERIFY_SEED_OFFSET
-    steps = [[2.0, 0]] + [[VERIFY_DWELL_S, r] for r in VERIFY_RATES_DPS] + [[2.5, 0]]
+    steps = lincal.table_steps(VERIFY_RATES_DPS, VERIFY_DWELL_S, VERIFY_REST_S) + [[2.5, 0]]
     duration = sum(st[0] for st in steps)
     # The on-demand self-test in the last 1.2 s, at rest; the rate is judged before it.
     t_selftest = duration - 1.2
@@ -295,20 +367,32 @@ def verify(part, cal_path):
     worst = float(np.max(err[judged])) if np.any(judged) else 0.0
     rest = in_dwell & valid & (np.abs(truth) < 1e-9)
     bias = float(np.mean(out[rest])) if np.any(rest) else float("nan")
-    sf_ppm = (res.sf - 1.0) * 1e6
+    # The scale factor is the slope over the thesis's table (+-20..160 deg/s); every
+    # sub-range's against it.
+    r_h, m_h, se_h = _held_means(log, "rate_dps", t_end_s=t_selftest)
+    m_h = m_h - np.where(r_h != 0.0, lincal.bias_between_rests(r_h, m_h), 0.0)
+    turning = np.abs(r_h) > 0.0  # the rests are the bias's (and the self-test's)
+    sub, sf = lincal.subrange_slopes(r_h[turning], m_h[turning], se_h[turning])
+    sf_ppm = (sf - 1.0) * 1e6
+    worst_sub = sub[0] if sub else None
     checks = {
         "scale_factor": abs(sf_ppm) <= VERIFY_SF_PPM,
+        "subrange_slopes": worst_sub is not None and
+        abs(worst_sub["slope_ppm"]) <= lincal.SUBRANGE_PPM,
         "bias_at_rest": bool(np.isfinite(bias) and abs(bias) <= VERIFY_BIAS_DPS),
         "valid_fraction": valid_frac >= VERIFY_VALID_FRAC,
         "no_valid_wrong_rate": worst <= VERIFY_MAX_ERR_DPS,
         "selftest": st_state == "PASS",
     }
     return {"command": cmd, "seed": seed, "rates_dps": list(VERIFY_RATES_DPS),
-            "dwell_s": VERIFY_DWELL_S, "scale_factor": res.sf, "scale_factor_ppm": sf_ppm,
-            "nonlinearity_fs": res.nonlinearity, "bias_at_rest_dps": bias,
+            "dwell_s": VERIFY_DWELL_S, "scale_factor": sf, "scale_factor_ppm": sf_ppm,
+            "scale_factor_all_rates": res.sf, "nonlinearity_fs": res.nonlinearity,
+            "subrange_min_span_dps": lincal.SUBRANGE_MIN_DPS, "subrange_worst": worst_sub,
+            "subrange_slopes": sub, "bias_at_rest_dps": bias,
             "valid_fraction_in_dwell": valid_frac, "worst_valid_error_dps": worst,
             "selftest": st_state,
             "limits": {"scale_factor_ppm": VERIFY_SF_PPM, "bias_dps": VERIFY_BIAS_DPS,
+                       "subrange_slope_ppm": lincal.SUBRANGE_PPM,
                        "valid_fraction": VERIFY_VALID_FRAC,
                        "worst_valid_error_dps": VERIFY_MAX_ERR_DPS},
             "checks": checks, "passed": all(checks.values())}

@@ -32,6 +32,9 @@ def test_only_a_verified_calibration_is_calibration_json(tmp_path, monkeypatch, 
     monkeypatch.setattr(calflow, "selfcal", lambda part: ("x", {"f0_hz": 1489.9, "q": 33.0}))
     monkeypatch.setattr(calflow, "rate_table", lambda part, path: (dict(values), [
         {"alpha_deg": 0.0, "gain": 1.0}]))
+    monkeypatch.setattr(calflow, "linearity", lambda part, v: (v, {
+        "rates_dps": [280], "slope": 1.0, "correction_at_fs": [0.0, 0.0],
+        "residual_rms_dps_linear": 0.01, "residual_rms_dps_linearised": 0.01}))
     monkeypatch.setattr(calflow, "thermal", lambda part, v: (v, {
         "plateaus_c": [-40.0, 85.0], "p_span_deg": 1.0, "fit_rms_1s_dps": 0.1}))
     monkeypatch.setattr(calflow, "selftest", lambda part, v: (v, {
