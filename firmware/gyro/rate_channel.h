@@ -104,6 +104,7 @@ typedef struct {
   float grad_k_dps_per_deg; /* bias per degree of P_f's high-pass: the thermal gradient */
   float grad_a;             /* that high-pass's 1 - exp(-T / tau) per new P_f */
   float p_rate_deg_per_dps; /* P's turn per deg/s of rate, taken out of the thermometer */
+  float p_rate_c1_per_dps;  /* its change per degree of x (the compensation's variable) */
   float comp_a;             /* P_c's low-pass of P_f: 1 - exp(-T / comp_tau) per new P_f */
   float p_mode_k;  /* per-block factor of the resonance's lag: 1 - exp(-T_block / (2Q/wn)) */
   float ref_lp_kp; /* LP2 per block: 2 zeta wn T_block ... */

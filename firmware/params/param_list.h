@@ -40,7 +40,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 8u
+#define PARAM_LAYOUT_VERSION 9u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -191,6 +191,12 @@
    * rate (a scale-factor error of slope x this). The flow measures it on its rate table */ \
   X(rate_p_rate_deg_per_dps, 0x0316u, "rate.p_rate_deg_per_dps", F32, "deg/(deg/s)", -0.01f, 0.01f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "drive phase P per deg/s of rate, taken out of P before it is the thermometer") \
+  /* uncalibrated: 0. That turn moves with temperature (the sense motion's phase to the
+   * drive's is the circuits'): on the 1300 Hz, Q 200 part from -9.4e-5 deg/(deg/s) at
+   * -40 degC to +6.6e-5 at 85 about its 25 degC value, a scale-factor error of 540 ppm
+   * at -25 degC at its bias slope. The flow fits it from its chamber run's rate steps */ \
+  X(rate_p_rate_c1_per_dps, 0x031Bu, "rate.p_rate_c1_per_dps", F32, "deg/(deg/s)/deg", -0.001f, 0.001f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "change of rate.p_rate_deg_per_dps per degree of the thermometer's deviation x") \
   /* 0: the compensation reads P_f itself. The thermometer's own noise (the drive loop's
    * phase noise) goes into the output at the bias slope; a slower thermometer for the
    * compensation alone (the monitors keep P_f) takes it out, and its lag is the

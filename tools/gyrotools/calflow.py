@@ -267,6 +267,7 @@ def thermal(part, values):
     v = dict(values)
     v.update(comp)
     v["rate.scale_dps"] = values["rate.scale_dps"] * s0
+    v["rate.p_rate_deg_per_dps"] = values["rate.p_rate_deg_per_dps"] + figs["p_turn_c0_deg_per_dps"]
     figs["command"] = cmd
     figs["seed"] = part.seed + THERMAL_SEED_OFFSET
     return v, figs

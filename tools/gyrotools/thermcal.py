@@ -4,8 +4,8 @@ The thermometer is the drive phase P (thesis 7.3: "sensorless"); the firmware co
 
     rate = u SF(x) - B(x) - k_g h,    x = P_c - cal.ref_p_deg,  h = P_c - LP_tau(P_c)
 
-(u the uncompensated output, P_c the thermometer P_f low-passed over rate.comp_tau_s,
-rate_channel.c). B is a cubic in x, SF a quartic; the gradient term
+(u the uncompensated output, linearised (lincal), P_c the thermometer P_f low-passed over
+rate.comp_tau_s, rate_channel.c). B is a cubic in x, SF a quartic; the gradient term
 k_g h stands for the structure-to-circuit temperature difference of a transient: P and the
 bias weigh the two nodes differently, so during a ramp the bias is off the plateaus' B(x)
 by an amount that follows P's recent change, which h measures (rate.grad_tau_s).
@@ -19,6 +19,9 @@ window (the bias there). P is the thermometer less the rate's own turn of it
   constant folded into rate.scale_dps so that SF(0) = 1;
 - B(x) and k_g (with tau from TAU_GRID_S, the smallest residual): least squares over the
   1 s means of the whole run at rest, plateaus and transitions alike, on y = u SF(x);
+- the rate's turn of P (rate.p_rate_deg_per_dps, measured at room temperature) against
+  x: P_f at +R against -R at each plateau, a line in x (rate.p_rate_c1_per_dps; its
+  constant added to the room-temperature value);
 - cal.ref_p_deg: the middle of the plateaus' P span; rate.p_range_deg: half that span
   plus P_RANGE_MARGIN (the rate is valid only where the fit had data).
 
@@ -127,7 +130,11 @@ def plateau_points(log, n, dwell_s, out="rate_unc_dps"):
         rest, pos, neg, pos2 = plateau_windows(t, k, dwell_s)
         u = log[out]
         u_pos = 0.5 * (np.mean(u[pos]) + np.mean(u[pos2]))
-        rows.append({"p_deg": float(np.mean(log["p_f_deg"][rest])),
+        pf = log["p_f_deg"]
+        p_pos = 0.5 * (np.mean(pf[pos]) + np.mean(pf[pos2]))
+        rows.append({"p_deg": float(np.mean(pf[rest])),
+                     "p_turn_deg_per_dps": float((p_pos - np.mean(pf[neg]))
+                                                 / (2 * STEP_RATE_DPS)),
                      "t_struct_c": float(np.mean(log["t_struct_c"][rest])),
                      "bias_dps": float(np.mean(u[rest])),
                      "gain": float((u_pos - np.mean(u[neg])) / (2 * STEP_RATE_DPS)),
@@ -192,7 +199,13 @@ def fit(log, n_plateaus, dwell_s):
     # rate = u s0 (SF/s0) - B - k h, the same B and k.
     bias_pl = np.array([r["bias_dps"] for r in pts]) * tempcomp.poly_eval(s, x_pl)
     resid_pl = bias_pl - tempcomp.poly_eval(c[:4], x_pl)
+    # What is left of the rate's turn of P at each plateau (the firmware took out
+    # rate.p_rate_deg_per_dps, measured at room temperature): a line in x, its constant
+    # for the caller to add to that value.
+    turn = np.array([r["p_turn_deg_per_dps"] for r in pts])
+    turn_c1, turn_c0 = (float(v) for v in np.polyfit(x_pl, turn, 1))
     values = dict(zip(tempcomp.BIAS_PARAMS, (float(x) for x in c[:4])))
+    values["rate.p_rate_c1_per_dps"] = turn_c1
     values.update({"cal.ref_p_deg": float(ref),
                    "rate.p_range_deg": float(half * (1 + 2 * P_RANGE_MARGIN)),
                    "rate.sf_c1_per_deg": float(sf_c[1]), "rate.sf_c2_per_deg2": float(sf_c[2]),
@@ -204,7 +217,9 @@ def fit(log, n_plateaus, dwell_s):
                "raw_bias_dps": [r["bias_dps"] for r in pts],
                "raw_gain": [r["gain"] for r in pts], "scale_factor_s0": float(s0),
                "plateau_residual_dps": resid_pl.tolist(),
-               "fit_rms_1s_dps": best["rms"], "grad_tau_s": best["tau"]}
+               "fit_rms_1s_dps": best["rms"], "grad_tau_s": best["tau"],
+               "p_turn_residual_deg_per_dps": turn.tolist(), "p_turn_c0_deg_per_dps": turn_c0,
+               "p_turn_c1_per_dps": turn_c1}
     return values, s0, figures
 
 
