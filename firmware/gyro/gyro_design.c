@@ -298,6 +298,7 @@ static gyro_design_status_t design_rate(const param_values_t *v, double tau_s, g
   t->rate.grad_k_dps_per_deg = v->rate_bias_grad_dps_per_deg;
   t->rate.p_rate_deg_per_dps = v->rate_p_rate_deg_per_dps;
   t->rate.p_rate_c1_per_dps = v->rate_p_rate_c1_per_dps;
+  t->rate.p_rate2_deg_per_dps2 = v->rate_p_rate2_deg_per_dps2;
   t->rate.comp_a = v->rate_comp_tau_s > 0.0f
                        ? (float)(1.0 -
                                  exp(-(double)RATE_P_DECIM / (fs * (double)v->rate_comp_tau_s)))

@@ -28,11 +28,12 @@ int rate_channel_cfg_ok(const rate_channel_cfg_t *cfg)
          cfg->p_lpf_alpha <= 1.0f && cfg->min_drive_v > 0.0f &&
          fm_isfinite(cfg->grad_k_dps_per_deg) && cfg->grad_a > 0.0f && cfg->grad_a <= 1.0f &&
          fm_isfinite(cfg->p_rate_deg_per_dps) && fm_isfinite(cfg->p_rate_c1_per_dps) &&
-         cfg->comp_a > 0.0f && cfg->comp_a <= 1.0f && fm_isfinite(cfg->min_drive_v) &&
-         fm_isfinite(cfg->p_ref_deg) && cfg->p_mode_k > 0.0f && cfg->p_mode_k <= 1.0f &&
-         cfg->ref_lp_kp > 0.0f && cfg->ref_lp_kp < 1.0f && cfg->ref_lp_ki > 0.0f &&
-         cfg->ref_lp_ki < cfg->ref_lp_kp && cfg->ref_wide_kp > 0.0f && cfg->ref_wide_kp < 1.0f &&
-         cfg->ref_wide_ki > 0.0f && cfg->ref_wide_ki < cfg->ref_wide_kp;
+         fm_isfinite(cfg->p_rate2_deg_per_dps2) && cfg->comp_a > 0.0f && cfg->comp_a <= 1.0f &&
+         fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg) && cfg->p_mode_k > 0.0f &&
+         cfg->p_mode_k <= 1.0f && cfg->ref_lp_kp > 0.0f && cfg->ref_lp_kp < 1.0f &&
+         cfg->ref_lp_ki > 0.0f && cfg->ref_lp_ki < cfg->ref_lp_kp && cfg->ref_wide_kp > 0.0f &&
+         cfg->ref_wide_kp < 1.0f && cfg->ref_wide_ki > 0.0f &&
+         cfg->ref_wide_ki < cfg->ref_wide_kp;
 }
 
 int rate_channel_init(const rate_channel_cfg_t *cfg, rate_channel_t *rc)
@@ -67,7 +68,8 @@ int rate_channel_same_path(const rate_channel_cfg_t *a, const rate_channel_cfg_t
              a->p_ref_deg == b->p_ref_deg && a->p_poly_off_deg == b->p_poly_off_deg &&
              a->grad_k_dps_per_deg == b->grad_k_dps_per_deg && a->grad_a == b->grad_a &&
              a->p_rate_deg_per_dps == b->p_rate_deg_per_dps &&
-             a->p_rate_c1_per_dps == b->p_rate_c1_per_dps && a->comp_a == b->comp_a &&
+             a->p_rate_c1_per_dps == b->p_rate_c1_per_dps &&
+             a->p_rate2_deg_per_dps2 == b->p_rate2_deg_per_dps2 && a->comp_a == b->comp_a &&
              a->lpf_sections == b->lpf_sections;
   for (int i = 0; i < 4; i++) {
     same = same && a->bias_c_dps[i] == b->bias_c_dps[i] && a->sf_c[i] == b->sf_c[i];
@@ -264,10 +266,12 @@ GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
     }
     if (rc->p_count == RATE_P_BLOCKS) {
       /* The thermometer is P less the rate's own turn of it (the reciprocal Coriolis force
-       * on the drive mode), from the latest output, at the temperature P_c reads: 1 % of
-       * rate error is 1 % of a turn of thousandths of a degree. */
+       * on the drive mode: linear through the quadrature's sense motion, at the
+       * temperature P_c reads, and with the square of the rate's own), from the latest
+       * output: 1 % of rate error is 1 % of a turn of thousandths of a degree. */
       const float x = rc->p_dev_deg - rc->p_comp_lag_deg + cfg->p_poly_off_deg;
-      const float turn = cfg->p_rate_deg_per_dps + cfg->p_rate_c1_per_dps * x;
+      const float turn = cfg->p_rate_deg_per_dps + cfg->p_rate_c1_per_dps * x +
+                         cfg->p_rate2_deg_per_dps2 * rc->rate_unc_dps;
       const float mean = rc->p_acc_deg * (1.0f / (float)RATE_P_BLOCKS) - turn * rc->rate_unc_dps;
       /* Fast start after a hold: the running mean of the means seen since the release
        * (the held value weighing as RATE_P_PRIOR of them) until its weight falls to the

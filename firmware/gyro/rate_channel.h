@@ -97,15 +97,16 @@ typedef struct {
   float sf_c[5];        /* [0] unused: SF(x) = 1 + c1 x + .. + c4 x^4 */
   float lin_c2_per_dps; /* L(u) = u + c2 u^2 + c3 u^3 */
   float lin_c3_per_dps2;
-  float p_ref_deg;          /* P around which its low-pass works (the start value) */
-  float p_poly_off_deg;     /* p_ref - cal.ref_p_deg: x = p_dev + this at P_f, the
+  float p_ref_deg;            /* P around which its low-pass works (the start value) */
+  float p_poly_off_deg;       /* p_ref - cal.ref_p_deg: x = p_dev + this at P_f, the
                              * compensation polynomials' variable */
-  float p_lpf_alpha;        /* first-order low-pass of P at fs / RATE_P_DECIM */
-  float grad_k_dps_per_deg; /* bias per degree of P_f's high-pass: the thermal gradient */
-  float grad_a;             /* that high-pass's 1 - exp(-T / tau) per new P_f */
-  float p_rate_deg_per_dps; /* P's turn per deg/s of rate, taken out of the thermometer */
-  float p_rate_c1_per_dps;  /* its change per degree of x (the compensation's variable) */
-  float comp_a;             /* P_c's low-pass of P_f: 1 - exp(-T / comp_tau) per new P_f */
+  float p_lpf_alpha;          /* first-order low-pass of P at fs / RATE_P_DECIM */
+  float grad_k_dps_per_deg;   /* bias per degree of P_f's high-pass: the thermal gradient */
+  float grad_a;               /* that high-pass's 1 - exp(-T / tau) per new P_f */
+  float p_rate_deg_per_dps;   /* P's turn per deg/s of rate, taken out of the thermometer */
+  float p_rate_c1_per_dps;    /* its change per degree of x (the compensation's variable) */
+  float p_rate2_deg_per_dps2; /* P's turn per (deg/s)^2 of rate */
+  float comp_a;               /* P_c's low-pass of P_f: 1 - exp(-T / comp_tau) per new P_f */
   float p_mode_k;  /* per-block factor of the resonance's lag: 1 - exp(-T_block / (2Q/wn)) */
   float ref_lp_kp; /* LP2 per block: 2 zeta wn T_block ... */
   float ref_lp_ki; /* ... and (wn T_block)^2 */

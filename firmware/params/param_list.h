@@ -40,7 +40,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 9u
+#define PARAM_LAYOUT_VERSION 10u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -197,6 +197,12 @@
    * at -25 degC at its bias slope. The flow fits it from its chamber run's rate steps */ \
   X(rate_p_rate_c1_per_dps, 0x031Bu, "rate.p_rate_c1_per_dps", F32, "deg/(deg/s)/deg", -0.001f, 0.001f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "change of rate.p_rate_deg_per_dps per degree of the thermometer's deviation x") \
+  /* uncalibrated: 0. The rate's own sense motion turns P as well, with its square (both
+   * senses of rotation alike): on the default part 2.5e-3 deg at +-270 deg/s, 0.09 deg/s
+   * of output at its bias slope, coming and going with the compensation's lags after
+   * each change of rate. The flow measures it on its rate table */ \
+  X(rate_p_rate2_deg_per_dps2, 0x031Cu, "rate.p_rate2_deg_per_dps2", F32, "deg/(deg/s)^2", -0.001f, 0.001f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "drive phase P per (deg/s)^2 of rate, taken out of P with the linear turn") \
   /* 0: the compensation reads P_f itself. The thermometer's own noise (the drive loop's
    * phase noise) goes into the output at the bias slope; a slower thermometer for the
    * compensation alone (the monitors keep P_f) takes it out, and its lag is the

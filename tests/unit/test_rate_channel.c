@@ -221,22 +221,26 @@ static void test_compensation_thermometer_lowpass(void **state)
  * temperature: with rate.p_rate_deg_per_dps set, P_f stays where it was while the rate
  * steps to 100 deg/s and P turns by 0.002 deg with it; without, it follows P. The turn
  * changes with temperature (rate.p_rate_c1_per_dps per degree of x): at x = 10.3 deg a
- * turn of 1e-5 + 1.03e-5 deg/(deg/s) is taken out as well. */
+ * turn of 1e-5 + 1.03e-5 deg/(deg/s) is taken out as well; and one with the square of the
+ * rate (rate.p_rate2_deg_per_dps2). */
 static void test_rate_taken_out_of_p(void **state)
 {
   (void)state;
   biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
   const double p0_deg = 0.3, r = 0.4; /* 250 x 0.4 = 100 deg/s */
   const struct {
-    double beta0, beta1, off_deg, beta_true;
+    double beta0, beta1, gamma, off_deg, beta_true;
     int taken;
-  } cases[] = {
-      {0.0, 0.0, 0.0, 2e-5, 0}, {2e-5, 0.0, 0.0, 2e-5, 1}, {1e-5, 1e-6, 10.0, 2.03e-5, 1}};
+  } cases[] = {{0.0, 0.0, 0.0, 0.0, 2e-5, 0},
+               {2e-5, 0.0, 0.0, 0.0, 2e-5, 1},
+               {1e-5, 1e-6, 0.0, 10.0, 2.03e-5, 1},
+               {1e-5, 0.0, 1e-7, 0.0, 2e-5, 1}}; /* 1e-7 x 100 deg/s: another 1e-5 */
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
     rate_channel_cfg_t c = base_cfg(sec, 0.0f);
     c.p_lpf_alpha = 1.25e-2f;
     c.p_rate_deg_per_dps = (float)cases[k].beta0;
     c.p_rate_c1_per_dps = (float)cases[k].beta1;
+    c.p_rate2_deg_per_dps2 = (float)cases[k].gamma;
     c.p_poly_off_deg = (float)cases[k].off_deg; /* x = P_f + 10 */
     rate_channel_t rc;
     assert_int_equal(rc_init(&rc, &c), 0);

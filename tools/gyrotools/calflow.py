@@ -179,11 +179,14 @@ def rate_table(part, params_path):
                        "quad_dps": res.quad_dps, "segments": res.n_segments})
         values["rate.demod_phase_deg"] = res.phase_deg
         values["rate.scale_dps"] = res.scale_dps
-        # The thermometer's reading of the rate (rate.p_rate_deg_per_dps), on top of what
-        # the firmware already took out: P's slope against the table's rate.
-        beta = p_rate_slope(log)
+        # The thermometer's reading of the rate (rate.p_rate_deg_per_dps, and with its
+        # square rate.p_rate2_deg_per_dps2), on top of what the firmware already took
+        # out: P against the table's rate.
+        beta, gamma = p_rate_turn(log)
         values["rate.p_rate_deg_per_dps"] += beta
+        values["rate.p_rate2_deg_per_dps2"] = values.get("rate.p_rate2_deg_per_dps2", 0.0) + gamma
         passes[-1]["p_rate_deg_per_dps"] = beta
+        passes[-1]["p_rate2_deg_per_dps2"] = gamma
         if abs(res.alpha_deg) <= ALPHA_TOL_DEG and abs(res.gain - 1.0) <= GAIN_TOL:
             break
     return values, passes
@@ -273,16 +276,19 @@ def thermal(part, values):
     return v, figs
 
 
-def p_rate_slope(log):
-    """Slope of the mean P_f against the table's rate over its held windows (deg per
-    deg/s): the drive phase the rate itself turns (the reciprocal Coriolis force)."""
+def p_rate_turn(log):
+    """The mean P_f against the table's rate over its held windows, a parabola: its slope
+    (deg per deg/s) and curvature (deg per (deg/s)^2): the drive phase the rate itself
+    turns (the reciprocal Coriolis force of the quadrature's sense motion, linear in the
+    rate, and of the rate's own, with its square)."""
     win = scalefactor.windows_from_truth(log["t_s"], log["rate_true_dps"], SETTLE_S, MIN_AVG_S)
     segs = scalefactor.segment_means(log["t_s"], log["rate_dps"], win, p_deg=log["p_f_deg"])
     r = np.array([s.rate_in_dps for s in segs])
     p = np.array([s.mean_p_deg for s in segs])
-    if r.size < 3 or np.ptp(r) <= 0.0:
+    if r.size < 4 or np.ptp(r) <= 0.0:
         raise FlowError("rate table: too few held rates to measure P against the rate")
-    return float(np.polyfit(r, p, 1)[0])
+    c2, c1, _ = np.polyfit(r, p, 2)
+    return float(c1), float(c2)
 
 
 def _status_value(reply, key):
