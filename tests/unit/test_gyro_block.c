@@ -111,33 +111,34 @@ static void test_ramp_valid_and_right(void **state)
   assert_true(worst < 0.1 * (double)d.valid.tol_dps);
 }
 
+/* A kick of dp_deg for dur_s on P at 300 s, the ramp at r: it trips the slew checks,
+ * the rate is never valid and wrong, and valid again by 600 s. */
+static void kick(double r_deg_s, double dp_deg, double dur_s)
+{
+  make();
+  uint32_t slew = 0u;
+  const double worst = worst_valid_error(r_deg_s, dp_deg, dur_s, 300.0, 600.0, &slew);
+  print_message("worst valid dynamic error %.3f deg/s\n", worst);
+  assert_int_not_equal(slew, 0u);
+  assert_true(worst <= (double)d.valid.tol_dps);
+  assert_int_equal(g.valid.thermo, 0u);
+}
+
 /* A 10 ms kick of 0.3 deg on P in the ramp: beyond the slew cap. Before, the cap
  * restarted the filters, which dropped the gradient term (1.1 deg/s here) and left the
- * rate valid and wrong for the gradient term's time constant. */
+ * rate valid and 0.90 deg/s wrong for the gradient term's time constant. */
 static void test_kick_in_ramp_never_valid_and_wrong(void **state)
 {
   (void)state;
-  make();
-  uint32_t slew = 0u;
-  const double worst = worst_valid_error(0.014, 0.3, 0.01, 300.0, 500.0, &slew);
-  assert_int_not_equal(slew, 0u);
-  print_message("worst valid dynamic error %.3f deg/s\n", worst);
-  assert_true(worst <= (double)d.valid.tol_dps);
+  kick(0.014, 0.3, 0.01);
 }
 
-/* A larger kick (3 deg for 50 ms) at rest: whatever it leaves in the filters keeps the
- * rate invalid until it is within the tolerance. */
+/* A larger kick (3 deg for 50 ms, beyond RATE_VALID_RESTART_CAPS) at rest: whatever it
+ * leaves in the filters keeps the rate invalid until it is within the tolerance. */
 static void test_large_kick_at_rest(void **state)
 {
   (void)state;
-  make();
-  uint32_t slew = 0u;
-  const double worst = worst_valid_error(0.0, 3.0, 0.05, 300.0, 600.0, &slew);
-  assert_int_not_equal(slew, 0u);
-  print_message("worst valid dynamic error %.3f deg/s\n", worst);
-  assert_true(worst <= (double)d.valid.tol_dps);
-  /* and the rate comes back: the checks pass again by the end */
-  assert_int_equal(g.valid.thermo, 0u);
+  kick(0.0, 3.0, 0.05);
 }
 
 /* The same kick in the ramp: the filters restart once P_f is at rest again and drop the
@@ -146,13 +147,7 @@ static void test_large_kick_at_rest(void **state)
 static void test_large_kick_in_ramp(void **state)
 {
   (void)state;
-  make();
-  uint32_t slew = 0u;
-  const double worst = worst_valid_error(0.014, 3.0, 0.05, 300.0, 600.0, &slew);
-  print_message("worst valid dynamic error %.3f deg/s\n", worst);
-  assert_int_not_equal(slew, 0u);
-  assert_true(worst <= (double)d.valid.tol_dps);
-  assert_int_equal(g.valid.thermo, 0u);
+  kick(0.014, 3.0, 0.05);
 }
 
 /* The 1300 Hz part's P_f is noisy enough (0.0017 deg rms over 0.1 s) that in its 2 K/min
