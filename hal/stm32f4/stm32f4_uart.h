@@ -9,7 +9,7 @@
 #include <stdint.h>
 
 #define STM32F4_UART_RX_BYTES 256u
-#define STM32F4_UART_TX_BYTES 16384u /* the longest reply (list, ~7.7 KB) beside telemetry */
+#define STM32F4_UART_TX_BYTES 16384u /* the longest reply (list, ~8.3 KB) beside telemetry */
 
 /* BRR for 16x oversampling: USARTDIV = f_pclk / (16 baud), mantissa = integer part,
  * fraction = 16ths rounded, i.e. BRR = round(f_pclk / baud) (RM0090 §30.3.4).

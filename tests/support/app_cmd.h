@@ -11,7 +11,7 @@
 
 static inline const char *app_cmd_line(app_t *a, const char *line)
 {
-  static char reply[8192];
+  static char reply[HAL_UART_HOST_TX_SIZE + 1u]; /* what the TX ring can hold: `list` is 8 KB */
   hal_uart_host_rx_push((const uint8_t *)line, strlen(line));
   app_poll(a);
   const size_t n = hal_uart_host_tx_pop((uint8_t *)reply, sizeof reply - 1u);
