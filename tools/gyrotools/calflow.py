@@ -27,8 +27,8 @@ firmware's generic defaults:
    the firmware marks valid where the input is held: scale factor over the thesis's
    range, the slope over every sub-range of at least lincal.SUBRANGE_MIN_DPS, bias at
    rest, never a valid rate off by more than VERIFY_MAX_ERR_DPS, then the on-demand
-   self-test at rest passes; other chamber plateaus, a heating ramp and the noise with the compensation
-   (thermcal: limits in thermcal.LIMITS).
+   self-test at rest passes; other chamber plateaus, a heating ramp and the noise with
+   the compensation (thermcal: limits in thermcal.LIMITS).
 """
 
 from __future__ import annotations
