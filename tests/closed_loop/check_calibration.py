@@ -15,6 +15,10 @@
                                         never used (-25 and 50 degC, the part starting
                                         there), the rate valid, at rest within 0.2 deg/s,
                                         and the scale factor (+-100 deg/s) within 500 ppm
+  check_calibration.py quick GYRO_SIM   an off-nominal part (1300 Hz, Q 200) through
+                                        tools/calibrate --quick: verified, right at
+                                        25 degC, never a valid rate at 60 degC (outside
+                                        the quick protocol's 15..35 degC)
   check_calibration.py commands GYRO_SIM  a scenario's "commands" (what the flow's
                                         self-test stage uses) reach the command line at
                                         their times; one due after the run has no reply
@@ -138,33 +142,73 @@ TC_WINDOWS = ((1.0, 3.0), (4.0, 6.0), (7.0, 9.0), (10.0, 12.0))
 TC_BIAS_DPS, TC_SF_PPM = 0.2, 500.0
 
 
+def plateau(sim, cal, amb, d, sets=()):
+    """The part (plant sets) with calibration cal started at ambient amb, the table's
+    rest, +R, -R, +R: (valid fraction per window, bias, scale-factor error in ppm, the
+    structure's temperature), or None if gyro-sim failed."""
+    scen = os.path.join(d, "tc.json")
+    with open(scen, "w", encoding="utf-8") as fh:
+        json.dump({"name": "tempcomp_oos", "description": "out-of-sample plateau",
+                   "mode": "closed_loop", "seed": 4242, "analyses": [],
+                   "duration_s": sum(s[0] for s in TC_STEPS), "csv_rate_hz": 200,
+                   "firmware_params": cal, "ambient_c": {"kind": "const", "value": amb},
+                   "rate_dps": {"kind": "steps", "edge_s": 0.2, "steps": TC_STEPS}}, fh)
+    csv = os.path.join(d, "tc.csv")
+    extra = ["--csv", csv] + [a for s in sets for a in ("--set", s)]
+    if not run_sim(sim, scen, extra):
+        return None
+    x = np.genfromtxt(csv, delimiter=",", names=True)
+    w = [(x["t_s"] >= a) & (x["t_s"] < b) for a, b in TC_WINDOWS]
+    valid = [float(np.mean(x["rate_valid"][m])) for m in w]
+    bias = float(np.mean(x["rate_dps"][w[0]]))
+    pos = 0.5 * (np.mean(x["rate_dps"][w[1]]) + np.mean(x["rate_dps"][w[3]]))
+    sf_ppm = ((pos - np.mean(x["rate_dps"][w[2]])) / (2 * TC_RATE_DPS) - 1.0) * 1e6
+    return valid, bias, sf_ppm, float(np.mean(x["t_struct_c"][w[0]]))
+
+
+def plateau_ok(res, amb):
+    valid, bias, sf_ppm, t_struct = res
+    ok = min(valid) == 1.0 and abs(bias) <= TC_BIAS_DPS and abs(sf_ppm) <= TC_SF_PPM
+    print(f"{'ok  ' if ok else 'FAIL'} {amb:g} degC (structure {t_struct:.2f} degC): bias "
+          f"{bias:+.4f} deg/s, scale factor {sf_ppm:+.1f} ppm, valid in the windows (%): "
+          + " ".join(f"{100 * v:.0f}" for v in valid))
+    return ok
+
+
 def tempcomp_out_of_sample(sim):
     bad = 0
     with tempfile.TemporaryDirectory() as d:
         for amb in TC_AMBIENTS_C:
-            scen = os.path.join(d, "tc.json")
-            with open(scen, "w", encoding="utf-8") as fh:
-                json.dump({"name": "tempcomp_oos", "description": "out-of-sample plateau",
-                           "mode": "closed_loop", "seed": 4242, "analyses": [],
-                           "duration_s": sum(s[0] for s in TC_STEPS), "csv_rate_hz": 200,
-                           "firmware_params": CAL, "ambient_c": {"kind": "const", "value": amb},
-                           "rate_dps": {"kind": "steps", "edge_s": 0.2, "steps": TC_STEPS}}, fh)
-            csv = os.path.join(d, "tc.csv")
-            if not run_sim(sim, scen, ["--csv", csv]):
+            res = plateau(sim, CAL, amb, d)
+            if res is None:
                 return 1
-            x = np.genfromtxt(csv, delimiter=",", names=True)
-            w = [(x["t_s"] >= a) & (x["t_s"] < b) for a, b in TC_WINDOWS]
-            valid = [float(np.mean(x["rate_valid"][m])) for m in w]
-            bias = float(np.mean(x["rate_dps"][w[0]]))
-            pos = 0.5 * (np.mean(x["rate_dps"][w[1]]) + np.mean(x["rate_dps"][w[3]]))
-            sf_ppm = ((pos - np.mean(x["rate_dps"][w[2]])) / (2 * TC_RATE_DPS) - 1.0) * 1e6
-            ok = min(valid) == 1.0 and abs(bias) <= TC_BIAS_DPS and abs(sf_ppm) <= TC_SF_PPM
-            print(f"{'ok  ' if ok else 'FAIL'} {amb:g} degC (structure "
-                  f"{np.mean(x['t_struct_c'][w[0]]):.2f} degC): bias {bias:+.4f} deg/s, scale "
-                  f"factor {sf_ppm:+.1f} ppm, valid in the windows (%): "
-                  + " ".join(f"{100 * v:.0f}" for v in valid))
-            bad += not ok
+            bad += not plateau_ok(res, amb)
     return 1 if bad else 0
+
+
+# quick: an off-nominal part through tools/calibrate --quick (15..35 degC): verified (exit
+# 0), right at 25 degC, and at 60 degC, outside its span, never a valid rate.
+QUICK_PART = ("plant.f_drive_hz=1300", "plant.q_drive=200")
+
+
+def quick(sim):
+    with tempfile.TemporaryDirectory() as d:
+        sets = [a for s in QUICK_PART for a in ("--set", s)]
+        r = run(["--sim", "--quick", "--seed", "7", "--out", d, "--gyro-sim", sim] + sets)
+        print(r.stdout + r.stderr)
+        if r.returncode != 0:
+            print(f"FAIL: exit {r.returncode}")
+            return 1
+        cal = os.path.join(d, "calibration.json")
+        inside, outside = plateau(sim, cal, 25.0, d, QUICK_PART), plateau(sim, cal, 60.0, d,
+                                                                           QUICK_PART)
+    if inside is None or outside is None:
+        return 1
+    ok = plateau_ok(inside, 25.0)
+    never = max(outside[0]) == 0.0
+    print(f"{'ok  ' if never else 'FAIL'} 60 degC, outside the quick calibration's span: valid "
+          "in the windows (%): " + " ".join(f"{100 * v:.0f}" for v in outside[0]))
+    return 0 if ok and never else 1
 
 
 def commands(sim):
@@ -187,7 +231,7 @@ def commands(sim):
 
 if __name__ == "__main__":
     modes = {"regen": regen, "usage": usage, "commands": commands, "defaults": tool_defaults,
-             "tempcomp": tempcomp_out_of_sample}
+             "tempcomp": tempcomp_out_of_sample, "quick": quick}
     if len(sys.argv) != 3 or sys.argv[1] not in modes:
         print(__doc__, file=sys.stderr)
         sys.exit(2)

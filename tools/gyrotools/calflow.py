@@ -65,8 +65,6 @@ VERIFY_VALID_FRAC = 0.9
 # scenario reports is measured on the noise a calibration was fitted to.
 RATE_TABLE_SEED_OFFSET = 100
 THERMAL_SEED_OFFSET = 200
-# --quick: three structure time constants of the default part per plateau.
-QUICK_DWELL_S = 1200.0
 VERIFY_SEED_OFFSET = 1000
 # The thermal verification's runs: plateaus, ramp, noise at +1001, +1002, +1003.
 # The self-test's response below this is no working self-test (the design's electrodes
@@ -96,7 +94,7 @@ class SimPart:
     sets: list      # ["plant.KEY=V", ...]
     seed: int
     work: str       # folder for the stages' files
-    thermal_dwell_s: float = thermcal.CAL_DWELL_S  # per chamber plateau (--quick: shorter)
+    protocol: thermcal.Protocol = thermcal.FULL  # the thermal profiles (--quick: QUICK)
 
 
 def _run(part, args, what):
@@ -254,9 +252,9 @@ def thermal(part, values):
     path = os.path.join(part.work, "thermal_params.json")
     values = dict(values, **{"rate.comp_tau_s": thermcal.COMP_TAU_S})
     paramset.write(path, paramset.from_values(values, meta={"stage": "thermal"}))
-    temps = thermcal.CAL_PLATEAUS_C
+    temps = part.protocol.cal_plateaus_c
     scen = _scenario(part, "calibrate_thermal", thermcal.plateau_scenario(
-        temps, part.thermal_dwell_s,
+        temps, part.protocol.dwell_s,
         {"description": "thermal calibration: chamber plateaus with rate steps at their ends"}))
     log, _, cmd = _sim(part, path, scen, part.seed + THERMAL_SEED_OFFSET, "thermal", csv=True,
                        columns=THERMAL_COLUMNS)
@@ -264,7 +262,8 @@ def thermal(part, values):
     log.data["rate_unc_dps"] = lincal.linearise(log["rate_unc_dps"],
                                                 values.get("rate.lin_c2_per_dps", 0.0),
                                                 values.get("rate.lin_c3_per_dps2", 0.0))
-    comp, s0, figs = thermcal.fit(log, len(temps), part.thermal_dwell_s)
+    comp, s0, figs = thermcal.fit(log, temps, part.protocol.dwell_s,
+                                  part.protocol.span_from_data)
     if not (np.isfinite(s0) and s0 > 0.0) or not all(np.isfinite(v) for v in comp.values()):
         raise FlowError(f"thermal calibration: implausible fit (scale {s0:.6g}) ({cmd})")
     v = dict(values)
@@ -408,7 +407,8 @@ def verify(part, cal_path):
 def _thermal_runs(part, cal_path):
     """The thermal verification's runs, as (name, function of nothing -> figures)."""
     seed = part.seed + VERIFY_SEED_OFFSET
-    temps = thermcal.VERIFY_PLATEAUS_C
+    proto = part.protocol
+    temps = proto.verify_plateaus_c
 
     def run(name, doc, k, judge):
         scen = _scenario(part, "calibrate_" + name, doc)
@@ -417,20 +417,20 @@ def _thermal_runs(part, cal_path):
         return dict(judge(log), command=cmd, seed=seed + k)
 
     def judge_plateaus(log):
-        rows = thermcal.verify_plateaus(log, temps, part.thermal_dwell_s)
+        rows = thermcal.verify_plateaus(log, temps, proto.dwell_s)
         return {"plateaus": rows, "ok": all(r["ok"] for r in rows)}
 
     return [
         ("thermal_plateaus", lambda: run("verify_plateaus", thermcal.plateau_scenario(
-            temps, part.thermal_dwell_s,
+            temps, proto.dwell_s,
             {"description": "verification of a thermal calibration: plateaus it never saw"}),
             1, judge_plateaus)),
         ("thermal_ramp", lambda: run("verify_ramp", thermcal.ramp_scenario(
-            {"description": "verification of a thermal calibration: a heating ramp"}),
-            2, thermcal.verify_ramp)),
+            {"description": "verification of a thermal calibration: a heating ramp"}, proto),
+            2, lambda log: thermcal.verify_ramp(log, proto))),
         ("noise", lambda: run("verify_noise", thermcal.noise_scenario(
-            {"description": "output noise with and without the temperature compensation"}),
-            3, thermcal.verify_noise)),
+            {"description": "output noise with and without the temperature compensation"},
+            proto), 3, lambda log: thermcal.verify_noise(log, proto))),
     ]
 
 

@@ -34,6 +34,8 @@ of the same run).
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 from scipy.signal import lfilter
 
@@ -71,6 +73,32 @@ BIN_S = 1.0
 RAMP_FROM_C, RAMP_TO_C, RAMP_K_PER_MIN = 25.0, 65.0, 2.0
 RAMP_LEAD_S, RAMP_TAIL_S = 120.0, 600.0
 NOISE_S = 300.0
+
+
+@dataclasses.dataclass(frozen=True)
+class Protocol:
+    """The thermal stage's and its verification's profiles."""
+    name: str
+    cal_plateaus_c: tuple
+    dwell_s: float            # per chamber plateau, calibration and verification alike
+    verify_plateaus_c: tuple
+    ramp: tuple               # (from degC, to degC, K/min, lead s, tail s)
+    noise_s: float
+    note: str
+    span_from_data: bool = False  # the valid thermometer span (thermcal.fitted_span)
+
+
+FULL = Protocol("full", CAL_PLATEAUS_C, CAL_DWELL_S, VERIFY_PLATEAUS_C,
+                (RAMP_FROM_C, RAMP_TO_C, RAMP_K_PER_MIN, RAMP_LEAD_S, RAMP_TAIL_S), NOISE_S,
+                "chamber -40..85 degC")
+# --quick (lots): the compensation over 15..35 degC only, from three plateaus of one
+# structure time constant of the default part (400 s) each: the plateaus are not settled,
+# the gradient term takes the transients; the rate is valid only over the thermometer
+# span the fit's data reached (rate.p_range_deg: about 19..29 degC of structure on the
+# default part), so outside it the part says so instead of guessing. Verified the same
+# way on plateaus and a ramp inside the span, at other temperatures.
+QUICK = Protocol("quick", (25.0, 15.0, 35.0), 400.0, (20.0, 30.0),
+                 (22.0, 28.0, 2.0, 60.0, 120.0), 120.0, "15..35 degC only", True)
 LIMITS = {"ramp_bias_std_dps": 0.2, "plateau_bias_dps": 0.2, "sf_ppm": 500.0,
           "noise_ratio": 1.1, "valid_fraction": 0.9}
 
@@ -93,16 +121,22 @@ def plateau_scenario(temps_c, dwell_s, doc):
                 rate_dps={"kind": "steps", "edge_s": TABLE_EDGE_S, "steps": rate})
 
 
-def ramp_scenario(doc):
-    dur_ramp = (RAMP_TO_C - RAMP_FROM_C) / RAMP_K_PER_MIN * 60.0
-    return dict(doc, duration_s=RAMP_LEAD_S + dur_ramp + RAMP_TAIL_S, csv_rate_hz=10,
-                ambient_c={"kind": "ramp", "value": RAMP_FROM_C,
-                           "slope_per_s": RAMP_K_PER_MIN / 60.0, "t_start_s": RAMP_LEAD_S,
-                           "t_end_s": RAMP_LEAD_S + dur_ramp})
+def ramp_scenario(doc, proto=FULL):
+    t_from, t_to, k_per_min, lead, tail = proto.ramp
+    dur_ramp = (t_to - t_from) / k_per_min * 60.0
+    return dict(doc, duration_s=lead + dur_ramp + tail, csv_rate_hz=10,
+                ambient_c={"kind": "ramp", "value": t_from, "slope_per_s": k_per_min / 60.0,
+                           "t_start_s": lead, "t_end_s": lead + dur_ramp})
 
 
-def noise_scenario(doc):
-    return dict(doc, duration_s=NOISE_S + START_S, csv_rate_hz=100)
+def noise_scenario(doc, proto=FULL):
+    return dict(doc, duration_s=proto.noise_s + START_S, csv_rate_hz=100)
+
+
+def rest_avg_s(dwell_s):
+    """The rest window judged before a plateau's rate steps: REST_AVG_S, or half of what a
+    short plateau leaves before them."""
+    return min(REST_AVG_S, 0.5 * (dwell_s - TAIL_S - 3 * STEP_S))
 
 
 def _window(t, t0, t1):
@@ -116,7 +150,7 @@ def plateau_windows(t, k, dwell_s):
     t_neg_end = t_pos2_end - STEP_S
     t_pos_end = t_neg_end - STEP_S
     t_rest_end = t_pos_end - STEP_S - TABLE_EDGE_S
-    return (_window(t, t_rest_end - REST_AVG_S, t_rest_end),
+    return (_window(t, t_rest_end - rest_avg_s(dwell_s), t_rest_end),
             _window(t, t_pos_end - STEP_AVG_S, t_pos_end),
             _window(t, t_neg_end - STEP_AVG_S, t_neg_end),
             _window(t, t_pos2_end - STEP_AVG_S, t_pos2_end))
@@ -170,12 +204,26 @@ def _lstsq(cols, y):
     return c, y - a @ c
 
 
-def fit(log, n_plateaus, dwell_s):
+def fitted_span(log, pts, span_from_data):
+    """(reference, half span) of the thermometer the fit covers: the plateaus' P, or with
+    span_from_data the extremes of the 1 s means of P_c at rest that the bias fit uses
+    (short plateaus do not reach their ambient; the transitions between them do reach
+    further, and the fit had them)."""
+    p = np.array([r["p_deg"] for r in pts])
+    if span_from_data:
+        t = log["t_s"]
+        rest = (np.abs(log["rate_true_dps"]) < 1e-9) & (t >= START_S)
+        p_c = comp_thermometer(t, log["p_f_deg"])
+        p = tempcomp.bin_average(t[rest], {"p": p_c[rest]}, BIN_S)["p"]
+    return 0.5 * (p.min() + p.max()), 0.5 * (p.max() - p.min())
+
+
+def fit(log, temps_c, dwell_s, span_from_data=False):
     """The compensation from the calibration run: a dict of firmware values and figures."""
+    n_plateaus = len(temps_c)
     pts = plateau_points(log, n_plateaus, dwell_s)
     p = np.array([r["p_deg"] for r in pts])
-    ref = 0.5 * (p.min() + p.max())
-    half = 0.5 * (p.max() - p.min())
+    ref, half = fitted_span(log, pts, span_from_data)
     x_pl = p - ref
     inv_gain = 1.0 / np.array([r["gain"] for r in pts])
     s = tempcomp.poly_fit(x_pl, inv_gain, min(SF_ORDER, n_plateaus - 2))
@@ -212,7 +260,7 @@ def fit(log, n_plateaus, dwell_s):
                    "rate.sf_c3_per_deg3": float(sf_c[3]), "rate.sf_c4_per_deg4": float(sf_c[4]),
                    "rate.bias_grad_dps_per_deg": float(c[4]),
                    "rate.grad_tau_s": float(best["tau"])})
-    figures = {"plateaus_c": list(CAL_PLATEAUS_C[:n_plateaus]), "dwell_s": dwell_s,
+    figures = {"plateaus_c": list(temps_c), "dwell_s": dwell_s,
                "p_deg": p.tolist(), "p_span_deg": float(2 * half),
                "raw_bias_dps": [r["bias_dps"] for r in pts],
                "raw_gain": [r["gain"] for r in pts], "scale_factor_s0": float(s0),
@@ -246,11 +294,12 @@ def verify_plateaus(log, temps_c, dwell_s):
     return rows
 
 
-def verify_ramp(log):
+def verify_ramp(log, proto=FULL):
+    t_from, t_to, k_per_min, lead, _ = proto.ramp
     t_end = log["t_s"][-1]
-    means, valid = bias_means(log, RAMP_LEAD_S, t_end)
+    means, valid = bias_means(log, lead, t_end)
     std = float(np.std(means)) if means.size else float("nan")
-    return {"from_c": RAMP_FROM_C, "to_c": RAMP_TO_C, "k_per_min": RAMP_K_PER_MIN,
+    return {"from_c": t_from, "to_c": t_to, "k_per_min": k_per_min,
             "bias_1s_std_dps": std,
             "bias_1s_max_abs_dps": float(np.max(np.abs(means))) if means.size else float("nan"),
             "valid_fraction": valid,
@@ -258,7 +307,7 @@ def verify_ramp(log):
                        valid >= LIMITS["valid_fraction"])}
 
 
-def verify_noise(log):
+def verify_noise(log, proto=FULL):
     t = log["t_s"]
     m = t >= START_S
     fs = 1.0 / float(np.median(np.diff(t)))
@@ -275,4 +324,4 @@ def verify_noise(log):
             "adev_10s_compensated_dph": at(comp, 10.0), "adev_10s_uncompensated_dph": at(unc, 10.0),
             "ratio_10s": at(comp, 10.0) / at(unc, 10.0),
             "how": "Allan deviation at 1 s (judged) and 10 s (reported) of rate_dps and "
-                   f"rate_unc_dps of the same {NOISE_S:g} s run at 25 degC, csv at {fs:g} Hz"}
+                   f"rate_unc_dps of the same {proto.noise_s:g} s run at 25 degC, csv at {fs:g} Hz"}
