@@ -11,6 +11,7 @@ import argparse
 import json
 import math
 import os
+import shlex
 import sys
 
 import numpy as np
@@ -23,6 +24,23 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
+
+    def parse_args(self, args=None, namespace=None):
+        """The options, with the command line as given kept for invocation()."""
+        argv = list(sys.argv[1:] if args is None else args)
+        ns = super().parse_args(argv, namespace)
+        ns.argv_ = argv
+        ns.prog_ = self.prog
+        return ns
+
+
+def invocation(a):
+    """What a tool's JSON records of how it was run: the command line as given (by a person
+    or by gyro-sim's analyses) and every option's value, defaults included, so that a
+    figure can be made again from its file alone."""
+    opts = {k: v for k, v in vars(a).items() if not k.endswith("_")}
+    return {"command": " ".join([a.prog_] + [shlex.quote(x) for x in a.argv_]),
+            "options": opts}
 
 
 def parser(prog, description):

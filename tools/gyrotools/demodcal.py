@@ -68,14 +68,24 @@ def calibrate(rates, mean_rate, mean_quad, phase_deg, scale_dps):
                     n_segments=int(x.size))
 
 
+def align(t_s, rate_dps, quad_dps, table):
+    """Where the table's schedule starts: its step edges in the output's principal
+    direction (the response lies along alpha, whatever the demodulation phase's error)."""
+    xy = np.column_stack([np.asarray(rate_dps, dtype=float), np.asarray(quad_dps, dtype=float)])
+    xy -= xy.mean(axis=0)
+    _, _, vt = np.linalg.svd(xy, full_matrices=False)
+    return scalefactor.align_table(t_s, xy @ vt[0], table, signed=False)[0]
+
+
 def analyse(t_s, rate_dps, quad_dps, phase_deg, scale_dps, rate_true_dps=None, table=None,
             t0_s=None, settle_s=1.0, min_avg_s=1.0):
     t_s = np.asarray(t_s, dtype=float)
     if rate_true_dps is not None:
         win = scalefactor.windows_from_truth(t_s, rate_true_dps, settle_s, min_avg_s)
     elif table is not None:
-        win = scalefactor.windows_from_table(t_s, table, t_s[0] if t0_s is None else t0_s,
-                                             settle_s, min_avg_s)
+        if t0_s is None:
+            t0_s = align(t_s, rate_dps, quad_dps, table)
+        win = scalefactor.windows_from_table(t_s, table, t0_s, settle_s, min_avg_s)
     else:
         raise InputError("the log has no rate_true_dps column: give the table schedule "
                          "(--table RATE:DWELL,...)")

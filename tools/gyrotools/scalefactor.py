@@ -17,8 +17,9 @@ cancel the bias, (out(+r) - out(-r)) / 2; those half differences are reported as
 
 Segments come from rate_true_dps when the log has it (gyro-sim): runs where it is
 constant. A `gyroctl` log of real hardware has no truth column: then the table schedule
-is given as a list of (rate deg/s, dwell s) starting at t0 (default: the first sample),
-e.g. "0:10,20:10,-20:10,40:10,-40:10".
+is given as a list of (rate deg/s, dwell s) starting at t0, e.g.
+"0:10,20:10,-20:10,40:10,-40:10"; t0 is found from the step edges (align_table: the lag
+at which the schedule correlates best with the output) unless given.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ import dataclasses
 import math
 
 import numpy as np
+from scipy import signal
 
 from .errors import InputError
 
@@ -108,6 +110,45 @@ def windows_from_table(t_s, table, t0_s, settle_s, min_avg_s):
     return out
 
 
+# Auto-alignment: the schedule's correlation with the output at the best lag below this is
+# no alignment (a table with the wrong schedule, or a log of something else).
+ALIGN_MIN_CORR = 0.9
+
+
+def schedule_wave(table, dt_s):
+    """The schedule's rate at steps of dt_s from its start."""
+    return np.concatenate([np.full(max(1, int(round(d / dt_s))), float(r)) for r, d in table])
+
+
+def align_table(t_s, out, table, signed=True):
+    """(t0, correlation): where the schedule [(rate, dwell)] starts in the log, from the
+    step edges: the lag at which the schedule's rate correlates best with the output (the
+    output is bias + SF rate + noise; its lag to the table is the 100 Hz output's few ms).
+    The whole schedule must lie in the log. signed=False: the output's sign is unknown
+    (the strongest correlation of either sign)."""
+    t_s = np.asarray(t_s, dtype=float)
+    dt = float(np.median(np.diff(t_s)))
+    wave = schedule_wave(table, dt)
+    y = np.asarray(out, dtype=float)
+    if wave.size > y.size:
+        raise InputError(f"record too short to align the table: {t_s[-1] - t_s[0]:.4g} s of "
+                         f"log, the schedule lasts {sum(d for _, d in table):.4g} s "
+                         "(give --t0, or a log of the whole table)")
+    w = wave - wave.mean()
+    if not np.any(w):
+        raise InputError("the table schedule has one rate only: nothing to align on")
+    num = signal.correlate(y - y.mean(), w, mode="valid")
+    k = int(np.argmax(num if signed else np.abs(num)))
+    seg = y[k:k + w.size]
+    corr = float(np.corrcoef(seg, w)[0, 1]) if np.std(seg) > 0 else 0.0
+    corr = corr if signed else abs(corr)
+    if not corr >= ALIGN_MIN_CORR:
+        raise InputError(f"cannot align the table schedule with the log (best correlation "
+                         f"{corr:.3f} at {t_s[k]:.4g} s, below {ALIGN_MIN_CORR:g}): check "
+                         "--table, or give --t0")
+    return float(t_s[k]), corr
+
+
 def segment_means(t_s, out, windows, p_deg=None):
     """Averages of out (and P) over each window."""
     segs = []
@@ -186,8 +227,9 @@ def analyse(t_s, out, rate_true_dps=None, table=None, t0_s=None, settle_s=1.0,
     if rate_true_dps is not None:
         win = windows_from_truth(t_s, rate_true_dps, settle_s, min_avg_s)
     elif table is not None:
-        win = windows_from_table(t_s, table, t_s[0] if t0_s is None else t0_s, settle_s,
-                                 min_avg_s)
+        if t0_s is None:
+            t0_s, _ = align_table(t_s, out, table)
+        win = windows_from_table(t_s, table, t0_s, settle_s, min_avg_s)
     else:
         raise InputError("the log has no rate_true_dps column: give the table schedule "
                          "(--table RATE:DWELL,...)")

@@ -106,6 +106,10 @@ def test_gyro_scalefactor_with_and_without_truth(run_script, logs, tmp_path):
     k = load(tmp_path, "scalefactor.json")
     assert k["segments_from"] == "--table"
     assert k["scale_factor_out_per_dps"] == pytest.approx(j["scale_factor_out_per_dps"])
+    # How each was made: the command line as given and every option, defaults included.
+    assert "--settle 1.5" in j["command"] and j["options"]["settle"] == 1.5
+    assert j["options"]["min_avg"] == pytest.approx(0.5) and "argv_" not in j["options"]
+    assert k["table_aligned"]["correlation"] > 0.9 and k["options"]["table"] == sched
 
 
 def test_gyro_freqresp(run_script, logs, tmp_path):

@@ -46,3 +46,21 @@ def test_corrected_frame_has_no_leakage():
 def test_rejects_single_rate():
     with pytest.raises(InputError):
         demodcal.calibrate([10, 10], [1, 1], [0, 0], 0.0, 1.0)
+
+
+@pytest.mark.parametrize("err_deg", [3.0, 100.0])
+def test_table_aligned_whatever_the_phase_error(err_deg):
+    """A log without truth starting before the table: the schedule's start is found from
+    the step edges of the output vector, even with the response far off the rate axis."""
+    fs, dwell, lead = 100.0, 4.0, 3.7
+    rates = [0, 40, -40, 80, -80, 160, -160, 0]
+    truth = np.concatenate([np.zeros(int(lead * fs))] + [np.full(int(dwell * fs), float(x))
+                                                          for x in rates])
+    a = math.radians(err_deg)
+    rng = np.random.default_rng(7)
+    z = (0.9 * truth + 1j * 1500.0) * np.exp(1j * a) + 0.05 * rng.standard_normal(truth.size)
+    t = np.arange(truth.size) / fs
+    table = [(float(x), dwell) for x in rates]
+    assert demodcal.align(t, z.real, z.imag, table) == pytest.approx(lead, abs=0.02)
+    res = demodcal.analyse(t, z.real, z.imag, 60.0, 100.0, table=table, settle_s=0.5)
+    assert res.phase_deg == pytest.approx(60.0 + err_deg, abs=0.01)

@@ -121,3 +121,30 @@ def test_negative_scale_factor_is_refused():
     out = [-0.47 * r + 0.1 for r in rates]
     with pytest.raises(InputError, match="negative"):
         scalefactor.fit(rates, out)
+
+
+def test_table_aligned_on_its_step_edges():
+    """A gyroctl log starts before the table: the schedule is found from the step edges,
+    and the scale factor is the one the truth gives."""
+    t, r, y = table_log()
+    lead = int(7.3 * FS)
+    y2 = np.concatenate([B + 0.02 * np.random.default_rng(3).standard_normal(lead), y])
+    t2 = np.arange(y2.size) / FS + 100.0
+    table = scalefactor.parse_table(",".join(f"{x:g}:{DWELL:g}" for x in RATES))
+    t0, corr = scalefactor.align_table(t2, y2, table)
+    # The output lags the table by the channel's low-pass (LAG_S): within one lag.
+    assert 107.3 <= t0 <= 107.3 + LAG_S
+    assert corr > 0.98  # the cubic and the lag are not in the schedule
+    a = scalefactor.analyse(t2, y2, table=table, settle_s=1.5)
+    b = scalefactor.analyse(t, y, rate_true_dps=r, settle_s=1.5)
+    assert a.sf == pytest.approx(b.sf, rel=1e-4)
+
+
+def test_alignment_refuses_a_short_record_and_a_wrong_schedule():
+    t, r, y = table_log()
+    table = scalefactor.parse_table(",".join(f"{x:g}:{DWELL:g}" for x in RATES))
+    with pytest.raises(InputError, match="record too short"):
+        scalefactor.align_table(t[: t.size // 2], y[: t.size // 2], table)
+    noise = np.random.default_rng(5).standard_normal(y.size)
+    with pytest.raises(InputError, match="cannot align"):
+        scalefactor.align_table(t, noise, scalefactor.parse_table("0:6,100:6,-100:6"))
