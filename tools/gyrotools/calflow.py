@@ -43,7 +43,7 @@ import zlib
 
 import numpy as np
 
-from . import csvlog, demodcal, lincal, paramset, scalefactor, thermcal
+from . import csvlog, demodcal, fields, lincal, paramset, scalefactor, thermcal
 from .errors import InputError
 
 # Rate-table iterations: the demodulation is linear in the phasors, so one pass is exact
@@ -135,7 +135,7 @@ def selfcal(part):
                  "true_f0_hz": f.get("selfcal_true_f0_hz"), "true_q": f.get("selfcal_true_q")}
 
 
-LOG_COLUMNS = ["rate_dps", "quad_dps", "rate_true_dps", "rate_valid"]
+LOG_COLUMNS = ["rate_dps", "quad_dps", "rate_true_dps", "rate_valid", "rate_invalid"]
 THERMAL_COLUMNS = LOG_COLUMNS + ["rate_unc_dps", "p_f_deg", "t_struct_c"]
 
 
@@ -396,6 +396,7 @@ def verify(part, cal_path):
             "subrange_min_span_dps": lincal.SUBRANGE_MIN_DPS, "subrange_worst": worst_sub,
             "subrange_slopes": sub, "bias_at_rest_dps": bias,
             "valid_fraction_in_dwell": valid_frac, "worst_valid_error_dps": worst,
+            "invalid_s_by_reason": fields.invalid_time_s(t, log["rate_invalid"]),
             "selftest": st_state,
             "limits": {"scale_factor_ppm": VERIFY_SF_PPM, "bias_dps": VERIFY_BIAS_DPS,
                        "subrange_slope_ppm": lincal.SUBRANGE_PPM,
@@ -414,7 +415,8 @@ def _thermal_runs(part, cal_path):
         scen = _scenario(part, "calibrate_" + name, doc)
         log, _, cmd = _sim(part, cal_path, scen, seed + k, name, csv=True,
                            columns=THERMAL_COLUMNS)
-        return dict(judge(log), command=cmd, seed=seed + k)
+        return dict(judge(log), command=cmd, seed=seed + k,
+                    invalid_s_by_reason=fields.invalid_time_s(log["t_s"], log["rate_invalid"]))
 
     def judge_plateaus(log):
         rows = thermcal.verify_plateaus(log, temps, proto.dwell_s)

@@ -11,7 +11,33 @@ Units follow the name's suffix, which the firmware's table keeps by rule
 
 from __future__ import annotations
 
+import numpy as np
+
 ALIASES = {"drive_amp": "drive_amp_v", "drive_amp_v": "drive_amp"}
+
+# The RATE_INVALID_* reasons by bit (firmware/gyro/rate_valid.h; the column rate_invalid
+# and `status`); tests/test_fields.py holds them to the header.
+RATE_INVALID = ("MODE", "SELFTEST", "SETTLING", "CLIP", "SENSE_RANGE", "OVER_RANGE", "PHASE",
+                "THERMO_RANGE", "THERMO_SLEW", "THERMO_SETTLE", "CONT_SELFTEST", "TRACKING",
+                "UNCALIBRATED")
+
+
+def invalid_time_s(t_s, rate_invalid):
+    """Seconds of a log with each RATE_INVALID_* reason set (a row stands for the time to
+    the next; reasons overlap, so the sum may exceed the invalid time): {name: s}, the
+    reasons never set left out."""
+    t = np.asarray(t_s, dtype=float)
+    bits = np.asarray(rate_invalid).astype(np.int64)
+    if t.size < 2:
+        return {}
+    dt = np.diff(t, append=t[-1] + float(np.median(np.diff(t))))
+    out = {}
+    for k, name in enumerate(RATE_INVALID):
+        sec = float(np.sum(dt[(bits >> k) & 1 == 1]))
+        if sec > 0.0:
+            out[name] = sec
+    return out
+
 
 # Units that the suffix rule cannot give.
 UNIT_BY_NAME = {"drive_amp": "V", "flags": "-", "mode": "-", "fault": "-", "tick": "-",
@@ -49,6 +75,8 @@ CSV_MEANING = {
                   "times rate.out_v_per_dps when valid, rate.fault_out_v when not (firmware)",
     "f_drive_hz": "drive (NCO) frequency, from its integer step: the tracked resonance with "
                   "drive.track 1 (firmware; telemetry f_drive_hz, a float)",
+    "rate_invalid": "RATE_INVALID_* reasons of the tick's verdict, 0 when the rate is valid "
+                    "(firmware/gyro/rate_valid.h; `status` names them)",
 }
 
 
