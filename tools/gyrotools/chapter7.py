@@ -151,7 +151,7 @@ def verification_rows(part, vf):
     rows = [
         ("flow verification: scale factor (+-20..160) / worst sub-range slope / bias at rest",
          f"{vf['sf_ppm']:+.0f} ppm / {vf['subrange_worst_ppm']:+.0f} ppm / {vf['bias_at_rest_dps']:+.3f} deg/s",
-         "7.25 mV/(deg/s) / 0.348 % FS"),
+         ""),
         (f"flow verification: unseen plateaus {pc} degC: bias / scale factor",
          f"{vf['plateau_bias_dps'][0]:+.3f}..{vf['plateau_bias_dps'][1]:+.3f} deg/s / "
          f"{vf['plateau_sf_ppm'][0]:+.0f}..{vf['plateau_sf_ppm'][1]:+.0f} ppm", ""),
