@@ -280,10 +280,11 @@ static int alg_exp(alg_t b, alg_t e)
 /* Taylor blocks at structure temperature temp_k (e = 0 there) and quality factors q:
  * exp(h A) in the truncated algebra is sum_i mono_i P_i, the P_i being the blocks
  * [Phi Gamma]. Returns -2 (blk untouched) for a non-finite generator. */
-static int discretise_blocks(const mech_cfg_t *c, double wr, double temp_k,
+static int discretise_blocks(const mech_cfg_t *c, double wr, double temp_k, double clock,
                              const double qual[2], alg_t blk)
 {
-  const double wn1 = wn_at(c, c->f1_hz, temp_k), wn2 = wn_at(c, c->f2_hz, temp_k);
+  const double wn1 = clock * wn_at(c, c->f1_hz, temp_k);
+  const double wn2 = clock * wn_at(c, c->f2_hz, temp_k);
   const double h = wr / c->fs_hz;
 
   alg_t ahat; /* 2.3 kB: the only scratch */
@@ -297,8 +298,9 @@ static int discretise_blocks(const mech_cfg_t *c, double wr, double temp_k,
 /* Re-discretise at temp_k with the Q of m->q_now; m unchanged on failure. */
 static int discretise(mech_t *m, double temp_k)
 {
-  if (discretise_blocks(&m->cfg, m->wr, temp_k, m->q_now, m->blk) != 0) return -2;
+  if (discretise_blocks(&m->cfg, m->wr, temp_k, m->clock, m->q_now, m->blk) != 0) return -2;
   m->temp_disc_k = temp_k;
+  m->clock_disc = m->clock;
   m->q_disc[0] = m->q_now[0];
   m->q_disc[1] = m->q_now[1];
   m->eps = 0.0;
@@ -326,8 +328,9 @@ int mech_init(mech_t *m, const mech_cfg_t *cfg, double temp_k, uint64_t seed)
   const double wr = 2.0 * kPi * c.f1_hz;
   int out[2];
   const double q[2] = {q_at(&c, 0, temp_k, &out[0]), q_at(&c, 1, temp_k, &out[1])};
-  if (discretise_blocks(&c, wr, temp_k, q, m->blk) != 0) return -2;
+  if (discretise_blocks(&c, wr, temp_k, 1.0, q, m->blk) != 0) return -2;
   m->cfg = c;
+  m->clock = m->clock_disc = 1.0;
   for (int i = 0; i < 2; i++) m->q_now[i] = m->q_disc[i] = q[i];
   m->q_out = (out[0] || out[1]) ? MECH_OUT_Q : 0u;
   m->duffing_out = 0u;
@@ -363,15 +366,15 @@ static int update_q(mech_t *m, double temp_k)
          fabs(m->q_now[1] / m->q_disc[1] - 1.0) > m->cfg.refresh_eps;
 }
 
-int mech_set_temp(mech_t *m, double temp_k)
+/* The blocks' e for the present temperature and clock; re-discretised when it (or Q)
+ * moved by refresh_eps. */
+static int rescale(mech_t *m, int q_moved)
 {
-  if (!temp_ok(&m->cfg, temp_k)) return -1;
-  if (temp_k == m->temp_k) return 0;
-  m->temp_k = temp_k;
-  const int q_moved = update_q(m, temp_k);
-  const double e = wn_at(&m->cfg, 1.0, temp_k) / wn_at(&m->cfg, 1.0, m->temp_disc_k) - 1.0;
+  const double e = m->clock * wn_at(&m->cfg, 1.0, m->temp_k) /
+                       (m->clock_disc * wn_at(&m->cfg, 1.0, m->temp_disc_k)) -
+                   1.0;
   if (fabs(e) > m->cfg.refresh_eps || q_moved) {
-    if (discretise(m, temp_k) != 0) {
+    if (discretise(m, m->temp_k) != 0) {
       /* cannot happen for a validated cfg (discretise fails before it writes
        * anything); stay on the old blocks */
       m->eps = e;
@@ -384,6 +387,22 @@ int mech_set_temp(mech_t *m, double temp_k)
   }
   update_noise(m);
   return 0;
+}
+
+int mech_set_temp(mech_t *m, double temp_k)
+{
+  if (!temp_ok(&m->cfg, temp_k)) return -1;
+  if (temp_k == m->temp_k) return 0;
+  m->temp_k = temp_k;
+  return rescale(m, update_q(m, temp_k));
+}
+
+int mech_set_clock(mech_t *m, double clock)
+{
+  if (!(isfinite(clock) && clock > 0.5 && clock < 2.0)) return -1;
+  if (clock == m->clock) return 0;
+  m->clock = clock;
+  return rescale(m, 0);
 }
 
 /* Collapse the temperature powers at the current e: q[p][r] = sum over the blocks of
@@ -532,8 +551,8 @@ void mech_set_state(mech_t *m, const mech_state_t *s)
   m->z[3] = s->vx_mps / m->wr;
 }
 
-double mech_wn1(const mech_t *m) { return wn_at(&m->cfg, m->cfg.f1_hz, m->temp_k); }
-double mech_wn2(const mech_t *m) { return wn_at(&m->cfg, m->cfg.f2_hz, m->temp_k); }
+double mech_wn1(const mech_t *m) { return m->clock * wn_at(&m->cfg, m->cfg.f1_hz, m->temp_k); }
+double mech_wn2(const mech_t *m) { return m->clock * wn_at(&m->cfg, m->cfg.f2_hz, m->temp_k); }
 
 double mech_q1(const mech_t *m) { return m->q_now[0]; }
 double mech_q2(const mech_t *m) { return m->q_now[1]; }

@@ -168,7 +168,9 @@ typedef struct {
   double wr;          /* scaling frequency wn1(T0), rad/s */
   double temp_k;      /* structure temperature now */
   double temp_disc_k; /* temperature of the current Taylor blocks */
-  double eps;         /* wn(temp_k)/wn(temp_disc_k) - 1 */
+  double eps;         /* wn(temp_k) clock/(wn(temp_disc_k) clock_disc) - 1 */
+  double clock;       /* time scale of the sample clock: wn seen per sample, 1 = exact */
+  double clock_disc;  /* ... of the current Taylor blocks */
   double blk[MECH_NMONO][MECH_NS][MECH_NS + MECH_NU]; /* Taylor blocks [Phi Gamma] */
   double q[4][2][MECH_NS][MECH_NS + MECH_NU];         /* blocks of w^p a^r summed over e^k */
   double qmax[4][2];                    /* largest entry of each, to skip negligible terms */
@@ -221,6 +223,13 @@ void mech_set_state(mech_t *m, const mech_state_t *s);
 
 /* Resonances at the current structure temperature (2-32), rad/s (mechanical: without
  * the electrostatic softening). */
+/* The sample clock runs fast by e (a crystal's error): the plant's physics see the
+ * sample period 1/(fs (1 + e)), so every rate of the mechanics per sample (resonances,
+ * their damping, the couplings: the generator's e-expansion) scales by
+ * clock = 1 / (1 + e). The Coriolis term and the input forces keep true time: their
+ * error is e itself (ppm of scale), against the resonance's e times 2Q of phase.
+ * Re-discretises like mech_set_temp. -1 for a non-finite or non-positive clock. */
+int mech_set_clock(mech_t *m, double clock);
 double mech_wn1(const mech_t *m);
 double mech_wn2(const mech_t *m);
 

@@ -264,6 +264,18 @@ static void truth_temps(plant_t *p, double ambient_k)
   t->q_drive = mech_q1(&p->mech);
 }
 
+/* The sample clock's error at time t_s (plant.h, clock_*): the mechanics see the sample
+ * period of a clock fast by it. */
+static void clock_update(plant_t *p, double t_s)
+{
+  const plant_cfg_t *c = &p->cfg;
+  const double board_c = thermal_temp(&p->thermal, THERMAL_BOARD) - 298.15;
+  const double e_ppm = c->clock_ppm + c->clock_tempco_ppm_per_k * board_c +
+                       c->clock_ageing_ppm_per_day * t_s / 86400.0;
+  p->truth.clock_ppm = e_ppm;
+  (void)mech_set_clock(&p->mech, 1.0 / (1.0 + 1e-6 * e_ppm));
+}
+
 int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
 {
   if (p == NULL) return -1;
@@ -341,6 +353,7 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   p->thermal_countdown = 0; /* first update at the first sample */
   p->truth_countdown = c->truth_decim;
   p->fz_alpha = 1.0 - exp(-p->T / c->truth_force_tau_s);
+  clock_update(p, 0.0);
   truth_temps(p, c->temp_k);
   if (out_mech) warn(p, PLANT_LAW_RESONANCE);
   for (int i = 0; i < 2; i++) warn_pickoff(p, i, p->pick[i].out_of_range);
@@ -413,6 +426,7 @@ static void thermal_update(plant_t *p, double t0)
   if (p->drift_on)
     (void)mech_set_coupling_drift(&p->mech, p->drift_kq_per_s2 * drift_step(&p->drift[0]),
                                   p->drift_dq_per_s * drift_step(&p->drift[1]));
+  clock_update(p, t0);
   truth_temps(p, amb);
 }
 

@@ -279,6 +279,14 @@
     "board sensor spot self-heating rise if alone") \
   X(double, thermal_dt_s, DOUBLE, 1e-5, 10.0, "s", \
     "thermal update period (rounded to whole samples)") \
+  /* the sample clock (the MCU's crystal): the firmware's time; the plant's physics keep \
+   * true time (mech_set_clock) */ \
+  X(double, clock_ppm, DOUBLE, -1000.0, 1000.0, "ppm", \
+    "sample clock's error at 25 degC board temperature, time zero (+: fast)") \
+  X(double, clock_tempco_ppm_per_k, DOUBLE, -10.0, 10.0, "ppm/K", \
+    "sample clock's change with the board node's temperature (linear about 25 degC)") \
+  X(double, clock_ageing_ppm_per_day, DOUBLE, -10.0, 10.0, "ppm/day", \
+    "sample clock's drift with time since power-on (ageing, linear)") \
   /* switches (kept at the end so the struct has no padding between fields) */ \
   X(int, truth_decim, INT, 1, 1000000, "", "phasor truth (amplitudes, phases) every n samples") \
   X(int, fb_mode, INT, 0, 2, "", \
@@ -323,7 +331,8 @@ typedef struct {
   double accel_g[3]; /* mean over the last sample */
   /* temperatures */
   double ambient_k, struct_k, circuit_k, board_k;
-  double wn_drive_rad_s; /* drive resonance now (2-32) */
+  double wn_drive_rad_s; /* drive resonance now (2-32), per second of the sample clock */
+  double clock_ppm;      /* the sample clock's error now (+: fast; plant_cfg_t clock_*) */
   double q_drive;        /* drive quality factor now (q_temp_law) */
   /* motion (state at t_s) */
   double y_m, vy_mps, x_m, vx_mps;

@@ -75,6 +75,55 @@ static void test_cfg_validation(void **state)
   assert_true(fabs(m.temp_k - 300.0) < 1e-12);
 }
 
+/* ------------------------------------------------ the sample clock --------------- */
+
+/* Mean period in samples of the free drive oscillation over n_cycles, from the linearly
+ * interpolated upward zero crossings of y. */
+static double ring_period_samples(mech_t *m, int n_cycles)
+{
+  mech_state_t s0 = {1e-6, 0.0, 0.0, 0.0};
+  mech_set_state(m, &s0);
+  double prev = 1e-6, first = -1.0, last = -1.0;
+  int crossings = 0;
+  for (int k = 1; crossings <= n_cycles && k < 100000; k++) {
+    mech_step(m, 0.0, 0.0, 0.0, 0.0);
+    const double y = mech_state(m).y_m;
+    if (prev < 0.0 && y >= 0.0) {
+      last = (double)(k - 1) + prev / (prev - y);
+      if (first < 0.0) first = last;
+      crossings++;
+    }
+    prev = y;
+  }
+  return (last - first) / (double)(crossings - 1);
+}
+
+/* A sample clock fast by e: the resonance per sample is lower by 1 / (1 + e), its
+ * damping with it (Q unchanged); bad clocks are refused and change nothing. */
+static void test_clock_scales_the_resonance_per_sample(void **state)
+{
+  (void)state;
+  mech_cfg_t c;
+  mech_default_cfg(&c);
+  c.q1 = 1e4;
+  c.brownian = 0;
+  static mech_t m;
+  assert_int_equal(mech_init(&m, &c, 300.0, 1u), 0);
+  const double wn = mech_wn1(&m), p0 = ring_period_samples(&m, 20);
+  const double e = 1e-3, clock = 1.0 / (1.0 + e);
+  assert_int_equal(mech_set_clock(&m, clock), 0);
+  assert_true(fabs(mech_wn1(&m) / wn - clock) < 1e-15);
+  const double p1 = ring_period_samples(&m, 20);
+  assert_true(fabs(p1 / p0 - (1.0 + e)) < 2e-6);
+  assert_true(fabs(mech_q1(&m) - 1e4) < 1e-9);
+  assert_true(mech_set_clock(&m, NAN) < 0);
+  assert_true(mech_set_clock(&m, 0.0) < 0);
+  assert_true(fabs(m.clock - clock) < 1e-15);
+  /* back to the exact clock: the period it had */
+  assert_int_equal(mech_set_clock(&m, 1.0), 0);
+  assert_true(fabs(ring_period_samples(&m, 20) / p0 - 1.0) < 2e-6);
+}
+
 /* -------------------------------------------- analytic steady states ------------ */
 
 typedef struct {
@@ -544,6 +593,7 @@ int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_cfg_validation),
+      cmocka_unit_test(test_clock_scales_the_resonance_per_sample),
       cmocka_unit_test(test_open_loop_2_24_2_25),
       cmocka_unit_test(test_full_kinematics_steady),
       cmocka_unit_test(test_closed_drive_2_28),

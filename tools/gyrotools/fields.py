@@ -41,7 +41,7 @@ def invalid_time_s(t_s, rate_invalid):
 
 # Units that the suffix rule cannot give.
 UNIT_BY_NAME = {"drive_amp": "V", "flags": "-", "mode": "-", "fault": "-", "tick": "-",
-                "rate_valid": "-", "rate_invalid": "-"}
+                "rate_valid": "-", "rate_invalid": "-", "clock_ppm": "ppm"}
 SUFFIX_UNITS = (("_dps", "deg/s"), ("_v2", "V^2"), ("_deg", "deg"), ("_v", "V"),
                 ("_c", "degC"), ("_m", "m"), ("_s", "s"), ("_hz", "Hz"))
 
@@ -75,6 +75,9 @@ CSV_MEANING = {
                   "times rate.out_v_per_dps when valid, rate.fault_out_v when not (firmware)",
     "f_drive_hz": "drive (NCO) frequency, from its integer step: the tracked resonance with "
                   "drive.track 1 (firmware; telemetry f_drive_hz, a float)",
+    "clock_ppm": "the sample clock's error (+: fast), plant.clock_* (truth)",
+    "f_drive_true_hz": "f_drive_hz in true time: the NCO's frequency on the sample clock as "
+                       "it really runs, f_drive_hz (1 + clock_ppm 1e-6) (truth)",
     "rate_invalid": "RATE_INVALID_* reasons of the tick's verdict, 0 when the rate is valid "
                     "(firmware/gyro/rate_valid.h; `status` names them)",
 }
