@@ -29,6 +29,10 @@ def _fail_text(line, x) -> str:
     return f"{line.figure} {x:.4g} > {line.hi:g}"
 
 
+def _failed(v) -> bool:
+    return v is not pd.NA and not bool(v)
+
+
 def judge(df: pd.DataFrame, lines) -> pd.DataFrame:
     """df with pass.FIGURE per line, pass and fail_reason (the previous ones replaced)."""
     df = df.drop(columns=[c for c in df.columns if c.startswith("pass.")] + ["pass", "fail_reason"],
@@ -42,7 +46,7 @@ def judge(df: pd.DataFrame, lines) -> pd.DataFrame:
     for i in df.index:
         why = [flow[i]] if flow[i] else []
         why += [_fail_text(ln, float(df.at[i, ln.figure])) for ln in lines
-                if cols[f"pass.{ln.figure}"][i] is False]
+                if _failed(cols[f"pass.{ln.figure}"][i])]
         reasons.append("; ".join(why))
         passed.append(not why)
     extra = pd.DataFrame(cols, index=df.index)

@@ -211,6 +211,23 @@ def _worst_md(df, lines, out) -> list:
     return md
 
 
+def _runs_md(out: str) -> list:
+    try:
+        with open(os.path.join(out, "runs.json"), encoding="utf-8") as fh:
+            runs = json.load(fh)
+    except (OSError, ValueError):
+        return []
+    md = ["## Runs", "", "Host facts (DIR/runs.json, DIR/timings.parquet); part-hours count the scenarios' "
+          "simulated time, not the calibration's.", "",
+          "| workers | parts run | wall (s) | simulated part-hours | part-hours per wall-hour |",
+          "| --- | --- | --- | --- | --- |"]
+    for r in runs:
+        rate = r.get("part_hours_per_wall_hour")
+        md.append(f"| {r.get('workers')} | {r.get('parts_run')} | {r.get('wall_s', 0):.1f} | "
+                  f"{r.get('sim_s', 0) / 3600:.3g} | {'n/a' if rate is None else f'{rate:.1f}'} |")
+    return md + [""]
+
+
 def report(out: str, title: str = "") -> str:
     df, lines, units = load_dir(out)
     ylines = line_yields(df, lines)
@@ -220,7 +237,7 @@ def report(out: str, title: str = "") -> str:
     for ln in lines:
         png = histogram(df, ln, units, out)
         md.append(f"![{ln.figure}]({png})" if png else f"`{ln.figure}`: not measured on any part.")
-    md += [""] + _cost_md(df, ylines, units, out) + _worst_md(df, lines, out)
+    md += [""] + _cost_md(df, ylines, units, out) + _worst_md(df, lines, out) + _runs_md(out)
     return write_text(os.path.join(out, "report.md"), "\n".join(md) + "\n")
 
 

@@ -1,13 +1,13 @@
 """The lot's engine: parts scheduled on Dask, each finished part kept, tables gathered.
 
-DIR/stamp.json is the version stamp (gyro-sim's sha256, the tools' git commit, the lot
-file's digest, --quick); every part's row carries its id, and a DIR made by another
-version is refused rather than mixed. A finished part is DIR/parts/NNNNN/row.json
-(written atomically, with timing.json and commands.json beside it); the same command
-run again skips those parts, so an interrupted lot loses nothing. A part that times out
-or whose worker dies is retried (Dask's retries); one that still fails is an error of
-the tool, not of the part: it has no row, the run exits non-zero, and the same command
-runs it again.
+DIR/stamp.json is the version stamp (gyro-sim's sha256, that of the Python making the
+parts' values, the lot file's digest, --quick; the git commit for the record); every
+part's row carries its id, and a DIR made by another version is refused, not mixed.
+A finished part is DIR/parts/NNNNN/row.json (written atomically, with timing.json and
+commands.json beside it); the same command run again skips those parts, so an
+interrupted lot loses nothing. A part that times out or whose worker dies is retried
+(Dask's retries); one that still fails is an error of the tool, not of the part: it has
+no row, the run exits non-zero, and the same command runs it again.
 
 Gathered: DIR/lot.parquet (one row per part, sorted, first column `part`; only values
 that the versions, the lot file and the part index decide) and DIR/timings.parquet
@@ -43,6 +43,14 @@ class Outcome:
     failed: int = 0
     errors: dict = dataclasses.field(default_factory=dict)
     wall_s: float = 0.0
+    sim_s: float = 0.0          # the scenarios' simulated time of the parts run (not the calibration's)
+    workers: int = 0
+
+    def record(self) -> dict:
+        """What DIR/runs.json keeps of this run (host facts, for the throughput)."""
+        return {"finished_unix_s": time.time(), "workers": self.workers, "parts_run": self.finished,
+                "errors": len(self.errors), "wall_s": self.wall_s, "sim_s": self.sim_s,
+                "part_hours_per_wall_hour": self.sim_s / self.wall_s if self.wall_s > 0 else None}
 
 
 def _sha256(path: str) -> str:
@@ -62,10 +70,26 @@ def _commit() -> str:
         return "unknown"
 
 
+def tools_digest() -> str:
+    """The Python that makes a part's values: tools/calibrate and gyrotools, less the
+    modules that only schedule, judge and report (judged again on every gather)."""
+    h = hashlib.sha256()
+    pkg = os.path.join(TOOLS, "gyrotools")
+    files = [os.path.join(TOOLS, "calibrate")] + sorted(
+        os.path.join(pkg, f) for f in os.listdir(pkg)
+        if f.endswith(".py") and f not in ("lotrun.py", "lotjudge.py", "lotreport.py", "plotting.py"))
+    for path in files:
+        with open(path, "rb") as fh:
+            h.update(os.path.basename(path).encode() + b"\0" + fh.read())
+    return h.hexdigest()
+
+
 def make_stamp(lot, gyro_sim: str, quick: bool) -> dict:
-    s = {"format": 1, "gyro_sim_sha256": _sha256(gyro_sim), "tools_commit": _commit(),
+    """What decides a part's values (its id guards DIR), and the git commit for the record."""
+    s = {"format": 1, "gyro_sim_sha256": _sha256(gyro_sim), "tools_sha256": tools_digest(),
          "lot_sha256": lot.digest, "quick": bool(quick)}
     s["id"] = hashlib.sha256(json.dumps(s, sort_keys=True).encode()).hexdigest()[:16]
+    s["git"] = _commit()
     return s
 
 
@@ -89,7 +113,7 @@ def claim(out: str, stamp: dict):
         except (OSError, ValueError):
             raise InputError(f"{path}: unreadable stamp; delete {out} or use another --out") from None
         if old.get("id") != stamp["id"]:
-            diff = [k for k in stamp if k != "id" and old.get(k) != stamp[k]]
+            diff = [k for k in stamp if k not in ("id", "git") and old.get(k) != stamp[k]]
             raise InputError(f"{out}: holds parts of another version ({', '.join(diff) or 'format'} "
                              "differ): use another --out, or delete it")
     else:
@@ -161,6 +185,7 @@ def schedule(lot, out: str, n: int, todo: list, opts) -> Outcome:
     from distributed import as_completed
     res = Outcome(done_before=n - len(todo))
     client, cluster = _client(opts.workers, opts.scheduler, getattr(opts, "threads", False))
+    res.workers = len(client.scheduler_info().get("workers", {}))
     bar = _bar(n, res.done_before, opts.progress)
     t0 = time.monotonic()
     try:
@@ -177,6 +202,7 @@ def schedule(lot, out: str, n: int, todo: list, opts) -> Outcome:
             else:
                 _keep(out, k, r)
                 res.finished += 1
+                res.sim_s += r["timing"].get("sim_s", 0.0)
                 res.failed += 0 if _passes(r["row"], lot) else 1
             bar.update(1)
             bar.set_postfix(failed=res.failed, errors=len(res.errors), refresh=False)
@@ -221,6 +247,17 @@ def gather(lot, out: str, n: int):
     tf = _frame(timings).sort_values("part").reset_index(drop=True)
     tf.to_parquet(os.path.join(out, "timings.parquet"), index=False)
     return df
+
+
+def log_run(out: str, res: Outcome):
+    """Appends the run's record to DIR/runs.json."""
+    path = os.path.join(out, "runs.json")
+    try:
+        with open(path, encoding="utf-8") as fh:
+            runs = json.load(fh)
+    except (OSError, ValueError):
+        runs = []
+    _write_atomic(out, "runs.json", runs + [res.record()])
 
 
 def save_inputs(lot, out: str):
