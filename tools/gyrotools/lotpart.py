@@ -108,6 +108,22 @@ def _sets(d: dict) -> list:
     return out
 
 
+def _kill_tree(p: subprocess.Popen):
+    """Ends a process and what it started (tools/calibrate runs gyro-sim). Kept in the
+    caller's process group, so that a Ctrl-C at the terminal reaches them all too."""
+    import psutil  # a dependency of distributed
+    try:
+        kids = psutil.Process(p.pid).children(recursive=True)
+    except psutil.NoSuchProcess:
+        kids = []
+    for c in kids + [p]:
+        try:
+            c.kill()
+        except (psutil.NoSuchProcess, ProcessLookupError):
+            pass
+    p.communicate()
+
+
 class _Runner:
     """Runs the part's processes against one deadline, timing each."""
 
@@ -121,11 +137,14 @@ class _Runner:
             raise PartTimeout(f"part {self.job.part}: over {self.job.timeout_s:g} s before {stage}")
         self.commands.append(shlex.join(cmd))
         t = time.monotonic()
+        p = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         try:
-            r = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=left)
+            out, err = p.communicate(timeout=left)
         except subprocess.TimeoutExpired:
+            _kill_tree(p)
             raise PartTimeout(f"part {self.job.part}: {stage} still running after the part's "
                               f"{self.job.timeout_s:g} s") from None
+        r = subprocess.CompletedProcess(cmd, p.returncode, out, err)
         self.stages[f"{stage}_wall_s"] = time.monotonic() - t
         return r
 

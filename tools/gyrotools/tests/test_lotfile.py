@@ -206,3 +206,21 @@ def test_not_measured_is_neither_pass_nor_fail():
     assert list(j["pass"]) == [True, False, False]
     assert "startup.lock_time_s 0.7 > 0.5" in j.at[1, "fail_reason"]
     assert j.at[2, "fail_reason"] == "startup: exit 1"
+
+
+def test_part_over_its_time_is_ended_with_its_children(tmp_path):
+    sim = tmp_path / "slow-sim"
+    pidfile = tmp_path / "child.pid"
+    sim.write_text(f"#!/bin/sh\nsleep 30 &\necho $! > {pidfile}\nwait\n")
+    sim.chmod(sim.stat().st_mode | stat.S_IXUSR)
+    sc = lotfile.Scenario("startup", str(sim), 0.3, None, False)
+    job = lotpart.PartJob(0, {"plant.q_drive": 30.0}, {}, 1, False, False, (sc,), str(sim), "",
+                          str(tmp_path / "p0"), 0.5, "x")
+    with pytest.raises(lotpart.PartTimeout, match="still running"):
+        lotpart.run_part(job)
+    psutil = pytest.importorskip("psutil")
+    try:
+        child = psutil.Process(int(pidfile.read_text()))
+        child.wait(timeout=2) if child.status() != psutil.STATUS_ZOMBIE else None
+    except psutil.NoSuchProcess:
+        pass                                    # gone, as it should be
