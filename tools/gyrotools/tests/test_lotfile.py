@@ -224,3 +224,11 @@ def test_part_over_its_time_is_ended_with_its_children(tmp_path):
         child.wait(timeout=2) if child.status() != psutil.STATUS_ZOMBIE else None
     except psutil.NoSuchProcess:
         pass                                    # gone, as it should be
+
+
+def test_yield_intervals():
+    from gyrotools import lotreport
+    p, lo, hi = lotreport.ci(0, 16)
+    assert p == 0 and lo == 0 and abs(hi - 0.2059) < 1e-3          # Clopper-Pearson
+    d, lo, hi = lotreport.newcombe(56, 70, 48, 80)                  # Newcombe (1998), method 10
+    assert abs(d - 0.2) < 1e-12 and abs(lo - 0.0524) < 1e-3 and abs(hi - 0.3339) < 1e-3
