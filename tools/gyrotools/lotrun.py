@@ -165,7 +165,7 @@ def _client(workers: int | None, scheduler: str | None, threads: bool = False):
             raise InputError(f"--scheduler {scheduler}: cannot connect ({e})") from None
     n = workers or os.cpu_count() or 1
     cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=not threads,
-                           dashboard_address=None, silence_logs=logging.ERROR)
+                           dashboard_address=":0", silence_logs=logging.ERROR)  # any free port
     return Client(cluster), cluster
 
 
