@@ -156,7 +156,7 @@ def _keep(out: str, k: int, res: dict):
     _write_atomic(d, "row.json", res["row"])   # last: its presence means "finished"
 
 
-def _client(workers: int | None, scheduler: str | None, threads: bool = False):
+def _client(workers: int | None, scheduler: str | None, processes: bool = False):
     from distributed import Client, LocalCluster
     if scheduler:
         try:
@@ -164,7 +164,7 @@ def _client(workers: int | None, scheduler: str | None, threads: bool = False):
         except (OSError, TimeoutError) as e:
             raise InputError(f"--scheduler {scheduler}: cannot connect ({e})") from None
     n = workers or os.cpu_count() or 1
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=not threads,
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=processes,
                            dashboard_address=":0", silence_logs=logging.ERROR)  # any free port
     return Client(cluster), cluster
 
@@ -184,7 +184,7 @@ def schedule(lot, out: str, n: int, todo: list, opts) -> Outcome:
     """Runs the parts in todo on Dask; keeps each as it finishes."""
     from distributed import as_completed
     res = Outcome(done_before=n - len(todo))
-    client, cluster = _client(opts.workers, opts.scheduler, getattr(opts, "threads", False))
+    client, cluster = _client(opts.workers, opts.scheduler, getattr(opts, "processes", False))
     res.workers = len(client.scheduler_info().get("workers", {}))
     bar = _bar(n, res.done_before, opts.progress)
     t0 = time.monotonic()

@@ -1,6 +1,6 @@
-"""A 2-part lot of tiny start-ups through a real Dask LocalCluster (worker processes):
-the same table with 1 and 2 workers; an interrupted lot (part 0 only) resumed without
-running part 0 again, into the same table; another version's folder refused; two lots
+"""A 2-part lot of tiny start-ups through a real Dask LocalCluster: the same table with
+1 and 2 worker processes; an interrupted lot (part 0 only) resumed without running part
+0 again, into the same table (the default thread workers); another version's folder refused; two lots
 compared. Needs gyro-sim: $GYRO_SIM (ctest python_lot sets it) or the host-release build;
 skipped without one."""
 import json
@@ -45,10 +45,10 @@ def table(out):
 
 def test_same_table_with_1_and_2_workers_and_resumed(run_script, lotfile, tmp_path):
     one, two, resumed = (str(tmp_path / x) for x in ("one", "two", "resumed"))
-    code, out, err = lot(run_script, lotfile, one, "--workers", "1")
+    code, out, err = lot(run_script, lotfile, one, "--workers", "1", "--processes")
     assert code == 0, err
     assert "0 of 2 parts pass" not in out
-    code, _, err = lot(run_script, lotfile, two, "--workers", "2")
+    code, _, err = lot(run_script, lotfile, two, "--workers", "2", "--processes")
     assert code == 0, err
     a, b = table(one), table(two)
     assert list(a.columns[:1]) == ["part"] and list(a["part"]) == [0, 1]
@@ -57,12 +57,12 @@ def test_same_table_with_1_and_2_workers_and_resumed(run_script, lotfile, tmp_pa
     assert "not measured" in open(os.path.join(one, "report.md")).read().lower()
 
     # Interrupted after the first part, then the same command for the whole lot.
-    code, _, err = lot(run_script, lotfile, resumed, "--workers", "2", "--threads", "--parts", "1")
+    code, _, err = lot(run_script, lotfile, resumed, "--workers", "2", "--parts", "1")
     assert code == 0, err
     row0 = os.path.join(resumed, "parts", "00000", "row.json")
     before = os.stat(row0).st_mtime_ns
     started = table_t(resumed)["started_unix_s"].tolist()
-    code, out, err = lot(run_script, lotfile, resumed, "--workers", "2", "--threads")
+    code, out, err = lot(run_script, lotfile, resumed, "--workers", "2")
     assert code == 0, err
     assert "1 already finished, 1 to run" in out
     assert os.stat(row0).st_mtime_ns == before
@@ -75,7 +75,7 @@ def test_same_table_with_1_and_2_workers_and_resumed(run_script, lotfile, tmp_pa
     s = json.load(open(stamp))
     s["id"], s["gyro_sim_sha256"] = "0" * 16, "0" * 64
     json.dump(s, open(stamp, "w"))
-    code, _, err = lot(run_script, lotfile, resumed, "--threads")
+    code, _, err = lot(run_script, lotfile, resumed)
     assert code == 2 and "another version" in err and "gyro_sim_sha256" in err
 
     # Two lots compared: the same parts, no difference.
