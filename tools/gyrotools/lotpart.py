@@ -9,7 +9,8 @@ host (timing: wall times, host name).
 
 A figure that a run did not give is NaN ("not measured"), never a pass: the report
 counts it apart. The part's flow is bounded by job.timeout_s in all; past it the part
-raises PartTimeout and Dask may retry it.
+raises PartTimeout, and a process ended from outside (Ctrl-C, kill) PartInterrupted:
+no row is kept, and Dask may retry it.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import math
 import os
 import shlex
 import shutil
+import signal
 import socket
 import subprocess
 import sys
@@ -42,8 +44,17 @@ CAL_FIGURES = {
 }
 
 
+# Exit statuses of a process ended from outside (Ctrl-C, kill, a closing worker): the
+# part's result would say nothing about the part, so none is kept.
+ENDED_FROM_OUTSIDE = {-signal.SIGINT, -signal.SIGTERM, -signal.SIGKILL, -signal.SIGHUP, 130, 143}
+
+
 class PartTimeout(RuntimeError):
     """The part's flow ran past its time limit."""
+
+
+class PartInterrupted(RuntimeError):
+    """A process of the part was ended from outside."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -144,6 +155,8 @@ class _Runner:
             _kill_tree(p)
             raise PartTimeout(f"part {self.job.part}: {stage} still running after the part's "
                               f"{self.job.timeout_s:g} s") from None
+        if p.returncode in ENDED_FROM_OUTSIDE:
+            raise PartInterrupted(f"part {self.job.part}: {stage} ended from outside (exit {p.returncode})")
         r = subprocess.CompletedProcess(cmd, p.returncode, out, err)
         self.stages[f"{stage}_wall_s"] = time.monotonic() - t
         return r

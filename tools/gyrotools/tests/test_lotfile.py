@@ -232,3 +232,13 @@ def test_yield_intervals():
     assert p == 0 and lo == 0 and abs(hi - 0.2059) < 1e-3          # Clopper-Pearson
     d, lo, hi = lotreport.newcombe(56, 70, 48, 80)                  # Newcombe (1998), method 10
     assert abs(d - 0.2) < 1e-12 and abs(lo - 0.0524) < 1e-3 and abs(hi - 0.3339) < 1e-3
+
+
+def test_part_ended_from_outside_keeps_no_row(tmp_path):
+    sim = tmp_path / "killed-sim"
+    sim.write_text("#!/bin/sh\nkill -INT $$\n")
+    sim.chmod(sim.stat().st_mode | stat.S_IXUSR)
+    sc = lotfile.Scenario("startup", str(sim), 0.3, None, False)
+    job = lotpart.PartJob(0, {}, {}, 1, False, False, (sc,), str(sim), "", str(tmp_path / "p0"), 10, "x")
+    with pytest.raises(lotpart.PartInterrupted, match="ended from outside"):
+        lotpart.run_part(job)
