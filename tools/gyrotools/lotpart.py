@@ -186,7 +186,7 @@ def _calibrate(job: PartJob, runner: _Runner, row: dict) -> str | None:
     for name in ("calibration.json", "calibration_unverified.json"):
         path = os.path.join(out, name)
         if os.path.isfile(path):
-            _written(path, row)
+            _written(path, row, runner.stages)
             if r.returncode != 0:
                 row["flow_error"].append(_reason("calibration", r, job.part_dir))
             return path
@@ -194,12 +194,17 @@ def _calibrate(job: PartJob, runner: _Runner, row: dict) -> str | None:
     return None
 
 
-def _written(path: str, row: dict):
-    """The calibration written, as calw.NAME columns."""
+# Values of the calibration written that the calendar decides, not the part: kept with
+# the timings.
+CAL_HOST_FACTS = {"cal.date"}
+
+
+def _written(path: str, row: dict, host: dict):
+    """The calibration written, as calw.NAME columns (its date in host)."""
     with open(path, encoding="utf-8") as fh:
         ps = json.load(fh)
     for e in ps.get("params", []):
-        row[f"calw.{e['name']}"] = _float(e.get("value"))
+        (host if e["name"] in CAL_HOST_FACTS else row)[f"calw.{e['name']}"] = _float(e.get("value"))
 
 
 def _scenario_duration(path: str):

@@ -242,3 +242,12 @@ def test_part_ended_from_outside_keeps_no_row(tmp_path):
     job = lotpart.PartJob(0, {}, {}, 1, False, False, (sc,), str(sim), "", str(tmp_path / "p0"), 10, "x")
     with pytest.raises(lotpart.PartInterrupted, match="ended from outside"):
         lotpart.run_part(job)
+
+
+def test_calibration_date_is_a_host_fact(tmp_path):
+    p = tmp_path / "calibration.json"
+    p.write_text(json.dumps({"params": [{"name": "rate.scale_dps", "value": 139.2},
+                                        {"name": "cal.date", "value": 20261124}]}))
+    row, host = {}, {}
+    lotpart._written(str(p), row, host)
+    assert row == {"calw.rate.scale_dps": 139.2} and host == {"calw.cal.date": 20261124.0}
