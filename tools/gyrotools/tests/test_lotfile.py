@@ -251,3 +251,33 @@ def test_calibration_date_is_a_host_fact(tmp_path):
     row, host = {}, {}
     lotpart._written(str(p), row, host)
     assert row == {"calw.rate.scale_dps": 139.2} and host == {"calw.cal.date": 20261124.0}
+
+
+FLAKY_SIM = """#!/bin/sh
+# --list-params: the table; a run: ended from outside the first time, figures after.
+if [ "$1" = "--list-params" ]; then cat <<'EOF2'
+PARAMS
+EOF2
+exit 0; fi
+if [ ! -e "MARK" ]; then touch "MARK"; kill -TERM $$; fi
+while [ $# -gt 0 ]; do [ "$1" = "--json" ] && out="$2"; shift; done
+echo '{"figures": {"lock_time_s": 0.02}}' > "$out"
+"""
+
+
+@pytest.mark.parametrize("retries,code", [("2", 0), ("0", 1)])
+def test_part_retried_through_dask(tmp_path, run_script, retries, code):
+    sim = tmp_path / "flaky-sim"
+    sim.write_text(FLAKY_SIM.replace("PARAMS", PARAMS_TEXT).replace("MARK", str(tmp_path / "mark")))
+    sim.chmod(sim.stat().st_mode | stat.S_IXUSR)
+    lot = good_lot()
+    lot["parts"] = 1
+    out = tmp_path / "lot_out"
+    code_, stdout, err = run_script("lot", [write(tmp_path, lot), "--out", out, "--gyro-sim", sim,
+                                            "--no-progress", "--workers", "1", "--retries", retries])
+    assert code_ == code, err
+    row = out / "parts" / "00000" / "row.json"
+    if code == 0:
+        assert json.loads(row.read_text())["startup.lock_time_s"] == 0.02
+    else:
+        assert not row.exists() and "ended from outside" in err and "run the same command again" in err
