@@ -19,7 +19,10 @@ APT_PKGS=(
   tmux picocom           # console mode at a real terminal (ctest e2e_console_picocom)
   python3 python3-pip python3-venv
 )
-PIP_PKGS=(numpy scipy matplotlib allantools pyserial pytest ruff)
+# dask/distributed, pandas, pyarrow, tqdm: tools/lot (the Monte Carlo lot: scheduling,
+# the Parquet tables, the progress bar)
+PIP_PKGS=(numpy scipy matplotlib allantools pyserial pytest ruff "dask[distributed]" distributed
+          pandas pyarrow tqdm)
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
@@ -39,7 +42,7 @@ fi
 
 PY=${PYTHON:-python3}
 need_pip=0
-for m in numpy scipy matplotlib allantools serial pytest ruff; do
+for m in numpy scipy matplotlib allantools serial pytest ruff dask distributed pandas pyarrow tqdm; do
   if ! "$PY" -c "import $m" >/dev/null 2>&1; then need_pip=1; fi
 done
 if [ "$need_pip" -eq 1 ]; then

@@ -13,6 +13,11 @@ gyroctl_bridge  writes fitted coefficients to the gyro through the `gyroctl` too
 paramset        firmware parameter sets (docs/param-set.md): read, check, write
 plotting        shared matplotlib helpers (Agg backend, no display needed)
 cli             what every command-line script shares: errors, output, JSON
+lotfile         a wafer lot's file and spec, validated; the parts drawn (Gaussian copula)
+lotpart         one part of a lot on a worker: calibration flow and scenarios
+lotjudge        a lot's table judged against its spec, per line and per part
+lotrun          the lot's engine: Dask scheduling, resumption, version stamp, tables
+lotreport       the lot report: yield and its interval, histograms, what costs yield
 
 Every function takes and returns plain numpy arrays and floats in the units its name
 says; InputError (errors.py) is raised for input that cannot give an answer.
