@@ -53,3 +53,25 @@ def test_only_a_verified_calibration_is_calibration_json(tmp_path, monkeypatch, 
     assert (out / "calibration_unverified.json").exists() == (not passed)
     kept = out / ("calibration.json" if passed else "calibration_unverified.json")
     assert paramset.read(str(kept)).values()["cal.ref_freq_hz"] == pytest.approx(1489.9)
+
+
+def test_a_value_out_of_the_firmwares_range_is_a_failed_stage(tmp_path, monkeypatch):
+    """A stage whose result the parameter set refuses (a vacuum part's thermometer span,
+    2140 deg, beyond rate.p_range_deg's 180) is a failed stage, exit 1, not a usage
+    error (it once exited 2)."""
+    from gyrotools.errors import InputError
+
+    tool = load_tool()
+    monkeypatch.setattr(calflow, "selfcal", lambda part: ("x", {"f0_hz": 1489.9, "q": 33.0}))
+
+    def refused(part, path):
+        raise InputError("rate.p_range_deg: 2140.6 out of range [0, 180]")
+
+    monkeypatch.setattr(calflow, "rate_table", refused)
+    sim = tmp_path / "gyro-sim"
+    sim.write_text("#!/bin/sh\n")
+    sim.chmod(0o755)
+    out = tmp_path / "out"
+    code = tool.main(["--sim", "--out", str(out), "--gyro-sim", str(sim)])
+    assert code == tool.EXIT_STAGE_FAILED
+    assert not (out / "calibration.json").exists()
