@@ -127,11 +127,11 @@ GYRO_RAMFUNC int rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_
   /* The shadow (state at this window's end): a restart leaves P_c = P_f and drops the
    * trusted content (what is left of the move in P_f is then the shadow's P_f); a move
    * beyond the cap is P_f's and the filters' next step (whole: the compensation saw it
-   * all; not while the filters wait for P_f's fast start, they take none of its moves). Such a move of P returns (the phase loop pulls P back to
-   * the temperature's, P_f follows in a second) and its return is counted too; what the
-   * count misses (the return's last windows, under the cap) leaks away over
-   * rate.comp_tau_s, or a noise trip in a ramp, one-sided, would pile up in the shadow
-   * as if P_f were off for good. */
+   * all; not while the filters wait for P_f's fast start, they take none of its moves).
+   * Such a move of P returns (the phase loop pulls P back to the temperature's, P_f
+   * follows in a second) and its return is counted too; what the count misses (the
+   * return's last windows, under the cap) leaks away over rate.comp_tau_s, or a noise
+   * trip in a ramp, one-sided, would pile up in the shadow as if P_f were off for good. */
   float *x = rv->spur_deg;
   if (restart) {
     /* P_f, returning from the move, is still about one window's move short of its end
