@@ -66,17 +66,16 @@ GYRO_RAMFUNC void rate_valid_settling(const rate_valid_cfg_t *restrict cfg,
   if (rv->settle_run >= RATE_VALID_SETTLE_BLOCKS) rv->settled = 1u;
 }
 
-/* The rate error a lag of P_f of lag_deg makes: the quadrature rotated by the lag and
- * the bias polynomial moved along its slope. */
-GYRO_RAMFUNC static float lag_error_dps(const rate_valid_cfg_t *restrict c, float lag_deg,
-                                        float quad_dps)
+/* The rate error a lag of P_f of lag_deg makes: the bias polynomial moved along its
+ * slope. (Not the quadrature: the rate reference follows P itself through the mode's lag
+ * and its type-2 low-pass, rate_channel.h, and reads no P_f.) */
+GYRO_RAMFUNC static float lag_error_dps(const rate_valid_cfg_t *restrict c, float lag_deg)
 {
-  return lag_deg * (fm_absf(quad_dps) * FM_RAD_PER_DEG_F + c->bias_slope_dps_per_deg);
+  return lag_deg * c->bias_slope_dps_per_deg;
 }
 
-GYRO_RAMFUNC void rate_valid_thermo(const rate_valid_cfg_t *restrict c,
-                                    rate_valid_t *restrict rv, float p_dev_deg,
-                                    float p_held_dev_deg, float p_held_w, float quad_dps)
+GYRO_RAMFUNC void rate_valid_thermo(const rate_valid_cfg_t *restrict c, rate_valid_t *restrict rv,
+                                    float p_dev_deg, float p_held_dev_deg, float p_held_w)
 {
   if (p_held_w > RATE_VALID_SLEW_W_MAX) {
     /* P_f still converging from a hold (THERMO_SETTLE bounds that): no slew of the
@@ -97,7 +96,7 @@ GYRO_RAMFUNC void rate_valid_thermo(const rate_valid_cfg_t *restrict c,
   if (!(fm_absf(p_dev_deg + c->p_range_off_deg) <= c->p_range_deg))
     r |= RATE_INVALID_THERMO_RANGE;
   /* |P_f - P| <= w / (1 - w) |P_held - P_f|, compared without the divide. */
-  const float gap = lag_error_dps(c, p_held_w * fm_absf(p_held_dev_deg - p_dev_deg), quad_dps);
+  const float gap = lag_error_dps(c, p_held_w * fm_absf(p_held_dev_deg - p_dev_deg));
   if (!(gap <= c->tol_dps * (1.0f - p_held_w))) r |= RATE_INVALID_THERMO_SETTLE;
   rv->thermo = r;
 }
@@ -111,12 +110,12 @@ GYRO_RAMFUNC static inline float spur_error_dps(const rate_valid_cfg_t *restrict
 }
 
 GYRO_RAMFUNC int rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_t *restrict rv,
-                                 float quad_dps, float comp_lag_deg, float comp_hp_deg)
+                                 float comp_lag_deg, float comp_hp_deg)
 {
   const float move = rv->p_window_change_deg, change = fm_absf(move);
   const int over_cap = !(change <= c->p_window_max_deg);
   const int slewing = over_cap || rv->restart_armed != 0u ||
-                      !(lag_error_dps(c, change * c->p_lag_per_deg, quad_dps) <= c->tol_dps);
+                      !(lag_error_dps(c, change * c->p_lag_per_deg) <= c->tol_dps);
   int restart = 0;
   if (!(change <= RATE_VALID_RESTART_CAPS * c->p_window_max_deg)) {
     rv->restart_armed = 1u;

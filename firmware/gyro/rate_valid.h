@@ -21,9 +21,9 @@
  *   THERMO_RANGE  the thermometer P_f outside the range its compensation holds for
  *   THERMO_SLEW   the thermometer moving faster than it was validated for
  *                 (p_slew_max), or so fast that P_f's low-pass lags it by more than
- *                 tol_dps of rate: a lag of P_f rotates the quadrature into the rate
- *                 (the reference's correction, rate_channel.h: Q x lag) and shifts the
- *                 bias polynomial (slope x lag); and afterwards, while what such a move
+ *                 tol_dps of rate: a lag of P_f shifts the bias polynomial (slope x
+ *                 lag; the rate reference follows P itself, rate_channel.h, so no
+ *                 quadrature is rotated by it); and afterwards, while what such a move
  *                 left in the compensation's filters (comp_filters.h: P_c's lag, the
  *                 gradient term's high-pass) could still make more than tol_dps. A
  *                 shadow of those filters holds their error: it runs on the moves beyond
@@ -44,15 +44,17 @@
  *                 error that makes as above
  *   CONT_SELFTEST the continuous self-test's response missing or out of its band
  *                 (selftest.h)
- *   TRACKING      the tracking drive runs (drive.track 1): its rate channel has no
- *                 calibration of its own yet (reference, scale and compensation are the
- *                 fixed drive's, its thermometer an equivalent of P): measured valid, it
- *                 read up to 28 deg/s wrong on a self-calibrated Q 10^3 part at rest
+ *   TRACKING      the tracking drive runs (drive.track 1) on a calibration made with
+ *                 the fixed drive (cal.ref_track 0): its reference, scale and compensation
+ *                 are the fixed drive's, its thermometer p_eq is not the P they were
+ *                 fitted on (measured valid, it read up to 28 deg/s wrong on a
+ *                 self-calibrated Q 10^3 part at rest). The calibration flow calibrates
+ *                 a part in the mode its sweep chose and records it (UNCALIBRATED too)
  *   UNCALIBRATED  the part has no calibration (cal.ref_freq_hz 0), or its calibration is
  *                 stale: made at another drive frequency than drive.freq_hz (a sweep, a
- *                 hand change). The demodulation phase and scale are a part's own;
- *                 measured valid without them, a 1300 Hz part read its rate with the
- *                 sign inverted
+ *                 hand change), another phase setpoint or the other drive mode. The
+ *                 demodulation phase and scale are a part's own; measured valid without
+ *                 them, a 1300 Hz part read its rate with the sign inverted
  * Each check is a few multiplies and compares per block; no divide, no libm. */
 #ifndef RATE_VALID_H
 #define RATE_VALID_H
@@ -166,16 +168,15 @@ void rate_valid_settling(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float ra
                          float quad_raw, float rate_unc_dps, float quad_dps, float scale_dps);
 
 /* At each new P_f (rate_channel_update_p): p_dev_deg = P_f - p_ref; p_held_dev_deg and
- * p_held_w where P_f's fast start began and the weight that value still has in P_f;
- * quad_dps the quadrature output. */
+ * p_held_w where P_f's fast start began and the weight that value still has in P_f. */
 void rate_valid_thermo(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float p_dev_deg,
-                       float p_held_dev_deg, float p_held_w, float quad_dps);
+                       float p_held_dev_deg, float p_held_w);
 /* On a tick after rate_valid_thermo ended a slew window (slew_due): THERMO_SLEW from the
  * window's change of P_f and from the shadow (apart, so that no tick carries both).
  * (comp_lag_deg, comp_hp_deg): the compensation's filters' content (rate_channel_t).
  * Returns 1 when the filters must restart now (rate_channel_comp_restart). */
-int rate_valid_slew(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float quad_dps,
-                    float comp_lag_deg, float comp_hp_deg);
+int rate_valid_slew(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float comp_lag_deg,
+                    float comp_hp_deg);
 /* The shadow's transition over RATE_VALID_SLEW_UPDATES P updates for the compensation's
  * filter weights comp_a, grad_a (rate_channel_cfg_t): m = (s<-s, lag<-s, lag<-lag,
  * hp<-s, hp<-lag, hp<-hp). Design time (double). */

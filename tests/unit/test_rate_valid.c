@@ -1,6 +1,6 @@
 /* The rate-valid verdict (gyro/rate_valid.h) on constructed evidence: each reason sets
  * on its own evidence and clears when it goes, the settling is measured, the
- * thermometer's bounds follow the quadrature and the bias slope, onsets are counted. */
+ * thermometer's bounds follow the bias slope, onsets are counted. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -119,17 +119,22 @@ static void test_phase_leak(void **state)
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_PHASE);
 }
 
-/* After a hold, P_f may still be w / (1 - w) |P_held - P_f| from P: with 1500 deg/s of
- * quadrature (26 deg/s per degree) a gap of 1 deg needs w below about 1 %. */
+/* After a hold, P_f may still be w / (1 - w) |P_held - P_f| from P: at a bias slope of
+ * 26 deg/s per degree a gap of 1 deg needs w below about 1 %. The quadrature does not
+ * count: the rate reference follows P itself, not P_f (rate_channel.h); counting it, as
+ * before, kept a Q 2e4 part's tracking thermometer (p_eq, 0.1 deg of noise) invalid. */
 static void test_thermo_settle_bound(void **state)
 {
   (void)state;
   assert_int_equal(settle(), 0u);
-  rate_valid_thermo(&s_cfg, &rv, 1.0f, 0.0f, 0.02f, 1500.0f);
+  rate_valid_thermo(&s_cfg, &rv, 1.0f, 0.0f, 0.02f);
+  assert_int_equal(rate_valid_verdict(&rv, 0u), 0u); /* no bias slope: no error */
+  s_cfg.bias_slope_dps_per_deg = 26.18f;
+  rate_valid_thermo(&s_cfg, &rv, 1.0f, 0.0f, 0.02f);
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SETTLE);
-  rate_valid_thermo(&s_cfg, &rv, 1.0f, 0.0f, 0.005f, 1500.0f);
+  rate_valid_thermo(&s_cfg, &rv, 1.0f, 0.0f, 0.005f);
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
-  rate_valid_thermo(&s_cfg, &rv, 9.0f, 9.0f, 0.0f, 1500.0f); /* out of the calibrated range */
+  rate_valid_thermo(&s_cfg, &rv, 9.0f, 9.0f, 0.0f); /* out of the calibrated range */
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_RANGE);
 }
 
@@ -142,9 +147,9 @@ static void test_thermo_range_about_reference(void **state)
   s_cfg.p_range_off_deg = -3.0f;
   const float in_deg[] = {-4.9f, 3.0f, 10.9f}, out_deg[] = {-5.1f, 11.1f, -9.0f};
   for (int i = 0; i < 3; i++) {
-    rate_valid_thermo(&s_cfg, &rv, in_deg[i], in_deg[i], 0.0f, 1500.0f);
+    rate_valid_thermo(&s_cfg, &rv, in_deg[i], in_deg[i], 0.0f);
     assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
-    rate_valid_thermo(&s_cfg, &rv, out_deg[i], out_deg[i], 0.0f, 1500.0f);
+    rate_valid_thermo(&s_cfg, &rv, out_deg[i], out_deg[i], 0.0f);
     assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_RANGE);
   }
 }
@@ -158,24 +163,34 @@ static void test_thermo_slew(void **state)
   float p = 0.0f;
   for (uint32_t i = 0; i < 3u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.004f / (float)RATE_VALID_SLEW_UPDATES; /* 0.04 deg/s, under the cap */
-    rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, 0.0f, 0.0f);
+    rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, 0.0f);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.004f / (float)RATE_VALID_SLEW_UPDATES;
-    /* 0.004 deg per 0.1 s leaves P_f 0.0064 deg behind: 0.33 deg/s of 3000 deg/s of
-     * quadrature rotated into the rate, beyond the tolerance though under the cap. */
-    rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f, 3000.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 3000.0f, 0.0f, 0.0f);
+    /* 0.004 deg per 0.1 s leaves P_f 0.0064 deg behind: with no bias slope no error,
+     * whatever the quadrature (the reference does not read P_f) ... */
+    rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, 0.0f);
+  }
+  assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
+  s_cfg.bias_slope_dps_per_deg = 52.0f;
+  for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
+    p += 0.004f / (float)RATE_VALID_SLEW_UPDATES;
+    /* ... at 52 deg/s per degree of bias slope 0.33 deg/s: beyond the tolerance though
+     * under the cap. */
+    rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, 0.0f);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
+  s_cfg.bias_slope_dps_per_deg = 0.0f;
   /* Under the cap: a temperature's move, none of it into the shadow of the compensation */
   assert_true(rv.spur_deg[0] == 0.0f && rv.spur_deg[1] == 0.0f && rv.spur_deg[2] == 0.0f);
   for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.006f / (float)RATE_VALID_SLEW_UPDATES; /* 0.06 deg/s: beyond the cap */
-    rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, 0.0f, 0.0f);
+    rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, 0.0f);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
   /* Beyond it: into the shadow (P_f carries 0.006 deg per window of it) */
