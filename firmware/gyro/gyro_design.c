@@ -372,7 +372,10 @@ static uint32_t cal_state(const param_values_t *v)
    * thermometer by itself), and the drive's phase against the Coriolis force's moves. */
   const int same_phase = fabs((double)v->drive_phase_set_deg -
                               (double)v->cal_ref_phase_set_deg) <= GYRO_CAL_PHASE_DEG;
-  return same_phase && fabs((double)v->drive_freq_hz - ref) <= GYRO_CAL_FREQ_REL * ref
+  /* And the drive mode: the tracking drive's thermometer is the tracked frequency (p_eq,
+   * drive_track.h), with the part's Q in its scale, where the fixed drive's is P. */
+  const int same_mode = v->drive_track == v->cal_ref_track;
+  return same_phase && same_mode && fabs((double)v->drive_freq_hz - ref) <= GYRO_CAL_FREQ_REL * ref
              ? GYRO_CAL_OK
              : GYRO_CAL_STALE;
 }
@@ -395,6 +398,7 @@ static gyro_design_status_t design_parts(const param_values_t *v, gyro_design_t 
   if (s == GYRO_DESIGN_OK) s = design_selftest(v, t);
   t->autostart = v->sys_autostart;
   t->cal_state = cal_state(v);
+  t->track_uncal = v->drive_track != 0u && v->cal_ref_track == 0u ? 1u : 0u;
   return s;
 }
 

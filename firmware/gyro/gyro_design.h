@@ -45,12 +45,15 @@ typedef struct {
   /* The calibration record (cal.ref_freq_hz) against the drive frequency: GYRO_CAL_*;
    * anything but OK makes the rate not valid (rate_valid.h, UNCALIBRATED). */
   uint32_t cal_state;
+  /* The tracking drive runs on a calibration made with the fixed drive (cal.ref_track 0):
+   * the TRACKING reason of rate_valid.h (its cal_state is STALE as well). */
+  uint32_t track_uncal;
 } gyro_design_t;
 
 /* gyro_design_t.cal_state */
 #define GYRO_CAL_NONE 0u  /* no calibration: cal.ref_freq_hz 0 */
-#define GYRO_CAL_OK 1u    /* made at drive.freq_hz and drive.phase_set_deg */
-#define GYRO_CAL_STALE 2u /* made at another drive frequency or phase setpoint */
+#define GYRO_CAL_OK 1u    /* made at drive.freq_hz, drive.phase_set_deg and drive.track */
+#define GYRO_CAL_STALE 2u /* made at another drive frequency, phase setpoint or drive mode */
 /* cal.ref_freq_hz and drive.freq_hz agree within this, relative: two steps of a float,
  * so that a value printed and set again through the command line still matches. */
 #define GYRO_CAL_FREQ_REL 2.0e-7

@@ -40,7 +40,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 10u
+#define PARAM_LAYOUT_VERSION 11u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -171,11 +171,14 @@
   /* the shipped values carry no temperature compensation: on the default plant the bias
    * moves 34.9 (deg/s)/deg of P (0.0765 deg/K), so they hold within 1 deg/s only for
    * 0.025 deg of P (+-0.33 K) around the thermometer's reference; a temperature
-   * calibration widens it to the range it was fitted over */ \
-  X(rate_p_range_deg, 0x0312u, "rate.p_range_deg", F32, "deg", 0.001f, 180.0f, 0.025f, 0u, \
+   * calibration widens it to the range it was fitted over.
+   * The tracking drive's thermometer is p_eq (drive_track.h), (2Q/f0) rad per Hz of the
+   * tracked resonance: 25 deg/K at Q 2e4, its 0.5 % window 57000 deg at Q 1e5 */ \
+  X(rate_p_range_deg, 0x0312u, "rate.p_range_deg", F32, "deg", 0.001f, 100000.0f, 0.025f, 0u, \
     PF_PERSIST | PF_LIVE, "thermometer range: largest |P_f - cal.ref_p_deg| the compensation holds for") \
-  /* 0.05 deg/s of P: 0.65 K/s on the air part, far above any thermal ramp it was run on */ \
-  X(rate_p_slew_max_deg_s, 0x0313u, "rate.p_slew_max_deg_s", F32, "deg/s", 0.001f, 100.0f, 0.05f, 0u, \
+  /* 0.05 deg/s of P: 0.65 K/s on the air part, far above any thermal ramp it was run on;
+   * the calibration flow sets the part's own (its thermometer's slope x 0.65 K/s) */ \
+  X(rate_p_slew_max_deg_s, 0x0313u, "rate.p_slew_max_deg_s", F32, "deg/s", 0.001f, 10000.0f, 0.05f, 0u, \
     PF_PERSIST | PF_LIVE, "thermometer slew: P_f moving faster than this makes the rate not valid") \
   /* uncalibrated: 0, no gradient term. The calibration flow fits it on its chamber run's
    * transitions, where the structure and the pickoff circuit part (tools/calibrate) */ \
@@ -282,11 +285,16 @@
    * that it stays what was fitted whatever P's absolute value (a hand-set
    * drive.p_init_deg moves the loop's start, not the compensation). Written by the
    * calibration flow (the centre of the P span it fitted over); 0 until then */ \
-  X(cal_ref_p_deg, 0x0804u, "cal.ref_p_deg", F32, "deg", -360.0f, 360.0f, 0.0f, 0u, \
+  X(cal_ref_p_deg, 0x0804u, "cal.ref_p_deg", F32, "deg", -100000.0f, 100000.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "thermometer reference: the compensation is in x = P_c - cal.ref_p_deg") \
   /* Written by the calibration flow; 0, the default setpoint, until then */ \
   X(cal_ref_phase_set_deg, 0x0805u, "cal.ref_phase_set_deg", F32, "deg", -180.0f, 180.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "drive.phase_set_deg the calibration was made at: at another it is stale") \
+  /* Written by the calibration flow (drive.track when it ran); 0, the fixed drive, until
+   * then and in images of before it. The two drives' thermometers differ (P, or the
+   * tracked frequency's p_eq, drive_track.h), and so do their demodulation phases */ \
+  X(cal_ref_track, 0x0806u, "cal.ref_track", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
+    PF_PERSIST | PF_LIVE, "drive.track the calibration was made with: with the other it is stale") \
   /* start the drive at power-on */ \
   X(sys_autostart, 0x0602u, "sys.autostart", ENUM, "-", 0u, 1u, 1u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
     PF_PERSIST | PF_RESTART, "start acquiring at power-on") \

@@ -19,6 +19,8 @@
                                         tools/calibrate --quick: verified, right at
                                         25 degC, never a valid rate at 60 degC (outside
                                         the quick protocol's 15..35 degC)
+  check_calibration.py quick_vacuum GYRO_SIM   the same for a vacuum part (Q 2e4: the
+                                        tracking drive and its frequency thermometer)
   check_calibration.py commands GYRO_SIM  a scenario's "commands" (what the flow's
                                         self-test stage uses) reach the command line at
                                         their times; one due after the run has no reply
@@ -142,23 +144,24 @@ TC_WINDOWS = ((1.0, 3.0), (4.0, 6.0), (7.0, 9.0), (10.0, 12.0))
 TC_BIAS_DPS, TC_SF_PPM = 0.2, 500.0
 
 
-def plateau(sim, cal, amb, d, sets=()):
-    """The part (plant sets) with calibration cal started at ambient amb, the table's
-    rest, +R, -R, +R: (valid fraction per window, bias, scale-factor error in ppm, the
-    structure's temperature), or None if gyro-sim failed."""
+def plateau(sim, cal, amb, d, sets=(), lead_s=0.0):
+    """The part (plant sets) with calibration cal started at ambient amb, after lead_s at
+    rest the table's rest, +R, -R, +R: (valid fraction per window, bias, scale-factor
+    error in ppm, the structure's temperature), or None if gyro-sim failed."""
+    steps = ([[lead_s, 0.0]] if lead_s > 0.0 else []) + TC_STEPS
     scen = os.path.join(d, "tc.json")
     with open(scen, "w", encoding="utf-8") as fh:
         json.dump({"name": "tempcomp_oos", "description": "out-of-sample plateau",
                    "mode": "closed_loop", "seed": 4242, "analyses": [],
-                   "duration_s": sum(s[0] for s in TC_STEPS), "csv_rate_hz": 200,
+                   "duration_s": sum(s[0] for s in steps), "csv_rate_hz": 200,
                    "firmware_params": cal, "ambient_c": {"kind": "const", "value": amb},
-                   "rate_dps": {"kind": "steps", "edge_s": 0.2, "steps": TC_STEPS}}, fh)
+                   "rate_dps": {"kind": "steps", "edge_s": 0.2, "steps": steps}}, fh)
     csv = os.path.join(d, "tc.csv")
     extra = ["--csv", csv] + [a for s in sets for a in ("--set", s)]
     if not run_sim(sim, scen, extra):
         return None
     x = np.genfromtxt(csv, delimiter=",", names=True)
-    w = [(x["t_s"] >= a) & (x["t_s"] < b) for a, b in TC_WINDOWS]
+    w = [(x["t_s"] >= a + lead_s) & (x["t_s"] < b + lead_s) for a, b in TC_WINDOWS]
     valid = [float(np.mean(x["rate_valid"][m])) for m in w]
     bias = float(np.mean(x["rate_dps"][w[0]]))
     pos = 0.5 * (np.mean(x["rate_dps"][w[1]]) + np.mean(x["rate_dps"][w[3]]))
@@ -189,26 +192,43 @@ def tempcomp_out_of_sample(sim):
 # quick: an off-nominal part through tools/calibrate --quick (15..35 degC): verified (exit
 # 0), right at 25 degC, and at 60 degC, outside its span, never a valid rate.
 QUICK_PART = ("plant.f_drive_hz=1300", "plant.q_drive=200")
+# quick_vacuum: the same for a vacuum part (drive Q 2e4, thermoelastic Q law; a quarter
+# less sense gain, as the vacuum family's, for the undamped sense response's headroom):
+# its sweep commits the tracking drive, so the flow calibrates the tracking drive, with
+# the tracked frequency as thermometer, and records it (cal.ref_track 1). Judged after 20 s
+# at rest: the rate reference's wide start lasts 4 drive time constants (2Q/wn = 4.3 s).
+VACUUM_PART = ("plant.q_drive=20000", "plant.q_sense=2000", "plant.q_temp_law=2",
+               "plant.pick_sense_gain_v_per_m=46350000")
 
 
-def quick(sim):
+def quick_part(sim, part, track, lead_s):
     with tempfile.TemporaryDirectory() as d:
-        sets = [a for s in QUICK_PART for a in ("--set", s)]
+        sets = [a for s in part for a in ("--set", s)]
         r = run(["--sim", "--quick", "--seed", "7", "--out", d, "--gyro-sim", sim] + sets)
         print(r.stdout + r.stderr)
         if r.returncode != 0:
             print(f"FAIL: exit {r.returncode}")
             return 1
         cal = os.path.join(d, "calibration.json")
-        inside, outside = plateau(sim, cal, 25.0, d, QUICK_PART), plateau(sim, cal, 60.0, d,
-                                                                           QUICK_PART)
+        mode = paramset.read(cal).values()["cal.ref_track"]
+        inside = plateau(sim, cal, 25.0, d, part, lead_s)
+        outside = plateau(sim, cal, 60.0, d, part, lead_s)
     if inside is None or outside is None:
         return 1
     ok = plateau_ok(inside, 25.0)
     never = max(outside[0]) == 0.0
     print(f"{'ok  ' if never else 'FAIL'} 60 degC, outside the quick calibration's span: valid "
           "in the windows (%): " + " ".join(f"{100 * v:.0f}" for v in outside[0]))
-    return 0 if ok and never else 1
+    print(f"{'ok  ' if mode == track else 'FAIL'} cal.ref_track {mode} (expected {track})")
+    return 0 if ok and never and mode == track else 1
+
+
+def quick(sim):
+    return quick_part(sim, QUICK_PART, 0, 0.0)
+
+
+def quick_vacuum(sim):
+    return quick_part(sim, VACUUM_PART, 1, 20.0)
 
 
 def commands(sim):
@@ -231,7 +251,7 @@ def commands(sim):
 
 if __name__ == "__main__":
     modes = {"regen": regen, "usage": usage, "commands": commands, "defaults": tool_defaults,
-             "tempcomp": tempcomp_out_of_sample, "quick": quick}
+             "tempcomp": tempcomp_out_of_sample, "quick": quick, "quick_vacuum": quick_vacuum}
     if len(sys.argv) != 3 or sys.argv[1] not in modes:
         print(__doc__, file=sys.stderr)
         sys.exit(2)

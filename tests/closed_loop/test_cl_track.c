@@ -173,6 +173,48 @@ static void test_steps_q1e5(void **state)
   check_steps(1.0e5);
 }
 
+/* The thermometer (drive_track.h): p_eq moves by (2Q/f0) rad per Hz of the tracked
+ * frequency, so a structure dT moving the resonance by -f0 kET/2 dT (2-32) reads
+ * Q kET dT rad in P_f (23 deg/K at Q 10^4). +1 K then -1 K of the whole structure, read
+ * back through P_f's means after each settles: within 1 % of each step (the drive
+ * circuit's own phase tempco moves the operating point too, a fraction of a percent). */
+static double p_f_mean_deg(double s)
+{
+  double sum = 0.0;
+  const int n = (int)(s * 1000.0);
+  for (int i = 0; i < n; i++) {
+    hal_host_run(50u);
+    app_poll(&app);
+    assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
+    sum += (double)app.gyro.rate.p_f_deg;
+  }
+  return sum / n;
+}
+
+static void test_thermometer_step(void **state)
+{
+  (void)state;
+  const double q = 1.0e4;
+  plant_cfg_t pc;
+  start_part(q, 25.0, 0.0, &pc);
+  run_s(1.5);
+  double p0 = p_f_mean_deg(0.5);
+  const double steps_k[] = {+1.0, -1.0};
+  for (size_t k = 0; k < 2; k++) {
+    const double f_before = true_f0(&pc);
+    double t[THERMAL_NODES];
+    for (int i = 0; i < THERMAL_NODES; i++) t[i] = thermal_temp(&plant.thermal, i) + steps_k[k];
+    thermal_set(&plant.thermal, t);
+    run_s(1.5); /* P_f's 1 Hz low-pass: e^-9 of the step left */
+    const double p1 = p_f_mean_deg(0.5);
+    const double read_k = (p1 - p0) * M_PI / 180.0 / (q * pc.ket_per_k);
+    printf("# Q %g, step %+.0f K: resonance %+.5f Hz, P_f %+.3f deg, read %+.4f K\n", q,
+           steps_k[k], true_f0(&pc) - f_before, p1 - p0, read_k);
+    assert_true(fabs(read_k - steps_k[k]) < 0.01);
+    p0 = p1;
+  }
+}
+
 /* The lowest Q the drive is specified for. */
 static void test_q_20(void **state)
 {
@@ -209,7 +251,7 @@ int main(void)
       cmocka_unit_test(test_q_1e5_hot),      cmocka_unit_test(test_steps_q33),
       cmocka_unit_test(test_steps_q1e3),     cmocka_unit_test(test_steps_q1e4),
       cmocka_unit_test(test_steps_q1e5),     cmocka_unit_test(test_q_20),
-      cmocka_unit_test(test_outside_window),
+      cmocka_unit_test(test_outside_window), cmocka_unit_test(test_thermometer_step),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -101,6 +101,28 @@ static void test_defaults_design(void **state)
   assert_int_equal(gyro_design(&v, &d), GYRO_DESIGN_P_INIT);
 }
 
+/* A calibration is the drive mode's it was made in: the tracking drive's thermometer is
+ * the tracked frequency (p_eq, drive_track.h), the fixed drive's the force phase, and the
+ * demodulation phase and scale differ with them. Made in the one and run in the other it
+ * is stale (calibrated no, the rate not valid). A fixed-drive calibration with
+ * drive.track 1 was "calibrated yes" before (only the TRACKING reason kept it invalid). */
+static void test_cal_belongs_to_its_drive_mode(void **state)
+{
+  (void)state;
+  param_values_t v;
+  param_values_defaults(&v);
+  v.cal_ref_freq_hz = v.drive_freq_hz;
+  gyro_design_t d;
+  const uint32_t track[4] = {0u, 1u, 0u, 1u}, cal_track[4] = {0u, 1u, 1u, 0u};
+  const uint32_t expect[4] = {GYRO_CAL_OK, GYRO_CAL_OK, GYRO_CAL_STALE, GYRO_CAL_STALE};
+  for (int i = 0; i < 4; i++) {
+    v.drive_track = track[i];
+    v.cal_ref_track = cal_track[i];
+    assert_int_equal(gyro_design(&v, &d), GYRO_DESIGN_OK);
+    assert_int_equal(d.cal_state, expect[i]);
+  }
+}
+
 /* Each refusal gives its own status, leaves the output untouched, and its reason names
  * the parameter. */
 static void test_each_refusal_named(void **state)
@@ -169,6 +191,7 @@ int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_defaults_design),
+      cmocka_unit_test(test_cal_belongs_to_its_drive_mode),
       cmocka_unit_test(test_each_refusal_named),
       cmocka_unit_test(test_every_status_reached),
       cmocka_unit_test(test_reasons_name_real_parameters),

@@ -20,7 +20,8 @@ firmware's generic defaults:
    amplitude on the calibrated part at rest (scenario "commands": `selftest`, `status`),
    at the drive setpoint (selftest.ref_amp_v);
 6. the calibration record: every value the firmware holds for this part, with
-   cal.ref_freq_hz (the drive frequency it was made at), cal.part_id and cal.date,
+   cal.ref_freq_hz (the drive frequency it was made at), cal.ref_track (the drive mode
+   it was made in), cal.part_id and cal.date,
    written as a param set (gyrotools.paramset);
 7. verification on profiles the fit never saw, each with its own noise seed, run side by
    side: another rate schedule (+-30..270 deg/s, other dwell), judged on the rate output
@@ -335,6 +336,7 @@ def record(values, sets, date=None):
     v = dict(values)
     v["cal.ref_freq_hz"] = v["drive.freq_hz"]
     v["cal.ref_phase_set_deg"] = v["drive.phase_set_deg"]
+    v["cal.ref_track"] = v["drive.track"]  # the mode the sweep chose and the stages ran in
     v["cal.part_id"] = part_id(sets)
     d = date or datetime.date.today()
     v["cal.date"] = d.year * 10000 + d.month * 100 + d.day

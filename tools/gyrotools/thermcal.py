@@ -23,7 +23,12 @@ window (the bias there). P is the thermometer less the rate's own turn of it
   x: P_f at +R against -R at each plateau, a line in x (rate.p_rate_c1_per_dps; its
   constant added to the room-temperature value);
 - cal.ref_p_deg: the middle of the plateaus' P span; rate.p_range_deg: half that span
-  plus P_RANGE_MARGIN (the rate is valid only where the fit had data).
+  plus P_RANGE_MARGIN (the rate is valid only where the fit had data);
+  rate.p_slew_max_deg_s: P's span over the plateaus' temperature span x SLEW_MAX_K_PER_S.
+
+On the tracking drive P is p_eq (drive_track.h): the tracked frequency's deviation,
+(2Q/f0) rad per Hz, so every one of these is in the deviation of the frequency from the
+stored reference (cal.ref_p_deg), whatever Q.
 
 Verification on profiles the fit never saw, each with its own noise seed: other plateaus
 (VERIFY_PLATEAUS_C, with rate steps: bias and SF there), a heating ramp 25 -> 65 degC at
@@ -59,6 +64,13 @@ TABLE_EDGE_S = 0.5
 # The gradient term's time constants tried; the part's own is the one that fits best.
 TAU_GRID_S = (10.0, 15.0, 20.0, 30.0, 40.0, 60.0, 90.0, 120.0, 180.0, 300.0, 600.0)
 P_RANGE_MARGIN = 0.05  # of the span, each side
+# The thermometer's slew limit (rate.p_slew_max_deg_s), in temperature: P moving faster
+# than the structure's temperature can is not temperature (a phase disturbance), and the
+# rate is not valid. 0.65 K/s is the firmware default's 0.05 deg/s on the air part, far
+# above any ramp a chamber or a vehicle makes; in P it is the part's own slope times this
+# (25 deg/K on a Q 2e4 part's tracking thermometer, 0.08 deg/K on the air part's P).
+SLEW_MAX_K_PER_S = 0.65
+SLEW_MIN_DEG_S = 0.001  # the parameter's own lower limit
 # The scale factor against x: a quartic (rate.sf_c4_per_deg4); the default part's peaks
 # near room temperature, and a cubic through the seven plateaus leaves 390 ppm.
 SF_ORDER = 4
@@ -254,6 +266,11 @@ def fit(log, temps_c, dwell_s, span_from_data=False):
     turn_c1, turn_c0 = (float(v) for v in np.polyfit(x_pl, turn, 1))
     values = dict(zip(tempcomp.BIAS_PARAMS, (float(x) for x in c[:4])))
     values["rate.p_rate_c1_per_dps"] = turn_c1
+    # P's span over the chamber's (what a bench knows): a structure that did not reach
+    # the chamber's extremes (short plateaus) makes the slope smaller, the limit tighter.
+    # (Not a line through the plateaus' P: short ones are read while P still moves.)
+    p_per_k = 2.0 * half / (max(temps_c) - min(temps_c))
+    values["rate.p_slew_max_deg_s"] = max(p_per_k * SLEW_MAX_K_PER_S, SLEW_MIN_DEG_S)
     values.update({"cal.ref_p_deg": float(ref),
                    "rate.p_range_deg": float(half * (1 + 2 * P_RANGE_MARGIN)),
                    "rate.sf_c1_per_deg": float(sf_c[1]), "rate.sf_c2_per_deg2": float(sf_c[2]),
@@ -267,7 +284,7 @@ def fit(log, temps_c, dwell_s, span_from_data=False):
                "plateau_residual_dps": resid_pl.tolist(),
                "fit_rms_1s_dps": best["rms"], "grad_tau_s": best["tau"],
                "p_turn_residual_deg_per_dps": turn.tolist(), "p_turn_c0_deg_per_dps": turn_c0,
-               "p_turn_c1_per_dps": turn_c1}
+               "p_turn_c1_per_dps": turn_c1, "p_per_k_deg": p_per_k}
     return values, s0, figures
 
 
