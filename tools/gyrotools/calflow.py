@@ -136,6 +136,30 @@ def selfcal(part):
                  "true_f0_hz": f.get("selfcal_true_f0_hz"), "true_q": f.get("selfcal_true_q")}
 
 
+# The fixed drive's reach (gyro/selfcal.h SELFCAL_Q_FIXED_MAX): above it the sweep commits
+# the tracking drive, and gyro_design refuses the fixed one.
+FIXED_Q_MAX = 5000.0
+DRIVES = ("auto", "fixed", "tracking")
+
+
+def choose_drive(part, sc_path, drive, q):
+    """The drive mode the later stages calibrate: the sweep's choice ("auto"), or the one
+    asked for, written into a copy of the self-calibration's param set. Returns its path."""
+    if drive not in DRIVES:
+        raise FlowError(f"drive mode {drive!r}: one of {', '.join(DRIVES)}")
+    if drive == "auto":
+        return sc_path
+    if drive == "fixed" and not q <= FIXED_Q_MAX:
+        raise FlowError(f"--drive fixed: the part's Q {q:.0f} is beyond the fixed drive's "
+                        f"{FIXED_Q_MAX:g} (its sweep chose the tracking drive)")
+    ps = paramset.read(sc_path)
+    values = ps.values()
+    values["drive.track"] = 1 if drive == "tracking" else 0
+    out = os.path.join(part.work, f"selfcal_{drive}_params.json")
+    paramset.write(out, paramset.from_values(values, meta=ps.meta))
+    return out
+
+
 LOG_COLUMNS = ["rate_dps", "quad_dps", "rate_true_dps", "rate_valid", "rate_invalid"]
 THERMAL_COLUMNS = LOG_COLUMNS + ["rate_unc_dps", "p_f_deg", "t_struct_c"]
 

@@ -34,7 +34,8 @@ LOT_REQUIRED = {"name", "seed", "distributions", "spec", "flow"}
 DIST_KEYS = {"normal": ({"mean", "sd"}, {"min", "max"}),
              "uniform": ({"min", "max"}, set()),
              "lognormal": ({"median", "sigma_ln"}, {"min", "max"})}
-FLOW_KEYS = {"calibrate", "scenarios"}
+FLOW_KEYS = {"calibrate", "scenarios", "drive"}
+DRIVES = ("auto", "fixed", "tracking")  # tools/calibrate --drive
 SCEN_KEYS = {"name", "scenario", "duration_s", "quick_duration_s", "selfcal"}
 LINE_KEYS = {"figure", "min", "max", "unit", "note"}
 SPEC_KEYS = {"name", "lines", "notes", "description"}
@@ -108,6 +109,7 @@ class Lot:
     timeout_s: float
     digest: str
     units: dict
+    drive: str = "auto"  # the drive mode the calibration flow calibrates (--drive)
 
 
 # ---------------------------------------------------------------- gyro-sim's table
@@ -323,7 +325,13 @@ def _flow(obj, folder: str, where: str) -> tuple:
     scen = _scenarios(obj["scenarios"], folder, f"{where}.scenarios")
     if not scen and not obj["calibrate"]:
         raise InputError(f"{where}: nothing to run (no calibration and no scenario)")
-    return obj["calibrate"], scen
+    drive = obj.get("drive", "auto")
+    if drive not in DRIVES:
+        raise InputError(f"{where}.drive: one of {', '.join(DRIVES)} (the drive mode the "
+                         "calibration flow calibrates)")
+    if drive != "auto" and not obj["calibrate"]:
+        raise InputError(f"{where}.drive: only with calibrate true (it is the flow's choice)")
+    return obj["calibrate"], scen, drive
 
 
 def _line(o, where: str, prefixes: set | None) -> SpecLine:
@@ -392,7 +400,7 @@ def load(path: str, table: dict) -> Lot:
     if both:
         raise InputError(f"{path}: '{both[0]}' is both fixed (base) and varying (distributions)")
     chol = _chol(obj.get("correlations", []), dists, f"{path}: correlations")
-    calibrate, scen = _flow(obj["flow"], folder, f"{path}: flow")
+    calibrate, scen, drive = _flow(obj["flow"], folder, f"{path}: flow")
     if not isinstance(obj["spec"], str):
         raise InputError(f"{path}: spec must be the path of the spec file")
     spec_path = os.path.abspath(os.path.join(folder, obj["spec"]))
@@ -400,4 +408,4 @@ def load(path: str, table: dict) -> Lot:
     units = {k: p.unit for k, p in table.items()}
     units.update({ln.figure: ln.unit for ln in spec})
     return Lot(os.path.abspath(path), obj["name"], seed, parts, base, dists, chol, calibrate,
-               scen, spec_path, spec, timeout, _digest(obj, scen), units)
+               scen, spec_path, spec, timeout, _digest(obj, scen), units, drive)

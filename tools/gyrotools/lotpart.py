@@ -71,6 +71,7 @@ class PartJob:
     part_dir: str
     timeout_s: float
     stamp: str
+    drive: str = "auto"   # tools/calibrate --drive
 
 
 def _get(obj, path):
@@ -174,7 +175,8 @@ def _calibrate(job: PartJob, runner: _Runner, row: dict) -> str | None:
     plant = {k: v for k, v in job.base.items() if k.startswith("plant.")}
     cmd = [sys.executable, os.path.join(job.tools_dir, "calibrate"), "--sim",
            *_sets({**plant, **job.values}), "--seed", str(job.seed), "--out", out,
-           "--gyro-sim", job.gyro_sim] + (["--quick"] if job.quick else [])
+           "--gyro-sim", job.gyro_sim] + (["--quick"] if job.quick else []) + (
+               ["--drive", job.drive] if job.drive != "auto" else [])
     r = runner.run("cal", cmd, job.part_dir)
     row["cal.exit"] = float(r.returncode)
     row["cal.verified"] = 1.0 if r.returncode == 0 else 0.0

@@ -145,7 +145,7 @@ def job(lot, k: int, out: str, gyro_sim: str, quick: bool, stamp_id: str) -> lot
     values, seed = lotfile.draw(lot, k)
     return lotpart.PartJob(k, values, dict(lot.base), seed, lot.calibrate, quick, lot.scenarios,
                            os.path.abspath(gyro_sim), TOOLS, os.path.abspath(part_dir(out, k)),
-                           lot.timeout_s, stamp_id)
+                           lot.timeout_s, stamp_id, lot.drive)
 
 
 def _keep(out: str, k: int, res: dict):

@@ -75,3 +75,23 @@ def test_a_value_out_of_the_firmwares_range_is_a_failed_stage(tmp_path, monkeypa
     code = tool.main(["--sim", "--out", str(out), "--gyro-sim", str(sim)])
     assert code == tool.EXIT_STAGE_FAILED
     assert not (out / "calibration.json").exists()
+
+
+# --drive: the sweep's choice (auto), or the mode asked for written into a copy of the
+# self-calibration's set; the fixed drive is refused beyond its reach.
+CAL = os.path.join(os.path.dirname(__file__), "..", "..", "..", "host_sim", "parts",
+                   "default", "calibration.json")
+
+
+def test_choose_drive(tmp_path):
+    part = calflow.SimPart("sim", "scen", [], 1, str(tmp_path))
+    assert calflow.choose_drive(part, CAL, "auto", 33.0) == CAL
+    tracked = calflow.choose_drive(part, CAL, "tracking", 33.0)
+    assert paramset.read(tracked).values()["drive.track"] == 1
+    assert paramset.read(CAL).values()["drive.track"] == 0  # the original untouched
+    fixed = calflow.choose_drive(part, tracked, "fixed", 4000.0)
+    assert paramset.read(fixed).values()["drive.track"] == 0
+    with pytest.raises(calflow.FlowError, match="beyond the fixed drive"):
+        calflow.choose_drive(part, CAL, "fixed", 2.0e4)
+    with pytest.raises(calflow.FlowError, match="one of"):
+        calflow.choose_drive(part, CAL, "pll", 33.0)

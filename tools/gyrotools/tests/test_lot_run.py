@@ -88,3 +88,27 @@ def test_same_table_with_1_and_2_workers_and_resumed(run_script, lotfile, tmp_pa
 
 def table_t(out):
     return pd.read_parquet(os.path.join(out, "timings.parquet"))
+
+
+def test_a_dead_worker_process_costs_nothing(run_script, lotfile, tmp_path):
+    """A worker process killed (SIGKILL) while it runs a part: Dask's nanny starts a new
+    one, the part runs again from nothing, and the table is the undisturbed lot's (but for
+    the version stamp: the stand-in simulator is another file). The stand-in kills its
+    parent, the worker process, on the first part run it sees, then is gyro-sim."""
+    mark = tmp_path / "killed"
+    sim = tmp_path / "gyro-sim"
+    sim.write_text("#!/bin/sh\n"
+                   "case \"$*\" in *--scenario*)\n"
+                   f"  if mkdir '{mark}' 2>/dev/null; then kill -9 $PPID; sleep 30; exit 1; fi;;\n"
+                   "esac\n"
+                   f"exec '{SIM}' \"$@\"\n")
+    sim.chmod(0o755)
+    calm, hit = str(tmp_path / "calm"), str(tmp_path / "hit")
+    code, _, err = lot(run_script, lotfile, calm, "--workers", "2", "--processes")
+    assert code == 0, err
+    code, _, err = run_script("lot", [lotfile, "--out", hit, "--gyro-sim", sim, "--no-progress",
+                                      "--workers", "2", "--processes"])
+    assert code == 0, err
+    assert mark.is_dir()  # a worker was killed
+    a, b = (table(x).drop(columns="stamp") for x in (calm, hit))
+    pd.testing.assert_frame_equal(a, b)

@@ -124,6 +124,7 @@ BAD = [
     (_mut(("spec",), "missing.json"), "cannot read the spec"),
     (_mut(("spec",), 3), "spec must be"),
     (_mut(("flow", "calibrate"), "yes"), "true or false"),
+    (_mut(("flow", "drive"), "pll"), "one of auto, fixed, tracking"),
     (_mut(("flow", "scenarios"), []), "nothing to run"),
     (_mut(("flow", "scenarios"), [{"name": "nope_not_there"}]), "no such file"),
     (_mut(("flow", "scenarios"), [{"name": "Startup!"}]), "identifier"),
@@ -281,3 +282,18 @@ def test_part_retried_through_dask(tmp_path, run_script, retries, code):
         assert json.loads(row.read_text())["startup.lock_time_s"] == 0.02
     else:
         assert not row.exists() and "ended from outside" in err and "run the same command again" in err
+
+
+def test_drive_mode_read(tmp_path):
+    """flow.drive: the calibration flow's drive mode (tools/calibrate --drive), part of the
+    lot's digest; auto by default; only with a calibration."""
+    lot = good_lot()
+    lot["flow"]["calibrate"] = True
+    plain = lotfile.load(write(tmp_path, lot), TABLE)
+    assert plain.drive == "auto"
+    lot["flow"]["drive"] = "tracking"
+    got = lotfile.load(write(tmp_path, lot), TABLE)
+    assert got.drive == "tracking" and got.digest != plain.digest
+    lot["flow"]["calibrate"] = False
+    with pytest.raises(InputError, match="only with calibrate true"):
+        lotfile.load(write(tmp_path, lot), TABLE)
