@@ -77,7 +77,8 @@ typedef enum {
   SELFCAL_HOLD,
   SELFCAL_READY,
   SELFCAL_DONE,
-  SELFCAL_FAILED
+  SELFCAL_FAILED,
+  SELFCAL_REBURST /* a burst went over the ADC budget: the vibration decays, drive off */
 } selfcal_state_t;
 
 /* Every STEPS point of the latest sweep (both placements when the points were placed
