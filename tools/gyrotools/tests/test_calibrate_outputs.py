@@ -95,3 +95,19 @@ def test_choose_drive(tmp_path):
         calflow.choose_drive(part, CAL, "fixed", 2.0e4)
     with pytest.raises(calflow.FlowError, match="one of"):
         calflow.choose_drive(part, CAL, "pll", 33.0)
+
+
+def test_startup_lead(tmp_path):
+    """The verification schedule waits for a high-Q part's start-up (4 drive time
+    constants and a margin beyond the schedule's own first 7 s at rest), and not at all
+    for the air part."""
+    assert calflow.startup_lead_s(CAL) == 0.0
+    ps = paramset.read(CAL)
+    v = ps.values()
+    v["drive.cal_q"] = 33330.0
+    v["drive.cal_f0_hz"] = 1499.24
+    path = str(tmp_path / "q.json")
+    paramset.write(path, paramset.from_values(v, meta=ps.meta))
+    tau = 2 * 33330.0 / (2 * 3.141592653589793 * 1499.24)  # 7.08 s
+    lead = calflow.startup_lead_s(path)
+    assert lead == float(int(4 * tau + 2.0 - 7.0) + 1) and lead > 20.0
