@@ -8,6 +8,7 @@ import importlib.machinery
 import importlib.util
 import os
 
+import numpy as np
 import pytest
 
 from gyrotools import calflow, paramset
@@ -111,3 +112,18 @@ def test_startup_lead(tmp_path):
     tau = 2 * 33330.0 / (2 * 3.141592653589793 * 1499.24)  # 7.08 s
     lead = calflow.startup_lead_s(path)
     assert lead == float(int(4 * tau + 2.0 - 7.0) + 1) and lead > 20.0
+
+
+def test_dwell_mask_leaves_out_the_start_up():
+    """With a lead, the verification's first held window (lead + the schedule's first
+    rests, at 0) is the start-up and not judged; without one, the schedule is judged as
+    before. Failed so on four parts of the vacuum lot before (the window was judged)."""
+    lead = 20.0
+    steps = [[lead, 0]] + calflow.lincal.table_steps((30, -30), 10.0, calflow.VERIFY_REST_S)
+    t = np.arange(0.0, sum(s[0] for s in steps), 0.005)
+    edges = np.cumsum([0.0] + [s[0] for s in steps])
+    truth = np.array([steps[np.searchsorted(edges, x, side="right") - 1][1] for x in t], float)
+    m = calflow.dwell_mask(t, truth, t[-1], lead)
+    assert not m[t < lead + 7.0].any() and m[(t > 40.0) & (t < 41.0)].all()
+    m0 = calflow.dwell_mask(t, truth, t[-1], 0.0)
+    assert m0[(t > 10.0) & (t < 20.0)].any()
