@@ -183,6 +183,40 @@ def _sim(part, params, scenario, seed, name, csv=False, columns=None):
     return log, replies, " ".join(cmd)
 
 
+# The rate table's run is judged from where the drive is LOCKED for good: before, P and the
+# demodulated phasors are the acquisition's (on thesis-preset parts of Q about 3000 the
+# fixed drive locks after 2.8 s or more; the fit then read P's turn with the rate squared
+# as 0.073 deg/(deg/s)^2 and the part failed). At most this fraction of the run may go.
+LOCK_WAIT_MAX = 0.5
+
+
+def lock_time_s(log):
+    """When the firmware is LOCKED for good (no MODE reason after it), from the log's start."""
+    bit = 1 << fields.RATE_INVALID.index("MODE")
+    last = np.flatnonzero((log["rate_invalid"].astype(np.int64) & bit) != 0)
+    t = log["t_s"]
+    return 0.0 if last.size == 0 else float(t[min(int(last[-1]) + 1, t.size - 1)] - t[0])
+
+
+def locked_log(log, what):
+    """The log from the first sample after which the firmware stays LOCKED (no MODE
+    reason), or the whole log when that is before the first judged window (SETTLE_S):
+    air parts (LOCKED at 0.04 s) are judged exactly as before."""
+    bit = 1 << fields.RATE_INVALID.index("MODE")
+    mode = (log["rate_invalid"].astype(np.int64) & bit) != 0
+    last = np.flatnonzero(mode)
+    if last.size == 0:
+        return log
+    i = int(last[-1]) + 1
+    t = log["t_s"]
+    if i >= t.size or t[i] - t[0] > LOCK_WAIT_MAX * (t[-1] - t[0]):
+        raise FlowError(f"{what}: the drive was not LOCKED for good before "
+                        f"{LOCK_WAIT_MAX:.0%} of the run")
+    if t[i] - t[0] <= SETTLE_S:
+        return log
+    return dataclasses.replace(log, data=log.data[i:])
+
+
 def rate_table(part, params_path):
     """Stage 2: demodulation phase and scale from rate tables, until the response lies
     on the rate axis. Returns the values and each pass's figures."""
@@ -194,6 +228,8 @@ def rate_table(part, params_path):
         paramset.write(cur, paramset.from_values(values, meta={"stage": f"rate table pass {k}"}))
         log, _, cmd = _sim(part, cur, scen, part.seed + RATE_TABLE_SEED_OFFSET + k,
                            f"rate_table_{k}", csv=True, columns=LOG_COLUMNS + ["p_f_deg"])
+        lock_s = lock_time_s(log)
+        log = locked_log(log, f"rate table pass {k}")
         res = demodcal.analyse(log["t_s"], log["rate_dps"], log["quad_dps"],
                                values["rate.demod_phase_deg"], values["rate.scale_dps"],
                                rate_true_dps=log["rate_true_dps"], settle_s=SETTLE_S,
@@ -204,7 +240,8 @@ def rate_table(part, params_path):
         passes.append({"command": cmd, "alpha_deg": res.alpha_deg,
                        "alpha_se_deg": res.alpha_se_deg, "gain": res.gain,
                        "phase_deg": res.phase_deg, "scale_dps": res.scale_dps,
-                       "quad_dps": res.quad_dps, "segments": res.n_segments})
+                       "quad_dps": res.quad_dps, "segments": res.n_segments,
+                       "lock_s": lock_s})
         values["rate.demod_phase_deg"] = res.phase_deg
         values["rate.scale_dps"] = res.scale_dps
         # The thermometer's reading of the rate (rate.p_rate_deg_per_dps, and with its
@@ -329,15 +366,20 @@ def _status_value(reply, key):
     return None
 
 
-def selftest(part, values):
-    """Stage 3: the self-test expectations, measured on the calibrated part at rest."""
+def selftest(part, values, lock_s=0.0):
+    """Stage 3: the self-test expectations, measured on the calibrated part at rest. The
+    commands wait for the drive's lock (lock_s, as the rate table measured it: the fixed
+    drive on a Q 3000 part locks after about 3 s, and a self-test asked at 1 s was refused:
+    'response 0 deg/s'); unchanged where it locks within half a second."""
     path = os.path.join(part.work, "selftest_params.json")
     paramset.write(path, paramset.from_values(values, meta={"stage": "self-test"}))
+    lead = float(np.ceil(lock_s)) if lock_s > 0.5 else 0.0
     scen = _scenario(part, "calibrate_selftest", {
         "description": "the self-test's responses on the calibrated part at rest",
-        "duration_s": 6.0, "commands": [
-            [1.0, "selftest"], [2.0, "status"],
-            [2.1, "set selftest.cont_expect_dps 1 selftest.continuous 1"], [5.9, "status"]]})
+        "duration_s": 6.0 + lead, "commands": [
+            [1.0 + lead, "selftest"], [2.0 + lead, "status"],
+            [2.1 + lead, "set selftest.cont_expect_dps 1 selftest.continuous 1"],
+            [5.9 + lead, "status"]]})
     _, replies, cmd = _sim(part, path, scen, part.seed, "self-test")
     on_demand = _status_value(replies[1] if len(replies) > 1 else None, "selftest_dps")
     cont = _status_value(replies[3] if len(replies) > 3 else None, "selftest_cont_dps")
@@ -432,7 +474,10 @@ def verify(part, cal_path):
     bias = float(np.mean(out[rest])) if np.any(rest) else float("nan")
     # The scale factor is the slope over the thesis's table (+-20..160 deg/s); every
     # sub-range's against it.
-    r_h, m_h, se_h = _held_means(log, "rate_dps", t_end_s=t_selftest)
+    # The held means from where the drive stays LOCKED (the fixed drive at Q 3000 locks
+    # after about 3 s; before, the output is the acquisition's: a scale factor of
+    # -5e10 ppm was read so).
+    r_h, m_h, se_h = _held_means(locked_log(log, "verify"), "rate_dps", t_end_s=t_selftest)
     m_h = m_h - np.where(r_h != 0.0, lincal.bias_between_rests(r_h, m_h), 0.0)
     turning = np.abs(r_h) > 0.0  # the rests are the bias's (and the self-test's)
     sub, sf = lincal.subrange_slopes(r_h[turning], m_h[turning], se_h[turning])

@@ -11,7 +11,7 @@ import os
 import numpy as np
 import pytest
 
-from gyrotools import calflow, paramset
+from gyrotools import calflow, csvlog, paramset
 
 TOOL = os.path.join(os.path.dirname(__file__), "..", "..", "calibrate")
 
@@ -38,7 +38,7 @@ def test_only_a_verified_calibration_is_calibration_json(tmp_path, monkeypatch, 
         "residual_rms_dps_linear": 0.01, "residual_rms_dps_linearised": 0.01}))
     monkeypatch.setattr(calflow, "thermal", lambda part, v: (v, {
         "plateaus_c": [-40.0, 85.0], "p_span_deg": 1.0, "fit_rms_1s_dps": 0.1}))
-    monkeypatch.setattr(calflow, "selftest", lambda part, v: (v, {
+    monkeypatch.setattr(calflow, "selftest", lambda part, v, *lock: (v, {
         "expect_dps": 5.5, "cont_expect_dps": 4.2}))
     monkeypatch.setattr(calflow, "verify_all", lambda part, cal: {"stub": {"ok": passed}})
     monkeypatch.setattr(tool, "summarise", lambda res: None)
@@ -127,3 +127,21 @@ def test_dwell_mask_leaves_out_the_start_up():
     assert not m[t < lead + 7.0].any() and m[(t > 40.0) & (t < 41.0)].all()
     m0 = calflow.dwell_mask(t, truth, t[-1], 0.0)
     assert m0[(t > 10.0) & (t < 20.0)].any()
+
+
+def test_locked_log():
+    """The rate table is judged from where the drive stays LOCKED: an air part's log
+    (LOCKED at 0.04 s) whole, a part locking at 3 s from there, one that locks only in
+    the second half of the run refused."""
+    t = np.arange(0.0, 26.0, 0.005)
+
+    def log(t_lock):
+        d = np.zeros(t.size, dtype=[("t_s", float), ("rate_invalid", float), ("x", float)])
+        d["t_s"], d["rate_invalid"], d["x"] = t, np.where(t < t_lock, 1.0, 0.0), t * 2
+        return csvlog.Log("log.csv", d, ("t_s", "rate_invalid", "x"))
+    air = log(0.04)
+    assert calflow.locked_log(air, "x") is air
+    late = calflow.locked_log(log(3.0), "x")
+    assert late["t_s"][0] == pytest.approx(3.0) and late["x"][0] == pytest.approx(6.0)
+    with pytest.raises(calflow.FlowError, match="not LOCKED"):
+        calflow.locked_log(log(14.0), "rate table pass 0")
