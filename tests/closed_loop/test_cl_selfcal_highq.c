@@ -40,13 +40,7 @@ static void test_burst_over_budget(void **state)
   plant_default_cfg(&pc);
   pc.f_drive_hz = 1474.5234585971245;
   pc.q_drive = 13344.8;
-  param_values_t v;
-  values_no_autostart(&v);
-  start(&pc, &v);
-  const double t = sweep();
-  check_identified_strict(&pc, t);
-  assert_int_equal(app.selfcal.state, SELFCAL_DONE);
-  check_lock();
+  vacuum_part_case(&pc);
 }
 
 int main(void)

@@ -251,23 +251,16 @@ static inline void check_identified_strict(const plant_cfg_t *pc, double t_s)
   assert_true(fabs(s->fit.q / pc->q_drive - 1.0) <= 0.02);
 }
 
-/* A part of resonance f_hz (at the reference temperature) and quality factor q, at an
- * ambient dtemp_k from the default, swept from the parameter defaults without
- * autostart. Within the fixed-frequency drive's reach the sweep hands over and the
+/* The part pc swept from the parameter defaults without autostart. Within the fixed-frequency drive's reach the sweep hands over and the
  * fixed drive's loops lock at the set point; beyond it the sweep identifies |H(wn)| by a
  * burst, commits drive.track 1 and hands over to the tracking drive, which locks. */
-static inline void vacuum_case(double f_hz, double q, double dtemp_k)
+static inline void vacuum_part_case(const plant_cfg_t *pc)
 {
-  plant_cfg_t pc;
-  plant_ideal_cfg(&pc);
-  pc.f_drive_hz = f_hz;
-  pc.q_drive = q;
-  pc.temp_k += dtemp_k;
   param_values_t v;
   values_no_autostart(&v);
-  start(&pc, &v);
+  start(pc, &v);
   const double t = sweep();
-  check_identified_strict(&pc, t);
+  check_identified_strict(pc, t);
   assert_int_equal(app.selfcal.state, SELFCAL_DONE);
   /* by the Q identified: a part of nominal Q 5000 may be found either side of the limit */
   const unsigned want_track = app.selfcal.fit.q > SELFCAL_Q_FIXED_MAX ? 1u : 0u;
@@ -276,6 +269,18 @@ static inline void vacuum_case(double f_hz, double q, double dtemp_k)
   assert_int_equal(app.gyro.design->track, want_track); /* taken by the ISR by now */
   const char *r = cmd("status\n");
   assert_non_null(strstr(r, want_track ? "drive_track 1" : "drive_track 0"));
+}
+
+/* The same on the ideal preset's part of resonance f_hz and quality factor q, at an
+ * ambient dtemp_k from the default. */
+static inline void vacuum_case(double f_hz, double q, double dtemp_k)
+{
+  plant_cfg_t pc;
+  plant_ideal_cfg(&pc);
+  pc.f_drive_hz = f_hz;
+  pc.q_drive = q;
+  pc.temp_k += dtemp_k;
+  vacuum_part_case(&pc);
 }
 
 /* The default part's resonance at the default ambient, quality factor q. */
