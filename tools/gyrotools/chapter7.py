@@ -15,6 +15,7 @@ absolute path left in a JSON document into one.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import os
 
@@ -61,6 +62,11 @@ def fmt(x, nd=4):
     if x is None or (isinstance(x, float) and not np.isfinite(x)):
         return "n/a"
     return f"{x:.{nd}g}"
+
+
+def figure(F, scen, key, nd=4):
+    """Scenario scen's figure key from the campaign's figures F, formatted (fmt)."""
+    return fmt(F[scen].get(key), nd)
 
 
 def part_cell(part, open_loop=False):
@@ -166,8 +172,7 @@ def verification_rows(part, vf):
 
 
 def drive_rows(F):
-    def v(scen, key, nd=4):
-        return fmt(F[scen].get(key), nd)
+    v = functools.partial(figure, F)
     sq_amp = fmt(F["square_law"]["square_law"][-1]["amp_v"])
     op = ("", "n/a", NA_OPEN)
     return [
@@ -185,8 +190,7 @@ def drive_rows(F):
 
 
 def rate_rows(F):
-    def v(scen, key, nd=4):
-        return fmt(F[scen].get(key), nd)
+    v = functools.partial(figure, F)
     return [
         Row("scale factor / nonlinearity (+-160 deg/s)",
             f"{v('rate_table', 'scale_factor', 7)} / {v('rate_table', 'nonlinearity_pct', 3)} % FS",
@@ -206,8 +210,7 @@ def rate_rows(F):
 
 
 def thermal_rows(F, D):
-    def v(scen, key, nd=4):
-        return fmt(F[scen].get(key), nd)
+    v = functools.partial(figure, F)
 
     def st(d):
         return (f"{fmt(d['std_dps'])} deg/s std, {fmt(d['pp_dps'])} p-p"
