@@ -190,24 +190,27 @@ def _sim(part, params, scenario, seed, name, csv=False, columns=None):
 LOCK_WAIT_MAX = 0.5
 
 
-def lock_time_s(log):
-    """When the firmware is LOCKED for good (no MODE reason after it), from the log's start."""
+def _lock_index(log):
+    """The first sample after which the firmware stays LOCKED (no MODE reason): 0 when
+    it always was, len(log) when it never is at the end."""
     bit = 1 << fields.RATE_INVALID.index("MODE")
     last = np.flatnonzero((log["rate_invalid"].astype(np.int64) & bit) != 0)
+    return 0 if last.size == 0 else int(last[-1]) + 1
+
+
+def lock_time_s(log):
+    """When the firmware is LOCKED for good, from the log's start."""
     t = log["t_s"]
-    return 0.0 if last.size == 0 else float(t[min(int(last[-1]) + 1, t.size - 1)] - t[0])
+    return float(t[min(_lock_index(log), t.size - 1)] - t[0])
 
 
 def locked_log(log, what):
     """The log from the first sample after which the firmware stays LOCKED (no MODE
     reason), or the whole log when that is before the first judged window (SETTLE_S):
     air parts (LOCKED at 0.04 s) are judged exactly as before."""
-    bit = 1 << fields.RATE_INVALID.index("MODE")
-    mode = (log["rate_invalid"].astype(np.int64) & bit) != 0
-    last = np.flatnonzero(mode)
-    if last.size == 0:
+    i = _lock_index(log)
+    if i == 0:
         return log
-    i = int(last[-1]) + 1
     t = log["t_s"]
     if i >= t.size or t[i] - t[0] > LOCK_WAIT_MAX * (t[-1] - t[0]):
         raise FlowError(f"{what}: the drive was not LOCKED for good before "
