@@ -57,8 +57,8 @@ static void check_startup(double q, double temp_c)
   for (int i = 0; i < 1000; i++) { /* 1 s, every millisecond */
     hal_host_run(50u);
     app_poll(&app);
-    /* Never a valid rate in tracking mode yet: its rate channel has no calibration of its
-     * own (TRACKING, rate_valid.h); valid, it read 28 deg/s wrong at Q 10^3 at rest. */
+    /* Never a valid rate on the fixed drive's calibration (cal.ref_track 0) in tracking
+     * mode (TRACKING, rate_valid.h); valid, it read 28 deg/s wrong at Q 10^3 at rest. */
     if (app.gyro.out.rate_valid != 0u) valid_ms++;
     assert_true(app.gyro.sup.mode != GYRO_MODE_LOCKED ||
                 (app.gyro.out.rate_invalid & RATE_INVALID_TRACKING) != 0u);
