@@ -483,6 +483,37 @@ static void report_square_law(report_t *r, const sim_square_t *sq)
            k, 100.0 * dmax / amax, rms_pct);
 }
 
+/* The same table read at the analog output (CSV aout_v, what the thesis's multimeter read
+ * in §7.2.4): the converter's INL and step size join the rate path's own nonlinearity. */
+static void analyse_rate_table_analog(report_t *r)
+{
+  char dir[1024];
+  snprintf(dir, sizeof dir, "%s/analog_out", r->out_dir);
+  if (mkdir_p(dir) != 0) {
+    fprintf(stderr, "gyro-sim: %s: cannot create the folder\n", dir);
+    r->failed = 1;
+    return;
+  }
+  const char *args[] = {r->csv_path, "--column", "aout_v",    "--unit", "V",
+                        "--settle",  "0.5",      "--min-avg", "0.5",    NULL};
+  cJSON *j = post_run_tool("gyro-scalefactor", args, dir, "scalefactor.json", r->err,
+                           sizeof r->err);
+  if (j == NULL) {
+    fprintf(stderr, "gyro-sim: %s\n", r->err);
+    r->failed = 1;
+    return;
+  }
+  add_num(r->fig, "aout_scale_factor_v_per_dps", post_num(j, "scale_factor_out_per_dps"));
+  add_num(r->fig, "aout_nonlinearity_pct", post_num(j, "nonlinearity_rms_percent_of_fs"));
+  add_num(r->fig, "aout_nonlinearity_max_pct", post_num(j, "nonlinearity_max_percent_of_fs"));
+  if (!r->quiet) {
+    printf("  analog output: scale factor %.7f V/(deg/s), nonlinearity %.4f %% FS rms\n",
+           post_num(j, "scale_factor_out_per_dps"),
+           post_num(j, "nonlinearity_rms_percent_of_fs"));
+  }
+  cJSON_Delete(j);
+}
+
 static void analyse_rate_table(report_t *r)
 {
   const char *args[] = {r->csv_path, "--settle", "0.5", "--min-avg", "0.5", NULL};
@@ -499,6 +530,7 @@ static void analyse_rate_table(report_t *r)
            post_num(j, "nonlinearity_rms_percent_of_fs"));
   }
   cJSON_Delete(j);
+  analyse_rate_table_analog(r);
 }
 
 /* White rate noise against the Brownian floor (4-24), from the Allan fit j scaled to the
@@ -539,6 +571,36 @@ static void report_allan(report_t *r, const cJSON *j, double sf)
   }
 }
 
+/* The Allan deviation of the output before temperature compensation (rate_unc_dps): the
+ * thesis's bias stability and rate ramp (table 7-3) are of an uncompensated gyro, and the
+ * compensation, which reads the drive phase, adds that phase's own flicker. */
+static void analyse_allan_uncompensated(report_t *r, const char *t_end, double sf)
+{
+  char dir[1024];
+  snprintf(dir, sizeof dir, "%s/uncompensated", r->out_dir);
+  const char *args[] = {r->csv_path, "--column", "rate_unc_dps", "--t-start",
+                        "1",         "--t-end",  t_end,          NULL};
+  cJSON *j = mkdir_p(dir) == 0
+                 ? post_run_tool("gyro-allan", args, dir, "allan.json", r->err, sizeof r->err)
+                 : NULL;
+  if (j == NULL) {
+    fprintf(stderr, "gyro-sim: %s: uncompensated Allan: %s\n", dir, r->err);
+    r->failed = 1;
+    return;
+  }
+  add_num(r->fig, "unc_arw_deg_rth", post_num(j, "arw_deg_per_rth") / sf);
+  add_num(r->fig, "unc_rate_ramp_dph_per_h", post_num(j, "rate_ramp_dph_per_h") / sf);
+  add_num(r->fig, "unc_adev_min_dph", post_num(j, "adev_min_measured_dph") / sf);
+  add_num(r->fig, "unc_tau_at_adev_min_s", post_num(j, "tau_at_min_measured_s"));
+  if (!r->quiet) {
+    printf("  uncompensated (rate_unc_dps): lowest Allan deviation %.3f deg/h at %.0f s, "
+           "rate ramp %.1f deg/h/h\n",
+           post_num(j, "adev_min_measured_dph") / sf, post_num(j, "tau_at_min_measured_s"),
+           post_num(j, "rate_ramp_dph_per_h") / sf);
+  }
+  cJSON_Delete(j);
+}
+
 static void analyse_noise_allan(report_t *r)
 {
   const sim_scenario_t *sc = r->sc;
@@ -571,6 +633,7 @@ static void analyse_noise_allan(report_t *r)
   if (sc->analyses & SIM_AN_NOISE) report_noise(r, j, sf);
   if (sc->analyses & SIM_AN_ALLAN) report_allan(r, j, sf);
   cJSON_Delete(j);
+  if (sc->analyses & SIM_AN_ALLAN) analyse_allan_uncompensated(r, tend, sf);
 }
 
 static void analyse_drive_noise(report_t *r)

@@ -78,6 +78,8 @@ CSV_MEANING = {
     "clock_ppm": "the sample clock's error (+: fast), plant.clock_* (truth)",
     "f_drive_true_hz": "f_drive_hz in true time: the NCO's frequency on the sample clock as "
                        "it really runs, f_drive_hz (1 + clock_ppm 1e-6) (truth)",
+    "aout_v": "the analog rate output's voltage as a meter reads it: the DAC's level of "
+              "rate_out_v with the converter's INL, gain and offset (truth)",
     "rate_invalid": "RATE_INVALID_* reasons of the tick's verdict, 0 when the rate is valid "
                     "(firmware/gyro/rate_valid.h; `status` names them)",
 }
