@@ -180,9 +180,10 @@ def drive_rows(F):
             *op, "sweep"),
         Row("drive Q", v("sweep", "q"), "33.33", *op, "sweep"),
         Row("phase at resonance", f"{v('sweep', 'phase_at_f0_deg')} deg", "-99.56 deg", *op, "sweep"),
-        Row("square law: amplitude at 12.75 V / nonlinearity",
-            f"{sq_amp} V / {v('square_law', 'square_law_nonlinearity_pct', 2)} %", "0.8754 V / 0.25 %",
-            *op, "square_law"),
+        Row("square law: amplitude at 12.75 V / nonlinearity (RMS residual of a line with "
+            "intercept over the largest amplitude, the thesis's method)",
+            f"{sq_amp} V / {v('square_law', 'square_law_nonlinearity_rms_pct', 2)} %",
+            "0.8754 V / 0.25 %", *op, "square_law"),
         Row("drive lock (amplitude within 1 %, held)",
             f"{v('startup', 'lock_time_s', 3)} s, overshoot {v('startup', 'overshoot_pct', 2)} %",
             "about 0.2 s, with overshoot", "default", "n/a", NA_DRIVE, "startup"),
@@ -192,16 +193,25 @@ def drive_rows(F):
 def rate_rows(F):
     v = functools.partial(figure, F)
     return [
-        Row("scale factor / nonlinearity (+-160 deg/s)",
-            f"{v('rate_table', 'scale_factor', 7)} / {v('rate_table', 'nonlinearity_pct', 3)} % FS",
-            "7.25 mV/(deg/s) / 0.348 % FS", "default", "yes", RATE_TABLE_NOTE, "rate_table"),
+        Row("scale factor / nonlinearity (+-160 deg/s): digital output; analog output (a meter "
+            "on the DAC, as the thesis measured)",
+            f"{v('rate_table', 'scale_factor', 7)} / {v('rate_table', 'nonlinearity_pct', 3)} % FS; "
+            f"{v('rate_table', 'aout_scale_factor_v_per_dps', 5)} V/(deg/s) / "
+            f"{v('rate_table', 'aout_nonlinearity_pct', 3)} % FS",
+            "7.25 mV/(deg/s) / 0.348 % FS (0.06 % without the table's resonance points)",
+            "default", "yes", RATE_TABLE_NOTE, "rate_table"),
         Row("rate noise vs Brownian floor (4-24), two-sided N",
             f"{v('brownian_only', 'arw_coeff_dph_rthz')} vs "
             f"{v('brownian_only', 'brownian_floor_dph_rthz')} deg/h/rtHz",
             "floor 18.0 at 1489.9 Hz; measured 26.4 one-sided (N 18.7)", "ideal", "yes", OUT, "brownian_only"),
         Row("all noise: ARW (fit) / lowest Allan deviation",
             f"{v('static_allan', 'arw_deg_rth')} deg/rt(h) / {v('static_allan', 'adev_min_dph')} deg/h",
-            "bias stability 31.3 deg/h, rate ramp 4.30 deg/s/h", "default", "yes", OUT, "static_allan"),
+            "", "default", "yes", OUT, "static_allan"),
+        Row("all noise, not compensated (rate_unc_dps): lowest Allan deviation (at tau)",
+            f"{v('static_allan', 'unc_adev_min_dph')} deg/h "
+            f"({v('static_allan', 'unc_tau_at_adev_min_s', 3)} s)",
+            "bias stability 31.3 deg/h (not compensated), rate ramp 4.30 deg/s/h from the "
+            "board's warm-up", "default", "no", "n/a (no compensation)", "static_allan"),
         Row("drive-amplitude noise 1-10 Hz: half-frequency / DC+AC",
             f"{v('drive_noise_halffreq', 'drive_amp_noise_lf_rel', 3)} / "
             f"{v('drive_noise_dcac', 'drive_amp_noise_lf_rel', 3)} /rtHz",
