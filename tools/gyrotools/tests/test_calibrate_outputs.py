@@ -6,6 +6,7 @@ The flow's stages are replaced by doubles (the real ones take minutes of simulat
 
 import importlib.machinery
 import importlib.util
+import json
 import os
 
 import numpy as np
@@ -145,3 +146,52 @@ def test_locked_log():
     assert late["t_s"][0] == pytest.approx(3.0) and late["x"][0] == pytest.approx(6.0)
     with pytest.raises(calflow.FlowError, match="not LOCKED"):
         calflow.locked_log(log(14.0), "rate table pass 0")
+
+
+def _fake_sim(tmp_path):
+    sim = tmp_path / "gyro-sim"
+    sim.write_text("#!/bin/sh\n")
+    sim.chmod(0o755)
+    return str(sim)
+
+
+@pytest.mark.parametrize("passed", [True, False])
+def test_verify_only_judges_a_given_calibration_and_leaves_it(tmp_path, monkeypatch, passed):
+    """--verify-only: no stage runs, the given set is verified as it is (never rewritten,
+    never copied as calibration.json), the verdict is the exit code and report.json."""
+    tool = load_tool()
+    cal = os.path.join(os.path.dirname(TOOL), "..", "host_sim", "parts", "default",
+                       "calibration.json")
+    before = open(cal, "rb").read()
+    seen = []
+
+    def no_stage(*a, **k):
+        raise AssertionError("a calibration stage ran under --verify-only")
+    for stage in ("selfcal", "rate_table", "linearity", "thermal", "selftest"):
+        monkeypatch.setattr(calflow, stage, no_stage)
+    monkeypatch.setattr(calflow, "verify_all",
+                        lambda part, path: seen.append(path) or {"stub": {"ok": passed}})
+    monkeypatch.setattr(tool, "summarise", lambda res: None)
+    out = tmp_path / "out"
+    code = tool.main(["--sim", "--verify-only", cal, "--out", str(out),
+                      "--gyro-sim", _fake_sim(tmp_path)])
+    assert code == (0 if passed else tool.EXIT_VERIFY_FAILED)
+    assert seen == [cal]
+    assert open(cal, "rb").read() == before
+    assert not (out / "calibration.json").exists()
+    assert not (out / "calibration_unverified.json").exists()
+    rep = json.load(open(out / "report.json"))
+    assert rep["verify_only"] == cal and rep["verify"] == {"stub": {"ok": passed}}
+
+
+@pytest.mark.parametrize("content", ["", "{}", "not json", '{"format": "gyro-param-set"}'])
+def test_verify_only_refuses_what_is_not_a_param_set(tmp_path, monkeypatch, content):
+    tool = load_tool()
+    monkeypatch.setattr(calflow, "verify_all", lambda part, path: pytest.fail("verified"))
+    bad = tmp_path / "bad.json"
+    bad.write_text(content)
+    out = tmp_path / "out"
+    with pytest.raises(paramset.ParamSetError, match="bad.json"):
+        tool.main(["--sim", "--verify-only", str(bad), "--out", str(out),
+                   "--gyro-sim", _fake_sim(tmp_path)])
+    assert not out.exists()
