@@ -154,7 +154,8 @@ static void test_band_against_sample_rate(void **state)
 }
 
 /* plant.thermal_preset takes 0, 1, 2; anything else is refused with the choices. The
- * imperfections' parameters go through --set like any other, with their ranges. */
+ * imperfections' parameters and plant.cold_start go through --set like any other, with
+ * their ranges. */
 static void test_settings(void **state)
 {
   (void)state;
@@ -182,6 +183,20 @@ static void test_settings(void **state)
   assert_int_equal(scenario_add_override(sc, "plant.q_temp_law=3", err, sizeof err), 0);
   assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), -1);
   assert_string_equal(err, "plant.q_temp_law: out of range (allowed 0 .. 2)");
+  /* plant.cold_start (power-on after a long power-off) is a switch: 0 or 1 */
+  assert_false(d.cold_start);
+  sc = fresh();
+  assert_int_equal(scenario_parse(sc, "{\"plant\": {\"cold_start\": 1}}", err, sizeof err), 0);
+  assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), 0);
+  assert_true(c.cold_start);
+  sc = fresh();
+  assert_int_equal(scenario_add_override(sc, "plant.cold_start=2", err, sizeof err), 0);
+  assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), -1);
+  assert_string_equal(err, "plant.cold_start: out of range (allowed 0 .. 1)");
+  sc = fresh();
+  assert_int_equal(scenario_add_override(sc, "plant.cold_start=0.5", err, sizeof err), 0);
+  assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), -1);
+  assert_string_equal(err, "plant.cold_start: must be a whole number (allowed 0 .. 1)");
   sc = fresh();
   assert_int_equal(scenario_add_override(sc, "plant.k3_drive_per_m2=2e7", err, sizeof err), 0);
   assert_int_equal(scenario_add_override(sc, "plant.fb_gap_m=3e-6", err, sizeof err), 0);
