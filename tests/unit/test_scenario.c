@@ -3,7 +3,7 @@
  * "accel_g", each field validated with the key named and nothing changed on error;
  * plant.thermal_preset, plant.preset and the new plant parameters through --set and in a
  * file; --list-params naming every plant parameter, plant.thermal_preset and plant.preset;
- * "firmware_params", a parameter set under the firmware settings. */
+ * "firmware_params", a parameter set under the firmware settings; the "analyses" names. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -274,6 +274,22 @@ static void test_preset_refused(void **state)
   }
 }
 
+/* "analyses": allan_unc (the Allan figures of the uncompensated rate) beside allan, by
+ * name both ways; an unknown name is refused with the list, the scenario unchanged. */
+static void test_analyses(void **state)
+{
+  (void)state;
+  char err[400];
+  sim_scenario_t *sc = fresh();
+  assert_int_equal(
+      scenario_parse(sc, "{\"analyses\": [\"allan\", \"allan_unc\"]}", err, sizeof err), 0);
+  assert_true(sc->analyses == (SIM_AN_ALLAN | SIM_AN_ALLAN_UNC));
+  assert_string_equal(scenario_analysis_name(SIM_AN_ALLAN_UNC), "allan_unc");
+  assert_int_equal(scenario_parse(sc, "{\"analyses\": [\"allan_raw\"]}", err, sizeof err), -1);
+  assert_non_null(strstr(err, "allan, allan_unc, drive_noise"));
+  assert_true(sc->analyses == (SIM_AN_ALLAN | SIM_AN_ALLAN_UNC));
+}
+
 /* --list-params: every plant parameter of the table and plant.thermal_preset, each on a
  * line of its own with its default and range. */
 static void test_list_params(void **state)
@@ -367,6 +383,7 @@ int main(void)
       cmocka_unit_test(test_settings),
       cmocka_unit_test(test_preset),
       cmocka_unit_test(test_preset_refused),
+      cmocka_unit_test(test_analyses),
       cmocka_unit_test(test_list_params),
       cmocka_unit_test(test_firmware_params),
   };
