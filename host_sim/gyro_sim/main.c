@@ -553,63 +553,50 @@ static void report_noise(report_t *r, const cJSON *j, double sf)
   }
 }
 
-static void report_allan(report_t *r, const cJSON *j, double sf)
+/* The Allan read-offs of gyro-allan's JSON j as figures named prefix + name: "" for the
+ * output rate_dps (divided by the measured scale factor sf), "unc_" for the
+ * uncompensated rate_unc_dps (sf 1). */
+static void report_allan(report_t *r, const cJSON *j, double sf, const char *prefix)
 {
-  add_num(r->fig, "arw_deg_rth", post_num(j, "arw_deg_per_rth") / sf);
-  add_num(r->fig, "bias_instability_dph", post_num(j, "bias_instability_dph") / sf);
-  add_num(r->fig, "rate_ramp_dph_per_h", post_num(j, "rate_ramp_dph_per_h") / sf);
   /* The fitted three-term model can read a change of white level as flicker; the
    * measured minimum bounds the bias instability whatever the model says. */
-  add_num(r->fig, "adev_min_dph", post_num(j, "adev_min_measured_dph") / sf);
-  add_num(r->fig, "tau_at_adev_min_s", post_num(j, "tau_at_min_measured_s"));
+  static const struct {
+    const char *fig, *key;
+    int per_sf; /* a rate: divided by sf */
+  } kFigs[] = {{"arw_deg_rth", "arw_deg_per_rth", 1},
+               {"bias_instability_dph", "bias_instability_dph", 1},
+               {"rate_ramp_dph_per_h", "rate_ramp_dph_per_h", 1},
+               {"adev_min_dph", "adev_min_measured_dph", 1},
+               {"tau_at_adev_min_s", "tau_at_min_measured_s", 0}};
+  for (size_t i = 0; i < sizeof kFigs / sizeof kFigs[0]; i++) {
+    char name[64];
+    snprintf(name, sizeof name, "%s%s", prefix, kFigs[i].fig);
+    add_num(r->fig, name, post_num(j, kFigs[i].key) / (kFigs[i].per_sf ? sf : 1.0));
+  }
   if (!r->quiet) {
-    printf("  Allan: ARW %.4f deg/rt(h), bias instability %.3f deg/h (fit), rate ramp %.3f deg/h/h;\n"
+    printf("  Allan%s: ARW %.4f deg/rt(h), bias instability %.3f deg/h (fit), rate ramp %.3f deg/h/h;\n"
            "    lowest measured Allan deviation %.3f deg/h at %.0f s\n",
+           prefix[0] != '\0' ? " of the uncompensated rate" : "",
            post_num(j, "arw_deg_per_rth") / sf, post_num(j, "bias_instability_dph") / sf,
            post_num(j, "rate_ramp_dph_per_h") / sf, post_num(j, "adev_min_measured_dph") / sf,
            post_num(j, "tau_at_min_measured_s"));
   }
 }
 
-/* The Allan deviation of the output before temperature compensation (rate_unc_dps): the
- * thesis's bias stability and rate ramp (table 7-3) are of an uncompensated gyro, and the
- * compensation, which reads the drive phase, adds that phase's own flicker. */
-static void analyse_allan_uncompensated(report_t *r, const char *t_end, double sf)
+/* End of the static part of the run: a scenario's last rate step (if any) is its
+ * scale-factor check and is left out of the Allan figures. */
+static double static_end_s(const sim_scenario_t *sc, int *sf_step)
 {
-  char dir[1024];
-  snprintf(dir, sizeof dir, "%s/uncompensated", r->out_dir);
-  const char *args[] = {r->csv_path, "--column", "rate_unc_dps", "--t-start",
-                        "1",         "--t-end",  t_end,          NULL};
-  cJSON *j = mkdir_p(dir) == 0
-                 ? post_run_tool("gyro-allan", args, dir, "allan.json", r->err, sizeof r->err)
-                 : NULL;
-  if (j == NULL) {
-    fprintf(stderr, "gyro-sim: %s: uncompensated Allan: %s\n", dir, r->err);
-    r->failed = 1;
-    return;
-  }
-  add_num(r->fig, "unc_arw_deg_rth", post_num(j, "arw_deg_per_rth") / sf);
-  add_num(r->fig, "unc_rate_ramp_dph_per_h", post_num(j, "rate_ramp_dph_per_h") / sf);
-  add_num(r->fig, "unc_adev_min_dph", post_num(j, "adev_min_measured_dph") / sf);
-  add_num(r->fig, "unc_tau_at_adev_min_s", post_num(j, "tau_at_min_measured_s"));
-  if (!r->quiet) {
-    printf("  uncompensated (rate_unc_dps): lowest Allan deviation %.3f deg/h at %.0f s, "
-           "rate ramp %.1f deg/h/h\n",
-           post_num(j, "adev_min_measured_dph") / sf, post_num(j, "tau_at_min_measured_s"),
-           post_num(j, "rate_ramp_dph_per_h") / sf);
-  }
-  cJSON_Delete(j);
+  *sf_step = sc->has_rate && sc->rate_dps.kind == PROFILE_STEPS && sc->rate_dps.n_steps > 1;
+  return *sf_step ? sc->rate_dps.step_s[0] : sc->duration_s;
 }
 
 static void analyse_noise_allan(report_t *r)
 {
   const sim_scenario_t *sc = r->sc;
   char tend[32];
-  /* Allan on the static part of the run: the scenario's last rate step (if any) is
-   * its scale-factor check and is left out. */
-  const int sf_step = sc->has_rate && sc->rate_dps.kind == PROFILE_STEPS &&
-                      sc->rate_dps.n_steps > 1;
-  const double t_end = sf_step ? sc->rate_dps.step_s[0] : sc->duration_s;
+  int sf_step;
+  const double t_end = static_end_s(sc, &sf_step);
   snprintf(tend, sizeof tend, "%.6f", t_end);
   const char *args[] = {r->csv_path, "--t-start", "1", "--t-end", tend, NULL};
   cJSON *j = post_run_tool("gyro-allan", args, r->out_dir, "allan.json", r->err, sizeof r->err);
@@ -631,9 +618,35 @@ static void analyse_noise_allan(report_t *r)
     return;
   }
   if (sc->analyses & SIM_AN_NOISE) report_noise(r, j, sf);
-  if (sc->analyses & SIM_AN_ALLAN) report_allan(r, j, sf);
+  if (sc->analyses & SIM_AN_ALLAN) report_allan(r, j, sf, "");
   cJSON_Delete(j);
-  if (sc->analyses & SIM_AN_ALLAN) analyse_allan_uncompensated(r, tend, sf);
+}
+
+/* allan_unc: the same read-offs of the uncompensated rate rate_unc_dps (figures unc_*,
+ * the tool's plot and JSON in OUT/allan_unc/). The thesis measured its part without
+ * temperature compensation (table 7-3, fig. 7-11); the part's calibration compensates
+ * the bias against P, which takes a warm-up's drift out of rate_dps. */
+static void analyse_allan_unc(report_t *r)
+{
+  char dir[1100], tend[32];
+  snprintf(dir, sizeof dir, "%s/allan_unc", r->out_dir);
+  if (mkdir_p(dir) != 0) {
+    fprintf(stderr, "gyro-sim: %s: %s\n", dir, strerror(errno));
+    r->failed = 1;
+    return;
+  }
+  int sf_step;
+  snprintf(tend, sizeof tend, "%.6f", static_end_s(r->sc, &sf_step));
+  const char *args[] = {r->csv_path, "--column", "rate_unc_dps", "--t-start",
+                        "1",         "--t-end",  tend,           NULL};
+  cJSON *j = post_run_tool("gyro-allan", args, dir, "allan.json", r->err, sizeof r->err);
+  if (j == NULL) {
+    fprintf(stderr, "gyro-sim: %s\n", r->err);
+    r->failed = 1;
+    return;
+  }
+  report_allan(r, j, 1.0, "unc_");
+  cJSON_Delete(j);
 }
 
 static void analyse_drive_noise(report_t *r)
@@ -683,6 +696,7 @@ static void analyse_trace(report_t *r)
   const uint32_t an = r->sc->analyses;
   if (an & SIM_AN_RATE_TABLE) analyse_rate_table(r);
   if (an & (SIM_AN_NOISE | SIM_AN_ALLAN)) analyse_noise_allan(r);
+  if (an & SIM_AN_ALLAN_UNC) analyse_allan_unc(r);
   if (an & SIM_AN_DRIVE_NOISE) analyse_drive_noise(r);
   if (an & SIM_AN_TEMP) analyse_temp(r);
 }
@@ -934,7 +948,8 @@ int main(int argc, char **argv)
   /* Analyses by the tools need a trace and a folder; without --out they use a temporary
    * one that is removed afterwards. */
   const uint32_t tool_analyses = SIM_AN_RATE_TABLE | SIM_AN_NOISE | SIM_AN_ALLAN |
-                                 SIM_AN_DRIVE_NOISE | SIM_AN_TEMP | SIM_AN_SWEEP;
+                                 SIM_AN_ALLAN_UNC | SIM_AN_DRIVE_NOISE | SIM_AN_TEMP |
+                                 SIM_AN_SWEEP;
   const int need_tools = a.analysis && (sc.analyses & tool_analyses) != 0u;
   char tmpdir[] = "/tmp/gyro-sim-XXXXXX";
   const char *out_dir = a.out_dir;

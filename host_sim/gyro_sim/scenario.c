@@ -22,6 +22,7 @@ static const struct {
     {SIM_AN_TEMP, "temp_comp"},
     {SIM_AN_SWEEP, "sweep"},
     {SIM_AN_SQUARE_LAW, "square_law"},
+    {SIM_AN_ALLAN_UNC, "allan_unc"},
 };
 
 const char *scenario_analysis_name(sim_analysis_t a)
@@ -557,7 +558,7 @@ int scenario_parse(sim_scenario_t *out, const char *json, char *err, size_t len)
           if (bit == 0u) {
             rc = fail(
                 err, len,
-                "analyses: unknown analysis (startup, rate_table, brownian_noise, allan, drive_noise, temp_comp, sweep, square_law)");
+                "analyses: unknown analysis (startup, rate_table, brownian_noise, allan, allan_unc, drive_noise, temp_comp, sweep, square_law)");
             break;
           }
           sc->analyses |= bit;

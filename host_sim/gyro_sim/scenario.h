@@ -6,6 +6,8 @@
  *     "name": "startup", "description": "...", "duration_s": 1.0, "seed": 1,
  *     "mode": "closed_loop" | "open_loop" | "open_loop_sweep",
  *     "analyses": ["startup", "rate_table", ...],
+ *                 ("allan": Allan figures of the output rate_dps; "allan_unc": the same of
+ *                  the uncompensated rate_unc_dps, as figures unc_*)
  *     "csv_rate_hz": 1000,
  *     "selfcal": false,   (true: the firmware's own `sweep` first, at the initial
  *                          conditions; the timeline then starts from power-on with
@@ -72,9 +74,10 @@ typedef enum {
   SIM_AN_NOISE = 1u << 2, /* Brownian floor comparison (brownian_only) */
   SIM_AN_ALLAN = 1u << 3, /* static Allan figures */
   SIM_AN_DRIVE_NOISE = 1u << 4,
-  SIM_AN_TEMP = 1u << 5,      /* temperature chamber / cool-down compensation */
-  SIM_AN_SWEEP = 1u << 6,     /* open-loop frequency response */
-  SIM_AN_SQUARE_LAW = 1u << 7 /* table 7-1: amplitude versus drive voltage */
+  SIM_AN_TEMP = 1u << 5,       /* temperature chamber / cool-down compensation */
+  SIM_AN_SWEEP = 1u << 6,      /* open-loop frequency response */
+  SIM_AN_SQUARE_LAW = 1u << 7, /* table 7-1: amplitude versus drive voltage */
+  SIM_AN_ALLAN_UNC = 1u << 8   /* static Allan figures of the uncompensated rate (unc_*) */
 } sim_analysis_t;
 
 typedef struct {

@@ -98,7 +98,8 @@ int sim_plant_cfg(const sim_scenario_t *sc, plant_cfg_t *cfg, plant_profiles_t *
   else profile_const(&prof->ambient_k, c.temp_k);
   if (sc->has_accel) prof->accel_g = sc->accel_g;
   else accel_profile_zero(&prof->accel_g);
-  /* The run starts with the thermal nodes settled at the ambient of t = 0. */
+  /* The run starts with the thermal nodes settled at the ambient of t = 0 (with
+   * plant.cold_start, all at that ambient: plant_init). */
   c.temp_k = profile_eval(&prof->ambient_k, 0.0, NULL);
   *cfg = c;
   return 0;

@@ -313,8 +313,10 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   make_vref_cfg(c, &vc);
 
   int out_mech = 0;
-  if (thermal_init(&p->thermal, &thc, c->temp_k) != 0)
-    what = "thermal (tau_*, couple_*, rise_*)";
+  /* cold_start: power-on after a long power-off, every node at the ambient (thermal.h) */
+  const int th_rc = c->cold_start ? thermal_init_cold(&p->thermal, &thc, c->temp_k)
+                                  : thermal_init(&p->thermal, &thc, c->temp_k);
+  if (th_rc != 0) what = "thermal (tau_*, couple_*, rise_*)";
   else if (mech_init(&p->mech, &mc,
                      mech_temp_clamp(&mc, thermal_temp(&p->thermal, THERMAL_STRUCT), &out_mech),
                      seed) != 0)

@@ -4,7 +4,9 @@
  *
  * One sample, plant_step(p, dac, adc), covering [t_k, t_k+1), t_k = k / fs:
  *   1. thermal network (every thermal_dt_s): ambient profile at mid-interval ->
- *      structure / circuit / board-sensor temperatures (thermal.h); the structure
+ *      structure / circuit / board-sensor temperatures (thermal.h; they start in the
+ *      steady state of the ambient at t = 0, or with cold_start all at that ambient,
+ *      warming as after a power-on); the structure
  *      temperature moves the resonances (2-32) and the quality factors (q_temp_law,
  *      qlaw.h) (mech.h), the circuit temperature (of the node chosen by
  *      pick_*_temp_node) the pickoff phases and gains (2-40) (pickoff.h, re-discretised
@@ -304,7 +306,10 @@
   X(bool, pick_drive_lag_allpass, BOOL, 0, 1, "", \
     "drive circuit lag as an all-pass (pure phase) instead of a low-pass") \
   X(bool, pick_sense_lag_allpass, BOOL, 0, 1, "", \
-    "sense circuit lag as an all-pass instead of a low-pass")
+    "sense circuit lag as an all-pass instead of a low-pass") \
+  X(bool, cold_start, BOOL, 0, 1, "", \
+    "power-on after a long power-off: every thermal node starts at the ambient and the " \
+    "self-heating (rise_*) then warms it; 0: the run starts in the thermal steady state")
 
 #define PLANT_CFG_FIELD(ctype, name, kind, lo, hi, unit, doc) ctype name;
 typedef struct {

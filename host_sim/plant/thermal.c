@@ -146,6 +146,14 @@ int thermal_init(thermal_t *th, const thermal_cfg_t *cfg, double ambient_k)
   return 0;
 }
 
+int thermal_init_cold(thermal_t *th, const thermal_cfg_t *cfg, double ambient_k)
+{
+  const int rc = thermal_init(th, cfg, ambient_k);
+  if (rc != 0) return rc;
+  for (int i = 0; i < THERMAL_NODES; i++) th->t_k[i] = ambient_k;
+  return 0;
+}
+
 int thermal_step(thermal_t *th, double ambient_k)
 {
   if (!isfinite(ambient_k)) return -1;

@@ -64,6 +64,12 @@ int thermal_cfg_check(const thermal_cfg_t *cfg, const char **key);
  * ambient_k. Returns 0, -1 (bad cfg or temperature; th unchanged), -2 (expm). */
 int thermal_init(thermal_t *th, const thermal_cfg_t *cfg, double ambient_k);
 
+/* As thermal_init, for a power-on after a long power-off: every node starts at the
+ * ambient (nothing has dissipated yet), and thermal_step then warms it towards the
+ * steady state of thermal_steady through the network's own modes, T(t) = Tss +
+ * exp(-L t)(Ta - Tss) at a constant ambient. Same returns; th unchanged on error. */
+int thermal_init_cold(thermal_t *th, const thermal_cfg_t *cfg, double ambient_k);
+
 /* Advance dt_s with the ambient held at ambient_k. Non-finite input is ignored
  * (returns -1, state unchanged). */
 int thermal_step(thermal_t *th, double ambient_k);

@@ -482,9 +482,62 @@ static void test_temperature_plumbing(void **state)
   assert_true(t->dac_rejects == 0);
   /* a bad frame is rejected and counted, the previous one held */
   hal_dac_frame_t bad = {{HAL_DAC_CODE_MAX + 1u, 0, 0, 0}};
+  /* the mid-scale level itself: 0 V but for the default part's DAC INL at that code */
+  const double held_v = plant_truth(&p)->dac_held_v[0];
+  assert_true(fabs(held_v) < 4.0 * HAL_DAC_V_PER_CODE);
   plant_step_hal(&p, &bad, NULL);
   assert_true(plant_truth(&p)->dac_rejects == 1);
-  assert_true(plant_truth(&p)->dac_held_v[0] == 0.0); /* mid-scale */
+  assert_true(plant_truth(&p)->dac_held_v[0] == held_v);
+}
+
+/* plant.cold_start: power-on after a long power-off. The nodes, the resonance and the
+ * pickoffs start at the ambient and warm as the thermal network alone does from there
+ * (thermal_init_cold); off (the default), they start in the steady state as before. The
+ * switch takes 0 or 1 only, and a refused value changes nothing. */
+static void test_cold_start(void **state)
+{
+  (void)state;
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  assert_false(c.cold_start);
+  quiet(&c);
+  thermal_cfg_t th;
+  thermal_preset(&th, THERMAL_PRESET_DEFAULT);
+  double tss[3];
+  thermal_steady(&th, c.temp_k, tss);
+  static plant_t p;
+  assert_int_equal(plant_init(&p, &c, 3u), 0);
+  assert_true(plant_truth(&p)->circuit_k == tss[THERMAL_CIRCUIT]);
+  assert_true(plant_truth(&p)->board_k == tss[THERMAL_BOARD]);
+  char err[200];
+  plant_cfg_t before = c;
+  const double bad[3] = {2.0, 0.5, -1.0};
+  for (int i = 0; i < 3; i++) {
+    assert_int_equal(plant_param_set(&c, "cold_start", bad[i], err, sizeof err), -1);
+    assert_non_null(strstr(err, "cold_start: "));
+    assert_memory_equal(&c, &before, sizeof c);
+  }
+  assert_int_equal(plant_param_set(&c, "cold_start", 1.0, err, sizeof err), 0);
+  assert_true(c.cold_start);
+  assert_int_equal(plant_init(&p, &c, 3u), 0);
+  const plant_truth_t *t = plant_truth(&p);
+  assert_true(t->struct_k == c.temp_k && t->circuit_k == c.temp_k && t->board_k == c.temp_k);
+  assert_true(p.pick[0].temp_k == c.temp_k && p.pick[1].temp_k == c.temp_k);
+  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  for (long k = 0; k < 500000; k++) plant_step(&p, &fr, NULL); /* 10 s */
+  static thermal_t ref;
+  assert_int_equal(thermal_init_cold(&ref, &th, c.temp_k), 0);
+  for (int k = 0; k < 10000; k++) thermal_step(&ref, c.temp_k);
+  printf("cold start, 10 s after power-on: structure %+.4f circuit %+.4f board %+.4f K\n",
+         t->struct_k - c.temp_k, t->circuit_k - c.temp_k, t->board_k - c.temp_k);
+  for (int i = 0; i < 3; i++) {
+    const double tk = i == 0 ? t->struct_k : i == 1 ? t->circuit_k : t->board_k;
+    assert_true(fabs(tk - thermal_temp(&ref, i)) < 1e-9);
+  }
+  /* warming: the circuit at its own heating rate rise/tau (1.5 K / 300 s) at first */
+  assert_true(t->circuit_k - c.temp_k > 0.8 * 10.0 * 1.5 / 300.0);
+  assert_true(t->circuit_k < tss[THERMAL_CIRCUIT] && t->board_k < tss[THERMAL_BOARD]);
+  assert_true(p.pick[0].temp_k == t->circuit_k);
 }
 
 /* The default part is built and runs at -40 and at 85 degC ambient (the sense circuit's
@@ -566,7 +619,7 @@ int main(void)
       cmocka_unit_test(test_init_validation),      cmocka_unit_test(test_open_loop_chain),
       cmocka_unit_test(test_table_7_1_square_law), cmocka_unit_test(test_table_7_4_slopes),
       cmocka_unit_test(test_adc_budget),           cmocka_unit_test(test_temperature_plumbing),
-      cmocka_unit_test(test_law_warnings),
+      cmocka_unit_test(test_cold_start),           cmocka_unit_test(test_law_warnings),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

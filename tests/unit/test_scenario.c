@@ -3,7 +3,7 @@
  * "accel_g", each field validated with the key named and nothing changed on error;
  * plant.thermal_preset, plant.preset and the new plant parameters through --set and in a
  * file; --list-params naming every plant parameter, plant.thermal_preset and plant.preset;
- * "firmware_params", a parameter set under the firmware settings. */
+ * "firmware_params", a parameter set under the firmware settings; the "analyses" names. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -154,7 +154,8 @@ static void test_band_against_sample_rate(void **state)
 }
 
 /* plant.thermal_preset takes 0, 1, 2; anything else is refused with the choices. The
- * imperfections' parameters go through --set like any other, with their ranges. */
+ * imperfections' parameters and plant.cold_start go through --set like any other, with
+ * their ranges. */
 static void test_settings(void **state)
 {
   (void)state;
@@ -182,6 +183,20 @@ static void test_settings(void **state)
   assert_int_equal(scenario_add_override(sc, "plant.q_temp_law=3", err, sizeof err), 0);
   assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), -1);
   assert_string_equal(err, "plant.q_temp_law: out of range (allowed 0 .. 2)");
+  /* plant.cold_start (power-on after a long power-off) is a switch: 0 or 1 */
+  assert_false(d.cold_start);
+  sc = fresh();
+  assert_int_equal(scenario_parse(sc, "{\"plant\": {\"cold_start\": 1}}", err, sizeof err), 0);
+  assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), 0);
+  assert_true(c.cold_start);
+  sc = fresh();
+  assert_int_equal(scenario_add_override(sc, "plant.cold_start=2", err, sizeof err), 0);
+  assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), -1);
+  assert_string_equal(err, "plant.cold_start: out of range (allowed 0 .. 1)");
+  sc = fresh();
+  assert_int_equal(scenario_add_override(sc, "plant.cold_start=0.5", err, sizeof err), 0);
+  assert_int_equal(sim_plant_cfg(sc, &c, &pr, err, sizeof err), -1);
+  assert_string_equal(err, "plant.cold_start: must be a whole number (allowed 0 .. 1)");
   sc = fresh();
   assert_int_equal(scenario_add_override(sc, "plant.k3_drive_per_m2=2e7", err, sizeof err), 0);
   assert_int_equal(scenario_add_override(sc, "plant.fb_gap_m=3e-6", err, sizeof err), 0);
@@ -257,6 +272,22 @@ static void test_preset_refused(void **state)
     assert_non_null(strstr(err, "plant.preset: "));
     assert_string_equal(sc->plant_preset, "");
   }
+}
+
+/* "analyses": allan_unc (the Allan figures of the uncompensated rate) beside allan, by
+ * name both ways; an unknown name is refused with the list, the scenario unchanged. */
+static void test_analyses(void **state)
+{
+  (void)state;
+  char err[400];
+  sim_scenario_t *sc = fresh();
+  assert_int_equal(
+      scenario_parse(sc, "{\"analyses\": [\"allan\", \"allan_unc\"]}", err, sizeof err), 0);
+  assert_true(sc->analyses == (SIM_AN_ALLAN | SIM_AN_ALLAN_UNC));
+  assert_string_equal(scenario_analysis_name(SIM_AN_ALLAN_UNC), "allan_unc");
+  assert_int_equal(scenario_parse(sc, "{\"analyses\": [\"allan_raw\"]}", err, sizeof err), -1);
+  assert_non_null(strstr(err, "allan, allan_unc, drive_noise"));
+  assert_true(sc->analyses == (SIM_AN_ALLAN | SIM_AN_ALLAN_UNC));
 }
 
 /* --list-params: every plant parameter of the table and plant.thermal_preset, each on a
@@ -352,6 +383,7 @@ int main(void)
       cmocka_unit_test(test_settings),
       cmocka_unit_test(test_preset),
       cmocka_unit_test(test_preset_refused),
+      cmocka_unit_test(test_analyses),
       cmocka_unit_test(test_list_params),
       cmocka_unit_test(test_firmware_params),
   };

@@ -1,6 +1,6 @@
 /* Three-node thermal network (host_sim/plant/thermal) against analytic step responses
- * and, for the general coupled case, the closed form T(t) = Tss + exp(-L t)(T0 - Tss)
- * evaluated with Eigen at each time (not stepped). */
+ * and, for the general coupled case and the power-on warm-up of a cold start, the closed
+ * form T(t) = Tss + exp(-L t)(T0 - Tss) evaluated with Eigen at each time (not stepped). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -174,6 +174,80 @@ static void test_presets_differ(void **state)
   assert_true(spread[1] > 3.0);
 }
 
+/* Power-on after a long power-off (thermal_init_cold): every node starts at the ambient
+ * and the self-heating warms it through the network's own modes, the closed form
+ * T(t) = Tss + exp(-L t)(Ta - Tss) (evaluated with Eigen, not stepped), towards the
+ * steady state that thermal_init starts in. thermal_init keeps that steady state. */
+static void test_cold_start(void **state)
+{
+  (void)state;
+  const thermal_preset_t presets[3] = {THERMAL_PRESET_DEFAULT, THERMAL_PRESET_TIGHT,
+                                       THERMAL_PRESET_LOOSE};
+  const double ta = 298.15;
+  for (int p = 0; p < 3; p++) {
+    thermal_cfg_t c;
+    thermal_preset(&c, presets[p]);
+    c.dt_s = 0.01;
+    static thermal_t cold, warm;
+    assert_int_equal(thermal_init_cold(&cold, &c, ta), 0);
+    assert_int_equal(thermal_init(&warm, &c, ta), 0);
+    double tss[3];
+    thermal_steady(&c, ta, tss);
+    for (int i = 0; i < 3; i++) {
+      assert_true(thermal_temp(&cold, i) == ta);
+      assert_true(thermal_temp(&warm, i) == tss[i]);
+    }
+    /* -L from the equations of thermal.h */
+    const double *g = c.couple_per_s;
+    const double gm[3][3] = {{0, g[0], g[1]}, {g[0], 0, g[2]}, {g[1], g[2], 0}};
+    double ml[9];
+    for (int i = 0; i < 3; i++) {
+      double s = 0.0;
+      for (int j = 0; j < 3; j++) {
+        ml[i * 3 + j] = gm[i][j];
+        s += gm[i][j];
+      }
+      ml[i * 3 + i] = -1.0 / c.tau_s[i] - s;
+    }
+    double worst = 0.0, settled = 0.0;
+    const int stride = 10000; /* every 100 s over 2 h */
+    for (int k = 1; k <= 720000; k++) {
+      thermal_step(&cold, ta);
+      thermal_step(&warm, ta);
+      if (k % stride) continue;
+      const double t = k * c.dt_s;
+      double a[9], e[9];
+      for (int i = 0; i < 9; i++) a[i] = ml[i] * t;
+      assert_int_equal(expm_ref(3, a, e), 0);
+      for (int i = 0; i < 3; i++) {
+        double want = tss[i];
+        for (int j = 0; j < 3; j++) want += e[i * 3 + j] * (ta - tss[j]);
+        worst = fmax(worst, fabs(thermal_temp(&cold, i) - want));
+        settled = fmax(settled, fabs(thermal_temp(&warm, i) - tss[i]));
+      }
+    }
+    printf("preset %d cold start: circuit %.4f K above ambient after 2 h (steady %.4f), "
+           "worst error %.2e K; steady start stays within %.1e K\n",
+           p, thermal_temp(&cold, THERMAL_CIRCUIT) - ta, tss[THERMAL_CIRCUIT] - ta, worst,
+           settled);
+    assert_true(worst < 1e-8);
+    assert_true(settled < 1e-9);
+    /* warmed: two hours are many times the slowest mode of every preset */
+    for (int i = 0; i < 3; i++) assert_true(fabs(thermal_temp(&cold, i) - tss[i]) < 1e-3);
+  }
+  /* a bad configuration is refused, the network left as it was */
+  thermal_cfg_t c;
+  thermal_default_cfg(&c);
+  static thermal_t th;
+  assert_int_equal(thermal_init(&th, &c, ta), 0);
+  const thermal_t before = th;
+  c.tau_s[2] = -1.0;
+  assert_true(thermal_init_cold(&th, &c, ta) < 0);
+  thermal_default_cfg(&c);
+  assert_true(thermal_init_cold(&th, &c, NAN) < 0);
+  assert_memory_equal(&th, &before, sizeof th);
+}
+
 static void test_validation(void **state)
 {
   (void)state;
@@ -213,7 +287,8 @@ int main(void)
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_uncoupled_step),  cmocka_unit_test(test_two_node_modes),
       cmocka_unit_test(test_general_network), cmocka_unit_test(test_ramp_midpoint),
-      cmocka_unit_test(test_presets_differ),  cmocka_unit_test(test_validation),
+      cmocka_unit_test(test_presets_differ),  cmocka_unit_test(test_cold_start),
+      cmocka_unit_test(test_validation),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
