@@ -296,7 +296,8 @@ def summary(doc):
     if "error" not in d:
         ieee = d["rate_dps"]["ieee952"]
         out.append("drift, compensated, IEEE 952: " + "; ".join(
-            f"{k} {_f(ieee[k]['value'], '.3g')} {ieee[k]['unit']}" for k in "NBKR"))
+            f"{k} " + ("n/a" if ieee[k]["value"] is None else f"{ieee[k]['value']:.3g} {ieee[k]['unit']}")
+            for k in "NBKR"))
     tp = doc.get("temperature", {})
     if "error" not in tp and "error" not in tp.get("plateaus", {"error": 1}):
         out.append("plateaus: " + ", ".join(

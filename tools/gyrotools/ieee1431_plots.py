@@ -14,9 +14,10 @@ WRAP = 95  # characters of the command per title line (a 7 in figure at 10 pt)
 
 
 def title(ctx, what, run):
+    """What the figure shows; the part and the run's seed; the command, wrapped."""
     cmd = ctx.report.get("command") or ""
-    return "\n".join([f"{what}: {ctx.part()}, seed {run.get('seed')}"]
-                     + textwrap.wrap(cmd, WRAP, break_on_hyphens=False))
+    return "\n".join([what, f"{ctx.part()}, seed {run.get('seed')}"]
+                      + textwrap.wrap(cmd, WRAP, break_on_hyphens=False))
 
 
 def _mark(axes, t, label, color):
@@ -108,16 +109,29 @@ def _plateau_panel(ax, pl, key, unit, limit):
 
 
 def _ramp_panel(ax, rp):
+    """The 1 s means against each logged temperature, and the fitted slope against the
+    one the JSON reports it for (the structure's when logged)."""
     m = rp["means_1s"]
-    for col, color, name in (("t_ambient_c", "C0", "ambient"), ("t_struct_c", "C1", "structure")):
+    for col, color, name in (("t_ambient_c", "C0", "the ambient (held at the end after "
+                                                    "the ramp)"),
+                             ("t_struct_c", "C1", "the structure")):
         if col in m:
-            ax.plot(m[col], m["rate_dps"], ".", ms=2, color=color,
-                    label=f"1 s means against the {name}")
+            ax.plot(m[col], m["rate_dps"], ".", ms=2, color=color, label=f"1 s means against {name}")
+    key = next(k for k in rp if k.startswith("bias_slope_dps_per_k_of_"))
+    struct = key.endswith("struct")
+    x = m["t_struct_c" if struct else "t_ambient_c"]
+    if np.isfinite(rp[key]):
+        xx = np.array([x.min(), x.max()])
+        b = np.mean(m["rate_dps"]) - rp[key] * np.mean(x)
+        ax.plot(xx, b + rp[key] * xx, "-", color="k", lw=1,
+                label=f"least squares: {rp[key]:+.4f} deg/s per K of the "
+                      + ("structure" if struct else "ambient"))
 
 
 def temperature(ctx, pl, rp):
     """Plateau bias and scale factor, and the ramp's 1 s bias means, against temperature."""
-    run = {"seed": ", ".join(str(x.get("seed")) for x in (pl, rp) if "seed" in x)}
+    run = {"seed": ", ".join(f"{x['seed']} ({what})" for x, what in ((pl, "plateaus"), (rp, "ramp"))
+                             if "seed" in x)}
     fig, (a1, a2, a3) = plotting.figure(3, 1, height_in=2.8)
     if "error" in pl:
         _unavailable(a1, pl)

@@ -283,22 +283,42 @@ def copy(made, tmp_path):
     return d
 
 
-def test_report_folder(made, tmp_path):
-    d = copy(made, tmp_path)
+@pytest.fixture(scope="module")
+def written(made, tmp_path_factory):
+    """The report of the whole synthetic folder, written once for the tests below (four
+    figures cost about 1.8 s of CPU, most of it matplotlib's layout and rendering)."""
+    d = tmp_path_factory.mktemp("written") / "dir"
+    shutil.copytree(made, d)
     path, doc, problems = ieee1431.write(str(d))
+    return d, path, doc, problems
+
+
+def test_report_folder_holds_every_series(written):
+    d, path, doc, problems = written
     assert problems == []
     folder = d / "ieee1431"
     assert path == str(folder / "ieee1431.json")
     for name in ("turn_on", "scale_factor", "drift", "temperature"):
         assert (folder / doc[name]["png"]).is_file()
         assert not os.path.isabs(doc[name]["png"])
+    assert ieee1431.pngs(doc) == ["turn_on.png", "scale_factor.png", "drift.png", "temperature.png"]
+
+
+def test_report_json_names_each_runs_command_seed_and_log(written):
+    _, _, doc, _ = written
     assert doc["turn_on"]["log"] == os.path.join("..", "work", "verify.csv")
     assert doc["drift"]["seed"] == 1004 and doc["drift"]["command"] == "gyro-sim --seed 1004"
     assert doc["temperature"]["ramp"]["seed"] == 1003
-    assert doc["part"] == "part plant.q_drive=40"
-    text = (folder / "ieee1431.json").read_text()
+    assert doc["temperature"]["plateaus"]["seed"] == 1002
+    assert doc["part"] == "part plant.q_drive=40" and doc["report"] == os.path.join("..", "report.json")
+
+
+def test_report_json_writes_what_is_not_measured_as_null(written):
+    d, _, _, _ = written
+    text = (d / "ieee1431" / "ieee1431.json").read_text()
     assert "NaN" not in text and "Infinity" not in text
-    assert json.loads(text)["drift"]["rate_dps"]["ieee952"]["K"]["value"] is None
+    k = json.loads(text)["drift"]["rate_dps"]["ieee952"]["K"]
+    assert k["value"] is None and k["source"].startswith("not observable")
 
 
 def test_missing_and_garbled_logs_are_named_and_the_rest_written(made, tmp_path):
