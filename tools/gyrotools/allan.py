@@ -373,11 +373,28 @@ def plot(res, out_dir, name="allan.png", title=""):
     the points' 68 % intervals, each asymptote over the taus its read-off came from."""
     from . import plotting
 
-    tau, ad = res.curve.tau_s, res.curve.adev_dph
     fig, ax = plotting.figure()
-    ax.fill_between(tau, res.ci_lo_dph, res.ci_hi_dph, color="C0", alpha=0.25,
-                    label="68 % confidence interval")
-    ax.loglog(tau, ad, "o", ms=3, color="C0", label="overlapping ADEV")
+    draw(ax, res)
+    ax.set_ylim(res.curve.adev_dph.min() / 3, res.curve.adev_dph.max() * 3)
+    plotting.finish(ax, title=title or "Allan deviation of the rate output",
+                    xlabel="averaging time tau [s]", ylabel="Allan deviation [deg/h]")
+    return plotting.save(fig, out_dir, name)
+
+
+def draw_points(ax, res, color="C0", what=""):
+    """The measured curve and its 68 % confidence band; `what` names the series in the
+    legend (a figure with two curves)."""
+    tau = res.curve.tau_s
+    ax.fill_between(tau, res.ci_lo_dph, res.ci_hi_dph, color=color, alpha=0.25,
+                    label=f"68 % confidence interval{what and ' (' + what + ')'}")
+    ax.loglog(tau, res.curve.adev_dph, "o", ms=3, color=color,
+              label=f"overlapping ADEV{what and ' of ' + what}")
+
+
+def draw(ax, res, what=""):
+    """plot()'s curve, fit and read-offs on the axes ax (another figure can hold them)."""
+    tau = res.curve.tau_s
+    draw_points(ax, res, "C0", what)
     grid = np.logspace(math.log10(tau[0]), math.log10(tau[-1]), 300)
     ok = fit_agreement(res)
     ok_grid = np.interp(np.log(grid), np.log(tau), ok.astype(float)) > 0.5
@@ -405,10 +422,6 @@ def plot(res, out_dir, name="allan.png", title=""):
     if res.tau_min_fit_s > tau[0]:
         ax.axvspan(tau[0], res.tau_min_fit_s, color="0.85", alpha=0.5, lw=0,
                    label="not fitted (smoothed by the output low-pass)")
-    ax.set_ylim(ad.min() / 3, ad.max() * 3)
-    plotting.finish(ax, title=title or "Allan deviation of the rate output",
-                    xlabel="averaging time tau [s]", ylabel="Allan deviation [deg/h]")
-    return plotting.save(fig, out_dir, name)
 
 
 def _plot_floor(ax, res, grid):

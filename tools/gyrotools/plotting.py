@@ -15,10 +15,13 @@ from .errors import InputError  # noqa: E402
 DPI = 120
 
 
-def figure(nrows=1, ncols=1, height_in=4.5, width_in=7.0, sharex=False):
-    """A new figure and its axes (a single Axes when nrows == ncols == 1)."""
+def figure(nrows=1, ncols=1, height_in=4.5, width_in=7.0, sharex=False, height_ratios=None):
+    """A new figure and its axes (a single Axes when nrows == ncols == 1); height_ratios
+    shares the rows' total height (height_in x nrows) unevenly (a 0/1 flag under a
+    signal needs less)."""
+    kw = {"height_ratios": height_ratios} if height_ratios else {}
     fig, axes = plt.subplots(nrows, ncols, figsize=(width_in, height_in * nrows),
-                             sharex=sharex, squeeze=True)
+                             sharex=sharex, squeeze=True, gridspec_kw=kw)
     return fig, axes
 
 

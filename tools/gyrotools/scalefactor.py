@@ -275,7 +275,7 @@ def plot(res, out_dir, name="scalefactor.png", title="", out_unit="deg/s"):
     xx = np.linspace(x.min(), x.max(), 2)
     ax1.plot(x, y, "o", ms=4, label="segment means")
     ax1.plot(xx, res.bias + res.sf * xx, "-", lw=1,
-             label=f"SF = {res.sf:.6g} {out_unit}/(deg/s), bias = {res.bias:.4g}")
+             label=f"SF = {res.sf:.6g} {out_unit}/(deg/s), bias = {res.bias:.4g} {out_unit}")
     plotting.finish(ax1, title=title or "Scale factor", ylabel=f"output ({out_unit})")
     order = np.argsort(x, kind="stable")
     ax2.plot(x[order], res.residual_in_dps[order], "o-", ms=4, lw=0.8)

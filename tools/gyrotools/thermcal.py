@@ -288,14 +288,22 @@ def fit(log, temps_c, dwell_s, span_from_data=False):
     return values, s0, figures
 
 
-def bias_means(log, t0, t1, out="rate_dps"):
-    """1 s means of the output at rest between t0 and t1, valid samples only."""
+def rest_bins(log, t0, t1, columns):
+    """1 s means of the named columns at rest between t0 and t1, valid samples only:
+    (dict column -> means, with "t_s"; the valid fraction of the window). The bins of the
+    ramp's judgement, so that a report's bias against temperature is the judged one."""
     t = log["t_s"]
     m = _window(t, t0, t1) & (np.abs(log["rate_true_dps"]) < 1e-9) & (log["rate_valid"] > 0.5)
     valid = float(np.mean(log["rate_valid"][_window(t, t0, t1)] > 0.5))
     if not np.any(m):
-        return np.zeros(0), valid
-    return tempcomp.bin_average(t[m], {"y": log[out][m]}, BIN_S)["y"], valid
+        return {c: np.zeros(0) for c in ("t_s",) + tuple(columns)}, valid
+    return tempcomp.bin_average(t[m], {c: log[c][m] for c in columns}, BIN_S), valid
+
+
+def bias_means(log, t0, t1, out="rate_dps"):
+    """1 s means of the output at rest between t0 and t1, valid samples only."""
+    bins, valid = rest_bins(log, t0, t1, (out,))
+    return bins[out], valid
 
 
 def verify_plateaus(log, temps_c, dwell_s):
