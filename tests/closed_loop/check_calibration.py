@@ -21,6 +21,10 @@
                                         the quick protocol's 15..35 degC)
   check_calibration.py quick_vacuum GYRO_SIM   the same for a vacuum part (Q 2e4: the
                                         tracking drive and its frequency thermometer)
+  check_calibration.py brownian_highq GYRO_SIM   issue 16's floor at high Q: the ideal
+                                        part at drive Q 1e4 calibrated by tools/calibrate
+                                        --quick, then brownian_only with that calibration:
+                                        the valid output's noise within 10 % of (4-24)
   check_calibration.py commands GYRO_SIM  a scenario's "commands" (what the flow's
                                         self-test stage uses) reach the command line at
                                         their times; one due after the run has no reply
@@ -231,6 +235,46 @@ def quick_vacuum(sim):
     return quick_part(sim, VACUUM_PART, 1, 20.0)
 
 
+# brownian_highq: the Brownian floor (4-24) at drive Q 1e4 through a calibration of that
+# part. The floor is the sense mode's force noise, the same whatever the drive's Q; what a
+# high drive Q adds is the quadrature turned by the drive's Brownian phase noise. Judged
+# on a calibration of this part: with another part's (the default calibration after a
+# --selfcal sweep) the rate is never valid and its scale factor is 0.79 (the compensation
+# reads the rate's turn of P, Q times larger at Q 1e4, as temperature), so the
+# input-referred noise read 1.24x the floor while the output's own noise sat on it.
+BROWNIAN_PART = ("plant.preset=ideal", "plant.q_drive=10000")
+
+
+def brownian_highq(sim):
+    with tempfile.TemporaryDirectory() as d:
+        sets = [a for s in BROWNIAN_PART for a in ("--set", s)]
+        r = run(["--sim", "--quick", "--out", d, "--gyro-sim", sim] + sets)
+        print(r.stdout[-2000:] + r.stderr)
+        if r.returncode != 0:
+            print(f"FAIL: calibration exit {r.returncode}")
+            return 1
+        js = os.path.join(d, "bo.json")
+        scen = os.path.join(ROOT, "host_sim", "scenarios", "brownian_only.json")
+        r = subprocess.run([sim, "--scenario", scen, "--quiet", "--firmware-params",
+                            os.path.join(d, "calibration.json"), "--set", "plant.q_drive=10000",
+                            "--json", js, "--out", os.path.join(d, "bo")],
+                           capture_output=True, text=True)
+        if r.returncode != 0:
+            print(f"FAIL: gyro-sim exit {r.returncode}: {r.stderr}")
+            return 1
+        with open(js, encoding="utf-8") as fh:
+            f = json.load(fh)["figures"]
+    # 1200 s of white noise: the Allan fit's own scatter is about 3 % (the scenario's
+    # note), so 10 % is the issue's goal with room for it; valid once the start-up
+    # (4 drive time constants, 8.6 s) is over; the scale factor is its calibration's.
+    checks = [("arw_over_floor", abs(f["arw_over_floor"] - 1.0) <= 0.10),
+              ("rate_valid_fraction", f["rate_valid_fraction"] >= 0.95),
+              ("scale_factor", abs(f["scale_factor"] - 1.0) <= 0.01)]
+    for name, ok in checks:
+        print(f"{'ok  ' if ok else 'FAIL'} {name} {f[name]:.4f}")
+    return 0 if all(ok for _, ok in checks) else 1
+
+
 def commands(sim):
     scen = os.path.join(ROOT, "tests", "vectors", "scenario_commands.json")
     freq = paramset.read(CAL).values()["drive.freq_hz"]
@@ -251,7 +295,8 @@ def commands(sim):
 
 if __name__ == "__main__":
     modes = {"regen": regen, "usage": usage, "commands": commands, "defaults": tool_defaults,
-             "tempcomp": tempcomp_out_of_sample, "quick": quick, "quick_vacuum": quick_vacuum}
+             "tempcomp": tempcomp_out_of_sample, "quick": quick, "quick_vacuum": quick_vacuum,
+             "brownian_highq": brownian_highq}
     if len(sys.argv) != 3 or sys.argv[1] not in modes:
         print(__doc__, file=sys.stderr)
         sys.exit(2)
