@@ -21,7 +21,7 @@ int adc_init(adc_t *a, const adc_cfg_t *cfg)
   memset(a, 0, sizeof *a);
   a->cfg = *cfg;
   a->inv_lsb = 32768.0 / cfg->full_scale_v;
-  (void)inl_init(&a->inl, &cfg->inl, ADC_BITS, cfg->seed, ADC_RNG_STREAM_INL);
+  (void)inl_init(&a->inl, &cfg->inl, ADC_BITS, cfg->inl_seed, ADC_RNG_STREAM_INL);
   rng_seed(&a->rng_aperture, cfg->seed, ADC_RNG_STREAM_APERTURE);
   return 0;
 }

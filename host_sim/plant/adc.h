@@ -41,7 +41,8 @@ typedef struct {
   double full_scale_v;      /* +-full scale; the board's reference gives HAL_ADC_FULL_SCALE_V */
   inl_cfg_t inl;            /* integral nonlinearity, LSB; zero: ideal */
   double aperture_jitter_s; /* rms timing error of the conversion clock, s; 0: none */
-  uint64_t seed;            /* the part's INL pattern and the jitter's draws */
+  uint64_t seed;            /* the run's jitter draws */
+  uint64_t inl_seed;        /* the board's INL pattern: the same board in every run */
 } adc_cfg_t;
 
 typedef struct {

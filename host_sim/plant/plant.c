@@ -77,12 +77,12 @@ static void make_thermal_cfg(const plant_cfg_t *c, thermal_cfg_t *t)
   t->dt_s = thermal_every(c) / c->fs_hz;
 }
 
-static void make_dac_cfg(const plant_cfg_t *c, uint64_t seed, dac_cfg_t *d)
+static void make_dac_cfg(const plant_cfg_t *c, dac_cfg_t *d)
 {
   dac_default_cfg(d);
   d->inl.bow_lsb = c->dac_inl_bow_lsb;
   d->inl.code_lsb = c->dac_inl_code_lsb;
-  d->inl_seed = seed;
+  d->inl_seed = (uint64_t)c->board_seed; /* the board's ladder, not the run's noise */
   d->fs_hz = c->fs_hz;
   d->recon_cutoff_hz = c->dac_recon_hz;
   d->recon_q = c->dac_recon_q;
@@ -151,6 +151,7 @@ static void make_adc_cfg(const plant_cfg_t *c, uint64_t seed, adc_cfg_t *a)
   a->inl.code_lsb = c->adc_inl_code_lsb;
   a->aperture_jitter_s = c->adc_aperture_jitter_s;
   a->seed = seed;
+  a->inl_seed = (uint64_t)c->board_seed;
 }
 
 static void make_vref_cfg(const plant_cfg_t *c, vref_cfg_t *v)
@@ -299,7 +300,7 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   mech_cfg_t mc;
   make_mech_cfg(c, &mc);
   dac_cfg_t dc;
-  make_dac_cfg(c, seed, &dc);
+  make_dac_cfg(c, &dc);
   actuator_cfg_t ac;
   make_actuator_cfg(c, &ac);
   pickoff_cfg_t pc[2];

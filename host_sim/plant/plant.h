@@ -297,6 +297,9 @@
     "thermal node of the drive circuit laws: 0 structure, 1 circuit, 2 board") \
   X(int, pick_sense_temp_node, INT, 0, 2, "", \
     "thermal node of the sense circuit laws: 0 structure, 1 circuit, 2 board") \
+  X(int, board_seed, INT, 0, 1000000000, "", \
+    "the board's draw of its converters' INL patterns (ADC, DAC): a property of the board, " \
+    "the same in every run whatever the noise seed; a lot draws one per part") \
   X(int, q_temp_law, INT, 0, 2, "", \
     "Q against structure temperature: 0 constant, 1 gas damping (air), 2 thermoelastic " \
     "(vacuum) (qlaw.h)") \

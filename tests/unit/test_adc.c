@@ -124,7 +124,7 @@ static void test_inl(void **state)
   assert_int_equal(adc_convert(&a, ADC_CH_DRIVE, -32768 * LSB), -32768);
   c.inl.bow_lsb = 0.0;
   c.inl.code_lsb = 3.0;
-  c.seed = 12u;
+  c.inl_seed = 12u;
   assert_int_equal(adc_init(&a, &c), 0);
   int moved = 0;
   for (int x = -32000; x <= 32000; x += 250) {

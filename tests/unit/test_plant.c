@@ -540,6 +540,29 @@ static void test_cold_start(void **state)
   assert_true(p.pick[0].temp_k == t->circuit_k);
 }
 
+/* The converters' INL patterns belong to the board (plant.board_seed), not to the run:
+ * two runs with other noise seeds on one board see the same ladders (a calibration and the
+ * runs after it see one part), and another board_seed is another board. */
+static void test_board_seed(void **state)
+{
+  (void)state;
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  c.adc_inl_code_lsb = 2.0;
+  static plant_t a, b;
+  assert_int_equal(plant_init(&a, &c, 11u), 0);
+  assert_int_equal(plant_init(&b, &c, 12u), 0);
+  for (int ch = 0; ch < DAC_NCH; ch++)
+    assert_memory_equal(a.dac.inl[ch].err_lsb, b.dac.inl[ch].err_lsb,
+                        sizeof a.dac.inl[ch].err_lsb);
+  assert_memory_equal(a.adc.inl.err_lsb, b.adc.inl.err_lsb, sizeof a.adc.inl.err_lsb);
+  c.board_seed = 2;
+  assert_int_equal(plant_init(&b, &c, 11u), 0);
+  assert_true(memcmp(a.dac.inl[2].err_lsb, b.dac.inl[2].err_lsb, sizeof a.dac.inl[2].err_lsb) !=
+              0);
+  assert_true(memcmp(a.adc.inl.err_lsb, b.adc.inl.err_lsb, sizeof a.adc.inl.err_lsb) != 0);
+}
+
 /* The default part is built and runs at -40 and at 85 degC ambient (the sense circuit's
  * lag of (2-40) has passed through zero into a 3.4 deg lead at -40 degC) with no law
  * outside its range; an off-nominal part whose laws leave their ranges is not refused
@@ -620,6 +643,7 @@ int main(void)
       cmocka_unit_test(test_table_7_1_square_law), cmocka_unit_test(test_table_7_4_slopes),
       cmocka_unit_test(test_adc_budget),           cmocka_unit_test(test_temperature_plumbing),
       cmocka_unit_test(test_cold_start),           cmocka_unit_test(test_law_warnings),
+      cmocka_unit_test(test_board_seed),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
