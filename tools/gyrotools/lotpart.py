@@ -120,6 +120,15 @@ def _sets(d: dict) -> list:
     return out
 
 
+def part_settings(job: PartJob, plant_only: bool = False) -> dict:
+    """The part's settings: its own board (the converters' INL patterns, plant.board_seed,
+    drawn from the part's seed, so the same board in its calibration and in every run
+    after it; a lot that sets plant.board_seed keeps its own), the lot's base and the
+    part's draws."""
+    base = {k: v for k, v in job.base.items() if k.startswith("plant.") or not plant_only}
+    return {"plant.board_seed": str(job.seed % 1000000000), **base, **job.values}
+
+
 def _kill_tree(p: subprocess.Popen):
     """Ends a process and what it started (tools/calibrate runs gyro-sim). Kept in the
     caller's process group, so that a Ctrl-C at the terminal reaches them all too."""
@@ -172,9 +181,8 @@ def _reason(stage: str, r, part_dir: str) -> str:
 def _calibrate(job: PartJob, runner: _Runner, row: dict) -> str | None:
     """Runs the calibration flow; returns the parameter set to load (None: none)."""
     out = os.path.join(job.part_dir, "cal")
-    plant = {k: v for k, v in job.base.items() if k.startswith("plant.")}
     cmd = [sys.executable, os.path.join(job.tools_dir, "calibrate"), "--sim",
-           *_sets({**plant, **job.values}), "--seed", str(job.seed), "--out", out,
+           *_sets(part_settings(job, plant_only=True)), "--seed", str(job.seed), "--out", out,
            "--gyro-sim", job.gyro_sim] + (["--quick"] if job.quick else []) + (
                ["--drive", job.drive] if job.drive != "auto" else [])
     r = runner.run("cal", cmd, job.part_dir)
@@ -218,7 +226,7 @@ def _scenario(job: PartJob, runner: _Runner, i: int, sc, params: str | None, row
     out = os.path.join(job.part_dir, f"{sc.name}.json")
     dur = sc.quick_duration_s if job.quick and sc.quick_duration_s else sc.duration_s
     cmd = [job.gyro_sim, "--scenario", sc.path, "--seed", str(job.seed + 5000 + i),
-           "--json", out, "--quiet", *_sets({**job.base, **job.values})]
+           "--json", out, "--quiet", *_sets(part_settings(job))]
     cmd += (["--duration", repr(float(dur))] if dur else []) + (["--selfcal"] if sc.selfcal else [])
     cmd += ["--firmware-params", params] if params else []
     r = runner.run(sc.name, cmd, job.part_dir)

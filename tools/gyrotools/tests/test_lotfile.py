@@ -297,3 +297,20 @@ def test_drive_mode_read(tmp_path):
     lot["flow"]["calibrate"] = False
     with pytest.raises(InputError, match="only with calibrate true"):
         lotfile.load(write(tmp_path, lot), TABLE)
+
+
+def test_each_part_is_its_own_board():
+    """A part's converters (plant.board_seed) follow from its seed, the same in its
+    calibration and its scenarios; another part is another board; a lot's own board_seed
+    wins; the calibration gets the plant keys only."""
+    from gyrotools import lotpart
+
+    def job(seed, base):
+        return lotpart.PartJob(0, {"plant.q_drive": 40.0}, base, seed, True, True, (), "sim",
+                               "tools", "dir", 10.0, "stamp")
+    a = lotpart.part_settings(job(123, {"firmware.drive.amp_set_v": 0.3}))
+    assert a["plant.board_seed"] == "123" and a["firmware.drive.amp_set_v"] == 0.3
+    cal = lotpart.part_settings(job(123, {"firmware.drive.amp_set_v": 0.3}), plant_only=True)
+    assert cal == {"plant.board_seed": "123", "plant.q_drive": 40.0}
+    assert lotpart.part_settings(job(124, {}))["plant.board_seed"] == "124"
+    assert lotpart.part_settings(job(123, {"plant.board_seed": 7}))["plant.board_seed"] == 7
