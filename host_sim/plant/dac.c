@@ -59,10 +59,16 @@ static int cfg_ok(const dac_cfg_t *c)
   return inl_check(&c->inl, DAC_BITS) == 0;
 }
 
-static double held_level(const dac_t *d, int c, uint16_t code)
+static double held_level(dac_t *d, int c, uint16_t code)
 {
   double u = d->scale[c] * (double)code + d->zero[c];
-  if (d->inl[c].active) u += d->scale[c] * inl_lsb(&d->inl[c], (long)code);
+  if (d->inl[c].active) {
+    if (d->inl_code[c] != code) {
+      d->inl_code[c] = code;
+      d->inl_v[c] = d->scale[c] * inl_lsb(&d->inl[c], (long)code);
+    }
+    u += d->inl_v[c];
+  }
   if (d->ref_rel != 0.0) {
     const double off = d->cfg.offset_v[c];
     u = off + (u - off) * (1.0 + d->ref_rel);
@@ -144,9 +150,11 @@ int dac_init(dac_t *d, const dac_cfg_t *cfg)
     t.scale[c] = cfg->gain[c] * lsb;
     t.zero[c] = cfg->offset_v[c] - cfg->gain[c] * lsb * (double)HAL_DAC_CODE_MID;
   }
-  for (int c = 0; c < DAC_NCH; c++)
+  for (int c = 0; c < DAC_NCH; c++) {
     (void)inl_init(&t.inl[c], &cfg->inl, DAC_BITS, cfg->inl_seed,
                    DAC_RNG_STREAM_INL + (uint64_t)c);
+    t.inl_code[c] = UINT32_MAX;
+  }
   for (int c = 0; c < DAC_NCH; c++) {
     t.latched[c] = cfg->initial_code[c];
     t.pending[c] = cfg->initial_code[c];

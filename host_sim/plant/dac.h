@@ -117,6 +117,10 @@ typedef struct {
   uint16_t pending[DAC_NCH]; /* code latched at the end of the current sample */
   double ref_rel;            /* reference error r (dac_set_ref) */
   inl_t inl[DAC_NCH];
+  /* the INL of the code last converted on each channel, in volts: the rate output and the
+   * spare hold a code for a block or longer, so most samples need no new lookup */
+  uint32_t inl_code[DAC_NCH]; /* > HAL_DAC_CODE_MAX: none yet */
+  double inl_v[DAC_NCH];
 } dac_t;
 
 /* fs 50 kHz, 2nd-order Butterworth at 20 kHz, ideal gain, no offset, mid-scale codes. */

@@ -15,6 +15,19 @@ int inl_check(const inl_cfg_t *cfg, int bits)
   return 0;
 }
 
+/* nib_lsb[k][v]: the weight errors of the set bits of v placed at bits 4k..4k+3 */
+static void build_nibbles(inl_t *n)
+{
+  for (int k = 0; k < INL_MAX_BITS / 4; k++) {
+    for (unsigned v = 0; v < 16u; v++) {
+      double s = 0.0;
+      for (int b = 0; b < 4; b++)
+        if ((v >> b) & 1u) s += n->err_lsb[4 * k + b];
+      n->nib_lsb[k][v] = s;
+    }
+  }
+}
+
 int inl_init(inl_t *n, const inl_cfg_t *cfg, int bits, uint64_t seed, uint64_t stream)
 {
   if (n == NULL || inl_check(cfg, bits) != 0) return -1;
@@ -34,6 +47,7 @@ int inl_init(inl_t *n, const inl_cfg_t *cfg, int bits, uint64_t seed, uint64_t s
       sum += n->err_lsb[i];
     }
     n->slope_lsb = sum / (ldexp(1.0, bits) - 1.0);
+    build_nibbles(n);
   }
   return 0;
 }
@@ -44,12 +58,15 @@ double inl_lsb(const inl_t *n, long code)
   const long top = (1L << n->bits) - 1L;
   if (code < 0) code = 0;
   if (code > top) code = top;
-  const double u = ((double)code - n->mid) / n->mid;
-  double e = n->bow_lsb * (1.0 - u * u);
+  double e = 0.0;
+  if (n->bow_lsb != 0.0) {
+    const double u = ((double)code - n->mid) / n->mid;
+    e = n->bow_lsb * (1.0 - u * u);
+  }
   if (n->pattern) {
-    double s = 0.0;
-    for (int i = 0; i < n->bits; i++)
-      if (((unsigned long)code >> i) & 1u) s += n->err_lsb[i];
+    const unsigned long c = (unsigned long)code;
+    const double s = n->nib_lsb[0][c & 15u] + n->nib_lsb[1][(c >> 4) & 15u] +
+                     n->nib_lsb[2][(c >> 8) & 15u] + n->nib_lsb[3][(c >> 12) & 15u];
     e += s - (double)code * n->slope_lsb;
   }
   return e;

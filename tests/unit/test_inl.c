@@ -45,6 +45,13 @@ static void test_code_pattern(void **state)
   double want = n.err_lsb[15] - n.slope_lsb;
   for (int i = 0; i < 15; i++) want -= n.err_lsb[i];
   assert_true(fabs(carry - want) < 1e-12);
+  /* the nibble tables give the sum over the set bits at every code */
+  for (long code = 0; code < 65536; code += 37) {
+    double sum = 0.0;
+    for (int i = 0; i < 16; i++)
+      if ((code >> i) & 1) sum += n.err_lsb[i];
+    assert_true(fabs(inl_lsb(&n, code) - (sum - (double)code * n.slope_lsb)) < 1e-12);
+  }
   double s2[16] = {0};
   const int parts = 2000;
   for (int k = 0; k < parts; k++) {
