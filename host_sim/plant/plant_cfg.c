@@ -303,7 +303,7 @@ void plant_ideal_cfg(plant_cfg_t *c)
  *    thesis's DAC is "4-channel 14-bit" (§4.4.2) and unnamed; an MSB weight error of
  *    1.75 LSB rms (inl.h; end-point INL about +-2 LSB on a typical draw) gives a median
  *    of 0.058 % over 12 boards (board_seed 1..12: 0.024..0.151 %; the default board,
- *    board_seed 1, 0.053 %). The board's AD5554 in its B grade (+-0.5 LSB, MSB error
+ *    board_seed 1, 0.054 %). The board's AD5554 in its B grade (+-0.5 LSB, MSB error
  *    0.44 LSB rms) gives 0.019 % (0.012..0.040 %); the digital output has no converter.
  * The chamber and the rate ramp are discussed in docs/honest-part.md. */
 #define PLANT_THESIS_PHASE_FLICKER_DEG_RTHZ 2.0e-4
