@@ -52,7 +52,26 @@ int inl_check(const inl_cfg_t *cfg, int bits);
 /* Validates, draws the weight errors. Returns 0, or -1 with n unchanged. */
 int inl_init(inl_t *n, const inl_cfg_t *cfg, int bits, uint64_t seed, uint64_t stream);
 
-/* INL at code c (offset binary, clamped to the range), LSB. 0 when not active. */
-double inl_lsb(const inl_t *n, long code);
+/* INL at code c (offset binary, clamped to the range), LSB. 0 when not active. Inline:
+ * the DAC converts four channels every sample. */
+static inline double inl_lsb(const inl_t *n, long code)
+{
+  if (!n->active) return 0.0;
+  const long top = (1L << n->bits) - 1L;
+  if (code < 0) code = 0;
+  if (code > top) code = top;
+  double e = 0.0;
+  if (n->bow_lsb != 0.0) {
+    const double u = ((double)code - n->mid) / n->mid;
+    e = n->bow_lsb * (1.0 - u * u);
+  }
+  if (n->pattern) {
+    const unsigned long c = (unsigned long)code;
+    const double s = n->nib_lsb[0][c & 15u] + n->nib_lsb[1][(c >> 4) & 15u] +
+                     n->nib_lsb[2][(c >> 8) & 15u] + n->nib_lsb[3][(c >> 12) & 15u];
+    e += s - (double)code * n->slope_lsb;
+  }
+  return e;
+}
 
 #endif /* PLANT_INL_H */
