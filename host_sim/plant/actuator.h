@@ -34,13 +34,16 @@
  *     Actuator Workshop, Hilton Head 1996, 283; M. Saukoski, System and circuit design for
  *     a capacitive MEMS gyroscope, thesis, Helsinki Univ. of Technology 2008;
  *     E. Tatar, S. E. Alper, T. Akin, J. Microelectromech. Syst. 21 (2012) 656): plates
- *     facing the sense axis across a gap d whose overlap along the drive axis is l0 + y
- *     on one set and l0 - y on the other, a set on each side of the proof mass. A plate
- *     pulls with eps h (l0 +- y) V^2 / (2 (d -+ x)^2); over the two sides of a set the
- *     static parts cancel and the parts in y add, eps h y V^2 / d^2: a stiffness coupling
- *     from the drive displacement to the sense axis in V^2, the sets at V1 and V2 giving
- *     it with either sign. c_q = eps h / (m d^2) (1/s^2 per V^2; plant.quadnull_dps_per_v2
- *     gives it as an equivalent quadrature c_q / (2 wc) per V^2). Across x the same plates
+ *     facing the sense axis across a gap d, each with a thickness h and an overlap along
+ *     the drive axis that the drive displacement changes. A plate pulls the proof mass
+ *     towards itself with eps h l V^2 / (2 (d -+ x)^2), l its overlap. Set 1 has a plate
+ *     on the +x side with overlap l0 - y and one on the -x side with l0 + y; set 2 the
+ *     mirror. Over a set the static parts cancel and the parts in y add: -eps h y V1^2 /
+ *     d^2 along x from set 1, +eps h y V2^2 / d^2 from set 2, a stiffness coupling from
+ *     the drive displacement to the sense axis, k_yx = c_q (V1^2 - V2^2) with
+ *     c_q = eps h / (m d^2) (1/s^2 per V^2; plant.quadnull_dps_per_v2 gives it as an
+ *     equivalent quadrature c_q / (2 wc) per V^2), either sign by which set is driven
+ *     (V1 adds to a positive k_q, V2 cancels it). Across x the same plates
  *     are parallel plates: each set softens the sense spring by eps h 2 l0 V^2 / d^3, in
  *     the same constant k_e = ke_q (V1^2 + V2^2), ke_q = 2 c_q (l0 / d)
  *     (plant.quadnull_overlap_per_gap), so nulling also tunes the sense mode down a little.
