@@ -757,6 +757,23 @@ static void report_plant_warnings(report_t *r)
   add_num(r->fig, "plant_warnings_total", (double)total);
 }
 
+/* sense_match: on a part with sense tuning electrodes, whether they can bring the sense
+ * resonance to the drive's at the ambient (plant_sense_match); a note on stderr when they
+ * cannot (tuning only lowers it). Nothing on a part without them. */
+static void report_sense_match(report_t *r)
+{
+  if (!(r->pc->tune_ke_per_s2_per_v2 > 0.0)) return;
+  plant_match_t m;
+  if (plant_sense_match(r->pc, r->pc->temp_k, 0.0, 0.0, &m) < 0) return;
+  cJSON *o = cJSON_AddObjectToObject(r->fig, "sense_match");
+  add_num(o, "reachable", (double)m.reachable);
+  add_num(o, "tune_v", m.tune_v);
+  add_num(o, "f_sense_hz", m.f_sense_hz);
+  add_num(o, "f_target_hz", m.f_target_hz);
+  cJSON_AddStringToObject(o, "message", m.msg);
+  if (!m.reachable && !r->quiet) fprintf(stderr, "gyro-sim: note: %s\n", m.msg);
+}
+
 /* The figures of a finished run: printed unless quiet, and into the JSON root. */
 static void report_figures(report_t *r, const cli_args_t *a, const bench_figs_t *isr,
                            const sim_sweep_t *sweep, const sim_square_t *sq, int need_tools)
@@ -772,6 +789,7 @@ static void report_figures(report_t *r, const cli_args_t *a, const bench_figs_t 
   add_num(r->fig, "adc_clips_drive", (double)r->res->adc_clips[0]);
   add_num(r->fig, "adc_clips_sense", (double)r->res->adc_clips[1]);
   report_plant_warnings(r);
+  report_sense_match(r);
   if (sc->loop == SIM_OPEN_LOOP_SWEEP && sweep->n > 0) report_sweep(r, sweep, a->analysis);
   if (sc->loop == SIM_OPEN_LOOP && sq->n > 1) {
     report_square_law(r, sq);

@@ -3,11 +3,13 @@
  * CSV columns (stable; more may be appended, never reordered):
  *   t_s, rate_true_dps, rate_dps, quad_dps, drive_amp, drive_phase_deg, p_deg,
  *   t_ambient_c, t_struct_c, t_board_c, u1_v, u2_v, adc_drive_v, adc_sense_v, flags,
- *   mode, t_circuit_c, rate_unc_dps, p_f_deg, drive_amp_true_m, f_cmd_v2
+ *   mode, t_circuit_c, rate_unc_dps, p_f_deg, drive_amp_true_m, f_cmd_v2, rate_valid,
+ *   rate_out_v, f_drive_hz, rate_invalid, clock_ppm, f_drive_true_hz, aout_v, quad_true_dps
  * drive_amp (V) and drive_phase_deg are the firmware's demodulated drive pickoff
  * (amplitude and arg against the NCO); u1_v/u2_v what it wrote to the drive DAC; adc_*
- * the analog voltages at the ADC inputs; flags the GYRO_FLAG_* bits. In open-loop runs
- * the firmware columns are 0.
+ * the analog voltages at the ADC inputs; flags the GYRO_FLAG_* bits; quad_true_dps the
+ * plant's true quadrature (plant_truth_t), to set beside the firmware's quad_dps. In
+ * open-loop runs the firmware columns are 0.
  */
 #ifndef SIM_OUT_H
 #define SIM_OUT_H

@@ -147,9 +147,11 @@ static double q_at(const mech_cfg_t *c, int i, double temp_k, int *out)
  * rows are stored: the input rows of [A B; 0 0] are zero. The generator is exactly
  * polynomial in (w, a, e): stiffness r^2 (1+e)^2, damping r (1+e) / Q (Q of the
  * temperature the blocks are made at), Coriolis and Euler linear, centrifugal quadratic;
- * the electrostatic softening is a constant stiffness. */
+ * the electrostatic softening and the electrodes' stiffness elec = {k_yx, k_e} at the
+ * discretisation (mech.h) are constant stiffnesses. */
 static void build_generator(const mech_cfg_t *c, double wr, double wn1, double wn2,
-                            const double q[2], double ahat[MECH_NMONO][MECH_NS][NA])
+                            const double q[2], const double elec[2],
+                            double ahat[MECH_NMONO][MECH_NS][NA])
 {
   const double r1 = wn1 / wr, r2 = wn2 / wr;
   const double q1 = q[0], q2 = q[1];
@@ -166,9 +168,11 @@ static void build_generator(const mech_cfg_t *c, double wr, double wn1, double w
   a0[1][4] = 1.0;
   a0[2][3] = 1.0;
   a0[3][0] = -kq;
+  if (elec[0] != 0.0) a0[3][0] -= elec[0] / (wr * wr); /* nulling electrodes' coupling */
   a0[3][1] = -dq;
   a0[3][2] = -r2 * r2;
   if (c->ke2_per_s2 != 0.0) a0[3][2] += c->ke2_per_s2 / (wr * wr); /* (6-3): softening */
+  if (elec[1] != 0.0) a0[3][2] += elec[1] / (wr * wr);             /* electrodes' softening */
   a0[3][3] = -r2 / q2;
   a0[3][5] = 1.0;
   /* e: wn -> wn (1 + e) */
@@ -281,14 +285,14 @@ static int alg_exp(alg_t b, alg_t e)
  * exp(h A) in the truncated algebra is sum_i mono_i P_i, the P_i being the blocks
  * [Phi Gamma]. Returns -2 (blk untouched) for a non-finite generator. */
 static int discretise_blocks(const mech_cfg_t *c, double wr, double temp_k, double clock,
-                             const double qual[2], alg_t blk)
+                             const double qual[2], const double elec[2], alg_t blk)
 {
   const double wn1 = clock * wn_at(c, c->f1_hz, temp_k);
   const double wn2 = clock * wn_at(c, c->f2_hz, temp_k);
   const double h = wr / c->fs_hz;
 
   alg_t ahat; /* 2.3 kB: the only scratch */
-  build_generator(c, wr, wn1, wn2, qual, ahat);
+  build_generator(c, wr, wn1, wn2, qual, elec, ahat);
   for (int i = 0; i < MECH_NMONO; i++)
     for (int r = 0; r < MECH_NS; r++)
       for (int q = 0; q < NA; q++) ahat[i][r][q] *= h;
@@ -298,7 +302,8 @@ static int discretise_blocks(const mech_cfg_t *c, double wr, double temp_k, doub
 /* Re-discretise at temp_k with the Q of m->q_now; m unchanged on failure. */
 static int discretise(mech_t *m, double temp_k)
 {
-  if (discretise_blocks(&m->cfg, m->wr, temp_k, m->clock, m->q_now, m->blk) != 0) return -2;
+  if (discretise_blocks(&m->cfg, m->wr, temp_k, m->clock, m->q_now, m->elec_disc, m->blk) != 0)
+    return -2;
   m->temp_disc_k = temp_k;
   m->clock_disc = m->clock;
   m->q_disc[0] = m->q_now[0];
@@ -328,13 +333,18 @@ int mech_init(mech_t *m, const mech_cfg_t *cfg, double temp_k, uint64_t seed)
   const double wr = 2.0 * kPi * c.f1_hz;
   int out[2];
   const double q[2] = {q_at(&c, 0, temp_k, &out[0]), q_at(&c, 1, temp_k, &out[1])};
-  if (discretise_blocks(&c, wr, temp_k, 1.0, q, m->blk) != 0) return -2;
+  const double no_elec[2] = {0.0, 0.0};
+  if (discretise_blocks(&c, wr, temp_k, 1.0, q, no_elec, m->blk) != 0) return -2;
   m->cfg = c;
   m->clock = m->clock_disc = 1.0;
   for (int i = 0; i < 2; i++) m->q_now[i] = m->q_disc[i] = q[i];
   m->q_out = (out[0] || out[1]) ? MECH_OUT_Q : 0u;
   m->duffing_out = 0u;
   m->drift_kq_per_s2 = m->drift_dq_per_s = 0.0;
+  m->elec_kyx_per_s2 = m->elec_ke_per_s2 = 0.0;
+  m->elec_disc[0] = m->elec_disc[1] = m->elec_sum[0] = m->elec_sum[1] = 0.0;
+  m->elec_n = 0;
+  m->elec_on = 0;
   m->held = c.k3_drive_per_m2 != 0.0 || c.k3_sense_per_m2 != 0.0 || c.nl_damp_drive_per_m2 != 0.0;
   m->wr = wr;
   m->temp_k = temp_k;
@@ -472,7 +482,8 @@ static double cubic(double k3, double u, unsigned flag, unsigned *out)
   return k3 * u * u * u;
 }
 
-/* The held forces of mech.h (Duffing, nonlinear drive damping, coupling drift) per unit mass, from the motion at
+/* The held forces of mech.h (Duffing, nonlinear drive damping, coupling drift, electrode
+ * stiffness) per unit mass, from the motion at
  * the middle of the sample: the cubic Hermite interpolant of the states at its start (z0)
  * and end without these forces (z1), scaled units (mech.h). */
 static void held_forces(mech_t *m, const double *z0, const double *z1, double *fy, double *fx)
@@ -495,6 +506,9 @@ static void held_forces(mech_t *m, const double *z0, const double *z1, double *f
     const double s = w1 / wn_at(c, c->f1_hz, c->temp_ref_k); /* as build_generator */
     *fx -= m->drift_kq_per_s2 * s * s * ym + m->drift_dq_per_s * s * vym;
   }
+  if (m->elec_on) /* the electrodes' stiffness beyond the generator's (mech.h) */
+    *fx -= (m->elec_kyx_per_s2 - m->elec_disc[0]) * ym -
+           (m->elec_ke_per_s2 - m->elec_disc[1]) * xm;
 }
 
 void mech_step(mech_t *m, double f_drive_mps2, double f_sense_mps2, double rate_rad_s,
@@ -522,6 +536,11 @@ void mech_step(mech_t *m, double f_drive_mps2, double f_sense_mps2, double rate_
     const double *kr = m->k[r];
     m->z[r] = kr[0] * v[0] + kr[1] * v[1] + kr[2] * v[2] + kr[3] * v[3] + kr[4] * v[4] +
               kr[5] * v[5];
+  }
+  if (m->elec_on) {
+    m->elec_sum[0] += m->elec_kyx_per_s2;
+    m->elec_sum[1] += m->elec_ke_per_s2;
+    m->elec_n++;
   }
   if (m->held) {
     /* the held forces from the sample's motion without them, then their share of the
@@ -557,14 +576,78 @@ double mech_wn2(const mech_t *m) { return m->clock * wn_at(&m->cfg, m->cfg.f2_hz
 double mech_q1(const mech_t *m) { return m->q_now[0]; }
 double mech_q2(const mech_t *m) { return m->q_now[1]; }
 
+/* Whether any held force of mech.h is on. */
+static void update_held(mech_t *m)
+{
+  m->held = m->cfg.k3_drive_per_m2 != 0.0 || m->cfg.k3_sense_per_m2 != 0.0 ||
+            m->cfg.nl_damp_drive_per_m2 != 0.0 || m->drift_kq_per_s2 != 0.0 ||
+            m->drift_dq_per_s != 0.0 || m->elec_on;
+}
+
 int mech_set_coupling_drift(mech_t *m, double dkq_per_s2, double ddq_per_s)
 {
   if (!(isfinite(dkq_per_s2) && isfinite(ddq_per_s))) return -1;
   m->drift_kq_per_s2 = dkq_per_s2;
   m->drift_dq_per_s = ddq_per_s;
-  m->held = m->cfg.k3_drive_per_m2 != 0.0 || m->cfg.k3_sense_per_m2 != 0.0 ||
-            m->cfg.nl_damp_drive_per_m2 != 0.0 || dkq_per_s2 != 0.0 || ddq_per_s != 0.0;
+  update_held(m);
   return 0;
+}
+
+int mech_set_elec(mech_t *m, double kyx_per_s2, double ke_per_s2)
+{
+  if (!(isfinite(kyx_per_s2) && fabs(kyx_per_s2) <= 1e9 && isfinite(ke_per_s2) &&
+        ke_per_s2 >= 0.0))
+    return -1;
+  /* pull-in margin of mech_cfg_check, on the sum with the configured softening */
+  const double w2 = 2.0 * kPi * m->cfg.f2_hz, lim = 0.5 * w2 * w2 - m->cfg.ke2_per_s2;
+  int held_at_edge = 0;
+  if (ke_per_s2 > lim) {
+    ke_per_s2 = lim;
+    m->duffing_out |= MECH_OUT_PULL_IN;
+    held_at_edge = 1;
+  }
+  m->elec_kyx_per_s2 = kyx_per_s2;
+  m->elec_ke_per_s2 = ke_per_s2;
+  if (!m->elec_on && (kyx_per_s2 != 0.0 || ke_per_s2 != 0.0)) {
+    m->elec_on = 1;
+    update_held(m);
+  }
+  return held_at_edge;
+}
+
+int mech_elec_rebase(mech_t *m)
+{
+  if (m->elec_n == 0) return 0;
+  const double kyx = m->elec_sum[0] / (double)m->elec_n, ke = m->elec_sum[1] / (double)m->elec_n;
+  m->elec_sum[0] = m->elec_sum[1] = 0.0;
+  m->elec_n = 0;
+  const double w1 = mech_wn1(m), w2 = mech_wn2(m);
+  const double kyx_step = 2.0 * w1 * m->cfg.refresh_eps * MECH_ELEC_KYX_REFRESH_DPS *
+                          (kPi / 180.0);
+  const double ke_step = 2.0 * m->cfg.refresh_eps * w2 * w2;
+  if (fabs(kyx - m->elec_disc[0]) <= kyx_step && fabs(ke - m->elec_disc[1]) <= ke_step)
+    return 0;
+  const double old[2] = {m->elec_disc[0], m->elec_disc[1]};
+  m->elec_disc[0] = kyx;
+  m->elec_disc[1] = ke;
+  if (discretise(m, m->temp_k) != 0) { /* not expected: the blocks stay as they were */
+    m->elec_disc[0] = old[0];
+    m->elec_disc[1] = old[1];
+    return -2;
+  }
+  return 1;
+}
+
+double mech_kyx_total(const mech_t *m)
+{
+  const double s = mech_wn1(m) / wn_at(&m->cfg, m->cfg.f1_hz, m->cfg.temp_ref_k);
+  return (m->cfg.kq_per_s2 + m->drift_kq_per_s2) * s * s + m->elec_kyx_per_s2;
+}
+
+double mech_wn2_eff(const mech_t *m)
+{
+  const double w2 = mech_wn2(m);
+  return sqrt(w2 * w2 - m->cfg.ke2_per_s2 - m->elec_ke_per_s2);
 }
 
 unsigned mech_laws_out(mech_t *m)

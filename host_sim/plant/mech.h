@@ -45,6 +45,31 @@
  * (2-32), and it leaves the damping (c = m wn2 / Q2) alone. It sits in the generator
  * like the other stiffness terms (exact).
  *
+ * Electrostatic stiffness of the sense electrodes (mech_set_elec; the plant's actuator
+ * gives it from their voltages, actuator.h): a coupling k_yx that adds to k_q (the
+ * quadrature-nulling electrodes, -k_yx y on the sense axis) and a softening k_e that adds
+ * to cfg.ke2_per_s2 (tuning, nulling and feedback-pair electrodes, +k_e x), per unit
+ * mass, set every sample. Like ke2_per_s2 neither scales with (2-32) nor touches the
+ * damping. The reaction of the nulling electrodes on the drive axis, -k_yx x, is left
+ * out as the anisoelastic coupling's is (|x| / |y| ~ 1e-2 and k_yx / wn1^2 ~ 3e-3: a
+ * drive force 3e-5 of its stiffness force). A varying stiffness cannot sit in the
+ * generator (each change would be a re-discretisation, ~0.2 ms), so the generator
+ * carries the values of its last discretisation and the difference is a held force
+ * (below), f_x -= (k_yx - k_yx,d) y_m - (k_e - k_e,d) x_m; the sample means since the
+ * last call are rebased into the generator by mech_elec_rebase (the plant calls it at
+ * every thermal update, 1 ms) when they have moved from the generator's by more than
+ *   k_e:   2 refresh_eps wn2^2  (a relative shift of the sense resonance of refresh_eps,
+ *          as a temperature refresh; the held part's error, 1 - sinc(wT/2) of it, is
+ *          then 2.6e-6 of the frequency at 2 kHz);
+ *   k_yx:  an equivalent quadrature k_yx / (2 wn1) of refresh_eps x 1e4 deg/s (10 deg/s
+ *          at the default, whose held error, 1 - sinc(wn1 T/2) = 0.145 % of it, is
+ *          0.015 deg/s).
+ * So a steady voltage is exact (in the generator) from the second thermal update after it
+ * is set, the electrode noise and the feedback pair's parametric part at 2 wc stay held
+ * forces, and a loop that moves a voltage re-discretises at most once per millisecond,
+ * only while it moves. The softening is held at the pull-in margin of the configured
+ * one, cfg.ke2_per_s2 + k_e <= wn2(T0)^2 / 2, and flagged (MECH_OUT_PULL_IN).
+ *
  * Held forces (not in the generator; added to the inputs f_y, f_x of the sample, only
  * when switched on), each evaluated from the motion at the middle of the sample: the
  * cubic Hermite interpolant between the state at its start and the state at its end
@@ -136,6 +161,11 @@
 #define MECH_OUT_Q 1u             /* Q(T) outside its law's temperature range, now */
 #define MECH_OUT_DUFFING_DRIVE 2u /* drive cubic term beyond MECH_DUFFING_MAX, since last */
 #define MECH_OUT_DUFFING_SENSE 4u /* sense cubic term beyond MECH_DUFFING_MAX, since last */
+#define MECH_OUT_PULL_IN 8u /* electrode softening held at the pull-in margin, since last */
+
+/* Rebase threshold of the electrostatic coupling: an equivalent quadrature of
+ * refresh_eps times this (mech.h above). */
+#define MECH_ELEC_KYX_REFRESH_DPS 1e4
 
 typedef struct {
   double f1_hz;           /* drive resonance at temp_ref_k */
@@ -186,9 +216,14 @@ typedef struct {
   double q_disc[2];       /* ... of the current Taylor blocks */
   double drift_kq_per_s2; /* coupling drift at T0 (mech_set_coupling_drift) */
   double drift_dq_per_s;
-  int held;             /* a held force of the header is on */
-  unsigned q_out;       /* MECH_OUT_Q at temp_k */
-  unsigned duffing_out; /* MECH_OUT_DUFFING_* since the last mech_laws_out */
+  double elec_kyx_per_s2, elec_ke_per_s2; /* electrode stiffness now (mech_set_elec) */
+  double elec_disc[2];                    /* k_yx, k_e in the current Taylor blocks */
+  double elec_sum[2];                     /* sums of k_yx, k_e since the last rebase */
+  long elec_n;                            /* samples in them */
+  int elec_on;                            /* mech_set_elec was given a non-zero stiffness */
+  int held;                               /* a held force of the header is on */
+  unsigned q_out;                         /* MECH_OUT_Q at temp_k */
+  unsigned duffing_out; /* MECH_OUT_DUFFING_*, MECH_OUT_PULL_IN since the last mech_laws_out */
 } mech_t;
 
 /* Defaults: the thesis linear gyro (fn1 1489.9 Hz, Q1 33.33, fn2 2000 Hz, Q2 3,
@@ -241,8 +276,30 @@ double mech_q2(const mech_t *m);
  * at T0 (held until the next call). Non-finite values are ignored (returns -1). */
 int mech_set_coupling_drift(mech_t *m, double dkq_per_s2, double ddq_per_s);
 
+/* The electrodes' stiffness per unit mass over the coming samples (mech.h above): the
+ * coupling k_yx (1/s^2, adds to k_q) and the softening k_e (1/s^2, >= 0, adds to
+ * cfg.ke2_per_s2; held at the pull-in margin, flagged). Returns -1 (nothing changed)
+ * for a non-finite value, |k_yx| > 1e9 or k_e < 0; 1 when k_e was held at the margin;
+ * 0 otherwise. */
+int mech_set_elec(mech_t *m, double kyx_per_s2, double ke_per_s2);
+
+/* Rebase the electrodes' stiffness into the generator: the means since the last call
+ * replace the generator's values when they have moved by the thresholds of the header
+ * (a re-discretisation). Returns 1 when it re-discretised, 0 otherwise (also with no
+ * samples since the last call), -2 if the exponential failed (blocks unchanged). */
+int mech_elec_rebase(mech_t *m);
+
+/* The sense-from-drive stiffness coupling now, per unit mass (1/s^2): k_q and its drift
+ * at the structure temperature plus the electrodes' k_yx (the quadrature is this over
+ * 2 wc). */
+double mech_kyx_total(const mech_t *m);
+
+/* The sense resonance now with the electrostatic softening (configured and electrodes'),
+ * rad/s of the sample clock as mech_wn2; sqrt(wn2^2 - k_e). */
+double mech_wn2_eff(const mech_t *m);
+
 /* MECH_OUT_* of the laws held at an edge: the Q law at the present temperature, the
- * cubic terms since the last call (cleared). */
+ * cubic terms and the pull-in margin since the last call (cleared). */
 unsigned mech_laws_out(mech_t *m);
 
 /* One-sided acceleration noise PSD of resonance 1 (drive) or 2 (sense) at the current temperature,

@@ -47,6 +47,13 @@ static void make_mech_cfg(const plant_cfg_t *c, mech_cfg_t *m)
   m->ke2_per_s2 = plant_fb_softening(c);
 }
 
+double plant_fb_pair_softening(const plant_cfg_t *c)
+{
+  /* (6-3) per electrode, 2 (Ks m) U^2 / d as in plant_fb_softening, on U3 and U4 */
+  if (c->fb_mode != 3 || !(c->fb_gap_m > 0.0)) return 0.0;
+  return 2.0 * c->ks_fb_mps2_per_v2 / c->fb_gap_m;
+}
+
 double plant_fb_softening(const plant_cfg_t *c)
 {
   /* (6-3) per electrode: k_e = eps A V^2 / d^3 = 2 (Ks m) V^2 / d, with Ks m = eps A / (2 d^2)
@@ -110,6 +117,19 @@ static void make_actuator_cfg(const plant_cfg_t *c, actuator_cfg_t *a)
   a->fb_noise.white_rthz = c->fb_noise_white_v_rthz;
   a->fb_noise.flicker_1hz_rthz = c->fb_noise_1hz_v_rthz;
   a->fb_noise.fmin_hz = c->fb_noise_fmin_hz;
+  a->fb_ke_per_s2_per_v2 = plant_fb_pair_softening(c);
+  /* c_q as an equivalent quadrature per V^2, scaled as quad_dps (make_mech_cfg) */
+  a->quadnull_kyx_per_s2_per_v2 = 2.0 * (2.0 * kPi * c->f_drive_hz) * c->quadnull_dps_per_v2 *
+                                  kDeg;
+  a->quadnull_ke_per_s2_per_v2 = 2.0 * a->quadnull_kyx_per_s2_per_v2 *
+                                 c->quadnull_overlap_per_gap;
+  a->quadnull_noise.white_rthz = c->quadnull_noise_white_v_rthz;
+  a->quadnull_noise.flicker_1hz_rthz = c->quadnull_noise_1hz_v_rthz;
+  a->quadnull_noise.fmin_hz = c->quadnull_noise_fmin_hz;
+  a->tune_ke_per_s2_per_v2 = c->tune_ke_per_s2_per_v2;
+  a->tune_noise.white_rthz = c->tune_noise_white_v_rthz;
+  a->tune_noise.flicker_1hz_rthz = c->tune_noise_1hz_v_rthz;
+  a->tune_noise.fmin_hz = c->tune_noise_fmin_hz;
 }
 
 static void make_pickoff_cfg(const plant_cfg_t *c, int axis, pickoff_cfg_t *q)
@@ -194,7 +214,7 @@ static int pick_node(const plant_cfg_t *c, int axis) { return PLANT_PICK(c, axis
 static const char *const kLawNames[PLANT_LAWS] = {
     "pick_drive_phase", "pick_sense_phase", "pick_drive_gain", "pick_sense_gain",
     "resonance",        "ambient",          "q_temp",          "duffing_drive",
-    "duffing_sense",    "pick_drive_gap",   "pick_sense_gap"};
+    "duffing_sense",    "pick_drive_gap",   "pick_sense_gap",  "sense_pull_in"};
 
 const char *plant_law_name(int law)
 {
@@ -236,6 +256,7 @@ static void warn_amplitude_laws(plant_t *p)
   if (m & MECH_OUT_Q) warn(p, PLANT_LAW_Q_TEMP);
   if (m & MECH_OUT_DUFFING_DRIVE) warn(p, PLANT_LAW_DUFFING_DRIVE);
   if (m & MECH_OUT_DUFFING_SENSE) warn(p, PLANT_LAW_DUFFING_SENSE);
+  if (m & MECH_OUT_PULL_IN) warn(p, PLANT_LAW_SENSE_PULL_IN);
   for (int i = 0; i < 2; i++) warn_pickoff(p, i, (int)pickoff_gap_out(&p->pick[i]));
 }
 
@@ -263,6 +284,18 @@ static void truth_temps(plant_t *p, double ambient_k)
   t->board_k = thermal_temp(&p->thermal, THERMAL_BOARD);
   t->wn_drive_rad_s = mech_wn1(&p->mech);
   t->q_drive = mech_q1(&p->mech);
+}
+
+/* The electrodes' part of the truth (plant_truth_t): the quadrature as an equivalent rate
+ * at the drive frequency of the truth, the sense resonance with its softening. */
+static void truth_sense(plant_t *p)
+{
+  plant_truth_t *t = &p->truth;
+  const double wc = 2.0 * kPi * t->drive_freq_hz;
+  t->quad_true_dps = mech_kyx_total(&p->mech) / (2.0 * wc) / kDeg;
+  const double w2 = mech_wn2(&p->mech), w2e = mech_wn2_eff(&p->mech);
+  t->sense_freq_hz = w2e / (2.0 * kPi);
+  t->sense_shift_hz = (w2e - w2) / (2.0 * kPi);
 }
 
 /* The sample clock's error at time t_s (plant.h, clock_*): the mechanics see the sample
@@ -358,6 +391,7 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   p->fz_alpha = 1.0 - exp(-p->T / c->truth_force_tau_s);
   clock_update(p, 0.0);
   truth_temps(p, c->temp_k);
+  truth_sense(p);
   if (out_mech) warn(p, PLANT_LAW_RESONANCE);
   for (int i = 0; i < 2; i++) warn_pickoff(p, i, p->pick[i].out_of_range);
   warn_amplitude_laws(p);
@@ -420,6 +454,7 @@ static void thermal_update(plant_t *p, double t0)
   (void)mech_set_temp(
       &p->mech, mech_temp_clamp(&p->mech.cfg, thermal_temp(&p->thermal, THERMAL_STRUCT), &out));
   if (out) warn(p, PLANT_LAW_RESONANCE);
+  if (p->act.elec) (void)mech_elec_rebase(&p->mech); /* the last update's mean stiffness */
   /* the gain follows at once; the phase re-discretises (microseconds) only when it moved
    * by pick_phase_step_rad. A law driven out of its range is held at its edge, counted. */
   for (int i = 0; i < 2; i++)
@@ -470,6 +505,7 @@ static void truth_phasors(plant_t *p)
   } else {
     t->sense_disp_m = t->sense_vel_m = 0.0;
   }
+  truth_sense(p);
 }
 
 /* Force phasor, every sample: the actuator gives per-sample means,
@@ -514,7 +550,12 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
   dac_out_t dout;
   dac_step(&p->dac, &dout);
   actuator_out_t aout;
-  actuator_step(&p->act, &dout, &aout);
+  if (p->act.elec) {
+    actuator_step_elec(&p->act, &dout, &p->elec_in, &aout);
+    (void)mech_set_elec(&p->mech, aout.kyx_per_s2, aout.ke_per_s2); /* margin: mech flags */
+  } else {
+    actuator_step(&p->act, &dout, &aout);
+  }
   double fd = aout.f_drive_mps2, fsn = aout.f_sense_mps2;
   if (p->accel_any) {
     if (p->accel_dynamic) accel_profile_mean(&p->prof.accel_g, t0, t0 + T, t->accel_g);
@@ -566,6 +607,40 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
   }
   p->f_prev[1] = p->f_prev[0];
   p->f_prev[0] = f;
+}
+
+/* A level v held over the sample, as the actuator takes an electrode's voltage. */
+static dac_chan_out_t held_level(double v)
+{
+  const dac_chan_out_t c = {
+      .held_v = v, .mean_v = v, .mean_sq_v2 = v * v, .end_v = v, .end_dvdt_v_per_s = 0.0};
+  return c;
+}
+
+int plant_set_electrodes(plant_t *p, const plant_electrodes_t *v)
+{
+  if (p == NULL || v == NULL) return -1;
+  const struct {
+    const char *key;
+    double v;
+  } e[5] = {{"fb_u1_v", v->fb_u1_v},
+            {"fb_u2_v", v->fb_u2_v},
+            {"quadnull_v1_v", v->quadnull_v1_v},
+            {"quadnull_v2_v", v->quadnull_v2_v},
+            {"tune_v", v->tune_v}};
+  for (int i = 0; i < 5; i++)
+    if (!(isfinite(e[i].v) && fabs(e[i].v) <= PLANT_ELECTRODE_MAX_V)) {
+      set_err(p, "electrodes: %s must be finite and within +-%g V", e[i].key,
+              PLANT_ELECTRODE_MAX_V);
+      return -1;
+    }
+  p->truth.elec_v = *v;
+  p->elec_in.fb[0] = held_level(v->fb_u1_v);
+  p->elec_in.fb[1] = held_level(v->fb_u2_v);
+  p->elec_in.quadnull[0] = held_level(v->quadnull_v1_v);
+  p->elec_in.quadnull[1] = held_level(v->quadnull_v2_v);
+  p->elec_in.tune = held_level(v->tune_v);
+  return 0;
 }
 
 void plant_step_hal(void *plant, const hal_dac_frame_t *dac, hal_adc_frame_t *adc)

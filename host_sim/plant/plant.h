@@ -18,13 +18,17 @@
  *      INL, output amplifier, reconstruction low-pass; the shared reference's noise
  *      (vref.h) on it and on the ADC;
  *   3. actuator (actuator.h): F = Ks (U1^2 - U2^2) (6-7) with 1/f electrode-voltage
- *      noise, mean over the sample, per unit mass; plus the inertial and g-sensitivity
+ *      noise, mean over the sample, per unit mass; the sense electrodes beyond the DAC
+ *      (plant_set_electrodes: the feedback pair of fb_mode 3, the quadrature-nulling and
+ *      the tuning electrodes) give their force and their stiffness (a coupling that adds
+ *      to k_q, a softening of the sense spring); plus the inertial and g-sensitivity
  *      forces of the acceleration profile (accel.h, exact mean over the sample of the
  *      constant, sine and half-sine shock parts; random vibration from vib.h);
  *   4. mechanics (mech.h): exact discretisation of (2-22)/(2-20) with the rate profile
  *      at mid-sample inside the transition matrix, Brownian force noise (4-20), the
  *      electrostatic softening of the biased feedback electrodes (6-3); held cubic
- *      stiffness and coupling drift forces;
+ *      stiffness and coupling drift forces; the electrodes' stiffness (held, rebased into
+ *      the transition matrix at the thermal updates while it moves, mech.h);
  *   5. pickoffs (pickoff.h): ring-diode front end (capacitive nonlinearity, gain and
  *      phase flicker), feedthrough, circuit phase, anti-alias band-pass, offset, noise,
  *      sampled at t_k+1 (+ delay, jitter, the ADC's aperture jitter);
@@ -37,7 +41,9 @@
  * vibration of the acceleration profile) is off at zero. The ideal part
  * (plant_ideal_cfg) has every one off; the default part (plant_default_cfg) has the
  * circuit phases' flicker and the amplitude-dependent drive damping on, set to reproduce
- * the thesis's measured bias stability and square law (docs/honest-part.md).
+ * the thesis's measured bias stability and square law (docs/honest-part.md). Neither
+ * has quadrature-nulling or tuning electrodes (quadnull_dps_per_v2 and
+ * tune_ke_per_s2_per_v2 zero: the thesis's part has none); a part with them sets those.
  *
  * Units and signs: rates in deg/s at the API (rad/s inside the mechanics), positive
  * rate gives a Coriolis force +2 Omega y' on the sense axis (thesis (2-22)); the
@@ -141,8 +147,29 @@
   X(double, fb_noise_fmin_hz, DOUBLE, 1e-7, 1.0, "Hz", \
     "feedback 1/f spectrum flattens below this") \
   X(double, fb_gap_m, DOUBLE, 0.0, 1e-3, "m", \
-    "parallel-plate gap of the feedback electrodes: their bias softens the sense spring " \
-    "(6-3), 0 = none") \
+    "parallel-plate gap of the feedback electrodes: their bias (fb_mode 2) or their voltages " \
+    "(fb_mode 3) soften the sense spring (6-3), 0 = none") \
+  X(double, quadnull_dps_per_v2, DOUBLE, 0.0, 1e4, "(deg/s)/V^2", \
+    "quadrature-nulling electrodes: coupling k_yx = c (V1^2 - V2^2) added to k_q, c as an " \
+    "equivalent quadrature c/(2 wc) per V^2 (actuator.h), 0 = none") \
+  X(double, quadnull_overlap_per_gap, DOUBLE, 0.0, 1e3, "", \
+    "overlap at rest over gap, l0/d, of the nulling electrodes: they soften the sense spring " \
+    "by 2 c (l0/d) (V1^2 + V2^2), 0 = none") \
+  X(double, quadnull_noise_white_v_rthz, DOUBLE, 0.0, 1e-3, "V/rtHz", \
+    "white noise on each nulling electrode") \
+  X(double, quadnull_noise_1hz_v_rthz, DOUBLE, 0.0, 1e-2, "V/rtHz", \
+    "1/f noise at 1 Hz on each nulling electrode") \
+  X(double, quadnull_noise_fmin_hz, DOUBLE, 1e-7, 1.0, "Hz", \
+    "nulling electrodes' 1/f spectrum flattens below this") \
+  X(double, tune_ke_per_s2_per_v2, DOUBLE, 0.0, 1e8, "(1/s^2)/V^2", \
+    "sense tuning electrodes: spring softening k_e/m = this x Vt^2 (a parallel-plate pair, " \
+    "2 eps A/(m g^3)); lowers the sense resonance only, 0 = none") \
+  X(double, tune_noise_white_v_rthz, DOUBLE, 0.0, 1e-3, "V/rtHz", \
+    "white noise on the tuning electrodes' voltage") \
+  X(double, tune_noise_1hz_v_rthz, DOUBLE, 0.0, 1e-2, "V/rtHz", \
+    "1/f noise at 1 Hz on the tuning electrodes' voltage") \
+  X(double, tune_noise_fmin_hz, DOUBLE, 1e-7, 1.0, "Hz", \
+    "tuning electrodes' 1/f spectrum flattens below this") \
   /* DAC (dac.h) */ \
   X(double, dac_recon_hz, DOUBLE, 0.0, 1e7, "Hz", \
     "reconstruction low-pass natural frequency, 0 = none") \
@@ -291,8 +318,9 @@
     "sample clock's drift with time since power-on (ageing, linear)") \
   /* switches (kept at the end so the struct has no padding between fields) */ \
   X(int, truth_decim, INT, 1, 1000000, "", "phasor truth (amplitudes, phases) every n samples") \
-  X(int, fb_mode, INT, 0, 2, "", \
-    "sense feedback actuator: 0 off, 1 single electrode, 2 differential") \
+  X(int, fb_mode, INT, 0, 3, "", \
+    "sense feedback actuator: 0 off, 1 single electrode, 2 differential (DC+AC: fb_bias_v " \
+    "+- the spare DAC), 3 pair driven from the electrode input (half-frequency, or DC+AC)") \
   X(int, pick_drive_temp_node, INT, 0, 2, "", \
     "thermal node of the drive circuit laws: 0 structure, 1 circuit, 2 board") \
   X(int, pick_sense_temp_node, INT, 0, 2, "", \
@@ -325,6 +353,18 @@ typedef struct {
   ((axis) == 0 ? (c)->pick_drive_##name : (c)->pick_sense_##name)
 #undef PLANT_CFG_FIELD
 
+/* Voltages of the sense electrodes that the four-channel DAC does not drive
+ * (plant_set_electrodes), V, held over every sample until the next call; 0 V at
+ * plant_init. An electrode the part does not have (its constant 0, or the feedback pair
+ * outside fb_mode 3) ignores its voltage. */
+typedef struct {
+  double fb_u1_v, fb_u2_v;             /* feedback pair U3, U4 (fb_mode 3) */
+  double quadnull_v1_v, quadnull_v2_v; /* nulling sets: k_yx = c (V1^2 - V2^2) */
+  double tune_v;                       /* tuning electrodes */
+} plant_electrodes_t;
+
+#define PLANT_ELECTRODE_MAX_V 100.0 /* largest |voltage| plant_set_electrodes accepts */
+
 typedef struct {
   profile_t rate_dps;      /* angular rate, deg/s */
   profile_t ambient_k;     /* ambient temperature, K */
@@ -353,6 +393,15 @@ typedef struct {
   double sense_vel_m;      /* sense displacement in phase with the drive velocity
                                  (Coriolis direction, (2-28)) */
   double sense_disp_m;     /* in phase with the drive displacement (quadrature) */
+  /* sense electrodes and what they do (every truth_decim samples, and at plant_init): */
+  plant_electrodes_t elec_v; /* the voltages last set (plant_set_electrodes), held since */
+  double quad_true_dps;      /* the quadrature as an equivalent rate: the stiffness coupling
+                                (k_q and its drift at the structure temperature, plus the
+                                nulling electrodes' k_yx) over 2 wc, wc the drive frequency
+                                above (drive_freq_hz) */
+  double sense_freq_hz;      /* sense resonance sqrt(wn2^2 - k_e) with the electrostatic
+                                softening k_e (fb bias and electrodes), sample clock */
+  double sense_shift_hz;     /* its shift by k_e, <= 0 */
   /* electrical */
   double f_drive_mps2, f_sense_mps2; /* actuator + acceleration forces per unit mass */
   double dac_held_v[4];              /* DAC output levels over the last sample */
@@ -371,12 +420,14 @@ typedef struct {
  *   Q_TEMP        the Q law (qlaw.h) at the structure temperature: 170..1900 K (gas),
  *                 200..500 K (thermoelastic);
  *   DUFFING_*     the cubic suspension term, |k3/k| x^2 <= 0.1 (mech.h);
- *   PICK_*_GAP    the capacitive pickoff law, |x| / gap <= 0.3 (pickoff.h).
+ *   PICK_*_GAP    the capacitive pickoff law, |x| / gap <= 0.3 (pickoff.h);
+ *   SENSE_PULL_IN the electrostatic softening of the sense spring, at most half of it
+ *                 (mech.h): the electrodes' voltages beyond it are held at the margin.
  * Every law holds over the -40..85 degC ambient of the default part and of the ranges
  * of the parameters' defaults. Outside its range a law is held at the edge (the ambient
  * at its last sane value) and each evaluation there (every thermal update, and once at
  * plant_init; the amplitude laws DUFFING_* and PICK_*_GAP once per thermal update in
- * which a sample left the range) is counted, never refused. */
+ * which a sample left the range; SENSE_PULL_IN likewise) is counted, never refused. */
 typedef enum {
   PLANT_LAW_PICK_DRIVE_PHASE = 0,
   PLANT_LAW_PICK_SENSE_PHASE,
@@ -389,6 +440,7 @@ typedef enum {
   PLANT_LAW_DUFFING_SENSE,
   PLANT_LAW_PICK_DRIVE_GAP,
   PLANT_LAW_PICK_SENSE_GAP,
+  PLANT_LAW_SENSE_PULL_IN,
   PLANT_LAWS
 } plant_law_t;
 
@@ -409,6 +461,8 @@ typedef struct {
   accel_t accel;
   vref_t vref;                            /* the converters' shared reference */
   vib_t vib;                              /* random vibration of the acceleration profile */
+  actuator_elec_in_t elec_in;             /* plant_set_electrodes' voltages, as the actuator
+                                             takes them */
   drift_t drift[2];                       /* slow drift of k_q and d_q */
   double drift_kq_per_s2, drift_dq_per_s; /* per unit of the drifts' values (deg/s) */
   uint64_t seed;
@@ -476,6 +530,12 @@ int plant_set_profiles(plant_t *p, const plant_profiles_t *prof);
  * frame held). adc: the frame sampled at the end of the interval. */
 void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc);
 
+/* Voltages of the electrodes beyond the DAC (plant_electrodes_t) from the next sample on,
+ * held over each sample (mean v, mean square v^2: no converter yet between them and the
+ * electrodes). Each finite and within +-PLANT_ELECTRODE_MAX_V, else -1 with the key in
+ * plant_error(p) and nothing changed. */
+int plant_set_electrodes(plant_t *p, const plant_electrodes_t *v);
+
 /* The same step in the shape of hal_host_plant_step_fn (hal/host/hal_host.h), so the
  * host HAL stub can attach a plant_t without a cast: plant is a plant_t *. */
 void plant_step_hal(void *plant, const hal_dac_frame_t *dac, hal_adc_frame_t *adc);
@@ -496,7 +556,33 @@ const char *plant_law_name(int law);
  * the other modes (no DC on the electrodes) or with fb_gap_m = 0. */
 double plant_fb_softening(const plant_cfg_t *cfg);
 
+/* k_e / m per V^2 of the feedback pair's softening in fb_mode 3, 2 ks_fb / fb_gap_m (the
+ * sum U3^2 + U4^2 multiplies it); 0 in the other modes or with fb_gap_m = 0. */
+double plant_fb_pair_softening(const plant_cfg_t *cfg);
+
 /* ------------------------------------------------------------ budgets -------- */
+
+/* Whether the tuning electrodes can put the sense resonance at the drive resonance plus
+ * split_hz (0: matched), and with which voltage, at structure temperature temp_k ((2-32)
+ * moves both resonances, the electrostatic softening stays). Tuning only lowers the sense
+ * resonance (k_e >= 0), so a part whose sense resonance (with the softening already on:
+ * the fb bias's and ke_other_per_s2, e.g. the nulling electrodes' at their voltages) is
+ * below the target cannot be reached; nor beyond the pull-in margin (half the sense
+ * stiffness, mech.h) or PLANT_ELECTRODE_MAX_V, nor without tuning electrodes. */
+typedef struct {
+  int reachable;      /* 1: tune_v puts the sense resonance at the target */
+  double f_drive_hz;  /* drive resonance at temp_k */
+  double f_sense_hz;  /* sense resonance at temp_k with the softening already on */
+  double f_target_hz; /* f_drive_hz + split_hz */
+  double ke_per_s2;   /* softening the tuning has to add, 1/s^2 (< 0: the target is above) */
+  double tune_v;      /* the voltage that does (0 when not reachable) */
+  char msg[200];      /* one line: the voltage and the move, or why it cannot be done */
+} plant_match_t;
+
+/* Fills out; 0 when reachable, 1 when not (out->msg says why), -1 for an invalid cfg or a
+ * non-finite argument (out->msg says which). */
+int plant_sense_match(const plant_cfg_t *cfg, double temp_k, double split_hz,
+                      double ke_other_per_s2, plant_match_t *out);
 
 /* Worst-case fraction of the ADC full scale used by each channel (drive, sense) at
  * the design point: drive amplitude drive_amp_m (largest drive voltage), quadrature,

@@ -1,8 +1,11 @@
-/* Design-point budgets of the plant: ADC range use and the drive chain's phase. */
+/* Design-point budgets of the plant: ADC range use, the drive chain's phase, and what
+ * matching the sense mode takes. */
 #include "plant/plant.h"
 
 #include <complex.h>
 #include <math.h>
+#include <stdio.h>
+#include <string.h>
 #include "plant/plant_const.h"
 
 static const double kPi = PLANT_PI;
@@ -112,4 +115,84 @@ double plant_adc_fraction(const plant_cfg_t *c, double frac[2])
   frac[0] = vd / c->adc_full_scale_v;
   frac[1] = vs / c->adc_full_scale_v;
   return frac[0] > frac[1] ? frac[0] : frac[1];
+}
+
+/* The resonance of f_hz at temp_k by (2-32), rad/s (as mech.c's, true time). */
+static double wn_at_temp(const plant_cfg_t *c, double f_hz, double temp_k)
+{
+  return 2.0 * kPi * f_hz * (1.0 - 0.5 * c->ket_per_k * (temp_k - c->temp_ref_k));
+}
+
+static int wt_ok(double w1, double split_hz) { return w1 + 2.0 * kPi * split_hz > 0.0; }
+
+/* Why the target cannot be reached, into out->msg (1), or the voltage (0). */
+static int match_verdict(const plant_cfg_t *c, double ke_have, plant_match_t *o)
+{
+  const double w2 = 2.0 * kPi * c->f_sense_hz, margin = 0.5 * w2 * w2; /* mech.h */
+  const int n = (int)sizeof o->msg;
+  if (o->ke_per_s2 < 0.0) {
+    snprintf(o->msg, n,
+             "sense resonance %.2f Hz is below the target %.2f Hz: tuning electrodes only lower "
+             "it, so this part cannot be matched",
+             o->f_sense_hz, o->f_target_hz);
+    return 1;
+  }
+  if (o->ke_per_s2 > 0.0 && !(c->tune_ke_per_s2_per_v2 > 0.0)) {
+    snprintf(o->msg, n,
+             "no tuning electrodes (tune_ke_per_s2_per_v2 = 0): the sense resonance "
+             "stays %.2f Hz, %.2f Hz from the target",
+             o->f_sense_hz, o->f_sense_hz - o->f_target_hz);
+    return 1;
+  }
+  if (ke_have + o->ke_per_s2 > margin) {
+    snprintf(o->msg, n,
+             "moving the sense resonance from %.2f to %.2f Hz softens it beyond half its "
+             "stiffness (pull-in margin)",
+             o->f_sense_hz, o->f_target_hz);
+    return 1;
+  }
+  const double v = o->ke_per_s2 > 0.0 ? sqrt(o->ke_per_s2 / c->tune_ke_per_s2_per_v2) : 0.0;
+  if (v > PLANT_ELECTRODE_MAX_V) {
+    snprintf(o->msg, n, "needs %.1f V on the tuning electrodes, beyond %.0f V", v,
+             PLANT_ELECTRODE_MAX_V);
+    return 1;
+  }
+  o->tune_v = v;
+  o->reachable = 1;
+  snprintf(o->msg, n,
+           "%.3f V on the tuning electrodes moves the sense resonance from %.2f to "
+           "%.2f Hz",
+           v, o->f_sense_hz, o->f_target_hz);
+  return 0;
+}
+
+int plant_sense_match(const plant_cfg_t *c, double temp_k, double split_hz,
+                      double ke_other_per_s2, plant_match_t *o)
+{
+  if (o == NULL) return -1;
+  memset(o, 0, sizeof *o);
+  if (plant_cfg_check(c, o->msg, sizeof o->msg) != 0) return -1;
+  if (!(isfinite(temp_k) && temp_k > 0.0 && isfinite(split_hz) && isfinite(ke_other_per_s2) &&
+        ke_other_per_s2 >= 0.0)) {
+    snprintf(o->msg, sizeof o->msg,
+             "plant_sense_match: temp_k, split_hz or ke_other_per_s2 "
+             "invalid");
+    return -1;
+  }
+  const double w1 = wn_at_temp(c, c->f_drive_hz, temp_k),
+               w2 = wn_at_temp(c, c->f_sense_hz, temp_k);
+  if (!(wt_ok(w1, split_hz))) {
+    snprintf(o->msg, sizeof o->msg,
+             "plant_sense_match: split_hz %g puts the target at or "
+             "below 0 Hz",
+             split_hz);
+    return -1;
+  }
+  const double ke_have = plant_fb_softening(c) + ke_other_per_s2;
+  const double w2e2 = w2 * w2 - ke_have, wt = w1 + 2.0 * kPi * split_hz;
+  o->f_drive_hz = w1 / (2.0 * kPi);
+  o->f_sense_hz = w2e2 > 0.0 ? sqrt(w2e2) / (2.0 * kPi) : 0.0;
+  o->f_target_hz = wt / (2.0 * kPi);
+  o->ke_per_s2 = w2e2 - wt * wt;
+  return match_verdict(c, ke_have, o);
 }

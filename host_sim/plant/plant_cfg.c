@@ -122,6 +122,37 @@ static void set_thermal(plant_cfg_t *c, const thermal_cfg_t *t)
   c->rise_board_k = t->rise_k[THERMAL_BOARD];
 }
 
+/* The ideal part's electrodes and their voltage noise (plant_ideal_cfg). */
+static void set_ideal_actuators(plant_cfg_t *c)
+{
+  /* actuators. Ks: the 10 um default amplitude needs A0 wn1^2 / Q1 = 26.3 m/s^2 at
+   * resonance; Ks/m = 0.411 gives it at 8.0 V half-frequency amplitude (table 7-1
+   * drives up to 12.75 V; the DAC gives 15 V). Voltage noise: placeholders (fig. 6-5
+   * shows only the 1/f shape), small against the Brownian floor. */
+  c->ks_drive_mps2_per_v2 = 0.411;
+  c->drive_noise_white_v_rthz = 200e-9;
+  c->drive_noise_1hz_v_rthz = 2e-6;
+  c->drive_noise_fmin_hz = 1e-3;
+  c->fb_mode = 2; /* differential sense electrodes, biased: the self-test
+                                  force (the thesis's sense axis is otherwise open loop) */
+  c->ks_fb_mps2_per_v2 = 0.01;
+  c->fb_bias_v = 5.0;
+  c->fb_noise_white_v_rthz = 200e-9;
+  c->fb_noise_1hz_v_rthz = 2e-6;
+  c->fb_noise_fmin_hz = 1e-3;
+  /* No quadrature-nulling or tuning electrodes: the thesis's part rejects its 1500 deg/s
+   * of quadrature by the demodulation phase alone and runs 510 Hz apart (the constants
+   * quadnull_dps_per_v2, tune_ke_per_s2_per_v2 stay 0, and quadnull_overlap_per_gap, their
+   * softening, too). When a part has them, their voltages carry the same noise as the
+   * other electrodes' (placeholders as above). */
+  c->quadnull_noise_white_v_rthz = 200e-9;
+  c->quadnull_noise_1hz_v_rthz = 2e-6;
+  c->quadnull_noise_fmin_hz = 1e-3;
+  c->tune_noise_white_v_rthz = 200e-9;
+  c->tune_noise_1hz_v_rthz = 2e-6;
+  c->tune_noise_fmin_hz = 1e-3;
+}
+
 void plant_ideal_cfg(plant_cfg_t *c)
 {
   memset(c, 0, sizeof *c);
@@ -173,21 +204,7 @@ void plant_ideal_cfg(plant_cfg_t *c)
   c->full_kinematics = true;
   c->brownian = true;
   c->mech_refresh_eps = 1e-3; /* mech.c: < 1e-9 error, one refresh per 50 K */
-  /* actuators. Ks: the 10 um default amplitude needs A0 wn1^2 / Q1 = 26.3 m/s^2 at
-   * resonance; Ks/m = 0.411 gives it at 8.0 V half-frequency amplitude (table 7-1
-   * drives up to 12.75 V; the DAC gives 15 V). Voltage noise: placeholders (fig. 6-5
-   * shows only the 1/f shape), small against the Brownian floor. */
-  c->ks_drive_mps2_per_v2 = 0.411;
-  c->drive_noise_white_v_rthz = 200e-9;
-  c->drive_noise_1hz_v_rthz = 2e-6;
-  c->drive_noise_fmin_hz = 1e-3;
-  c->fb_mode = 2; /* differential sense electrodes, biased: the self-test
-                                  force (the thesis's sense axis is otherwise open loop) */
-  c->ks_fb_mps2_per_v2 = 0.01;
-  c->fb_bias_v = 5.0;
-  c->fb_noise_white_v_rthz = 200e-9;
-  c->fb_noise_1hz_v_rthz = 2e-6;
-  c->fb_noise_fmin_hz = 1e-3;
+  set_ideal_actuators(c);
   /* DAC: fig. 4-14 low-pass after the DAC. 30 kHz Butterworth: 2.0 deg at the 745 Hz
    * drive voltage, 4.0 deg on the 1490 Hz force (see the phase budget below). */
   c->dac_recon_hz = 30000.0;
@@ -441,10 +458,17 @@ int plant_cfg_check(const plant_cfg_t *c, char *buf, size_t n)
          c->fs_hz / 1000.0);
     return -1;
   }
-  if (c->fb_noise_1hz_v_rthz > 0.0 && c->fb_noise_fmin_hz > c->fs_hz / 1000.0) {
-    errf(buf, n, "%s: must not exceed fs_hz/1000 (%g Hz)", "fb_noise_fmin_hz", c->fs_hz / 1000.0);
-    return -1;
-  }
+  const struct {
+    const char *key;
+    double k_1hz, fmin_hz;
+  } fl[3] = {{"fb_noise_fmin_hz", c->fb_noise_1hz_v_rthz, c->fb_noise_fmin_hz},
+             {"quadnull_noise_fmin_hz", c->quadnull_noise_1hz_v_rthz, c->quadnull_noise_fmin_hz},
+             {"tune_noise_fmin_hz", c->tune_noise_1hz_v_rthz, c->tune_noise_fmin_hz}};
+  for (int i = 0; i < 3; i++)
+    if (fl[i].k_1hz > 0.0 && fl[i].fmin_hz > c->fs_hz / 1000.0) {
+      errf(buf, n, "%s: must not exceed fs_hz/1000 (%g Hz)", fl[i].key, c->fs_hz / 1000.0);
+      return -1;
+    }
   if (check_imperfections(c, buf, n) != 0) return -1;
   const struct {
     const char *key;

@@ -32,6 +32,8 @@ static void quiet_cfg(actuator_cfg_t *a)
   const flicker_spec_t off = {0.0, 0.0, 0.0};
   a->drive_noise = off;
   a->fb_noise = off;
+  a->quadnull_noise = off;
+  a->tune_noise = off;
 }
 
 typedef enum { HALF_FREQ, DC_AC } scheme_t;
@@ -152,6 +154,77 @@ static void test_schemes_through_dac(void **state)
   free(fy);
 }
 
+/* The sense feedback pair (FB_PAIR) is the drive's actuator on the sense axis: its two
+ * voltages made by the DAC's drive channels (latency, hold, reconstruction filter) as
+ * the half-frequency (6-18) and DC+AC (6-20) frames above, given to the pair through
+ * the electrode input, give the sense force the exact spectrum predicts, to 1e-5 as the
+ * drive's (test_schemes_through_dac), at the drive frequency (the force's frequency):
+ * ks_fb A^2 for half-frequency, 4 ks_fb D A for DC+AC, each times the chain's gain; and
+ * with ks_fb = ks_drive, bit for bit the drive force of the same voltages. The drive
+ * comb (ks_drive 0 in the second actuator) then carries none. */
+static void test_feedback_pair_schemes(void **state)
+{
+  (void)state;
+  const double fs = 50000.0, T = 1.0 / fs, f = 1489.9, w = 2.0 * k_pi * f;
+  dac_cfg_t dc;
+  dac_default_cfg(&dc);
+  actuator_cfg_t drv, fbp;
+  quiet_cfg(&drv);
+  quiet_cfg(&fbp);
+  fbp.fb = ACTUATOR_FB_PAIR;
+  fbp.ks_fb_mps2_per_v2 = drv.ks_drive_mps2_per_v2;
+  fbp.ks_drive_mps2_per_v2 = 0.0;
+  const int warm = 200, n = 20000;
+  double *fx = malloc((size_t)n * sizeof *fx);
+  assert_non_null(fx);
+  for (int s = 0; s < 2; s++) {
+    const scheme_t sch = (s == 0) ? HALF_FREQ : DC_AC;
+    const double amp = (sch == HALF_FREQ) ? 8.0 : 4.0, dcv = 4.0, p = -0.7;
+    dac_t d;
+    actuator_t ad, af;
+    assert_int_equal(dac_init(&d, &dc), 0);
+    assert_int_equal(actuator_init(&ad, &drv, 1u), 0);
+    assert_int_equal(actuator_init(&af, &fbp, 1u), 0);
+    for (int k = 0; k < warm + n; k++) {
+      const hal_dac_frame_t fr = drive_frame(sch, (double)k * T, f, amp, dcv, p);
+      dac_write(&d, &fr);
+      dac_out_t o;
+      dac_step(&d, &o);
+      actuator_elec_in_t e;
+      memset(&e, 0, sizeof e);
+      e.fb[0] = o.ch[HAL_DAC_DRIVE_U1];
+      e.fb[1] = o.ch[HAL_DAC_DRIVE_U2];
+      dac_out_t none = o; /* the pair's voltages are not on the drive comb */
+      none.ch[HAL_DAC_DRIVE_U1].mean_v = none.ch[HAL_DAC_DRIVE_U1].mean_sq_v2 = 0.0;
+      none.ch[HAL_DAC_DRIVE_U2].mean_v = none.ch[HAL_DAC_DRIVE_U2].mean_sq_v2 = 0.0;
+      actuator_out_t od, of;
+      actuator_step(&ad, &o, &od);
+      actuator_step_elec(&af, &none, &e, &of);
+      assert_true(of.f_sense_mps2 == od.f_drive_mps2); /* the drive's code path */
+      assert_true(of.f_drive_mps2 == 0.0 && of.kyx_per_s2 == 0.0 && of.ke_per_s2 == 0.0);
+      if (k >= warm) fx[k - warm] = of.f_sense_mps2;
+    }
+    double coef[5];
+    const double fr2[2] = {f, 2.0 * f};
+    ref_sine_fit(fx, (size_t)n, (double)warm * T, T, fr2, 2, coef);
+    const double complex got = coef[1] - I * coef[2];
+    const double complex want = mean_force_phasor(sch == HALF_FREQ, &dc, fbp.ks_fb_mps2_per_v2,
+                                                  w, amp, dcv, p);
+    const double nominal = sch == HALF_FREQ ? fbp.ks_fb_mps2_per_v2 * amp * amp
+                                            : 4.0 * fbp.ks_fb_mps2_per_v2 * dcv * amp;
+    const double rel = cabs(got - want) / cabs(want);
+    print_message("pair, %s: sense force %.6f m/s^2 at %.1f Hz (exact spectrum %.6f, law %.6f "
+                  "before the chain), error %.2e\n",
+                  sch == HALF_FREQ ? "half-freq" : "DC+AC", cabs(got), f, cabs(want), nominal,
+                  rel);
+    assert_true(rel < 1e-5);
+    assert_true(fabs(cabs(got) / nominal - 1.0) < 0.05); /* the chain's gain, a few % */
+    assert_true(fabs(coef[0]) < 1e-4 * cabs(want));
+    assert_true(hypot(coef[3], coef[4]) < 1e-4 * cabs(want));
+  }
+  free(fx);
+}
+
 /* The force law with noise, and the feedback electrodes, on hand-made constant
  * voltages (a constant v has mean v and mean square v^2 over the sample):
  *   f_drv = ks ((v1 + w1)^2 - (v2 + w2)^2)
@@ -160,8 +233,9 @@ static void test_schemes_through_dac(void **state)
 static void test_force_law(void **state)
 {
   (void)state;
-  const actuator_fb_t modes[3] = {ACTUATOR_FB_OFF, ACTUATOR_FB_SINGLE, ACTUATOR_FB_DIFFERENTIAL};
-  for (int mi = 0; mi < 3; mi++) {
+  const actuator_fb_t modes[4] = {ACTUATOR_FB_OFF, ACTUATOR_FB_SINGLE, ACTUATOR_FB_DIFFERENTIAL,
+                                  ACTUATOR_FB_PAIR};
+  for (int mi = 0; mi < 4; mi++) {
     actuator_cfg_t cfg;
     actuator_default_cfg(&cfg);
     cfg.drive_noise.white_rthz = 1e-3; /* large, to see it */
@@ -171,6 +245,7 @@ static void test_force_law(void **state)
     assert_int_equal(actuator_init(&a, &cfg, 77u), 0);
     for (int k = 0; k < 100; k++) {
       const double v1 = 7.0 * sin(0.1 * k), v2 = -3.0 + 0.01 * k, u = 2.0 * cos(0.2 * k);
+      const double e3 = 5.0 * cos(0.05 * k), e4 = 5.0 * sin(0.05 * k);
       dac_out_t o;
       memset(&o, 0, sizeof o);
       o.ch[0].mean_v = v1;
@@ -179,9 +254,17 @@ static void test_force_law(void **state)
       o.ch[1].mean_sq_v2 = v2 * v2;
       o.ch[3].mean_v = u;
       o.ch[3].mean_sq_v2 = u * u;
+      actuator_elec_in_t e;
+      memset(&e, 0, sizeof e);
+      e.fb[0].mean_v = e3;
+      e.fb[0].mean_sq_v2 = e3 * e3;
+      e.fb[1].mean_v = e4;
+      e.fb[1].mean_sq_v2 = e4 * e4;
       actuator_out_t out;
-      actuator_step(&a, &o, &out);
+      actuator_step_elec(&a, &o, &e, &out);
       const double *w = out.noise_v;
+      assert_true(w[4] == 0.0 && w[5] == 0.0 && w[6] == 0.0); /* no such electrodes */
+      assert_true(out.kyx_per_s2 == 0.0 && out.ke_per_s2 == 0.0);
       assert_true(w[0] != 0.0 && w[1] != 0.0 && w[0] != w[1]);
       const double fd = cfg.ks_drive_mps2_per_v2 *
                         ((v1 + w[0]) * (v1 + w[0]) - (v2 + w[1]) * (v2 + w[1]));
@@ -194,10 +277,65 @@ static void test_force_law(void **state)
       } else if (modes[mi] == ACTUATOR_FB_DIFFERENTIAL) {
         fsn = cfg.ks_fb_mps2_per_v2 *
               ((vb + u + w[2]) * (vb + u + w[2]) - (vb - u + w[3]) * (vb - u + w[3]));
+      } else if (modes[mi] == ACTUATOR_FB_PAIR) { /* the electrode input, not the spare DAC */
+        fsn = cfg.ks_fb_mps2_per_v2 * ((e3 + w[2]) * (e3 + w[2]) - (e4 + w[3]) * (e4 + w[3]));
       } else {
         assert_true(w[2] == 0.0 && w[3] == 0.0);
       }
       assert_true(fabs(out.f_sense_mps2 - fsn) < 1e-12 * (1.0 + fabs(fsn)));
+    }
+  }
+}
+
+/* The electrodes' stiffness with noise on hand-made voltages (the header):
+ *   k_yx = c_q ((V1 + w5)^2 - (V2 + w6)^2)
+ *   k_e  = ke_q ((V1 + w5)^2 + (V2 + w6)^2) + ke_t (Vt + w7)^2 + ke_fb ((U3 + w3)^2 + (U4 + w4)^2)
+ * the last only in FB_PAIR; a per-sample mean square that is not the square of the mean
+ * (a varying voltage) enters as such. */
+static void test_electrode_stiffness(void **state)
+{
+  (void)state;
+  for (int pair = 0; pair < 2; pair++) {
+    actuator_cfg_t cfg;
+    actuator_default_cfg(&cfg);
+    cfg.fb = pair ? ACTUATOR_FB_PAIR : ACTUATOR_FB_DIFFERENTIAL;
+    cfg.fb_ke_per_s2_per_v2 = 1e4;
+    cfg.quadnull_kyx_per_s2_per_v2 = 2e4;
+    cfg.quadnull_ke_per_s2_per_v2 = 3e5;
+    cfg.tune_ke_per_s2_per_v2 = 5e5;
+    cfg.quadnull_noise.white_rthz = 1e-3;
+    cfg.tune_noise.white_rthz = 3e-3;
+    actuator_t a;
+    assert_int_equal(actuator_init(&a, &cfg, 78u), 0);
+    for (int k = 0; k < 100; k++) {
+      actuator_elec_in_t e;
+      memset(&e, 0, sizeof e);
+      const double v1 = 2.0 + 0.01 * k, v2 = 6.0 * sin(0.3 * k), vt = 9.0 - 0.02 * k;
+      const double u3 = 4.0 * cos(0.4 * k), u4 = 4.0 * sin(0.4 * k);
+      e.quadnull[0].mean_v = v1;
+      e.quadnull[0].mean_sq_v2 = v1 * v1 + 0.25; /* a ripple within the sample */
+      e.quadnull[1].mean_v = v2;
+      e.quadnull[1].mean_sq_v2 = v2 * v2;
+      e.tune.mean_v = vt;
+      e.tune.mean_sq_v2 = vt * vt;
+      e.fb[0].mean_v = u3;
+      e.fb[0].mean_sq_v2 = u3 * u3;
+      e.fb[1].mean_v = u4;
+      e.fb[1].mean_sq_v2 = u4 * u4;
+      dac_out_t o;
+      memset(&o, 0, sizeof o);
+      actuator_out_t out;
+      actuator_step_elec(&a, &o, &e, &out);
+      const double *w = out.noise_v;
+      assert_true(w[4] != 0.0 && w[5] != 0.0 && w[6] != 0.0 && w[4] != w[5]);
+      const double m1 = v1 * v1 + 0.25 + w[4] * (2.0 * v1 + w[4]);
+      const double m2 = (v2 + w[5]) * (v2 + w[5]), mt = (vt + w[6]) * (vt + w[6]);
+      const double kyx = cfg.quadnull_kyx_per_s2_per_v2 * (m1 - m2);
+      double ke = cfg.quadnull_ke_per_s2_per_v2 * (m1 + m2) + cfg.tune_ke_per_s2_per_v2 * mt;
+      if (pair)
+        ke += cfg.fb_ke_per_s2_per_v2 * ((u3 + w[2]) * (u3 + w[2]) + (u4 + w[3]) * (u4 + w[3]));
+      assert_true(fabs(out.kyx_per_s2 - kyx) < 1e-12 * fabs(kyx) + 1e-9);
+      assert_true(fabs(out.ke_per_s2 - ke) < 1e-12 * ke);
     }
   }
 }
@@ -229,6 +367,22 @@ static void test_bad_cfg(void **state)
   assert_int_equal(actuator_init(&a, &c, 1u), -1);
   c = good;
   c.fb_bias_v = INFINITY;
+  assert_int_equal(actuator_init(&a, &c, 1u), -1);
+  c = good;
+  c.quadnull_kyx_per_s2_per_v2 = -1.0;
+  assert_int_equal(actuator_init(&a, &c, 1u), -1);
+  c = good;
+  c.tune_ke_per_s2_per_v2 = NAN;
+  assert_int_equal(actuator_init(&a, &c, 1u), -1);
+  c = good;
+  c.fb_ke_per_s2_per_v2 = -2.0;
+  assert_int_equal(actuator_init(&a, &c, 1u), -1);
+  c = good;
+  c.quadnull_kyx_per_s2_per_v2 = 1.0;
+  c.quadnull_noise.fmin_hz = 0.0;
+  assert_int_equal(actuator_init(&a, &c, 1u), -1);
+  c = good;
+  c.fb = (actuator_fb_t)4;
   assert_int_equal(actuator_init(&a, &c, 1u), -1);
   assert_memory_equal(&a, &before, sizeof a);
 }
@@ -363,7 +517,9 @@ int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_schemes_through_dac),
+      cmocka_unit_test(test_feedback_pair_schemes),
       cmocka_unit_test(test_force_law),
+      cmocka_unit_test(test_electrode_stiffness),
       cmocka_unit_test(test_bad_cfg),
       cmocka_unit_test(test_low_frequency_noise_placement),
   };

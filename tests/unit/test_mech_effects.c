@@ -5,6 +5,9 @@
  *  - electrostatic spring softening: df = -f0 k_e / (2 k) (exactly sqrt(1 - k_e/k));
  *  - Q against temperature (qlaw.h) at two temperatures, from the ring-down;
  *  - the coupling drifts act as the configured couplings do;
+ *  - the electrodes' stiffness (mech_set_elec): a coupling acts as the configured k_q and
+ *    nulls it, a softening moves the sense resonance by the sqrt law, held before the
+ *    rebase, exact after it; the pull-in margin;
  *  - all off by default, bad values refused with nothing changed, the cubic law's range
  *    flagged. */
 #include <setjmp.h>
@@ -310,6 +313,96 @@ static void test_coupling_drift(void **state)
   assert_true(m.drift_kq_per_s2 == 0.0 && m.held == 0);
 }
 
+/* The nulling electrodes' coupling k_yx (mech_set_elec) adds to k_q: before the rebase (a
+ * held force) the sense response equals the configured coupling's within the hold's
+ * sinc(wn1 T/2) = 0.99855 (0.3 %, as the drift); after mech_elec_rebase it is in the
+ * generator, the same response within 1e-9; k_yx = -k_q nulls the quadrature motion to
+ * 1e-9 of it. A small change after that stays held (no re-discretisation). */
+static void test_elec_coupling(void **state)
+{
+  (void)state;
+  const double kq = 2.0 * (kTwoPi * 1489.9) * 1500.0 * (kTwoPi / 360.0); /* 1500 deg/s */
+  mech_cfg_t c;
+  quiet_cfg(&c);
+  c.kq_per_s2 = kq;
+  static mech_t ref, el;
+  assert_int_equal(mech_init(&ref, &c, c.temp_ref_k, 6u), 0);
+  double a0, p0, a1, p1;
+  sense_phasor(&ref, &a0, &p0);
+  quiet_cfg(&c);
+  assert_int_equal(mech_init(&el, &c, c.temp_ref_k, 6u), 0);
+  assert_int_equal(mech_set_elec(&el, kq, 0.0), 0);
+  assert_int_equal(el.held, 1);
+  sense_phasor(&el, &a1, &p1);
+  print_message("k_yx held: %.6e m at %.4f deg (configured k_q %.6e m at %.4f deg)\n", a1,
+                p1 * 360.0 / kTwoPi, a0, p0 * 360.0 / kTwoPi);
+  assert_true(fabs(a1 / a0 - 1.0) < 3e-3 && fabs(a1 / a0 - 1.0) > 1e-4);
+  assert_true(fabs(p1 - p0) * 360.0 / kTwoPi < 0.05);
+  const uint64_t r0 = el.refresh_count;
+  assert_int_equal(mech_elec_rebase(&el), 1);
+  assert_true(el.refresh_count == r0 + 1 && fabs(el.elec_disc[0] / kq - 1.0) < 1e-12);
+  assert_int_equal(mech_init(&ref, &ref.cfg, c.temp_ref_k, 6u), 0);
+  mech_set_state(&el, &(mech_state_t){0.0, 0.0, 0.0, 0.0});
+  sense_phasor(&ref, &a0, &p0);
+  sense_phasor(&el, &a1, &p1);
+  print_message("k_yx rebased: %.9e m (configured %.9e m)\n", a1, a0);
+  assert_true(fabs(a1 / a0 - 1.0) < 1e-9 && fabs(p1 - p0) < 1e-9);
+  /* 0.5 deg/s more: below the 10 deg/s threshold, stays held */
+  assert_int_equal(mech_set_elec(&el, kq * (1.0 + 0.5 / 1500.0), 0.0), 0);
+  sense_phasor(&el, &a1, &p1);
+  assert_int_equal(mech_elec_rebase(&el), 0);
+  assert_true(fabs(el.elec_disc[0] / kq - 1.0) < 1e-12);
+  /* nulling: the configured k_q against k_yx = -k_q, rebased */
+  quiet_cfg(&c);
+  c.kq_per_s2 = kq;
+  assert_int_equal(mech_init(&el, &c, c.temp_ref_k, 6u), 0);
+  assert_int_equal(mech_set_elec(&el, -kq, 0.0), 0);
+  for (int k = 0; k < 50; k++) mech_step(&el, 0.0, 0.0, 0.0, 0.0);
+  assert_int_equal(mech_elec_rebase(&el), 1);
+  assert_true(fabs(mech_kyx_total(&el)) < 1e-9 * kq);
+  sense_phasor(&el, &a1, &p1);
+  print_message("k_q nulled by k_yx: %.3e m (%.3e of the quadrature motion)\n", a1, a1 / a0);
+  assert_true(a1 < 1e-9 * a0);
+}
+
+/* The electrodes' softening k_e (mech_set_elec) moves the sense resonance to
+ * sqrt(wn2^2 - k_e) (mech_wn2_eff): 1 % of the stiffness, held before the rebase (within
+ * the hold's error on the shift, (1 - sinc(wn2 T/2)) k_e / (2 k) = 1.3e-5 of f) and
+ * exact after it (1e-6, as test_spring_softening); held at the pull-in margin beyond half
+ * the stiffness and flagged; bad values refused with nothing changed. */
+static void test_elec_softening(void **state)
+{
+  (void)state;
+  mech_cfg_t c;
+  quiet_cfg(&c);
+  c.q1 = c.q2 = 1e6;
+  static mech_t m, before;
+  assert_int_equal(mech_init(&m, &c, c.temp_ref_k, 3u), 0);
+  const double f0 = free_frequency(&m, 1, 1e-7, 10000, NULL);
+  const double k = (kTwoPi * c.f2_hz) * (kTwoPi * c.f2_hz), ke = 0.01 * k;
+  assert_int_equal(mech_set_elec(&m, 0.0, ke), 0);
+  const double f_held = free_frequency(&m, 1, 1e-7, 10000, NULL);
+  assert_int_equal(mech_elec_rebase(&m), 1);
+  const double f_exact = free_frequency(&m, 1, 1e-7, 10000, NULL);
+  print_message("k_e/k = 1 %%: held %.5f Hz, rebased %.5f Hz, law %.5f Hz (truth %.5f Hz)\n",
+                f_held, f_exact, f0 * sqrt(0.99), mech_wn2_eff(&m) / kTwoPi);
+  assert_true(fabs(f_held / (f0 * sqrt(0.99)) - 1.0) < 2e-5);
+  assert_true(fabs(f_exact / (f0 * sqrt(0.99)) - 1.0) < 1e-6);
+  assert_true(fabs(mech_wn2_eff(&m) / (kTwoPi * c.f2_hz * sqrt(0.99)) - 1.0) < 1e-12);
+  assert_true(mech_laws_out(&m) == 0u);
+  /* pull-in margin: held at half the stiffness, flagged until read */
+  assert_int_equal(mech_set_elec(&m, 0.0, 0.6 * k), 1);
+  assert_true(m.elec_ke_per_s2 == 0.5 * k);
+  assert_true(mech_laws_out(&m) == MECH_OUT_PULL_IN);
+  assert_true(mech_laws_out(&m) == 0u);
+  before = m;
+  const double bad[][2] = {{NAN, 0.0}, {0.0, INFINITY}, {0.0, -1.0}, {2e9, 0.0}};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    assert_int_equal(mech_set_elec(&m, bad[i][0], bad[i][1]), -1);
+    assert_memory_equal(&m, &before, sizeof m);
+  }
+}
+
 /* Off by default: the default configuration has every imperfection at zero, and a
  * mechanics with them explicitly zero runs bit for bit as the default. Bad values are
  * refused with the field named and nothing changed. */
@@ -324,6 +417,7 @@ static void test_off_by_default_and_validation(void **state)
   assert_int_equal(mech_init(&a, &c, 310.0, 7u), 0);
   assert_int_equal(mech_init(&b, &c, 310.0, 7u), 0);
   assert_int_equal(mech_set_coupling_drift(&b, 0.0, 0.0), 0);
+  assert_int_equal(mech_set_elec(&b, 0.0, 0.0), 0);
   assert_int_equal(b.held, 0);
   for (int k = 0; k < 2000; k++) {
     const double f = 20.0 * sin(0.187 * k);
@@ -331,6 +425,8 @@ static void test_off_by_default_and_validation(void **state)
     mech_step(&b, f, 0.0, 0.5, 0.0);
   }
   assert_memory_equal(a.z, b.z, sizeof a.z);
+  assert_int_equal(mech_elec_rebase(&b), 0);
+  assert_true(b.refresh_count == a.refresh_count);
   const struct {
     const char *key;
     int field;
@@ -364,6 +460,8 @@ int main(void)
       cmocka_unit_test(test_q_law_two_temperatures),
       cmocka_unit_test(test_q_law_range),
       cmocka_unit_test(test_coupling_drift),
+      cmocka_unit_test(test_elec_coupling),
+      cmocka_unit_test(test_elec_softening),
       cmocka_unit_test(test_off_by_default_and_validation),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -3,10 +3,12 @@
  * one off there (the ideal part runs bit for bit as with them explicitly off), each switched on by its parameter and reaching its module with
  * the expected size, the converters' shared reference and the ADC's common aperture
  * jitter, shocks and random vibration through the g-sensitivity, Q(T) in the truth, the
- * laws' warnings over -40..85 degC and beyond, and the cross-field refusals. The physics
+ * laws' warnings over -40..85 degC and beyond, and the cross-field refusals; the sense
+ * electrodes beyond the DAC (plant_set_electrodes): nulling, tuning, the half-frequency
+ * feedback pair, matching (plant_sense_match). The physics
  * of each effect is tested on its module (test_mech_effects, test_pickoff_effects,
  * test_qlaw, test_inl, test_vref, test_drift, test_vib, test_profile, test_adc,
- * test_dac). */
+ * test_dac, test_actuator). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -19,6 +21,7 @@
 
 #include "plant/plant.h"
 #include "plant/qlaw.h"
+#include "sine_fit_ref.h"
 
 static const double kTwoPi = 6.28318530717958647692;
 static const double kDeg = 6.28318530717958647692 / 360.0;
@@ -480,6 +483,301 @@ static void test_cross_checks(void **state)
   }
 }
 
+
+/* ------------------------------------------------------------ sense electrodes -- */
+
+/* The ideal part without Brownian noise (the truth's motion is then the response alone),
+ * sense Q q2; the electrodes' voltage noise stays at its default. */
+static void electrode_part(plant_cfg_t *c, double q2)
+{
+  plant_ideal_cfg(c);
+  c->brownian = false;
+  c->q_sense = q2;
+}
+
+/* Quadrature nulling: on a part with nulling electrodes of c = 20 (deg/s)/V^2, the
+ * voltage pair V1 = 0, V2 = sqrt(quad_dps / c) = 8.660 V cancels the 1500 deg/s of k_q
+ * (the electrode noise moves the coupling by 2 w / V, about 1e-5 of it, 0.01 deg/s), and
+ * the sense motion in phase with the drive displacement (the truth's sense_disp_m) falls
+ * to within 1e-4 of its value without the voltages (0.15 deg/s), once
+ * rebased (the second thermal update, mech.h); the Coriolis-direction motion is not
+ * touched (no rate: both within 1e-4 of the quadrature's). Without voltages the truth
+ * gives the configured quadrature at the structure's temperature and the drive frequency
+ * (1500 s^2 f_drive_hz / drive_freq_hz, s = wn1(T) / wn1(T0): the part self-heats by about
+ * 1 K). The voltage is computed at T0, so 1500 (1 - s^2) = 0.08 deg/s stays: quad_true_dps
+ * within 0.1 deg/s of 0, the motion within 1e-4 of the open one.
+ * The same electrodes with an overlap l0/d = 5 soften the sense spring by
+ * 2 c (l0/d) (V1^2 + V2^2), which the truth's sense_freq_hz shows. */
+static void test_quadrature_nulling(void **state)
+{
+  (void)state;
+  plant_cfg_t c;
+  electrode_part(&c, 3.0);
+  c.quadnull_dps_per_v2 = 20.0;
+  static plant_t p;
+  assert_int_equal(plant_init(&p, &c, 21u), 0);
+  run(&p, 15000, NULL);
+  const plant_truth_t *t = plant_truth(&p);
+  const double open_disp = t->sense_disp_m, open_quad = t->quad_true_dps;
+  print_message("without voltages: quad_true_dps %.4f (drive at %.4f Hz), sense_disp %.4e m\n",
+                open_quad, t->drive_freq_hz, open_disp);
+  const double s = t->wn_drive_rad_s / (kTwoPi * c.f_drive_hz); /* (2-32) at the structure */
+  assert_true(fabs(open_quad / (1500.0 * s * s * c.f_drive_hz / t->drive_freq_hz) - 1.0) < 1e-9);
+  const double v2 = sqrt(c.quad_dps / c.quadnull_dps_per_v2);
+  const plant_electrodes_t e = {0.0, 0.0, 0.0, v2, 0.0};
+  assert_int_equal(plant_init(&p, &c, 21u), 0);
+  assert_int_equal(plant_set_electrodes(&p, &e), 0);
+  run(&p, 15000, NULL);
+  print_message("V2 = %.4f V: quad_true_dps %.5f, sense_disp %.4e m (%.2e of it), sense_vel "
+                "%.4e m\n",
+                v2, t->quad_true_dps, t->sense_disp_m, t->sense_disp_m / open_disp,
+                t->sense_vel_m);
+  assert_true(fabs(t->quad_true_dps) < 0.1);
+  assert_true(
+      fabs(t->quad_true_dps - 1500.0 * (s * s - 1.0) * c.f_drive_hz / t->drive_freq_hz) < 0.01);
+  assert_true(fabs(t->sense_disp_m) < 1e-4 * fabs(open_disp));
+  assert_true(fabs(t->sense_vel_m) < 1e-4 * fabs(open_disp));
+  assert_true(t->elec_v.quadnull_v2_v == v2);
+  assert_true(t->sense_shift_hz == 0.0); /* no overlap given: no softening */
+  /* their softening with an overlap */
+  c.quadnull_overlap_per_gap = 5.0;
+  assert_int_equal(plant_init(&p, &c, 21u), 0);
+  assert_int_equal(plant_set_electrodes(&p, &e), 0);
+  run(&p, 500, NULL);
+  const double cq = 2.0 * kTwoPi * c.f_drive_hz * c.quadnull_dps_per_v2 * kDeg;
+  const double w2 = kTwoPi * c.f_sense_hz * s, ke = 2.0 * cq * 5.0 * v2 * v2;
+  const double want = sqrt(w2 * w2 - ke) / kTwoPi;
+  print_message("overlap/gap 5: sense resonance %.4f Hz (law %.4f Hz, shift %.3f Hz)\n",
+                t->sense_freq_hz, want, t->sense_shift_hz);
+  assert_true(fabs(t->sense_freq_hz / want - 1.0) < 1e-5); /* the voltage noise: 7e-6 of k_e */
+  assert_true(fabs(t->sense_shift_hz / (want - w2 / kTwoPi) - 1.0) < 1e-3);
+}
+
+/* Upward zero crossings of the truth's sense displacement over n samples with the DAC at
+ * mid-scale (no drive): the free sense oscillation's frequency. */
+static double sense_ring_hz(plant_t *p, long n)
+{
+  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  const mech_state_t s0 = {0.0, 0.0, 1e-7, 0.0};
+  mech_set_state(&p->mech, &s0);
+  double prev = 1e-7, t_first = -1.0, t_last = 0.0;
+  long crossings = 0;
+  for (long k = 0; k < n; k++) {
+    plant_step(p, &fr, NULL);
+    const double x = plant_truth(p)->x_m, tk = plant_truth(p)->t_s;
+    if (prev < 0.0 && x >= 0.0) {
+      const double tc = tk - p->T * x / (x - prev);
+      if (t_first < 0.0) t_first = tc;
+      t_last = tc;
+      crossings++;
+    }
+    prev = x;
+  }
+  assert_true(crossings > 10);
+  return (double)(crossings - 1) / (t_last - t_first);
+}
+
+/* Frequency tuning: Vt = 4 V on electrodes of k_e/m = 1e6 (1/s^2)/V^2 softens the sense
+ * spring by 1.6e7 1/s^2, 10 % of it: the sense mode rings at sqrt(wn2^2 - k_e) (times
+ * sqrt(1 - 1/(4 Q^2)) for Q = 1000) within 2e-5 (the crossings' timing over 90 cycles,
+ * the voltage noise's 1e-6), and the truth's sense_freq_hz and sense_shift_hz give the
+ * law within 1e-6; the resonances at the structure temperature (the part self-heats by about
+ * 1 K: (2-32)). The drive resonance is not moved. */
+static void test_tuning_moves_sense(void **state)
+{
+  (void)state;
+  plant_cfg_t c;
+  electrode_part(&c, 1000.0);
+  c.tune_ke_per_s2_per_v2 = 1e6;
+  static plant_t p;
+  assert_int_equal(plant_init(&p, &c, 22u), 0);
+  const double f0 = sense_ring_hz(&p, 2500);
+  const plant_electrodes_t e = {0.0, 0.0, 0.0, 0.0, 4.0};
+  assert_int_equal(plant_set_electrodes(&p, &e), 0);
+  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  for (int k = 0; k < 150; k++) plant_step(&p, &fr, NULL); /* rebased at 2 ms */
+  const double f1 = sense_ring_hz(&p, 2500);
+  const plant_truth_t *t = plant_truth(&p);
+  const double s = t->wn_drive_rad_s / (kTwoPi * c.f_drive_hz); /* (2-32) at the structure */
+  const double w2 = kTwoPi * c.f_sense_hz * s, ke = 1e6 * 16.0, damp = sqrt(1.0 - 0.25e-6);
+  const double want = sqrt(w2 * w2 - ke) / kTwoPi;
+  print_message("Vt 0: rings at %.4f Hz (law %.4f); Vt 4 V: %.4f Hz (law %.4f), truth %.4f Hz, "
+                "shift %.3f Hz\n",
+                f0, w2 / kTwoPi * damp, f1, want * damp, t->sense_freq_hz, t->sense_shift_hz);
+  assert_true(fabs(f0 / (w2 / kTwoPi * damp) - 1.0) < 2e-5);
+  assert_true(fabs(f1 / (want * damp) - 1.0) < 2e-5);
+  assert_true(fabs(t->sense_freq_hz / want - 1.0) < 1e-6);
+  assert_true(fabs(t->sense_shift_hz / (want - w2 / kTwoPi) - 1.0) < 1e-4);
+  assert_true(t->wn_drive_rad_s == kTwoPi * c.f_drive_hz * s); /* not moved by the tuning */
+  assert_true(p.mech.refresh_count >= 1);                      /* rebased into the generator */
+}
+
+/* Half-frequency feedback through the plant (fb_mode 3): U3 = A cos(wc t/2 + p),
+ * U4 = A sin(wc t/2 + p), written every sample at its middle (the held levels of the
+ * electrode input), give the sense force ks_fb A^2 cos(wc t + 2p) at the drive frequency,
+ * per sample exactly (noise off): fitted amplitude within 1e-9, phase 2p within 1e-9 rad,
+ * no static part. The fb electrodes' noise on then moves it by its own size only. In
+ * fb_mode 2 the pair's voltages reach nothing: bit for bit the run without them. */
+static void test_half_frequency_feedback(void **state)
+{
+  (void)state;
+  plant_cfg_t c;
+  electrode_part(&c, 3.0);
+  c.fb_mode = 3;
+  c.fb_noise_white_v_rthz = c.fb_noise_1hz_v_rthz = 0.0;
+  static plant_t p;
+  assert_int_equal(plant_init(&p, &c, 23u), 0);
+  const double f = c.f_drive_hz, A = 6.0, ph = 0.4, T = p.T;
+  enum { N = 5000 };
+  double *fx = malloc(sizeof(double) * N);
+  assert_non_null(fx);
+  for (long k = 0; k < N; k++) {
+    const double tm = ((double)k + 0.5) * T, th = 0.5 * kTwoPi * f * tm + ph;
+    const plant_electrodes_t e = {A * cos(th), A * sin(th), 0.0, 0.0, 0.0};
+    assert_int_equal(plant_set_electrodes(&p, &e), 0);
+    run(&p, 1, NULL);
+    fx[k] = plant_truth(&p)->f_sense_mps2;
+  }
+  double coef[3];
+  ref_sine_fit(fx, N, 0.5 * T, T, &f, 1, coef);
+  const double amp = hypot(coef[1], coef[2]), phase = atan2(-coef[2], coef[1]);
+  const double want = c.ks_fb_mps2_per_v2 * A * A;
+  print_message("half-frequency feedback, %.1f V: sense force %.9f m/s^2 at %.1f Hz (law "
+                "%.9f), phase %.9f rad (2p = %.9f), static %.2e\n",
+                A, amp, f, want, phase, 2.0 * ph, coef[0]);
+  assert_true(fabs(amp / want - 1.0) < 1e-9);
+  assert_true(fabs(phase - 2.0 * ph) < 1e-9);
+  assert_true(fabs(coef[0]) < 1e-9 * want);
+  free(fx);
+  /* fb_mode 2: the pair's voltages are not connected */
+  plant_ideal_cfg(&c);
+  static plant_t a, b;
+  assert_int_equal(plant_init(&a, &c, 24u), 0);
+  assert_int_equal(plant_init(&b, &c, 24u), 0);
+  const plant_electrodes_t e = {7.0, -7.0, 0.0, 0.0, 0.0};
+  assert_int_equal(plant_set_electrodes(&b, &e), 0);
+  run(&a, 2000, NULL);
+  run(&b, 2000, NULL);
+  assert_memory_equal(&a.mech.z, &b.mech.z, sizeof a.mech.z);
+  assert_memory_equal(&a.truth.adc, &b.truth.adc, sizeof a.truth.adc);
+}
+
+/* Matching (plant_sense_match): on the default part with tuning electrodes of 1e6
+ * (1/s^2)/V^2 the sense resonance (2000 Hz) is brought to the drive's (1489.9 Hz) by
+ * sqrt((wn2^2 - wn1^2) / 1e6) = 8.385 V, which the plant confirms (the truth's
+ * sense_freq_hz within 1e-6 of the drive resonance), also at 85 degC and for a 110 Hz
+ * split; a part whose sense mode (1400 Hz) is below its drive is reported unmatched, and
+ * so are a part without tuning electrodes, a move past the pull-in margin and a voltage
+ * beyond 100 V; bad arguments are refused. */
+static void test_sense_match(void **state)
+{
+  (void)state;
+  plant_cfg_t c;
+  electrode_part(&c, 3.0);
+  c.tune_ke_per_s2_per_v2 = 1e6;
+  c.tune_noise_white_v_rthz = c.tune_noise_1hz_v_rthz = 0.0; /* the law alone */
+  plant_match_t m;
+  static plant_t p;
+  const double temps[2] = {298.15, 358.15}, splits[2] = {0.0, 110.0};
+  for (int i = 0; i < 2; i++) {
+    c.temp_k = temps[i];
+    assert_int_equal(plant_init(&p, &c, 25u), 0);
+    /* at the structure's temperature (self-heated above the ambient) */
+    assert_int_equal(plant_sense_match(&c, plant_truth(&p)->struct_k, splits[i], 0.0, &m), 0);
+    print_message("%s\n", m.msg);
+    assert_true(m.reachable == 1 && m.tune_v > 0.0);
+    const plant_electrodes_t e = {0.0, 0.0, 0.0, 0.0, m.tune_v};
+    assert_int_equal(plant_set_electrodes(&p, &e), 0);
+    run(&p, 200, NULL);
+    const double f_drive = plant_truth(&p)->wn_drive_rad_s / kTwoPi;
+    print_message("  plant: sense %.6f Hz, drive resonance %.6f Hz + %.0f Hz\n",
+                  plant_truth(&p)->sense_freq_hz, f_drive, splits[i]);
+    assert_true(fabs(plant_truth(&p)->sense_freq_hz / (f_drive + splits[i]) - 1.0) < 1e-6);
+  }
+  const double w1 = kTwoPi * c.f_drive_hz, w2 = kTwoPi * c.f_sense_hz;
+  assert_int_equal(plant_sense_match(&c, c.temp_ref_k, 0.0, 0.0, &m), 0);
+  assert_true(fabs(m.tune_v / sqrt((w2 * w2 - w1 * w1) / 1e6) - 1.0) < 1e-12);
+  /* sense below drive */
+  c.f_sense_hz = 1400.0;
+  assert_int_equal(plant_sense_match(&c, c.temp_ref_k, 0.0, 0.0, &m), 1);
+  print_message("%s\n", m.msg);
+  assert_true(m.reachable == 0 && m.tune_v == 0.0);
+  assert_non_null(strstr(m.msg, "cannot be matched"));
+  /* no tuning electrodes; past the pull-in margin; beyond 100 V */
+  electrode_part(&c, 3.0);
+  assert_int_equal(plant_sense_match(&c, c.temp_ref_k, 0.0, 0.0, &m), 1);
+  assert_non_null(strstr(m.msg, "no tuning electrodes"));
+  c.tune_ke_per_s2_per_v2 = 1e6;
+  c.f_sense_hz = 3000.0;
+  assert_int_equal(plant_sense_match(&c, c.temp_ref_k, 0.0, 0.0, &m), 1);
+  assert_non_null(strstr(m.msg, "pull-in"));
+  c.f_sense_hz = 2000.0;
+  c.tune_ke_per_s2_per_v2 = 1.0;
+  assert_int_equal(plant_sense_match(&c, c.temp_ref_k, 0.0, 0.0, &m), 1);
+  assert_non_null(strstr(m.msg, "beyond 100 V"));
+  print_message("%s\n", m.msg);
+  assert_int_equal(plant_sense_match(&c, NAN, 0.0, 0.0, &m), -1);
+  assert_int_equal(plant_sense_match(&c, 300.0, -2000.0, 0.0, &m), -1);
+  assert_int_equal(plant_sense_match(&c, 300.0, 0.0, -1.0, &m), -1);
+  c.fb_mode = 9;
+  assert_int_equal(plant_sense_match(&c, 300.0, 0.0, 0.0, &m), -1);
+  assert_non_null(strstr(m.msg, "fb_mode"));
+}
+
+/* Refusals: an electrode voltage not finite or beyond 100 V (the plant unchanged, the key
+ * named); the new parameters out of range (cfg unchanged). A tuning voltage past the pull-in margin is held there and counted as
+ * sense_pull_in once per thermal update. */
+static void test_electrode_refusals(void **state)
+{
+  (void)state;
+  plant_cfg_t c;
+  electrode_part(&c, 3.0);
+  c.tune_ke_per_s2_per_v2 = 1e6;
+  static plant_t p, before;
+  assert_int_equal(plant_init(&p, &c, 26u), 0);
+  before = p;
+  const plant_electrodes_t bad[2] = {{0.0, 0.0, NAN, 0.0, 0.0}, {0.0, 0.0, 0.0, 0.0, -100.5}};
+  for (int i = 0; i < 2; i++) {
+    assert_int_equal(plant_set_electrodes(&p, &bad[i]), -1);
+    print_message("%s\n", plant_error(&p));
+    assert_non_null(strstr(plant_error(&p), i == 0 ? "quadnull_v1_v" : "tune_v"));
+    assert_memory_equal(&p, &before, offsetof(plant_t, err));
+  }
+  const struct {
+    const char *key;
+    double v;
+  } params[] = {{"quadnull_dps_per_v2", -1.0},
+                {"quadnull_overlap_per_gap", 2e3},
+                {"tune_ke_per_s2_per_v2", NAN},
+                {"tune_noise_white_v_rthz", 1.0},
+                {"fb_mode", 4.0}};
+  for (size_t i = 0; i < sizeof params / sizeof params[0]; i++) {
+    plant_cfg_t b = c;
+    char err[200];
+    assert_int_equal(plant_param_set(&b, params[i].key, params[i].v, err, sizeof err), -1);
+    assert_non_null(strstr(err, params[i].key));
+    assert_memory_equal(&b, &c, sizeof b);
+  }
+  /* pull-in: 10 V gives 1e8 1/s^2, beyond half of the 1.58e8 stiffness */
+  const plant_electrodes_t e = {0.0, 0.0, 0.0, 0.0, 10.0};
+  assert_int_equal(plant_set_electrodes(&p, &e), 0);
+  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  for (long k = 0; k < 500; k++) plant_step(&p, &fr, NULL);
+  const plant_warning_t *w = plant_warnings(&p);
+  print_message("sense_pull_in: %llu from %.4f s; sense resonance %.2f Hz (about 2000 / sqrt 2 "
+                "= %.2f)\n",
+                (unsigned long long)w[PLANT_LAW_SENSE_PULL_IN].count,
+                w[PLANT_LAW_SENSE_PULL_IN].first_t_s, plant_truth(&p)->sense_freq_hz,
+                2000.0 / sqrt(2.0));
+  assert_true(w[PLANT_LAW_SENSE_PULL_IN].count == 9);
+  /* held at half the stiffness at T0, wn2(T)^2 - wn2(T0)^2 / 2 (the structure self-heats) */
+  const double s = plant_truth(&p)->wn_drive_rad_s / (kTwoPi * c.f_drive_hz);
+  const double w2 = kTwoPi * c.f_sense_hz;
+  const double want = sqrt(w2 * w2 * s * s - 0.5 * w2 * w2) / kTwoPi;
+  assert_true(fabs(plant_truth(&p)->sense_freq_hz / want - 1.0) < 1e-12);
+  assert_string_equal(plant_law_name(PLANT_LAW_SENSE_PULL_IN), "sense_pull_in");
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -493,6 +791,11 @@ int main(void)
       cmocka_unit_test(test_truth_q),
       cmocka_unit_test(test_law_warnings),
       cmocka_unit_test(test_cross_checks),
+      cmocka_unit_test(test_quadrature_nulling),
+      cmocka_unit_test(test_tuning_moves_sense),
+      cmocka_unit_test(test_half_frequency_feedback),
+      cmocka_unit_test(test_sense_match),
+      cmocka_unit_test(test_electrode_refusals),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

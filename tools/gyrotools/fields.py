@@ -52,6 +52,10 @@ CSV_MEANING = {
     "rate_true_dps": "input rate applied to the plant (truth)",
     "rate_dps": "rate output, compensated and filtered (firmware)",
     "quad_dps": "quadrature, as an equivalent rate (firmware)",
+    "quad_true_dps": "the plant's quadrature as an equivalent rate, beside the firmware's "
+                     "quad_dps: the stiffness coupling (k_q = 2 wc quad_dps and its drift, "
+                     "both following the structure temperature, plus the quadrature-nulling "
+                     "electrodes' k_yx) over 2 wc at the drive frequency (truth)",
     "drive_amp": "demodulated drive pickoff amplitude (firmware; telemetry drive_amp_v)",
     "drive_phase_deg": "phase of the drive pickoff phasor (firmware)",
     "p_deg": "the temperature signal: force phase P (fixed drive), or its equivalent from the "
