@@ -134,9 +134,8 @@ int flicker_init(flicker_t *f, const flicker_spec_t *spec, double fs_hz, uint64_
   return 0;
 }
 
-double flicker_step(flicker_t *f)
+double flicker_step_active(flicker_t *f)
 {
-  if (!f->active) return 0.0;
   double x = f->in_sd * gauss_zig(&f->zig, &f->rng);
   for (int i = 0; i < f->nsec; i++) {
     const double y = f->b0[i] * x + f->b1[i] * f->xp[i] - f->a1[i] * f->yp[i];

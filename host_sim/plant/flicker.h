@@ -61,8 +61,15 @@ int flicker_check(const flicker_spec_t *spec, double fs_hz);
 int flicker_init(flicker_t *f, const flicker_spec_t *spec, double fs_hz, uint64_t seed,
                  uint64_t stream);
 
-/* Next sample (unit of the spec). */
-double flicker_step(flicker_t *f);
+/* Next sample of an active generator (unit of the spec). */
+double flicker_step_active(flicker_t *f);
+
+/* Next sample (unit of the spec); 0 from a generator that is off. Inline: the plant asks
+ * every generator every sample, most of them off in most parts. */
+static inline double flicker_step(flicker_t *f)
+{
+  return f->active ? flicker_step_active(f) : 0.0;
+}
 
 /* The analytic target W^2 + K^2/f of the spec (fc cap applied), one-sided unit^2/Hz,
  * valid above about 10 fmin (for tests and reports). */

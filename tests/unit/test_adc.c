@@ -34,6 +34,16 @@ static void test_rounding(void **state)
     assert_int_equal(adc_convert(&a, ADC_CH_DRIVE, (k + 0.6) * LSB), k + 1);
     assert_int_equal(adc_convert(&a, ADC_CH_DRIVE, (k - 0.6) * LSB), k - 1);
   }
+  /* ties go away from zero, as round() (the converter rounds without libm), and a
+   * hair below a tie goes down */
+  assert_int_equal(adc_convert(&a, ADC_CH_DRIVE, 2.5 * LSB), 3);
+  assert_int_equal(adc_convert(&a, ADC_CH_DRIVE, -2.5 * LSB), -3);
+  assert_int_equal(adc_convert(&a, ADC_CH_DRIVE, 0.49999999999999994 * LSB), 0);
+  assert_int_equal(adc_convert(&a, ADC_CH_DRIVE, -0.49999999999999994 * LSB), 0);
+  for (int i = -4000; i <= 4000; i++) {
+    const double x = 8.1234567 * i + 0.37;
+    assert_int_equal(adc_convert(&a, ADC_CH_SENSE, x * LSB), (int)round(x * LSB * a.inv_lsb));
+  }
   assert_int_equal(a.clip_count[ADC_CH_DRIVE], 0);
   assert_true(fabs(adc_code_to_v(&a, -32768) + 5.0) < 1e-15);
   assert_true(fabs(adc_code_to_v(&a, 16384) - 2.5) < 1e-15);
