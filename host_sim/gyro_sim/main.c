@@ -494,8 +494,10 @@ static void analyse_rate_table_analog(report_t *r)
     r->failed = 1;
     return;
   }
-  const char *args[] = {r->csv_path, "--column", "aout_v",    "--unit", "V",
-                        "--settle",  "0.5",      "--min-avg", "0.5",    NULL};
+  /* a meter reads the output once it is valid: before, it sits at the fault level */
+  const char *args[] = {r->csv_path, "--column",       "aout_v",     "--unit",
+                        "V",         "--settle",       "0.5",        "--min-avg",
+                        "0.5",       "--valid-column", "rate_valid", NULL};
   cJSON *j = post_run_tool("gyro-scalefactor", args, dir, "scalefactor.json", r->err,
                            sizeof r->err);
   if (j == NULL) {

@@ -68,6 +68,7 @@ def main():
     p.add_argument("--duration", default=None)
     p.add_argument("--isr-figures", default=None)
     p.add_argument("--selfcal", action="store_true")
+    p.add_argument("--firmware-params", default=None)
     p.add_argument("--expect", action="append", default=[])
     a = p.parse_args()
     with tempfile.TemporaryDirectory() as d:
@@ -81,6 +82,8 @@ def main():
             cmd += ["--isr-figures", a.isr_figures]
         if a.selfcal:
             cmd += ["--selfcal"]
+        if a.firmware_params:
+            cmd += ["--firmware-params", a.firmware_params]
         print(" ".join(cmd), flush=True)
         r = subprocess.run(cmd, text=True)
         if r.returncode != 0:

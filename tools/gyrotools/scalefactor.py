@@ -149,15 +149,20 @@ def align_table(t_s, out, table, signed=True):
     return float(t_s[k]), corr
 
 
-def segment_means(t_s, out, windows, p_deg=None):
-    """Averages of out (and P) over each window."""
+def segment_means(t_s, out, windows, p_deg=None, valid=None):
+    """Averages of out (and P) over each window; with valid (a boolean per sample) over its
+    valid samples only, a window without any left out (an analog output at its fault
+    level is no reading of the rate)."""
     segs = []
     for rate, i0, i1 in windows:
-        y = out[i0:i1]
+        keep = np.ones(i1 - i0, dtype=bool) if valid is None else np.asarray(valid[i0:i1], bool)
+        if not keep.any():
+            continue
+        y = out[i0:i1][keep]
         segs.append(Segment(rate_in_dps=rate, t_start_s=float(t_s[i0]),
-                            t_end_s=float(t_s[i1 - 1]), n=int(i1 - i0),
+                            t_end_s=float(t_s[i1 - 1]), n=int(keep.sum()),
                             mean_out=float(np.mean(y)), std_out=float(np.std(y)),
-                            mean_p_deg=float(np.mean(p_deg[i0:i1])) if p_deg is not None
+                            mean_p_deg=float(np.mean(p_deg[i0:i1][keep])) if p_deg is not None
                             else float("nan")))
     return segs
 
@@ -220,7 +225,7 @@ def fit(rate_in_dps, mean_out, segments=None):
 
 
 def analyse(t_s, out, rate_true_dps=None, table=None, t0_s=None, settle_s=1.0,
-            min_avg_s=1.0):
+            min_avg_s=1.0, valid=None):
     """Segment the log (truth column, else the table schedule), average and fit."""
     t_s = np.asarray(t_s, dtype=float)
     out = np.asarray(out, dtype=float)
@@ -236,7 +241,7 @@ def analyse(t_s, out, rate_true_dps=None, table=None, t0_s=None, settle_s=1.0,
     if len(win) < MIN_SEGMENTS:
         raise InputError(f"found {len(win)} constant-rate segments longer than settle "
                          f"{settle_s:g} s + {min_avg_s:g} s; need at least {MIN_SEGMENTS}")
-    segs = segment_means(t_s, out, win)
+    segs = segment_means(t_s, out, win, valid=valid)
     return fit([s.rate_in_dps for s in segs], [s.mean_out for s in segs], segs)
 
 

@@ -148,3 +148,24 @@ def test_alignment_refuses_a_short_record_and_a_wrong_schedule():
     noise = np.random.default_rng(5).standard_normal(y.size)
     with pytest.raises(InputError, match="cannot align"):
         scalefactor.align_table(t, noise, scalefactor.parse_table("0:6,100:6,-100:6"))
+
+
+def test_invalid_samples_are_left_out():
+    """An analog output at its fault level while the rate is not valid (the first 0.3 s
+    here, inside the first window) is no reading: with valid given it is left out of the
+    means; without, the fault level pulls the first segment's mean."""
+    t = np.arange(0.0, 8.0, 0.01)
+    truth = np.where(t < 2, 0.0, np.where(t < 4, 50.0, np.where(t < 6, -50.0, 100.0)))
+    out = 0.00725 * truth
+    valid = t >= 0.3
+    out = np.where(valid, out, -10.0)
+    good = scalefactor.analyse(t, out, rate_true_dps=truth, settle_s=0.2, min_avg_s=0.5,
+                               valid=valid)
+    assert good.sf == pytest.approx(0.00725, rel=1e-9)
+    assert good.rms_residual_dps < 1e-9
+    bad = scalefactor.analyse(t, out, rate_true_dps=truth, settle_s=0.2, min_avg_s=0.5)
+    assert bad.rms_residual_dps > 10.0
+    none = np.zeros_like(valid)
+    none[t >= 2] = True
+    assert len(scalefactor.analyse(t, out, rate_true_dps=truth, settle_s=0.2, min_avg_s=0.5,
+                                   valid=none).segments) == 3
