@@ -195,3 +195,23 @@ def test_verify_only_refuses_what_is_not_a_param_set(tmp_path, monkeypatch, cont
         tool.main(["--sim", "--verify-only", str(bad), "--out", str(out),
                    "--gyro-sim", _fake_sim(tmp_path)])
     assert not out.exists()
+
+
+def test_verify_only_a_calibration_the_part_cannot_run_fails_the_verification(tmp_path,
+                                                                               monkeypatch):
+    """Another part's calibration on this part (the default set on the 1300 Hz part): the
+    drive never locks, the verification's runs cannot be judged. That is a verification
+    the set failed (exit 3, report.json says why), not a stage of the flow that broke."""
+    tool = load_tool()
+    cal = os.path.join(os.path.dirname(TOOL), "..", "host_sim", "parts", "default",
+                       "calibration.json")
+
+    def no_lock(part, path):
+        raise calflow.FlowError("verify: the drive was not LOCKED for good before 50% of the run")
+    monkeypatch.setattr(calflow, "verify_all", no_lock)
+    out = tmp_path / "out"
+    code = tool.main(["--sim", "--verify-only", cal, "--out", str(out),
+                      "--gyro-sim", _fake_sim(tmp_path)])
+    assert code == tool.EXIT_VERIFY_FAILED
+    rep = json.load(open(out / "report.json"))
+    assert rep["verify"]["passed"] is False and "LOCKED" in rep["verify"]["could_not_run"]
