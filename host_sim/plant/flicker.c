@@ -129,14 +129,13 @@ int flicker_init(flicker_t *f, const flicker_spec_t *spec, double fs_hz, uint64_
     f->nsec = 0;
     f->in_sd = unit_sd * sqrt(w2);
   }
-  gauss_zig_init(&f->zig);
   rng_seed(&f->rng, seed, stream);
   return 0;
 }
 
 double flicker_step_active(flicker_t *f)
 {
-  double x = f->in_sd * gauss_zig(&f->zig, &f->rng);
+  double x = f->in_sd * gauss_zig(&f->rng);
   for (int i = 0; i < f->nsec; i++) {
     const double y = f->b0[i] * x + f->b1[i] * f->xp[i] - f->a1[i] * f->yp[i];
     f->xp[i] = x;

@@ -47,7 +47,6 @@ typedef struct {
   double b0[FLICKER_MAX_SECTIONS], b1[FLICKER_MAX_SECTIONS], a1[FLICKER_MAX_SECTIONS];
   double xp[FLICKER_MAX_SECTIONS], yp[FLICKER_MAX_SECTIONS];
   rng_t rng;
-  gauss_zig_t zig; /* normal deviates by the ziggurat: no log per sample (gauss_zig.h) */
 } flicker_t;
 
 /* 0 if flicker_init would accept (spec, fs_hz): finite, W, K >= 0, fs > 0; if K > 0:

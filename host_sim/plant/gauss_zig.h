@@ -15,6 +15,8 @@
 #ifndef PLANT_GAUSS_ZIG_H
 #define PLANT_GAUSS_ZIG_H
 
+#include <stdint.h>
+
 #include "plant/rng.h"
 
 #define GAUSS_ZIG_LAYERS 128
@@ -24,10 +26,26 @@ typedef struct {
   double f[GAUSS_ZIG_LAYERS + 1]; /* f(x[i]) */
 } gauss_zig_t;
 
-/* Build the layer table (init time). */
-void gauss_zig_init(gauss_zig_t *z);
+/* The one layer table every generator shares (gauss_zig_table.c, written by
+ * tools/gen_zig_table.py; read-only). */
+extern const gauss_zig_t gauss_zig_table;
 
-/* One N(0,1) deviate from r. */
-double gauss_zig(const gauss_zig_t *z, rng_t *r);
+/* The rare paths of a draw whose fast test failed: layer i, signed uniform v, abscissa
+ * x = v x[i]. Returns the deviate (drawing again if it must). */
+double gauss_zig_slow(rng_t *r, int i, double v, double x);
+
+/* One N(0,1) deviate from r. Inline: the plant draws about a dozen per sample, and the
+ * fast path is a table lookup and a compare. */
+static inline double gauss_zig(rng_t *r)
+{
+  const uint64_t u = rng_next_u64(r);
+  const int i = (int)(u & (GAUSS_ZIG_LAYERS - 1));
+  /* bits 11..63 (independent of the layer bits): signed uniform in (-1, 1) */
+  const double v = ((double)(u >> 11) + 0.5) * 0x1.0p-52 - 1.0;
+  const double x = v * gauss_zig_table.x[i];
+  const double ax = x < 0.0 ? -x : x;
+  if (ax < gauss_zig_table.x[i + 1]) return x;
+  return gauss_zig_slow(r, i, v, x);
+}
 
 #endif /* PLANT_GAUSS_ZIG_H */

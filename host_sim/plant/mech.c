@@ -360,7 +360,6 @@ int mech_init(mech_t *m, const mech_cfg_t *cfg, double temp_k, uint64_t seed)
   m->refresh_count = 0;
   rng_seed(&m->rng[0], seed, MECH_RNG_STREAM_DRIVE);
   rng_seed(&m->rng[1], seed, MECH_RNG_STREAM_SENSE);
-  gauss_zig_init(&m->zig);
   update_noise(m);
   return 0;
 }
@@ -529,8 +528,8 @@ void mech_step(mech_t *m, double f_drive_mps2, double f_sense_mps2, double rate_
   v[4] = f_drive_mps2 * in_scale;
   v[5] = f_sense_mps2 * in_scale;
   if (m->cfg.brownian) {
-    v[4] += m->noise_sd[0] * gauss_zig(&m->zig, &m->rng[0]);
-    v[5] += m->noise_sd[1] * gauss_zig(&m->zig, &m->rng[1]);
+    v[4] += m->noise_sd[0] * gauss_zig(&m->rng[0]);
+    v[5] += m->noise_sd[1] * gauss_zig(&m->rng[1]);
   }
   for (int r = 0; r < MECH_NS; r++) {
     const double *kr = m->k[r];

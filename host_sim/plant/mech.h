@@ -209,8 +209,7 @@ typedef struct {
   int q_valid, k_valid;
   double z[MECH_NS];        /* scaled state */
   double noise_sd[MECH_NU]; /* per-sample sd of the held noise, scaled units */
-  rng_t rng[MECH_NU];       /* one source per axis */
-  gauss_zig_t zig;          /* normal deviates from them (gauss_zig.h) */
+  rng_t rng[MECH_NU];       /* one source per axis; normal deviates by gauss_zig.h */
   uint64_t refresh_count;
   double q_now[2];        /* Q of drive, sense at temp_k (the law) */
   double q_disc[2];       /* ... of the current Taylor blocks */

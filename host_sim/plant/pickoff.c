@@ -350,7 +350,6 @@ int pickoff_init(pickoff_t *p, const pickoff_cfg_t *cfg, double temp_k, uint64_t
   p->noise_sd = c.noise_v_rthz * sqrt(c.fs_hz / 2.0);
   rng_seed(&p->rng_noise, seed, PICKOFF_RNG_STREAM_NOISE + (uint64_t)c.axis);
   rng_seed(&p->rng_jitter, seed, PICKOFF_RNG_STREAM_JITTER + (uint64_t)c.axis);
-  gauss_zig_init(&p->zig);
   p->preamp_clip_count = 0;
   /* imperfections (checked by cfg_ok, so the flicker inits cannot fail) */
   p->gap_on = c.gap_m > 0.0;
@@ -467,11 +466,10 @@ double pickoff_step_at(pickoff_t *p, double pos_m, double vel_mps, const dac_out
     double dy = 0.0;
     for (int i = 0; i < PICKOFF_MAX_N; i++) dy += p->dout_z[i] * zn[i];
     for (int i = 0; i < 4; i++) dy += p->dout_u[i] * u[i];
-    if (c->jitter_rms_s > 0.0)
-      v += c->jitter_rms_s * p->inv_t * gauss_zig(&p->zig, &p->rng_jitter) * dy;
+    if (c->jitter_rms_s > 0.0) v += c->jitter_rms_s * p->inv_t * gauss_zig(&p->rng_jitter) * dy;
     if (te != 0.0) v += te * p->inv_t * dy;
   }
   v += c->offset_v;
-  if (p->noise_sd > 0.0) v += p->noise_sd * gauss_zig(&p->zig, &p->rng_noise);
+  if (p->noise_sd > 0.0) v += p->noise_sd * gauss_zig(&p->rng_noise);
   return v;
 }

@@ -181,7 +181,6 @@ typedef struct {
   double s_prev, m_prev; /* input and T * slope at the previous tick */
   double noise_sd;
   rng_t rng_noise, rng_jitter;
-  gauss_zig_t zig; /* normal deviates by the ziggurat: no log per sample (gauss_zig.h) */
   uint64_t preamp_clip_count;
   /* imperfections */
   int gap_on, gain_fl_on, phase_fl_on;

@@ -2,8 +2,6 @@
 
 #include <math.h>
 
-static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
-
 static uint64_t splitmix64(uint64_t *x)
 {
   uint64_t z = (*x += 0x9E3779B97F4A7C15ull);
@@ -23,20 +21,6 @@ void rng_seed(rng_t *r, uint64_t seed, uint64_t stream)
   for (int i = 0; i < 4; i++) r->s[i] = splitmix64(&x);
   r->has_spare = 0;
   r->spare = 0.0;
-}
-
-uint64_t rng_next_u64(rng_t *r)
-{
-  uint64_t *s = r->s;
-  const uint64_t result = rotl(s[1] * 5, 7) * 9;
-  const uint64_t t = s[1] << 17;
-  s[2] ^= s[0];
-  s[3] ^= s[1];
-  s[1] ^= s[2];
-  s[0] ^= s[3];
-  s[2] ^= t;
-  s[3] = rotl(s[3], 45);
-  return result;
 }
 
 double rng_uniform(rng_t *r) { return (double)(rng_next_u64(r) >> 11) * 0x1.0p-53; }

@@ -15,7 +15,21 @@ typedef struct {
 
 /* Seed from a run seed and a stream id (distinct streams are independent sequences). */
 void rng_seed(rng_t *r, uint64_t seed, uint64_t stream);
-uint64_t rng_next_u64(rng_t *r);
+/* Next 64 bits (xoshiro256**). Inline: every noise source asks for it every sample. */
+static inline uint64_t rng_next_u64(rng_t *r)
+{
+  uint64_t *s = r->s;
+  const uint64_t m = s[1] * 5;
+  const uint64_t result = ((m << 7) | (m >> 57)) * 9;
+  const uint64_t t = s[1] << 17;
+  s[2] ^= s[0];
+  s[3] ^= s[1];
+  s[1] ^= s[2];
+  s[0] ^= s[3];
+  s[2] ^= t;
+  s[3] = (s[3] << 45) | (s[3] >> 19);
+  return result;
+}
 /* Uniform on [0, 1) with 53 random bits. */
 double rng_uniform(rng_t *r);
 /* Standard normal N(0, 1). */
