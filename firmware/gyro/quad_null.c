@@ -2,62 +2,120 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "dsp/fastmath.h"
 #include "dsp/math_const.h"
 
 static int pos_finite(float x) { return isfinite(x) && x > 0.0f; }
 
+/* updates in t_s at dt_s, or -1 if it does not fit a counter */
+static int64_t updates(float t_s, float dt_s)
+{
+  const float n = t_s / dt_s;
+  return (isfinite(n) && n >= 0.0f && n < 4.0e9f) ? (int64_t)n : -1;
+}
+
+static int cfg_ok(const quad_null_cfg_t *c)
+{
+  return pos_finite(c->bw_hz) && pos_finite(c->v_max_v) && pos_finite(c->settle_dps) &&
+         isfinite(c->settle_s) && c->settle_s >= 0.0f && pos_finite(c->probe_v) &&
+         c->probe_v <= c->v_max_v && isfinite(c->probe_wait_s) && c->probe_wait_s >= 0.0f &&
+         isfinite(c->probe_avg_s) && c->probe_avg_s >= c->dt_s && pos_finite(c->min_step_dps) &&
+         pos_finite(c->dt_s) && c->bw_hz * c->dt_s <= 0.1f; /* first order: f_c << rate */
+}
+
 int quad_null_design(const quad_null_cfg_t *cfg, quad_null_design_t *d)
 {
-  if (cfg == NULL || d == NULL) return -1;
-  const float c = cfg->gain_dps_per_v2;
-  if (!(isfinite(c) && c != 0.0f) || !pos_finite(cfg->bw_hz) || !pos_finite(cfg->v_max_v) ||
-      !pos_finite(cfg->settle_dps) || !(isfinite(cfg->settle_s) && cfg->settle_s >= 0.0f) ||
-      !pos_finite(cfg->dt_s))
-    return -1;
-  /* a first-order loop needs its crossover well under the update rate */
-  if (cfg->bw_hz * cfg->dt_s > 0.1f) return -1;
-  const float updates = cfg->settle_s / cfg->dt_s;
-  if (!(updates < 4.0e9f)) return -1;
-  const float u_max = cfg->v_max_v * cfg->v_max_v;
-  /* e = -q and q = q0 + c u: Ki = 2 pi f_c / c gives the crossover f_c */
-  const pi_cfg_t pc = {0.0f, FM_TWO_PI_F * cfg->bw_hz / c, cfg->dt_s, -u_max, u_max, 0.0f};
-  quad_null_design_t t;
-  if (pi_design(&pc, &t.pi) != 0) return -1;
-  t.settle_dps = cfg->settle_dps;
-  t.settle_updates = (uint32_t)updates;
-  *d = t;
+  if (cfg == NULL || d == NULL || !cfg_ok(cfg)) return -1;
+  const int64_t settle = updates(cfg->settle_s, cfg->dt_s);
+  const int64_t wait = updates(cfg->probe_wait_s, cfg->dt_s);
+  const int64_t avg = updates(cfg->probe_avg_s, cfg->dt_s);
+  if (settle < 0 || wait < 0 || avg < 1) return -1;
+  d->wc_dt = FM_TWO_PI_F * cfg->bw_hz * cfg->dt_s;
+  d->u_max_v2 = cfg->v_max_v * cfg->v_max_v;
+  d->u_probe_v2 = cfg->probe_v * cfg->probe_v;
+  d->settle_dps = cfg->settle_dps;
+  d->min_step_dps = cfg->min_step_dps;
+  d->settle_updates = (uint32_t)settle;
+  d->wait_updates = (uint32_t)wait;
+  d->avg_updates = (uint32_t)avg;
   return 0;
 }
 
 /* u -> the electrode pair: one electrode carries sqrt(|u|), the other nothing */
-static void electrodes(const quad_null_design_t *d, quad_null_t *q, float u)
+static void electrodes(quad_null_t *q, float u, float u_max)
 {
-  q->at_limit = (u >= d->pi.u_max || u <= d->pi.u_min) ? 1u : 0u;
+  q->at_limit = (u >= u_max || u <= -u_max) ? 1u : 0u;
   q->v1_v = u > 0.0f ? fm_sqrtf(u) : 0.0f;
   q->v2_v = u < 0.0f ? fm_sqrtf(-u) : 0.0f;
 }
 
-void quad_null_reset(const quad_null_design_t *d, quad_null_t *q, float u_v2)
+void quad_null_stop(quad_null_t *q)
 {
-  const float u = isfinite(u_v2) ? u_v2 : 0.0f;
-  (void)pi_reset(&d->pi, &q->pi, u, 0.0f);
-  q->integ_v2 = q->pi.u;
-  q->in_band = 0u;
-  q->settled = 0u;
-  electrodes(d, q, q->pi.u);
+  memset(q, 0, sizeof *q);
+  q->mode = QUAD_NULL_OFF;
 }
 
-void quad_null_update(const quad_null_design_t *d, quad_null_t *q, float quad_dps)
+void quad_null_start(const quad_null_design_t *d, quad_null_t *q)
 {
-  if (!isfinite(quad_dps)) { /* no measurement: hold the voltages, not settled */
-    q->in_band = 0u;
-    q->settled = 0u;
+  (void)d;
+  quad_null_stop(q);
+  q->mode = QUAD_NULL_PROBE_BASE;
+}
+
+int quad_null_start_with_gain(const quad_null_design_t *d, quad_null_t *q, float c_dps_per_v2)
+{
+  quad_null_stop(q);
+  if (!(isfinite(c_dps_per_v2) && c_dps_per_v2 != 0.0f)) return -1;
+  /* e = -q and q = q0 + c u: Ki T = 2 pi f_c T / c puts the crossover at f_c */
+  const pi_cfg_t pc = {0.0f, d->wc_dt / c_dps_per_v2, 1.0f, -d->u_max_v2, d->u_max_v2, 0.0f};
+  if (pi_design(&pc, &q->pi) != 0) return -1;
+  q->gain_dps_per_v2 = c_dps_per_v2;
+  q->mode = QUAD_NULL_RUN;
+  return 0;
+}
+
+/* The probe's phases: wait, then average; returns 1 when the mean is complete. */
+static int probe_mean(const quad_null_design_t *d, quad_null_t *q, float quad_dps, float *mean)
+{
+  q->count++;
+  if (q->count <= d->wait_updates) return 0;
+  q->sum_dps += quad_dps;
+  if (q->count < d->wait_updates + d->avg_updates) return 0;
+  *mean = q->sum_dps / (float)d->avg_updates;
+  q->count = 0u;
+  q->sum_dps = 0.0f;
+  return 1;
+}
+
+static void probe(const quad_null_design_t *d, quad_null_t *q, float quad_dps)
+{
+  float mean;
+  if (!probe_mean(d, q, quad_dps, &mean)) return;
+  if (q->mode == QUAD_NULL_PROBE_BASE) {
+    q->base_dps = mean;
+    q->mode = QUAD_NULL_PROBE_STEP;
+    electrodes(q, d->u_probe_v2, d->u_max_v2);
     return;
   }
-  const float u = pi_step_position(&d->pi, &q->pi, &q->integ_v2, -quad_dps);
-  electrodes(d, q, u);
+  const float step = mean - q->base_dps;
+  if (!((step < 0.0f ? -step : step) >= d->min_step_dps) ||
+      quad_null_start_with_gain(d, q, step / d->u_probe_v2) != 0) {
+    quad_null_stop(q);
+    q->mode = QUAD_NULL_FAILED;
+    return;
+  }
+  /* bumpless: the loop takes over from the probe's voltage */
+  (void)pi_reset(&q->pi, &q->pi_state, d->u_probe_v2, 0.0f);
+  q->integ_v2 = q->pi_state.u;
+  electrodes(q, q->integ_v2, d->u_max_v2);
+}
+
+static void run(const quad_null_design_t *d, quad_null_t *q, float quad_dps)
+{
+  const float u = pi_step_position(&q->pi, &q->pi_state, &q->integ_v2, -quad_dps);
+  electrodes(q, u, d->u_max_v2);
   const float a = quad_dps < 0.0f ? -quad_dps : quad_dps;
   if (a <= d->settle_dps && !q->at_limit) {
     if (q->in_band < d->settle_updates) q->in_band++;
@@ -65,4 +123,23 @@ void quad_null_update(const quad_null_design_t *d, quad_null_t *q, float quad_dp
     q->in_band = 0u;
   }
   q->settled = q->in_band >= d->settle_updates ? 1u : 0u;
+}
+
+void quad_null_update(const quad_null_design_t *d, quad_null_t *q, float quad_dps)
+{
+  if (!isfinite(quad_dps)) { /* no measurement: hold, and a probe mean starts again */
+    q->in_band = 0u;
+    q->settled = 0u;
+    q->count = 0u;
+    q->sum_dps = 0.0f;
+    return;
+  }
+  switch (q->mode) {
+  case QUAD_NULL_PROBE_BASE:
+  case QUAD_NULL_PROBE_STEP: probe(d, q, quad_dps); break;
+  case QUAD_NULL_RUN: run(d, q, quad_dps); break;
+  case QUAD_NULL_OFF:
+  case QUAD_NULL_FAILED:
+  default: break;
+  }
 }

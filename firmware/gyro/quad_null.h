@@ -27,6 +27,14 @@
  * channel's 5 kHz block and 0.003 deg/s at its 500 Hz thermometer block
  * (RATE_P_DECIM), the rate it is meant to run at.
  *
+ * Identification (every start): the gain c is the part's and its wiring's (sign
+ * included), so the loop measures it before it closes: the quadrature's mean over
+ * probe_avg_s with u = 0, then again with u = +probe_v^2 after probe_wait_s for the
+ * channel's filters to settle; c = (q_step - q_base) / probe_v^2. A change under
+ * min_step_dps means the electrodes do not act (not fitted, not wired, a dead driver):
+ * the loop stops with both at 0 V and says so (failed). No stored value of a particular
+ * part is needed; a calibrated gain may be given instead (quad_null_start_with_gain).
+ *
  * Limits: |u| <= v_max^2 (the electrode driver's rail); a quadrature the electrodes
  * cannot reach holds the output at the limit (at_limit) and the loop never counts as
  * settled. Settled: |q| <= settle_dps for settle_s without a break, the monitor the
@@ -40,23 +48,41 @@
 #include "dsp/pi.h"
 
 typedef struct {
-  float gain_dps_per_v2; /* c: quadrature per V^2 of u; != 0 (its sign is the wiring's) */
-  float bw_hz;           /* f_c, the loop's crossover; > 0 */
-  float v_max_v;         /* electrode limit; > 0 */
-  float settle_dps;      /* |q| below this counts as nulled; > 0 */
-  float settle_s;        /* for this long; >= 0 */
-  float dt_s;            /* update period (the rate channel's block); > 0 */
+  float bw_hz;        /* f_c, the loop's crossover; > 0, under a tenth of the update rate */
+  float v_max_v;      /* electrode limit; > 0 */
+  float settle_dps;   /* |q| below this counts as nulled; > 0 */
+  float settle_s;     /* for this long; >= 0 */
+  float probe_v;      /* identification step; 0 < probe_v <= v_max_v */
+  float probe_wait_s; /* settling before each mean; >= 0 */
+  float probe_avg_s;  /* each mean's length; >= one update */
+  float min_step_dps; /* the probe's smallest credible effect; > 0 */
+  float dt_s;         /* update period; > 0 */
 } quad_null_cfg_t;
 
 /* What the update uses, from quad_null_design. */
 typedef struct {
-  pi_coeffs_t pi; /* on e = -q, output u in V^2 */
-  float settle_dps;
-  uint32_t settle_updates;
+  float wc_dt;    /* 2 pi f_c T: Ki T = wc_dt / c */
+  float u_max_v2; /* v_max^2 */
+  float u_probe_v2;
+  float settle_dps, min_step_dps;
+  uint32_t settle_updates, wait_updates, avg_updates;
 } quad_null_design_t;
 
+typedef enum {
+  QUAD_NULL_OFF = 0,
+  QUAD_NULL_PROBE_BASE, /* u = 0: the quadrature as it is */
+  QUAD_NULL_PROBE_STEP, /* u = probe: the electrodes' effect */
+  QUAD_NULL_RUN,        /* the loop closed on the identified gain */
+  QUAD_NULL_FAILED      /* the probe saw no effect: both electrodes at 0 V */
+} quad_null_mode_t;
+
 typedef struct {
-  pi_t pi;
+  quad_null_mode_t mode;
+  uint32_t count;          /* updates in the current probe phase */
+  float sum_dps, base_dps; /* the probe's sums and its base mean */
+  float gain_dps_per_v2;   /* c, identified (0 until then) */
+  pi_coeffs_t pi;          /* on e = -q, output u in V^2 */
+  pi_t pi_state;
   float integ_v2;   /* the integrator (u before the clamp of the output) */
   uint32_t in_band; /* consecutive updates with |q| <= settle_dps */
   uint8_t settled;  /* in_band reached settle_updates */
@@ -64,15 +90,23 @@ typedef struct {
   float v1_v, v2_v; /* the electrode voltages, one of them 0 */
 } quad_null_t;
 
-/* Validates cfg (every value finite and in its range, f_c below a tenth of the update
- * rate) and derives the design. Returns 0, or -1 with *d unchanged. */
+/* Validates cfg (every value finite and in its range) and derives the design. Returns
+ * 0, or -1 with *d unchanged. */
 int quad_null_design(const quad_null_cfg_t *cfg, quad_null_design_t *d);
 
-/* Start from u = u_v2 (clamped into the limits; 0: both electrodes off), not settled. */
-void quad_null_reset(const quad_null_design_t *d, quad_null_t *q, float u_v2);
+/* Both electrodes to 0 V, the loop off. */
+void quad_null_stop(quad_null_t *q);
+
+/* Start: identify the gain (the probe), then close the loop from u = 0. */
+void quad_null_start(const quad_null_design_t *d, quad_null_t *q);
+
+/* Start with a known gain c (from a calibration): close the loop at once. Returns 0, or
+ * -1 (c not finite or 0; q stopped). */
+int quad_null_start_with_gain(const quad_null_design_t *d, quad_null_t *q, float c_dps_per_v2);
 
 /* One update with the measured quadrature (deg/s, the rate channel's). A non-finite
- * value is no measurement: the voltages hold and the loop is not settled. */
+ * value is no measurement: the voltages hold, the loop is not settled, and a probe
+ * phase starts its mean again. */
 void quad_null_update(const quad_null_design_t *d, quad_null_t *q, float quad_dps);
 
 #endif /* QUAD_NULL_H */

@@ -44,74 +44,79 @@ static float run(const quad_null_design_t *d, quad_null_t *q, model_t *m, long n
   return t_in;
 }
 
-static quad_null_cfg_t cfg_for(float c_dps_per_v2, float bw_hz)
+/* f_c 2 Hz, 12 V, settled within 1 deg/s for 0.1 s; probe 3 V, 30 ms + 50 ms means */
+static quad_null_design_t design(void)
 {
-  const quad_null_cfg_t c = {c_dps_per_v2, bw_hz, 12.0f, 1.0f, 0.1f, DT_S};
-  return c;
+  const quad_null_cfg_t c = {2.0f, 12.0f, 1.0f, 0.1f, 3.0f, 0.03f, 0.05f, 1.0f, DT_S};
+  quad_null_design_t d;
+  assert_int_equal(quad_null_design(&c, &d), 0);
+  return d;
 }
 
-/* 1500 deg/s under 1 deg/s within ln(1500) / (2 pi f_c) plus the lag: 0.58 s at 2 Hz
- * (bound 0.7 s); the voltage the model needs, sqrt(1500 / 20) = 8.660 V on V2. */
-static void test_nulls_1500(void **state)
+/* From power-on of the loop: the probe (two 80 ms phases) identifies c within 1 %
+ * through the lag, then 1500 deg/s falls under 1 deg/s within ln(1500) / (2 pi f_c)
+ * (0.58 s at 2 Hz): in all under 0.85 s. The voltage the model needs,
+ * sqrt(1500 / 20) = 8.660 V, on V2. */
+static void test_identifies_and_nulls(void **state)
 {
   (void)state;
-  quad_null_design_t d;
-  const quad_null_cfg_t cfg = cfg_for(20.0f, 2.0f);
-  assert_int_equal(quad_null_design(&cfg, &d), 0);
+  const quad_null_design_t d = design();
   quad_null_t q;
-  quad_null_reset(&d, &q, 0.0f);
+  quad_null_start(&d, &q);
+  assert_int_equal(q.mode, QUAD_NULL_PROBE_BASE);
   assert_true(q.v1_v == 0.0f && q.v2_v == 0.0f);
   model_t m = {1500.0f, 20.0f, 0.0f};
   const float t_in = run(&d, &q, &m, 1000, 0.0f); /* 2 s */
-  print_message("1500 deg/s: within 1 deg/s from %.3f s; V1 %.4f V, V2 %.4f V, q %.2e\n", t_in,
-                q.v1_v, q.v2_v, model_quad(&m, &q));
-  /* the float integrator's dead band: half an ulp of u (75 V^2) over Ki T */
-  assert_true(fabsf(model_quad(&m, &q)) < 0.01f);
-  assert_true(t_in >= 0.0f && t_in < 0.7f);
+  print_message("1500 deg/s: c identified %.4f (20), within 1 deg/s from %.3f s; V1 %.4f V, "
+                "V2 %.4f V, q %.2e\n",
+                q.gain_dps_per_v2, t_in, q.v1_v, q.v2_v, model_quad(&m, &q));
+  assert_int_equal(q.mode, QUAD_NULL_RUN);
+  assert_true(fabsf(q.gain_dps_per_v2 / 20.0f - 1.0f) < 0.01f);
+  assert_true(t_in >= 0.0f && t_in < 0.85f);
   assert_true(q.v1_v == 0.0f);
   assert_true(fabsf(q.v2_v - sqrtf(1500.0f / 20.0f)) < 1e-3f);
+  /* the float integrator's dead band: half an ulp of u (75 V^2) over Ki T */
+  assert_true(fabsf(model_quad(&m, &q)) < 0.01f);
   assert_true(q.settled && !q.at_limit);
 }
 
-/* Negative quadrature goes on the other electrode. */
-static void test_sign_picks_electrode(void **state)
+/* Negative quadrature goes on the other electrode; a reversed wiring (c < 0) is
+ * identified as such and nulled all the same. */
+static void test_sign_and_wiring(void **state)
 {
   (void)state;
-  quad_null_design_t d;
-  const quad_null_cfg_t cfg = cfg_for(20.0f, 2.0f);
-  assert_int_equal(quad_null_design(&cfg, &d), 0);
+  const quad_null_design_t d = design();
   quad_null_t q;
-  quad_null_reset(&d, &q, 0.0f);
+  quad_null_start(&d, &q);
   model_t m = {-800.0f, 20.0f, 0.0f};
   assert_true(run(&d, &q, &m, 1000, 0.0f) >= 0.0f);
   assert_true(q.v2_v == 0.0f && fabsf(q.v1_v - sqrtf(40.0f)) < 1e-3f);
+  quad_null_start(&d, &q);
+  model_t r = {1500.0f, -20.0f, 0.0f};
+  assert_true(run(&d, &q, &r, 1000, 0.0f) >= 0.0f);
+  assert_true(q.gain_dps_per_v2 < 0.0f && q.v2_v == 0.0f && q.v1_v > 8.6f);
 }
 
-/* The identified gain off by 2x either way: still first order (f_c scales with the
- * error), still nulled within 1.5 s; the rate of a ramp's residual r / (2 pi f_c). */
+/* A calibrated gain off by 2x either way: still first order (f_c scales with the
+ * error), nulled within 1.2 s; a ramp of k_q leaves r / (2 pi f_c). */
 static void test_gain_error_and_ramp(void **state)
 {
   (void)state;
+  const quad_null_design_t d = design();
   const float c_hat[] = {10.0f, 40.0f};
   for (int i = 0; i < 2; i++) {
-    quad_null_design_t d;
-    const quad_null_cfg_t cfg = cfg_for(c_hat[i], 2.0f);
-    assert_int_equal(quad_null_design(&cfg, &d), 0);
     quad_null_t q;
-    quad_null_reset(&d, &q, 0.0f);
+    assert_int_equal(quad_null_start_with_gain(&d, &q, c_hat[i]), 0);
     model_t m = {1500.0f, 20.0f, 0.0f};
     const float t_in = run(&d, &q, &m, 750, 0.0f);
-    print_message("identified c %.0f of 20: within 1 deg/s from %.3f s\n", c_hat[i], t_in);
-    assert_true(t_in >= 0.0f && t_in < 1.5f);
+    print_message("gain %.0f given, 20 true: within 1 deg/s from %.3f s\n", c_hat[i], t_in);
+    assert_true(t_in >= 0.0f && t_in < 1.2f);
   }
   /* k_q follows the structure: 1500 deg/s at -0.03 /K (about 2x the silicon's
    * frequency tempco, thermoelastic) and 2 K/min is 1.5 deg/s per second; at 2 Hz the
-   * residual is 1.5 / (2 pi 2) = 0.12 deg/s */
-  quad_null_design_t d;
-  const quad_null_cfg_t cfg = cfg_for(20.0f, 2.0f);
-  assert_int_equal(quad_null_design(&cfg, &d), 0);
+   * residual is 1.5 / (2 pi 2) = 0.12 deg/s, plus the lag's r T_lag */
   quad_null_t q;
-  quad_null_reset(&d, &q, 0.0f);
+  quad_null_start(&d, &q);
   model_t m = {1500.0f, 20.0f, 0.0f};
   (void)run(&d, &q, &m, 1000, 0.0f);
   (void)run(&d, &q, &m, 1000, 1.5f);
@@ -128,11 +133,9 @@ static void test_gain_error_and_ramp(void **state)
 static void test_limit(void **state)
 {
   (void)state;
-  quad_null_design_t d;
-  const quad_null_cfg_t cfg = cfg_for(20.0f, 2.0f);
-  assert_int_equal(quad_null_design(&cfg, &d), 0);
+  const quad_null_design_t d = design();
   quad_null_t q;
-  quad_null_reset(&d, &q, 0.0f);
+  quad_null_start(&d, &q);
   model_t m = {5000.0f, 20.0f, 0.0f}; /* 12 V reaches 2880 deg/s */
   assert_true(run(&d, &q, &m, 1000, 0.0f) < 0.0f);
   assert_true(q.at_limit && !q.settled);
@@ -142,39 +145,68 @@ static void test_limit(void **state)
   assert_true(!q.at_limit && q.settled);
 }
 
-/* No measurement holds the voltages and clears settled; a bad design changes nothing. */
+/* Electrodes that do nothing (not fitted, a dead driver): the probe sees no step, the
+ * loop fails with both at 0 V and never settles. */
+static void test_no_electrodes(void **state)
+{
+  (void)state;
+  const quad_null_design_t d = design();
+  quad_null_t q;
+  quad_null_start(&d, &q);
+  model_t m = {1500.0f, 0.05f, 0.0f}; /* 9 V^2 moves it 0.45 deg/s: under 1 */
+  (void)run(&d, &q, &m, 500, 0.0f);
+  assert_int_equal(q.mode, QUAD_NULL_FAILED);
+  assert_true(q.v1_v == 0.0f && q.v2_v == 0.0f && !q.settled);
+}
+
+/* No measurement holds the voltages and clears settled; a bad design or gain changes
+ * nothing it should not. */
 static void test_bad_input(void **state)
 {
   (void)state;
-  quad_null_design_t d;
-  const quad_null_cfg_t good = cfg_for(20.0f, 2.0f);
-  assert_int_equal(quad_null_design(&good, &d), 0);
+  quad_null_design_t d = design();
   quad_null_t q;
-  quad_null_reset(&d, &q, 0.0f);
+  quad_null_start(&d, &q);
   model_t m = {1500.0f, 20.0f, 0.0f};
   (void)run(&d, &q, &m, 1000, 0.0f);
   const float v2 = q.v2_v;
   quad_null_update(&d, &q, NAN);
   quad_null_update(&d, &q, INFINITY);
   assert_true(q.v2_v == v2 && !q.settled);
+  assert_int_equal(quad_null_start_with_gain(&d, &q, 0.0f), -1);
+  assert_int_equal(q.mode, QUAD_NULL_OFF);
+  assert_int_equal(quad_null_start_with_gain(&d, &q, NAN), -1);
   const quad_null_design_t before = d;
-  const quad_null_cfg_t bad[] = {
-      {0.0f, 2.0f, 12.0f, 1.0f, 0.1f, DT_S},     {NAN, 2.0f, 12.0f, 1.0f, 0.1f, DT_S},
-      {20.0f, 0.0f, 12.0f, 1.0f, 0.1f, DT_S},    {20.0f, 600.0f, 12.0f, 1.0f, 0.1f, DT_S},
-      {20.0f, 2.0f, -1.0f, 1.0f, 0.1f, DT_S},    {20.0f, 2.0f, 12.0f, 0.0f, 0.1f, DT_S},
-      {20.0f, 2.0f, 12.0f, 1.0f, -1.0f, DT_S},   {20.0f, 2.0f, 12.0f, 1.0f, 0.1f, 0.0f},
-      {20.0f, 2.0f, INFINITY, 1.0f, 0.1f, DT_S}, {20.0f, 2.0f, 12.0f, 1.0f, 1e9f, DT_S}};
-  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-    assert_int_equal(quad_null_design(&bad[i], &d), -1);
-    assert_memory_equal(&d, &before, sizeof d);
+  const quad_null_cfg_t ok = {2.0f, 12.0f, 1.0f, 0.1f, 3.0f, 0.03f, 0.05f, 1.0f, DT_S};
+  for (int i = 0; i < 9; i++) {
+    const float bad_vals[] = {0.0f, NAN, -1.0f, INFINITY};
+    for (int j = 0; j < 4; j++) {
+      quad_null_cfg_t b = ok;
+      float *f = &b.bw_hz + i;        /* the fields are floats, in order */
+      if (i == 3 && j == 0) continue; /* settle_s 0 is valid */
+      if (i == 5 && j == 0) continue; /* probe_wait_s 0 is valid */
+      *f = bad_vals[j];
+      assert_int_equal(quad_null_design(&b, &d), -1);
+      assert_memory_equal(&d, &before, sizeof d);
+    }
   }
+  quad_null_cfg_t b = ok;
+  b.bw_hz = 60.0f; /* f_c T = 0.12: not first order */
+  assert_int_equal(quad_null_design(&b, &d), -1);
+  b = ok;
+  b.probe_v = 13.0f; /* beyond the limit */
+  assert_int_equal(quad_null_design(&b, &d), -1);
+  b = ok;
+  b.settle_s = 1e9f;
+  assert_int_equal(quad_null_design(&b, &d), -1);
+  assert_memory_equal(&d, &before, sizeof d);
 }
 
 int main(void)
 {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_nulls_1500), cmocka_unit_test(test_sign_picks_electrode),
-      cmocka_unit_test(test_gain_error_and_ramp), cmocka_unit_test(test_limit),
-      cmocka_unit_test(test_bad_input)};
+      cmocka_unit_test(test_identifies_and_nulls), cmocka_unit_test(test_sign_and_wiring),
+      cmocka_unit_test(test_gain_error_and_ramp),  cmocka_unit_test(test_limit),
+      cmocka_unit_test(test_no_electrodes),        cmocka_unit_test(test_bad_input)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
