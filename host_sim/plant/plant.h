@@ -403,10 +403,10 @@ typedef struct {
                                 softening k_e (fb bias and electrodes), sample clock */
   double sense_shift_hz;     /* its shift by k_e, <= 0 */
   /* electrical */
-  double f_drive_mps2, f_sense_mps2; /* actuator + acceleration forces per unit mass */
-  double dac_held_v[4];              /* DAC output levels over the last sample */
-  double adc_v[2];                   /* analog voltages at the ADC inputs (drive, sense) */
-  hal_adc_frame_t adc;               /* the codes returned */
+  double f_drive_mps2, f_sense_mps2;       /* actuator + acceleration forces per unit mass */
+  double dac_held_v[HAL_DAC_NUM_CHANNELS]; /* DAC output levels over the last sample */
+  double adc_v[2];     /* analog voltages at the ADC inputs (drive, sense) */
+  hal_adc_frame_t adc; /* the codes returned */
   uint64_t adc_clip[2], dac_rejects;
   uint64_t mech_refreshes;
 } plant_truth_t;
