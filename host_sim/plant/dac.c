@@ -83,11 +83,11 @@ static inline __attribute__((always_inline)) double held_level(dac_t *d, int c, 
 void dac_set_ref(dac_t *d, double ref_rel) { d->ref_rel = ref_rel; }
 
 /* Exact forms of the filter over one sample, in normalised time s = t / T. */
-static int discretise(dac_t *d)
+static int discretise(dac_forms_t *d, double w0, double fs_hz, double recon_q)
 {
-  const double T = 1.0 / d->cfg.fs_hz;
-  const double wt = d->w0 * T;
-  const double iq = 1.0 / d->cfg.recon_q;
+  const double T = 1.0 / fs_hz;
+  const double wt = w0 * T;
+  const double iq = 1.0 / recon_q;
   /* X = F T, F = [[A, B], [0, 0]], A = w0 [[0, 1], [-1, -1/Q]], B = w0 [0, 1]^T */
   double x[9] = {0.0, wt, 0.0, -wt, -wt * iq, wt, 0.0, 0.0, 0.0};
   double e[9];
@@ -143,33 +143,37 @@ static int discretise(dac_t *d)
 int dac_init(dac_t *d, const dac_cfg_t *cfg)
 {
   if (d == NULL || cfg == NULL || !cfg_ok(cfg)) return -1;
-  dac_t t;
-  memset(&t, 0, sizeof t);
-  t.cfg = *cfg;
-  t.filtered = cfg->recon_cutoff_hz > 0.0;
-  t.w0 = 2.0 * k_pi * cfg->recon_cutoff_hz;
-  if (t.filtered && discretise(&t) != 0) return -1;
+  const int filtered = cfg->recon_cutoff_hz > 0.0;
+  const double w0 = 2.0 * k_pi * cfg->recon_cutoff_hz;
+  dac_forms_t form;
+  memset(&form, 0, sizeof form);
+  if (filtered && discretise(&form, w0, cfg->fs_hz, cfg->recon_q) != 0) return -1;
+  /* nothing can fail from here on: built in place (cfg may be &d->cfg: copied first) */
+  const dac_cfg_t c0 = *cfg;
+  memset(d, 0, sizeof *d);
+  d->cfg = c0;
+  d->filtered = filtered;
+  d->w0 = w0;
+  d->form = form;
   const double lsb = 2.0 * (double)HAL_DAC_FULL_SCALE_V / 16384.0;
   for (int c = 0; c < DAC_NCH; c++) {
-    t.scale[c] = cfg->gain[c] * lsb;
-    t.zero[c] = cfg->offset_v[c] - cfg->gain[c] * lsb * (double)HAL_DAC_CODE_MID;
+    d->scale[c] = c0.gain[c] * lsb;
+    d->zero[c] = c0.offset_v[c] - c0.gain[c] * lsb * (double)HAL_DAC_CODE_MID;
   }
   for (int c = 0; c < DAC_NCH; c++) {
-    (void)inl_init(&t.inl[c], &cfg->inl, DAC_BITS, cfg->inl_seed,
-                   DAC_RNG_STREAM_INL + (uint64_t)c);
-    t.inl_code[c] = UINT32_MAX;
+    (void)inl_init(&d->inl[c], &c0.inl, DAC_BITS, c0.inl_seed, DAC_RNG_STREAM_INL + (uint64_t)c);
+    d->inl_code[c] = UINT32_MAX;
   }
   for (int c = 0; c < DAC_NCH; c++)
-    if (cfg->modelled[c]) t.on[t.n_on++] = (uint8_t)c;
-  t.first_all = 1;
-  for (int c = 0; c < DAC_FIRST; c++) t.first_all &= cfg->modelled[c];
+    if (c0.modelled[c]) d->on[d->n_on++] = (uint8_t)c;
+  d->first_all = 1;
+  for (int c = 0; c < DAC_FIRST; c++) d->first_all &= c0.modelled[c];
   for (int c = 0; c < DAC_NCH; c++) {
-    t.latched[c] = cfg->initial_code[c];
-    t.pending[c] = cfg->initial_code[c];
-    t.x[c][0] = held_level(&t, c, cfg->initial_code[c]);
-    t.x[c][1] = 0.0;
+    d->latched[c] = c0.initial_code[c];
+    d->pending[c] = c0.initial_code[c];
+    d->x[c][0] = held_level(d, c, c0.initial_code[c]);
+    d->x[c][1] = 0.0;
   }
-  *d = t;
   return 0;
 }
 
@@ -209,16 +213,17 @@ static inline __attribute__((always_inline)) void step_held(dac_t *d, int c, dac
 /* One channel's sample through the reconstruction filter (the header's exact forms). */
 static inline __attribute__((always_inline)) void step_filtered(dac_t *d, int c, dac_out_t *out)
 {
-  const double *q = d->q2;
+  const dac_forms_t *f = &d->form;
+  const double *q = f->q2;
   dac_chan_out_t *o = &out->ch[c];
   const double u = held_level(d, c, d->latched[c]);
   const double z0 = d->x[c][0], z1 = d->x[c][1];
   o->held_v = u;
-  o->mean_v = d->mv[0] * z0 + d->mv[1] * z1 + d->mv[2] * u;
+  o->mean_v = f->mv[0] * z0 + f->mv[1] * z1 + f->mv[2] * u;
   o->mean_sq_v2 = z0 * (q[0] * z0 + q[1] * z1 + q[2] * u) + z1 * (q[3] * z1 + q[4] * u) +
                   q[5] * u * u;
-  const double n0 = d->ad[0][0] * z0 + d->ad[0][1] * z1 + d->bd[0] * u;
-  const double n1 = d->ad[1][0] * z0 + d->ad[1][1] * z1 + d->bd[1] * u;
+  const double n0 = f->ad[0][0] * z0 + f->ad[0][1] * z1 + f->bd[0] * u;
+  const double n1 = f->ad[1][0] * z0 + f->ad[1][1] * z1 + f->bd[1] * u;
   d->x[c][0] = n0;
   d->x[c][1] = n1;
   o->end_v = n0;

@@ -115,14 +115,19 @@ typedef struct {
   dac_chan_out_t ch[DAC_NCH];
 } dac_out_t;
 
+/* The reconstruction filter over one sample (the header's exact forms). */
+typedef struct {
+  double ad[2][2], bd[2]; /* exact ZOH discretisation */
+  double mv[3];           /* mean form */
+  double msq[3][3];       /* mean-square form */
+  double q2[6];           /* msq as q00, 2q01, 2q02, q11, 2q12, q22 (per-sample use) */
+} dac_forms_t;
+
 typedef struct {
   dac_cfg_t cfg;
   int filtered;              /* 0 when recon_cutoff_hz == 0 */
   double w0;                 /* rad/s */
-  double ad[2][2], bd[2];    /* exact ZOH discretisation */
-  double mv[3];              /* mean form */
-  double msq[3][3];          /* mean-square form */
-  double q2[6];              /* msq as q00, 2q01, 2q02, q11, 2q12, q22 (per-sample use) */
+  dac_forms_t form;          /* the filter's exact forms over one sample */
   double scale[DAC_NCH];     /* volts per code, gain included */
   double zero[DAC_NCH];      /* volts at code 0, gain and offset included */
   double x[DAC_NCH][2];      /* filter states [v, v'/w0] */
@@ -144,8 +149,9 @@ typedef struct {
 void dac_default_cfg(dac_cfg_t *cfg);
 
 /* Validates cfg (fs > 0; cutoff 0 or in (0, fs]; Q in [0.1, 10]; |gain| in (0, 2];
- * |offset| <= 15 V; codes <= 16383; modelled 0 or 1; inl_check). Returns 0, or -1 with d unchanged. The
- * filters start settled at the initial codes. */
+ * |offset| <= 15 V; codes <= 16383; modelled 0 or 1; inl_check). Returns 0, or -1 with d
+ * unchanged. The filters start settled at the initial codes. Built in place once nothing
+ * can fail (a scratch dac_t, eight channels' INL tables, was 6 kB of a target's stack). */
 int dac_init(dac_t *d, const dac_cfg_t *cfg);
 
 /* The reference's relative error r for the samples that follow (0: exact). */
