@@ -151,18 +151,6 @@ static inline void count_rails(gyro_t *g, const hal_adc_frame_t *adc)
   }
 }
 
-/* The sense electrodes of the closed sense loop (the feedback pair's second electrode, the
- * quadrature-nulling sets, the tuning electrodes, hal_dac.h) at 0 V: no loop drives them
- * yet (issue 19 item 3), and a part without them ignores their channels. Written every
- * tick because the frame is rebuilt every tick. */
-GYRO_RAMFUNC static inline void dac_sense_electrodes_rest(hal_dac_frame_t *dac)
-{
-  dac->code[HAL_DAC_SENSE_FB_U2] = (uint16_t)HAL_DAC_CODE_MID;
-  dac->code[HAL_DAC_QUADNULL_V1] = (uint16_t)HAL_DAC_CODE_MID;
-  dac->code[HAL_DAC_QUADNULL_V2] = (uint16_t)HAL_DAC_CODE_MID;
-  dac->code[HAL_DAC_TUNE] = (uint16_t)HAL_DAC_CODE_MID;
-}
-
 /* A SWEEP tick: the self-calibration executive measures the drive LMSD's phasor and
  * sets the excitation and the NCO's next step on every tick (selfcal_exec.h). The sense
  * channel and the self-test forces rest (the rate is not valid in SWEEP and the sweep
@@ -180,7 +168,6 @@ GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc,
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
   dac->code[HAL_DAC_RATE_OUT] = g->rate_code;
   dac->code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID;
-  dac_sense_electrodes_rest(dac);
   g->out.tick++;
   const uint32_t slot = g->slot;
   g->slot = slot + 1u == GYRO_BLOCK ? 0u : slot + 1u;
@@ -217,7 +204,6 @@ GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame
                                  ? gyro_volts_to_dac(
                                        selftest_force(&g->selftest, ref.sin_wc, ref.cos_wc))
                                  : (uint16_t)HAL_DAC_CODE_MID;
-  dac_sense_electrodes_rest(dac);
   g->out.tick++;
 
   /* Everything slower than the carrier: this tick's job of the block (gyro_block.h),

@@ -131,6 +131,20 @@ static void test_write_frame_only_fills_words(void **state)
   assert_int_equal(w[0], 9u);
   assert_int_equal(w[3], 0xC000u | 12u);
   assert_int_equal(w[7], 0xC000u | 16u);
+  /* a code beyond 14 bits is saturated as the M4's USAT16 does (signed half-words: full
+   * scale up to 32767, zero scale above), never let into the address bits */
+  const hal_dac_frame_t h = {{9u, 16384u, 32767u, 12u, 13u, 20000u, 15u, 65535u}};
+  hal_dac_write_frame(&h);
+  assert_int_equal(w[1], 0x4000u | 16383u);
+  assert_int_equal(w[2], 0x8000u | 16383u);
+  assert_int_equal(w[5], 0x4000u | 16383u);
+  assert_int_equal(w[6], 0x8000u | 15u);
+  assert_int_equal(w[7], 0xC000u);
+  const hal_dac_frame_t m = {{32768u, 40000u, 0u, 16383u, 0u, 0u, 0u, 0u}};
+  hal_dac_write_frame(&m);
+  assert_int_equal(w[0], 0u);
+  assert_int_equal(w[1], 0x4000u);
+  assert_int_equal(w[3], 0xC000u | 16383u);
   assert_int_equal(stm32f4_dac_late(), 0);
 }
 
