@@ -92,6 +92,7 @@ static void keep_designable(app_t *a, param_values_t *v)
 int app_init_with(app_t *a, const param_values_t *values)
 {
   memset(a, 0, sizeof *a);
+  hal_dac_frame_midscale(&a->dac);
   param_values_t initial;
   param_values_defaults(&initial);
 
@@ -184,10 +185,9 @@ GYRO_RAMFUNC void app_sample_isr(void *ctx)
   }
 
   hal_adc_frame_t adc;
-  hal_dac_frame_t dac;
   hal_adc_read_frame(&adc);
-  gyro_tick(&a->gyro, &adc, &dac);
-  hal_dac_write_frame(&dac);
+  gyro_tick(&a->gyro, &adc, &a->dac);
+  hal_dac_write_frame(&a->dac);
   app_tlm_isr(&a->tlm, &a->gyro.out);
 
   a->isr_ticks++; /* its cycles: the HAL measures the whole handler (hal_sample_isr_cycles) */

@@ -65,6 +65,11 @@ typedef struct {
   uint32_t selfcal_ticks;    /* its length up to the hand-over */
   /* Self-measurement of the sample ISR (DWT cycles on the board). */
   uint32_t isr_ticks;
+  /* The DAC frame handed to the HAL every tick: gyro_tick rewrites the channels it drives,
+   * the sense electrodes' channels keep the mid-scale (0 V) of app_init until a loop
+   * drives them (issue 19 item 3). Kept here rather than rebuilt on the stack because
+   * four constant stores a tick were 5 of the interrupt's cycles. */
+  hal_dac_frame_t dac;
   /* Set by the image's main after app_init (NULL: nothing added, as on the host). */
   app_status_fn status_board;
 } app_t;

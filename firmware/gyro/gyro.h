@@ -40,7 +40,11 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d);
  * the drive off, the NCO retuned only when the drive frequency changes. */
 void gyro_apply(gyro_t *g, const gyro_design_t *d);
 
-/* One sample: ADC frame in, DAC frame out (latched by the HAL at the next tick). */
+/* One sample: ADC frame in, DAC frame out (latched by the HAL at the next tick). Writes the
+ * channels the gyro drives (the drive pair, the rate output, the spare's self-test force);
+ * the sense electrodes' channels (HAL_DAC_SENSE_FB_U2 .. HAL_DAC_TUNE) keep what the
+ * caller's frame holds: no loop drives them yet, and the application's frame holds them
+ * at mid-scale (0 V). */
 void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac);
 
 /* The HAL's count of lost samples (hal_sample_lost_counter), read once per block: a

@@ -20,18 +20,13 @@ static struct {
   int running;
 } host;
 
-static void dac_midscale(hal_dac_frame_t *f)
-{
-  for (int i = 0; i < HAL_DAC_NUM_CHANNELS; i++) f->code[i] = (uint16_t)HAL_DAC_CODE_MID;
-}
-
 void hal_host_attach(hal_host_plant_step_fn step, void *plant)
 {
   host.step = step;
   host.plant = plant;
   host.ticks = 0u;
-  dac_midscale(&host.active);
-  dac_midscale(&host.pending);
+  hal_dac_frame_midscale(&host.active);
+  hal_dac_frame_midscale(&host.pending);
   host.adc.drive = 0;
   host.adc.sense = 0;
   if (step != NULL) {

@@ -70,6 +70,7 @@ typedef struct {
 #define STM32F4_PWR_BASE 0x40007000UL
 #define STM32F4_IWDG_BASE 0x40003000UL
 #define STM32F4_SPI2_BASE 0x40003800UL
+#define STM32F4_SPI3_BASE 0x40003C00UL
 #define STM32F4_TIM1_BASE 0x40010000UL
 #define STM32F4_TIM8_BASE 0x40010400UL
 #define STM32F4_USART1_BASE 0x40011000UL
@@ -94,7 +95,7 @@ typedef struct {
   stm32f4_flash_t *flash;
   stm32f4_gpio_t *gpioa, *gpiob, *gpioc;
   stm32f4_tim_t *tim1, *tim2, *tim4, *tim8;
-  stm32f4_spi_t *spi1, *spi2;
+  stm32f4_spi_t *spi1, *spi2, *spi3;
   stm32f4_dma_t *dma2;
   stm32f4_usart_t *usart1;
   stm32f4_iwdg_t *iwdg;
@@ -141,6 +142,7 @@ void stm32f4_qemu_flash_controller(void);
 #define TIM8 STM32F4_PERIPH(tim8, stm32f4_tim_t, STM32F4_TIM8_BASE)
 #define SPI1 STM32F4_PERIPH(spi1, stm32f4_spi_t, STM32F4_SPI1_BASE)
 #define SPI2 STM32F4_PERIPH(spi2, stm32f4_spi_t, STM32F4_SPI2_BASE)
+#define SPI3 STM32F4_PERIPH(spi3, stm32f4_spi_t, STM32F4_SPI3_BASE)
 #define DMA2 STM32F4_PERIPH(dma2, stm32f4_dma_t, STM32F4_DMA2_BASE)
 #define USART1 STM32F4_PERIPH(usart1, stm32f4_usart_t, STM32F4_USART1_BASE)
 #define IWDG STM32F4_PERIPH(iwdg, stm32f4_iwdg_t, STM32F4_IWDG_BASE)
@@ -179,6 +181,7 @@ void stm32f4_qemu_flash_controller(void);
 #define RCC_APB1ENR_TIM2EN (1u << 0)
 #define RCC_APB1ENR_TIM4EN (1u << 2)
 #define RCC_APB1ENR_SPI2EN (1u << 14)
+#define RCC_APB1ENR_SPI3EN (1u << 15)
 #define RCC_APB1ENR_PWREN (1u << 28)
 #define RCC_APB2ENR_TIM1EN (1u << 0)
 #define RCC_APB2ENR_TIM8EN (1u << 1)
@@ -229,6 +232,7 @@ void stm32f4_qemu_flash_controller(void);
 #define TIM_CR1_OPM (1u << 3)
 #define TIM_CR1_ARPE (1u << 7)
 #define TIM_DIER_CC1DE (1u << 9)
+#define TIM_DIER_CC2DE (1u << 10)
 #define TIM_DIER_CC3DE (1u << 11)
 #define TIM_DIER_CC4DE (1u << 12)
 #define TIM_EGR_UG (1u << 0)

@@ -757,6 +757,9 @@ static void report_plant_warnings(report_t *r)
               plant_law_name(i), (unsigned long long)pw->count, pw->first_t_s);
   }
   add_num(r->fig, "plant_warnings_total", (double)total);
+  /* frames the plant's DAC refused (a code beyond 14 bits): 0 unless the firmware or the
+   * open-loop drive wrote a bad frame */
+  add_num(r->fig, "plant_dac_rejects", (double)r->res->dac_rejects);
 }
 
 /* sense_match: on a part with sense tuning electrodes, whether they can bring the sense

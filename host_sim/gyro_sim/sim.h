@@ -70,6 +70,7 @@ typedef struct {
   double adc_fraction[2]; /* worst-case budget from plant_adc_fraction */
   uint64_t adc_clips[2];
   plant_warning_t plant_warnings[PLANT_LAWS]; /* plant laws outside their range */
+  uint64_t dac_rejects; /* frames the plant's DAC refused (a code out of range): 0 */
   uint32_t faults;
   double rate_valid_fraction; /* of the run's ticks with the rate output valid */
   double rate_first_valid_s;  /* first tick with the rate valid; -1: never */

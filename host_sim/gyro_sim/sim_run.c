@@ -319,6 +319,7 @@ static void cl_results(const cl_run_t *r, const cl_stats_t *st, const plant_cfg_
   res->adc_clips[0] = tr->adc_clip[0];
   res->adc_clips[1] = tr->adc_clip[1];
   memcpy(res->plant_warnings, plant_warnings(r->plant), sizeof res->plant_warnings);
+  res->dac_rejects = plant_truth(r->plant)->dac_rejects;
   (void)plant_adc_fraction(pc, res->adc_fraction);
   res->faults = r->app->gyro.sup.fault_count;
   res->rate_valid_fraction = n_ticks > 0u ? (double)st->valid_ticks / (double)n_ticks : 0.0;
@@ -585,10 +586,9 @@ static void ol_isr(void *ctx)
     o->acc_n++;
   }
   hal_dac_frame_t dac;
+  hal_dac_frame_midscale(&dac); /* every channel: the sense electrodes' at 0 V */
   dac.code[HAL_DAC_DRIVE_U1] = dac_v_to_code(o->u_amp_v * cos(o->psi));
   dac.code[HAL_DAC_DRIVE_U2] = dac_v_to_code(o->u_amp_v * sin(o->psi));
-  dac.code[HAL_DAC_RATE_OUT] = (uint16_t)HAL_DAC_CODE_MID;
-  dac.code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID;
   hal_dac_write_frame(&dac);
   o->psi += o->dpsi;
   if (o->psi > 2.0 * PLANT_PI) o->psi -= 2.0 * PLANT_PI;
@@ -691,6 +691,7 @@ int sim_run_open_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_resul
   res->adc_clips[0] = plant_truth(plant)->adc_clip[0];
   res->adc_clips[1] = plant_truth(plant)->adc_clip[1];
   memcpy(res->plant_warnings, plant_warnings(plant), sizeof res->plant_warnings);
+  res->dac_rejects = plant_truth(plant)->dac_rejects;
   (void)plant_adc_fraction(&pc, res->adc_fraction);
   sim_csv_close(&csv);
   hal_sample_timer_stop();

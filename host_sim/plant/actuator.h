@@ -13,7 +13,8 @@
  *      FB_DIFFERENTIAL: U3 = Vb + u + w3, U4 = Vb - u + w4 (bias +- the DAC voltage)
  *                       -> f_sen = 4 ks_fb Vb u + noise (linear in u, the DC+AC idea)
  *      FB_PAIR:         U3 = e3 + w3, U4 = e4 + w4, both voltages from the electrode input
- *                       (actuator_elec_in_t, not the four-channel DAC): the drive's law on
+ *                       (actuator_elec_in_t; the plant fills it from the DAC's spare channel
+ *                       and the second converter's, plant.h): the drive's law on
  *                       the sense axis, so half-frequency feedback (e3 = A cos(wc t/2 + p),
  *                       e4 = A sin(wc t/2 + p): f_sen = ks_fb A^2 cos(wc t + 2p)) and DC+AC
  *                       (e3 = Vb + u, e4 = Vb - u) are the same electrodes with other
@@ -117,8 +118,8 @@ typedef struct {
   flicker_spec_t tune_noise;         /* on Vt */
 } actuator_cfg_t;
 
-/* The voltages of the electrodes beyond the four-channel DAC over one sample (the header:
- * mean and mean square; end_v and the slope are not used). */
+/* The voltages of the sense electrodes over one sample (the header: mean and mean square;
+ * end_v and the slope are not used), apart from the dac_out_t the drive takes. */
 typedef struct {
   dac_chan_out_t fb[2];       /* U3, U4 of FB_PAIR */
   dac_chan_out_t quadnull[2]; /* V1, V2 */

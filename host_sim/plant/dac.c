@@ -38,6 +38,7 @@ void dac_default_cfg(dac_cfg_t *cfg)
     cfg->gain[c] = 1.0;
     cfg->offset_v[c] = 0.0;
     cfg->initial_code[c] = (uint16_t)HAL_DAC_CODE_MID;
+    cfg->modelled[c] = 1u;
   }
 }
 
@@ -55,11 +56,14 @@ static int cfg_ok(const dac_cfg_t *c)
     if (!(isfinite(c->offset_v[i]) && fabs(c->offset_v[i]) <= (double)HAL_DAC_FULL_SCALE_V))
       return 0;
     if (c->initial_code[i] > HAL_DAC_CODE_MAX) return 0;
+    if (c->modelled[i] > 1u) return 0;
   }
   return inl_check(&c->inl, DAC_BITS) == 0;
 }
 
-static double held_level(dac_t *d, int c, uint16_t code)
+/* Inlined into dac_step's loops (called for every modelled channel every sample; a call
+ * cost 2 % of a run's instructions when the loop became one over a channel list). */
+static inline __attribute__((always_inline)) double held_level(dac_t *d, int c, uint16_t code)
 {
   double u = d->scale[c] * (double)code + d->zero[c];
   if (d->inl[c].active) {
@@ -79,11 +83,11 @@ static double held_level(dac_t *d, int c, uint16_t code)
 void dac_set_ref(dac_t *d, double ref_rel) { d->ref_rel = ref_rel; }
 
 /* Exact forms of the filter over one sample, in normalised time s = t / T. */
-static int discretise(dac_t *d)
+static int discretise(dac_forms_t *d, double w0, double fs_hz, double recon_q)
 {
-  const double T = 1.0 / d->cfg.fs_hz;
-  const double wt = d->w0 * T;
-  const double iq = 1.0 / d->cfg.recon_q;
+  const double T = 1.0 / fs_hz;
+  const double wt = w0 * T;
+  const double iq = 1.0 / recon_q;
   /* X = F T, F = [[A, B], [0, 0]], A = w0 [[0, 1], [-1, -1/Q]], B = w0 [0, 1]^T */
   double x[9] = {0.0, wt, 0.0, -wt, -wt * iq, wt, 0.0, 0.0, 0.0};
   double e[9];
@@ -139,71 +143,111 @@ static int discretise(dac_t *d)
 int dac_init(dac_t *d, const dac_cfg_t *cfg)
 {
   if (d == NULL || cfg == NULL || !cfg_ok(cfg)) return -1;
-  dac_t t;
-  memset(&t, 0, sizeof t);
-  t.cfg = *cfg;
-  t.filtered = cfg->recon_cutoff_hz > 0.0;
-  t.w0 = 2.0 * k_pi * cfg->recon_cutoff_hz;
-  if (t.filtered && discretise(&t) != 0) return -1;
+  const int filtered = cfg->recon_cutoff_hz > 0.0;
+  const double w0 = 2.0 * k_pi * cfg->recon_cutoff_hz;
+  dac_forms_t form;
+  memset(&form, 0, sizeof form);
+  if (filtered && discretise(&form, w0, cfg->fs_hz, cfg->recon_q) != 0) return -1;
+  /* nothing can fail from here on: built in place (cfg may be &d->cfg: copied first) */
+  const dac_cfg_t c0 = *cfg;
+  memset(d, 0, sizeof *d);
+  d->cfg = c0;
+  d->filtered = filtered;
+  d->w0 = w0;
+  d->form = form;
   const double lsb = 2.0 * (double)HAL_DAC_FULL_SCALE_V / 16384.0;
   for (int c = 0; c < DAC_NCH; c++) {
-    t.scale[c] = cfg->gain[c] * lsb;
-    t.zero[c] = cfg->offset_v[c] - cfg->gain[c] * lsb * (double)HAL_DAC_CODE_MID;
+    d->scale[c] = c0.gain[c] * lsb;
+    d->zero[c] = c0.offset_v[c] - c0.gain[c] * lsb * (double)HAL_DAC_CODE_MID;
   }
   for (int c = 0; c < DAC_NCH; c++) {
-    (void)inl_init(&t.inl[c], &cfg->inl, DAC_BITS, cfg->inl_seed,
-                   DAC_RNG_STREAM_INL + (uint64_t)c);
-    t.inl_code[c] = UINT32_MAX;
+    (void)inl_init(&d->inl[c], &c0.inl, DAC_BITS, c0.inl_seed, DAC_RNG_STREAM_INL + (uint64_t)c);
+    d->inl_code[c] = UINT32_MAX;
   }
+  for (int c = 0; c < DAC_NCH; c++)
+    if (c0.modelled[c]) d->on[d->n_on++] = (uint8_t)c;
+  d->first_all = 1;
+  for (int c = 0; c < DAC_FIRST; c++) d->first_all &= c0.modelled[c];
   for (int c = 0; c < DAC_NCH; c++) {
-    t.latched[c] = cfg->initial_code[c];
-    t.pending[c] = cfg->initial_code[c];
-    t.x[c][0] = held_level(&t, c, cfg->initial_code[c]);
-    t.x[c][1] = 0.0;
+    d->latched[c] = c0.initial_code[c];
+    d->pending[c] = c0.initial_code[c];
+    d->x[c][0] = held_level(d, c, c0.initial_code[c]);
+    d->x[c][1] = 0.0;
   }
-  *d = t;
   return 0;
 }
 
 int dac_write(dac_t *d, const hal_dac_frame_t *frame)
 {
   if (d == NULL || frame == NULL) return -1;
-  for (int c = 0; c < DAC_NCH; c++)
-    if (frame->code[c] > HAL_DAC_CODE_MAX) return -1;
-  for (int c = 0; c < DAC_NCH; c++) d->pending[c] = frame->code[c];
+  /* HAL_DAC_CODE_MAX is all ones below bit 14, so some code exceeds it exactly when the OR
+   * of all codes does: one test for the frame (the compiler makes the OR one vector
+   * operation), not a branch per channel, every sample */
+  _Static_assert((HAL_DAC_CODE_MAX & (HAL_DAC_CODE_MAX + 1u)) == 0u, "CODE_MAX = 2^n - 1");
+  uint16_t any = 0u;
+  for (int c = 0; c < DAC_NCH; c++) any = (uint16_t)(any | frame->code[c]);
+  if (any > HAL_DAC_CODE_MAX) return -1;
+  memcpy(d->pending, frame->code, sizeof d->pending);
   return 0;
 }
 
+/* Codes of every channel move to the held ones (the unmodelled too: their codes stay
+ * what the board would hold). */
+static void latch(dac_t *d)
+{
+  for (int c = 0; c < DAC_NCH; c++) d->latched[c] = d->pending[c];
+}
+
+/* One channel's sample, staircase alone (no reconstruction filter). */
+static inline __attribute__((always_inline)) void step_held(dac_t *d, int c, dac_out_t *out)
+{
+  dac_chan_out_t *o = &out->ch[c];
+  const double u = held_level(d, c, d->latched[c]);
+  o->held_v = u;
+  o->mean_v = u;
+  o->mean_sq_v2 = u * u;
+  o->end_v = u;
+  o->end_dvdt_v_per_s = 0.0;
+}
+
+/* One channel's sample through the reconstruction filter (the header's exact forms). */
+static inline __attribute__((always_inline)) void step_filtered(dac_t *d, int c, dac_out_t *out)
+{
+  const dac_forms_t *f = &d->form;
+  const double *q = f->q2;
+  dac_chan_out_t *o = &out->ch[c];
+  const double u = held_level(d, c, d->latched[c]);
+  const double z0 = d->x[c][0], z1 = d->x[c][1];
+  o->held_v = u;
+  o->mean_v = f->mv[0] * z0 + f->mv[1] * z1 + f->mv[2] * u;
+  o->mean_sq_v2 = z0 * (q[0] * z0 + q[1] * z1 + q[2] * u) + z1 * (q[3] * z1 + q[4] * u) +
+                  q[5] * u * u;
+  const double n0 = f->ad[0][0] * z0 + f->ad[0][1] * z1 + f->bd[0] * u;
+  const double n1 = f->ad[1][0] * z0 + f->ad[1][1] * z1 + f->bd[1] * u;
+  d->x[c][0] = n0;
+  d->x[c][1] = n1;
+  o->end_v = n0;
+  o->end_dvdt_v_per_s = d->w0 * n1;
+}
+
+/* The modelled channels: the first converter's four by a loop of constant count when all
+ * four are modelled (the compiler unrolls it: a loop over the channel list instead cost
+ * 60 instructions a sample), then the rest of the list. */
 void dac_step(dac_t *d, dac_out_t *out)
 {
+  int i = 0;
   if (!d->filtered) {
-    for (int c = 0; c < DAC_NCH; c++) {
-      dac_chan_out_t *o = &out->ch[c];
-      const double u = held_level(d, c, d->latched[c]);
-      o->held_v = u;
-      o->mean_v = u;
-      o->mean_sq_v2 = u * u;
-      o->end_v = u;
-      o->end_dvdt_v_per_s = 0.0;
-      d->latched[c] = d->pending[c];
+    if (d->first_all) {
+      for (int c = 0; c < DAC_FIRST; c++) step_held(d, c, out);
+      i = DAC_FIRST;
     }
-    return;
+    for (; i < d->n_on; i++) step_held(d, d->on[i], out);
+  } else {
+    if (d->first_all) {
+      for (int c = 0; c < DAC_FIRST; c++) step_filtered(d, c, out);
+      i = DAC_FIRST;
+    }
+    for (; i < d->n_on; i++) step_filtered(d, d->on[i], out);
   }
-  const double *q = d->q2;
-  for (int c = 0; c < DAC_NCH; c++) {
-    dac_chan_out_t *o = &out->ch[c];
-    const double u = held_level(d, c, d->latched[c]);
-    const double z0 = d->x[c][0], z1 = d->x[c][1];
-    o->held_v = u;
-    o->mean_v = d->mv[0] * z0 + d->mv[1] * z1 + d->mv[2] * u;
-    o->mean_sq_v2 = z0 * (q[0] * z0 + q[1] * z1 + q[2] * u) + z1 * (q[3] * z1 + q[4] * u) +
-                    q[5] * u * u;
-    const double n0 = d->ad[0][0] * z0 + d->ad[0][1] * z1 + d->bd[0] * u;
-    const double n1 = d->ad[1][0] * z0 + d->ad[1][1] * z1 + d->bd[1] * u;
-    d->x[c][0] = n0;
-    d->x[c][1] = n1;
-    o->end_v = n0;
-    o->end_dvdt_v_per_s = d->w0 * n1;
-    d->latched[c] = d->pending[c];
-  }
+  latch(d);
 }

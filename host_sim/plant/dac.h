@@ -50,7 +50,18 @@
  * error r (dac_set_ref, vref.h), which scales the converter's part of the level:
  * offset + (level - offset) (1 + r).
  *
- * Channels (hal/include/hal/hal_dac.h): 0 drive U1, 1 drive U2, 2 analog rate output, 3 spare.
+ * Channels (hal/include/hal/hal_dac.h): 0 drive U1, 1 drive U2, 2 analog rate output, 3 spare
+ * (sense feedback; the feedback pair's U3 in plant fb_mode 3), then the second converter of
+ * the board: 4 the pair's U4, 5 and 6 the quadrature-nulling sets V1 and V2, 7 the tuning
+ * electrodes. Every channel is the same part (AD5554) behind the same x1.5 driver stage,
+ * with its own gain, offset and INL pattern (stream DAC_RNG_STREAM_INL + channel, so the
+ * first four keep the patterns they had before the second converter existed).
+ *
+ * Channels not modelled (cfg.modelled[c] = 0: the plant's part has no electrode there):
+ * their codes are still checked and latched, but dac_step never computes their output and
+ * leaves out->ch[c] as the caller had it (a zeroed dac_out_t reads 0 V). A channel without
+ * a load costs a compare per sample, not a filter update (the simulator's speed is a
+ * product goal; the default part has none of the sense electrodes).
  *
  * One plant sample [t_k, t_k+1) with the electrical modules (the top level's order):
  *   dac_step(&dac, &dout)                         voltages over the sample
@@ -77,6 +88,7 @@
 
 #define DAC_NCH HAL_DAC_NUM_CHANNELS
 #define DAC_BITS 14
+#define DAC_FIRST 4 /* channels of the board's first converter (drive, rate output, spare) */
 #define DAC_RNG_STREAM_INL 0x7501u /* + channel */
 
 typedef struct {
@@ -86,6 +98,7 @@ typedef struct {
   double gain[DAC_NCH];           /* output amplifier gain, 1 = ideal */
   double offset_v[DAC_NCH];       /* output offset, V */
   uint16_t initial_code[DAC_NCH]; /* held before the first latched frame */
+  uint8_t modelled[DAC_NCH];      /* 1: output computed by dac_step; 0: codes only */
   inl_cfg_t inl;                  /* integral nonlinearity of every channel, LSB */
   uint64_t inl_seed;              /* the part's INL patterns */
 } dac_cfg_t;
@@ -102,20 +115,28 @@ typedef struct {
   dac_chan_out_t ch[DAC_NCH];
 } dac_out_t;
 
+/* The reconstruction filter over one sample (the header's exact forms). */
+typedef struct {
+  double ad[2][2], bd[2]; /* exact ZOH discretisation */
+  double mv[3];           /* mean form */
+  double msq[3][3];       /* mean-square form */
+  double q2[6];           /* msq as q00, 2q01, 2q02, q11, 2q12, q22 (per-sample use) */
+} dac_forms_t;
+
 typedef struct {
   dac_cfg_t cfg;
   int filtered;              /* 0 when recon_cutoff_hz == 0 */
   double w0;                 /* rad/s */
-  double ad[2][2], bd[2];    /* exact ZOH discretisation */
-  double mv[3];              /* mean form */
-  double msq[3][3];          /* mean-square form */
-  double q2[6];              /* msq as q00, 2q01, 2q02, q11, 2q12, q22 (per-sample use) */
+  dac_forms_t form;          /* the filter's exact forms over one sample */
   double scale[DAC_NCH];     /* volts per code, gain included */
   double zero[DAC_NCH];      /* volts at code 0, gain and offset included */
   double x[DAC_NCH][2];      /* filter states [v, v'/w0] */
   uint16_t latched[DAC_NCH]; /* code held over the current sample */
   uint16_t pending[DAC_NCH]; /* code latched at the end of the current sample */
   double ref_rel;            /* reference error r (dac_set_ref) */
+  int n_on;                  /* modelled channels, */
+  uint8_t on[DAC_NCH];       /* their indices in ascending order */
+  int first_all;             /* channels 0..DAC_FIRST-1 all modelled (on[] starts with them) */
   inl_t inl[DAC_NCH];
   /* the INL of the code last converted on each channel, in volts: the rate output and the
    * spare hold a code for a block or longer, so most samples need no new lookup */
@@ -123,12 +144,14 @@ typedef struct {
   double inl_v[DAC_NCH];
 } dac_t;
 
-/* fs 50 kHz, 2nd-order Butterworth at 20 kHz, ideal gain, no offset, mid-scale codes. */
+/* fs 50 kHz, 2nd-order Butterworth at 20 kHz, ideal gain, no offset, mid-scale codes, every
+ * channel modelled. */
 void dac_default_cfg(dac_cfg_t *cfg);
 
 /* Validates cfg (fs > 0; cutoff 0 or in (0, fs]; Q in [0.1, 10]; |gain| in (0, 2];
- * |offset| <= 15 V; codes <= 16383; inl_check). Returns 0, or -1 with d unchanged. The
- * filters start settled at the initial codes. */
+ * |offset| <= 15 V; codes <= 16383; modelled 0 or 1; inl_check). Returns 0, or -1 with d
+ * unchanged. The filters start settled at the initial codes. Built in place once nothing
+ * can fail (a scratch dac_t, eight channels' INL tables, was 6 kB of a target's stack). */
 int dac_init(dac_t *d, const dac_cfg_t *cfg);
 
 /* The reference's relative error r for the samples that follow (0: exact). */
@@ -138,8 +161,8 @@ void dac_set_ref(dac_t *d, double ref_rel);
  * the previously queued frame. */
 int dac_write(dac_t *d, const hal_dac_frame_t *frame);
 
-/* Advance one sample period: outputs over [t_k, t_k + T) for every channel, then latch
- * the queued frame. */
+/* Advance one sample period: outputs over [t_k, t_k + T) for every modelled channel (the
+ * others' entries of out untouched), then latch the queued frame on every channel. */
 void dac_step(dac_t *d, dac_out_t *out);
 
 /* Ideal transfer (gain 1, no offset): volts of an offset-binary code. */

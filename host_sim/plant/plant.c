@@ -84,6 +84,21 @@ static void make_thermal_cfg(const plant_cfg_t *c, thermal_cfg_t *t)
   t->dt_s = thermal_every(c) / c->fs_hz;
 }
 
+/* The DAC channel of each electrode (plant_electrodes_t order). */
+static const int kElecChannel[PLANT_ELECTRODES] = {HAL_DAC_SENSE_FB_U1, HAL_DAC_SENSE_FB_U2,
+                                                   HAL_DAC_QUADNULL_V1, HAL_DAC_QUADNULL_V2,
+                                                   HAL_DAC_TUNE};
+
+/* Which electrodes the part has (plant_electrodes_t order), as the actuator decides
+ * (actuator.h): the feedback pair in fb_mode 3, the nulling sets and the tuning electrodes
+ * when their constants are non-zero. */
+static void plant_electrodes_of(const plant_cfg_t *c, uint8_t has[PLANT_ELECTRODES])
+{
+  has[0] = has[1] = c->fb_mode == 3;
+  has[2] = has[3] = c->quadnull_dps_per_v2 > 0.0;
+  has[4] = c->tune_ke_per_s2_per_v2 > 0.0;
+}
+
 static void make_dac_cfg(const plant_cfg_t *c, dac_cfg_t *d)
 {
   dac_default_cfg(d);
@@ -101,6 +116,21 @@ static void make_dac_cfg(const plant_cfg_t *c, dac_cfg_t *d)
   d->offset_v[HAL_DAC_DRIVE_U2] = c->dac_offset_u2_v;
   d->offset_v[HAL_DAC_RATE_OUT] = c->dac_offset_rate_v;
   d->offset_v[HAL_DAC_SPARE] = c->dac_offset_spare_v;
+  d->gain[HAL_DAC_SENSE_FB_U2] = c->dac_gain_fb_u2;
+  d->gain[HAL_DAC_QUADNULL_V1] = c->dac_gain_quadnull_v1;
+  d->gain[HAL_DAC_QUADNULL_V2] = c->dac_gain_quadnull_v2;
+  d->gain[HAL_DAC_TUNE] = c->dac_gain_tune;
+  d->offset_v[HAL_DAC_SENSE_FB_U2] = c->dac_offset_fb_u2_v;
+  d->offset_v[HAL_DAC_QUADNULL_V1] = c->dac_offset_quadnull_v1_v;
+  d->offset_v[HAL_DAC_QUADNULL_V2] = c->dac_offset_quadnull_v2_v;
+  d->offset_v[HAL_DAC_TUNE] = c->dac_offset_tune_v;
+  /* the second converter's channels load only the electrodes the part has (dac.h) */
+  uint8_t has[PLANT_ELECTRODES];
+  plant_electrodes_of(c, has);
+  d->modelled[HAL_DAC_SENSE_FB_U2] = has[1];
+  d->modelled[HAL_DAC_QUADNULL_V1] = has[2];
+  d->modelled[HAL_DAC_QUADNULL_V2] = has[3];
+  d->modelled[HAL_DAC_TUNE] = has[4];
 }
 
 static void make_actuator_cfg(const plant_cfg_t *c, actuator_cfg_t *a)
@@ -371,6 +401,7 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
     return -2;
   }
 
+  plant_electrodes_of(c, p->elec_has);
   profile_const(&p->prof.rate_dps, c->rate_dps);
   profile_const(&p->prof.ambient_k, c->temp_k);
   accel_profile_zero(&p->prof.accel_g);
@@ -522,6 +553,41 @@ static void truth_force(plant_t *p, double f)
   p->fz_im = ri + p->fz_alpha * (ii - ri);
 }
 
+/* An electrode's voltage over the sample: its DAC channel's output in series with the held
+ * level e (plant_set_electrodes), mean((v + e)^2) = mean(v^2) + e (2 mean(v) + e). */
+static dac_chan_out_t in_series(const dac_chan_out_t *v, double e)
+{
+  const dac_chan_out_t c = {.held_v = v->held_v + e,
+                            .mean_v = v->mean_v + e,
+                            .mean_sq_v2 = v->mean_sq_v2 + e * (2.0 * v->mean_v + e),
+                            .end_v = v->end_v + e,
+                            .end_dvdt_v_per_s = v->end_dvdt_v_per_s};
+  return c;
+}
+
+/* The electrodes' voltages over this sample from the DAC's outputs (p->dout) and the series
+ * levels, for the actuator and the truth (plant_truth_t elec_mean_v, quadnull_v). */
+static void elec_feed(plant_t *p)
+{
+  const plant_electrodes_t *e = &p->elec_series;
+  const double series[PLANT_ELECTRODES] = {e->fb_u1_v, e->fb_u2_v, e->quadnull_v1_v,
+                                           e->quadnull_v2_v, e->tune_v};
+  dac_chan_out_t *const in[PLANT_ELECTRODES] = {&p->elec_in.fb[0], &p->elec_in.fb[1],
+                                                &p->elec_in.quadnull[0],
+                                                &p->elec_in.quadnull[1], &p->elec_in.tune};
+  double mean[PLANT_ELECTRODES];
+  for (int i = 0; i < PLANT_ELECTRODES; i++) {
+    if (p->elec_has[i]) *in[i] = in_series(&p->dout.ch[kElecChannel[i]], series[i]);
+    mean[i] = p->elec_has[i] ? in[i]->mean_v : 0.0;
+  }
+  plant_truth_t *t = &p->truth;
+  t->elec_mean_v = (plant_electrodes_t){mean[0], mean[1], mean[2], mean[3], mean[4]};
+  if (p->elec_has[2]) {
+    const double d = p->elec_in.quadnull[0].mean_sq_v2 - p->elec_in.quadnull[1].mean_sq_v2;
+    t->quadnull_v = d >= 0.0 ? sqrt(d) : -sqrt(-d);
+  }
+}
+
 void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out)
 {
   const double T = p->T;
@@ -547,14 +613,15 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
     dac_set_ref(&p->dac, r);
     adc_set_ref(&p->adc, r);
   }
-  dac_out_t dout;
-  dac_step(&p->dac, &dout);
+  dac_out_t *const dout = &p->dout;
+  dac_step(&p->dac, dout);
   actuator_out_t aout;
   if (p->act.elec) {
-    actuator_step_elec(&p->act, &dout, &p->elec_in, &aout);
+    elec_feed(p);
+    actuator_step_elec(&p->act, dout, &p->elec_in, &aout);
     (void)mech_set_elec(&p->mech, aout.kyx_per_s2, aout.ke_per_s2); /* margin: mech flags */
   } else {
-    actuator_step(&p->act, &dout, &aout);
+    actuator_step(&p->act, dout, &aout);
   }
   double fd = aout.f_drive_mps2, fsn = aout.f_sense_mps2;
   if (p->accel_any) {
@@ -573,8 +640,8 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
   const mech_state_t s = mech_state(&p->mech);
 
   const double ta = adc_aperture_draw(&p->adc); /* common to both channels (adc.h) */
-  const double vd = pickoff_step_at(&p->pick[0], s.y_m, s.vy_mps, &dout, ta);
-  const double vs = pickoff_step_at(&p->pick[1], s.x_m, s.vx_mps, &dout, ta);
+  const double vd = pickoff_step_at(&p->pick[0], s.y_m, s.vy_mps, dout, ta);
+  const double vs = pickoff_step_at(&p->pick[1], s.x_m, s.vx_mps, dout, ta);
   adc_convert_frame(&p->adc, vd, vs, &t->adc);
   if (adc_out != NULL) *adc_out = t->adc;
   p->k++;
@@ -589,7 +656,7 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
   t->vx_mps = s.vx_mps;
   t->f_drive_mps2 = fd;
   t->f_sense_mps2 = fsn;
-  for (int i = 0; i < DAC_NCH; i++) t->dac_held_v[i] = dout.ch[i].held_v;
+  for (int i = 0; i < DAC_NCH; i++) t->dac_held_v[i] = dout->ch[i].held_v;
   t->adc_v[0] = vd;
   t->adc_v[1] = vs;
   for (int i = 0; i < 2; i++) t->adc_clip[i] = p->adc.clip_count[i];
@@ -607,14 +674,6 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
   }
   p->f_prev[1] = p->f_prev[0];
   p->f_prev[0] = f;
-}
-
-/* A level v held over the sample, as the actuator takes an electrode's voltage. */
-static dac_chan_out_t held_level(double v)
-{
-  const dac_chan_out_t c = {
-      .held_v = v, .mean_v = v, .mean_sq_v2 = v * v, .end_v = v, .end_dvdt_v_per_s = 0.0};
-  return c;
 }
 
 int plant_set_electrodes(plant_t *p, const plant_electrodes_t *v)
@@ -635,11 +694,7 @@ int plant_set_electrodes(plant_t *p, const plant_electrodes_t *v)
       return -1;
     }
   p->truth.elec_v = *v;
-  p->elec_in.fb[0] = held_level(v->fb_u1_v);
-  p->elec_in.fb[1] = held_level(v->fb_u2_v);
-  p->elec_in.quadnull[0] = held_level(v->quadnull_v1_v);
-  p->elec_in.quadnull[1] = held_level(v->quadnull_v2_v);
-  p->elec_in.tune = held_level(v->tune_v);
+  p->elec_series = *v;
   return 0;
 }
 

@@ -18,10 +18,11 @@
  *      INL, output amplifier, reconstruction low-pass; the shared reference's noise
  *      (vref.h) on it and on the ADC;
  *   3. actuator (actuator.h): F = Ks (U1^2 - U2^2) (6-7) with 1/f electrode-voltage
- *      noise, mean over the sample, per unit mass; the sense electrodes beyond the DAC
- *      (plant_set_electrodes: the feedback pair of fb_mode 3, the quadrature-nulling and
- *      the tuning electrodes) give their force and their stiffness (a coupling that adds
- *      to k_q, a softening of the sense spring); plus the inertial and g-sensitivity
+ *      noise, mean over the sample, per unit mass; the sense electrodes (the feedback pair
+ *      of fb_mode 3, the quadrature-nulling and the tuning electrodes), driven by the DAC's
+ *      channels 3..7 (hal_dac.h) in series with plant_set_electrodes' voltages, give their
+ *      force and their stiffness (a coupling that adds to k_q, a softening of the sense
+ *      spring); plus the inertial and g-sensitivity
  *      forces of the acceleration profile (accel.h, exact mean over the sample of the
  *      constant, sine and half-sine shock parts; random vibration from vib.h);
  *   4. mechanics (mech.h): exact discretisation of (2-22)/(2-20) with the rate profile
@@ -183,6 +184,17 @@
   X(double, dac_offset_u2_v, DOUBLE, -15.0, 15.0, "V", "output offset, U2") \
   X(double, dac_offset_rate_v, DOUBLE, -15.0, 15.0, "V", "output offset, rate output") \
   X(double, dac_offset_spare_v, DOUBLE, -15.0, 15.0, "V", "output offset, spare") \
+  X(double, dac_gain_fb_u2, DOUBLE, -2.0, 2.0, "", \
+    "output amplifier gain, sense feedback pair's second electrode U4 (second converter)") \
+  X(double, dac_gain_quadnull_v1, DOUBLE, -2.0, 2.0, "", \
+    "output amplifier gain, quadrature-nulling set 1 (V1)") \
+  X(double, dac_gain_quadnull_v2, DOUBLE, -2.0, 2.0, "", \
+    "output amplifier gain, quadrature-nulling set 2 (V2)") \
+  X(double, dac_gain_tune, DOUBLE, -2.0, 2.0, "", "output amplifier gain, tuning electrodes") \
+  X(double, dac_offset_fb_u2_v, DOUBLE, -15.0, 15.0, "V", "output offset, feedback U4") \
+  X(double, dac_offset_quadnull_v1_v, DOUBLE, -15.0, 15.0, "V", "output offset, nulling V1") \
+  X(double, dac_offset_quadnull_v2_v, DOUBLE, -15.0, 15.0, "V", "output offset, nulling V2") \
+  X(double, dac_offset_tune_v, DOUBLE, -15.0, 15.0, "V", "output offset, tuning electrodes") \
   X(double, dac_inl_bow_lsb, DOUBLE, -64.0, 64.0, "LSB", \
     "DAC INL bow at mid-scale, zero at the ends (inl.h), 0 = none") \
   X(double, dac_inl_code_lsb, DOUBLE, 0.0, 64.0, "LSB", \
@@ -353,10 +365,11 @@ typedef struct {
   ((axis) == 0 ? (c)->pick_drive_##name : (c)->pick_sense_##name)
 #undef PLANT_CFG_FIELD
 
-/* Voltages of the sense electrodes that the four-channel DAC does not drive
- * (plant_set_electrodes), V, held over every sample until the next call; 0 V at
- * plant_init. An electrode the part does not have (its constant 0, or the feedback pair
- * outside fb_mode 3) ignores its voltage. */
+/* Voltages of the sense electrodes, V: the feedback pair U3, U4 (fb_mode 3; U3 is the DAC's
+ * spare channel), the nulling sets V1, V2 and the tuning electrodes Vt (DAC channels
+ * HAL_DAC_SENSE_FB_U1 .. HAL_DAC_TUNE). An electrode the part does not have (its constant
+ * 0, or the feedback pair outside fb_mode 3) ignores its voltage, and its DAC channel is
+ * not modelled (dac.h: no cost per sample). */
 typedef struct {
   double fb_u1_v, fb_u2_v;             /* feedback pair U3, U4 (fb_mode 3) */
   double quadnull_v1_v, quadnull_v2_v; /* nulling sets: k_yx = c (V1^2 - V2^2) */
@@ -364,6 +377,7 @@ typedef struct {
 } plant_electrodes_t;
 
 #define PLANT_ELECTRODE_MAX_V 100.0 /* largest |voltage| plant_set_electrodes accepts */
+#define PLANT_ELECTRODES 5          /* fb U3, fb U4, nulling V1, V2, tuning Vt */
 
 typedef struct {
   profile_t rate_dps;      /* angular rate, deg/s */
@@ -394,19 +408,29 @@ typedef struct {
                                  (Coriolis direction, (2-28)) */
   double sense_disp_m;     /* in phase with the drive displacement (quadrature) */
   /* sense electrodes and what they do (every truth_decim samples, and at plant_init): */
-  plant_electrodes_t elec_v; /* the voltages last set (plant_set_electrodes), held since */
-  double quad_true_dps;      /* the quadrature as an equivalent rate: the stiffness coupling
+  plant_electrodes_t elec_v;      /* the series voltages last set (plant_set_electrodes) */
+  plant_electrodes_t elec_mean_v; /* every sample: each electrode's mean voltage over the last
+                                     sample as the part sees it (its DAC channel plus the
+                                     series voltage, without the electrode noise); 0 for an
+                                     electrode the part does not have */
+  double quadnull_v;              /* the nulling sets as one signed voltage: sign(m1 - m2)
+                                sqrt|m1 - m2|, m the sets' mean squares, so k_yx =
+                                c quadnull_v |quadnull_v|: +V1 with set 1 alone driven,
+                                -V2 with set 2 alone (the one that cancels a positive
+                                k_q); 0 without nulling electrodes */
+  double quad_true_dps;  /* the quadrature as an equivalent rate: the stiffness coupling
                                 (k_q and its drift at the structure temperature, plus the
                                 nulling electrodes' k_yx) over 2 wc, wc the drive frequency
                                 above (drive_freq_hz) */
-  double sense_freq_hz;      /* sense resonance sqrt(wn2^2 - k_e) with the electrostatic
+  double sense_freq_hz;  /* sense resonance sqrt(wn2^2 - k_e) with the electrostatic
                                 softening k_e (fb bias and electrodes), sample clock */
-  double sense_shift_hz;     /* its shift by k_e, <= 0 */
+  double sense_shift_hz; /* its shift by k_e, <= 0 */
   /* electrical */
-  double f_drive_mps2, f_sense_mps2; /* actuator + acceleration forces per unit mass */
-  double dac_held_v[4];              /* DAC output levels over the last sample */
-  double adc_v[2];                   /* analog voltages at the ADC inputs (drive, sense) */
-  hal_adc_frame_t adc;               /* the codes returned */
+  double f_drive_mps2, f_sense_mps2;       /* actuator + acceleration forces per unit mass */
+  double dac_held_v[HAL_DAC_NUM_CHANNELS]; /* DAC output levels over the last sample (0 V
+                                              on a channel that is not modelled, dac.h) */
+  double adc_v[2];     /* analog voltages at the ADC inputs (drive, sense) */
+  hal_adc_frame_t adc; /* the codes returned */
   uint64_t adc_clip[2], dac_rejects;
   uint64_t mech_refreshes;
 } plant_truth_t;
@@ -455,14 +479,18 @@ typedef struct {
   mech_t mech;
   thermal_t thermal;
   dac_t dac;
+  dac_out_t dout; /* the DAC's outputs over the current sample (unmodelled channels 0 V) */
   actuator_t act;
   pickoff_t pick[2];
   adc_t adc;
   accel_t accel;
   vref_t vref;                            /* the converters' shared reference */
   vib_t vib;                              /* random vibration of the acceleration profile */
-  actuator_elec_in_t elec_in;             /* plant_set_electrodes' voltages, as the actuator
-                                             takes them */
+  actuator_elec_in_t elec_in;             /* the electrodes' voltages over the sample, as the
+                                             actuator takes them (DAC + series) */
+  plant_electrodes_t elec_series;         /* plant_set_electrodes' voltages */
+  uint8_t elec_has[PLANT_ELECTRODES];     /* the part has that electrode (fb U3, U4, V1,
+                                             V2, Vt) */
   drift_t drift[2];                       /* slow drift of k_q and d_q */
   double drift_kq_per_s2, drift_dq_per_s; /* per unit of the drifts' values (deg/s) */
   uint64_t seed;
@@ -530,10 +558,12 @@ int plant_set_profiles(plant_t *p, const plant_profiles_t *prof);
  * frame held). adc: the frame sampled at the end of the interval. */
 void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc);
 
-/* Voltages of the electrodes beyond the DAC (plant_electrodes_t) from the next sample on,
- * held over each sample (mean v, mean square v^2: no converter yet between them and the
- * electrodes). Each finite and within +-PLANT_ELECTRODE_MAX_V, else -1 with the key in
- * plant_error(p) and nothing changed. */
+/* Voltages in series with the electrodes' DAC channels (plant_electrodes_t), from the next
+ * sample on, held: a source between the board's driver and the electrode (a bench supply
+ * in a test, a bias beyond the driver's +-15 V). The electrode sees its channel's output
+ * (filtered, per-sample mean and mean square, dac.h) plus this level; 0 V at plant_init,
+ * so the DAC alone drives the electrodes. Each finite and within +-PLANT_ELECTRODE_MAX_V,
+ * else -1 with the key in plant_error(p) and nothing changed. */
 int plant_set_electrodes(plant_t *p, const plant_electrodes_t *v);
 
 /* The same step in the shape of hal_host_plant_step_fn (hal/host/hal_host.h), so the

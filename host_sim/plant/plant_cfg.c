@@ -211,6 +211,10 @@ void plant_ideal_cfg(plant_cfg_t *c)
   c->dac_recon_q = 0.70710678118654752;
   c->dac_gain_u1 = c->dac_gain_u2 = c->dac_gain_rate = c->dac_gain_spare = 1.0;
   c->dac_offset_u1_v = c->dac_offset_u2_v = c->dac_offset_rate_v = c->dac_offset_spare_v = 0.0;
+  /* the second converter (the sense electrodes): the same part and driver stage, ideal */
+  c->dac_gain_fb_u2 = c->dac_gain_quadnull_v1 = c->dac_gain_quadnull_v2 = c->dac_gain_tune = 1.0;
+  c->dac_offset_fb_u2_v = c->dac_offset_quadnull_v1_v = c->dac_offset_quadnull_v2_v = 0.0;
+  c->dac_offset_tune_v = 0.0;
   /* Drive pickoff gain from table 7-1: the demodulated drive amplitude is
    * 5.4246e-3 V per V^2 of half-frequency amplitude (least squares through the origin
    * of the 16 points, 1.5..12.75 V, at 1490 Hz). At resonance that is
@@ -473,11 +477,15 @@ int plant_cfg_check(const plant_cfg_t *c, char *buf, size_t n)
   const struct {
     const char *key;
     double v;
-  } gains[4] = {{"dac_gain_u1", c->dac_gain_u1},
+  } gains[8] = {{"dac_gain_u1", c->dac_gain_u1},
                 {"dac_gain_u2", c->dac_gain_u2},
                 {"dac_gain_rate", c->dac_gain_rate},
-                {"dac_gain_spare", c->dac_gain_spare}};
-  for (int i = 0; i < 4; i++)
+                {"dac_gain_spare", c->dac_gain_spare},
+                {"dac_gain_fb_u2", c->dac_gain_fb_u2},
+                {"dac_gain_quadnull_v1", c->dac_gain_quadnull_v1},
+                {"dac_gain_quadnull_v2", c->dac_gain_quadnull_v2},
+                {"dac_gain_tune", c->dac_gain_tune}};
+  for (int i = 0; i < 8; i++)
     if (gains[i].v == 0.0) {
       errf(buf, n, "%s: must be non-zero", gains[i].key);
       return -1;

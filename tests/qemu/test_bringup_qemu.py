@@ -138,6 +138,10 @@ def main():
               f"ADC loopback sees the DAC frame through the ISR ({adc})")
         check(con.command("dac 1 2 3", r"dac ok|error").startswith("error"),
               "malformed dac command refused")
+        check(con.command("dac 100 16000 8192 0 1 2 3 16383", r"dac ok|error") == "dac ok",
+              "dac command with the second converter's four codes accepted")
+        check(con.command("dac 1 2 3 4 5", r"dac ok|error").startswith("error"),
+              "dac command with a partial second converter refused")
 
         check(con.command("fault clear", r"fault cleared") == "fault cleared", "fault clear")
         check(con.command("fault", r"fault") == "fault none", "no fault recorded")

@@ -305,6 +305,49 @@ static void test_inl_off_and_bad(void **state)
   assert_memory_equal(&d, &before, sizeof d);
 }
 
+/* A channel not modelled (cfg.modelled 0: no electrode on it) is never converted: dac_step
+ * leaves its output as the caller had it, while its codes are still checked and latched
+ * (a bad code refuses the frame as on any channel) and the modelled channels run as in a
+ * converter of all channels, bit for bit; modelled must be 0 or 1. */
+static void test_unmodelled_channel(void **state)
+{
+  (void)state;
+  dac_cfg_t cfg;
+  dac_default_cfg(&cfg);
+  cfg.inl.code_lsb = 0.5;
+  cfg.inl_seed = 9u;
+  dac_cfg_t part = cfg;
+  part.modelled[HAL_DAC_QUADNULL_V2] = 0u;
+  part.modelled[HAL_DAC_TUNE] = 0u;
+  dac_t all, d;
+  assert_int_equal(dac_init(&all, &cfg), 0);
+  assert_int_equal(dac_init(&d, &part), 0);
+  assert_int_equal(d.n_on, DAC_NCH - 2);
+  dac_out_t oa, o;
+  memset(&o, 0, sizeof o);
+  o.ch[HAL_DAC_TUNE].held_v = 123.0; /* the caller's */
+  for (int k = 0; k < 50; k++) {
+    hal_dac_frame_t f = frame_all((uint16_t)(4000 + 211 * k));
+    assert_int_equal(dac_write(&all, &f), 0);
+    assert_int_equal(dac_write(&d, &f), 0);
+    dac_step(&all, &oa);
+    dac_step(&d, &o);
+    for (int c = 0; c < DAC_NCH; c++) {
+      if (!part.modelled[c]) continue;
+      assert_true(o.ch[c].mean_sq_v2 == oa.ch[c].mean_sq_v2);
+      assert_true(o.ch[c].end_v == oa.ch[c].end_v);
+    }
+    assert_true(o.ch[HAL_DAC_TUNE].held_v == 123.0);
+    assert_true(o.ch[HAL_DAC_QUADNULL_V2].held_v == 0.0);
+    assert_int_equal(d.latched[HAL_DAC_TUNE], f.code[HAL_DAC_TUNE]);
+  }
+  hal_dac_frame_t bad = frame_all(100);
+  bad.code[HAL_DAC_TUNE] = 16384;
+  assert_int_equal(dac_write(&d, &bad), -1);
+  part.modelled[HAL_DAC_TUNE] = 2u;
+  assert_int_equal(dac_init(&d, &part), -1);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -317,6 +360,7 @@ int main(void)
       cmocka_unit_test(test_inl),
       cmocka_unit_test(test_reference_error),
       cmocka_unit_test(test_inl_off_and_bad),
+      cmocka_unit_test(test_unmodelled_channel),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -199,6 +199,7 @@ static void run_open_loop(plant_t *p, double u_v, double f_hz, long n_settle, lo
   assert_non_null(ys);
   for (long k = 0; k < n_settle + n_fit; k++) {
     hal_dac_frame_t fr;
+    hal_dac_frame_midscale(&fr);
     const double tk = (double)k * T;
     fr.code[HAL_DAC_DRIVE_U1] = dac_v_to_code(u_v * cos(0.5 * wc * tk));
     fr.code[HAL_DAC_DRIVE_U2] = dac_v_to_code(u_v * sin(0.5 * wc * tk));
@@ -423,6 +424,7 @@ static void test_adc_budget(void **state)
   double peak[2] = {0, 0};
   for (long k = 0; k < 40000; k++) {
     hal_dac_frame_t fr;
+    hal_dac_frame_midscale(&fr);
     fr.code[0] = dac_v_to_code(u * cos(0.5 * wc * k * p.T));
     fr.code[1] = dac_v_to_code(u * sin(0.5 * wc * k * p.T));
     fr.code[2] = fr.code[3] = (uint16_t)HAL_DAC_CODE_MID;
@@ -455,7 +457,8 @@ static void test_temperature_plumbing(void **state)
   plant_profiles_t pr = p.prof;
   profile_const(&pr.ambient_k, c.temp_k + 20.0);
   assert_int_equal(plant_set_profiles(&p, &pr), 0);
-  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  hal_dac_frame_t fr;
+  hal_dac_frame_midscale(&fr);
   for (long k = 0; k < 500000; k++) plant_step(&p, &fr, NULL); /* 10 s */
   const plant_truth_t *t = plant_truth(&p);
   /* the closed form of thermal.h after 10 s from the settled start */
@@ -523,7 +526,8 @@ static void test_cold_start(void **state)
   const plant_truth_t *t = plant_truth(&p);
   assert_true(t->struct_k == c.temp_k && t->circuit_k == c.temp_k && t->board_k == c.temp_k);
   assert_true(p.pick[0].temp_k == c.temp_k && p.pick[1].temp_k == c.temp_k);
-  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  hal_dac_frame_t fr;
+  hal_dac_frame_midscale(&fr);
   for (long k = 0; k < 500000; k++) plant_step(&p, &fr, NULL); /* 10 s */
   static thermal_t ref;
   assert_int_equal(thermal_init_cold(&ref, &th, c.temp_k), 0);
@@ -572,7 +576,8 @@ static void test_law_warnings(void **state)
   (void)state;
   static plant_t p;
   plant_cfg_t c;
-  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  hal_dac_frame_t fr;
+  hal_dac_frame_midscale(&fr);
   const double ambients[2] = {233.15, 358.15};
   for (int i = 0; i < 2; i++) {
     plant_default_cfg(&c);

@@ -53,6 +53,7 @@ static const char *const kSwitches[] = {"quad_drift_dps",
 static void drive_frame(long k, double fs, hal_dac_frame_t *fr)
 {
   const double ph = 0.5 * kTwoPi * 1489.9 * (double)k / fs;
+  hal_dac_frame_midscale(fr);
   fr->code[HAL_DAC_DRIVE_U1] = dac_v_to_code(8.0 * cos(ph));
   fr->code[HAL_DAC_DRIVE_U2] = dac_v_to_code(8.0 * sin(ph));
   fr->code[HAL_DAC_RATE_OUT] = (uint16_t)HAL_DAC_CODE_MID;
@@ -190,7 +191,8 @@ static void test_softening_and_drift_wiring(void **state)
   assert_true(p.mech.drift_kq_per_s2 == 0.0); /* starts at the configured values */
   double skq = 0.0, sdq = 0.0;
   int cnt = 0;
-  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  hal_dac_frame_t fr;
+  hal_dac_frame_midscale(&fr);
   for (long k = 0; k < 150000; k++) {
     plant_step(&p, &fr, NULL);
     if (k % 50 == 0) {
@@ -312,7 +314,8 @@ static void test_shock_response(void **state)
   pr.accel_g.shock_peak_g[0] = 100.0;
   pr.accel_g.shock_dur_s[0] = 1e-4;
   assert_int_equal(plant_set_profiles(&p, &pr), 0);
-  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  hal_dac_frame_t fr;
+  hal_dac_frame_midscale(&fr);
   double sum_a = 0.0;
   for (long k = 0; k < 1000; k++) {
     plant_step(&p, &fr, NULL);
@@ -347,7 +350,8 @@ static void test_random_vibration_and_refusals(void **state)
   pr.accel_g.band_f_hi_hz[0] = 500.0;
   assert_int_equal(plant_set_profiles(&p, &pr), 0);
   assert_true(p.vib_on && p.accel_any && !p.accel_dynamic);
-  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  hal_dac_frame_t fr;
+  hal_dac_frame_midscale(&fr);
   double s2 = 0.0;
   const long n = 200000;
   for (long k = 0; k < n; k++) {
@@ -427,7 +431,8 @@ static void test_law_warnings(void **state)
   /* a free 10 um drive oscillation (Q 1e5, no drive: a strong cubic term would detune a
    * driven one) past the edge of each amplitude law: counted once per thermal update
    * from the first one after the start */
-  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  hal_dac_frame_t fr;
+  hal_dac_frame_midscale(&fr);
   for (int which = 0; which < 2; which++) {
     plant_ideal_cfg(&c);
     c.q_drive = 1e5;
@@ -580,7 +585,8 @@ static void test_quadrature_nulling(void **state)
  * mid-scale (no drive): the free sense oscillation's frequency. */
 static double sense_ring_hz(plant_t *p, long n)
 {
-  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  hal_dac_frame_t fr;
+  hal_dac_frame_midscale(&fr);
   const mech_state_t s0 = {0.0, 0.0, 1e-7, 0.0};
   mech_set_state(&p->mech, &s0);
   double prev = 1e-7, t_first = -1.0, t_last = 0.0;
@@ -617,7 +623,8 @@ static void test_tuning_moves_sense(void **state)
   const double f0 = sense_ring_hz(&p, 2500);
   const plant_electrodes_t e = {0.0, 0.0, 0.0, 0.0, 4.0};
   assert_int_equal(plant_set_electrodes(&p, &e), 0);
-  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  hal_dac_frame_t fr;
+  hal_dac_frame_midscale(&fr);
   for (int k = 0; k < 150; k++) plant_step(&p, &fr, NULL); /* rebased at 2 ms */
   const double f1 = sense_ring_hz(&p, 2500);
   const plant_truth_t *t = plant_truth(&p);
@@ -784,7 +791,8 @@ static void test_electrode_refusals(void **state)
   /* pull-in: 10 V gives 1e8 1/s^2, beyond half of the 1.58e8 stiffness */
   const plant_electrodes_t e = {0.0, 0.0, 0.0, 0.0, 10.0};
   assert_int_equal(plant_set_electrodes(&p, &e), 0);
-  hal_dac_frame_t fr = {{HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID, HAL_DAC_CODE_MID}};
+  hal_dac_frame_t fr;
+  hal_dac_frame_midscale(&fr);
   for (long k = 0; k < 500; k++) plant_step(&p, &fr, NULL);
   const plant_warning_t *w = plant_warnings(&p);
   print_message("sense_pull_in: %llu from %.4f s; sense resonance %.2f Hz (about 2000 / sqrt 2 "

@@ -373,6 +373,34 @@ static void test_firmware_params(void **state)
   remove(dir);
 }
 
+/* The open-loop drive (sim_run_open_loop: sweep and square law) writes a whole frame every
+ * tick: the sense electrodes' channels at mid-scale too, so the plant's DAC refuses none
+ * (a frame with a code beyond 14 bits is refused and the previous one held: the drive
+ * would stop moving). A three-point sweep over the resonance. */
+static void test_open_loop_frames_taken(void **state)
+{
+  (void)state;
+  char err[400];
+  sim_scenario_t *sc = fresh();
+  assert_int_equal(scenario_parse(sc,
+                                  "{\"mode\": \"open_loop_sweep\", \"duration_s\": 0.06,"
+                                  " \"open_loop\": {\"u_amp_v\": 12.0, \"sweep\": {"
+                                  "\"f_start_hz\": 1480, \"f_stop_hz\": 1500, \"points\": 3,"
+                                  " \"dwell_s\": 0.02, \"settle_s\": 0.01}}}",
+                                  err, sizeof err),
+                   0);
+  static sim_result_t res;
+  static sim_sweep_t sw;
+  static sim_square_t sq;
+  const sim_opts_t opt = {NULL, 100.0, 0, 0, NULL};
+  assert_int_equal(sim_run_open_loop(sc, &opt, &res, &sw, &sq, err, sizeof err), 0);
+  assert_int_equal(sw.n, 3);
+  print_message("open-loop sweep: %llu frames refused, amplitude %.4f V at %.0f Hz\n",
+                (unsigned long long)res.dac_rejects, sw.amp_v[2], sw.f_hz[2]);
+  assert_int_equal(res.dac_rejects, 0);
+  assert_true(sw.amp_v[1] > 0.1); /* the drive moved the resonator */
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -386,6 +414,7 @@ int main(void)
       cmocka_unit_test(test_analyses),
       cmocka_unit_test(test_list_params),
       cmocka_unit_test(test_firmware_params),
+      cmocka_unit_test(test_open_loop_frames_taken),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -96,6 +96,7 @@ int main(int argc, char **argv)
    * periods only approximately, which does not matter for timing */
   const double wc = 2.0 * kPi * c.f_drive_hz, T = 1.0 / c.fs_hz;
   for (int k = 0; k < NFR; k++) {
+    hal_dac_frame_midscale(&g_frames[k]);
     g_frames[k].code[0] = dac_v_to_code(8.0 * cos(0.5 * wc * k * T));
     g_frames[k].code[1] = dac_v_to_code(8.0 * sin(0.5 * wc * k * T));
     g_frames[k].code[2] = g_frames[k].code[3] = (uint16_t)HAL_DAC_CODE_MID;

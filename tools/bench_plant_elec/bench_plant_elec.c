@@ -48,7 +48,8 @@ int main(int argc, char **argv)
   double c1 = 1.0, s1 = 0.0, c2 = 1.0, s2 = 0.0, sink = 0.0;
   const double t0 = now_s();
   for (long k = 0; k < n; k++) {
-    hal_dac_frame_t fr = {{0}};
+    hal_dac_frame_t fr;
+    hal_dac_frame_midscale(&fr);
     fr.code[0] = dac_v_to_code(10.0 * c2);
     fr.code[1] = dac_v_to_code(10.0 * s2);
     fr.code[2] = (uint16_t)HAL_DAC_CODE_MID;

@@ -56,6 +56,17 @@ CSV_MEANING = {
                      "quad_dps: the stiffness coupling (k_q = 2 wc quad_dps and its drift, "
                      "both following the structure temperature, plus the quadrature-nulling "
                      "electrodes' k_yx) over 2 wc at the drive frequency (truth)",
+    "fb_u1_v": "sense feedback pair electrode U3 (fb_mode 3), mean voltage over the sample as "
+               "the part sees it: the DAC's spare channel plus any series voltage, without "
+               "the electrode noise; 0 on a part without the pair (truth)",
+    "fb_u2_v": "sense feedback pair electrode U4, as fb_u1_v, from the second converter's "
+               "channel HAL_DAC_SENSE_FB_U2 (truth)",
+    "quadnull_v": "quadrature-nulling voltage, signed: sign(m1 - m2) sqrt|m1 - m2| of the two "
+                  "sets' mean squares, so the coupling is c quadnull_v |quadnull_v|; +V1 "
+                  "with set 1 alone driven (adds to a positive quadrature), -V2 with set 2 "
+                  "alone (cancels it); 0 on a part without nulling electrodes (truth)",
+    "tune_v": "sense tuning electrodes' mean voltage (the softening goes as its square); 0 on "
+              "a part without them (truth)",
     "drive_amp": "demodulated drive pickoff amplitude (firmware; telemetry drive_amp_v)",
     "drive_phase_deg": "phase of the drive pickoff phasor (firmware)",
     "p_deg": "the temperature signal: force phase P (fixed drive), or its equivalent from the "

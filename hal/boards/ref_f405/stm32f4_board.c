@@ -74,6 +74,8 @@ int stm32f4_board_init(void)
   stm32f4_gpio_config(GPIOB, 13u, GPIO_MODE_AF, 5u, 0);
   stm32f4_gpio_config(GPIOB, 15u, GPIO_MODE_AF, 5u, 0);
   stm32f4_gpio_config(GPIOC, 6u, GPIO_MODE_AF, 3u, 0);
+  stm32f4_gpio_config(GPIOC, 10u, GPIO_MODE_AF, 6u, 0); /* second AD5554: SPI3 SCK */
+  stm32f4_gpio_config(GPIOC, 12u, GPIO_MODE_AF, 6u, 0); /* SPI3 MOSI */
 
   stm32f4_gpio_config(GPIOB, 6u, GPIO_MODE_AF, 7u, 0);
   stm32f4_gpio_config(GPIOB, 7u, GPIO_MODE_AF, 7u, 1);

@@ -5,7 +5,8 @@
  * names (hal/PORTING.md).
  *
  * The board: an STM32F405 (Cortex-M4F, 1 MB flash, 128 KB SRAM + 64 KB CCM), an AD7606
- * ADC on SPI1, an AD5554 DAC on SPI2 behind a x1.5 electrode driver stage, the tuning
+ * ADC on SPI1, two AD5554 DACs (SPI2: drive, rate output, sense feedback; SPI3: the sense
+ * electrodes of the closed sense loop) behind x1.5 electrode driver stages, the tuning
  * port on USART1 (hal/boards/ref_f405/README.md: why these parts, the timing of a tick). */
 #ifndef BOARD_H
 #define BOARD_H
@@ -24,8 +25,9 @@
  *   ADC: AD7606, 16-bit, bipolar +-5 V (RANGE strapped low), two's complement, one
  *        code = 10 V / 65536. Drive pickoff on V1, sense pickoff on V2, both sampled by
  *        one CONVST edge.
- *   DAC: AD5554, quad 14-bit, 4-quadrant output stage on a 10 V reference, then x1.5
- *        electrode drivers: offset binary over +-15 V, one code = 30 V / 16384. */
+ *   DAC: 2 x AD5554, quad 14-bit, 4-quadrant output stage on a 10 V reference, then x1.5
+ *        electrode drivers: offset binary over +-15 V, one code = 30 V / 16384, the same
+ *        on all eight channels. */
 #define HAL_ADC_BITS 16
 #define HAL_ADC_FULL_SCALE_V 5.0f /* +-5 V */
 #define HAL_ADC_CODE_MAX 32767
@@ -57,20 +59,22 @@
  *
  *   pin   function         AF  direction  purpose
  *   PA8   TIM1_CH1         1   out        ADC CONVST A+B: its rising edge is the sample instant
- *   PA9   TIM1_CH2         1   out        DAC LDAC: latches the four DAC words at once
+ *   PA9   TIM1_CH2         1   out        DAC LDAC (both AD5554): latches all eight words at once
  *   PA10  TIM1_CH3         1   out        ADC CS: frames the 32-clock read of V1, V2
  *   PA5   SPI1_SCK         5   out        ADC SCLK (10.5 MHz)
  *   PA6   SPI1_MISO        5   in         ADC DOUTA (V1 drive pickoff, V2 sense pickoff)
- *   PC6   TIM8_CH1         3   out        DAC CS: one slot per DAC word
- *   PB13  SPI2_SCK         5   out        DAC CLK (21 MHz)
- *   PB15  SPI2_MOSI        5   out        DAC SDI
+ *   PC6   TIM8_CH1         3   out        DAC CS (both AD5554): one slot per word pair
+ *   PB13  SPI2_SCK         5   out        DAC A CLK (21 MHz): drive, rate out, feedback U3
+ *   PB15  SPI2_MOSI        5   out        DAC A SDI
+ *   PC10  SPI3_SCK         6   out        DAC B CLK (21 MHz): feedback U4, nulling, tuning
+ *   PC12  SPI3_MOSI        6   out        DAC B SDI
  *   PB0   GPIO             -   out        ADC RESET (pulsed high at start-up)
- *   PB1   GPIO             -   out        DAC RS, low = reset to mid-scale (0 V)
+ *   PB1   GPIO             -   out        DAC RS (both), low = reset to mid-scale (0 V)
  *   PC7   GPIO             -   in         ADC BUSY (diagnostics only)
  *   PB6   USART1_TX        7   out        tuning port TX
  *   PB7   USART1_RX        7   in         tuning port RX (pull-up)
  *
  * Strapped on the board: AD7606 PAR/SER/BYTE SEL high (serial), RANGE low (+-5 V),
- * OS[2:0] = 000 (no oversampling); AD5554 MSB high (RS resets to mid-scale = 0 V). */
+ * OS[2:0] = 000 (no oversampling); both AD5554 MSB high (RS resets to mid-scale = 0 V). */
 
 #endif /* BOARD_H */

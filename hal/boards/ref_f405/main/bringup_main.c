@@ -8,7 +8,10 @@
  *                overruns, DMA errors, dropped UART bytes, uptime
  *   clear        reset the worst-case and period statistics
  *   adc          last ADC frame (codes)
- *   dac A B C D  DAC codes (0..16383, mid-scale 8192 = 0 V) written at every tick
+ *   dac A B C D [E F G H]
+ *                DAC codes (0..16383, mid-scale 8192 = 0 V) written at every tick: the
+ *                first converter's four channels, then optionally the second's (the
+ *                sense electrodes, hal_dac.h; mid-scale when left out)
  *   clk          clock status, frequencies and the reset cause
  *   fault        the fault record kept across the last reset ("fault clear" erases it)
  *   crash        execute an undefined instruction (tests the fault record path)
@@ -219,18 +222,31 @@ static void cmd_fault(out_t *o, const char *args)
   out_kx(o, "bfar", r.bfar);
 }
 
+/* 1 when nothing but spaces is left. */
+static int at_end(const char *s)
+{
+  while (*s == ' ') ++s;
+  return *s == '\0';
+}
+
 static void cmd_dac(bringup_t *b, out_t *o, const char *args)
 {
   hal_dac_frame_t f;
+  hal_dac_frame_midscale(&f);
   const char *p = args;
   for (uint32_t ch = 0u; ch < HAL_DAC_NUM_CHANNELS; ++ch) {
+    if (ch == 4u && at_end(p)) break; /* the second converter's codes are optional */
     uint32_t v = 0u;
     p = (p != 0) ? parse_u32(p, &v) : 0;
     if (p == 0 || v > HAL_DAC_CODE_MAX) {
-      out_str(o, "error: dac A B C D, codes 0..16383");
+      out_str(o, "error: dac A B C D [E F G H], codes 0..16383");
       return;
     }
     f.code[ch] = (uint16_t)v;
+  }
+  if (!at_end(p)) {
+    out_str(o, "error: dac A B C D [E F G H], codes 0..16383");
+    return;
   }
   const uint32_t cs = hal_critical_enter();
   b->dac = f;
@@ -304,9 +320,7 @@ static void poll_uart(bringup_t *b)
 int main(void)
 {
   bringup_t *b = &s_bringup;
-  for (uint32_t ch = 0u; ch < HAL_DAC_NUM_CHANNELS; ++ch) {
-    b->dac.code[ch] = (uint16_t)HAL_DAC_CODE_MID;
-  }
+  hal_dac_frame_midscale(&b->dac);
   b->period_min = 0xFFFFFFFFu;
   (void)stm32f4_board_init();
   stm32f4_uptime_init();

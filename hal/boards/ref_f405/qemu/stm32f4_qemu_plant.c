@@ -21,16 +21,11 @@ static const volatile float *s_trace_src;
 static float s_trace[QEMU_TRACE_LEN];
 static volatile uint32_t s_trace_n;
 
-static void midscale(hal_dac_frame_t *f)
-{
-  for (uint32_t i = 0u; i < HAL_DAC_NUM_CHANNELS; ++i) f->code[i] = (uint16_t)HAL_DAC_CODE_MID;
-}
-
 int stm32f4_qemu_plant_init(void)
 {
   if (qemu_plant_setup(&s_plant, &s_prof) != 0) return -1;
-  midscale(&s_active);
-  midscale(&s_pending);
+  hal_dac_frame_midscale(&s_active); /* all eight channels at 0 V, as RS leaves them */
+  hal_dac_frame_midscale(&s_pending);
   s_adc.drive = 0;
   s_adc.sense = 0;
   plant_step(&s_plant, &s_active, &s_adc);
