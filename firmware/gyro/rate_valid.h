@@ -111,7 +111,7 @@ typedef struct {
   float bias_slope_dps_per_deg; /* |dB/dP| of the compensation over its range */
   float p_range_off_deg;        /* x = p_dev + this at P_f (rate_channel.h) */
   float grad_k_abs_dps_per_deg; /* |k| of the gradient term */
-  float spur_m[6]; /* the shadow's transition over a slew window (rate_valid_spur_matrix) */
+  float spur_m[10]; /* the shadow's transition over a slew window (rate_valid_spur_matrix) */
 } rate_valid_cfg_t;
 
 typedef struct {
@@ -128,12 +128,14 @@ typedef struct {
   uint32_t slew;             /* RATE_INVALID_THERMO_SLEW of the latest window */
   uint32_t slew_due;         /* a window ended: rate_valid_slew judges it */
   float p_window_change_deg; /* change of P_f over the window that ended */
-  float spur_deg[3];         /* the shadow: the moves beyond the cap in P_f, and in the
-                              * compensation's filters (P_f - P_c, the gradient term's
-                              * input; comp_filters.h), at the next window's end */
+  float spur_deg[4];         /* the shadow: the moves beyond the cap in P_f, and in the
+                              * compensation's filters (P_f - P_1, P_f - P_c, the
+                              * gradient term's input; comp_filters.h), at the next
+                              * window's end */
   uint32_t restart_armed;    /* a window's move beyond RATE_VALID_RESTART_CAPS caps */
   float snap_lag_deg;        /* the compensation's filters at the latest window's end */
-  float snap_hp_deg;         /* with the checks passed and no restart armed */
+  float snap_lag1_deg;
+  float snap_hp_deg;       /* with the checks passed and no restart armed */
   uint32_t spur;           /* RATE_INVALID_THERMO_SLEW while the shadow's error is beyond tol */
   uint32_t filters_held;   /* the compensation's filters wait for P_f (comp_filters.h) */
   float phase_err_lp_rad;  /* the drive phase error through RATE_VALID_PHASE_K */
@@ -173,14 +175,17 @@ void rate_valid_thermo(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float p_de
                        float p_held_dev_deg, float p_held_w);
 /* On a tick after rate_valid_thermo ended a slew window (slew_due): THERMO_SLEW from the
  * window's change of P_f and from the shadow (apart, so that no tick carries both).
- * (comp_lag_deg, comp_hp_deg): the compensation's filters' content (rate_channel_t).
+ * (comp_lag_deg, comp_lag1_deg, comp_hp_deg): the compensation's filters' content
+ * (rate_channel_t).
  * Returns 1 when the filters must restart now (rate_channel_comp_restart). */
 int rate_valid_slew(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float comp_lag_deg,
-                    float comp_hp_deg);
+                    float comp_lag1_deg, float comp_hp_deg);
 /* The shadow's transition over RATE_VALID_SLEW_UPDATES P updates for the compensation's
- * filter weights comp_a, grad_a (rate_channel_cfg_t): m = (s<-s, lag<-s, lag<-lag,
- * hp<-s, hp<-lag, hp<-hp). Design time (double). */
-void rate_valid_spur_matrix(float comp_a, float grad_a, float m[6]);
+ * filter weights comp_a, grad_a and its stages (rate_channel_cfg_t), lower triangular in
+ * the state (s, lag1, lag, hp), row by row: m = (s<-s, lag1<-s, lag1<-lag1, lag<-s,
+ * lag<-lag1, lag<-lag, hp<-s, hp<-lag1, hp<-lag, hp<-hp); lag1's row is 0 with one
+ * stage. Design time (double). */
+void rate_valid_spur_matrix(float comp_a, float grad_a, uint32_t stages, float m[10]);
 
 /* Once per block, after the quadrature filter: the drive phase error as the supervisor
  * low-passed it, the quadrature output and the squared sense pickoff amplitude ->
