@@ -320,7 +320,8 @@ def linearity(part, values):
 def thermal(part, values):
     """Stage 3: the temperature compensation from a chamber run (gyrotools.thermcal)."""
     path = os.path.join(part.work, "thermal_params.json")
-    values = dict(values, **{"rate.comp_tau_s": thermcal.COMP_TAU_S})
+    values = dict(values, **{"rate.comp_tau_s": thermcal.COMP_TAU_S,
+                              "rate.comp_stages": thermcal.COMP_STAGES})
     paramset.write(path, paramset.from_values(values, meta={"stage": "thermal"}))
     temps = part.protocol.cal_plateaus_c
     scen = _scenario(part, "calibrate_thermal", thermcal.plateau_scenario(
