@@ -213,11 +213,11 @@
   X(rate_comp_tau_s, 0x0317u, "rate.comp_tau_s", F32, "s", 0.0f, 1000.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "low-pass time constant of P_f for the compensation's polynomials (0: P_f itself)") \
   /* 1: one stage (the sets made before this parameter). The thermometer's noise is the
-   * drive pickoff's phase flicker (1/f): a second stage takes it down as 1/f^2 above
+   * drive pickoff's phase flicker (1/f): each stage takes it down by another 1/f above
    * 1 / (2 pi rate.comp_tau_s), so that the compensation's output noise at 10 s stays
-   * within 1.1x the uncompensated; its ramp lag (2 x rate.comp_tau_s) is the gradient
-   * term's to take, fitted with it in place (docs/compensation-noise.md) */ \
-  X(rate_comp_stages, 0x031Du, "rate.comp_stages", U32, "-", 1u, 2u, 1u, 0u, \
+   * within 1.1x the uncompensated; the ramp lag (stages x rate.comp_tau_s) is the
+   * gradient term's to take, fitted with them in place (docs/compensation-noise.md) */ \
+  X(rate_comp_stages, 0x031Du, "rate.comp_stages", U32, "-", 1u, 3u, 1u, 0u, \
     PF_PERSIST | PF_LIVE, "first-order stages of rate.comp_tau_s in the compensation's low-pass of P_f") \
   /* 50 % over the setpoint: beyond any PI overshoot, short of the stops */ \
   X(sup_amp_trip_rel, 0x0401u, "sup.amp_trip_rel", F32, "-", 1.2f, 5.0f, 1.5f, 0u, \
