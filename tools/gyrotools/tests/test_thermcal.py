@@ -93,3 +93,11 @@ def test_noise_ratio_at_10s_reported_only_on_a_short_record():
     assert r["ratio_10s"] > 1.5
     assert not r["ratio_10s_judged"] and r["ok"]
     assert "reported" in r["how"]
+
+
+def test_each_protocol_fits_with_its_own_thermometer_filter():
+    # The full protocol's settled plateaus take the slow three-stage thermometer; the quick
+    # one's 400 s plateaus are all transients and keep one 5 s stage (with three of 15 s the
+    # default part's quick calibration left -0.39 deg/s at 20 degC).
+    assert (thermcal.FULL.comp_tau_s, thermcal.FULL.comp_stages) == (15.0, 3)
+    assert (thermcal.QUICK.comp_tau_s, thermcal.QUICK.comp_stages) == (5.0, 1)
