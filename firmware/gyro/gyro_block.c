@@ -192,7 +192,8 @@ GYRO_RAMFUNC void gyro_block_p(gyro_t *g, int hold)
     rc->p_new = 0u;
     rate_valid_thermo(&d->valid, &g->valid, rc->p_dev_deg, rc->p_held_dev_deg, rc->p_held_w);
   } else if (g->valid.slew_due != 0u) {
-    if (rate_valid_slew(&d->valid, &g->valid, rc->p_comp_lag_deg, rc->p_hp_deg))
+    if (rate_valid_slew(&d->valid, &g->valid, rc->p_comp_lag_deg, rc->p_comp_mid_deg,
+                        rc->p_hp_deg))
       rate_channel_comp_restart(rc);
   }
   /* Last, as a tail call: its new P_f is flagged in rc->p_new. */

@@ -96,7 +96,7 @@ static gyro_design_status_t design_validity(const param_values_t *v, gyro_design
                               fm_absf(v->rate_bias_grad_dps_per_deg),
                               {0.0f}};
   t->valid = c;
-  rate_valid_spur_matrix(t->rate.comp_a, t->rate.grad_a, t->valid.spur_m);
+  rate_valid_spur_matrix(t->rate.comp_a, t->rate.grad_a, t->rate.comp_stages, t->valid.spur_m);
   t->rate_fault_out_v = v->rate_fault_out_v;
   return GYRO_DESIGN_OK;
 }
@@ -303,6 +303,7 @@ static gyro_design_status_t design_rate(const param_values_t *v, double tau_s, g
                        ? (float)(1.0 -
                                  exp(-(double)RATE_P_DECIM / (fs * (double)v->rate_comp_tau_s)))
                        : 1.0f;
+  t->rate.comp_stages = v->rate_comp_stages;
   t->rate.grad_a = (float)(1.0 - exp(-(double)RATE_P_DECIM / (fs * (double)v->rate_grad_tau_s)));
   /* First-order low-pass of P at the decimated rate fs / RATE_P_DECIM. */
   t->rate.p_lpf_alpha = (float)(1.0 - exp(-2.0 * FM_PI * (double)v->rate_p_lpf_hz *

@@ -29,6 +29,7 @@ int rate_channel_cfg_ok(const rate_channel_cfg_t *cfg)
          fm_isfinite(cfg->grad_k_dps_per_deg) && cfg->grad_a > 0.0f && cfg->grad_a <= 1.0f &&
          fm_isfinite(cfg->p_rate_deg_per_dps) && fm_isfinite(cfg->p_rate_c1_per_dps) &&
          fm_isfinite(cfg->p_rate2_deg_per_dps2) && cfg->comp_a > 0.0f && cfg->comp_a <= 1.0f &&
+         cfg->comp_stages >= 1u && cfg->comp_stages <= COMP_STAGES_MAX &&
          fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg) && cfg->p_mode_k > 0.0f &&
          cfg->p_mode_k <= 1.0f && cfg->ref_lp_kp > 0.0f && cfg->ref_lp_kp < 1.0f &&
          cfg->ref_lp_ki > 0.0f && cfg->ref_lp_ki < cfg->ref_lp_kp && cfg->ref_wide_kp > 0.0f &&
@@ -70,7 +71,7 @@ int rate_channel_same_path(const rate_channel_cfg_t *a, const rate_channel_cfg_t
              a->p_rate_deg_per_dps == b->p_rate_deg_per_dps &&
              a->p_rate_c1_per_dps == b->p_rate_c1_per_dps &&
              a->p_rate2_deg_per_dps2 == b->p_rate2_deg_per_dps2 && a->comp_a == b->comp_a &&
-             a->lpf_sections == b->lpf_sections;
+             a->comp_stages == b->comp_stages && a->lpf_sections == b->lpf_sections;
   for (int i = 0; i < 4; i++) {
     same = same && a->bias_c_dps[i] == b->bias_c_dps[i] && a->sf_c[i] == b->sf_c[i];
   }
@@ -101,6 +102,7 @@ GYRO_RAMFUNC void rate_channel_reset(const rate_channel_cfg_t *restrict cfg,
   rc->p_held_w = 0.0f;
   rc->p_hp_deg = 0.0f;
   rc->p_comp_lag_deg = 0.0f;
+  rc->p_comp_mid_deg[0] = rc->p_comp_mid_deg[1] = 0.0f;
   rc->p_last_rad = p_deg * FM_RAD_PER_DEG_F;
   rc->p_lag_rad = 0.0f;
   rc->ref_dev_rad = 0.0f;
@@ -239,10 +241,12 @@ GYRO_RAMFUNC static inline void comp_filters_update(const rate_channel_cfg_t *re
     /* P_f's way from a held value to P is no temperature change: the filters start once
      * that value weighs less than COMP_FILTERS_HELD_W_MAX in P_f. */
     rc->p_comp_lag_deg = 0.0f;
+    rc->p_comp_mid_deg[0] = rc->p_comp_mid_deg[1] = 0.0f;
     rc->p_hp_deg = 0.0f;
     return;
   }
-  comp_filters_step(&rc->p_comp_lag_deg, &rc->p_hp_deg, step, cfg->comp_a, cfg->grad_a);
+  comp_filters_step(&rc->p_comp_lag_deg, rc->p_comp_mid_deg, &rc->p_hp_deg, step, cfg->comp_a,
+                    cfg->grad_a, cfg->comp_stages);
 }
 
 GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
@@ -256,6 +260,7 @@ GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
     rc->p_held_w = 1.0f;
     rc->p_hp_deg = 0.0f;
     rc->p_comp_lag_deg = 0.0f;
+    rc->p_comp_mid_deg[0] = rc->p_comp_mid_deg[1] = 0.0f;
   } else {
     rc->p_acc_deg += p_rad * FM_DEG_PER_RAD_F - cfg->p_ref_deg;
     if (++rc->p_count == 1u && rc->p_n < RATE_P_FAST_MAX) {

@@ -47,6 +47,7 @@
 #include <stdint.h>
 
 #include "dsp/biquad.h"
+#include "gyro/comp_filters.h"
 
 /* The channel runs on block means of RATE_DECIM ticks (fs / 10 = 5 kHz): every tick
  * only adds the sense phasor to a sum (rate_channel_accumulate); once per block
@@ -107,6 +108,7 @@ typedef struct {
   float p_rate_c1_per_dps;    /* its change per degree of x (the compensation's variable) */
   float p_rate2_deg_per_dps2; /* P's turn per (deg/s)^2 of rate */
   float comp_a;               /* P_c's low-pass of P_f: 1 - exp(-T / comp_tau) per new P_f */
+  uint32_t comp_stages;       /* first-order stages of that low-pass, 1..COMP_STAGES_MAX */
   float p_mode_k;  /* per-block factor of the resonance's lag: 1 - exp(-T_block / (2Q/wn)) */
   float ref_lp_kp; /* LP2 per block: 2 zeta wn T_block ... */
   float ref_lp_ki; /* ... and (wn T_block)^2 */
@@ -122,12 +124,13 @@ typedef struct {
 typedef struct {
   float p_acc_deg; /* sum of (P - p_ref), one sample per block, over RATE_P_DECIM ticks */
   uint32_t p_count;
-  float p_dev_deg;        /* low-passed P - p_ref */
-  float p_held_dev_deg;   /* P_f - p_ref while held: where the fast start began */
-  float p_held_w;         /* weight the held value still has in P_f (1 while held) */
-  float p_hp_deg;         /* P_c - LP_tau(P_c): the gradient term's input */
-  float p_comp_lag_deg;   /* P_f - P_c: P_c the compensation's thermometer */
-  float p_last_rad;       /* P at the last projection */
+  float p_dev_deg;      /* low-passed P - p_ref */
+  float p_held_dev_deg; /* P_f - p_ref while held: where the fast start began */
+  float p_held_w;       /* weight the held value still has in P_f (1 while held) */
+  float p_hp_deg;       /* P_c - LP_tau(P_c): the gradient term's input */
+  float p_comp_lag_deg; /* P_f - P_c: P_c the compensation's thermometer */
+  float p_comp_mid_deg[COMP_STAGES_MAX - 1u]; /* P_f - P_k, P_c's stages before its last */
+  float p_last_rad;                           /* P at the last projection */
   float p_lag_rad;        /* P - LP_tau(P): the resonance's lag still to come */
   float ref_dev_rad;      /* the reference's correction delta = theta - set */
   float ref_slope_rad;    /* LP2's slope state, per block */
@@ -194,6 +197,7 @@ static inline void rate_channel_hold_p(rate_channel_t *rc, int hold)
 static inline void rate_channel_comp_restart(rate_channel_t *rc)
 {
   rc->p_comp_lag_deg = 0.0f;
+  rc->p_comp_mid_deg[0] = rc->p_comp_mid_deg[1] = 0.0f;
   rc->p_hp_deg = 0.0f;
 }
 

@@ -11,9 +11,12 @@
 static int spur_m_ok(const float *m)
 {
   int ok = 1;
-  for (int i = 0; i < 6; i++) ok = ok && fm_isfinite(m[i]);
-  return ok && m[0] >= 0.0f && m[0] < 1.0f && m[2] >= 0.0f && m[2] < 1.0f && m[5] >= 0.0f &&
-         m[5] < 1.0f;
+  for (uint32_t i = 0u; i < RATE_VALID_SPUR_M; i++) ok = ok && fm_isfinite(m[i]);
+  for (uint32_t i = 0u; i < RATE_VALID_SPUR_N; i++) {
+    const float d = m[i * (i + 1u) / 2u + i]; /* row i's diagonal */
+    ok = ok && d >= 0.0f && d < 1.0f;
+  }
+  return ok;
 }
 
 int rate_valid_cfg_ok(const rate_valid_cfg_t *c)
@@ -43,8 +46,9 @@ int rate_valid_init(const rate_valid_cfg_t *cfg, rate_valid_t *rv)
   rv->slew = rv->slew_due = rv->restart_armed = rv->spur = 0u;
   rv->filters_held = 1u;
   rv->snap_lag_deg = rv->snap_hp_deg = 0.0f;
+  rv->snap_mid_deg[0] = rv->snap_mid_deg[1] = 0.0f;
   rv->p_window_change_deg = 0.0f;
-  rv->spur_deg[0] = rv->spur_deg[1] = rv->spur_deg[2] = 0.0f;
+  for (uint32_t i = 0u; i < RATE_VALID_SPUR_N; i++) rv->spur_deg[i] = 0.0f;
   rv->phase_err_lp_rad = 0.0f;
   rv->blocks = 0u;
   rv->onsets_pending = rv->onset_block = 0u;
@@ -103,14 +107,16 @@ GYRO_RAMFUNC void rate_valid_thermo(const rate_valid_cfg_t *restrict c, rate_val
 
 /* The shadow's rate error: P_c's part (s - lag) at the bias slope, the gradient term's. */
 GYRO_RAMFUNC static inline float spur_error_dps(const rate_valid_cfg_t *restrict c,
-                                                const float x[3])
+                                                const float x[RATE_VALID_SPUR_N])
 {
-  return c->bias_slope_dps_per_deg * fm_absf(x[0] - x[1]) +
-         c->grad_k_abs_dps_per_deg * fm_absf(x[2]);
+  return c->bias_slope_dps_per_deg * fm_absf(x[0] - x[3]) +
+         c->grad_k_abs_dps_per_deg * fm_absf(x[4]);
 }
 
 GYRO_RAMFUNC int rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_t *restrict rv,
-                                 float comp_lag_deg, float comp_hp_deg)
+                                 float comp_lag_deg,
+                                 const float comp_mid_deg[COMP_STAGES_MAX - 1u],
+                                 float comp_hp_deg)
 {
   const float move = rv->p_window_change_deg, change = fm_absf(move);
   const int over_cap = !(change <= c->p_window_max_deg);
@@ -136,19 +142,25 @@ GYRO_RAMFUNC int rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_
     /* P_f, returning from the move, is still about one window's move short of its end
      * (its 1 Hz low-pass covers about half the way in a window), and P_c = P_f has it. */
     x[0] = -move;
-    x[1] = -rv->snap_lag_deg;
-    x[2] = -rv->snap_hp_deg;
+    x[1] = -rv->snap_mid_deg[0];
+    x[2] = -rv->snap_mid_deg[1];
+    x[3] = -rv->snap_lag_deg;
+    x[4] = -rv->snap_hp_deg;
   } else if (over_cap && rv->filters_held == 0u) {
-    x[0] += move;
-    x[1] += move;
+    /* P_f moved, no stage yet: every lag grows by the move (a stage not in use has a
+     * zero row and column in the transition) */
+    for (uint32_t i = 0u; i < RATE_VALID_SPUR_N - 1u; i++) x[i] += move;
   }
   const float e_now = spur_error_dps(c, x);
   /* On to the next window's end (the window's transition, lower triangular): judged at
    * both ends, the error between them is judged with it. */
   const float *m = c->spur_m;
-  x[2] = m[3] * x[0] + m[4] * x[1] + m[5] * x[2];
-  x[1] = m[1] * x[0] + m[2] * x[1];
-  x[0] = m[0] * x[0];
+  for (uint32_t i = RATE_VALID_SPUR_N; i-- > 0u;) { /* lower triangular: in place, last row first */
+    const float *row = &m[i * (i + 1u) / 2u];
+    float y = 0.0f;
+    for (uint32_t j = 0u; j <= i; j++) y += row[j] * x[j];
+    x[i] = y;
+  }
   const float e_next = spur_error_dps(c, x);
   rv->spur = (e_now <= c->tol_dps && e_next <= c->tol_dps) ? 0u : RATE_INVALID_THERMO_SLEW;
   rv->slew = slewing ? RATE_INVALID_THERMO_SLEW : 0u;
@@ -156,33 +168,64 @@ GYRO_RAMFUNC int rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_
   rv->slew_due = 0u;
   if ((rv->thermo | rv->restart_armed) == 0u) {
     rv->snap_lag_deg = comp_lag_deg;
+    rv->snap_mid_deg[0] = comp_mid_deg[0];
+    rv->snap_mid_deg[1] = comp_mid_deg[1];
     rv->snap_hp_deg = comp_hp_deg;
   }
   return restart;
 }
 
-void rate_valid_spur_matrix(float comp_a, float grad_a, float m[6])
+/* One P update of the compensation's filters (comp_filters_step) in double, on the
+ * shadow's state (s, mid[0], mid[1], lag, hp) without input: s leaks by comp_a, and its
+ * step goes through the filters like a step of P_f. */
+static void spur_update(double x[RATE_VALID_SPUR_N], double ca, double ga, uint32_t stages)
 {
-  /* One P update of the shadow (s, lag, hp) without input: s leaks by comp_a, and its
-   * step goes through the filters (comp_filters.h) like a step of P_f. */
-  const double ca = (double)comp_a, kc = 1.0 - ca, kg = 1.0 - (double)grad_a;
-  const double t[3][3] = {{kc, 0.0, 0.0}, {-ca * kc, kc, 0.0}, {-kg * ca * ca, kg * ca, kg}};
-  double p[3][3] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+  const double step = -ca * x[0];
+  x[0] += step;
+  double lag_before = 0.0, step_before = step;
+  for (uint32_t k = 0u; k < stages; k++) {
+    double *lag = k + 1u == stages ? &x[COMP_STAGES_MAX] : &x[1u + k];
+    const double d = (*lag - lag_before) + step_before;
+    const double step_k = ca * d;
+    lag_before = *lag;
+    *lag = (*lag + step) - step_k;
+    step_before = step_k;
+  }
+  x[RATE_VALID_SPUR_N - 1u] = (1.0 - ga) * (x[RATE_VALID_SPUR_N - 1u] + step_before);
+}
+
+void rate_valid_spur_matrix(float comp_a, float grad_a, uint32_t stages,
+                            float m[RATE_VALID_SPUR_M])
+{
+  /* The update is linear: its matrix column by column from the unit states (a mid stage
+   * not in use stays where it was, so its row is taken as 0), then its power. */
+  enum { N = RATE_VALID_SPUR_N };
+  double t[N][N], p[N][N];
+  for (uint32_t j = 0u; j < N; j++) {
+    double x[N] = {0.0};
+    x[j] = 1.0;
+    spur_update(x, (double)comp_a, (double)grad_a, stages);
+    for (uint32_t i = 0u; i < N; i++) {
+      const int unused = i >= 1u && i < COMP_STAGES_MAX && i >= stages;
+      t[i][j] = unused ? 0.0 : x[i];
+      p[i][j] = i == j ? 1.0 : 0.0;
+    }
+  }
   for (uint32_t n = 0; n < RATE_VALID_SLEW_UPDATES; n++) {
-    double q[3][3];
-    for (int i = 0; i < 3; i++) {
-      for (int j = 0; j < 3; j++) {
-        q[i][j] = t[i][0] * p[0][j] + t[i][1] * p[1][j] + t[i][2] * p[2][j];
+    double q[N][N];
+    for (uint32_t i = 0u; i < N; i++) {
+      for (uint32_t j = 0u; j < N; j++) {
+        double acc = 0.0;
+        for (uint32_t k = 0u; k < N; k++) acc += t[i][k] * p[k][j];
+        q[i][j] = acc;
       }
     }
     memcpy(p, q, sizeof p);
   }
-  m[0] = (float)p[0][0];
-  m[1] = (float)p[1][0];
-  m[2] = (float)p[1][1];
-  m[3] = (float)p[2][0];
-  m[4] = (float)p[2][1];
-  m[5] = (float)p[2][2];
+  uint32_t k = 0u;
+  for (uint32_t i = 0u; i < N; i++) {
+    for (uint32_t j = 0u; j <= i; j++) m[k++] = (float)p[i][j];
+  }
 }
 
 GYRO_RAMFUNC void rate_valid_drive(const rate_valid_cfg_t *restrict c, rate_valid_t *restrict rv,

@@ -61,6 +61,8 @@
 
 #include <stdint.h>
 
+#include "gyro/comp_filters.h"
+
 #define RATE_INVALID_MODE (1u << 0)
 #define RATE_INVALID_SELFTEST (1u << 1)
 #define RATE_INVALID_SETTLING (1u << 2)
@@ -99,6 +101,10 @@
 /* Fraction of the ADC range the sense amplitude may use. */
 #define RATE_VALID_SENSE_FRAC 0.8f
 
+/* The shadow's state: the move left in P_f, P_c's stages' lags, the gradient term's input. */
+#define RATE_VALID_SPUR_N (COMP_STAGES_MAX + 2u)
+#define RATE_VALID_SPUR_M (RATE_VALID_SPUR_N * (RATE_VALID_SPUR_N + 1u) / 2u)
+
 typedef struct {
   float tol_dps; /* the largest rate error each source may leave */
   float full_scale_dps;
@@ -111,29 +117,31 @@ typedef struct {
   float bias_slope_dps_per_deg; /* |dB/dP| of the compensation over its range */
   float p_range_off_deg;        /* x = p_dev + this at P_f (rate_channel.h) */
   float grad_k_abs_dps_per_deg; /* |k| of the gradient term */
-  float spur_m[6]; /* the shadow's transition over a slew window (rate_valid_spur_matrix) */
+  float spur_m[RATE_VALID_SPUR_M]; /* the shadow's transition over a slew window */
 } rate_valid_cfg_t;
 
 typedef struct {
-  uint32_t reasons;          /* RATE_INVALID_* of the latest verdict */
-  uint32_t thermo;           /* RATE_INVALID_THERMO_* of the latest P update */
-  uint32_t drive;            /* RATE_INVALID_PHASE, _SENSE_RANGE of the latest block */
-  uint32_t range;            /* RATE_INVALID_OVER_RANGE of the latest block */
-  uint32_t settled;          /* nonzero once settled since the last disturbance */
-  uint32_t settle_run;       /* blocks in a row inside the settling tolerance */
-  uint32_t was_locked;       /* LOCKED at the previous verdict (entering it disturbs) */
-  float x_rate, x_quad;      /* fast low-passes of the filters' inputs (raw units) */
-  float p_dev_window_deg;    /* P_f - p_ref at the start of the slew window */
-  uint32_t p_updates;        /* P_f updates into the slew window */
-  uint32_t slew;             /* RATE_INVALID_THERMO_SLEW of the latest window */
-  uint32_t slew_due;         /* a window ended: rate_valid_slew judges it */
-  float p_window_change_deg; /* change of P_f over the window that ended */
-  float spur_deg[3];         /* the shadow: the moves beyond the cap in P_f, and in the
-                              * compensation's filters (P_f - P_c, the gradient term's
-                              * input; comp_filters.h), at the next window's end */
-  uint32_t restart_armed;    /* a window's move beyond RATE_VALID_RESTART_CAPS caps */
-  float snap_lag_deg;        /* the compensation's filters at the latest window's end */
-  float snap_hp_deg;         /* with the checks passed and no restart armed */
+  uint32_t reasons;                  /* RATE_INVALID_* of the latest verdict */
+  uint32_t thermo;                   /* RATE_INVALID_THERMO_* of the latest P update */
+  uint32_t drive;                    /* RATE_INVALID_PHASE, _SENSE_RANGE of the latest block */
+  uint32_t range;                    /* RATE_INVALID_OVER_RANGE of the latest block */
+  uint32_t settled;                  /* nonzero once settled since the last disturbance */
+  uint32_t settle_run;               /* blocks in a row inside the settling tolerance */
+  uint32_t was_locked;               /* LOCKED at the previous verdict (entering it disturbs) */
+  float x_rate, x_quad;              /* fast low-passes of the filters' inputs (raw units) */
+  float p_dev_window_deg;            /* P_f - p_ref at the start of the slew window */
+  uint32_t p_updates;                /* P_f updates into the slew window */
+  uint32_t slew;                     /* RATE_INVALID_THERMO_SLEW of the latest window */
+  uint32_t slew_due;                 /* a window ended: rate_valid_slew judges it */
+  float p_window_change_deg;         /* change of P_f over the window that ended */
+  float spur_deg[RATE_VALID_SPUR_N]; /* the shadow: the moves beyond the cap in P_f,
+                                      * and in the compensation's filters (their mid
+                                      * stages', P_f - P_c, the gradient term's input;
+                                      * comp_filters.h), at the next window's end */
+  uint32_t restart_armed;            /* a window's move beyond RATE_VALID_RESTART_CAPS caps */
+  float snap_lag_deg;                /* the compensation's filters at the latest window's end */
+  float snap_mid_deg[COMP_STAGES_MAX - 1u];
+  float snap_hp_deg;       /* with the checks passed and no restart armed */
   uint32_t spur;           /* RATE_INVALID_THERMO_SLEW while the shadow's error is beyond tol */
   uint32_t filters_held;   /* the compensation's filters wait for P_f (comp_filters.h) */
   float phase_err_lp_rad;  /* the drive phase error through RATE_VALID_PHASE_K */
@@ -173,14 +181,18 @@ void rate_valid_thermo(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float p_de
                        float p_held_dev_deg, float p_held_w);
 /* On a tick after rate_valid_thermo ended a slew window (slew_due): THERMO_SLEW from the
  * window's change of P_f and from the shadow (apart, so that no tick carries both).
- * (comp_lag_deg, comp_hp_deg): the compensation's filters' content (rate_channel_t).
+ * (comp_lag_deg, comp_mid_deg, comp_hp_deg): the compensation's filters' content
+ * (rate_channel_t).
  * Returns 1 when the filters must restart now (rate_channel_comp_restart). */
 int rate_valid_slew(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float comp_lag_deg,
-                    float comp_hp_deg);
+                    const float comp_mid_deg[COMP_STAGES_MAX - 1u], float comp_hp_deg);
 /* The shadow's transition over RATE_VALID_SLEW_UPDATES P updates for the compensation's
- * filter weights comp_a, grad_a (rate_channel_cfg_t): m = (s<-s, lag<-s, lag<-lag,
- * hp<-s, hp<-lag, hp<-hp). Design time (double). */
-void rate_valid_spur_matrix(float comp_a, float grad_a, float m[6]);
+ * filter weights comp_a, grad_a and its stages (rate_channel_cfg_t): lower triangular in
+ * the state (s, mid[0], mid[1], lag, hp) (comp_filters.h; a mid stage's row is 0 where
+ * there are fewer stages), its rows packed in order (row i holds i + 1 entries). Design
+ * time (double). */
+void rate_valid_spur_matrix(float comp_a, float grad_a, uint32_t stages,
+                            float m[RATE_VALID_SPUR_M]);
 
 /* Once per block, after the quadrature filter: the drive phase error as the supervisor
  * low-passed it, the quadrature output and the squared sense pickoff amplitude ->

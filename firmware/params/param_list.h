@@ -40,7 +40,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 11u
+#define PARAM_LAYOUT_VERSION 12u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -212,6 +212,13 @@
    * calibration's to model: the flow fits the gradient term with it in place */ \
   X(rate_comp_tau_s, 0x0317u, "rate.comp_tau_s", F32, "s", 0.0f, 1000.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "low-pass time constant of P_f for the compensation's polynomials (0: P_f itself)") \
+  /* 1: one stage (the sets made before this parameter). The thermometer's noise is the
+   * drive pickoff's phase flicker (1/f): each stage takes it down by another 1/f above
+   * 1 / (2 pi rate.comp_tau_s), so that the compensation's output noise at 10 s stays
+   * within 1.1x the uncompensated; the ramp lag (stages x rate.comp_tau_s) is the
+   * gradient term's to take, fitted with them in place (docs/compensation-noise.md) */ \
+  X(rate_comp_stages, 0x031Du, "rate.comp_stages", U32, "-", 1u, 3u, 1u, 0u, \
+    PF_PERSIST | PF_LIVE, "first-order stages of rate.comp_tau_s in the compensation's low-pass of P_f") \
   /* 50 % over the setpoint: beyond any PI overshoot, short of the stops */ \
   X(sup_amp_trip_rel, 0x0401u, "sup.amp_trip_rel", F32, "-", 1.2f, 5.0f, 1.5f, 0u, \
     PF_PERSIST | PF_LIVE, "over-amplitude trip, as a multiple of drive.amp_set_v") \

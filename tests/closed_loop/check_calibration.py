@@ -25,6 +25,11 @@
                                         part at drive Q 1e4 calibrated by tools/calibrate
                                         --quick, then brownian_only with that calibration:
                                         the valid output's noise within 10 % of (4-24)
+  check_calibration.py noise GYRO_SIM  the compensation's cost in noise with the default
+                                        part's committed calibration: static_allan (seed 4,
+                                        noise the flow's verification never saw) for 640 s,
+                                        the Allan deviation of rate_dps within 1.1x that of
+                                        rate_unc_dps at 1 s and at 10 s (thermcal.verify_noise)
   check_calibration.py commands GYRO_SIM  a scenario's "commands" (what the flow's
                                         self-test stage uses) reach the command line at
                                         their times; one due after the run has no reply
@@ -293,10 +298,31 @@ def commands(sim):
     return 0 if ok else 1
 
 
+NOISE_RUN_S = 640.0  # NOISE_10S_MIN_WINDOWS windows of 10 s after the start-up left out
+
+
+def noise(sim):
+    from gyrotools import csvlog, thermcal
+    scen = os.path.join(ROOT, "host_sim", "scenarios", "static_allan.json")
+    with tempfile.TemporaryDirectory() as d:
+        csv = os.path.join(d, "noise.csv")
+        if not run_sim(sim, scen, ["--duration", f"{NOISE_RUN_S:g}", "--csv", csv,
+                                   "--csv-rate", "100", "--firmware-params", CAL]):
+            return 1
+        log = csvlog.read_log(csv, need=["rate_dps", "rate_unc_dps"])
+        r = thermcal.verify_noise(log, thermcal.FULL)
+    print(f"noise: Allan deviation ratio compensated / uncompensated {r['ratio']:.3f} at 1 s, "
+          f"{r['ratio_10s']:.3f} at 10 s ({r['adev_10s_compensated_dph']:.1f} / "
+          f"{r['adev_10s_uncompensated_dph']:.1f} deg/h), 10 s judged: {r['ratio_10s_judged']}")
+    ok = r["ok"] and r["ratio_10s_judged"]
+    print("ok" if ok else "FAIL")
+    return 0 if ok else 1
+
+
 if __name__ == "__main__":
     modes = {"regen": regen, "usage": usage, "commands": commands, "defaults": tool_defaults,
              "tempcomp": tempcomp_out_of_sample, "quick": quick, "quick_vacuum": quick_vacuum,
-             "brownian_highq": brownian_highq}
+             "brownian_highq": brownian_highq, "noise": noise}
     if len(sys.argv) != 3 or sys.argv[1] not in modes:
         print(__doc__, file=sys.stderr)
         sys.exit(2)

@@ -8,6 +8,7 @@
 #include <math.h>
 #include <cmocka.h>
 
+#include "gyro/comp_filters.h"
 #include "gyro/rate_valid.h"
 
 static rate_valid_cfg_t cfg(void)
@@ -22,11 +23,12 @@ static rate_valid_cfg_t cfg(void)
                         .bias_slope_dps_per_deg = 0.0f,
                         .grad_k_abs_dps_per_deg = 0.0f,
                         .spur_m = {0.0f}};
-  rate_valid_spur_matrix(4e-4f, 1e-4f, c.spur_m); /* P_c over 5 s, the gradient over 20 s */
+  rate_valid_spur_matrix(4e-4f, 1e-4f, 1u, c.spur_m); /* P_c over 5 s, the gradient over 20 s */
   return c;
 }
 
 static rate_valid_t rv;
+static const float k_no_mid[COMP_STAGES_MAX - 1u] = {0.0f, 0.0f};
 static rate_valid_history_t hist;
 /* The configuration the monitors under test run with. */
 static rate_valid_cfg_t s_cfg;
@@ -66,7 +68,7 @@ static void test_bad_cfg(void **state)
   c.full_scale_dps = NAN;
   assert_int_equal(rv_init(&rv, &c), -1);
   c = cfg();
-  c.spur_m[5] = 1.0f; /* a shadow that never fades */
+  c.spur_m[14] = 1.0f; /* a shadow that never fades (hp's diagonal) */
   assert_int_equal(rv_init(&rv, &c), -1);
 }
 
@@ -164,7 +166,7 @@ static void test_thermo_slew(void **state)
   for (uint32_t i = 0; i < 3u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.004f / (float)RATE_VALID_SLEW_UPDATES; /* 0.04 deg/s, under the cap */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, k_no_mid, 0.0f);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
@@ -172,7 +174,7 @@ static void test_thermo_slew(void **state)
     /* 0.004 deg per 0.1 s leaves P_f 0.0064 deg behind: with no bias slope no error,
      * whatever the quadrature (the reference does not read P_f) ... */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, k_no_mid, 0.0f);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   s_cfg.bias_slope_dps_per_deg = 52.0f;
@@ -181,16 +183,17 @@ static void test_thermo_slew(void **state)
     /* ... at 52 deg/s per degree of bias slope 0.33 deg/s: beyond the tolerance though
      * under the cap. */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, k_no_mid, 0.0f);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
   s_cfg.bias_slope_dps_per_deg = 0.0f;
   /* Under the cap: a temperature's move, none of it into the shadow of the compensation */
-  assert_true(rv.spur_deg[0] == 0.0f && rv.spur_deg[1] == 0.0f && rv.spur_deg[2] == 0.0f);
+  assert_true(rv.spur_deg[0] == 0.0f && rv.spur_deg[1] == 0.0f && rv.spur_deg[2] == 0.0f &&
+              rv.spur_deg[3] == 0.0f);
   for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.006f / (float)RATE_VALID_SLEW_UPDATES; /* 0.06 deg/s: beyond the cap */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, k_no_mid, 0.0f);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
   /* Beyond it: into the shadow (P_f carries 0.006 deg per window of it) */
@@ -216,6 +219,36 @@ static void test_onsets_counted(void **state)
   assert_string_equal(rate_valid_reason_name(RATE_INVALID_KINDS), "?");
 }
 
+/* The shadow's transition (rate_valid_spur_matrix) is the compensation's filters
+ * (comp_filters_step) run on a leaking move of P_f, for one, two and three stages: from
+ * any state, RATE_VALID_SLEW_UPDATES updates of both agree. */
+static void test_spur_matrix_is_the_filters(void **state)
+{
+  (void)state;
+  const float ca = 4e-3f, ga = 1e-3f;
+  for (uint32_t stages = 1u; stages <= COMP_STAGES_MAX; stages++) {
+    float m[RATE_VALID_SPUR_M];
+    rate_valid_spur_matrix(ca, ga, stages, m);
+    double s = 1.0;
+    float mid[2] = {stages >= 2u ? 0.3f : 0.0f, stages >= 3u ? 0.4f : 0.0f};
+    float lag = 0.5f, hp = -0.2f;
+    const double x0[5] = {s, mid[0], mid[1], lag, hp};
+    for (uint32_t n = 0; n < RATE_VALID_SLEW_UPDATES; n++) {
+      const double step = -(double)ca * s;
+      s += step;
+      comp_filters_step(&lag, mid, &hp, (float)step, ca, ga, stages);
+    }
+    const double x1[5] = {s, mid[0], mid[1], lag, hp};
+    int k = 0;
+    for (uint32_t i = 0; i < 5u; i++) {
+      double y = 0.0;
+      for (uint32_t j = 0; j <= i; j++) y += (double)m[k++] * x0[j];
+      if (i >= 1u && i < 3u && i >= stages) continue; /* a stage not in use */
+      assert_true(fabs(y - x1[i]) < 1e-5);
+    }
+  }
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -227,6 +260,7 @@ int main(void)
       cmocka_unit_test(test_thermo_range_about_reference),
       cmocka_unit_test(test_thermo_slew),
       cmocka_unit_test(test_onsets_counted),
+      cmocka_unit_test(test_spur_matrix_is_the_filters),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

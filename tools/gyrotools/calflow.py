@@ -320,7 +320,8 @@ def linearity(part, values):
 def thermal(part, values):
     """Stage 3: the temperature compensation from a chamber run (gyrotools.thermcal)."""
     path = os.path.join(part.work, "thermal_params.json")
-    values = dict(values, **{"rate.comp_tau_s": thermcal.COMP_TAU_S})
+    values = dict(values, **{"rate.comp_tau_s": part.protocol.comp_tau_s,
+                              "rate.comp_stages": part.protocol.comp_stages})
     paramset.write(path, paramset.from_values(values, meta={"stage": "thermal"}))
     temps = part.protocol.cal_plateaus_c
     scen = _scenario(part, "calibrate_thermal", thermcal.plateau_scenario(
@@ -333,7 +334,9 @@ def thermal(part, values):
                                                 values.get("rate.lin_c2_per_dps", 0.0),
                                                 values.get("rate.lin_c3_per_dps2", 0.0))
     comp, s0, figs = thermcal.fit(log, temps, part.protocol.dwell_s,
-                                  part.protocol.span_from_data)
+                                  part.protocol.span_from_data,
+                                  comp_tau_s=part.protocol.comp_tau_s,
+                                  comp_stages=part.protocol.comp_stages)
     if not (np.isfinite(s0) and s0 > 0.0) or not all(np.isfinite(v) for v in comp.values()):
         raise FlowError(f"thermal calibration: implausible fit (scale {s0:.6g}) ({cmd})")
     v = dict(values)

@@ -37,7 +37,9 @@ def test_span_from_data_covers_the_transients():
     ref_d, half_d = thermcal.fitted_span(log, pts, True)
     assert (ref_pl, half_pl) == pytest.approx((25.0, 0.1))
     assert ref_d == pytest.approx(25.0, abs=0.02)
-    assert half_d == pytest.approx(0.5, abs=0.03)  # P_c's 5 s low-pass trims the peaks
+    # P_c's low-passes (two of 25 s) trim the peaks: 0.5 / (1 + (w tau)^2)
+    w_tau = 2 * np.pi / 400.0 * thermcal.COMP_TAU_S
+    assert half_d == pytest.approx(0.5 / (1 + w_tau ** 2) ** (thermcal.COMP_STAGES / 2), abs=0.03)
 
 
 def test_quick_ramp_and_plateaus_lie_inside_its_calibrated_range():
@@ -45,3 +47,57 @@ def test_quick_ramp_and_plateaus_lie_inside_its_calibrated_range():
     lo, hi = min(q.cal_plateaus_c), max(q.cal_plateaus_c)
     assert all(lo < t < hi for t in q.verify_plateaus_c + q.ramp[:2])
     assert not set(q.verify_plateaus_c) & set(q.cal_plateaus_c)
+
+
+def test_comp_thermometer_starts_where_the_firmwares_does():
+    # A gyro-sim log's first row has P_f = 0 (before the first P update); the firmware's
+    # P_c starts at P_f once P_f has settled (comp_filters.h), so a slow P_c must not
+    # creep up from that 0 for its time constants and read as a temperature change.
+    log = _log(lambda t: np.where(t < 0.05, 0.0, 25.0), 300.0)
+    t = log["t_s"]
+    p_c = thermcal.comp_thermometer(t, log["p_f_deg"], 20.0)
+    after = t >= thermcal.START_S
+    assert np.max(np.abs(p_c[after] - 25.0)) < 1e-9
+
+
+def _noise_log(dur_s, slow_dps, seed=1):
+    # rate_unc: white, 0.1 deg/s per sample at 100 Hz; rate_dps: the same plus a slow
+    # wander (white noise through a 20 s low-pass) that the 1 s deviation hardly sees.
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, dur_s, 0.01)
+    unc = 0.1 * rng.standard_normal(t.size)
+    keep = np.exp(-0.01 / 20.0)
+    from scipy.signal import lfilter
+    lead = 20000  # 10 time constants of the low-pass, dropped: a stationary wander
+    slow = lfilter([1 - keep], [1, -keep], rng.standard_normal(t.size + lead))[lead:]
+    slow *= slow_dps / np.sqrt((1 - keep) / (1 + keep))
+    return {"t_s": t, "rate_unc_dps": unc, "rate_dps": unc + slow}
+
+
+def test_noise_ratio_judged_at_10s_on_a_long_record():
+    proto = thermcal.FULL
+    # Within 1.1x at 1 s, well beyond it at 10 s: a failed verification.
+    r = thermcal.verify_noise(_noise_log(proto.noise_s + thermcal.START_S, 0.01), proto)
+    assert r["ratio"] <= thermcal.LIMITS["noise_ratio"]
+    assert r["ratio_10s"] > 1.5
+    assert r["ratio_10s_judged"] and not r["ok"]
+    assert "10 s (judged)" in r["how"]
+    # No slow wander: both ratios about 1, passed.
+    r = thermcal.verify_noise(_noise_log(proto.noise_s + thermcal.START_S, 0.0), proto)
+    assert r["ratio_10s"] == pytest.approx(1.0, abs=1e-9) and r["ok"]
+
+
+def test_noise_ratio_at_10s_reported_only_on_a_short_record():
+    proto = thermcal.QUICK
+    r = thermcal.verify_noise(_noise_log(proto.noise_s + thermcal.START_S, 0.01), proto)
+    assert r["ratio_10s"] > 1.5
+    assert not r["ratio_10s_judged"] and r["ok"]
+    assert "reported" in r["how"]
+
+
+def test_each_protocol_fits_with_its_own_thermometer_filter():
+    # The full protocol's settled plateaus take the slow three-stage thermometer; the quick
+    # one's 400 s plateaus are all transients and keep one 5 s stage (with three of 15 s the
+    # default part's quick calibration left -0.39 deg/s at 20 degC).
+    assert (thermcal.FULL.comp_tau_s, thermcal.FULL.comp_stages) == (15.0, 3)
+    assert (thermcal.QUICK.comp_tau_s, thermcal.QUICK.comp_stages) == (5.0, 1)
