@@ -218,78 +218,69 @@ static void test_compensation_thermometer_lowpass(void **state)
   assert_true(fabs((double)rc.rate_dps + c1 * dp_deg) < 1e-4);
 }
 
-/* Two stages (rate.comp_stages 2): after a step of P, P_c has 1 - 2/e of it at one
- * rate.comp_tau_s (one stage: 1 - 1/e), all of it in the end; on a ramp of P, P_c lags
- * P_f by 2 tau (the gradient term's to take); a stage count outside 1..3 is refused. */
-static void test_compensation_thermometer_two_stages(void **state)
+/* The compensation thermometer with n stages of tau = 2 s (c1 = 10 (deg/s)/deg): after
+ * a step of P of 0.1 deg held step_s, the output has a fraction in (lo, hi) of its final
+ * value (P_f's own 1 Hz low-pass, 0.16 s, delays it a little), all of it after settle_s
+ * more; then a ramp of 0.01 deg/s for ramp_s leaves P_c behind P_f by n tau, to tol. */
+static void check_stages(uint32_t n, double step_s, double lo, double hi, double settle_s,
+                         double ramp_s, double tol)
 {
-  (void)state;
   biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
   rate_channel_cfg_t c = base_cfg(sec, 0.0f);
   const double tau_s = 2.0, c1 = 10.0, dp_deg = 0.1;
   c.p_lpf_alpha = 1.25e-2f;
   c.bias_c_dps[1] = (float)c1;
   c.comp_a = (float)(1.0 - exp(-(RATE_P_DECIM / 50000.0) / tau_s));
-  c.comp_stages = 2u;
+  c.comp_stages = n;
   rate_channel_t rc;
   assert_int_equal(rc_init(&rc, &c), 0);
   rate_channel_reset(s_cfg, &rc, 0.0f);
   const long blocks_per_s = 50000 / RATE_DECIM;
-  for (long n = 0; n < 2 * blocks_per_s; n++) block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f);
+  for (long k = 0; k < 2 * blocks_per_s; k++) block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f);
   assert_true(fabs((double)rc.rate_dps) < 1e-6);
   const float p_rad = (float)(dp_deg * M_PI / 180.0);
-  for (long n = 0; n < 2 * blocks_per_s; n++) block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, p_rad);
-  /* 1 - 2/e = 0.264 at 2 s; P_f's own 1 Hz low-pass (0.16 s) delays it: 0.225 .. 0.265
-   * (one stage would be past 0.55) */
+  for (long k = 0; k < (long)(step_s * blocks_per_s); k++)
+    block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, p_rad);
   const double frac = -(double)rc.rate_dps / (c1 * dp_deg);
-  assert_true(frac > 0.225 && frac < 0.265);
-  for (long n = 0; n < 40 * blocks_per_s; n++) block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, p_rad);
+  print_message("%u stages: %.4f of the step at %.0f s\n", n, frac, step_s);
+  assert_true(frac > lo && frac < hi);
+  for (long k = 0; k < (long)(settle_s * blocks_per_s); k++)
+    block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, p_rad);
   assert_true(fabs((double)rc.rate_dps + c1 * dp_deg) < 1e-4);
-  /* A ramp of 0.01 deg/s for 60 s: P_f - P_c = 2 tau x 0.01 = 0.04 deg, to 1 %. */
   const double slope_deg_s = 0.01;
   double p_deg = dp_deg;
-  for (long n = 0; n < 60 * blocks_per_s; n++) {
+  for (long k = 0; k < (long)(ramp_s * blocks_per_s); k++) {
     p_deg += slope_deg_s / (double)blocks_per_s;
     block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, (float)(p_deg * M_PI / 180.0));
   }
-  assert_true(fabs((double)rc.p_comp_lag_deg - 2.0 * tau_s * slope_deg_s) < 4e-4);
+  assert_true(fabs((double)rc.p_comp_lag_deg - (double)n * tau_s * slope_deg_s) < tol);
+}
+
+/* Two stages (rate.comp_stages 2): after a step of P, P_c has 1 - 2/e = 0.264 of it at
+ * one rate.comp_tau_s (one stage would be past 0.55), all of it in the end; on a ramp
+ * of P, P_c lags P_f by 2 tau (the gradient term's to take), to 1 %; a stage count
+ * outside 1..3 is refused. */
+static void test_compensation_thermometer_two_stages(void **state)
+{
+  (void)state;
+  check_stages(2u, 2.0, 0.225, 0.265, 40.0, 60.0, 4e-4);
+  biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
+  rate_channel_cfg_t c = base_cfg(sec, 0.0f);
+  rate_channel_t rc;
+  c.comp_stages = COMP_STAGES_MAX;
+  assert_int_equal(rc_init(&rc, &c), 0);
   c.comp_stages = COMP_STAGES_MAX + 1u;
   assert_int_equal(rc_init(&rc, &c), -1);
   c.comp_stages = 0u;
   assert_int_equal(rc_init(&rc, &c), -1);
 }
 
-/* Three stages: at 3 tau after a step P_c has 1 - (1 + 3 + 9/2)/e^3 = 0.577 of it; on a
- * ramp it lags P_f by 3 tau. */
+/* Three stages: at 3 tau after a step P_c has 1 - (1 + 3 + 9/2)/e^3 = 0.577 of it (two
+ * stages: 0.80); on a ramp it lags P_f by 3 tau. */
 static void test_compensation_thermometer_three_stages(void **state)
 {
   (void)state;
-  biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
-  rate_channel_cfg_t c = base_cfg(sec, 0.0f);
-  const double tau_s = 2.0, c1 = 10.0, dp_deg = 0.1;
-  c.p_lpf_alpha = 1.25e-2f;
-  c.bias_c_dps[1] = (float)c1;
-  c.comp_a = (float)(1.0 - exp(-(RATE_P_DECIM / 50000.0) / tau_s));
-  c.comp_stages = 3u;
-  rate_channel_t rc;
-  assert_int_equal(rc_init(&rc, &c), 0);
-  rate_channel_reset(s_cfg, &rc, 0.0f);
-  const long blocks_per_s = 50000 / RATE_DECIM;
-  for (long n = 0; n < 2 * blocks_per_s; n++) block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f);
-  const float p_rad = (float)(dp_deg * M_PI / 180.0);
-  for (long n = 0; n < 6 * blocks_per_s; n++) block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, p_rad);
-  /* 0.577 at 6 s; P_f's own 0.16 s delays it: 0.55 .. 0.58 (two stages: 0.80) */
-  const double frac = -(double)rc.rate_dps / (c1 * dp_deg);
-  assert_true(frac > 0.55 && frac < 0.58);
-  for (long n = 0; n < 60 * blocks_per_s; n++) block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, p_rad);
-  assert_true(fabs((double)rc.rate_dps + c1 * dp_deg) < 1e-4);
-  const double slope_deg_s = 0.01;
-  double p_deg = dp_deg;
-  for (long n = 0; n < 80 * blocks_per_s; n++) {
-    p_deg += slope_deg_s / (double)blocks_per_s;
-    block(&rc, 1.0f, 0.0f, 0.0f, 0.0f, (float)(p_deg * M_PI / 180.0));
-  }
-  assert_true(fabs((double)rc.p_comp_lag_deg - 3.0 * tau_s * slope_deg_s) < 6e-4);
+  check_stages(3u, 6.0, 0.55, 0.58, 60.0, 80.0, 6e-4);
 }
 
 /* The rate's own turn of P (the reciprocal Coriolis force on the drive mode) is no
