@@ -204,6 +204,10 @@ static void put_fault(cli_t *cli, app_t *a)
 static void put_rate(cli_t *cli, app_t *a)
 {
   cli_data_f32(cli, "rate_dps", a->gyro.out.rate_dps);
+  /* The temperature compensation taken off, and the fast thermometer's weight in it
+   * (rate_channel_comp_refresh: 0 at rest, 1 in a transient the slow one lags). */
+  cli_data_f32(cli, "comp_bias_dps", a->gyro.rate.comp_bias_dps);
+  cli_data_f32(cli, "comp_fast_w", a->gyro.rate.comp_fast_w);
 }
 
 static void put_drive(cli_t *cli, app_t *a)

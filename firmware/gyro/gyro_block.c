@@ -195,6 +195,10 @@ GYRO_RAMFUNC void gyro_block_p(gyro_t *g, int hold)
     if (rate_valid_slew(&d->valid, &g->valid, rc->p_comp_lag_deg, rc->p_comp_mid_deg,
                         rc->p_hp_deg))
       rate_channel_comp_restart(rc);
+  } else if (rc->comp_due != 0u) {
+    /* The compensation of the filters' new state, on a block with neither check: the
+     * rate takes it from the next block on (a P_f is 10 blocks apart). */
+    rate_channel_comp_refresh(&d->rate, rc);
   }
   /* Last, as a tail call: its new P_f is flagged in rc->p_new. */
   (void)rate_channel_update_p(&d->rate, rc, g->drive.p_eq_rad);

@@ -304,6 +304,13 @@ static gyro_design_status_t design_rate(const param_values_t *v, double tau_s, g
                                  exp(-(double)RATE_P_DECIM / (fs * (double)v->rate_comp_tau_s)))
                        : 1.0f;
   t->rate.comp_stages = v->rate_comp_stages;
+  t->rate.comp_fast_a = v->rate_comp_fast_tau_s > 0.0f
+                            ? (float)(1.0 - exp(-(double)RATE_P_DECIM /
+                                                (fs * (double)v->rate_comp_fast_tau_s)))
+                            : 0.0f;
+  t->rate.grad_fast_k_dps_per_deg = v->rate_grad_fast_dps_per_deg;
+  t->rate.blend_dps = v->rate_comp_blend_dps;
+  t->rate.blend_inv_per_dps = 1.0f / v->rate_comp_blend_dps;
   t->rate.grad_a = (float)(1.0 - exp(-(double)RATE_P_DECIM / (fs * (double)v->rate_grad_tau_s)));
   /* First-order low-pass of P at the decimated rate fs / RATE_P_DECIM. */
   t->rate.p_lpf_alpha = (float)(1.0 - exp(-2.0 * FM_PI * (double)v->rate_p_lpf_hz *

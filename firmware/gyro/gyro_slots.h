@@ -39,7 +39,7 @@
  *         the block's rail codes; the continuous
  *         self-test's modulation
  *   6     the continuous self-test's notch (rate axis);   projection (5), modulation (5)
- *         rate: output filter, scale, compensation;       P_f (8, last block)
+ *         rate: output filter, scale, compensation;       its refresh (8, a block before)
  *         its range check (or, after a clear, the rate
  *         channel's reset)
  *   7     finiteness check, second half (loop and rate    weights' half (2)
@@ -49,7 +49,9 @@
  *   8     P's hold and low-pass (its mean every 10th      P (1)
  *         block), the thermometer checks of the P_f       P_f (8, last block)
  *         made the block before, the slew of a window     P_f (8, last blocks)
- *         that ended the block before that; the self-
+ *         that ended the block before that, or else      P_f (8, last blocks)
+ *         the compensation's refresh (bias and scale
+ *         factor of the filters' new state); the self-
  *         test sequence while it runs                     projection (5)
  *   9     rate-valid verdict, rate half of the output     checks (2, 6, 7), rails (5),
  *         snapshot, analog rate code (the fault level     everything

@@ -30,11 +30,14 @@ int rate_channel_cfg_ok(const rate_channel_cfg_t *cfg)
          fm_isfinite(cfg->p_rate_deg_per_dps) && fm_isfinite(cfg->p_rate_c1_per_dps) &&
          fm_isfinite(cfg->p_rate2_deg_per_dps2) && cfg->comp_a > 0.0f && cfg->comp_a <= 1.0f &&
          cfg->comp_stages >= 1u && cfg->comp_stages <= COMP_STAGES_MAX &&
-         fm_isfinite(cfg->min_drive_v) && fm_isfinite(cfg->p_ref_deg) && cfg->p_mode_k > 0.0f &&
-         cfg->p_mode_k <= 1.0f && cfg->ref_lp_kp > 0.0f && cfg->ref_lp_kp < 1.0f &&
-         cfg->ref_lp_ki > 0.0f && cfg->ref_lp_ki < cfg->ref_lp_kp && cfg->ref_wide_kp > 0.0f &&
-         cfg->ref_wide_kp < 1.0f && cfg->ref_wide_ki > 0.0f &&
-         cfg->ref_wide_ki < cfg->ref_wide_kp;
+         cfg->comp_fast_a >= 0.0f && cfg->comp_fast_a <= 1.0f &&
+         fm_isfinite(cfg->grad_fast_k_dps_per_deg) && cfg->blend_dps > 0.0f &&
+         fm_isfinite(cfg->blend_dps) && cfg->blend_inv_per_dps > 0.0f &&
+         fm_isfinite(cfg->blend_inv_per_dps) && fm_isfinite(cfg->min_drive_v) &&
+         fm_isfinite(cfg->p_ref_deg) && cfg->p_mode_k > 0.0f && cfg->p_mode_k <= 1.0f &&
+         cfg->ref_lp_kp > 0.0f && cfg->ref_lp_kp < 1.0f && cfg->ref_lp_ki > 0.0f &&
+         cfg->ref_lp_ki < cfg->ref_lp_kp && cfg->ref_wide_kp > 0.0f && cfg->ref_wide_kp < 1.0f &&
+         cfg->ref_wide_ki > 0.0f && cfg->ref_wide_ki < cfg->ref_wide_kp;
 }
 
 int rate_channel_init(const rate_channel_cfg_t *cfg, rate_channel_t *rc)
@@ -61,6 +64,7 @@ void rate_channel_rebase(const rate_channel_cfg_t *old, const rate_channel_cfg_t
   rc->p_dev_deg = rc->p_f_deg - cfg->p_ref_deg;
   rc->p_acc_deg = 0.0f;
   rc->p_count = 0u;
+  rc->comp_due = 1u; /* the new configuration's compensation, from the next refresh */
 }
 
 int rate_channel_same_path(const rate_channel_cfg_t *a, const rate_channel_cfg_t *b)
@@ -71,7 +75,9 @@ int rate_channel_same_path(const rate_channel_cfg_t *a, const rate_channel_cfg_t
              a->p_rate_deg_per_dps == b->p_rate_deg_per_dps &&
              a->p_rate_c1_per_dps == b->p_rate_c1_per_dps &&
              a->p_rate2_deg_per_dps2 == b->p_rate2_deg_per_dps2 && a->comp_a == b->comp_a &&
-             a->comp_stages == b->comp_stages && a->lpf_sections == b->lpf_sections;
+             a->comp_stages == b->comp_stages && a->comp_fast_a == b->comp_fast_a &&
+             a->grad_fast_k_dps_per_deg == b->grad_fast_k_dps_per_deg &&
+             a->blend_dps == b->blend_dps && a->lpf_sections == b->lpf_sections;
   for (int i = 0; i < 4; i++) {
     same = same && a->bias_c_dps[i] == b->bias_c_dps[i] && a->sf_c[i] == b->sf_c[i];
   }
@@ -110,8 +116,11 @@ GYRO_RAMFUNC void rate_channel_reset(const rate_channel_cfg_t *restrict cfg,
   rc->ref_wide_left = cfg->ref_wide_blocks;
   rc->ref_kp = cfg->ref_wide_kp;
   rc->ref_ki = cfg->ref_wide_ki;
+  rc->p_fast_lag_deg = 0.0f;
+  rc->p_fast_hp_deg = 0.0f;
   rc->p_f_deg = p_deg;
   rc->rate_dps = 0.0f;
+  rate_channel_comp_refresh(cfg, rc);
 }
 
 /* Blocks of RATE_DECIM ticks per low-pass sample of P. */
@@ -185,20 +194,6 @@ GYRO_RAMFUNC void rate_channel_project(const rate_channel_cfg_t *restrict cfg,
 GYRO_RAMFUNC void rate_channel_filter_rate(const rate_channel_cfg_t *restrict cfg,
                                            rate_channel_t *restrict rc)
 {
-  /* Temperature compensation in P_c (P_f low-passed again, rate.comp_tau_s; the thesis
-   * fits the bias linear in P, 7.3.2), in its deviation from the calibration's
-   * reference (x = P_c - cal.ref_p_deg); formed before the filter so that the
-   * configuration is
-   * not needed after it. */
-  const float p = rc->p_dev_deg - rc->p_comp_lag_deg + cfg->p_poly_off_deg;
-  const float *b3 = cfg->bias_c_dps, *s3 = cfg->sf_c;
-  /* The gradient term: in a thermal transient the structure and the pickoff circuit part,
-   * and P (which weighs them otherwise than the bias does) reads a temperature the bias
-   * does not have; their difference follows P's recent change, which P - LP_tau(P)
-   * measures without a derivative's noise (rate.grad_tau_s). */
-  const float bias = b3[0] + p * (b3[1] + p * (b3[2] + p * b3[3])) +
-                     cfg->grad_k_dps_per_deg * rc->p_hp_deg;
-  const float sf = 1.0f + p * (s3[1] + p * (s3[2] + p * (s3[3] + p * s3[4])));
   const float scale = cfg->scale_dps;
   const float unc = scale * biquad_sections_step(cfg->lpf, rc->lpf_rate, cfg->lpf_sections,
                                                  rc->rate_raw);
@@ -206,7 +201,7 @@ GYRO_RAMFUNC void rate_channel_filter_rate(const rate_channel_cfg_t *restrict cf
   /* The linearisation acts on the whole in-phase signal (rate and raw bias), as the
    * pickoff's nonlinearity does (rate_channel.h). */
   const float lin = unc + unc * unc * (cfg->lin_c2_per_dps + unc * cfg->lin_c3_per_dps2);
-  rc->rate_dps = lin * sf - bias;
+  rc->rate_dps = lin * rc->comp_sf - rc->comp_bias_dps;
 }
 
 GYRO_RAMFUNC void rate_channel_filter_quad(const rate_channel_cfg_t *restrict cfg,
@@ -219,6 +214,7 @@ GYRO_RAMFUNC void rate_channel_filter_quad(const rate_channel_cfg_t *restrict cf
 void rate_channel_update(const rate_channel_cfg_t *cfg, rate_channel_t *rc, float w_i,
                          float w_q, float p_rad, float e_rad)
 {
+  if (rc->comp_due != 0u) rate_channel_comp_refresh(cfg, rc);
   rate_channel_project(cfg, rc, w_i, w_q, p_rad, e_rad);
   rate_channel_filter_rate(cfg, rc);
   rate_channel_filter_quad(cfg, rc);
@@ -231,6 +227,7 @@ GYRO_RAMFUNC void rate_channel_shift_p(rate_channel_t *restrict rc, float shift_
   rc->p_held_dev_deg += shift_deg;
   rc->p_acc_deg += shift_deg * (float)rc->p_count;
   rc->p_last_rad += shift_deg * FM_RAD_PER_DEG_F; /* the lag does not see the turn */
+  rc->comp_due = 1u;
 }
 
 /* The compensation's filters (comp_filters.h) take P_f's step. */
@@ -240,13 +237,17 @@ GYRO_RAMFUNC static inline void comp_filters_update(const rate_channel_cfg_t *re
   if (rc->p_held_w > COMP_FILTERS_HELD_W_MAX) {
     /* P_f's way from a held value to P is no temperature change: the filters start once
      * that value weighs less than COMP_FILTERS_HELD_W_MAX in P_f. */
-    rc->p_comp_lag_deg = 0.0f;
-    rc->p_comp_mid_deg[0] = rc->p_comp_mid_deg[1] = 0.0f;
-    rc->p_hp_deg = 0.0f;
+    rate_channel_comp_restart(rc);
     return;
   }
   comp_filters_step(&rc->p_comp_lag_deg, rc->p_comp_mid_deg, &rc->p_hp_deg, step, cfg->comp_a,
                     cfg->grad_a, cfg->comp_stages);
+  if (cfg->comp_fast_a > 0.0f) {
+    float unused[COMP_STAGES_MAX - 1u]; /* one stage has no middle */
+    comp_filters_step(&rc->p_fast_lag_deg, unused, &rc->p_fast_hp_deg, step, cfg->comp_fast_a,
+                      cfg->grad_a, 1u);
+  }
+  rc->comp_due = 1u;
 }
 
 GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
@@ -258,9 +259,7 @@ GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
     rc->p_n = 0u;
     rc->p_held_dev_deg = rc->p_dev_deg;
     rc->p_held_w = 1.0f;
-    rc->p_hp_deg = 0.0f;
-    rc->p_comp_lag_deg = 0.0f;
-    rc->p_comp_mid_deg[0] = rc->p_comp_mid_deg[1] = 0.0f;
+    rate_channel_comp_restart(rc);
   } else {
     rc->p_acc_deg += p_rad * FM_DEG_PER_RAD_F - cfg->p_ref_deg;
     if (++rc->p_count == 1u && rc->p_n < RATE_P_FAST_MAX) {
@@ -307,4 +306,40 @@ GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
     }
   }
   return 0;
+}
+
+/* B(x) + k_g h for a thermometer lag and its high-pass. */
+GYRO_RAMFUNC static inline float comp_bias(const rate_channel_cfg_t *restrict cfg, float x,
+                                           float grad_k, float hp_deg)
+{
+  const float *b3 = cfg->bias_c_dps;
+  return b3[0] + x * (b3[1] + x * (b3[2] + x * b3[3])) + grad_k * hp_deg;
+}
+
+GYRO_RAMFUNC void rate_channel_comp_refresh(const rate_channel_cfg_t *restrict cfg,
+                                            rate_channel_t *restrict rc)
+{
+  /* Temperature compensation in P_c (P_f low-passed again, rate.comp_tau_s; the thesis
+   * fits the bias linear in P, 7.3.2), in its deviation from the calibration's reference
+   * (x = P_c - cal.ref_p_deg). The gradient term: in a thermal transient the structure
+   * and the pickoff circuit part, and P (which weighs them otherwise than the bias does)
+   * reads a temperature the bias does not have; their difference follows P's recent
+   * change, which P - LP_tau(P) measures without a derivative's noise (rate.grad_tau_s). */
+  rc->comp_due = 0u;
+  const float base = rc->p_dev_deg + cfg->p_poly_off_deg;
+  const float x = base - rc->p_comp_lag_deg;
+  const float *s3 = cfg->sf_c;
+  rc->comp_sf = 1.0f + x * (s3[1] + x * (s3[2] + x * (s3[3] + x * s3[4])));
+  float bias = comp_bias(cfg, x, cfg->grad_k_dps_per_deg, rc->p_hp_deg);
+  float w = 0.0f;
+  if (cfg->comp_fast_a > 0.0f) {
+    /* The blend (rate_channel.h): the fast path where the slow one lags a transient. */
+    const float d = comp_bias(cfg, base - rc->p_fast_lag_deg, cfg->grad_fast_k_dps_per_deg,
+                              rc->p_fast_hp_deg) -
+                    bias;
+    w = fm_clampf((fm_absf(d) - cfg->blend_dps) * cfg->blend_inv_per_dps, 0.0f, 1.0f);
+    bias += w * d;
+  }
+  rc->comp_fast_w = w;
+  rc->comp_bias_dps = bias;
 }

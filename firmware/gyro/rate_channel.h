@@ -98,17 +98,21 @@ typedef struct {
   float sf_c[5];        /* [0] unused: SF(x) = 1 + c1 x + .. + c4 x^4 */
   float lin_c2_per_dps; /* L(u) = u + c2 u^2 + c3 u^3 */
   float lin_c3_per_dps2;
-  float p_ref_deg;            /* P around which its low-pass works (the start value) */
-  float p_poly_off_deg;       /* p_ref - cal.ref_p_deg: x = p_dev + this at P_f, the
+  float p_ref_deg;               /* P around which its low-pass works (the start value) */
+  float p_poly_off_deg;          /* p_ref - cal.ref_p_deg: x = p_dev + this at P_f, the
                              * compensation polynomials' variable */
-  float p_lpf_alpha;          /* first-order low-pass of P at fs / RATE_P_DECIM */
-  float grad_k_dps_per_deg;   /* bias per degree of P_f's high-pass: the thermal gradient */
-  float grad_a;               /* that high-pass's 1 - exp(-T / tau) per new P_f */
-  float p_rate_deg_per_dps;   /* P's turn per deg/s of rate, taken out of the thermometer */
-  float p_rate_c1_per_dps;    /* its change per degree of x (the compensation's variable) */
-  float p_rate2_deg_per_dps2; /* P's turn per (deg/s)^2 of rate */
-  float comp_a;               /* P_c's low-pass of P_f: 1 - exp(-T / comp_tau) per new P_f */
-  uint32_t comp_stages;       /* first-order stages of that low-pass, 1..COMP_STAGES_MAX */
+  float p_lpf_alpha;             /* first-order low-pass of P at fs / RATE_P_DECIM */
+  float grad_k_dps_per_deg;      /* bias per degree of P_f's high-pass: the thermal gradient */
+  float grad_a;                  /* that high-pass's 1 - exp(-T / tau) per new P_f */
+  float p_rate_deg_per_dps;      /* P's turn per deg/s of rate, taken out of the thermometer */
+  float p_rate_c1_per_dps;       /* its change per degree of x (the compensation's variable) */
+  float p_rate2_deg_per_dps2;    /* P's turn per (deg/s)^2 of rate */
+  float comp_a;                  /* P_c's low-pass of P_f: 1 - exp(-T / comp_tau) per new P_f */
+  uint32_t comp_stages;          /* first-order stages of that low-pass, 1..COMP_STAGES_MAX */
+  float comp_fast_a;             /* the fast path's one low-pass of P_f (0: no fast path) */
+  float grad_fast_k_dps_per_deg; /* the fast path's gradient term */
+  float blend_dps;               /* the paths' difference where the fast one starts to weigh */
+  float blend_inv_per_dps;       /* 1 / blend_dps */
   float p_mode_k;  /* per-block factor of the resonance's lag: 1 - exp(-T_block / (2Q/wn)) */
   float ref_lp_kp; /* LP2 per block: 2 zeta wn T_block ... */
   float ref_lp_ki; /* ... and (wn T_block)^2 */
@@ -130,7 +134,13 @@ typedef struct {
   float p_hp_deg;       /* P_c - LP_tau(P_c): the gradient term's input */
   float p_comp_lag_deg; /* P_f - P_c: P_c the compensation's thermometer */
   float p_comp_mid_deg[COMP_STAGES_MAX - 1u]; /* P_f - P_k, P_c's stages before its last */
-  float p_last_rad;                           /* P at the last projection */
+  float p_fast_lag_deg;                       /* P_f - P_c of the fast path */
+  float p_fast_hp_deg;                        /* its P_c - LP_tau(P_c) */
+  float comp_bias_dps;    /* the compensation's bias and scale factor at the filters' latest */
+  float comp_sf;          /* state (rate_channel_comp_refresh) */
+  float comp_fast_w;      /* the fast path's weight in that bias, 0..1 */
+  uint32_t comp_due;      /* the filters moved: the compensation is to be refreshed */
+  float p_last_rad;       /* P at the last projection */
   float p_lag_rad;        /* P - LP_tau(P): the resonance's lag still to come */
   float ref_dev_rad;      /* the reference's correction delta = theta - set */
   float ref_slope_rad;    /* LP2's slope state, per block */
@@ -199,7 +209,21 @@ static inline void rate_channel_comp_restart(rate_channel_t *rc)
   rc->p_comp_lag_deg = 0.0f;
   rc->p_comp_mid_deg[0] = rc->p_comp_mid_deg[1] = 0.0f;
   rc->p_hp_deg = 0.0f;
+  rc->p_fast_lag_deg = 0.0f;
+  rc->p_fast_hp_deg = 0.0f;
+  rc->comp_due = 1u;
 }
+
+/* The temperature compensation (bias, scale factor) from the filters' state, where
+ * rate_channel_filter_rate takes it. The filters move only with a new P_f (every
+ * RATE_P_BLOCKS blocks), a hold, a restart or a wrap, each of which sets comp_due: the
+ * caller refreshes on a block whose P slot has room (gyro_block_p), so the rate's own
+ * tick carries no polynomial. With a fast path (comp_fast_a > 0) the bias blends the two:
+ *   d = B_fast - B_slow,  w = clamp((|d| - blend) / blend, 0, 1),  B = B_slow + w d,
+ * the slow thermometer's (low noise at 10 s) while the two agree within blend_dps, the
+ * fast one's beyond twice that (a transient the slow one lags), and never further from
+ * the fast one than blend_dps in between. */
+void rate_channel_comp_refresh(const rate_channel_cfg_t *cfg, rate_channel_t *rc);
 
 /* Once per RATE_DECIM ticks, after the block's last accumulate. (w_i, w_q): the drive
  * LMSD's weights (only to tell that the drive runs); p_rad: force phase (the phase loop
@@ -215,7 +239,7 @@ void rate_channel_update(const rate_channel_cfg_t *cfg, rate_channel_t *rc, floa
  *   rate_channel_project      block mean of S, reference correction -> rate_raw, quad_raw
  *                             (clears the sum: the next block starts here)
  *   rate_channel_filter_rate  after project: output low-pass and scale of rate_raw,
- *                             compensation in P_f -> rate_unc_dps, rate_dps
+ *                             the compensation's latest refresh -> rate_unc_dps, rate_dps
  *   rate_channel_filter_quad  after project: the same for quad_raw -> quad_dps
  *   rate_channel_update_p     any time: P's block sum, its low-pass every RATE_P_DECIM
  *                             ticks -> P_f (the compensation's from then on) */

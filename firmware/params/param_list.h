@@ -40,7 +40,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 12u
+#define PARAM_LAYOUT_VERSION 13u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -219,6 +219,23 @@
    * gradient term's to take, fitted with them in place (docs/compensation-noise.md) */ \
   X(rate_comp_stages, 0x031Du, "rate.comp_stages", U32, "-", 1u, 3u, 1u, 0u, \
     PF_PERSIST | PF_LIVE, "first-order stages of rate.comp_tau_s in the compensation's low-pass of P_f") \
+  /* 0: no fast path, the compensation is the slow thermometer's alone (the sets made
+   * before this parameter). A slow thermometer (stages x rate.comp_tau_s of lag) keeps the
+   * phase flicker out at 10 s but lags a fast transient (a cool-down's start), which its
+   * gradient term takes back only for a steady rate of change: a second, fast
+   * thermometer of one stage with its own gradient term carries the output while the two
+   * disagree (rate.comp_blend_dps) */ \
+  X(rate_comp_fast_tau_s, 0x031Eu, "rate.comp_fast_tau_s", F32, "s", 0.0f, 1000.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "the fast compensation path's one low-pass of P_f (0: no fast path)") \
+  /* uncalibrated: 0. Fitted by the flow with the fast thermometer in place, the same
+   * polynomial and rate.grad_tau_s */ \
+  X(rate_grad_fast_dps_per_deg, 0x031Fu, "rate.grad_fast_dps_per_deg", F32, "deg/s/deg", -10000.0f, 10000.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "the fast path's gradient term: deg/s per degree of its P_c above its low-pass") \
+  /* 0.1 deg/s: half the bias a compensation is held to (+-0.2 deg/s over temperature), so
+   * that where the blend departs from the fast path it is by less than that; the flow sets
+   * the part's own (4 sd of the two paths' difference at rest, within 0.02..0.1) */ \
+  X(rate_comp_blend_dps, 0x0320u, "rate.comp_blend_dps", F32, "deg/s", 0.001f, 10.0f, 0.1f, 0u, \
+    PF_PERSIST | PF_LIVE, "slow path while the fast one agrees within this; the fast path beyond twice this") \
   /* 50 % over the setpoint: beyond any PI overshoot, short of the stops */ \
   X(sup_amp_trip_rel, 0x0401u, "sup.amp_trip_rel", F32, "-", 1.2f, 5.0f, 1.5f, 0u, \
     PF_PERSIST | PF_LIVE, "over-amplitude trip, as a multiple of drive.amp_set_v") \

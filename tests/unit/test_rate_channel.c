@@ -25,6 +25,9 @@ static rate_channel_cfg_t base_cfg(biquad_coeffs_t *sec, float phi_dm)
                           .grad_a = 1.0f, /* no gradient term unless a test sets one */
                           .comp_a = 1.0f, /* the compensation reads P_f */
                           .comp_stages = 1u,
+                          .comp_fast_a = 0.0f, /* no fast path unless a test sets one */
+                          .blend_dps = 0.1f,
+                          .blend_inv_per_dps = 10.0f,
                           .p_mode_k = 2.7658e-2f, /* 1 - (1 - 2.8e-3)^10 per block */
                           /* 1 Hz, zeta 0.707 per 0.2 ms block (gyro_design.c) */
                           .ref_lp_kp = 1.7772e-3f,
@@ -283,6 +286,72 @@ static void test_compensation_thermometer_three_stages(void **state)
   check_stages(3u, 6.0, 0.55, 0.58, 60.0, 80.0, 6e-4);
 }
 
+/* The fast path (rate.comp_fast_tau_s) and the blend: a slow thermometer of three 2 s
+ * stages and a fast one of 0.5 s, bias slope c1 = 10 (deg/s)/deg, no gradient terms.
+ * At rest both agree: the slow path's output, the fast one's weight 0. On a ramp of P at
+ * r the slow one lags by 6 s r and the fast one by 0.5 s r, their biases differ by
+ * d = c1 5.5 s r: at r = 0.01 deg/s (d = 0.55 > 2 x 0.1) the output is the fast path's
+ * alone, as a channel of that one stage gives it; at r = 0.0025 (d = 0.1375, between
+ * blend and twice it) the weight is (d - blend) / blend and the output within blend of the
+ * fast path. A blend of 0 or a fast low-pass outside 0..1 is refused. */
+static void run_ramp(rate_channel_t *rc, const rate_channel_cfg_t *c, double r_deg_s, double s)
+{
+  const long blocks_per_s = 50000 / RATE_DECIM;
+  s_cfg = c;
+  double p_deg = 0.0;
+  for (long k = 0; k < 10 * blocks_per_s; k++) block(rc, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f);
+  assert_true(fabs((double)rc->rate_dps) < 1e-6);
+  assert_true(rc->comp_fast_w == 0.0f);
+  for (long k = 0; k < (long)(s * blocks_per_s); k++) {
+    p_deg += r_deg_s / (double)blocks_per_s;
+    block(rc, 1.0f, 0.0f, 0.0f, 0.0f, (float)(p_deg * M_PI / 180.0));
+  }
+}
+
+static void test_compensation_fast_path_blend(void **state)
+{
+  (void)state;
+  biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
+  const double t_upd_s = RATE_P_DECIM / 50000.0, c1 = 10.0, blend = 0.1;
+  rate_channel_cfg_t slow = base_cfg(sec, 0.0f);
+  slow.p_lpf_alpha = 1.25e-2f;
+  slow.bias_c_dps[1] = (float)c1;
+  slow.comp_a = (float)(1.0 - exp(-t_upd_s / 2.0));
+  slow.comp_stages = 3u;
+  slow.comp_fast_a = (float)(1.0 - exp(-t_upd_s / 0.5));
+  slow.blend_dps = (float)blend;
+  slow.blend_inv_per_dps = (float)(1.0 / blend);
+  rate_channel_cfg_t fast = slow; /* the fast path alone, as a channel of its own */
+  fast.comp_a = slow.comp_fast_a;
+  fast.comp_stages = 1u;
+  fast.comp_fast_a = 0.0f;
+  rate_channel_t rc, rf;
+  assert_int_equal(rc_init(&rc, &slow), 0);
+  assert_int_equal(rc_init(&rf, &fast), 0);
+  run_ramp(&rc, &slow, 0.01, 30.0);
+  run_ramp(&rf, &fast, 0.01, 30.0);
+  print_message("r 0.01: w %.3f, out %.5f, fast alone %.5f\n", (double)rc.comp_fast_w,
+                (double)rc.rate_dps, (double)rf.rate_dps);
+  assert_true(rc.comp_fast_w == 1.0f);
+  assert_true(fabs((double)rc.rate_dps - (double)rf.rate_dps) < 1e-5);
+  assert_true(fabs((double)rc.rate_dps + c1 * 0.01 * (30.0 - 0.5 - 0.16)) < 0.01);
+  assert_int_equal(rc_init(&rc, &slow), 0);
+  assert_int_equal(rc_init(&rf, &fast), 0);
+  run_ramp(&rc, &slow, 0.0025, 40.0);
+  run_ramp(&rf, &fast, 0.0025, 40.0);
+  const double d = c1 * 5.5 * 0.0025, w = (d - blend) / blend;
+  print_message("r 0.0025: w %.3f (%.3f), out %.5f, fast alone %.5f\n", (double)rc.comp_fast_w,
+                w, (double)rc.rate_dps, (double)rf.rate_dps);
+  assert_true(fabs((double)rc.comp_fast_w - w) < 0.02);
+  assert_true(fabs((double)rc.rate_dps - (double)rf.rate_dps) <= blend);
+  assert_true(fabs((double)rc.rate_dps - (double)rf.rate_dps) > 0.5 * (1.0 - w) * d);
+  slow.blend_dps = 0.0f;
+  assert_int_equal(rc_init(&rc, &slow), -1);
+  slow.blend_dps = (float)blend;
+  slow.comp_fast_a = 1.5f;
+  assert_int_equal(rc_init(&rc, &slow), -1);
+}
+
 /* The rate's own turn of P (the reciprocal Coriolis force on the drive mode) is no
  * temperature: with rate.p_rate_deg_per_dps set, P_f stays where it was while the rate
  * steps to 100 deg/s and P turns by 0.002 deg with it; without, it follows P. The turn
@@ -506,6 +575,7 @@ int main(void)
       cmocka_unit_test(test_compensation_thermometer_lowpass),
       cmocka_unit_test(test_compensation_thermometer_two_stages),
       cmocka_unit_test(test_compensation_thermometer_three_stages),
+      cmocka_unit_test(test_compensation_fast_path_blend),
       cmocka_unit_test(test_dc_linearity),
       cmocka_unit_test(test_reference_follows_drive_jitter),
       cmocka_unit_test(test_reference_high_q_loop),

@@ -325,13 +325,21 @@ static void stage_param(const char *name, param_value_t val)
 
 /* Every loop on: the continuous self-test too (it is off by default). It needs an
  * expectation, which the generic defaults leave 0 (a part's calibration measures it):
- * any nonzero one lets it run, and the bench measures its cost, not its verdict. Both
- * in one commit: the bank takes one change per tick. */
+ * any nonzero one lets it run, and the bench measures its cost, not its verdict. The
+ * temperature compensation as the calibration flow sets it (three stages of the slow
+ * thermometer and the fast path, whose blend has its cost on the P slot). All in one
+ * commit: the bank takes one change per tick. */
 static void continuous_selftest_on(void)
 {
   param_value_t val;
   val.f = 1.0f;
   stage_param("selftest.cont_expect_dps", val);
+  val.f = 15.0f;
+  stage_param("rate.comp_tau_s", val);
+  val.f = 5.0f;
+  stage_param("rate.comp_fast_tau_s", val);
+  val.u = 3u;
+  stage_param("rate.comp_stages", val);
   val.u = 1u;
   stage_param("selftest.continuous", val);
   params_err_t err;
