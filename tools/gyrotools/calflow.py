@@ -28,8 +28,8 @@ firmware's generic defaults:
    the firmware marks valid where the input is held: scale factor over the thesis's
    range, the slope over every sub-range of at least lincal.SUBRANGE_MIN_DPS, bias at
    rest, never a valid rate off by more than VERIFY_MAX_ERR_DPS, then the on-demand
-   self-test at rest passes; other chamber plateaus, a heating ramp and the noise with
-   the compensation (thermcal: limits in thermcal.LIMITS).
+   self-test at rest passes; other chamber plateaus, a heating ramp, a fast transient
+   and the noise with the compensation (thermcal: limits in thermcal.LIMITS).
 """
 
 from __future__ import annotations
@@ -321,7 +321,8 @@ def thermal(part, values):
     """Stage 3: the temperature compensation from a chamber run (gyrotools.thermcal)."""
     path = os.path.join(part.work, "thermal_params.json")
     values = dict(values, **{"rate.comp_tau_s": part.protocol.comp_tau_s,
-                              "rate.comp_stages": part.protocol.comp_stages})
+                              "rate.comp_stages": part.protocol.comp_stages,
+                              "rate.comp_fast_tau_s": part.protocol.comp_fast_tau_s})
     paramset.write(path, paramset.from_values(values, meta={"stage": "thermal"}))
     temps = part.protocol.cal_plateaus_c
     scen = _scenario(part, "calibrate_thermal", thermcal.plateau_scenario(
@@ -336,7 +337,8 @@ def thermal(part, values):
     comp, s0, figs = thermcal.fit(log, temps, part.protocol.dwell_s,
                                   part.protocol.span_from_data,
                                   comp_tau_s=part.protocol.comp_tau_s,
-                                  comp_stages=part.protocol.comp_stages)
+                                  comp_stages=part.protocol.comp_stages,
+                                  comp_fast_tau_s=part.protocol.comp_fast_tau_s)
     if not (np.isfinite(s0) and s0 > 0.0) or not all(np.isfinite(v) for v in comp.values()):
         raise FlowError(f"thermal calibration: implausible fit (scale {s0:.6g}) ({cmd})")
     v = dict(values)
@@ -541,6 +543,10 @@ def _thermal_runs(part, cal_path):
         ("noise", lambda: run("verify_noise", thermcal.noise_scenario(
             {"description": "output noise with and without the temperature compensation"},
             proto), 3, lambda log: thermcal.verify_noise(log, proto))),
+        ("thermal_transient", lambda: run("verify_transient", thermcal.transient_scenario(
+            {"description": "verification of a thermal calibration: a fast transient (heat "
+                            "gun, then the room)"}, proto),
+            4, lambda log: thermcal.verify_transient(log, proto))),
     ]
 
 

@@ -134,6 +134,7 @@ def verification(doc):
     """The out-of-sample figures of a part's calibration flow (its report.json)."""
     v = doc["verify"]
     r, pl, ramp, nz = v["rate"], v["thermal_plateaus"]["plateaus"], v["thermal_ramp"], v["noise"]
+    tr = v.get("thermal_transient")  # a calibration verified before the transient had none
     return {
         "command": doc["command"],
         "seeds": [r["seed"], v["thermal_plateaus"]["seed"], ramp["seed"], nz["seed"]],
@@ -146,7 +147,11 @@ def verification(doc):
         "ramp_valid": ramp["valid_fraction"], "ramp_k_per_min": ramp["k_per_min"],
         "ramp_c": [ramp["from_c"], ramp["to_c"]],
         "noise_ratio_1s": nz["ratio"], "noise_ratio_10s": nz["ratio_10s"],
-        "passed": bool(r["passed"] and v["thermal_plateaus"]["ok"] and ramp["ok"] and nz["ok"]),
+        "transient": None if tr is None else {
+            k: tr[k] for k in ("base_c", "hot_c", "heat_s", "bias_1s_std_dps", "bias_1s_pp_dps",
+                               "valid_fraction", "seed")},
+        "passed": bool(r["passed"] and v["thermal_plateaus"]["ok"] and ramp["ok"] and nz["ok"]
+                       and (tr is None or tr["ok"])),
     }
 
 
@@ -168,6 +173,14 @@ def verification_rows(part, vf):
         ("flow verification: Allan deviation compensated / not, at 1 s and 10 s",
          f"{vf['noise_ratio_1s']:.2f}x / {vf['noise_ratio_10s']:.2f}x", ""),
     ]
+    tr = vf.get("transient")
+    if tr is not None:
+        rows.append((f"flow verification: transient {tr['base_c']:g} -> {tr['hot_c']:g} degC "
+                     f"for {tr['heat_s']:g} s and back (seed {tr['seed']}), 1 s means of the "
+                     "bias: std (p-p)",
+                     f"{fmt(tr['bias_1s_std_dps'], 2)} deg/s ({fmt(tr['bias_1s_pp_dps'], 2)}), "
+                     f"valid {100 * tr['valid_fraction']:.1f} %",
+                     "0.462 deg/s over its cool-down (in sample)"))
     return [Row(f, v, t, part, "yes", OUT, src) for f, v, t in rows]
 
 

@@ -27,18 +27,31 @@ from . import allan, thermcal
 TAUS_S = (1.0, 10.0, 100.0, 1000.0)
 
 
+def _bias(v, x):
+    return v["rate.bias_c0_dps"] + x * (v["rate.bias_c1_dps_per_deg"] + x * (
+        v["rate.bias_c2_dps_per_deg2"] + x * v["rate.bias_c3_dps_per_deg3"]))
+
+
 def compensate(log, v, comp_tau_s, comp_stages):
     """The firmware's output from a log's rate_unc_dps and P_f for the values v
-    (rate.*, cal.ref_p_deg) and the filter (comp_tau_s, comp_stages)."""
+    (rate.*, cal.ref_p_deg) and the filter (comp_tau_s, comp_stages); with
+    rate.comp_fast_tau_s > 0 in v, blended with the fast path as
+    rate_channel_comp_refresh does."""
     t = log["t_s"]
     p_c = thermcal.comp_thermometer(t, log["p_f_deg"], comp_tau_s, comp_stages)
     x = p_c - v["cal.ref_p_deg"]
     h = thermcal.gradient_hp(t, p_c, v["rate.grad_tau_s"])
     sf = 1.0 + x * (v["rate.sf_c1_per_deg"] + x * (v["rate.sf_c2_per_deg2"] + x * (
         v["rate.sf_c3_per_deg3"] + x * v["rate.sf_c4_per_deg4"])))
-    b = v["rate.bias_c0_dps"] + x * (v["rate.bias_c1_dps_per_deg"] + x * (
-        v["rate.bias_c2_dps_per_deg2"] + x * v["rate.bias_c3_dps_per_deg3"]))
-    return np.asarray(log["rate_unc_dps"]) * sf - b - v["rate.bias_grad_dps_per_deg"] * h
+    b = _bias(v, x) + v["rate.bias_grad_dps_per_deg"] * h
+    tau_f = v.get("rate.comp_fast_tau_s", 0.0)
+    if tau_f > 0.0:
+        p_f = thermcal.comp_thermometer(t, log["p_f_deg"], tau_f, 1)
+        h_f = thermcal.gradient_hp(t, p_f, v["rate.grad_tau_s"])
+        d = _bias(v, p_f - v["cal.ref_p_deg"]) + v["rate.grad_fast_dps_per_deg"] * h_f - b
+        blend = v["rate.comp_blend_dps"]
+        b = b + np.clip((np.abs(d) - blend) / blend, 0.0, 1.0) * d
+    return np.asarray(log["rate_unc_dps"]) * sf - b
 
 
 class _View(dict):

@@ -40,6 +40,7 @@ CAL_FIGURES = {
     "cal.valid_fraction": ("verify", "rate", "valid_fraction_in_dwell"),
     "cal.worst_valid_error_dps": ("verify", "rate", "worst_valid_error_dps"),
     "cal.ramp_bias_std_dps": ("verify", "thermal_ramp", "bias_1s_std_dps"),
+    "cal.transient_bias_std_dps": ("verify", "thermal_transient", "bias_1s_std_dps"),
     "cal.noise_ratio_1s": ("verify", "noise", "ratio"),
 }
 

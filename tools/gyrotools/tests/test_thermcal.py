@@ -101,3 +101,71 @@ def test_each_protocol_fits_with_its_own_thermometer_filter():
     # default part's quick calibration left -0.39 deg/s at 20 degC).
     assert (thermcal.FULL.comp_tau_s, thermcal.FULL.comp_stages) == (15.0, 3)
     assert (thermcal.QUICK.comp_tau_s, thermcal.QUICK.comp_stages) == (5.0, 1)
+
+
+def _thermal_log(ambient_of_t, dur_s, rate_of_t=None, tau_s=400.0, seed=None):
+    # A part whose structure follows its surroundings with one time constant; P reads
+    # the structure at 0.03 deg/K, the bias is 35 (deg/s)/deg of P (the default part's
+    # slopes), the scale factor 1. 10 Hz rows, as the flow's chamber logs.
+    t = np.arange(0.0, dur_s, 0.1)
+    amb = ambient_of_t(t)
+    keep = np.exp(-0.1 / tau_s)
+    from scipy.signal import lfilter
+    ts = amb[0] + lfilter([1 - keep], [1, -keep], amb - amb[0])
+    p = 25.0 + 0.03 * (ts - 25.0)
+    if seed is not None:  # the thermometer's noise: white, 2e-4 deg per row
+        p = p + 2e-4 * np.random.default_rng(seed).standard_normal(t.size)
+    r = np.zeros_like(t) if rate_of_t is None else rate_of_t(t)
+    bias = 35.0 * 0.03 * (ts - 25.0)
+    return {"t_s": t, "p_f_deg": p, "t_struct_c": ts, "rate_true_dps": r,
+            "rate_unc_dps": r + bias, "rate_valid": np.ones_like(t)}
+
+
+def _chamber_log(proto, seed=None):
+    amb, rate, dur = thermcal._plateau_profiles(proto.cal_plateaus_c, proto.dwell_s)
+
+    def steps(spec):
+        edges = np.cumsum([d for d, _ in spec])
+        vals = np.array([v for _, v in spec])
+        return lambda t: vals[np.minimum(np.searchsorted(edges, t, side="right"), vals.size - 1)]
+    return _thermal_log(steps(amb), dur, steps(rate), seed=seed)
+
+
+def test_fast_path_follows_a_transient_the_slow_one_lags():
+    # Fitted on the full protocol's chamber run, applied to a heat-gun transient (the
+    # surroundings to 65 degC for 600 s, then back): the slow thermometer (three 15 s
+    # stages) lags the transient's reversals, the blend follows them with the fast path,
+    # and at constant temperature the output is the slow path's alone.
+    from gyrotools import compstudy
+    proto = thermcal.FULL
+    log = _chamber_log(proto, seed=3)
+    v, s0, figs = thermcal.fit(log, proto.cal_plateaus_c, proto.dwell_s,
+                               comp_tau_s=proto.comp_tau_s, comp_stages=proto.comp_stages,
+                               comp_fast_tau_s=proto.comp_fast_tau_s)
+    assert s0 == pytest.approx(1.0, abs=1e-3)
+    assert v["rate.comp_fast_tau_s"] == proto.comp_fast_tau_s
+    # The gradient terms take back each path's lag on a ramp: c1 x lag / tau_g.
+    c1, tau_g = v["rate.bias_c1_dps_per_deg"], v["rate.grad_tau_s"]
+    assert v["rate.bias_grad_dps_per_deg"] == pytest.approx(c1 * 45.0 / tau_g, rel=0.1)
+    assert v["rate.grad_fast_dps_per_deg"] == pytest.approx(c1 * 5.0 / tau_g, rel=0.1)
+    assert thermcal.BLEND_MIN_DPS <= v["rate.comp_blend_dps"] <= thermcal.BLEND_MAX_DPS
+
+    base, hot, lead, heat, tau_h, tau_c, total = proto.transient
+
+    def heat_cool(t):
+        on = (t >= lead) & (t < lead + heat)
+        rise = hot + (base - hot) * np.exp(-np.clip(t - lead, 0, None) / tau_h)
+        top = hot + (base - hot) * np.exp(-heat / tau_h)
+        fall = base + (top - base) * np.exp(-np.clip(t - lead - heat, 0, None) / tau_c)
+        return np.where(t < lead, base, np.where(on, rise, fall))
+    tr = _thermal_log(heat_cool, total)
+    slow_only = dict(v, **{"rate.comp_fast_tau_s": 0.0})
+    m = tr["t_s"] >= lead
+    err_slow = compstudy.compensate(tr, slow_only, proto.comp_tau_s, proto.comp_stages)[m]
+    err_blend = compstudy.compensate(tr, v, proto.comp_tau_s, proto.comp_stages)[m]
+    assert np.std(err_blend) < 0.5 * np.std(err_slow)
+    assert np.max(np.abs(err_blend)) < 0.5 * np.max(np.abs(err_slow))
+    rest = _thermal_log(lambda t: np.full_like(t, 25.0), 600.0, seed=5)
+    np.testing.assert_array_equal(
+        compstudy.compensate(rest, v, proto.comp_tau_s, proto.comp_stages),
+        compstudy.compensate(rest, slow_only, proto.comp_tau_s, proto.comp_stages))
