@@ -191,10 +191,10 @@ GYRO_RAMFUNC void gyro_block_p(gyro_t *g, int hold)
      * block in RATE_P_BLOCKS, the checks on the next, so that no tick carries both. */
     rc->p_new = 0u;
     rate_valid_thermo(&d->valid, &g->valid, rc->p_dev_deg, rc->p_held_dev_deg, rc->p_held_w);
+    if ((g->valid.thermo & RATE_INVALID_THERMO_SLEW) != 0u)
+      rate_channel_fast_hold(&d->rate, rc);
   } else if (g->valid.slew_due != 0u) {
-    if (rate_valid_slew(&d->valid, &g->valid, rc->p_comp_lag_deg, rc->p_comp_mid_deg,
-                        rc->p_hp_deg))
-      rate_channel_comp_restart(rc);
+    if (rate_valid_slew(&d->valid, &g->valid, rc)) rate_channel_comp_restart(rc);
   } else if (rc->comp_due != 0u) {
     /* The compensation of the filters' new state, on a block with neither check: the
      * rate takes it from the next block on (a P_f is 10 blocks apart). */

@@ -94,9 +94,13 @@ static gyro_design_status_t design_validity(const param_values_t *v, gyro_design
                               (float)slope,
                               p_poly_off_deg(v),
                               fm_absf(v->rate_bias_grad_dps_per_deg),
+                              fm_absf(v->rate_grad_fast_dps_per_deg),
+                              t->rate.grad_a,
+                              t->rate.comp_fast_a > 0.0f ? 1u : 0u,
                               {0.0f}};
   t->valid = c;
-  rate_valid_spur_matrix(t->rate.comp_a, t->rate.grad_a, t->rate.comp_stages, t->valid.spur_m);
+  rate_valid_spur_matrix(t->rate.comp_a, t->rate.grad_a, t->rate.comp_stages,
+                         t->rate.comp_fast_a, t->valid.spur_m);
   t->rate_fault_out_v = v->rate_fault_out_v;
   return GYRO_DESIGN_OK;
 }
@@ -311,6 +315,9 @@ static gyro_design_status_t design_rate(const param_values_t *v, double tau_s, g
   t->rate.grad_fast_k_dps_per_deg = v->rate_grad_fast_dps_per_deg;
   t->rate.blend_dps = v->rate_comp_blend_dps;
   t->rate.blend_inv_per_dps = 1.0f / v->rate_comp_blend_dps;
+  t->rate.fast_hold_updates = (uint32_t)(3.0 *
+                                         (double)(v->rate_comp_fast_tau_s + v->rate_grad_tau_s) *
+                                         fs / (double)RATE_P_DECIM);
   t->rate.grad_a = (float)(1.0 - exp(-(double)RATE_P_DECIM / (fs * (double)v->rate_grad_tau_s)));
   /* First-order low-pass of P at the decimated rate fs / RATE_P_DECIM. */
   t->rate.p_lpf_alpha = (float)(1.0 - exp(-2.0 * FM_PI * (double)v->rate_p_lpf_hz *

@@ -118,6 +118,7 @@ GYRO_RAMFUNC void rate_channel_reset(const rate_channel_cfg_t *restrict cfg,
   rc->ref_ki = cfg->ref_wide_ki;
   rc->p_fast_lag_deg = 0.0f;
   rc->p_fast_hp_deg = 0.0f;
+  rc->fast_hold = 0u;
   rc->p_f_deg = p_deg;
   rc->rate_dps = 0.0f;
   rate_channel_comp_refresh(cfg, rc);
@@ -243,6 +244,7 @@ GYRO_RAMFUNC static inline void comp_filters_update(const rate_channel_cfg_t *re
   comp_filters_step(&rc->p_comp_lag_deg, rc->p_comp_mid_deg, &rc->p_hp_deg, step, cfg->comp_a,
                     cfg->grad_a, cfg->comp_stages);
   if (cfg->comp_fast_a > 0.0f) {
+    if (rc->fast_hold != 0u) rc->fast_hold--;
     float unused[COMP_STAGES_MAX - 1u]; /* one stage has no middle */
     comp_filters_step(&rc->p_fast_lag_deg, unused, &rc->p_fast_hp_deg, step, cfg->comp_fast_a,
                       cfg->grad_a, 1u);
@@ -332,7 +334,7 @@ GYRO_RAMFUNC void rate_channel_comp_refresh(const rate_channel_cfg_t *restrict c
   rc->comp_sf = 1.0f + x * (s3[1] + x * (s3[2] + x * (s3[3] + x * s3[4])));
   float bias = comp_bias(cfg, x, cfg->grad_k_dps_per_deg, rc->p_hp_deg);
   float w = 0.0f;
-  if (cfg->comp_fast_a > 0.0f) {
+  if (cfg->comp_fast_a > 0.0f && rc->fast_hold == 0u) {
     /* The blend (rate_channel.h): the fast path where the slow one lags a transient. */
     const float d = comp_bias(cfg, base - rc->p_fast_lag_deg, cfg->grad_fast_k_dps_per_deg,
                               rc->p_fast_hp_deg) -

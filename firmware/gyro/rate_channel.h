@@ -113,6 +113,9 @@ typedef struct {
   float grad_fast_k_dps_per_deg; /* the fast path's gradient term */
   float blend_dps;               /* the paths' difference where the fast one starts to weigh */
   float blend_inv_per_dps;       /* 1 / blend_dps */
+  uint32_t fast_hold_updates;    /* P updates the fast path sits out after a move of P_f no
+                                  * temperature made: its own settling (3 (its tau + the
+                                  * gradient term's)) */
   float p_mode_k;  /* per-block factor of the resonance's lag: 1 - exp(-T_block / (2Q/wn)) */
   float ref_lp_kp; /* LP2 per block: 2 zeta wn T_block ... */
   float ref_lp_ki; /* ... and (wn T_block)^2 */
@@ -139,6 +142,7 @@ typedef struct {
   float comp_bias_dps;    /* the compensation's bias and scale factor at the filters' latest */
   float comp_sf;          /* state (rate_channel_comp_refresh) */
   float comp_fast_w;      /* the fast path's weight in that bias, 0..1 */
+  uint32_t fast_hold;     /* P updates the fast path still sits out (rate_channel_fast_hold) */
   uint32_t comp_due;      /* the filters moved: the compensation is to be refreshed */
   float p_last_rad;       /* P at the last projection */
   float p_lag_rad;        /* P - LP_tau(P): the resonance's lag still to come */
@@ -211,6 +215,17 @@ static inline void rate_channel_comp_restart(rate_channel_t *rc)
   rc->p_hp_deg = 0.0f;
   rc->p_fast_lag_deg = 0.0f;
   rc->p_fast_hp_deg = 0.0f;
+  rc->comp_due = 1u;
+}
+
+/* The thermometer checks saw a move of P_f no temperature makes (THERMO_SLEW): the fast
+ * path sits out for cfg->fast_hold_updates from now. What such a move leaves in the
+ * compensation's filters is known only in part (rate_valid.h: the shadow counts the
+ * windows beyond the cap), and the fast path takes more of it in than the slow one, for
+ * less time: the slow path alone carries the output until the fast one has settled. */
+static inline void rate_channel_fast_hold(const rate_channel_cfg_t *cfg, rate_channel_t *rc)
+{
+  rc->fast_hold = cfg->fast_hold_updates;
   rc->comp_due = 1u;
 }
 

@@ -29,7 +29,8 @@ int rate_valid_cfg_ok(const rate_valid_cfg_t *c)
          fm_isfinite(c->sense_max_v2) && c->phase_tol_rad > 0.0f &&
          fm_isfinite(c->phase_tol_rad) && c->bias_slope_dps_per_deg >= 0.0f &&
          fm_isfinite(c->bias_slope_dps_per_deg) && c->grad_k_abs_dps_per_deg >= 0.0f &&
-         fm_isfinite(c->grad_k_abs_dps_per_deg) && spur_m_ok(c->spur_m);
+         fm_isfinite(c->grad_k_abs_dps_per_deg) && c->grad_fast_abs_dps_per_deg >= 0.0f &&
+         fm_isfinite(c->grad_fast_abs_dps_per_deg) && spur_m_ok(c->spur_m);
 }
 
 int rate_valid_init(const rate_valid_cfg_t *cfg, rate_valid_t *rv)
@@ -43,10 +44,12 @@ int rate_valid_init(const rate_valid_cfg_t *cfg, rate_valid_t *rv)
   rv->x_rate = rv->x_quad = 0.0f;
   rv->p_dev_window_deg = 0.0f;
   rv->p_updates = 0u;
-  rv->slew = rv->slew_due = rv->restart_armed = rv->spur = 0u;
+  rv->slew = rv->slew_due = rv->restart_armed = rv->spur = rv->displaced = 0u;
+  rv->trend_p_deg = rv->trend_step_deg = 0.0f;
   rv->filters_held = 1u;
   rv->snap_lag_deg = rv->snap_hp_deg = 0.0f;
   rv->snap_mid_deg[0] = rv->snap_mid_deg[1] = 0.0f;
+  rv->snap_fast_lag_deg = rv->snap_fast_hp_deg = 0.0f;
   rv->p_window_change_deg = 0.0f;
   for (uint32_t i = 0u; i < RATE_VALID_SPUR_N; i++) rv->spur_deg[i] = 0.0f;
   rv->phase_err_lp_rad = 0.0f;
@@ -92,11 +95,27 @@ GYRO_RAMFUNC void rate_valid_thermo(const rate_valid_cfg_t *restrict c, rate_val
     rv->slew_due = 1u;
     rv->p_dev_window_deg = p_dev_deg;
     rv->p_updates = 0u;
+  } else if (!(fm_absf(p_dev_deg - rv->p_dev_window_deg) <= c->p_window_max_deg)) {
+    /* The window is over its cap before its end: THERMO_SLEW now, not a window later
+     * (rate_valid_slew judges the whole window at its end). A kick of P moves the
+     * compensation's fast path within that time (rate_channel_comp_refresh). */
+    rv->slew = RATE_INVALID_THERMO_SLEW;
   }
   /* The reasons after the window's bookkeeping (which leaves slew alone): fewer values
    * live at once, no register to save. */
   rv->filters_held = p_held_w > COMP_FILTERS_HELD_W_MAX;
   uint32_t r = rv->slew | rv->spur;
+  /* After a move no temperature makes (a window beyond the cap), P_f is trusted again
+   * only back where the temperature alone would have it (its trend before the move,
+   * carried on), to half the tolerance (the other half is the filters', the shadow's): a
+   * move that lasts (a change of the drive circuit's phase) would otherwise be read as
+   * one of temperature once the filters have taken it in. A hold (the drive acquiring
+   * again) ends it. */
+  rv->trend_p_deg += rv->trend_step_deg;
+  if (rv->filters_held != 0u ||
+      lag_error_dps(c, fm_absf(p_dev_deg - rv->trend_p_deg)) <= 0.5f * c->tol_dps)
+    rv->displaced = 0u;
+  if (rv->displaced != 0u) r |= RATE_INVALID_THERMO_SLEW;
   if (!(fm_absf(p_dev_deg + c->p_range_off_deg) <= c->p_range_deg))
     r |= RATE_INVALID_THERMO_RANGE;
   /* |P_f - P| <= w / (1 - w) |P_held - P_f|, compared without the divide. */
@@ -105,18 +124,22 @@ GYRO_RAMFUNC void rate_valid_thermo(const rate_valid_cfg_t *restrict c, rate_val
   rv->thermo = r;
 }
 
-/* The shadow's rate error: P_c's part (s - lag) at the bias slope, the gradient term's. */
+/* The shadow's rate error: P_c's part (s - lag) at the bias slope, the gradient term's;
+ * with a fast path the larger of the two paths' (the blend lies between them,
+ * rate_channel_comp_refresh). */
 GYRO_RAMFUNC static inline float spur_error_dps(const rate_valid_cfg_t *restrict c,
                                                 const float x[RATE_VALID_SPUR_N])
 {
-  return c->bias_slope_dps_per_deg * fm_absf(x[0] - x[3]) +
-         c->grad_k_abs_dps_per_deg * fm_absf(x[4]);
+  const float e = c->bias_slope_dps_per_deg * fm_absf(x[0] - x[COMP_STAGES_MAX]) +
+                  c->grad_k_abs_dps_per_deg * fm_absf(x[RATE_VALID_SPUR_HP]);
+  if (c->fast_on == 0u) return e;
+  const float e_fast = c->bias_slope_dps_per_deg * fm_absf(x[0] - x[RATE_VALID_SPUR_FAST_LAG]) +
+                       c->grad_fast_abs_dps_per_deg * fm_absf(x[RATE_VALID_SPUR_FAST_HP]);
+  return fm_maxf(e, e_fast);
 }
 
 GYRO_RAMFUNC int rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_t *restrict rv,
-                                 float comp_lag_deg,
-                                 const float comp_mid_deg[COMP_STAGES_MAX - 1u],
-                                 float comp_hp_deg)
+                                 const rate_channel_t *restrict rc)
 {
   const float move = rv->p_window_change_deg, change = fm_absf(move);
   const int over_cap = !(change <= c->p_window_max_deg);
@@ -138,18 +161,22 @@ GYRO_RAMFUNC int rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_
    * return's last windows, under the cap) leaks away over rate.comp_tau_s, or a noise
    * trip in a ramp, one-sided, would pile up in the shadow as if P_f were off for good. */
   float *x = rv->spur_deg;
+  if (over_cap) rv->displaced = 1u;
   if (restart) {
     /* P_f, returning from the move, is still about one window's move short of its end
      * (its 1 Hz low-pass covers about half the way in a window), and P_c = P_f has it. */
     x[0] = -move;
     x[1] = -rv->snap_mid_deg[0];
     x[2] = -rv->snap_mid_deg[1];
-    x[3] = -rv->snap_lag_deg;
-    x[4] = -rv->snap_hp_deg;
+    x[COMP_STAGES_MAX] = -rv->snap_lag_deg;
+    x[RATE_VALID_SPUR_HP] = -rv->snap_hp_deg;
+    x[RATE_VALID_SPUR_FAST_LAG] = -rv->snap_fast_lag_deg;
+    x[RATE_VALID_SPUR_FAST_HP] = -rv->snap_fast_hp_deg;
   } else if (over_cap && rv->filters_held == 0u) {
-    /* P_f moved, no stage yet: every lag grows by the move (a stage not in use has a
-     * zero row and column in the transition) */
-    for (uint32_t i = 0u; i < RATE_VALID_SPUR_N - 1u; i++) x[i] += move;
+    /* P_f moved, no stage yet: every lag grows by the move (a stage not in use, and the
+     * fast path without one, have a zero row and column in the transition) */
+    for (uint32_t i = 0u; i <= COMP_STAGES_MAX; i++) x[i] += move;
+    x[RATE_VALID_SPUR_FAST_LAG] += move;
   }
   const float e_now = spur_error_dps(c, x);
   /* On to the next window's end (the window's transition, lower triangular): judged at
@@ -162,23 +189,34 @@ GYRO_RAMFUNC int rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_
     x[i] = y;
   }
   const float e_next = spur_error_dps(c, x);
-  rv->spur = (e_now <= c->tol_dps && e_next <= c->tol_dps) ? 0u : RATE_INVALID_THERMO_SLEW;
+  /* Half the tolerance: the other half is P_f's own way back to its trend (displaced,
+   * rate_valid_thermo), which the shadow does not hold. */
+  const float half_tol = 0.5f * c->tol_dps;
+  rv->spur = (e_now <= half_tol && e_next <= half_tol) ? 0u : RATE_INVALID_THERMO_SLEW;
   rv->slew = slewing ? RATE_INVALID_THERMO_SLEW : 0u;
-  rv->thermo = (rv->thermo & ~RATE_INVALID_THERMO_SLEW) | rv->slew | rv->spur;
+  rv->thermo = (rv->thermo & ~RATE_INVALID_THERMO_SLEW) | rv->slew | rv->spur |
+               (rv->displaced != 0u ? RATE_INVALID_THERMO_SLEW : 0u);
   rv->slew_due = 0u;
   if ((rv->thermo | rv->restart_armed) == 0u) {
-    rv->snap_lag_deg = comp_lag_deg;
-    rv->snap_mid_deg[0] = comp_mid_deg[0];
-    rv->snap_mid_deg[1] = comp_mid_deg[1];
-    rv->snap_hp_deg = comp_hp_deg;
+    rv->snap_lag_deg = rc->p_comp_lag_deg;
+    rv->snap_mid_deg[0] = rc->p_comp_mid_deg[0];
+    rv->snap_mid_deg[1] = rc->p_comp_mid_deg[1];
+    rv->snap_hp_deg = rc->p_hp_deg;
+    rv->snap_fast_lag_deg = rc->p_fast_lag_deg;
+    rv->snap_fast_hp_deg = rc->p_fast_hp_deg;
+    /* The trend of a passed window: P_f at its end, moving as the gradient term's input
+     * says (a ramp at r holds it at r tau_g: r T per update is that times grad_a). */
+    rv->trend_p_deg = rv->p_dev_window_deg;
+    rv->trend_step_deg = rc->p_hp_deg * c->grad_a;
   }
   return restart;
 }
 
 /* One P update of the compensation's filters (comp_filters_step) in double, on the
- * shadow's state (s, mid[0], mid[1], lag, hp) without input: s leaks by comp_a, and its
- * step goes through the filters like a step of P_f. */
-static void spur_update(double x[RATE_VALID_SPUR_N], double ca, double ga, uint32_t stages)
+ * shadow's state (s, mid[0], mid[1], lag, hp, fast lag, fast hp) without input: s leaks
+ * by comp_a, and its step goes through the filters like a step of P_f. */
+static void spur_update(double x[RATE_VALID_SPUR_N], double ca, double ga, uint32_t stages,
+                        double fa)
 {
   const double step = -ca * x[0];
   x[0] += step;
@@ -191,10 +229,13 @@ static void spur_update(double x[RATE_VALID_SPUR_N], double ca, double ga, uint3
     *lag = (*lag + step) - step_k;
     step_before = step_k;
   }
-  x[RATE_VALID_SPUR_N - 1u] = (1.0 - ga) * (x[RATE_VALID_SPUR_N - 1u] + step_before);
+  x[RATE_VALID_SPUR_HP] = (1.0 - ga) * (x[RATE_VALID_SPUR_HP] + step_before);
+  const double step_f = fa * (x[RATE_VALID_SPUR_FAST_LAG] + step);
+  x[RATE_VALID_SPUR_FAST_LAG] += step - step_f;
+  x[RATE_VALID_SPUR_FAST_HP] = (1.0 - ga) * (x[RATE_VALID_SPUR_FAST_HP] + step_f);
 }
 
-void rate_valid_spur_matrix(float comp_a, float grad_a, uint32_t stages,
+void rate_valid_spur_matrix(float comp_a, float grad_a, uint32_t stages, float fast_a,
                             float m[RATE_VALID_SPUR_M])
 {
   /* The update is linear: its matrix column by column from the unit states (a mid stage
@@ -204,9 +245,10 @@ void rate_valid_spur_matrix(float comp_a, float grad_a, uint32_t stages,
   for (uint32_t j = 0u; j < N; j++) {
     double x[N] = {0.0};
     x[j] = 1.0;
-    spur_update(x, (double)comp_a, (double)grad_a, stages);
+    spur_update(x, (double)comp_a, (double)grad_a, stages, (double)fast_a);
     for (uint32_t i = 0u; i < N; i++) {
-      const int unused = i >= 1u && i < COMP_STAGES_MAX && i >= stages;
+      const int unused = (i >= 1u && i < COMP_STAGES_MAX && i >= stages) ||
+                         (i >= RATE_VALID_SPUR_FAST_LAG && !(fast_a > 0.0f));
       t[i][j] = unused ? 0.0 : x[i];
       p[i][j] = i == j ? 1.0 : 0.0;
     }

@@ -62,6 +62,7 @@
 #include <stdint.h>
 
 #include "gyro/comp_filters.h"
+#include "gyro/rate_channel.h"
 
 #define RATE_INVALID_MODE (1u << 0)
 #define RATE_INVALID_SELFTEST (1u << 1)
@@ -101,8 +102,12 @@
 /* Fraction of the ADC range the sense amplitude may use. */
 #define RATE_VALID_SENSE_FRAC 0.8f
 
-/* The shadow's state: the move left in P_f, P_c's stages' lags, the gradient term's input. */
-#define RATE_VALID_SPUR_N (COMP_STAGES_MAX + 2u)
+/* The shadow's state: the move left in P_f, P_c's stages' lags, the gradient term's input,
+ * then the fast path's lag and gradient input (rate_channel.h; rows of 0 without one). */
+#define RATE_VALID_SPUR_HP (COMP_STAGES_MAX + 1u)
+#define RATE_VALID_SPUR_FAST_LAG (COMP_STAGES_MAX + 2u)
+#define RATE_VALID_SPUR_FAST_HP (COMP_STAGES_MAX + 3u)
+#define RATE_VALID_SPUR_N (COMP_STAGES_MAX + 4u)
 #define RATE_VALID_SPUR_M (RATE_VALID_SPUR_N * (RATE_VALID_SPUR_N + 1u) / 2u)
 
 typedef struct {
@@ -117,6 +122,9 @@ typedef struct {
   float bias_slope_dps_per_deg; /* |dB/dP| of the compensation over its range */
   float p_range_off_deg;        /* x = p_dev + this at P_f (rate_channel.h) */
   float grad_k_abs_dps_per_deg; /* |k| of the gradient term */
+  float grad_fast_abs_dps_per_deg; /* |k| of the fast path's gradient term */
+  float grad_a;                    /* the gradient term's 1 - exp(-T / tau) per P update */
+  uint32_t fast_on;                /* the compensation has a fast path (comp_fast_a > 0) */
   float spur_m[RATE_VALID_SPUR_M]; /* the shadow's transition over a slew window */
 } rate_valid_cfg_t;
 
@@ -139,9 +147,14 @@ typedef struct {
                                       * stages', P_f - P_c, the gradient term's input;
                                       * comp_filters.h), at the next window's end */
   uint32_t restart_armed;            /* a window's move beyond RATE_VALID_RESTART_CAPS caps */
-  float snap_lag_deg;                /* the compensation's filters at the latest window's end */
+  uint32_t displaced;                /* the filters restarted on a P_f no temperature made */
+  float trend_p_deg;    /* P_f - p_ref where the temperature alone would have it: the
+                           * latest passed window's end, carried on at its trend */
+  float trend_step_deg; /* that trend per P update (the gradient term's input x grad_a) */
+  float snap_lag_deg;   /* the compensation's filters at the latest window's end */
   float snap_mid_deg[COMP_STAGES_MAX - 1u];
-  float snap_hp_deg;       /* with the checks passed and no restart armed */
+  float snap_hp_deg;                         /* with the checks passed and no restart armed */
+  float snap_fast_lag_deg, snap_fast_hp_deg; /* the fast path's, the same */
   uint32_t spur;           /* RATE_INVALID_THERMO_SLEW while the shadow's error is beyond tol */
   uint32_t filters_held;   /* the compensation's filters wait for P_f (comp_filters.h) */
   float phase_err_lp_rad;  /* the drive phase error through RATE_VALID_PHASE_K */
@@ -181,17 +194,17 @@ void rate_valid_thermo(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float p_de
                        float p_held_dev_deg, float p_held_w);
 /* On a tick after rate_valid_thermo ended a slew window (slew_due): THERMO_SLEW from the
  * window's change of P_f and from the shadow (apart, so that no tick carries both).
- * (comp_lag_deg, comp_mid_deg, comp_hp_deg): the compensation's filters' content
- * (rate_channel_t).
+ * rc: the compensation's filters' content (rate_channel_t: the slow path's lag, mids and
+ * high-pass, the fast path's lag and high-pass).
  * Returns 1 when the filters must restart now (rate_channel_comp_restart). */
-int rate_valid_slew(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float comp_lag_deg,
-                    const float comp_mid_deg[COMP_STAGES_MAX - 1u], float comp_hp_deg);
+int rate_valid_slew(const rate_valid_cfg_t *cfg, rate_valid_t *rv, const rate_channel_t *rc);
 /* The shadow's transition over RATE_VALID_SLEW_UPDATES P updates for the compensation's
- * filter weights comp_a, grad_a and its stages (rate_channel_cfg_t): lower triangular in
- * the state (s, mid[0], mid[1], lag, hp) (comp_filters.h; a mid stage's row is 0 where
- * there are fewer stages), its rows packed in order (row i holds i + 1 entries). Design
- * time (double). */
-void rate_valid_spur_matrix(float comp_a, float grad_a, uint32_t stages,
+ * filter weights comp_a, grad_a, its stages and the fast path's weight fast_a (0: none)
+ * (rate_channel_cfg_t): lower triangular in the state (s, mid[0], mid[1], lag, hp,
+ * fast lag, fast hp) (comp_filters.h; the row of a mid stage not in use, and the fast
+ * path's without one, are 0), its rows packed in order (row i holds i + 1 entries).
+ * Design time (double). */
+void rate_valid_spur_matrix(float comp_a, float grad_a, uint32_t stages, float fast_a,
                             float m[RATE_VALID_SPUR_M]);
 
 /* Once per block, after the quadrature filter: the drive phase error as the supervisor
@@ -205,6 +218,7 @@ void rate_valid_drive(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float phase
 static inline void rate_valid_shift_p(rate_valid_t *rv, float shift_deg)
 {
   rv->p_dev_window_deg += shift_deg;
+  rv->trend_p_deg += shift_deg;
 }
 
 /* Once per block, after the rate's output filter: OVER_RANGE. */

@@ -118,7 +118,7 @@ static void kick(double r_deg_s, double dp_deg, double dur_s)
   make();
   uint32_t slew = 0u;
   const double worst = worst_valid_error(r_deg_s, dp_deg, dur_s, 300.0, 600.0, &slew);
-  print_message("worst valid dynamic error %.3f deg/s\n", worst);
+  print_message("worst valid dynamic error %.5f deg/s\n", worst);
   assert_int_not_equal(slew, 0u);
   assert_true(worst <= (double)d.valid.tol_dps);
   assert_int_equal(g.valid.thermo, 0u);
@@ -150,6 +150,17 @@ static void test_large_kick_in_ramp(void **state)
   kick(0.014, 3.0, 0.05);
 }
 
+/* A move of P that lasts (0.3 deg for 2 s, at rest and in the ramp): the filters restart
+ * once P_f is at rest at the moved value, which is no temperature. Before, the
+ * compensation then read the moved P_f as valid: 1.49 deg/s wrong until P returned. */
+static void test_lasting_move_never_valid_and_wrong(void **state)
+{
+  (void)state;
+  kick(0.0, 0.3, 2.0);
+  kick(0.014, 0.3, 2.0);
+  kick(0.014, -0.5, 20.0);
+}
+
 /* The 1300 Hz part's P_f is noisy enough (0.0017 deg rms over 0.1 s) that in its 2 K/min
  * ramp a window tips over the cap every few seconds: those trips are no move to keep the
  * rate invalid for, and the filters keep the ramp's gradient (before, each trip dropped
@@ -167,6 +178,88 @@ static void test_noisy_ramp(void **state)
   assert_true(valid > 0.95);
 }
 
+/* The compensation as the flow now sets it (three 15 s stages of P_c, the fast path of one
+ * 5 s stage and the blend) on a part with the default part's bias slope, 35 (deg/s)/deg,
+ * and gradient terms that take each path's ramp lag back (k = c1 x lag / tau_g): the
+ * bias the firmware takes off (comp_bias_dps, whichever path carries it) against the one
+ * the temperature alone makes, c1 (P - r P_f's delay). A kick on P moves the fast path
+ * further and for a shorter time than the slow one, whose trace the validity's shadow
+ * follows: the rate must still never be valid and wrong. */
+static const double C1_FAST = 35.0, TAU_G_FAST_S = 10.0;
+
+static void make_fast(void)
+{
+  param_values_t v;
+  param_values_defaults(&v);
+  v.rate_bias_c1_dps_per_deg = (float)C1_FAST;
+  v.rate_grad_tau_s = (float)TAU_G_FAST_S;
+  v.rate_comp_tau_s = 15.0f;
+  v.rate_comp_stages = 3u;
+  v.rate_bias_grad_dps_per_deg = (float)(C1_FAST * 45.0 / TAU_G_FAST_S);
+  v.rate_comp_fast_tau_s = 5.0f;
+  v.rate_grad_fast_dps_per_deg = (float)(C1_FAST * 5.0 / TAU_G_FAST_S);
+  v.rate_comp_blend_dps = 0.1f;
+  v.rate_p_range_deg = 30.0f;
+  assert_int_equal(gyro_design(&v, &d), 0);
+  assert_int_equal(gyro_init_from_design(&g, &d), 0);
+}
+
+static double worst_valid_bias_error(double r_deg_s, double dp_deg, double dur_s, double t_dist_s,
+                                     double t_end_s, uint32_t *slew_seen, double *fast_w_max)
+{
+  const double blocks_per_s = 50000.0 / RATE_DECIM;
+  const double p0_deg = (double)d.rate.p_ref_deg;
+  const double a = (double)d.rate.p_lpf_alpha, t_upd_s = RATE_P_DECIM / 50000.0;
+  const double delay_s = t_upd_s * (1.0 - a) / a + 0.5 * t_upd_s;
+  double worst = 0.0;
+  *slew_seen = 0u;
+  *fast_w_max = 0.0;
+  for (long n = 0; n < (long)(t_end_s * blocks_per_s); n++) {
+    const double t = (double)n / blocks_per_s;
+    const int in_dist = t >= t_dist_s && t < t_dist_s + dur_s;
+    const double p_deg = p0_deg + r_deg_s * t + (in_dist ? dp_deg : 0.0);
+    g.drive.p_eq_rad = (float)(p_deg * M_PI / 180.0);
+    gyro_block_p(&g, 0);
+    *slew_seen |= g.valid.thermo & RATE_INVALID_THERMO_SLEW;
+    if (t >= t_dist_s) *fast_w_max = fmax(*fast_w_max, (double)g.rate.comp_fast_w);
+    if (t > 300.0 && g.valid.thermo == 0u) {
+      const double want = C1_FAST * (r_deg_s * (t - delay_s)) + (double)d.rate.bias_c_dps[0];
+      worst = fmax(worst, fabs((double)g.rate.comp_bias_dps - want));
+    }
+  }
+  return worst;
+}
+
+static void kick_fast(double r_deg_s, double dp_deg, double dur_s)
+{
+  make_fast();
+  uint32_t slew = 0u;
+  double w_max = 0.0;
+  const double worst = worst_valid_bias_error(r_deg_s, dp_deg, dur_s, 400.0, 900.0, &slew,
+                                              &w_max);
+  print_message("fast path: kick %.2f deg for %.2f s in %.3f deg/s: worst valid error %.3f "
+                "deg/s, fast weight up to %.2f\n",
+                dp_deg, dur_s, r_deg_s, worst, w_max);
+  assert_true(worst <= (double)d.valid.tol_dps);
+  assert_int_equal(g.valid.thermo, 0u);
+  if (dp_deg != 0.0) {
+    assert_int_not_equal(slew, 0u);
+    assert_true(w_max == 0.0); /* the fast path sat the move out (rate_channel_fast_hold) */
+  }
+}
+
+static void test_fast_path_kicks_never_valid_and_wrong(void **state)
+{
+  (void)state;
+  kick_fast(0.014, 0.0, 0.0); /* the ramp alone: both paths agree, valid and right */
+  kick_fast(0.014, 0.3, 0.01);
+  kick_fast(0.0, 3.0, 0.05);
+  kick_fast(0.014, 3.0, 0.05);
+  kick_fast(0.0, 0.3, 0.5); /* a drive-phase disturbance of half a second */
+  kick_fast(0.014, -0.03, 5.0);
+  kick_fast(0.014, -0.1, 5.0);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -175,6 +268,8 @@ int main(void)
       cmocka_unit_test(test_large_kick_at_rest),
       cmocka_unit_test(test_large_kick_in_ramp),
       cmocka_unit_test(test_noisy_ramp),
+      cmocka_unit_test(test_lasting_move_never_valid_and_wrong),
+      cmocka_unit_test(test_fast_path_kicks_never_valid_and_wrong),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -23,12 +23,13 @@ static rate_valid_cfg_t cfg(void)
                         .bias_slope_dps_per_deg = 0.0f,
                         .grad_k_abs_dps_per_deg = 0.0f,
                         .spur_m = {0.0f}};
-  rate_valid_spur_matrix(4e-4f, 1e-4f, 1u, c.spur_m); /* P_c over 5 s, the gradient over 20 s */
+  rate_valid_spur_matrix(4e-4f, 1e-4f, 1u, 0.0f,
+                         c.spur_m); /* P_c over 5 s, the gradient over 20 s */
   return c;
 }
 
 static rate_valid_t rv;
-static const float k_no_mid[COMP_STAGES_MAX - 1u] = {0.0f, 0.0f};
+static const rate_channel_t k_filters_at_rest; /* the compensation's filters all 0 */
 static rate_valid_history_t hist;
 /* The configuration the monitors under test run with. */
 static rate_valid_cfg_t s_cfg;
@@ -129,6 +130,7 @@ static void test_thermo_settle_bound(void **state)
 {
   (void)state;
   assert_int_equal(settle(), 0u);
+  s_cfg.p_window_max_deg = 100.0f; /* the jumps below are no slew here (test_thermo_slew) */
   rate_valid_thermo(&s_cfg, &rv, 1.0f, 0.0f, 0.02f);
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u); /* no bias slope: no error */
   s_cfg.bias_slope_dps_per_deg = 26.18f;
@@ -147,6 +149,7 @@ static void test_thermo_range_about_reference(void **state)
   (void)state;
   assert_int_equal(settle(), 0u);
   s_cfg.p_range_off_deg = -3.0f;
+  s_cfg.p_window_max_deg = 100.0f; /* the jumps below are no slew here (test_thermo_slew) */
   const float in_deg[] = {-4.9f, 3.0f, 10.9f}, out_deg[] = {-5.1f, 11.1f, -9.0f};
   for (int i = 0; i < 3; i++) {
     rate_valid_thermo(&s_cfg, &rv, in_deg[i], in_deg[i], 0.0f);
@@ -166,7 +169,7 @@ static void test_thermo_slew(void **state)
   for (uint32_t i = 0; i < 3u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.004f / (float)RATE_VALID_SLEW_UPDATES; /* 0.04 deg/s, under the cap */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, k_no_mid, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
@@ -174,7 +177,7 @@ static void test_thermo_slew(void **state)
     /* 0.004 deg per 0.1 s leaves P_f 0.0064 deg behind: with no bias slope no error,
      * whatever the quadrature (the reference does not read P_f) ... */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, k_no_mid, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   s_cfg.bias_slope_dps_per_deg = 52.0f;
@@ -183,7 +186,7 @@ static void test_thermo_slew(void **state)
     /* ... at 52 deg/s per degree of bias slope 0.33 deg/s: beyond the tolerance though
      * under the cap. */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, k_no_mid, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
   s_cfg.bias_slope_dps_per_deg = 0.0f;
@@ -193,11 +196,50 @@ static void test_thermo_slew(void **state)
   for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.006f / (float)RATE_VALID_SLEW_UPDATES; /* 0.06 deg/s: beyond the cap */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, 0.0f, k_no_mid, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
   /* Beyond it: into the shadow (P_f carries 0.006 deg per window of it) */
   assert_true(rv.spur_deg[0] > 0.005f);
+}
+
+/* A move beyond the cap is THERMO_SLEW on the update that makes it, not a window later;
+ * and P_f is trusted again only back at its trend from before the move: a move that
+ * lasts keeps the rate invalid for as long as it lasts, one that returns frees it. */
+static void test_slew_at_once_and_until_back(void **state)
+{
+  (void)state;
+  assert_int_equal(settle(), 0u);
+  s_cfg.bias_slope_dps_per_deg = 10.0f; /* half the tolerance: 0.0125 deg of P */
+  float p = 0.0f;
+  for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
+    rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
+  }
+  assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
+  while (rv.p_updates != 1u) {
+    rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
+  }
+  p = 0.05f; /* ten caps in one update, at the start of a window */
+  rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
+  assert_false(rv.slew_due);
+  assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
+  for (uint32_t i = 0; i < 100u * RATE_VALID_SLEW_UPDATES; i++) { /* 10 s at the moved P */
+    rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
+    assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
+  }
+  assert_true(rv.displaced != 0u);
+  p = 0.005f; /* back, to 0.05 deg/s: within half the tolerance of its trend */
+  uint32_t n = 0;
+  do {
+    rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
+  } while (rate_valid_verdict(&rv, 0u) != 0u && ++n < 100u * RATE_VALID_SLEW_UPDATES);
+  assert_int_equal(rv.displaced, 0u);
+  assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
+  s_cfg.bias_slope_dps_per_deg = 0.0f;
 }
 
 static void test_onsets_counted(void **state)
@@ -220,32 +262,45 @@ static void test_onsets_counted(void **state)
 }
 
 /* The shadow's transition (rate_valid_spur_matrix) is the compensation's filters
- * (comp_filters_step) run on a leaking move of P_f, for one, two and three stages: from
- * any state, RATE_VALID_SLEW_UPDATES updates of both agree. */
+ * (comp_filters_step) run on a leaking move of P_f, for one, two and three stages, with
+ * and without the fast path: from any state, RATE_VALID_SLEW_UPDATES updates of both
+ * agree; without a fast path its rows are 0. */
+static void check_spur_matrix(uint32_t stages, float fa)
+{
+  enum { N = RATE_VALID_SPUR_N };
+  const float ca = 4e-3f, ga = 1e-3f;
+  float m[RATE_VALID_SPUR_M];
+  rate_valid_spur_matrix(ca, ga, stages, fa, m);
+  double s = 1.0;
+  float mid[2] = {stages >= 2u ? 0.3f : 0.0f, stages >= 3u ? 0.4f : 0.0f};
+  float lag = 0.5f, hp = -0.2f, f_lag = 0.25f, f_hp = 0.1f, no_mid[2] = {0.0f, 0.0f};
+  const double x0[N] = {s, mid[0], mid[1], lag, hp, f_lag, f_hp};
+  for (uint32_t n = 0; n < RATE_VALID_SLEW_UPDATES; n++) {
+    const double step = -(double)ca * s;
+    s += step;
+    comp_filters_step(&lag, mid, &hp, (float)step, ca, ga, stages);
+    if (fa > 0.0f) comp_filters_step(&f_lag, no_mid, &f_hp, (float)step, fa, ga, 1u);
+  }
+  const double x1[N] = {s, mid[0], mid[1], lag, hp, f_lag, f_hp};
+  int k = 0;
+  for (uint32_t i = 0; i < N; i++) {
+    double y = 0.0;
+    for (uint32_t j = 0; j <= i; j++) y += (double)m[k++] * x0[j];
+    if (i >= 1u && i < 3u && i >= stages) continue; /* a stage not in use */
+    if (i >= RATE_VALID_SPUR_FAST_LAG && fa == 0.0f) {
+      assert_true(y == 0.0); /* no fast path: its rows are 0 */
+      continue;
+    }
+    assert_true(fabs(y - x1[i]) < 1e-5);
+  }
+}
+
 static void test_spur_matrix_is_the_filters(void **state)
 {
   (void)state;
-  const float ca = 4e-3f, ga = 1e-3f;
   for (uint32_t stages = 1u; stages <= COMP_STAGES_MAX; stages++) {
-    float m[RATE_VALID_SPUR_M];
-    rate_valid_spur_matrix(ca, ga, stages, m);
-    double s = 1.0;
-    float mid[2] = {stages >= 2u ? 0.3f : 0.0f, stages >= 3u ? 0.4f : 0.0f};
-    float lag = 0.5f, hp = -0.2f;
-    const double x0[5] = {s, mid[0], mid[1], lag, hp};
-    for (uint32_t n = 0; n < RATE_VALID_SLEW_UPDATES; n++) {
-      const double step = -(double)ca * s;
-      s += step;
-      comp_filters_step(&lag, mid, &hp, (float)step, ca, ga, stages);
-    }
-    const double x1[5] = {s, mid[0], mid[1], lag, hp};
-    int k = 0;
-    for (uint32_t i = 0; i < 5u; i++) {
-      double y = 0.0;
-      for (uint32_t j = 0; j <= i; j++) y += (double)m[k++] * x0[j];
-      if (i >= 1u && i < 3u && i >= stages) continue; /* a stage not in use */
-      assert_true(fabs(y - x1[i]) < 1e-5);
-    }
+    check_spur_matrix(stages, 0.0f);
+    check_spur_matrix(stages, 1.2e-2f);
   }
 }
 
@@ -259,6 +314,7 @@ int main(void)
       cmocka_unit_test(test_thermo_settle_bound),
       cmocka_unit_test(test_thermo_range_about_reference),
       cmocka_unit_test(test_thermo_slew),
+      cmocka_unit_test(test_slew_at_once_and_until_back),
       cmocka_unit_test(test_onsets_counted),
       cmocka_unit_test(test_spur_matrix_is_the_filters),
   };
