@@ -162,9 +162,11 @@ GYRO_RAMFUNC int rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_
    * trip in a ramp, one-sided, would pile up in the shadow as if P_f were off for good. */
   float *x = rv->spur_deg;
   if (over_cap) rv->displaced = 1u;
-  if (restart) {
+  if (restart && rv->filters_held == 0u) {
     /* P_f, returning from the move, is still about one window's move short of its end
-     * (its 1 Hz low-pass covers about half the way in a window), and P_c = P_f has it. */
+     * (its 1 Hz low-pass covers about half the way in a window), and P_c = P_f has it.
+     * (Not while the filters wait for P_f: they took none of the move, and start on P_f
+     * once its held value has gone.) */
     x[0] = -move;
     x[1] = -rv->snap_mid_deg[0];
     x[2] = -rv->snap_mid_deg[1];

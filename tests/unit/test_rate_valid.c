@@ -242,6 +242,39 @@ static void test_slew_at_once_and_until_back(void **state)
   s_cfg.bias_slope_dps_per_deg = 0.0f;
 }
 
+/* A start far from the reference (a cold part): P_f converges from its held value, its
+ * first windows far over the cap while the compensation's filters wait for P_f (they
+ * take none of its moves), so nothing of them is the shadow's and the rate is valid
+ * once P_f has settled (the cold plateau of cl_tempcomp_out_of_sample never came valid:
+ * the restart that ended the armed windows put a window's move into the shadow). */
+static void test_start_far_from_reference_comes_valid(void **state)
+{
+  (void)state;
+  assert_int_equal(settle(), 0u);
+  s_cfg.bias_slope_dps_per_deg = 35.0f;
+  /* P_f's fast start covers 3.8 deg: held at the reference (the drive's p_init), the
+   * part's P at -25 degC is there (the default part's). Its first windows move beyond
+   * RATE_VALID_RESTART_CAPS caps while the filters wait for P_f. */
+  const float p = -3.8f, p_held = 0.0f;
+  const float decay = expf(-0.002f / 0.159f); /* the 1 Hz low-pass per update */
+  float w = 1.0f;
+  uint32_t first_valid = 0u;
+  for (uint32_t i = 1u; i <= 1500u; i++) { /* 3 s at 500 Hz */
+    w *= decay;
+    rate_valid_thermo(&s_cfg, &rv, p + w * (p_held - p), p_held, w);
+    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
+    if (rate_valid_verdict(&rv, 0u) == 0u) {
+      if (first_valid == 0u) first_valid = i;
+    } else {
+      first_valid = 0u;
+    }
+  }
+  assert_int_equal(rv.displaced, 0u);
+  assert_int_not_equal(first_valid, 0u);
+  assert_true(first_valid <= 1000u); /* within 2 s of the hold's end */
+  s_cfg.bias_slope_dps_per_deg = 0.0f;
+}
+
 static void test_onsets_counted(void **state)
 {
   (void)state;
@@ -315,6 +348,7 @@ int main(void)
       cmocka_unit_test(test_thermo_range_about_reference),
       cmocka_unit_test(test_thermo_slew),
       cmocka_unit_test(test_slew_at_once_and_until_back),
+      cmocka_unit_test(test_start_far_from_reference_comes_valid),
       cmocka_unit_test(test_onsets_counted),
       cmocka_unit_test(test_spur_matrix_is_the_filters),
   };
