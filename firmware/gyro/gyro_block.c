@@ -186,18 +186,26 @@ GYRO_RAMFUNC void gyro_block_p(gyro_t *g, int hold)
   rate_channel_t *rc = &g->rate;
   /* The hold first (only rate_channel_update_p reads it): hold need not outlive a call. */
   rate_channel_hold_p(rc, hold);
-  if (rc->p_new != 0u) {
+  if (rate_channel_p_update_now(rc)) {
+    /* The new P_f's tick: no other job (a job still waiting runs after it). */
+  } else if (rc->p_new != 0u) {
     /* The thermometer checks of the P_f the last block made: P's low-pass runs on one
      * block in RATE_P_BLOCKS, the checks on the next, so that no tick carries both. */
     rc->p_new = 0u;
     rate_valid_thermo(&d->valid, &g->valid, rc->p_dev_deg, rc->p_held_dev_deg, rc->p_held_w);
     if ((g->valid.thermo & RATE_INVALID_THERMO_SLEW) != 0u)
       rate_channel_fast_hold(&d->rate, rc);
+  } else if (rc->filters_due != 0u) {
+    rate_channel_comp_filters(&d->rate, rc);
   } else if (g->valid.slew_due != 0u) {
-    if (rate_valid_slew(&d->valid, &g->valid, rc)) rate_channel_comp_restart(rc);
+    if (rate_valid_slew(&d->valid, &g->valid)) rate_channel_comp_restart(rc);
+  } else if (g->valid.shadow_phase != 0u) {
+    rate_valid_shadow(&d->valid, &g->valid, rc);
   } else if (rc->comp_due != 0u) {
-    /* The compensation of the filters' new state, on a block with neither check: the
-     * rate takes it from the next block on (a P_f is 10 blocks apart). */
+    /* The compensation of the filters' new state, on a block with no other job: the
+     * rate takes it from the next block on. A new P_f is 10 blocks apart; its jobs (the
+     * checks, the filters' step, a window's judgement, the shadow's five parts, this)
+     * take the nine blocks between at most. */
     rate_channel_comp_refresh(&d->rate, rc);
   }
   /* Last, as a tail call: its new P_f is flagged in rc->p_new. */

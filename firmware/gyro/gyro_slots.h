@@ -47,12 +47,14 @@
  *         self-test's notch (quadrature axis),
  *         quadrature filter; the filters' settling        rate filter (6)
  *   8     P's hold and low-pass (its mean every 10th      P (1)
- *         block), the thermometer checks of the P_f       P_f (8, last block)
- *         made the block before, the slew of a window     P_f (8, last blocks)
- *         that ended the block before that, or else      P_f (8, last blocks)
- *         the compensation's refresh (bias and scale
- *         factor of the filters' new state); the self-
- *         test sequence while it runs                     projection (5)
+ *         block: that block carries nothing else); on     P_f (8, last block)
+ *         the nine blocks between, one job each, in
+ *         order: the thermometer checks of the new P_f,
+ *         the compensation's filters' step, the slew of   P_f (8, last blocks)
+ *         a window that ended, the shadow in five parts
+ *         (rate_valid.h), the compensation's refresh
+ *         (bias and scale factor of the filters' new
+ *         state); the self-test sequence while it runs    projection (5)
  *   9     rate-valid verdict, rate half of the output     checks (2, 6, 7), rails (5),
  *         snapshot, analog rate code (the fault level     everything
  *         when not valid)

@@ -119,13 +119,13 @@ GYRO_RAMFUNC void rate_channel_reset(const rate_channel_cfg_t *restrict cfg,
   rc->p_fast_lag_deg = 0.0f;
   rc->p_fast_hp_deg = 0.0f;
   rc->fast_hold = 0u;
+  rc->filters_due = 0u;
+  rc->p_step_deg = 0.0f;
   rc->p_f_deg = p_deg;
   rc->rate_dps = 0.0f;
   rate_channel_comp_refresh(cfg, rc);
 }
 
-/* Blocks of RATE_DECIM ticks per low-pass sample of P. */
-#define RATE_P_BLOCKS (RATE_P_DECIM / RATE_DECIM)
 _Static_assert(RATE_P_DECIM % RATE_DECIM == 0u && RATE_P_BLOCKS >= 2u,
                "P's average spans whole blocks, at least two");
 
@@ -215,6 +215,7 @@ GYRO_RAMFUNC void rate_channel_filter_quad(const rate_channel_cfg_t *restrict cf
 void rate_channel_update(const rate_channel_cfg_t *cfg, rate_channel_t *rc, float w_i,
                          float w_q, float p_rad, float e_rad)
 {
+  if (rc->filters_due != 0u) rate_channel_comp_filters(cfg, rc);
   if (rc->comp_due != 0u) rate_channel_comp_refresh(cfg, rc);
   rate_channel_project(cfg, rc, w_i, w_q, p_rad, e_rad);
   rate_channel_filter_rate(cfg, rc);
@@ -232,9 +233,11 @@ GYRO_RAMFUNC void rate_channel_shift_p(rate_channel_t *restrict rc, float shift_
 }
 
 /* The compensation's filters (comp_filters.h) take P_f's step. */
-GYRO_RAMFUNC static inline void comp_filters_update(const rate_channel_cfg_t *restrict cfg,
-                                                    rate_channel_t *restrict rc, float step)
+GYRO_RAMFUNC void rate_channel_comp_filters(const rate_channel_cfg_t *restrict cfg,
+                                            rate_channel_t *restrict rc)
 {
+  const float step = rc->p_step_deg;
+  rc->filters_due = 0u;
   if (rc->p_held_w > COMP_FILTERS_HELD_W_MAX) {
     /* P_f's way from a held value to P is no temperature change: the filters start once
      * that value weighs less than COMP_FILTERS_HELD_W_MAX in P_f. */
@@ -298,8 +301,10 @@ GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
       const float before = rc->p_dev_deg;
       rc->p_dev_deg += a * (mean - before);
       /* The step P_f took (exact, Sterbenz), not a * (mean - P_f): within P_f's own dead
-       * band the latter is a constant the compensation's filters would integrate. */
-      comp_filters_update(cfg, rc, rc->p_dev_deg - before);
+       * band the latter is a constant the compensation's filters would integrate. Taken
+       * by them on a later block (rate_channel_comp_filters). */
+      rc->p_step_deg = rc->p_dev_deg - before;
+      rc->filters_due = 1u;
       rc->p_f_deg = cfg->p_ref_deg + rc->p_dev_deg;
       rc->p_acc_deg = 0.0f;
       rc->p_count = 0u;

@@ -66,6 +66,8 @@
  * low-pass of P - p_ref has no dead band worth mentioning (at 50 kHz a 1 Hz first-order
  * update is smaller than half an ulp of P and the filter would stick). */
 #define RATE_P_DECIM 100u
+/* Blocks of RATE_DECIM ticks per low-pass sample of P. */
+#define RATE_P_BLOCKS (RATE_P_DECIM / RATE_DECIM)
 /* The reference's complementary low-pass (above): natural frequency and damping of
  * LP2. Low enough that little of the pickoff's phase noise reaches the reference, high
  * enough that a change of the resonance's own phase (a thermal transient) is followed
@@ -144,6 +146,8 @@ typedef struct {
   float comp_fast_w;      /* the fast path's weight in that bias, 0..1 */
   uint32_t fast_hold;     /* P updates the fast path still sits out (rate_channel_fast_hold) */
   uint32_t comp_due;      /* the filters moved: the compensation is to be refreshed */
+  uint32_t filters_due;   /* a new P_f: the filters are to take its step (p_step_deg) */
+  float p_step_deg;       /* the step P_f took at its latest update */
   float p_last_rad;       /* P at the last projection */
   float p_lag_rad;        /* P - LP_tau(P): the resonance's lag still to come */
   float ref_dev_rad;      /* the reference's correction delta = theta - set */
@@ -216,7 +220,19 @@ static inline void rate_channel_comp_restart(rate_channel_t *rc)
   rc->p_fast_lag_deg = 0.0f;
   rc->p_fast_hp_deg = 0.0f;
   rc->comp_due = 1u;
+  rc->filters_due = 0u;
 }
+
+/* 1 when this block's rate_channel_update_p makes a new P_f: that tick carries the
+ * low-pass and no other job of the thermometer (gyro_block_p). */
+static inline int rate_channel_p_update_now(const rate_channel_t *rc)
+{
+  return rc->p_hold == 0u && rc->p_count + 1u == RATE_P_BLOCKS;
+}
+
+/* The compensation's filters take P_f's latest step (filters_due, from
+ * rate_channel_update_p), on a block of their own (gyro_block_p), then comp_due. */
+void rate_channel_comp_filters(const rate_channel_cfg_t *cfg, rate_channel_t *rc);
 
 /* The thermometer checks saw a move of P_f no temperature makes (THERMO_SLEW): the fast
  * path sits out for cfg->fast_hold_updates from now. What such a move leaves in the
@@ -257,7 +273,8 @@ void rate_channel_update(const rate_channel_cfg_t *cfg, rate_channel_t *rc, floa
  *                             the compensation's latest refresh -> rate_unc_dps, rate_dps
  *   rate_channel_filter_quad  after project: the same for quad_raw -> quad_dps
  *   rate_channel_update_p     any time: P's block sum, its low-pass every RATE_P_DECIM
- *                             ticks -> P_f (the compensation's from then on) */
+ *                             ticks -> P_f (the compensation's filters take its step in
+ *                             rate_channel_comp_filters, then rate_channel_comp_refresh) */
 void rate_channel_project(const rate_channel_cfg_t *cfg, rate_channel_t *rc, float w_i,
                           float w_q, float p_rad, float e_rad);
 void rate_channel_filter_rate(const rate_channel_cfg_t *cfg, rate_channel_t *rc);

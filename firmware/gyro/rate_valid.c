@@ -45,6 +45,8 @@ int rate_valid_init(const rate_valid_cfg_t *cfg, rate_valid_t *rv)
   rv->p_dev_window_deg = 0.0f;
   rv->p_updates = 0u;
   rv->slew = rv->slew_due = rv->restart_armed = rv->spur = rv->displaced = 0u;
+  rv->shadow_phase = 0u;
+  rv->e_now_dps = 0.0f;
   rv->trend_p_deg = rv->trend_step_deg = 0.0f;
   rv->filters_held = 1u;
   rv->snap_lag_deg = rv->snap_hp_deg = 0.0f;
@@ -138,8 +140,7 @@ GYRO_RAMFUNC static inline float spur_error_dps(const rate_valid_cfg_t *restrict
   return fm_maxf(e, e_fast);
 }
 
-GYRO_RAMFUNC int rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_t *restrict rv,
-                                 const rate_channel_t *restrict rc)
+GYRO_RAMFUNC int rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_t *restrict rv)
 {
   const float move = rv->p_window_change_deg, change = fm_absf(move);
   const int over_cap = !(change <= c->p_window_max_deg);
@@ -180,26 +181,75 @@ GYRO_RAMFUNC int rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_
     for (uint32_t i = 0u; i <= COMP_STAGES_MAX; i++) x[i] += move;
     x[RATE_VALID_SPUR_FAST_LAG] += move;
   }
-  const float e_now = spur_error_dps(c, x);
-  /* On to the next window's end (the window's transition, lower triangular): judged at
-   * both ends, the error between them is judged with it. */
-  const float *m = c->spur_m;
-  for (uint32_t i = RATE_VALID_SPUR_N; i-- > 0u;) { /* lower triangular: in place, last row first */
-    const float *row = &m[i * (i + 1u) / 2u];
-    float y = 0.0f;
-    for (uint32_t j = 0u; j <= i; j++) y += row[j] * x[j];
-    x[i] = y;
-  }
-  const float e_next = spur_error_dps(c, x);
-  /* Half the tolerance: the other half is P_f's own way back to its trend (displaced,
-   * rate_valid_thermo), which the shadow does not hold. */
-  const float half_tol = 0.5f * c->tol_dps;
-  rv->spur = (e_now <= half_tol && e_next <= half_tol) ? 0u : RATE_INVALID_THERMO_SLEW;
   rv->slew = slewing ? RATE_INVALID_THERMO_SLEW : 0u;
   rv->thermo = (rv->thermo & ~RATE_INVALID_THERMO_SLEW) | rv->slew | rv->spur |
                (rv->displaced != 0u ? RATE_INVALID_THERMO_SLEW : 0u);
   rv->slew_due = 0u;
-  if ((rv->thermo | rv->restart_armed) == 0u) {
+  rv->shadow_phase = 1u;
+  return restart;
+}
+
+/* Rows hi - 1 down to lo of the shadow's window transition, in place (lower triangular:
+ * row i reads x[0..i], none of which a later row of the same pass has written). Inlined
+ * with constant bounds and unrolled: a multiply-add per entry, the state in registers
+ * (the loops as loops cost eight instructions an entry). */
+GYRO_RAMFUNC static inline __attribute__((always_inline)) void
+shadow_rows(const float *restrict m, float *restrict x, uint32_t hi, uint32_t lo)
+{
+#pragma GCC unroll 8
+  for (uint32_t i = hi; i-- > lo;) {
+    const float *row = &m[i * (i + 1u) / 2u];
+    float y = 0.0f;
+#pragma GCC unroll 8
+    for (uint32_t j = 0u; j <= i; j++) y += row[j] * x[j];
+    x[i] = y;
+  }
+}
+
+/* THERMO_SLEW from the shadow's verdict (and the window's slew, a lasting move). */
+GYRO_RAMFUNC static inline void shadow_verdict(rate_valid_t *restrict rv, int beyond)
+{
+  if (beyond) rv->spur = RATE_INVALID_THERMO_SLEW;
+  rv->thermo = (rv->thermo & ~RATE_INVALID_THERMO_SLEW) | rv->slew | rv->spur |
+               (rv->displaced != 0u ? RATE_INVALID_THERMO_SLEW : 0u);
+}
+
+GYRO_RAMFUNC void rate_valid_shadow(const rate_valid_cfg_t *restrict c,
+                                    rate_valid_t *restrict rv, const rate_channel_t *restrict rc)
+{
+  float *x = rv->spur_deg;
+  /* Half the tolerance: the other half is P_f's own way back to its trend (displaced,
+   * rate_valid_thermo), which the shadow does not hold. */
+  const float half_tol = 0.5f * c->tol_dps;
+  switch (rv->shadow_phase) {
+  case 1u: /* its error at the window's end, judged at once */
+    rv->e_now_dps = spur_error_dps(c, x);
+    shadow_verdict(rv, !(rv->e_now_dps <= half_tol));
+    break;
+  case 2u: { /* the fast path's rows (they read s and the fast path's own states alone),
+              * then the gradient term's */
+    const float *m = c->spur_m;
+    const float *r6 = &m[RATE_VALID_SPUR_FAST_HP * (RATE_VALID_SPUR_FAST_HP + 1u) / 2u];
+    const float *r5 = &m[RATE_VALID_SPUR_FAST_LAG * (RATE_VALID_SPUR_FAST_LAG + 1u) / 2u];
+    x[RATE_VALID_SPUR_FAST_HP] = r6[0] * x[0] +
+                                 r6[RATE_VALID_SPUR_FAST_LAG] * x[RATE_VALID_SPUR_FAST_LAG] +
+                                 r6[RATE_VALID_SPUR_FAST_HP] * x[RATE_VALID_SPUR_FAST_HP];
+    x[RATE_VALID_SPUR_FAST_LAG] = r5[0] * x[0] +
+                                  r5[RATE_VALID_SPUR_FAST_LAG] * x[RATE_VALID_SPUR_FAST_LAG];
+    shadow_rows(m, x, RATE_VALID_SPUR_FAST_LAG, RATE_VALID_SPUR_HP);
+    break;
+  }
+  case 3u: shadow_rows(c->spur_m, x, RATE_VALID_SPUR_HP, 1u); break;
+  case 4u: { /* at the next window's end: judged at both ends, the error between them
+              * is judged with it */
+    shadow_rows(c->spur_m, x, 1u, 0u);
+    const float e_next = spur_error_dps(c, x);
+    rv->spur = 0u;
+    shadow_verdict(rv, !(rv->e_now_dps <= half_tol && e_next <= half_tol));
+    rv->shadow_phase = (rv->thermo | rv->restart_armed) == 0u ? 5u : 0u;
+    return;
+  }
+  default: /* every check passed: what a later move would drop */
     rv->snap_lag_deg = rc->p_comp_lag_deg;
     rv->snap_mid_deg[0] = rc->p_comp_mid_deg[0];
     rv->snap_mid_deg[1] = rc->p_comp_mid_deg[1];
@@ -210,8 +260,10 @@ GYRO_RAMFUNC int rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_
      * says (a ramp at r holds it at r tau_g: r T per update is that times grad_a). */
     rv->trend_p_deg = rv->p_dev_window_deg;
     rv->trend_step_deg = rc->p_hp_deg * c->grad_a;
+    rv->shadow_phase = 0u;
+    return;
   }
-  return restart;
+  rv->shadow_phase++;
 }
 
 /* One P update of the compensation's filters (comp_filters_step) in double, on the

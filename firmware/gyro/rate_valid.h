@@ -147,7 +147,10 @@ typedef struct {
                                       * stages', P_f - P_c, the gradient term's input;
                                       * comp_filters.h), at the next window's end */
   uint32_t restart_armed;            /* a window's move beyond RATE_VALID_RESTART_CAPS caps */
-  uint32_t displaced;                /* the filters restarted on a P_f no temperature made */
+  uint32_t displaced;                /* P_f moved as no temperature does, not back yet */
+  uint32_t shadow_phase;             /* the shadow's job still to run (rate_valid_shadow):
+                                      * 1..5, 0 none */
+  float e_now_dps;                   /* the shadow's error at the judged window's end */
   float trend_p_deg;    /* P_f - p_ref where the temperature alone would have it: the
                            * latest passed window's end, carried on at its trend */
   float trend_step_deg; /* that trend per P update (the gradient term's input x grad_a) */
@@ -193,11 +196,18 @@ void rate_valid_settling(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float ra
 void rate_valid_thermo(const rate_valid_cfg_t *cfg, rate_valid_t *rv, float p_dev_deg,
                        float p_held_dev_deg, float p_held_w);
 /* On a tick after rate_valid_thermo ended a slew window (slew_due): THERMO_SLEW from the
- * window's change of P_f and from the shadow (apart, so that no tick carries both).
- * rc: the compensation's filters' content (rate_channel_t: the slow path's lag, mids and
- * high-pass, the fast path's lag and high-pass).
- * Returns 1 when the filters must restart now (rate_channel_comp_restart). */
-int rate_valid_slew(const rate_valid_cfg_t *cfg, rate_valid_t *rv, const rate_channel_t *rc);
+ * window's change of P_f, the move into the shadow, its error at the window's end (apart
+ * from the thermometer checks, so that no tick carries both). Returns 1 when the filters
+ * must restart now (rate_channel_comp_restart). Sets shadow_phase: */
+int rate_valid_slew(const rate_valid_cfg_t *cfg, rate_valid_t *rv);
+/* on each of the next ticks with shadow_phase set, a part of the shadow's work, so that
+ * none carries more than a few dozen instructions of it: (1) its error at the window's
+ * end, judged (THERMO_SLEW beyond half the tolerance); (2) (3) (4) the window's
+ * transition, its rows in three parts, and on (4) its verdict at both ends; (5) with
+ * every check passed, the compensation's filters' content (rc: the slow path's lag, mids
+ * and high-pass, the fast path's lag and high-pass) and P_f's trend, kept for what a
+ * later move drops. */
+void rate_valid_shadow(const rate_valid_cfg_t *cfg, rate_valid_t *rv, const rate_channel_t *rc);
 /* The shadow's transition over RATE_VALID_SLEW_UPDATES P updates for the compensation's
  * filter weights comp_a, grad_a, its stages and the fast path's weight fast_a (0: none)
  * (rate_channel_cfg_t): lower triangular in the state (s, mid[0], mid[1], lag, hp,

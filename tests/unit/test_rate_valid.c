@@ -30,9 +30,21 @@ static rate_valid_cfg_t cfg(void)
 
 static rate_valid_t rv;
 static const rate_channel_t k_filters_at_rest; /* the compensation's filters all 0 */
-static rate_valid_history_t hist;
 /* The configuration the monitors under test run with. */
 static rate_valid_cfg_t s_cfg;
+
+/* A window that ended is judged, and its shadow run, as gyro_block_p does over up to
+ * six blocks. */
+static void judge_window(void)
+{
+  if (!rv.slew_due) return;
+  (void)rate_valid_slew(&s_cfg, &rv);
+  assert_int_equal(rv.shadow_phase, 1u);
+  for (uint32_t k = 0u; k < 5u && rv.shadow_phase != 0u; k++)
+    rate_valid_shadow(&s_cfg, &rv, &k_filters_at_rest);
+  assert_int_equal(rv.shadow_phase, 0u);
+}
+static rate_valid_history_t hist;
 
 static int rv_init(rate_valid_t *v, const rate_valid_cfg_t *c)
 {
@@ -169,7 +181,7 @@ static void test_thermo_slew(void **state)
   for (uint32_t i = 0; i < 3u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.004f / (float)RATE_VALID_SLEW_UPDATES; /* 0.04 deg/s, under the cap */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
+    judge_window();
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
@@ -177,7 +189,7 @@ static void test_thermo_slew(void **state)
     /* 0.004 deg per 0.1 s leaves P_f 0.0064 deg behind: with no bias slope no error,
      * whatever the quadrature (the reference does not read P_f) ... */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
+    judge_window();
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   s_cfg.bias_slope_dps_per_deg = 52.0f;
@@ -186,7 +198,7 @@ static void test_thermo_slew(void **state)
     /* ... at 52 deg/s per degree of bias slope 0.33 deg/s: beyond the tolerance though
      * under the cap. */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
+    judge_window();
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
   s_cfg.bias_slope_dps_per_deg = 0.0f;
@@ -196,7 +208,7 @@ static void test_thermo_slew(void **state)
   for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
     p += 0.006f / (float)RATE_VALID_SLEW_UPDATES; /* 0.06 deg/s: beyond the cap */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
+    judge_window();
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
   /* Beyond it: into the shadow (P_f carries 0.006 deg per window of it) */
@@ -214,12 +226,12 @@ static void test_slew_at_once_and_until_back(void **state)
   float p = 0.0f;
   for (uint32_t i = 0; i < 2u * RATE_VALID_SLEW_UPDATES; i++) {
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
+    judge_window();
   }
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
   while (rv.p_updates != 1u) {
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
+    judge_window();
   }
   p = 0.05f; /* ten caps in one update, at the start of a window */
   rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
@@ -227,7 +239,7 @@ static void test_slew_at_once_and_until_back(void **state)
   assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
   for (uint32_t i = 0; i < 100u * RATE_VALID_SLEW_UPDATES; i++) { /* 10 s at the moved P */
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
+    judge_window();
     assert_int_equal(rate_valid_verdict(&rv, 0u), RATE_INVALID_THERMO_SLEW);
   }
   assert_true(rv.displaced != 0u);
@@ -235,7 +247,7 @@ static void test_slew_at_once_and_until_back(void **state)
   uint32_t n = 0;
   do {
     rate_valid_thermo(&s_cfg, &rv, p, 0.0f, 0.0f);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
+    judge_window();
   } while (rate_valid_verdict(&rv, 0u) != 0u && ++n < 100u * RATE_VALID_SLEW_UPDATES);
   assert_int_equal(rv.displaced, 0u);
   assert_int_equal(rate_valid_verdict(&rv, 0u), 0u);
@@ -262,7 +274,7 @@ static void test_start_far_from_reference_comes_valid(void **state)
   for (uint32_t i = 1u; i <= 1500u; i++) { /* 3 s at 500 Hz */
     w *= decay;
     rate_valid_thermo(&s_cfg, &rv, p + w * (p_held - p), p_held, w);
-    if (rv.slew_due) (void)rate_valid_slew(&s_cfg, &rv, &k_filters_at_rest);
+    judge_window();
     if (rate_valid_verdict(&rv, 0u) == 0u) {
       if (first_valid == 0u) first_valid = i;
     } else {
