@@ -103,11 +103,20 @@ class SimPart:
     protocol: thermcal.Protocol = thermcal.FULL  # the thermal profiles (--quick: QUICK)
 
 
+def shown_path(path):
+    """A path as a command recorded in the report shows it: relative to the folder the
+    flow runs in when it lies below it (as the flow's own command line is written), so
+    that the report reads the same in every clone; absolute otherwise."""
+    rel = os.path.relpath(path)
+    return path if rel == ".." or rel.startswith(".." + os.sep) else rel
+
+
 def _run(part, args, what):
     cmd = [part.gyro_sim] + args
     for s in part.sets:
         cmd += ["--set", s]
     r = subprocess.run(cmd, capture_output=True, text=True)
+    cmd[0] = shown_path(cmd[0])
     if r.returncode != 0:
         msg = (r.stderr.strip() or r.stdout.strip()).splitlines()
         raise FlowError(f"{what}: gyro-sim exit {r.returncode}: "

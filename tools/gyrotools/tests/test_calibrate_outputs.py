@@ -215,3 +215,14 @@ def test_verify_only_a_calibration_the_part_cannot_run_fails_the_verification(tm
     assert code == tool.EXIT_VERIFY_FAILED
     rep = json.load(open(out / "report.json"))
     assert rep["verify"]["passed"] is False and "LOCKED" in rep["verify"]["could_not_run"]
+
+
+def test_recorded_commands_are_relative_below_the_run_folder(tmp_path, monkeypatch):
+    """The report's stage commands name the simulator as the flow's own command line is
+    written (the committed report.json had this machine's absolute build path in each)."""
+    sim = tmp_path / "build" / "host-release" / "host_sim" / "gyro-sim"
+    monkeypatch.chdir(tmp_path)
+    assert calflow.shown_path(str(sim)) == os.path.join("build", "host-release", "host_sim",
+                                                        "gyro-sim")
+    outside = tmp_path.parent / "elsewhere" / "gyro-sim"
+    assert calflow.shown_path(str(outside)) == str(outside)
