@@ -92,9 +92,20 @@ static void test_phase_setpoint_walk(void **state)
   assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
   assert_false(rate_valid_now());
   assert_non_null(strstr(cmd("status\n"), "- calibrated stale\r\n"));
-  /* Not a dead end: back on the setpoint the values were taken at, valid again. */
+  /* Not a dead end: back on the setpoint the values were taken at, valid again. P's way
+   * back to the old setpoint is a move of P_f no temperature makes; the compensation's
+   * fast path (the default part's calibration has one) takes in more of it than the slow
+   * path and sits it out, and the shadow keeps the rate invalid until what the fast path
+   * took in has decayed under half the tolerance: 14.5 s here (2 s with the slow
+   * path alone). Judged over the whole wait: never valid and wrong. */
   assert_true(strncmp(cmd("set drive.phase_set_deg 0\n"), "ok", 2) == 0);
-  judge_run(&j, 2.0);
+  double waited_s = 0.0, valid_from_s = 0.0;
+  while (waited_s < 20.0) {
+    judge_run(&j, 0.5);
+    waited_s += 0.5;
+    if (!rate_valid_now()) valid_from_s = waited_s;
+  }
+  print_message("# valid for good from %.1f s after the setpoint's return\n", valid_from_s);
   judge_assert(&j);
   assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
   assert_true(rate_valid_now());
