@@ -66,6 +66,7 @@ typedef struct {
   float u_probe_v2;
   float settle_dps, min_step_dps;
   uint32_t settle_updates, wait_updates, avg_updates;
+  float inv_avg, inv_u_probe_v2; /* 1 / avg_updates, 1 / u_probe_v2 */
 } quad_null_design_t;
 
 typedef enum {
