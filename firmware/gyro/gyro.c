@@ -41,6 +41,8 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   t.out.rate_invalid = RATE_INVALID_MODE;
   t.sup_in.state_finite = 1;
   t.weights_finite = 1u;
+  quad_null_stop(&t.quad);
+  t.quad_bits = d->quad_on != 0u ? RATE_INVALID_QUAD_NULL : 0u; /* not nulled yet */
   *g = t;
   if (d->autostart != 0u) {
     gyro_start(g);
@@ -98,6 +100,12 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
     rate_valid_disturb(&g->valid);
   }
   rate_channel_rebase(&old->rate, &d->rate, &g->rate);
+  /* Quadrature nulling turned on: not nulled until its loop says so; turned off: its
+   * reason goes at once, the electrodes at its next update (the P_f block, 2 ms). The
+   * running loop keeps its identified gain through other changes of quad.*. */
+  if (d->quad_on != old->quad_on) {
+    g->quad_bits = d->quad_on != 0u && g->quad.settled == 0u ? RATE_INVALID_QUAD_NULL : 0u;
+  }
   g->design = d;
 }
 
@@ -171,7 +179,7 @@ GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc,
   g->out.tick++;
   const uint32_t slot = g->slot;
   g->slot = slot + 1u == GYRO_BLOCK ? 0u : slot + 1u;
-  gyro_block_sweep(g, slot, u1, u2);
+  gyro_block_sweep(g, slot, u1, u2, dac);
 }
 
 GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
@@ -210,5 +218,5 @@ GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame
    * last, as a tail call. */
   const uint32_t slot = g->slot;
   g->slot = slot + 1u == GYRO_BLOCK ? 0u : slot + 1u;
-  gyro_block_run(g, slot, u1, u2);
+  gyro_block_run(g, slot, u1, u2, dac);
 }

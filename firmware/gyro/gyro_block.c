@@ -180,14 +180,56 @@ GYRO_RAMFUNC void gyro_block_rate(gyro_t *g)
   rate_valid_range(&g->design->valid, &g->valid, rc->rate_dps);
 }
 
-GYRO_RAMFUNC void gyro_block_p(gyro_t *g, int hold)
+/* The nulling electrodes' voltages into the frame, once per update: a DC level the
+ * second converter holds until the next (hal_dac.h). */
+GYRO_RAMFUNC static void quad_null_codes(const quad_null_t *q, hal_dac_frame_t *dac)
+{
+  dac->code[HAL_DAC_QUADNULL_V1] = gyro_volts_to_dac(q->v1_v);
+  dac->code[HAL_DAC_QUADNULL_V2] = gyro_volts_to_dac(q->v2_v);
+}
+
+GYRO_RAMFUNC void gyro_block_quad_off(gyro_t *g, hal_dac_frame_t *dac)
+{
+  quad_null_stop(&g->quad);
+  dac->code[HAL_DAC_QUADNULL_V1] = (uint16_t)HAL_DAC_CODE_MID;
+  dac->code[HAL_DAC_QUADNULL_V2] = (uint16_t)HAL_DAC_CODE_MID;
+  g->quad_bits = g->design->quad_on != 0u ? RATE_INVALID_QUAD_NULL : 0u;
+}
+
+/* The quadrature-nulling loop's update (quad_null.h) on the rate channel's filtered
+ * quadrature (GYRO_SLOT_QUAD of this block), at the thermometer's 500 Hz: at the rate
+ * channel's 5 kHz the float integrator's dead band would be ten times wider. LOCKED
+ * only (the new P_f's block); it starts with its probe on the first update after lock. */
+GYRO_RAMFUNC static void gyro_block_quad_null(gyro_t *g, hal_dac_frame_t *dac)
+{
+  const gyro_design_t *d = g->design;
+  quad_null_t *q = &g->quad;
+  if (d->quad_on == 0u) { /* turned off while running (gyro_apply) */
+    gyro_block_quad_off(g, dac);
+    return;
+  }
+  if (q->mode == QUAD_NULL_OFF) quad_null_start(&d->quad, q);
+  quad_null_update(&d->quad, q, g->rate.quad_dps);
+  quad_null_codes(q, dac);
+  /* settled implies RUN and not at the limit (quad_null.c); FAILED never settles */
+  g->quad_bits = q->settled != 0u ? 0u : RATE_INVALID_QUAD_NULL;
+}
+
+GYRO_RAMFUNC void gyro_block_p(gyro_t *g, int hold, hal_dac_frame_t *dac)
 {
   const gyro_design_t *d = g->design; /* kept across the call: a register saved anyway */
   rate_channel_t *rc = &g->rate;
   /* The hold first (only rate_channel_update_p reads it): hold need not outlive a call. */
   rate_channel_hold_p(rc, hold);
   if (rate_channel_p_update_now(rc)) {
-    /* The new P_f's tick: no other job (a job still waiting runs after it). */
+    /* The new P_f's tick: no other job of the thermometer (a job still waiting runs
+     * after it); the quadrature-nulling loop's update, at its 500 Hz, while it is on
+     * or still energised (gyro_slots.h). */
+    if (d->quad_on != 0u || g->quad.mode != QUAD_NULL_OFF) gyro_block_quad_null(g, dac);
+  } else if (GYRO_UNLIKELY(hold != 0 && g->quad.mode != QUAD_NULL_OFF)) {
+    /* Not LOCKED (a fault, drive off, a re-acquisition): the electrodes off, once; the
+     * loop starts again, with its probe, at the next lock. */
+    gyro_block_quad_off(g, dac);
   } else if (rc->p_new != 0u) {
     /* The thermometer checks of the P_f the last block made: P's low-pass runs on one
      * block in RATE_P_BLOCKS, the checks on the next, so that no tick carries both. */
@@ -212,13 +254,13 @@ GYRO_RAMFUNC void gyro_block_p(gyro_t *g, int hold)
   (void)rate_channel_update_p(&d->rate, rc, g->drive.p_eq_rad);
 }
 
-GYRO_RAMFUNC void gyro_block_p_selftest(gyro_t *g)
+GYRO_RAMFUNC void gyro_block_p_selftest(gyro_t *g, hal_dac_frame_t *dac)
 {
   const int locked = g->sup.mode == GYRO_MODE_LOCKED;
   selftest_update(&g->design->selftest, &g->selftest, locked, g->rate.rate_raw);
   /* The test force disturbs the rate output: its filters settle again afterwards. */
   rate_valid_disturb(&g->valid);
-  gyro_block_p(g, !locked);
+  gyro_block_p(g, !locked, dac);
 }
 
 /* The snapshot for telemetry and status, at fs / GYRO_BLOCK (5 kHz: the telemetry's
@@ -235,7 +277,8 @@ GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
                                                                    : 0u) |
                               /* the reference's wide start (rate_channel.h): it passes
                                * the acquisition's tail of the measured phase */
-                              (g->rate.ref_wide_left != 0u ? RATE_INVALID_SETTLING : 0u);
+                              (g->rate.ref_wide_left != 0u ? RATE_INVALID_SETTLING : 0u) |
+                              g->quad_bits; /* the nulling loop's, from its update */
   const uint32_t invalid = rate_valid_verdict(&g->valid, block_bits);
   /* Never a valid-looking wrong rate: the analog output goes to the fault level in the
    * same sample as the verdict, without a slew. */
@@ -289,7 +332,8 @@ GYRO_RAMFUNC void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v)
   g->flags_acc = 0u;
 }
 
-GYRO_RAMFUNC void gyro_block_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
+GYRO_RAMFUNC void gyro_block_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v,
+                                   hal_dac_frame_t *dac)
 {
   selfcal_exec_t *x = &g->cal;
   selfcal_exec_tick(x, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
@@ -300,6 +344,9 @@ GYRO_RAMFUNC void gyro_block_sweep(gyro_t *g, uint32_t slot, float u1_v, float u
    * snapshot's job, and every job settles for far longer than that. */
   if (GYRO_SWEEP_IDLE_SLOT(slot)) {
     drive_synth_follow(&g->synth, x->f_cmd_v2, x->p_rad);
+    /* The nulling electrodes off in SWEEP (entered from LOCKED without a held block):
+     * the sweep measures the part as it is; the loop starts again after it. */
+    if (GYRO_UNLIKELY(g->quad.mode != QUAD_NULL_OFF)) gyro_block_quad_off(g, dac);
     selfcal_exec_take(x); /* a new job starts on a tick without a job of its own */
     return;
   }

@@ -47,7 +47,11 @@
  *         self-test's notch (quadrature axis),
  *         quadrature filter; the filters' settling        rate filter (6)
  *   8     P's hold and low-pass (its mean every 10th      P (1)
- *         block: that block carries nothing else); on     P_f (8, last block)
+ *         block: that block carries nothing of the
+ *         thermometer's, but the quadrature-nulling       quad (7)
+ *         loop's update at its 500 Hz, quad.null 1,
+ *         quad_null.h, and its electrodes' DAC codes;
+ *         held, the loop's stop, once); on                P_f (8, last block)
  *         the nine blocks between, one job each, in
  *         order: the thermometer checks of the new P_f,
  *         the compensation's filters' step, the slew of   P_f (8, last blocks)

@@ -17,6 +17,7 @@
 #include "gyro/gyro_dac.h"
 #include "gyro/gyro_design.h"
 #include "gyro/gyro_slots.h"
+#include "gyro/quad_null.h"
 #include "gyro/rate_channel.h"
 #include "gyro/rate_valid.h"
 #include "gyro/selfcal_exec.h"
@@ -79,6 +80,8 @@ typedef struct {
   const volatile uint32_t *lost_count;         /* the HAL's count of lost samples */
   uint32_t lost_seen;                          /* its value at the last block */
   uint32_t cont_fail;      /* the continuous self-test's verdict (GYRO_SLOT_PHASE_PI) */
+  uint32_t quad_bits;      /* RATE_INVALID_QUAD_NULL while the nulling loop is on and not
+                            * settled (its update, GYRO_SLOT_P), for the verdict */
   uint32_t rate_clear_due; /* the loop-state clear's rate-channel half is due (GYRO_SLOT_RATE) */
   uint32_t flags_acc;      /* GYRO_FLAG_* seen since the last snapshot */
   supervisor_in_t sup_in;  /* the supervisor's evidence, gathered by the jobs before
@@ -92,6 +95,9 @@ typedef struct {
   rate_valid_t valid; /* the rate-valid verdict and its monitors (once per block) */
   selfcal_exec_t cal; /* self-calibration jobs, run while the supervisor is in SWEEP */
   rate_valid_history_t valid_history; /* onsets of the reasons, for `status` */
+  /* The quadrature-nulling loop (quad.null 1), once per RATE_P_DECIM ticks: its electrodes'
+   * codes go into the caller's frame when they change (HAL_DAC_QUADNULL_V1, _V2). */
+  quad_null_t quad;
 } gyro_t;
 
 #endif /* GYRO_STATE_H */
