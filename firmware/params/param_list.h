@@ -323,7 +323,10 @@
   /* two periods of the output filter's cut-off and more */ \
   X(quad_probe_avg_s, 0x0908u, "quad.probe_avg_s", F32, "s", 0.002f, 10.0f, 0.02f, 0u, \
     PF_PERSIST | PF_LIVE, "length of each of the probe's two means of the quadrature") \
-  /* MIN_STEP_PLACEHOLDER */ \
+  /* 5 deg/s: what 2 V moves at 1.25 (deg/s)/V^2, and far above the probe's error on a
+   * part without electrodes (the difference of two 20 ms means of the filtered
+   * quadrature: its noise and its drift over 40 ms after lock), so that such a part
+   * stops rather than integrate its own noise */ \
   X(quad_min_step_dps, 0x0909u, "quad.min_step_dps", F32, "deg/s", 0.001f, 1000.0f, 5.0f, 0u, \
     PF_PERSIST | PF_LIVE, "the probe's smallest credible effect: less means no working electrodes (the loop stops)") \
   /* 0: no calibration. The compensation, the demodulation phase and the scale hold at
