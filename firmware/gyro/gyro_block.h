@@ -46,6 +46,13 @@ void gyro_block_clear(gyro_t *g);
  * outputs) and its verdict for the supervisor (sup_in: the next block's supervisor acts
  * on it), then the quadrature's output filter. */
 void gyro_block_quad(gyro_t *g);
+/* The quadrature-nulling loop's job (its steps at the end of GYRO_SLOT_OUTPUT,
+ * gyro_block.c) as quad.null says: waiting for the next update, or none. */
+void gyro_quad_reset(gyro_t *g);
+/* Its halt at once, outside the tick's jobs (the drive's stop, a re-acquisition, a sweep,
+ * quad.null 0): not settled, both electrodes at 0 V (mid-scale codes into the attached
+ * frame), the job waiting (or none). */
+void gyro_quad_off(gyro_t *g);
 /* GYRO_SLOT_PHASE_PI: the phase loop's update; a whole turn of P it took is passed on to
  * the thermometer (rate_channel_shift_p). Tracking drive: the PLL's update instead (the
  * NCO's step from the next tick on). */
@@ -67,22 +74,17 @@ void gyro_block_phase_judge(gyro_t *g, int drive_on);
  * filter, scale and compensation, its range check. */
 void gyro_block_rate(gyro_t *g);
 /* GYRO_SLOT_P: P's hold and low-pass (hold: not LOCKED); the thermometer checks of the
- * P_f the last block made. On the new P_f's block (LOCKED, every RATE_P_BLOCKS blocks)
- * the quadrature-nulling loop's update instead, its electrodes' codes into dac; held,
- * the loop stops (both electrodes at 0 V). */
-void gyro_block_p(gyro_t *g, int hold, hal_dac_frame_t *dac);
+ * P_f the last block made. */
+void gyro_block_p(gyro_t *g, int hold);
 /* GYRO_SLOT_P while a self-test runs: its sequence on the block's projection, then P's
  * hold and low-pass. */
-void gyro_block_p_selftest(gyro_t *g, hal_dac_frame_t *dac);
-/* The quadrature-nulling loop stopped: state, both electrodes at 0 V (mid-scale codes),
- * its reason for the verdict as quad.null says (GYRO_SLOT_P held, SWEEP). */
-void gyro_block_quad_off(gyro_t *g, hal_dac_frame_t *dac);
+void gyro_block_p_selftest(gyro_t *g);
 /* GYRO_SLOT_OUTPUT: the snapshot for telemetry and status, the analog rate code.
  * (u1_v, u2_v): the drive voltages of this tick. */
 void gyro_block_output(gyro_t *g, float u1_v, float u2_v);
 /* Every tick in SWEEP, instead of gyro_block_run: the self-calibration job's
  * excitation (from the next tick on) and NCO step, then the slot's job. */
-void gyro_block_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v, hal_dac_frame_t *dac);
+void gyro_block_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v);
 
 /* GYRO_SLOT_PROJECT, in every mode: the rail codes of the ticks whose sense sum is
  * projected now (the verdict's and, drive channel only, the supervisor's evidence). */
@@ -94,10 +96,8 @@ static inline void gyro_block_take_rails(gyro_t *g)
   g->clip_drive_count = 0u;
 }
 
-/* The job of tick `slot` of the block. Every branch ends in one call (a tail call). dac:
- * the tick's frame, for the jobs that write a slow channel (the nulling electrodes). */
-static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2_v,
-                                  hal_dac_frame_t *dac)
+/* The job of tick `slot` of the block. Every branch ends in one call (a tail call). */
+static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
 {
   const int drive_on = supervisor_drive_enabled(&g->sup);
   switch (slot) {
@@ -128,9 +128,9 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
   case GYRO_SLOT_QUAD: gyro_block_quad(g); break;
   case GYRO_SLOT_P:
     if (selftest_running(&g->selftest)) {
-      gyro_block_p_selftest(g, dac);
+      gyro_block_p_selftest(g);
     } else {
-      gyro_block_p(g, g->sup.mode != GYRO_MODE_LOCKED, dac);
+      gyro_block_p(g, g->sup.mode != GYRO_MODE_LOCKED);
     }
     break;
   default: /* GYRO_SLOT_OUTPUT */ gyro_block_output(g, u1_v, u2_v); break;

@@ -36,8 +36,10 @@ static double quad_true_dps(void) { return plant_truth(&plant)->quad_true_dps; }
 
 /* The first time after which |quad_true| stayed <= 1 deg/s up to t_end_s, and whether
  * the rate's QUAD_NULL bit agreed with the loop's settled flag on every block (the
- * verdict of each block follows its update), the first block the rate was valid, and
- * whether it was valid on every block after the loop settled for good. */
+ * verdict of a block takes the flag as the block before left it: the loop's steps run
+ * one a block before the verdict, and the one after its settling test passes it on),
+ * the first block the rate was valid, and whether it was valid on every block after
+ * the loop settled for good. */
 typedef struct {
   double t_nulled_s;    /* -1: never */
   double t_valid_s;     /* first valid block, -1: never */
@@ -51,6 +53,8 @@ static run_t run_to(double t_end_s)
 {
   run_t r = {-1.0, -1.0, -1.0, 0, 0, 0.0};
   long n_after = 0, valid_after = 0;
+  /* settled as the verdict sees it: as the block before left it */
+  int settled_before = app.gyro.quad.settled != 0u;
   const long blocks = (long)(t_end_s * 50000.0 / GYRO_BLOCK);
   for (long n = 1; n <= blocks; n++) {
     hal_host_run(GYRO_BLOCK);
@@ -69,8 +73,11 @@ static run_t run_to(double t_end_s)
       r.t_settled_s = -1.0;
     }
     if (o->rate_valid != 0u && r.t_valid_s < 0.0) r.t_valid_s = t;
-    if (o->rate_valid != 0u && !settled) r.valid_unsettled = 1;
-    if (((o->rate_invalid & RATE_INVALID_QUAD_NULL) != 0u) == settled) r.bit_disagrees = 1;
+    if (o->rate_valid != 0u && !settled_before) r.valid_unsettled = 1;
+    if (((o->rate_invalid & RATE_INVALID_QUAD_NULL) != 0u) == settled_before) {
+      r.bit_disagrees = 1;
+    }
+    settled_before = settled;
     if (r.t_settled_s >= 0.0 && t >= r.t_settled_s + 0.1) {
       n_after++;
       valid_after += o->rate_valid != 0u;

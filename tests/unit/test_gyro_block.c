@@ -16,7 +16,6 @@
 
 static gyro_t g;
 static gyro_design_t d;
-static hal_dac_frame_t dac; /* the P slot's frame: quad.null 0 leaves it alone */
 
 /* A part like the 1300 Hz / Q 200 one the calibration flow made (its ramp is the one
  * whose bias was 1 deg/s off while valid): bias slope 5 (deg/s)/deg, gradient term
@@ -80,7 +79,7 @@ static double worst_valid_error_noisy(double r_deg_s, double dp_deg, double dur_
     const int in_dist = t >= t_dist_s && t < t_dist_s + dur_s;
     const double p_deg = p0_deg + r_deg_s * t + (in_dist ? dp_deg : 0.0) + sd_deg * gauss();
     g.drive.p_eq_rad = (float)(p_deg * M_PI / 180.0);
-    gyro_block_p(&g, 0, &dac);
+    gyro_block_p(&g, 0);
     *slew_seen |= g.valid.thermo & RATE_INVALID_THERMO_SLEW;
     if (t > 10.0 * (TAU_G_S + TAU_C_S)) {
       judged++;
@@ -220,7 +219,7 @@ static double worst_valid_bias_error(double r_deg_s, double dp_deg, double dur_s
     const int in_dist = t >= t_dist_s && t < t_dist_s + dur_s;
     const double p_deg = p0_deg + r_deg_s * t + (in_dist ? dp_deg : 0.0);
     g.drive.p_eq_rad = (float)(p_deg * M_PI / 180.0);
-    gyro_block_p(&g, 0, &dac);
+    gyro_block_p(&g, 0);
     *slew_seen |= g.valid.thermo & RATE_INVALID_THERMO_SLEW;
     if (t >= t_dist_s) *fast_w_max = fmax(*fast_w_max, (double)g.rate.comp_fast_w);
     if (t > 300.0 && g.valid.thermo == 0u) {
