@@ -127,8 +127,9 @@ GYRO_RAMFUNC void gyro_block_quad(gyro_t *g)
  *           settled), sign, V1's code, V2's code
  *   probe   take, accumulate, then on a complete mean: mean, verdict, and after the
  *           base root .. V2's code; after the step judge, then gain, close, engage (the
- *           command stays the probe's), or (FAILED, at 0 V) V1's and V2's codes
- * at most nine blocks after the wait's, so one update ends before the next begins. The
+ *           command stays the probe's), or fail_a, fail_b, V1's and V2's codes
+ * at most nine blocks after the wait's, so one update ends before the next begins (the
+ * start, three blocks, before the first update). The
  * voltages follow the measurement by 1.6 ms, against the loop's 80 ms time constant at
  * 2 Hz; the reason by 1.2 ms. Not LOCKED, the wait halts the loop (both electrodes at
  * 0 V); it starts again, with its probe, at the next lock. The drive's stop, a
@@ -173,15 +174,22 @@ GYRO_RAMFUNC static void quad_close(gyro_t *g)
   quad_null_close(&g->design->quad, &g->quad);
 }
 
-/* After the judgement: the gain into the loop, or (FAILED: the voltages are 0 V) the
- * codes. */
+/* After the judgement: the gain into the loop, or FAILED (both electrodes at 0 V, in
+ * two halves, then the codes). */
+GYRO_RAMFUNC static void quad_fail_b(gyro_t *g)
+{
+  g->quad_job = quad_code_v1;
+  quad_null_fail_b(&g->quad);
+}
+
 GYRO_RAMFUNC static void quad_after_judge(gyro_t *g)
 {
   if (g->quad.close_due != 0u) {
     g->quad_job = quad_close;
     quad_null_gain(&g->design->quad, &g->quad);
   } else {
-    quad_code_v1(g);
+    g->quad_job = quad_fail_b;
+    quad_null_fail_a(&g->quad);
   }
 }
 
@@ -247,11 +255,25 @@ GYRO_RAMFUNC static void quad_take(gyro_t *g)
   g->quad_job = next;
 }
 
+/* The start (quad_null_start) in three parts; its first measurement on the next update. */
+GYRO_RAMFUNC static void quad_start_c(gyro_t *g)
+{
+  g->quad_job = quad_wait;
+  quad_null_clear_c(&g->quad);
+  g->quad.mode = QUAD_NULL_PROBE_BASE;
+}
+
+GYRO_RAMFUNC static void quad_start_b(gyro_t *g)
+{
+  g->quad_job = quad_start_c;
+  quad_null_clear_b(&g->quad);
+}
+
 GYRO_RAMFUNC static void quad_start(gyro_t *g)
 {
-  g->quad_job = quad_wait; /* its first measurement on the next update */
+  g->quad_job = quad_start_b;
   g->quad_bits = RATE_INVALID_QUAD_NULL;
-  quad_null_start(&g->design->quad, &g->quad);
+  quad_null_clear_a(&g->quad);
 }
 
 GYRO_RAMFUNC static void quad_halt_codes(gyro_t *g)

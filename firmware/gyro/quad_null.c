@@ -46,35 +46,11 @@ int quad_null_design(const quad_null_cfg_t *cfg, quad_null_design_t *d)
   return 0;
 }
 
-/* Field by field rather than memset: the sample interrupt starts the loop, and the
- * library's memset lies in flash (linker/check_ramfunc.py). */
-GYRO_RAMFUNC void quad_null_stop(quad_null_t *q)
+void quad_null_stop(quad_null_t *q)
 {
-  q->mode = QUAD_NULL_OFF;
-  q->count = 0u;
-  q->sum_dps = 0.0f;
-  q->base_dps = 0.0f;
-  q->gain_dps_per_v2 = 0.0f;
-  q->pi.kp = 0.0f;
-  q->pi.ki_t = 0.0f;
-  q->pi.u_min = 0.0f;
-  q->pi.u_max = 0.0f;
-  q->pi_state.u = 0.0f;
-  q->pi_state.e_prev = 0.0f;
-  q->integ_v2 = 0.0f;
-  q->u_cmd_v2 = 0.0f;
-  q->x_dps = 0.0f;
-  q->in_band = 0u;
-  q->settled = 0u;
-  q->at_limit = 0u;
-  q->close_due = 0u;
-  q->mean_due = 0u;
-  q->skip = 0u;
-  q->step_dps = 0.0f;
-  q->mean_dps = 0.0f;
-  q->root_v = 0.0f;
-  q->v1_v = 0.0f;
-  q->v2_v = 0.0f;
+  quad_null_clear_a(q);
+  quad_null_clear_b(q);
+  quad_null_clear_c(q);
 }
 
 GYRO_RAMFUNC void quad_null_halt(quad_null_t *q)
@@ -89,7 +65,7 @@ GYRO_RAMFUNC void quad_null_halt(quad_null_t *q)
   q->close_due = 0u;
 }
 
-GYRO_RAMFUNC void quad_null_start(const quad_null_design_t *d, quad_null_t *q)
+void quad_null_start(const quad_null_design_t *d, quad_null_t *q)
 {
   (void)d;
   quad_null_stop(q);
@@ -141,7 +117,11 @@ void quad_null_update(const quad_null_design_t *d, quad_null_t *q, float quad_dp
     quad_null_verdict(d, q);
     if (step_mean) {
       quad_null_judge(d, q);
-      if (q->close_due == 0u) return; /* FAILED: both electrodes at 0 V already */
+      if (q->close_due == 0u) { /* FAILED: both electrodes at 0 V */
+        quad_null_fail_a(q);
+        quad_null_fail_b(q);
+        return;
+      }
       quad_null_gain(d, q);
       quad_null_close(d, q);
       quad_null_engage(d, q); /* on the probe's command: the voltages stay */

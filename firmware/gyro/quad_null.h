@@ -136,8 +136,8 @@ void quad_null_halt(quad_null_t *q);
  *   accumulate  the probe's sums; mean_due when a mean is complete (else nothing more)
  *   mean        the mean
  *   verdict     the base (the step on), or (PROBE_STEP) the step's effect
- *   judge       after the step's: too small (FAILED, both at 0 V, nothing more), or
- *               close_due
+ *   judge       after the step's: close_due if its effect is large enough, else
+ *   fail_a, _b  FAILED: both electrodes at 0 V (nothing more)
  *   gain        close_due: the gain and the integrator's coefficient (one divide)
  *   close       close_due: the integrator from the probe's command, bumpless
  *   engage      then: RUN on the probe's command (the voltages stay: nothing more)
@@ -158,11 +158,63 @@ GYRO_RAMFUNC static inline void quad_null_command(quad_null_t *q, float u, float
   q->at_limit = (u >= u_max || u <= -u_max) ? 1u : 0u;
 }
 
-/* The probe saw no effect (or gave no usable gain): both electrodes at 0 V, for good. */
-GYRO_RAMFUNC static inline void quad_null_fail(quad_null_t *q)
+/* quad_null_stop in three parts (the sample interrupt starts the loop with them, one a
+ * tick, then the mode PROBE_BASE), field by field rather than memset, whose library copy
+ * lies in flash (linker/check_ramfunc.py): the integrator, the values, the counts,
+ * flags and voltages. */
+GYRO_RAMFUNC static inline void quad_null_clear_a(quad_null_t *q)
 {
-  quad_null_halt(q);
+  q->pi.kp = 0.0f;
+  q->pi.ki_t = 0.0f;
+  q->pi.u_min = 0.0f;
+  q->pi.u_max = 0.0f;
+  q->pi_state.u = 0.0f;
+  q->pi_state.e_prev = 0.0f;
+  q->integ_v2 = 0.0f;
+}
+
+GYRO_RAMFUNC static inline void quad_null_clear_b(quad_null_t *q)
+{
+  q->sum_dps = 0.0f;
+  q->base_dps = 0.0f;
+  q->gain_dps_per_v2 = 0.0f;
+  q->x_dps = 0.0f;
+  q->step_dps = 0.0f;
+  q->mean_dps = 0.0f;
+  q->root_v = 0.0f;
+}
+
+GYRO_RAMFUNC static inline void quad_null_clear_c(quad_null_t *q)
+{
+  q->mode = QUAD_NULL_OFF;
+  q->count = 0u;
+  q->u_cmd_v2 = 0.0f;
+  q->in_band = 0u;
+  q->settled = 0u;
+  q->at_limit = 0u;
+  q->close_due = 0u;
+  q->mean_due = 0u;
+  q->skip = 0u;
+  q->v1_v = 0.0f;
+  q->v2_v = 0.0f;
+}
+
+/* The probe saw no effect: FAILED, the command and both electrodes at 0 V (fail_a), the
+ * rest of its state cleared (fail_b); two halves for the tick's budget. */
+GYRO_RAMFUNC static inline void quad_null_fail_a(quad_null_t *q)
+{
   q->mode = QUAD_NULL_FAILED;
+  q->u_cmd_v2 = 0.0f;
+  q->v1_v = 0.0f;
+  q->v2_v = 0.0f;
+}
+
+GYRO_RAMFUNC static inline void quad_null_fail_b(quad_null_t *q)
+{
+  q->root_v = 0.0f;
+  q->settled = 0u;
+  q->at_limit = 0u;
+  q->close_due = 0u;
   q->gain_dps_per_v2 = 0.0f;
   q->integ_v2 = 0.0f;
   q->in_band = 0u;
@@ -216,11 +268,7 @@ GYRO_RAMFUNC static inline void quad_null_judge(const quad_null_design_t *d, qua
   /* (A mean is of finite measurements, so the step is finite: an infinite one would need
    * a quadrature near 1e37 deg/s.) */
   const float step = q->step_dps;
-  if (!((step < 0.0f ? -step : step) >= d->min_step_dps)) {
-    quad_null_fail(q);
-    return;
-  }
-  q->close_due = 1u;
+  q->close_due = (step < 0.0f ? -step : step) >= d->min_step_dps ? 1u : 0u;
 }
 
 GYRO_RAMFUNC static inline void quad_null_integrate(quad_null_t *q)
