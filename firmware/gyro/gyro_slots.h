@@ -31,12 +31,17 @@
  *         thermometer's phase (P, or p_eq from the       P (1), the tracker's step (1)
  *         tracking drive's step)
  *         drive_synth_set(f_cmd, P): the waveform's       f_cmd (2), P (1)
- *         amplitude (square root) and phase offset
+ *         amplitude (square root) and phase offset;
+ *         then, quad.null 1, one step of the              quad (7), P_f (8)
+ *         quadrature-nulling loop's update (500 Hz,
+ *         from the block after each new P_f; gyro_block.c:
+ *         take .. the electrodes' DAC codes, one a
+ *         block; between updates a wait, which also
+ *         halts the loop when not LOCKED)
  *   4     the last verdict's onsets into the history      verdict (9, last block)
  *         (rare); supervisor (its clear request: slot 5)  evidence (3), finiteness (7, last block)
  *   5     rate channel: block mean of S, projection       sense sum, P (1)
- *         (or, on request, the loop state cleared, and
- *         the nulling loop's halt posted);
+ *         (or, on request, the loop state cleared);
  *         the block's rail codes; the continuous
  *         self-test's modulation
  *   6     the continuous self-test's notch (rate axis);   projection (5), modulation (5)
@@ -48,9 +53,7 @@
  *         self-test's notch (quadrature axis),
  *         quadrature filter; the filters' settling        rate filter (6)
  *   8     P's hold and low-pass (its mean every 10th      P (1)
- *         block: that block carries nothing else but
- *         the post of the quadrature-nulling loop's
- *         update, quad.null 1); on                        P_f (8, last block)
+ *         block: that block carries nothing else); on     P_f (8, last block)
  *         the nine blocks between, one job each, in
  *         order: the thermometer checks of the new P_f,
  *         the compensation's filters' step, the slew of   P_f (8, last blocks)
@@ -60,13 +63,7 @@
  *         state); the self-test sequence while it runs    projection (5)
  *   9     rate-valid verdict, rate half of the output     checks (2, 6, 7), rails (5),
  *         snapshot, analog rate code (the fault level     everything
- *         when not valid); then one step of the
- *         quadrature-nulling loop's update at its 500     quad (7), posted (8)
- *         Hz: take, integrate, judge, route (its reason
- *         of the verdict), [gain, close after the
- *         probe], square root, V1's, V2's DAC code, one
- *         per block (gyro_block.c); or its halt, posted
- *         by a fault's clear (5), and its 0 V codes
+ *         when not valid)
  *
  * The drive command thus reaches the DAC (COMMAND + 1 - slot) ticks after the sample
  * the loop measured: 4 for the phase loop, 2 for the amplitude loop; gyro_design adds

@@ -85,7 +85,7 @@ typedef struct gyro_s {
   uint32_t lost_seen;                          /* its value at the last block */
   uint32_t cont_fail;        /* the continuous self-test's verdict (GYRO_SLOT_PHASE_PI) */
   uint32_t quad_bits;        /* RATE_INVALID_QUAD_NULL while nulling is on and not settled */
-  gyro_quad_step_t quad_job; /* the nulling loop's next step (GYRO_SLOT_OUTPUT), or NULL */
+  gyro_quad_step_t quad_job; /* the nulling loop's next step (GYRO_SLOT_COMMAND), or NULL */
   uint32_t rate_clear_due; /* the loop-state clear's rate-channel half is due (GYRO_SLOT_RATE) */
   uint32_t flags_acc;      /* GYRO_FLAG_* seen since the last snapshot */
   supervisor_in_t sup_in;  /* the supervisor's evidence, gathered by the jobs before
