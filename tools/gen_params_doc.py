@@ -30,6 +30,7 @@ GROUP_TITLE = {
     "rate": "Rate channel (`rate.*`)",
     "sup": "Supervisor (`sup.*`)",
     "selftest": "Self-test (`selftest.*`)",
+    "quad": "Quadrature nulling (`quad.*`)",
     "tlm": "Telemetry (`tlm.*`)",
     "sys": "System (`sys.*`)",
 }

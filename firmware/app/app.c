@@ -131,6 +131,7 @@ int app_init_with(app_t *a, const param_values_t *values)
     return -2;
   }
   gyro_attach_lost_counter(&a->gyro, hal_sample_lost_counter());
+  gyro_attach_dac_frame(&a->gyro, &a->dac); /* the nulling electrodes' channels */
   a->applied = view.derived;
 
   const cli_cfg_t cc = {&a->params, &a->store,        cli_write,

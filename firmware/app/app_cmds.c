@@ -240,6 +240,24 @@ static void put_calibration(cli_t *cli, app_t *a)
   cli_data_u32(cli, "cal_date", v->cal_date);
 }
 
+/* Quadrature nulling (quad.null 1, quad_null.h): the loop's mode, its identified gain c
+ * ((deg/s)/V^2, sign included; 0 before its probe), whether it has settled and is at its
+ * limit, and the electrodes' voltages. */
+static void put_quad_null(cli_t *cli, app_t *a)
+{
+  static const char *const names[] = {"off", "probe_base", "probe_step", "run", "failed"};
+  const quad_null_t *q = &a->gyro.quad;
+  const uint32_t m = (uint32_t)q->mode;
+  cli_putf(cli, "quad_null %s", m < sizeof names / sizeof names[0] ? names[m] : "?");
+  cli_emit_data(cli);
+  cli_data_u32(cli, "quad_null_on", a->gyro.design->quad_on);
+  cli_data_f32(cli, "quad_gain_dps_per_v2", q->gain_dps_per_v2);
+  cli_data_u32(cli, "quad_settled", q->settled);
+  cli_data_u32(cli, "quad_at_limit", q->at_limit);
+  cli_data_f32(cli, "quad_v1_v", q->v1_v);
+  cli_data_f32(cli, "quad_v2_v", q->v2_v);
+}
+
 static void put_store(cli_t *cli, app_t *a)
 {
   cli_putf(cli, "store %s", param_store_status_str(a->store_status));
@@ -311,6 +329,7 @@ static const status_row_t k_status_rows[] = {
     {"rate_valid", NULL, put_integrity},
     {"calibrated", NULL, put_calibration},
     {"drive", NULL, put_drive},
+    {"quad_null", NULL, put_quad_null},
     {"design", NULL, put_design},
     {"ticks", isr_ticks, NULL},
     {"isr_cycles_last", isr_cycles_last, NULL},

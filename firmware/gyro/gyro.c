@@ -7,6 +7,14 @@
 #include "gyro/gyro_block.h"
 #include "dsp/ramfunc.h"
 
+/* No frame attached (gyro_attach_dac_frame): the nulling electrodes' codes go here. */
+static hal_dac_frame_t s_no_frame;
+
+void gyro_attach_dac_frame(gyro_t *g, hal_dac_frame_t *frame)
+{
+  g->dac_frame = frame != NULL ? frame : &s_no_frame;
+}
+
 /* No counter of lost samples attached (gyro_attach_lost_counter): none are lost. */
 static const volatile uint32_t k_no_loss = 0u;
 
@@ -41,6 +49,10 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   t.out.rate_invalid = RATE_INVALID_MODE;
   t.sup_in.state_finite = 1;
   t.weights_finite = 1u;
+  quad_null_stop(&t.quad);
+  gyro_attach_dac_frame(&t, NULL);
+  t.quad_bits = d->quad_on != 0u ? RATE_INVALID_QUAD_NULL : 0u; /* not nulled yet */
+  gyro_quad_reset(&t);
   *g = t;
   if (d->autostart != 0u) {
     gyro_start(g);
@@ -99,6 +111,15 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   }
   rate_channel_rebase(&old->rate, &d->rate, &g->rate);
   g->design = d;
+  /* Quadrature nulling turned off, or no longer LOCKED (a re-acquisition above): the
+   * electrodes at 0 V now; turned on, not nulled until its loop says so, from the next
+   * update if LOCKED. The running loop keeps its identified gain through other changes
+   * of quad.*. */
+  if (g->quad.mode != QUAD_NULL_OFF && (d->quad_on == 0u || g->sup.mode != GYRO_MODE_LOCKED)) {
+    gyro_quad_off(g);
+  }
+  g->quad_bits = d->quad_on != 0u && g->quad.settled == 0u ? RATE_INVALID_QUAD_NULL : 0u;
+  if ((d->quad_on != 0u) != (old->quad_on != 0u)) gyro_quad_reset(g);
 }
 
 void gyro_start(gyro_t *g) { supervisor_start(&g->sup); }
@@ -106,6 +127,7 @@ void gyro_start(gyro_t *g) { supervisor_start(&g->sup); }
 void gyro_stop(gyro_t *g)
 {
   supervisor_stop(&g->sup);
+  if (g->quad.mode != QUAD_NULL_OFF) gyro_quad_off(g); /* its electrodes at 0 V */
   drive_loop_reset(&g->design->drive, &g->drive);
   /* The drive starts again from the calibrated frequency, whatever moved the NCO (the
    * tracking drive, or a sweep that ended without its hand-over). */
@@ -114,7 +136,8 @@ void gyro_stop(gyro_t *g)
 
 void gyro_sweep_begin(gyro_t *g)
 {
-  gyro_stop(g);
+  gyro_stop(g); /* the nulling electrodes at 0 V too: the sweep measures the part as it
+                 * is, and the loop starts again, with its probe, after it */
   supervisor_enter_sweep(&g->sup);
   selfcal_exec_reset(&g->cal, g->nco.half_step);
 }

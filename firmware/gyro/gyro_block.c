@@ -60,6 +60,10 @@ GYRO_RAMFUNC void gyro_block_command(gyro_t *g)
   const gyro_design_t *d = g->design;
   g->drive.p_eq_rad = d->track != 0u ? drive_track_p_eq_rad(&d->track_cfg, &g->track)
                                      : g->drive.p_rad;
+  /* Last, as a tail call: the quadrature-nulling loop's step of this block (quad.null 1;
+   * below). */
+  const gyro_quad_step_t step = g->quad_job;
+  if (step != NULL) step(g);
 }
 
 GYRO_RAMFUNC void gyro_block_clear(gyro_t *g)
@@ -108,6 +112,203 @@ GYRO_RAMFUNC void gyro_block_quad(gyro_t *g)
   const gyro_design_t *d = g->design;
   rate_valid_settling(&d->valid, &g->valid, rc->rate_raw, rc->quad_raw, rc->rate_unc_dps,
                       rc->quad_dps, d->rate.scale_dps);
+}
+
+/* The quadrature-nulling loop (quad_null.h) at the thermometer's 500 Hz (RATE_P_DECIM: at
+ * the block's 5 kHz the float integrator's dead band would be ten times wider) on the
+ * filtered quadrature (GYRO_SLOT_QUAD), while LOCKED. No tick has room for a whole
+ * update beside its own job (measured: 216 cycles on the new P_f's P slot, which had 81
+ * to spare; some tens on the others), so the update runs as quad_null.h's steps, one a
+ * block, at the end of GYRO_SLOT_COMMAND: a tail call through g->quad_job, which each
+ * step sets to the next on quad_null_update's path. Between updates the job is
+ * quad_wait, which starts one on the block after a new P_f (LOCKED, every
+ * RATE_P_BLOCKS blocks):
+ *   RUN     take, integrate, limit, settle, root (and the verdict's reason from
+ *           settled), sign, V1's code, V2's code
+ *   probe   take, accumulate, then on a complete mean: mean, verdict, and after the
+ *           base root .. V2's code; after the step judge, then gain, close, engage (the
+ *           command stays the probe's), or fail_a, fail_b, V1's and V2's codes
+ * at most nine blocks after the wait's, so one update ends before the next begins (the
+ * start, three blocks, before the first update). The
+ * voltages follow the measurement by 1.6 ms, against the loop's 80 ms time constant at
+ * 2 Hz; the reason by 1.2 ms. Not LOCKED, the wait halts the loop (both electrodes at
+ * 0 V); it starts again, with its probe, at the next lock. The drive's stop, a
+ * re-acquisition, a sweep and quad.null 0 halt it at once (gyro_quad_off). */
+static void quad_wait(gyro_t *g);
+
+GYRO_RAMFUNC static void quad_code_v2(gyro_t *g)
+{
+  g->quad_job = quad_wait;
+  g->dac_frame->code[HAL_DAC_QUADNULL_V2] = gyro_volts_to_dac(g->quad.v2_v);
+}
+
+GYRO_RAMFUNC static void quad_code_v1(gyro_t *g)
+{
+  g->quad_job = quad_code_v2;
+  g->dac_frame->code[HAL_DAC_QUADNULL_V1] = gyro_volts_to_dac(g->quad.v1_v);
+}
+
+GYRO_RAMFUNC static void quad_sign(gyro_t *g)
+{
+  g->quad_job = quad_code_v1;
+  quad_null_sign(&g->quad);
+}
+
+GYRO_RAMFUNC static void quad_root(gyro_t *g)
+{
+  g->quad_job = quad_sign;
+  /* settled implies RUN and not at the limit (quad_null.c); FAILED never settles */
+  g->quad_bits = g->quad.settled != 0u ? 0u : RATE_INVALID_QUAD_NULL;
+  quad_null_root(&g->quad);
+}
+
+GYRO_RAMFUNC static void quad_engage(gyro_t *g)
+{
+  g->quad_job = quad_wait;
+  quad_null_engage(&g->design->quad, &g->quad);
+}
+
+GYRO_RAMFUNC static void quad_close(gyro_t *g)
+{
+  g->quad_job = quad_engage;
+  quad_null_close(&g->design->quad, &g->quad);
+}
+
+/* After the judgement: the gain into the loop, or FAILED (both electrodes at 0 V, in
+ * two halves, then the codes). */
+GYRO_RAMFUNC static void quad_fail_b(gyro_t *g)
+{
+  g->quad_job = quad_code_v1;
+  quad_null_fail_b(&g->quad);
+}
+
+GYRO_RAMFUNC static void quad_after_judge(gyro_t *g)
+{
+  if (g->quad.close_due != 0u) {
+    g->quad_job = quad_close;
+    quad_null_gain(&g->design->quad, &g->quad);
+  } else {
+    g->quad_job = quad_fail_b;
+    quad_null_fail_a(&g->quad);
+  }
+}
+
+GYRO_RAMFUNC static void quad_judge(gyro_t *g)
+{
+  g->quad_job = quad_after_judge;
+  quad_null_judge(&g->design->quad, &g->quad);
+}
+
+/* The probe's verdict: on the base, the step's voltages next; on the step, its judgement. */
+GYRO_RAMFUNC static void quad_verdict(gyro_t *g)
+{
+  g->quad_job = g->quad.mode == QUAD_NULL_PROBE_BASE ? quad_root : quad_judge;
+  quad_null_verdict(&g->design->quad, &g->quad);
+}
+
+/* A complete mean: its verdict next; else the update ends (the command holds). */
+GYRO_RAMFUNC static void quad_mean(gyro_t *g)
+{
+  if (g->quad.mean_due == 0u) {
+    g->quad_job = quad_wait;
+    return;
+  }
+  g->quad_job = quad_verdict;
+  quad_null_mean(&g->design->quad, &g->quad);
+}
+
+GYRO_RAMFUNC static void quad_accumulate(gyro_t *g)
+{
+  g->quad_job = quad_mean;
+  quad_null_accumulate(&g->design->quad, &g->quad);
+}
+
+GYRO_RAMFUNC static void quad_settle(gyro_t *g)
+{
+  g->quad_job = quad_root;
+  quad_null_settle(&g->design->quad, &g->quad);
+}
+
+GYRO_RAMFUNC static void quad_limit(gyro_t *g)
+{
+  g->quad_job = quad_settle;
+  quad_null_limit(&g->design->quad, &g->quad);
+}
+
+GYRO_RAMFUNC static void quad_integrate(gyro_t *g)
+{
+  g->quad_job = quad_limit;
+  quad_null_integrate(&g->quad);
+}
+
+GYRO_RAMFUNC static void quad_take(gyro_t *g)
+{
+  quad_null_t *q = &g->quad;
+  quad_null_take(q, g->rate.quad_dps);
+  const quad_null_mode_t mode = q->mode;
+  gyro_quad_step_t next = quad_accumulate; /* the probe */
+  if (q->skip != 0u || mode == QUAD_NULL_FAILED) {
+    next = quad_wait; /* no measurement, or nothing moves */
+  } else if (mode == QUAD_NULL_RUN) {
+    next = quad_integrate;
+  }
+  g->quad_job = next;
+}
+
+/* The start (quad_null_start) in three parts; its first measurement on the next update. */
+GYRO_RAMFUNC static void quad_start_c(gyro_t *g)
+{
+  g->quad_job = quad_wait;
+  quad_null_clear_c(&g->quad);
+  g->quad.mode = QUAD_NULL_PROBE_BASE;
+}
+
+GYRO_RAMFUNC static void quad_start_b(gyro_t *g)
+{
+  g->quad_job = quad_start_c;
+  quad_null_clear_b(&g->quad);
+}
+
+GYRO_RAMFUNC static void quad_start(gyro_t *g)
+{
+  g->quad_job = quad_start_b;
+  g->quad_bits = RATE_INVALID_QUAD_NULL;
+  quad_null_clear_a(&g->quad);
+}
+
+GYRO_RAMFUNC static void quad_halt_codes(gyro_t *g)
+{
+  g->quad_job = quad_wait;
+  hal_dac_frame_t *f = g->dac_frame;
+  f->code[HAL_DAC_QUADNULL_V1] = (uint16_t)HAL_DAC_CODE_MID;
+  f->code[HAL_DAC_QUADNULL_V2] = (uint16_t)HAL_DAC_CODE_MID;
+}
+
+GYRO_RAMFUNC static void quad_halt(gyro_t *g)
+{
+  g->quad_job = quad_halt_codes;
+  g->quad_bits = RATE_INVALID_QUAD_NULL; /* quad.null is 1 while the job runs */
+  quad_null_halt(&g->quad);
+}
+
+/* Between updates: the next one on the new P_f's block (LOCKED); not LOCKED, the halt. */
+GYRO_RAMFUNC static void quad_wait(gyro_t *g)
+{
+  if (g->sup.mode != GYRO_MODE_LOCKED) {
+    if (GYRO_UNLIKELY(g->quad.mode != QUAD_NULL_OFF)) g->quad_job = quad_halt;
+  } else if (g->rate.p_new != 0u) { /* the block after a new P_f's (GYRO_SLOT_P) */
+    g->quad_job = g->quad.mode == QUAD_NULL_OFF ? quad_start : quad_take;
+  }
+}
+
+void gyro_quad_reset(gyro_t *g) { g->quad_job = g->design->quad_on != 0u ? quad_wait : NULL; }
+
+void gyro_quad_off(gyro_t *g)
+{
+  quad_null_halt(&g->quad);
+  quad_halt_codes(g);
+  gyro_quad_reset(g);
+  g->quad_bits = g->design->quad_on != 0u ? RATE_INVALID_QUAD_NULL : 0u;
 }
 
 GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
@@ -235,7 +436,8 @@ GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
                                                                    : 0u) |
                               /* the reference's wide start (rate_channel.h): it passes
                                * the acquisition's tail of the measured phase */
-                              (g->rate.ref_wide_left != 0u ? RATE_INVALID_SETTLING : 0u);
+                              (g->rate.ref_wide_left != 0u ? RATE_INVALID_SETTLING : 0u) |
+                              g->quad_bits; /* nulling on and not (yet) nulled */
   const uint32_t invalid = rate_valid_verdict(&g->valid, block_bits);
   /* Never a valid-looking wrong rate: the analog output goes to the fault level in the
    * same sample as the verdict, without a slew. */

@@ -36,7 +36,8 @@ static inline void gyro_track_restart(gyro_t *g)
 void gyro_block_amp_measure(gyro_t *g);
 void gyro_block_amp(gyro_t *g);
 /* GYRO_SLOT_COMMAND: the rest of the supervisor's evidence (sup_in), and the block's
- * drive command into the synthesis (once, after both loops). */
+ * drive command into the synthesis (once, after both loops); then the quadrature-nulling
+ * loop's step, if one is due (g->quad_job). */
 void gyro_block_command(gyro_t *g);
 /* GYRO_SLOT_PROJECT when the supervisor asked for it: clear every integrating state, so
  * that nothing of the old state (possibly NaN) survives into the next acquisition; the
@@ -46,6 +47,13 @@ void gyro_block_clear(gyro_t *g);
  * outputs) and its verdict for the supervisor (sup_in: the next block's supervisor acts
  * on it), then the quadrature's output filter. */
 void gyro_block_quad(gyro_t *g);
+/* The quadrature-nulling loop's job (its steps at the end of GYRO_SLOT_COMMAND,
+ * gyro_block.c) as quad.null says: waiting for the next update, or none. */
+void gyro_quad_reset(gyro_t *g);
+/* Its halt at once, outside the tick's jobs (the drive's stop, a re-acquisition, a sweep,
+ * quad.null 0): not settled, both electrodes at 0 V (mid-scale codes into the attached
+ * frame), the job waiting (or none). */
+void gyro_quad_off(gyro_t *g);
 /* GYRO_SLOT_PHASE_PI: the phase loop's update; a whole turn of P it took is passed on to
  * the thermometer (rate_channel_shift_p). Tracking drive: the PLL's update instead (the
  * NCO's step from the next tick on). */

@@ -151,6 +151,28 @@ static gyro_design_status_t design_selftest(const param_values_t *v, gyro_design
   return GYRO_DESIGN_OK;
 }
 
+/* Quadrature nulling (quad_null.h): updated once per RATE_P_DECIM ticks (the
+ * thermometer's block, 500 Hz: the float integrator's dead band, quad_null.h), its
+ * electrodes on the second converter, whose largest output is the limit's bound. */
+static gyro_design_status_t design_quad_null(const param_values_t *v, gyro_design_t *t)
+{
+  const double v_dac_max = (double)(HAL_DAC_CODE_MAX - HAL_DAC_CODE_MID) *
+                           (double)HAL_DAC_V_PER_CODE;
+  const quad_null_cfg_t qc = {v->quad_bw_hz,
+                              v->quad_v_max_v,
+                              v->quad_settle_dps,
+                              v->quad_settle_s,
+                              v->quad_probe_v,
+                              v->quad_probe_wait_s,
+                              v->quad_probe_avg_s,
+                              v->quad_min_step_dps,
+                              (float)((double)RATE_P_DECIM / (double)v->sys_fs_hz)};
+  if (!((double)v->quad_v_max_v <= v_dac_max) || quad_null_design(&qc, &t->quad) != 0) {
+    return GYRO_DESIGN_QUAD_NULL;
+  }
+  t->quad_on = v->quad_null;
+  return GYRO_DESIGN_OK;
+}
 
 /* The NCO at the drive frequency, below fs / 4: the 2 wc terms of the demodulation
  * (lmsd.h) then stay below fs / 2. */
@@ -411,6 +433,7 @@ static gyro_design_status_t design_parts(const param_values_t *v, gyro_design_t 
   if (s == GYRO_DESIGN_OK) s = design_supervisor(v, tau_s, t);
   if (s == GYRO_DESIGN_OK) s = design_validity(v, t);
   if (s == GYRO_DESIGN_OK) s = design_selftest(v, t);
+  if (s == GYRO_DESIGN_OK) s = design_quad_null(v, t);
   t->autostart = v->sys_autostart;
   t->cal_state = cal_state(v);
   t->track_uncal = v->drive_track != 0u && v->cal_ref_track == 0u ? 1u : 0u;
@@ -481,6 +504,9 @@ static const char *const k_reasons[GYRO_DESIGN_STATUS_COUNT] = {
                               "a quarter of the block rate (sys.fs_hz / 40)",
     [GYRO_DESIGN_CONT_EXPECT] = "selftest.cont_expect_dps and rate.scale_dps must not be 0, and "
                                 "selftest.tol_rel must be below 1",
+    [GYRO_DESIGN_QUAD_NULL] = "quad.probe_v must not exceed quad.v_max_v, quad.v_max_v must lie "
+                              "within the DAC's range (14.99 V), quad.bw_hz at most a tenth "
+                              "of the 500 Hz update, quad.probe_avg_s at least one update (2 ms)",
     [GYRO_DESIGN_MODULE] = "a value outside its parameter's range: a module refused its part of "
                            "the design",
 };

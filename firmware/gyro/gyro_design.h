@@ -13,6 +13,7 @@
 #include "gyro/drive_loop.h"
 #include "gyro/drive_synth.h"
 #include "gyro/drive_track.h"
+#include "gyro/quad_null.h"
 #include "gyro/rate_channel.h"
 #include "gyro/rate_valid.h"
 #include "gyro/selftest.h"
@@ -48,6 +49,11 @@ typedef struct {
   /* The tracking drive runs on a calibration made with the fixed drive (cal.ref_track 0):
    * the TRACKING reason of rate_valid.h (its cal_state is STALE as well). */
   uint32_t track_uncal;
+  /* Quadrature nulling (quad.null 1, quad_null.h): its design is made in either state
+   * (a bad configuration is refused even while off); the sample path runs it only when
+   * quad_on is 1, at the thermometer's block rate (RATE_P_DECIM). */
+  uint32_t quad_on;
+  quad_null_design_t quad;
 } gyro_design_t;
 
 /* gyro_design_t.cal_state */
@@ -87,6 +93,7 @@ typedef enum {
   GYRO_DESIGN_BIAS_SLOPE,     /* rate.bias_c*, rate.p_range_deg */
   GYRO_DESIGN_CONT_FREQ,      /* selftest.cont_freq_hz against rate.lpf_cutoff_hz */
   GYRO_DESIGN_CONT_EXPECT,    /* selftest.cont_expect_dps, selftest.tol_rel */
+  GYRO_DESIGN_QUAD_NULL,      /* quad.* against each other, the update rate, the DAC */
   GYRO_DESIGN_MODULE,         /* a module refused its part: a value outside its range */
   GYRO_DESIGN_STATUS_COUNT
 } gyro_design_status_t;

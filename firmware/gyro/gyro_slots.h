@@ -31,7 +31,13 @@
  *         thermometer's phase (P, or p_eq from the       P (1), the tracker's step (1)
  *         tracking drive's step)
  *         drive_synth_set(f_cmd, P): the waveform's       f_cmd (2), P (1)
- *         amplitude (square root) and phase offset
+ *         amplitude (square root) and phase offset;
+ *         then, quad.null 1, one step of the              quad (7), P_f (8)
+ *         quadrature-nulling loop's update (500 Hz,
+ *         from the block after each new P_f; gyro_block.c:
+ *         take .. the electrodes' DAC codes, one a
+ *         block; between updates a wait, which also
+ *         halts the loop when not LOCKED)
  *   4     the last verdict's onsets into the history      verdict (9, last block)
  *         (rare); supervisor (its clear request: slot 5)  evidence (3), finiteness (7, last block)
  *   5     rate channel: block mean of S, projection       sense sum, P (1)

@@ -17,6 +17,7 @@
 #include "gyro/gyro_dac.h"
 #include "gyro/gyro_design.h"
 #include "gyro/gyro_slots.h"
+#include "gyro/quad_null.h"
 #include "gyro/rate_channel.h"
 #include "gyro/rate_valid.h"
 #include "gyro/selfcal_exec.h"
@@ -58,7 +59,11 @@ typedef struct {
 #define GYRO_FLAG_UNCALIBRATED \
   (1u << 8) /* no calibration, or a stale one: status `calibrated` */
 
-typedef struct {
+struct gyro_s;
+/* A step of the quadrature-nulling loop's update (gyro_block_quad_null). */
+typedef void (*gyro_quad_step_t)(struct gyro_s *g);
+
+typedef struct gyro_s {
   /* The design the sample path runs with: the parameter bank's published block, whole
    * (gyro_apply swaps it at a tick boundary). Every module's configuration is read
    * through it; what follows is what the modules remember. */
@@ -78,7 +83,9 @@ typedef struct {
   uint32_t clip_drive_count, clip_drive_block; /* the same, drive channel only */
   const volatile uint32_t *lost_count;         /* the HAL's count of lost samples */
   uint32_t lost_seen;                          /* its value at the last block */
-  uint32_t cont_fail;      /* the continuous self-test's verdict (GYRO_SLOT_PHASE_PI) */
+  uint32_t cont_fail;        /* the continuous self-test's verdict (GYRO_SLOT_PHASE_PI) */
+  uint32_t quad_bits;        /* RATE_INVALID_QUAD_NULL while nulling is on and not settled */
+  gyro_quad_step_t quad_job; /* the nulling loop's next step (GYRO_SLOT_COMMAND), or NULL */
   uint32_t rate_clear_due; /* the loop-state clear's rate-channel half is due (GYRO_SLOT_RATE) */
   uint32_t flags_acc;      /* GYRO_FLAG_* seen since the last snapshot */
   supervisor_in_t sup_in;  /* the supervisor's evidence, gathered by the jobs before
@@ -92,6 +99,11 @@ typedef struct {
   rate_valid_t valid; /* the rate-valid verdict and its monitors (once per block) */
   selfcal_exec_t cal; /* self-calibration jobs, run while the supervisor is in SWEEP */
   rate_valid_history_t valid_history; /* onsets of the reasons, for `status` */
+  /* The quadrature-nulling loop (quad.null 1), one update per RATE_P_DECIM ticks cut into
+   * steps over the blocks (quad_job, gyro_block.h); its electrodes' codes go into the
+   * attached frame (gyro_attach_dac_frame) on each update and when it stops. */
+  quad_null_t quad;
+  hal_dac_frame_t *dac_frame; /* the frame every tick writes (the application's) */
 } gyro_t;
 
 #endif /* GYRO_STATE_H */

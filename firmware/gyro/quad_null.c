@@ -2,10 +2,10 @@
 
 #include <math.h>
 #include <stddef.h>
-#include <string.h>
 
 #include "dsp/fastmath.h"
 #include "dsp/math_const.h"
+#include "dsp/ramfunc.h"
 
 static int pos_finite(float x) { return isfinite(x) && x > 0.0f; }
 
@@ -40,21 +40,29 @@ int quad_null_design(const quad_null_cfg_t *cfg, quad_null_design_t *d)
   d->settle_updates = (uint32_t)settle;
   d->wait_updates = (uint32_t)wait;
   d->avg_updates = (uint32_t)avg;
+  /* the probe's two divides, here: the sample interrupt's block carries at most one */
+  d->inv_avg = 1.0f / (float)avg;
+  d->inv_u_probe_v2 = 1.0f / d->u_probe_v2;
   return 0;
-}
-
-/* u -> the electrode pair: one electrode carries sqrt(|u|), the other nothing */
-static void electrodes(quad_null_t *q, float u, float u_max)
-{
-  q->at_limit = (u >= u_max || u <= -u_max) ? 1u : 0u;
-  q->v1_v = u > 0.0f ? fm_sqrtf(u) : 0.0f;
-  q->v2_v = u < 0.0f ? fm_sqrtf(-u) : 0.0f;
 }
 
 void quad_null_stop(quad_null_t *q)
 {
-  memset(q, 0, sizeof *q);
+  quad_null_clear_a(q);
+  quad_null_clear_b(q);
+  quad_null_clear_c(q);
+}
+
+GYRO_RAMFUNC void quad_null_halt(quad_null_t *q)
+{
   q->mode = QUAD_NULL_OFF;
+  q->u_cmd_v2 = 0.0f;
+  q->root_v = 0.0f;
+  q->v1_v = 0.0f;
+  q->v2_v = 0.0f;
+  q->settled = 0u;
+  q->at_limit = 0u;
+  q->close_due = 0u;
 }
 
 void quad_null_start(const quad_null_design_t *d, quad_null_t *q)
@@ -64,82 +72,68 @@ void quad_null_start(const quad_null_design_t *d, quad_null_t *q)
   q->mode = QUAD_NULL_PROBE_BASE;
 }
 
+/* The loop's integrator for the gain c (deg/s per V^2, sign included): e = -q and
+ * q = q0 + c u, so Ki T = 2 pi f_c T / c puts the crossover at f_c (what pi_design makes
+ * for Kp = 0). Returns Ki T, or NaN for a c that gives none. */
+static inline float ki_t_for(const quad_null_design_t *d, float c_dps_per_v2)
+{
+  if (!(fm_isfinite(c_dps_per_v2) && c_dps_per_v2 != 0.0f)) return NAN;
+  return d->wc_dt / c_dps_per_v2;
+}
+
+/* The loop closed with Ki T on the gain c, from u (within the limits). */
+static inline void close_loop(const quad_null_design_t *d, quad_null_t *q, float ki_t, float u)
+{
+  q->pi.kp = 0.0f;
+  q->pi.ki_t = ki_t;
+  q->pi.u_min = -d->u_max_v2;
+  q->pi.u_max = d->u_max_v2;
+  q->pi_state.u = u;
+  q->pi_state.e_prev = 0.0f;
+  q->integ_v2 = u;
+  q->mode = QUAD_NULL_RUN;
+  quad_null_command(q, u, d->u_max_v2);
+}
+
 int quad_null_start_with_gain(const quad_null_design_t *d, quad_null_t *q, float c_dps_per_v2)
 {
   quad_null_stop(q);
-  if (!(isfinite(c_dps_per_v2) && c_dps_per_v2 != 0.0f)) return -1;
-  /* e = -q and q = q0 + c u: Ki T = 2 pi f_c T / c puts the crossover at f_c */
-  const pi_cfg_t pc = {0.0f, d->wc_dt / c_dps_per_v2, 1.0f, -d->u_max_v2, d->u_max_v2, 0.0f};
-  if (pi_design(&pc, &q->pi) != 0) return -1;
+  const float ki_t = ki_t_for(d, c_dps_per_v2);
+  if (!fm_isfinite(ki_t)) return -1;
+  close_loop(d, q, ki_t, 0.0f);
   q->gain_dps_per_v2 = c_dps_per_v2;
-  q->mode = QUAD_NULL_RUN;
   return 0;
-}
-
-/* The probe's phases: wait, then average; returns 1 when the mean is complete. */
-static int probe_mean(const quad_null_design_t *d, quad_null_t *q, float quad_dps, float *mean)
-{
-  q->count++;
-  if (q->count <= d->wait_updates) return 0;
-  q->sum_dps += quad_dps;
-  if (q->count < d->wait_updates + d->avg_updates) return 0;
-  *mean = q->sum_dps / (float)d->avg_updates;
-  q->count = 0u;
-  q->sum_dps = 0.0f;
-  return 1;
-}
-
-static void probe(const quad_null_design_t *d, quad_null_t *q, float quad_dps)
-{
-  float mean;
-  if (!probe_mean(d, q, quad_dps, &mean)) return;
-  if (q->mode == QUAD_NULL_PROBE_BASE) {
-    q->base_dps = mean;
-    q->mode = QUAD_NULL_PROBE_STEP;
-    electrodes(q, d->u_probe_v2, d->u_max_v2);
-    return;
-  }
-  const float step = mean - q->base_dps;
-  if (!((step < 0.0f ? -step : step) >= d->min_step_dps) ||
-      quad_null_start_with_gain(d, q, step / d->u_probe_v2) != 0) {
-    quad_null_stop(q);
-    q->mode = QUAD_NULL_FAILED;
-    return;
-  }
-  /* bumpless: the loop takes over from the probe's voltage */
-  (void)pi_reset(&q->pi, &q->pi_state, d->u_probe_v2, 0.0f);
-  q->integ_v2 = q->pi_state.u;
-  electrodes(q, q->integ_v2, d->u_max_v2);
-}
-
-static void run(const quad_null_design_t *d, quad_null_t *q, float quad_dps)
-{
-  const float u = pi_step_position(&q->pi, &q->pi_state, &q->integ_v2, -quad_dps);
-  electrodes(q, u, d->u_max_v2);
-  const float a = quad_dps < 0.0f ? -quad_dps : quad_dps;
-  if (a <= d->settle_dps && !q->at_limit) {
-    if (q->in_band < d->settle_updates) q->in_band++;
-  } else {
-    q->in_band = 0u;
-  }
-  q->settled = q->in_band >= d->settle_updates ? 1u : 0u;
 }
 
 void quad_null_update(const quad_null_design_t *d, quad_null_t *q, float quad_dps)
 {
-  if (!isfinite(quad_dps)) { /* no measurement: hold, and a probe mean starts again */
-    q->in_band = 0u;
-    q->settled = 0u;
-    q->count = 0u;
-    q->sum_dps = 0.0f;
-    return;
+  quad_null_take(q, quad_dps);
+  if (q->skip != 0u) return; /* no measurement: the voltages hold */
+  if (q->mode == QUAD_NULL_PROBE_BASE || q->mode == QUAD_NULL_PROBE_STEP) {
+    quad_null_accumulate(d, q);
+    if (q->mean_due == 0u) return; /* the command has not changed */
+    quad_null_mean(d, q);
+    const int step_mean = q->mode == QUAD_NULL_PROBE_STEP;
+    quad_null_verdict(d, q);
+    if (step_mean) {
+      quad_null_judge(d, q);
+      if (q->close_due == 0u) { /* FAILED: both electrodes at 0 V */
+        quad_null_fail_a(q);
+        quad_null_fail_b(q);
+        return;
+      }
+      quad_null_gain(d, q);
+      quad_null_close(d, q);
+      quad_null_engage(d, q); /* on the probe's command: the voltages stay */
+      return;
+    }
+  } else if (q->mode == QUAD_NULL_RUN) {
+    quad_null_integrate(q);
+    quad_null_limit(d, q);
+    quad_null_settle(d, q);
+  } else {
+    return; /* OFF, FAILED: both electrodes stay at 0 V */
   }
-  switch (q->mode) {
-  case QUAD_NULL_PROBE_BASE:
-  case QUAD_NULL_PROBE_STEP: probe(d, q, quad_dps); break;
-  case QUAD_NULL_RUN: run(d, q, quad_dps); break;
-  case QUAD_NULL_OFF:
-  case QUAD_NULL_FAILED:
-  default: break;
-  }
+  quad_null_root(q);
+  quad_null_sign(q);
 }

@@ -55,6 +55,13 @@
  *                 hand change), another phase setpoint or the other drive mode. The
  *                 demodulation phase and scale are a part's own; measured valid without
  *                 them, a 1300 Hz part read its rate with the sign inverted
+ *   QUAD_NULL     quadrature nulling is on (quad.null 1) and its loop has not nulled the
+ *                 quadrature: not running (not LOCKED yet), identifying its gain,
+ *                 not yet within quad.settle_dps for quad.settle_s, at its electrodes'
+ *                 limit (a quadrature they cannot reach), or its probe saw no effect of
+ *                 the electrodes (none fitted or wired: they stay at 0 V). While the
+ *                 quadrature moves by hundreds of deg/s, a demodulation phase error of
+ *                 a tenth of a degree puts a moving deg/s into the rate
  * Each check is a few multiplies and compares per block; no divide, no libm. */
 #ifndef RATE_VALID_H
 #define RATE_VALID_H
@@ -77,7 +84,8 @@
 #define RATE_INVALID_CONT_SELFTEST (1u << 10)
 #define RATE_INVALID_TRACKING (1u << 11)
 #define RATE_INVALID_UNCALIBRATED (1u << 12)
-#define RATE_INVALID_KINDS 13u
+#define RATE_INVALID_QUAD_NULL (1u << 13)
+#define RATE_INVALID_KINDS 14u
 
 /* Blocks in a row inside the settling tolerance (2 ms): longer than the noise's
  * correlation time at the filters' 100 Hz, far shorter than their settling. */

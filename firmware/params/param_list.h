@@ -40,7 +40,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 13u
+#define PARAM_LAYOUT_VERSION 14u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -293,6 +293,42 @@
   /* the default setpoint, at which the expectations above were measured */ \
   X(selftest_ref_amp_v, 0x0708u, "selftest.ref_amp_v", F32, "V", 0.01f, 4.5f, 0.349f, 0u, \
     PF_PERSIST | PF_LIVE, "drive amplitude setpoint at which the self-test expectations were measured") \
+  /* off: a part without nulling electrodes (the default part) runs as before, bit for
+   * bit; a part with them turns it on (gyro/quad_null.h). The loop identifies its own
+   * gain by a probe step at every lock, so it needs no calibrated value */ \
+  X(quad_null, 0x0901u, "quad.null", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
+    PF_PERSIST | PF_LIVE, "quadrature nulling: 0 off (electrodes at 0 V), 1 the loop on the nulling electrodes") \
+  /* 2 Hz: 1500 deg/s of quadrature under 1 deg/s in ln(1500) / (2 pi f_c) = 0.58 s, first
+   * order far under the 100 Hz output filter; at most a tenth of the 500 Hz update */ \
+  X(quad_bw_hz, 0x0902u, "quad.bw_hz", F32, "Hz", 0.01f, 50.0f, 2.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "crossover of the quadrature-nulling loop (its closed-loop bandwidth)") \
+  /* the second converter's output stage (board.h: +-15 V); 10 V leaves the rail's
+   * headroom. The design refuses a limit the converter cannot put out */ \
+  X(quad_v_max_v, 0x0903u, "quad.v_max_v", F32, "V", 0.1f, 15.0f, 10.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "limit of each nulling electrode's voltage; the loop at it never counts as settled") \
+  /* the quadrature left over as nulled: 1 deg/s turns into 0.02 deg/s of rate per degree
+   * of demodulation phase error */ \
+  X(quad_settle_dps, 0x0904u, "quad.settle_dps", F32, "deg/s", 0.001f, 100.0f, 1.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "|quadrature| below this counts as nulled") \
+  /* 25 updates at 500 Hz: longer than the 100 Hz filter's noise correlation */ \
+  X(quad_settle_s, 0x0905u, "quad.settle_s", F32, "s", 0.0f, 10.0f, 0.05f, 0u, \
+    PF_PERSIST | PF_LIVE, "the quadrature within quad.settle_dps this long before the loop counts as settled") \
+  /* 2 V: 4 V^2, a step of 80 deg/s at 20 (deg/s)/V^2, small against the electrodes'
+   * range, large against the quadrature's noise over the mean */ \
+  X(quad_probe_v, 0x0906u, "quad.probe_v", F32, "V", 0.01f, 15.0f, 2.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "identification step on nulling electrode V1 at each start (at most quad.v_max_v)") \
+  /* the 100 Hz output filter settles to 1e-4 in about 20 ms */ \
+  X(quad_probe_wait_s, 0x0907u, "quad.probe_wait_s", F32, "s", 0.0f, 10.0f, 0.02f, 0u, \
+    PF_PERSIST | PF_LIVE, "settling before each of the probe's two means") \
+  /* two periods of the output filter's cut-off and more */ \
+  X(quad_probe_avg_s, 0x0908u, "quad.probe_avg_s", F32, "s", 0.002f, 10.0f, 0.02f, 0u, \
+    PF_PERSIST | PF_LIVE, "length of each of the probe's two means of the quadrature") \
+  /* 5 deg/s: what 2 V moves at 1.25 (deg/s)/V^2, and far above the probe's error on a
+   * part without electrodes (the difference of two 20 ms means of the filtered
+   * quadrature: its noise and its drift over 40 ms after lock), so that such a part
+   * stops rather than integrate its own noise */ \
+  X(quad_min_step_dps, 0x0909u, "quad.min_step_dps", F32, "deg/s", 0.001f, 1000.0f, 5.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "the probe's smallest credible effect: less means no working electrodes (the loop stops)") \
   /* 0: no calibration. The compensation, the demodulation phase and the scale hold at
    * the drive frequency they were measured at: another one (a sweep, a hand change)
    * makes them stale. Equal within 2e-7 (two float steps), so that a value that went

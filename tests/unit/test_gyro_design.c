@@ -42,6 +42,20 @@ static void cont_expect_zero(param_values_t *v)
   v->selftest_continuous = 1u;
   v->selftest_cont_expect_dps = 0.0f;
 }
+/* Quadrature nulling (quad_null.h): each of its cross-checks, refused whether the loop
+ * is on or not (a part turned on later must not start from a bad set). */
+static void quad_probe_over_limit(param_values_t *v)
+{
+  v->quad_v_max_v = 5.0f;
+  v->quad_probe_v = 6.0f;
+}
+static void quad_limit_beyond_dac(param_values_t *v) { v->quad_v_max_v = 15.0f; }
+static void quad_bw_over_rate(param_values_t *v)
+{
+  v->quad_null = 1u;
+  v->quad_bw_hz = 60.0f; /* more than a tenth of the 500 Hz update */
+}
+static void quad_avg_under_update(param_values_t *v) { v->quad_probe_avg_s = 0.001f; }
 /* Outside a parameter's range: refused by the parameter bank before a design, but
  * gyro_design is also called directly (simulator, bench) and names them too. */
 static void fs_zero(param_values_t *v) { v->sys_fs_hz = 0u; }
@@ -80,6 +94,10 @@ static const refusal_t k_refusals[] = {
     {GYRO_DESIGN_BIAS_SLOPE, "rate.bias_c1_dps_per_deg", bias_slope_huge},
     {GYRO_DESIGN_CONT_FREQ, "selftest.cont_freq_hz", cont_freq_in_band},
     {GYRO_DESIGN_CONT_EXPECT, "selftest.cont_expect_dps", cont_expect_zero},
+    {GYRO_DESIGN_QUAD_NULL, "quad.probe_v", quad_probe_over_limit},
+    {GYRO_DESIGN_QUAD_NULL, "quad.v_max_v", quad_limit_beyond_dac},
+    {GYRO_DESIGN_QUAD_NULL, "quad.bw_hz", quad_bw_over_rate},
+    {GYRO_DESIGN_QUAD_NULL, "quad.probe_avg_s", quad_avg_under_update},
     {GYRO_DESIGN_MODULE, "range", clip_count_zero},
 };
 #define N_REFUSALS (sizeof k_refusals / sizeof k_refusals[0])

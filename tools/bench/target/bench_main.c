@@ -331,8 +331,9 @@ static void stage_param(const char *name, param_value_t val)
  * expectation, which the generic defaults leave 0 (a part's calibration measures it):
  * any nonzero one lets it run, and the bench measures its cost, not its verdict. The
  * temperature compensation as the calibration flow sets it (three stages of the slow
- * thermometer and the fast path, whose blend has its cost on the P slot). All in one
- * commit: the bank takes one change per tick. */
+ * thermometer and the fast path, whose blend has its cost on the P slot). Quadrature
+ * nulling on (its update on the new P_f's P slot). All in one commit: the bank takes one
+ * change per tick. */
 static void continuous_selftest_on(void)
 {
   param_value_t val;
@@ -345,6 +346,7 @@ static void continuous_selftest_on(void)
   val.u = 3u;
   stage_param("rate.comp_stages", val);
   val.u = 1u;
+  stage_param("quad.null", val);
   stage_param("selftest.continuous", val);
   params_err_t err;
   if (params_commit(&s_app.params, &err) != PARAM_OK) fail("selftest.continuous", -1);
@@ -371,6 +373,21 @@ static void post_job(uint32_t kind)
   memset(&x->res, 0, sizeof x->res); /* as selfcal_exec_post does */
   x->job = j;
   atomic_store(&x->job_seq, atomic_load(&x->job_seq) + 1u);
+}
+
+/* The quadrature-nulling loop's costliest update inside the traced LOCKED ticks (one in
+ * 100): its probe's last, which takes the second mean, divides for the gain and closes
+ * the loop (the bench's plant has no nulling electrodes, so its own probe failed long
+ * before: the state is set as the probe leaves it, with a credible step). The tracking
+ * drive's trace then runs the closed loop's update. */
+static void quad_null_probe_ends(void)
+{
+  quad_null_t *q = &s_app.gyro.quad;
+  const quad_null_design_t *qd = &s_app.gyro.design->quad;
+  quad_null_start(qd, q);
+  q->mode = QUAD_NULL_PROBE_STEP;
+  q->count = qd->wait_updates + qd->avg_updates - 1u;
+  q->base_dps = s_app.gyro.rate.quad_dps - 100.0f;
 }
 
 /* The tracking drive (drive.track 1) takes over the running drive, as a design change
@@ -444,6 +461,7 @@ static void bench_app(uint32_t settle, int trace)
      * window ending (once in RATE_VALID_SLEW_UPDATES P updates, one in 100 ticks). */
     s_app.gyro.selftest.cont_blocks = s_app.gyro.design->selftest.cont_settle_blocks;
     s_app.gyro.valid.p_updates = RATE_VALID_SLEW_UPDATES - 1u;
+    quad_null_probe_ends();
     s_each = 1;
     put_state("isr_app_cb");
     irq_case("isr_app_cb", bench_cb);
