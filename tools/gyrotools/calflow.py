@@ -116,7 +116,7 @@ def _run(part, args, what):
     for s in part.sets:
         cmd += ["--set", s]
     r = subprocess.run(cmd, capture_output=True, text=True)
-    cmd[0] = shown_path(cmd[0])
+    cmd = [shown_path(a) if os.path.isabs(a) else a for a in cmd]
     if r.returncode != 0:
         msg = (r.stderr.strip() or r.stdout.strip()).splitlines()
         raise FlowError(f"{what}: gyro-sim exit {r.returncode}: "
