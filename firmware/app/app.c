@@ -190,8 +190,8 @@ GYRO_RAMFUNC void app_sample_isr(void *ctx)
   gyro_tick(&a->gyro, &adc, &a->dac);
   hal_dac_write_frame(&a->dac);
   app_tlm_isr(&a->tlm, &a->gyro.out);
-
-  a->isr_ticks++; /* its cycles: the HAL measures the whole handler (hal_sample_isr_cycles) */
+  /* Its ticks are the gyro's (app_ticks), its cycles the HAL's, which measures the whole
+   * handler (hal_sample_isr_cycles). */
 }
 
 void app_cli_feed(app_t *a, const uint8_t *data, size_t len) { cli_feed(&a->cli, data, len); }

@@ -61,10 +61,8 @@ typedef struct {
                               * in SWEEP and start from them, so drive.track may change */
   app_tlm_t tlm;             /* telemetry stream and its commands (app_tlm.c) */
   selfcal_t selfcal;         /* self-calibration sequencer (background, app_selfcal.c) */
-  uint32_t selfcal_t0_ticks; /* isr_ticks when the sweep was requested */
+  uint32_t selfcal_t0_ticks; /* app_ticks when the sweep was requested */
   uint32_t selfcal_ticks;    /* its length up to the hand-over */
-  /* Self-measurement of the sample ISR (DWT cycles on the board). */
-  uint32_t isr_ticks;
   /* The DAC frame handed to the HAL every tick: gyro_tick rewrites the channels it drives,
    * the sense electrodes' channels keep the mid-scale (0 V) of app_init until a loop
    * drives them (issue 19 item 3). Kept here rather than rebuilt on the stack because
@@ -73,6 +71,11 @@ typedef struct {
   /* Set by the image's main after app_init (NULL: nothing added, as on the host). */
   app_status_fn status_board;
 } app_t;
+
+/* The sample ISR's calls since app_init: the gyro's own count of its ticks (one per
+ * call, gyro_out_t.tick), which the ISR keeps anyway; a second counter of the same
+ * thing cost the interrupt 5 cycles. */
+static inline uint32_t app_ticks(const app_t *a) { return a->gyro.out.tick; }
 
 /* Boot: stored value i set back to its default because the stored set could not be
  * designed with it (status lists them). */
