@@ -1,4 +1,5 @@
-/* GYRO_RAMFUNC marks a function of the sample interrupt's path where it is defined.
+/* The code layout of the sample interrupt's path: GYRO_RAMFUNC marks a function of it
+ * where it is defined, GYRO_UNLIKELY a branch of it rarely taken.
  *
  * On the target it puts the function into an input section of its own named
  * .ramfunc.<line>, which the linker script places in SRAM (no flash wait states, and it
@@ -20,6 +21,15 @@
 #define GYRO_RAMFUNC __attribute__((section(".ramfunc." GYRO_RAMFUNC_STR(__LINE__))))
 #else
 #define GYRO_RAMFUNC
+#endif
+
+/* A condition rarely true on the sample path: the compiler lays its branch out so that
+ * the common path falls through (a taken branch refills the pipeline). Block layout
+ * only, never what is computed. */
+#if defined(__GNUC__)
+#define GYRO_UNLIKELY(x) __builtin_expect((x) != 0, 0)
+#else
+#define GYRO_UNLIKELY(x) ((x) != 0)
 #endif
 
 #endif /* RAMFUNC_H */

@@ -6,6 +6,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "dsp/ramfunc.h" /* GYRO_UNLIKELY */
 #include "hal/hal_dac.h"
 
 #if defined(__ARM_FEATURE_DSP)
@@ -33,11 +34,6 @@
  * before adding it or after is the same rounding (checked for all 2^32 inputs against a
  * model of the three instructions, and on the target for the ties and the special
  * values). IEEE 754 single precision with round-to-nearest, the same on host and target. */
-#if defined(__GNUC__)
-#define GYRO_UNLIKELY(x) __builtin_expect((x) != 0, 0) /* block layout only */
-#else
-#define GYRO_UNLIKELY(x) ((x) != 0)
-#endif
 #define GYRO_DAC_ROUND_F 12582912.0f    /* 1.5 * 2^23 */
 #define GYRO_DAC_ROUND_BITS 0x4B400000u /* its bit pattern */
 #if defined(__ARM_FP) && defined(__ARM_FEATURE_DSP) && defined(__thumb2__)
