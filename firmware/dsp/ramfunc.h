@@ -1,5 +1,6 @@
 /* The code layout of the sample interrupt's path: GYRO_RAMFUNC marks a function of it
- * where it is defined, GYRO_UNLIKELY a branch of it rarely taken.
+ * where it is defined, GYRO_UNLIKELY a branch of it rarely taken, GYRO_NOINLINE a rare
+ * part of it kept out of its caller.
  *
  * On the target it puts the function into an input section of its own named
  * .ramfunc.<line>, which the linker script places in SRAM (no flash wait states, and it
@@ -26,10 +27,14 @@
 /* A condition rarely true on the sample path: the compiler lays its branch out so that
  * the common path falls through (a taken branch refills the pipeline). Block layout
  * only, never what is computed. */
+/* GYRO_NOINLINE keeps a rarely run part of it out of its caller, so that the caller's
+ * common path saves no register for it. */
 #if defined(__GNUC__)
 #define GYRO_UNLIKELY(x) __builtin_expect((x) != 0, 0)
+#define GYRO_NOINLINE __attribute__((noinline))
 #else
 #define GYRO_UNLIKELY(x) ((x) != 0)
+#define GYRO_NOINLINE
 #endif
 
 #endif /* RAMFUNC_H */
