@@ -23,7 +23,6 @@ static volatile uint16_t s_adc_tx_dummy = 0u;
 static struct {
   hal_sample_isr_fn isr;
   void *ctx;
-  volatile uint32_t ticks;
   volatile uint32_t overruns;
   volatile uint32_t dma_errors;
   volatile uint32_t isr_cycles_last;
@@ -122,7 +121,6 @@ int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
   hal_sample_timer_stop();
   s_chain.isr = isr;
   s_chain.ctx = ctx;
-  s_chain.ticks = 0u;
   s_chain.overruns = 0u;
   s_chain.dma_errors = 0u;
   s_chain.isr_cycles_last = 0u;
@@ -199,7 +197,6 @@ CM4_RAMFUNC void DMA2_Stream0_IRQHandler(void)
   if (CM4_UNLIKELY(flags & (DMA_FLAG_TEIF | DMA_FLAG_DMEIF))) ++s_chain.dma_errors;
   if (CM4_UNLIKELY((flags & DMA_FLAG_TCIF) == 0u)) return;
 
-  ++s_chain.ticks;
   s_chain.isr(s_chain.ctx);
   if (CM4_UNLIKELY(stm32f4_dma_flags(DMA2, ADC_RX_STREAM) & DMA_FLAG_TCIF)) ++s_chain.overruns;
   const uint32_t dc = DWT->CYCCNT - c0;
@@ -224,7 +221,6 @@ const volatile uint32_t *hal_sample_lost_counter(void) { return &s_chain.overrun
 void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
 {
   if (stats == 0) return;
-  stats->ticks = s_chain.ticks;
   stats->overruns = s_chain.overruns;
   stats->dma_errors = s_chain.dma_errors;
 }
