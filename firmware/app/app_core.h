@@ -47,10 +47,11 @@ typedef struct {
    * ISR takes req_word[req_tail % APP_REQ_QUEUE] and advances req_tail. */
   volatile uint32_t req_word[APP_REQ_QUEUE];
   volatile uint32_t req_head, req_tail;
-  /* The DAC frame handed to the HAL every tick: gyro_tick rewrites the channels it drives,
-   * the sense electrodes' channels keep the mid-scale (0 V) of app_init until a loop
-   * drives them (issue 19 item 3). Kept here rather than rebuilt on the stack because
-   * four constant stores a tick were 5 of the interrupt's cycles. */
+  /* The DAC frame handed to the HAL every tick, attached to the gyro, which writes each
+   * channel when its value changes (gyro_tick); the sense electrodes' channels keep the
+   * mid-scale (0 V) of app_init until a loop drives them (issue 19 item 3). Kept here
+   * rather than rebuilt on the stack because four constant stores a tick were 5 of the
+   * interrupt's cycles. */
   hal_dac_frame_t dac;
   /* The ADC frame of the tick, here rather than on the ISR's stack, so that the ISR
    * ends in a tail call (the HAL's DAC write). */

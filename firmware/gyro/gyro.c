@@ -7,7 +7,7 @@
 #include "gyro/gyro_block.h"
 #include "dsp/ramfunc.h"
 
-/* No frame attached (gyro_attach_dac_frame): the nulling electrodes' codes go here. */
+/* No frame attached (gyro_attach_dac_frame): the codes go here, where nothing reads them. */
 static hal_dac_frame_t s_no_frame;
 
 void gyro_attach_dac_frame(gyro_t *g, hal_dac_frame_t *frame)
@@ -178,9 +178,9 @@ static inline void count_rails(gyro_t *g, const hal_adc_frame_t *adc)
  * sets the excitation and the NCO's next step on every tick (selfcal_exec.h). The sense
  * channel and the self-test forces rest (the rate is not valid in SWEEP and the sweep
  * does not use it), so that the executive's step fits the tick's budget. */
-GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc,
-                                         hal_dac_frame_t *dac)
+GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc)
 {
+  hal_dac_frame_t *dac = g->dac_frame;
   nco_out_t ref;
   nco_step(&g->nco, &ref);
   lmsd_step(&g->lmsd_drive, (float)adc->drive * g->adc_v_per_code, ref.sin_wc, ref.cos_wc);
@@ -189,7 +189,6 @@ GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc,
   drive_synth_step(&g->synth, ref.phase, ref.half_phase, &u1, &u2);
   dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
-  dac->code[HAL_DAC_RATE_OUT] = g->rate_code;
   dac->code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID;
   g->out.tick++;
   const uint32_t slot = g->slot;
@@ -197,11 +196,11 @@ GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc,
   gyro_block_sweep(g, slot, u1, u2);
 }
 
-GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
+GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc)
 {
   const gyro_mode_t mode = g->sup.mode;
   if (GYRO_UNLIKELY(mode == GYRO_MODE_SWEEP)) {
-    gyro_tick_sweep(g, adc, dac);
+    gyro_tick_sweep(g, adc);
     return;
   }
   nco_out_t ref;
@@ -219,9 +218,10 @@ GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame
   if (mode == GYRO_MODE_ACQUIRE || mode == GYRO_MODE_LOCKED) {
     drive_synth_step(&g->synth, ref.phase, ref.half_phase, &u1, &u2);
   }
+  hal_dac_frame_t *dac = g->dac_frame;
   dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
-  dac->code[HAL_DAC_RATE_OUT] = g->rate_code; /* the rate changes once per block */
+  /* (The rate output's code changes once per block: GYRO_SLOT_PHASE_MEAS writes it.) */
   /* Built-in self-test force on the sense feedback electrodes (selftest.h). */
   dac->code[HAL_DAC_SPARE] = g->selftest.force_on != 0u
                                  ? gyro_volts_to_dac(

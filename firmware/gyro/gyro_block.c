@@ -321,9 +321,10 @@ GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
   selftest_cont_advance(&g->design->selftest, &g->selftest);
 }
 
-GYRO_RAMFUNC void gyro_block_measure(gyro_t *g, int drive_on)
+GYRO_RAMFUNC void gyro_block_measure(gyro_t *g)
 {
-  if (drive_on) {
+  g->dac_frame->code[HAL_DAC_RATE_OUT] = g->rate_code;
+  if (supervisor_drive_enabled(&g->sup)) {
     drive_loop_measure_phase(&g->drive, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
     /* The tracking drive's error and its notch here, its PI next tick (the budget). */
     const gyro_design_t *d = g->design;
@@ -353,16 +354,16 @@ GYRO_RAMFUNC void gyro_block_supervise(gyro_t *g)
   (void)supervisor_step(&g->design->sup, &g->sup, &g->sup_in);
 }
 
-GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g, int drive_on)
+GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g)
 {
-  if (drive_on) gyro_block_phase(g);
+  if (supervisor_drive_enabled(&g->sup)) gyro_block_phase(g);
   g->cont_fail = selftest_cont_judge(&g->design->selftest, &g->selftest,
                                      g->sup.mode == GYRO_MODE_LOCKED);
 }
 
-GYRO_RAMFUNC void gyro_block_track_judge(gyro_t *g, int drive_on)
+GYRO_RAMFUNC void gyro_block_track_judge(gyro_t *g)
 {
-  if (drive_on) gyro_block_track(g);
+  if (supervisor_drive_enabled(&g->sup)) gyro_block_track(g);
   g->cont_fail = selftest_cont_judge(&g->design->selftest, &g->selftest,
                                      g->sup.mode == GYRO_MODE_LOCKED);
 }

@@ -59,8 +59,10 @@ void gyro_quad_off(gyro_t *g);
  * NCO's step from the next tick on). */
 void gyro_block_phase(gyro_t *g);
 /* GYRO_SLOT_PHASE_MEAS: arg Z (drive on; the tracking drive's notched error), the drive
- * half of the output snapshot. */
-void gyro_block_measure(gyro_t *g, int drive_on);
+ * half of the output snapshot; the analog rate output's code of the block into the
+ * attached frame (GYRO_SLOT_OUTPUT made it on the block's last tick: the frame carries
+ * it from this tick on, as the ticks' own copy of it did). */
+void gyro_block_measure(gyro_t *g);
 /* GYRO_SLOT_SUPERVISE, in every mode: the last verdict's onsets into the history (rare),
  * then the supervisor. */
 void gyro_block_supervise(gyro_t *g);
@@ -69,8 +71,8 @@ void gyro_block_project(gyro_t *g);
 /* GYRO_SLOT_PHASE_PI: the phase loop (drive on, gyro_block_phase), or the tracking
  * drive's PLL (gyro_block_track), and the continuous self-test's verdict. */
 void gyro_block_track(gyro_t *g);
-void gyro_block_track_judge(gyro_t *g, int drive_on);
-void gyro_block_phase_judge(gyro_t *g, int drive_on);
+void gyro_block_track_judge(gyro_t *g);
+void gyro_block_phase_judge(gyro_t *g);
 /* GYRO_SLOT_RATE: the continuous self-test's notch on the rate axis, the rate's output
  * filter, scale and compensation, its range check. */
 void gyro_block_rate(gyro_t *g);
@@ -97,17 +99,17 @@ static inline void gyro_block_take_rails(gyro_t *g)
   g->clip_drive_count = 0u;
 }
 
-/* The job of tick `slot` of the block. Every branch ends in one call (a tail call). */
+/* The job of tick `slot` of the block. Every branch ends in one call (a tail call); what
+ * only some jobs need (whether the drive runs) they find out themselves. */
 static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
 {
-  const int drive_on = supervisor_drive_enabled(&g->sup);
   switch (slot) {
-  case GYRO_SLOT_PHASE_MEAS: gyro_block_measure(g, drive_on); break;
+  case GYRO_SLOT_PHASE_MEAS: gyro_block_measure(g); break;
   case GYRO_SLOT_PHASE_PI:
     if (g->design->track != 0u) {
-      gyro_block_track_judge(g, drive_on);
+      gyro_block_track_judge(g);
     } else {
-      gyro_block_phase_judge(g, drive_on);
+      gyro_block_phase_judge(g);
     }
     break;
   case GYRO_SLOT_AMP: gyro_block_amp(g); break;
@@ -162,7 +164,7 @@ static inline void gyro_block_finite(gyro_t *g)
 static inline void gyro_block_run_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
 {
   switch (slot) {
-  case GYRO_SLOT_PHASE_MEAS: gyro_block_measure(g, 0); break;
+  case GYRO_SLOT_PHASE_MEAS: gyro_block_measure(g); break; /* the drive is off in SWEEP */
   case GYRO_SLOT_AMP: gyro_block_amp_measure(g); break;
   case GYRO_SLOT_COMMAND: gyro_block_command(g); break;
   case GYRO_SLOT_SUPERVISE: gyro_block_supervise(g); break;
