@@ -193,7 +193,13 @@ GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc)
   g->out.tick++;
   const uint32_t slot = g->slot;
   g->slot = slot + 1u == GYRO_BLOCK ? 0u : slot + 1u;
-  gyro_block_sweep(g, slot, u1, u2);
+  if (slot == GYRO_SLOT_OUTPUT) {
+    /* The snapshot's drive voltages, here: its job (gyro_block_output_sweep) runs after
+     * the executive's step, across which they would have to be saved. */
+    g->out.u1_v = u1;
+    g->out.u2_v = u2;
+  }
+  gyro_block_sweep(g, slot);
 }
 
 GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc)

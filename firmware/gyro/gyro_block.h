@@ -87,7 +87,7 @@ void gyro_block_p_selftest(gyro_t *g);
 void gyro_block_output(gyro_t *g, float u1_v, float u2_v);
 /* Every tick in SWEEP, instead of gyro_block_run: the self-calibration job's
  * excitation (from the next tick on) and NCO step, then the slot's job. */
-void gyro_block_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v);
+void gyro_block_sweep(gyro_t *g, uint32_t slot);
 
 /* GYRO_SLOT_PROJECT, in every mode: the rail codes of the ticks whose sense sum is
  * projected now (the verdict's and, drive channel only, the supervisor's evidence). */
@@ -141,7 +141,7 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
 }
 
 /* GYRO_SLOT_OUTPUT in SWEEP: the verdict and the snapshot of what SWEEP changes. */
-void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v);
+void gyro_block_output_sweep(gyro_t *g);
 
 /* The finiteness check's second half (loop and rate outputs) and its verdict for the
  * supervisor (GYRO_SLOT_QUAD, in every mode). */
@@ -151,17 +151,19 @@ static inline void gyro_block_finite(gyro_t *g)
   g->sup_in.state_finite = g->weights_finite != 0u && fm_isfinite(sum);
 }
 
-/* The ticks of the block without a job in SWEEP (gyro_block_run_sweep): the drive loops'
- * and the rate channel's. */
-#define GYRO_SWEEP_IDLE_SLOT(slot) \
-  ((slot) == GYRO_SLOT_PHASE_PI || (slot) == GYRO_SLOT_RATE || (slot) == GYRO_SLOT_P)
+/* The ticks of the block without a job of their own in SWEEP (the drive loops' and the
+ * rate channel's, gyro_block_run_sweep): a new force command (a job's start, a back-off)
+ * goes to the synthesis, and a newly posted job starts, on the next of them, at most
+ * four ticks (80 us) late: neither would fit beside the supervisor's or the snapshot's
+ * job, and every job settles for far longer than that. */
+void gyro_block_sweep_idle(gyro_t *g);
 
 /* The jobs of a SWEEP tick, on top of the self-calibration executive's step: the rate
  * is not valid in SWEEP (rate_valid.h, MODE), so the rate channel's jobs (projection,
  * filters, P, the continuous self-test) wait for the loops to be back; the supervisor
  * with its evidence, the finiteness check, the rail counts and the output snapshot run
  * as in the other modes. */
-static inline void gyro_block_run_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
+static inline void gyro_block_run_sweep(gyro_t *g, uint32_t slot)
 {
   switch (slot) {
   case GYRO_SLOT_PHASE_MEAS: gyro_block_measure(g); break; /* the drive is off in SWEEP */
@@ -173,8 +175,10 @@ static inline void gyro_block_run_sweep(gyro_t *g, uint32_t slot, float u1_v, fl
     if (g->sup.clear_req != 0u) gyro_block_clear(g);
     break;
   case GYRO_SLOT_QUAD: gyro_block_finite(g); break;
-  case GYRO_SLOT_OUTPUT: gyro_block_output_sweep(g, u1_v, u2_v); break;
-  default: /* the drive loops' and the rate channel's jobs */ break;
+  case GYRO_SLOT_OUTPUT: gyro_block_output_sweep(g); break;
+  default: /* GYRO_SLOT_PHASE_PI, _RATE, _P: the drive loops' and the rate channel's */
+    gyro_block_sweep_idle(g);
+    break;
   }
 }
 
