@@ -29,11 +29,16 @@
  * only, never what is computed. */
 /* GYRO_NOINLINE keeps a rarely run part of it out of its caller, so that the caller's
  * common path saves no register for it. */
+/* GYRO_COSTLY marks the branch whose work sets the interrupt's worst tick, though not
+ * the common one (a feature that is off by default): laid out to fall through, since
+ * the budget is the worst tick's. */
 #if defined(__GNUC__)
 #define GYRO_UNLIKELY(x) __builtin_expect((x) != 0, 0)
+#define GYRO_COSTLY(x) __builtin_expect((x) != 0, 1)
 #define GYRO_NOINLINE __attribute__((noinline))
 #else
 #define GYRO_UNLIKELY(x) ((x) != 0)
+#define GYRO_COSTLY(x) ((x) != 0)
 #define GYRO_NOINLINE
 #endif
 

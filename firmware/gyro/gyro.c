@@ -166,11 +166,13 @@ int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d)
  * carrier cycle and never a long run, yet its demodulated phasor is wrong. */
 static inline void count_rails(gyro_t *g, const hal_adc_frame_t *adc)
 {
-  if (GYRO_UNLIKELY(adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN ||
-                    adc->sense == HAL_ADC_CODE_MAX || adc->sense == HAL_ADC_CODE_MIN)) {
+  const int drive_rail = adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN;
+  const int sense_rail = adc->sense == HAL_ADC_CODE_MAX || adc->sense == HAL_ADC_CODE_MIN;
+  /* One branch for both channels (| rather than ||: the tick's path falls through). */
+  if (GYRO_UNLIKELY(drive_rail | sense_rail)) {
     g->flags_acc |= GYRO_FLAG_ADC_RAIL;
     g->clip_count++;
-    if (adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN) g->clip_drive_count++;
+    if (drive_rail) g->clip_drive_count++;
   }
 }
 
@@ -220,8 +222,10 @@ GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc)
   count_rails(g, adc);
 
   /* The waveform of the command the loops last set (ACQUIRE, LOCKED, once per block). */
-  float u1 = 0.0f, u2 = 0.0f;
-  if (mode == GYRO_MODE_ACQUIRE || mode == GYRO_MODE_LOCKED) {
+  float u1, u2;
+  if (GYRO_UNLIKELY(mode != GYRO_MODE_ACQUIRE && mode != GYRO_MODE_LOCKED)) {
+    u1 = u2 = 0.0f; /* the drive off: no force */
+  } else {
     drive_synth_step(&g->synth, ref.phase, ref.half_phase, &u1, &u2);
   }
   hal_dac_frame_t *dac = g->dac_frame;
@@ -229,7 +233,7 @@ GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc)
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
   /* (The rate output's code changes once per block: GYRO_SLOT_PHASE_MEAS writes it.) */
   /* Built-in self-test force on the sense feedback electrodes (selftest.h). */
-  dac->code[HAL_DAC_SPARE] = g->selftest.force_on != 0u
+  dac->code[HAL_DAC_SPARE] = GYRO_COSTLY(g->selftest.force_on)
                                  ? gyro_volts_to_dac(
                                        selftest_force(&g->selftest, ref.sin_wc, ref.cos_wc))
                                  : (uint16_t)HAL_DAC_CODE_MID;
