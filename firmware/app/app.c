@@ -131,7 +131,8 @@ int app_init_with(app_t *a, const param_values_t *values)
     return -2;
   }
   gyro_attach_lost_counter(&a->gyro, hal_sample_lost_counter());
-  gyro_attach_dac_frame(&a->gyro, &a->dac); /* the frame every tick writes */
+  gyro_attach_dac_frame(&a->gyro, &a->dac);         /* the frame every tick writes */
+  gyro_attach_adc_frame(&a->gyro, hal_adc_frame()); /* and the one it reads */
   a->applied = view.derived;
 
   const cli_cfg_t cc = {&a->params, &a->store,        cli_write,
@@ -197,8 +198,7 @@ GYRO_RAMFUNC void app_sample_isr(void *ctx)
     take_changes(a, view.derived);
   }
 
-  hal_adc_read_frame(&a->adc);
-  gyro_tick(&a->gyro, &a->adc); /* into a->dac, attached at init */
+  gyro_tick(&a->gyro); /* the HAL's ADC frame in, a->dac out: attached at init */
   app_tlm_isr(&a->tlm, &a->gyro.out);
   /* Last, as a tail call: the frame is sent at the DAC's slots late in the period, and
    * what the telemetry takes of the tick does not touch it. Its ticks are the gyro's

@@ -39,7 +39,7 @@ typedef void (*app_status_fn)(cli_t *cli, void *ctx);
 typedef struct {
   /* What the sample ISR touches on every tick first, each within one load's immediate
    * offset of the instance (4 KB), so that it needs no address arithmetic: the bank
-   * (its published generation), the block it runs with, the request queue, the frames,
+   * (its published generation), the block it runs with, the request queue, the DAC frame,
    * the gyro and the telemetry's ISR side (app_tlm_t begins with it). */
   params_t params;
   const void *applied; /* derived block the ISR runs with */
@@ -53,9 +53,6 @@ typedef struct {
    * rather than rebuilt on the stack because four constant stores a tick were 5 of the
    * interrupt's cycles. */
   hal_dac_frame_t dac;
-  /* The ADC frame of the tick, here rather than on the ISR's stack, so that the ISR
-   * ends in a tail call (the HAL's DAC write). */
-  hal_adc_frame_t adc;
   gyro_t gyro;
   app_tlm_t tlm;            /* telemetry stream and its commands (app_tlm.c) */
   gyro_design_t derived[2]; /* the bank's derived blocks */

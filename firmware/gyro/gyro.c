@@ -15,6 +15,14 @@ void gyro_attach_dac_frame(gyro_t *g, hal_dac_frame_t *frame)
   g->dac_frame = frame != NULL ? frame : &s_no_frame;
 }
 
+/* No ADC frame attached (gyro_attach_adc_frame): the codes read 0. */
+static const hal_adc_frame_t k_no_adc_frame;
+
+void gyro_attach_adc_frame(gyro_t *g, const volatile hal_adc_frame_t *frame)
+{
+  g->adc_frame = frame != NULL ? frame : &k_no_adc_frame;
+}
+
 /* No counter of lost samples attached (gyro_attach_lost_counter): none are lost. */
 static const volatile uint32_t k_no_loss = 0u;
 
@@ -51,6 +59,7 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   t.weights_finite = 1u;
   quad_null_stop(&t.quad);
   gyro_attach_dac_frame(&t, NULL);
+  gyro_attach_adc_frame(&t, NULL);
   t.quad_bits = d->quad_on != 0u ? RATE_INVALID_QUAD_NULL : 0u; /* not nulled yet */
   gyro_quad_reset(&t);
   *g = t;
@@ -204,8 +213,12 @@ GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc)
   gyro_block_sweep(g, slot);
 }
 
-GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc)
+GYRO_RAMFUNC void gyro_tick(gyro_t *g)
 {
+  /* The frame the converters left, read once (where the DMA keeps writing it). */
+  const volatile hal_adc_frame_t *in = g->adc_frame;
+  const hal_adc_frame_t frame = {in->drive, in->sense};
+  const hal_adc_frame_t *adc = &frame;
   const gyro_mode_t mode = g->sup.mode;
   if (GYRO_UNLIKELY(mode == GYRO_MODE_SWEEP)) {
     gyro_tick_sweep(g, adc);

@@ -40,15 +40,21 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d);
  * the drive off, the NCO retuned only when the drive frequency changes. */
 void gyro_apply(gyro_t *g, const gyro_design_t *d);
 
-/* One sample: ADC frame in, DAC frame out: the attached frame (gyro_attach_dac_frame),
- * which the caller hands to the HAL after the tick (latched at the next tick). A channel
+/* One sample: ADC frame in, DAC frame out. It reads the attached ADC frame
+ * (gyro_attach_adc_frame: the HAL's, where the converters leave it) and writes the
+ * attached DAC frame (gyro_attach_dac_frame), which the caller hands to the HAL after
+ * the tick (latched at the next tick). A channel
  * is written when its value changes, so the frame is the same one from tick to tick (the
  * application's, at mid-scale, 0 V, from its start): the drive pair and the spare's
  * self-test force every tick, the rate output once per block (GYRO_SLOT_PHASE_MEAS), the
  * quadrature-nulling electrodes HAL_DAC_QUADNULL_V1, _V2 on the loop's updates (once per
  * RATE_P_DECIM ticks) and when it stops; no loop drives the other sense electrodes'
  * channels (HAL_DAC_SENSE_FB_U2, HAL_DAC_TUNE) yet. */
-void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc);
+void gyro_tick(gyro_t *g);
+
+/* The frame every tick reads: the HAL's (hal_adc_frame), read once at the start of each
+ * tick. NULL: none (the codes read 0). */
+void gyro_attach_adc_frame(gyro_t *g, const volatile hal_adc_frame_t *frame);
 
 /* The frame every tick writes (the application's, which it hands to the HAL). NULL:
  * none (the codes go nowhere). */

@@ -104,6 +104,7 @@ typedef struct gyro_s {
    * attached frame (gyro_attach_dac_frame) on each update and when it stops. */
   quad_null_t quad;
   hal_dac_frame_t *dac_frame; /* the frame every tick writes (the application's) */
+  const volatile hal_adc_frame_t *adc_frame; /* the frame every tick reads (the HAL's) */
 } gyro_t;
 
 #endif /* GYRO_STATE_H */

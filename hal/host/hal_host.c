@@ -70,7 +70,7 @@ uint32_t hal_host_rate_hz(void) { return host.rate_hz; }
 const hal_dac_frame_t *hal_host_last_dac(void) { return &host.pending; }
 const hal_adc_frame_t *hal_host_next_adc(void) { return &host.adc; }
 
-void hal_adc_read_frame(hal_adc_frame_t *frame) { *frame = host.adc; }
+const volatile hal_adc_frame_t *hal_adc_frame(void) { return &host.adc; }
 
 const volatile uint32_t *hal_sample_lost_counter(void) { return &s_lost; }
 

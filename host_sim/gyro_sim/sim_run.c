@@ -576,11 +576,9 @@ typedef struct {
 static void ol_isr(void *ctx)
 {
   ol_t *o = ctx;
-  hal_adc_frame_t adc;
-  hal_adc_read_frame(&adc);
   const double phi = 2.0 * o->psi;
   if (o->measuring) {
-    const double v = (double)adc.drive * o->v_per_code;
+    const double v = (double)hal_adc_frame()->drive * o->v_per_code;
     o->acc_i += v * cos(phi);
     o->acc_q += v * sin(phi);
     o->acc_n++;

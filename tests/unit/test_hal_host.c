@@ -31,10 +31,9 @@ typedef struct {
 static void isr(void *ctx)
 {
   isr_log_t *log = ctx;
-  hal_adc_frame_t f;
-  hal_adc_read_frame(&f);
-  log->seen_drive[log->n] = f.drive;
-  log->seen_sense[log->n] = f.sense;
+  const volatile hal_adc_frame_t *f = hal_adc_frame();
+  log->seen_drive[log->n] = f->drive;
+  log->seen_sense[log->n] = f->sense;
   hal_dac_frame_t d = {{0, 0, 0, 0}};
   d.code[HAL_DAC_DRIVE_U1] = (uint16_t)(100 + log->n);
   hal_dac_write_frame(&d);

@@ -104,7 +104,8 @@ static void probe_isr(void *ctx)
 {
   isr_probe_t *p = (isr_probe_t *)ctx;
   p->calls++;
-  hal_adc_read_frame(&p->frame);
+  p->frame.drive = hal_adc_frame()->drive;
+  p->frame.sense = hal_adc_frame()->sense;
   DWT->CYCCNT += p->cycles; /* the cycles this tick "takes" */
   /* Hardware clears LISR on the LIFCR write; a frame landing meanwhile sets it again. */
   DMA2->LISR = p->leave_tc_pending ? DMA_FLAG_TCIF : 0u;
@@ -216,9 +217,9 @@ static void test_interrupt_calls_isr_and_rearms_nothing(void **state)
   (void)state;
   isr_probe_t probe = {0};
   assert_int_equal(hal_sample_timer_start(50000u, probe_isr, &probe), 0);
-  volatile int16_t *rx = stm32f4_sample_host_rx();
-  rx[0] = -12345; /* V1: drive pickoff */
-  rx[1] = 321;    /* V2: sense pickoff */
+  volatile hal_adc_frame_t *rx = stm32f4_sample_host_rx();
+  rx->drive = -12345; /* V1: drive pickoff */
+  rx->sense = 321;    /* V2: sense pickoff */
   const stm32f4_dma_t dma_before = *DMA2;
   const stm32f4_tim_t tim1_before = *TIM1, tim4_before = *TIM4, tim8_before = *TIM8;
   const stm32f4_spi_t spi1_before = *SPI1;

@@ -1,7 +1,6 @@
 #include "stm32f4_sample.h"
 
 #include <stddef.h>
-#include <string.h>
 
 #include "hal/hal_adc.h"
 #include "hal/hal_sample_timer.h"
@@ -17,14 +16,11 @@
 
 /* DMA sources and targets live in SRAM (.bss/.data), deliberately not const: the DMA
  * streams cannot reach the CCM, and a DMA read from flash would stall for the whole of
- * a parameter-sector erase, stopping the sample chain. */
-/* The ADC frame: the two conversions in the order SPI1 reads them, drive first, which is
- * hal_adc_frame_t's layout; the interrupt copies both in one 32-bit load and store. */
-static volatile union {
-  int16_t code[2];
-  uint32_t both;
-} s_adc_rx;
-_Static_assert(sizeof(hal_adc_frame_t) == sizeof(uint32_t) &&
+ * a parameter-sector erase, stopping the sample chain. The ADC frame is the two
+ * conversions in the order SPI1 reads them, drive first: hal_adc_frame_t's layout, so
+ * that the firmware reads them where the DMA leaves them (hal_adc_frame). */
+static volatile hal_adc_frame_t s_adc_rx;
+_Static_assert(sizeof(hal_adc_frame_t) == 2u * sizeof(int16_t) &&
                    offsetof(hal_adc_frame_t, drive) == 0u &&
                    offsetof(hal_adc_frame_t, sense) == sizeof(int16_t),
                "hal_adc_frame_t is the DMA's two half-words, drive first");
@@ -149,7 +145,7 @@ int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
 
   /* Stream 0: SPI1 RX -> frame, circular (re-arms itself), interrupt on completion. */
   DMA2->S[ADC_RX_STREAM].PAR = (uint32_t)(uintptr_t)&SPI1->DR;
-  DMA2->S[ADC_RX_STREAM].M0AR = (uint32_t)(uintptr_t)s_adc_rx.code;
+  DMA2->S[ADC_RX_STREAM].M0AR = (uint32_t)(uintptr_t)&s_adc_rx;
   DMA2->S[ADC_RX_STREAM].NDTR = 2u;
   DMA2->S[ADC_RX_STREAM].CR = CHSEL(3) | DMA_SXCR_PL_VERY_HIGH | DMA_SXCR_MSIZE_16 |
                               DMA_SXCR_PSIZE_16 | DMA_SXCR_MINC | DMA_SXCR_CIRC |
@@ -222,11 +218,7 @@ void hal_sample_isr_cycles(uint32_t *last, uint32_t *max)
   if (max != 0) *max = s_chain.isr_cycles_max;
 }
 
-CM4_RAMFUNC void hal_adc_read_frame(hal_adc_frame_t *frame)
-{
-  const uint32_t both = s_adc_rx.both;
-  memcpy(frame, &both, sizeof both);
-}
+const volatile hal_adc_frame_t *hal_adc_frame(void) { return &s_adc_rx; }
 
 const volatile uint32_t *hal_sample_lost_counter(void) { return &s_chain.overruns; }
 
@@ -238,5 +230,5 @@ void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
 }
 
 #ifdef STM32F4_HOST_TEST
-volatile int16_t *stm32f4_sample_host_rx(void) { return s_adc_rx.code; }
+volatile hal_adc_frame_t *stm32f4_sample_host_rx(void) { return &s_adc_rx; }
 #endif

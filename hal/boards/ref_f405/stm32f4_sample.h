@@ -18,8 +18,8 @@
  *                 from 0 at 84 MHz, and its OC1REF, rising at the DAC start time, is its
  *                 TRGO, which starts TIM8's four DAC slots (stm32f4_dac.h).
  *   DMA2 stream 0 transfer complete = the sample interrupt (priority 0): it clears the
- *   flags and calls the registered ISR, which reads the frame with hal_adc_read_frame
- *   and leaves the DAC frame with hal_dac_write_frame. Every stream is circular and
+ *   flags and calls the registered ISR, which reads the frame where stream 0 left it
+ *   (hal_adc_frame) and leaves the DAC frame with hal_dac_write_frame. Every stream is circular and
  *   every transfer is started by a timer: the interrupt re-arms nothing, and nothing in
  *   software starts a conversion, a read or a DAC word, or waits on an SPI.
  */
@@ -27,6 +27,8 @@
 #define STM32F4_SAMPLE_H
 
 #include <stdint.h>
+
+#include "hal/hal_adc.h"
 
 /* Timing of the chain, ns (datasheet figures in hal/boards/ref_f405/README.md). */
 #define STM32F4_STROBE_NS 250u        /* CONVST / LDAC low pulse */
@@ -73,9 +75,9 @@ void stm32f4_sample_stats(stm32f4_sample_stats_t *stats);
 void DMA2_Stream0_IRQHandler(void);
 
 #ifdef STM32F4_HOST_TEST
-/* The two-word buffer DMA stream 0 fills (the host's 64-bit pointers do not fit the
- * 32-bit DMA address registers, so a test reaches it through this instead). */
-volatile int16_t *stm32f4_sample_host_rx(void);
+/* The frame DMA stream 0 fills (the host's 64-bit pointers do not fit the 32-bit DMA
+ * address registers, so a test reaches it through this instead). */
+volatile hal_adc_frame_t *stm32f4_sample_host_rx(void);
 #endif
 
 #endif /* STM32F4_SAMPLE_H */

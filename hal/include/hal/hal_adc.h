@@ -10,8 +10,11 @@ typedef struct {
   int16_t sense; /* sense-axis pickoff, ADC code */
 } hal_adc_frame_t;
 
-/* The frame converted at the most recent sample tick. Called from the sample ISR only;
- * never blocks (the conversion was started by the timer and moved by DMA). */
-void hal_adc_read_frame(hal_adc_frame_t *frame);
+/* Where the converters leave the frame of each sample tick: the one converted at the most
+ * recent tick, for the sample ISR to read during its tick (the conversion was started by
+ * the timer and moved by DMA; the next one replaces it at the next tick). The same
+ * address for the life of the program, never NULL: the firmware takes it once and reads
+ * the two codes at the start of each tick, without a call or a copy. */
+const volatile hal_adc_frame_t *hal_adc_frame(void);
 
 #endif /* HAL_ADC_H */

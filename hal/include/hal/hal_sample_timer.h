@@ -1,5 +1,6 @@
 /* The sample clock: a hardware timer starts both conversions and raises the sample
- * interrupt at fs. The ISR reads the ADC frame, runs the tick and writes the DAC frame. */
+ * interrupt at fs. The ISR reads the ADC frame (hal_adc_frame), runs the tick and writes
+ * the DAC frame. */
 #ifndef HAL_SAMPLE_TIMER_H
 #define HAL_SAMPLE_TIMER_H
 

@@ -12,7 +12,7 @@
 
 #include "hal/hal_adc.h"
 
-/* Play the ADC DMA: the frame the next hal_adc_read_frame returns. */
+/* Play the ADC DMA: the frame the next interrupt reads (hal_adc_frame). */
 void bench_board_set_frame(const hal_adc_frame_t *frame);
 
 /* State at the transfer-complete interrupt: stream 0 TCIF set. */

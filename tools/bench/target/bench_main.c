@@ -10,8 +10,9 @@
  *   done | error WHAT CODE
  *
  * Besides the kernels (tools/bench/common), it counts:
- *   app_sample_isr      called directly, with the board HAL calls (hal_adc_read_frame,
- *                       hal_dac_write_frame; the self-measurement is the handler's)
+ *   app_sample_isr      called directly, with the board HAL's DAC write (its ADC frame
+ *                       read where the DMA leaves it; the self-measurement is the
+ *                       handler's)
  *   isr_app_cb          the real DMA2_Stream0_IRQHandler pended through the NVIC, its
  *                       callback being bench_cb = app_sample_isr + clearing the fake
  *                       TCIF; baseline: an IRQ whose handler is a lone BX LR

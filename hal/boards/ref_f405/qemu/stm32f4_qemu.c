@@ -58,6 +58,7 @@ static uint32_t s_ns_per_sample;     /* 1e9 / rate_hz */
 static uint32_t s_lost_skip;         /* ticks after a stretch change: periods mixed */
 #else
 static hal_dac_frame_t s_dac;
+static volatile hal_adc_frame_t s_adc; /* the loopback of the last DAC frame */
 #endif
 
 void board_system_init(void)
@@ -89,6 +90,8 @@ int stm32f4_board_init(void)
   for (uint32_t ch = 0u; ch < HAL_DAC_NUM_CHANNELS; ++ch) {
     s_dac.code[ch] = (uint16_t)HAL_DAC_CODE_MID;
   }
+  s_adc.drive = 0; /* the loopback of mid-scale */
+  s_adc.sense = 0;
 #endif
   return stm32f4_uart_init(s_info.clock.pclk2_hz, BOARD_UART_BAUD);
 }
@@ -233,13 +236,15 @@ static int16_t loopback_code(uint16_t dac_code)
   return (int16_t)(((int32_t)dac_code - (int32_t)HAL_DAC_CODE_MID) * 4);
 }
 
-CM4_RAMFUNC void hal_adc_read_frame(hal_adc_frame_t *frame)
-{
-  frame->drive = loopback_code(s_dac.code[HAL_DAC_DRIVE_U1]);
-  frame->sense = loopback_code(s_dac.code[HAL_DAC_DRIVE_U2]);
-}
+const volatile hal_adc_frame_t *hal_adc_frame(void) { return &s_adc; }
 
-CM4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame) { s_dac = *frame; }
+/* The next tick's ADC frame is this frame's drive pair. */
+CM4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame)
+{
+  s_dac = *frame;
+  s_adc.drive = loopback_code(s_dac.code[HAL_DAC_DRIVE_U1]);
+  s_adc.sense = loopback_code(s_dac.code[HAL_DAC_DRIVE_U2]);
+}
 #endif
 
 void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)

@@ -7,7 +7,7 @@
  * figures are instruction counts (tools/bench/target uses the same counter); under
  * shift=auto they are emulated time, 2^shift ns per instruction.
  *   isr_ns     SysTick entry to the return of the application's ISR (the handler's own
- *              bookkeeping, hal_adc_read_frame, app_sample_isr, hal_dac_write_frame):
+ *              bookkeeping, app_sample_isr with its ADC frame and hal_dac_write_frame):
  *              what the board's sample interrupt runs, without the plant
  *   plant_ns   the plant's step after it (emulator only)
  *   overruns   ticks whose handler was still running when the next period began

@@ -68,6 +68,6 @@ uint32_t stm32f4_qemu_trace_count(void) { return s_trace_n; }
 
 float stm32f4_qemu_trace_at(uint32_t i) { return i < s_trace_n ? s_trace[i] : 0.0f; }
 
-CM4_RAMFUNC void hal_adc_read_frame(hal_adc_frame_t *frame) { *frame = s_adc; }
+const volatile hal_adc_frame_t *hal_adc_frame(void) { return &s_adc; }
 
 CM4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame) { s_pending = *frame; }
