@@ -126,7 +126,8 @@ int app_init_with(app_t *a, const param_values_t *values)
       return -1;
     }
   }
-  const params_view_t view = params_isr_acquire(&a->params);
+  const uint32_t gen = params_isr_ack(&a->params);
+  const params_view_t view = params_isr_view(&a->params, gen);
   if (gyro_init_from_design(&a->gyro, view.derived) != 0) {
     return -2;
   }
@@ -134,6 +135,7 @@ int app_init_with(app_t *a, const param_values_t *values)
   gyro_attach_dac_frame(&a->gyro, &a->dac);         /* the frame every tick writes */
   gyro_attach_adc_frame(&a->gyro, hal_adc_frame()); /* and the one it reads */
   a->applied = view.derived;
+  a->applied_gen = gen;
 
   const cli_cfg_t cc = {&a->params, &a->store,        cli_write,
                         a,          cli_builtin_cmds, cli_builtin_count()};
@@ -171,14 +173,16 @@ static void take_request(app_t *a, uint32_t req)
 }
 
 /* ISR: what a tick takes on at its start besides the frame, rarely: a new design (the
- * bank's block published since the last tick), then one queued request. Out of line, so
- * that the tick's path keeps nothing but the application across its calls; in flash,
- * like gyro_apply and the requests' calls (linker/check_ramfunc.py, OFF_PATH). */
-GYRO_NOINLINE static void take_changes(app_t *a, const void *derived)
+ * bank's generation gen, published since the last tick), then one queued request. Out of
+ * line, so that the tick's path keeps nothing but the application across its calls; in
+ * flash, like gyro_apply and the requests' calls (linker/check_ramfunc.py, OFF_PATH). */
+GYRO_NOINLINE static void take_changes(app_t *a, uint32_t gen)
 {
-  if (derived != a->applied) {
-    gyro_apply(&a->gyro, derived);
-    a->applied = derived;
+  if (gen != a->applied_gen) {
+    const params_view_t view = params_isr_view(&a->params, gen);
+    gyro_apply(&a->gyro, view.derived);
+    a->applied = view.derived;
+    a->applied_gen = gen;
   }
   const uint32_t tail = a->req_tail;
   if (tail != a->req_head) {
@@ -192,10 +196,10 @@ GYRO_RAMFUNC void app_sample_isr(void *ctx)
 {
   app_t *a = ctx;
 
-  const params_view_t view = params_isr_acquire(&a->params);
+  const uint32_t gen = params_isr_ack(&a->params); /* this tick's parameters */
   /* Both tests in one branch (| rather than ||: the tick's path falls through). */
-  if (GYRO_UNLIKELY((view.derived != a->applied) | (a->req_tail != a->req_head))) {
-    take_changes(a, view.derived);
+  if (GYRO_UNLIKELY((gen != a->applied_gen) | (a->req_tail != a->req_head))) {
+    take_changes(a, gen);
   }
 
   gyro_tick(&a->gyro); /* the HAL's ADC frame in, a->dac out: attached at init */

@@ -42,7 +42,8 @@ typedef struct {
    * (its published generation), the block it runs with, the request queue, the DAC frame,
    * the gyro and the telemetry's ISR side (app_tlm_t begins with it). */
   params_t params;
-  const void *applied; /* derived block the ISR runs with */
+  const void *applied;  /* derived block the ISR runs with */
+  uint32_t applied_gen; /* the bank's generation of it (params_isr_ack) */
   /* Request queue: words written by the background before it advances req_head; the
    * ISR takes req_word[req_tail % APP_REQ_QUEUE] and advances req_tail. */
   volatile uint32_t req_word[APP_REQ_QUEUE];

@@ -172,15 +172,31 @@ const void *params_current_derived(const params_t *p);
 const param_values_t *params_staged(const params_t *p);
 bool params_loop_safe(const params_t *p);
 
-/* ISR: call once at the start of every tick; use the view for the whole tick. */
-static inline params_view_t params_isr_acquire(params_t *p)
+/* ISR: call once at the start of every tick: takes the published generation (and
+ * acknowledges it) and returns it; its view (params_isr_view) holds for the whole tick.
+ * A commit waits for the acknowledgement, so the ISR sees every generation, in order: a
+ * new generation is a new block, which an ISR that keeps the last one it used can tell
+ * by comparing two words, without forming the view on every tick. */
+static inline uint32_t params_isr_ack(params_t *p)
 {
   const uint32_t seq = atomic_load_explicit(&p->published, memory_order_relaxed);
   atomic_signal_fence(memory_order_acquire);
   atomic_store_explicit(&p->ack, seq, memory_order_relaxed);
+  return seq;
+}
+
+/* ISR: the view of generation seq, taken this tick by params_isr_ack. */
+static inline params_view_t params_isr_view(const params_t *p, uint32_t seq)
+{
   const uint32_t i = seq & 1u;
   const params_view_t view = {&p->block[i], p->cfg.derived[i]};
   return view;
+}
+
+/* ISR: params_isr_ack and its view; use the view for the whole tick. */
+static inline params_view_t params_isr_acquire(params_t *p)
+{
+  return params_isr_view(p, params_isr_ack(p));
 }
 
 #endif /* PARAMS_H */
