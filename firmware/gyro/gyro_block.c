@@ -382,36 +382,78 @@ GYRO_RAMFUNC void gyro_block_rate(gyro_t *g)
   rate_valid_range(&g->design->valid, &g->valid, rc->rate_dps);
 }
 
-GYRO_RAMFUNC void gyro_block_p(gyro_t *g, int hold)
+/* The P slot's jobs (gyro_block_p): each a function of its own that ends in P's low-pass
+ * as a tail call, so that only the one that runs saves registers, and only the
+ * instance: the design is read again after its call (gyro_block_quad). */
+static inline void p_low_pass(gyro_t *g)
 {
-  const gyro_design_t *d = g->design; /* kept across the call: a register saved anyway */
+  /* Its new P_f is flagged in rc->p_new. */
+  (void)rate_channel_update_p(&g->design->rate, &g->rate, g->drive.p_eq_rad);
+}
+
+/* The thermometer checks of the P_f the last block made: P's low-pass runs on one block
+ * in RATE_P_BLOCKS, the checks on the next, so that no tick carries both. */
+GYRO_RAMFUNC GYRO_NOINLINE static void p_thermo(gyro_t *g)
+{
   rate_channel_t *rc = &g->rate;
-  /* The hold first (only rate_channel_update_p reads it): hold need not outlive a call. */
-  rate_channel_hold_p(rc, hold);
-  if (rate_channel_p_update_now(rc)) {
-    /* The new P_f's tick: no other job (a job still waiting runs after it). */
-  } else if (rc->p_new != 0u) {
-    /* The thermometer checks of the P_f the last block made: P's low-pass runs on one
-     * block in RATE_P_BLOCKS, the checks on the next, so that no tick carries both. */
-    rc->p_new = 0u;
-    rate_valid_thermo(&d->valid, &g->valid, rc->p_dev_deg, rc->p_held_dev_deg, rc->p_held_w);
-    if ((g->valid.thermo & RATE_INVALID_THERMO_SLEW) != 0u)
-      rate_channel_fast_hold(&d->rate, rc);
-  } else if (rc->filters_due != 0u) {
-    rate_channel_comp_filters(&d->rate, rc);
-  } else if (g->valid.slew_due != 0u) {
-    if (rate_valid_slew(&d->valid, &g->valid)) rate_channel_comp_restart(rc);
-  } else if (g->valid.shadow_phase != 0u) {
-    rate_valid_shadow(&d->valid, &g->valid, rc);
-  } else if (rc->comp_due != 0u) {
-    /* The compensation of the filters' new state, on a block with no other job: the
-     * rate takes it from the next block on. A new P_f is 10 blocks apart; its jobs (the
-     * checks, the filters' step, a window's judgement, the shadow's five parts, this)
-     * take the nine blocks between at most. */
-    rate_channel_comp_refresh(&d->rate, rc);
+  rc->p_new = 0u;
+  rate_valid_thermo(&g->design->valid, &g->valid, rc->p_dev_deg, rc->p_held_dev_deg,
+                    rc->p_held_w);
+  if ((g->valid.thermo & RATE_INVALID_THERMO_SLEW) != 0u) {
+    rate_channel_fast_hold(&g->design->rate, rc);
   }
-  /* Last, as a tail call: its new P_f is flagged in rc->p_new. */
-  (void)rate_channel_update_p(&d->rate, rc, g->drive.p_eq_rad);
+  p_low_pass(g);
+}
+
+GYRO_RAMFUNC GYRO_NOINLINE static void p_filters(gyro_t *g)
+{
+  rate_channel_comp_filters(&g->design->rate, &g->rate);
+  p_low_pass(g);
+}
+
+GYRO_RAMFUNC GYRO_NOINLINE static void p_slew(gyro_t *g)
+{
+  if (rate_valid_slew(&g->design->valid, &g->valid)) rate_channel_comp_restart(&g->rate);
+  p_low_pass(g);
+}
+
+GYRO_RAMFUNC GYRO_NOINLINE static void p_shadow(gyro_t *g)
+{
+  rate_valid_shadow(&g->design->valid, &g->valid, &g->rate);
+  p_low_pass(g);
+}
+
+/* The compensation of the filters' new state, on a block with no other job: the rate
+ * takes it from the next block on. A new P_f is 10 blocks apart; its jobs (the checks,
+ * the filters' step, a window's judgement, the shadow's five parts, this) take the nine
+ * blocks between at most. */
+GYRO_RAMFUNC GYRO_NOINLINE static void p_refresh(gyro_t *g)
+{
+  rate_channel_comp_refresh(&g->design->rate, &g->rate);
+  p_low_pass(g);
+}
+
+GYRO_RAMFUNC void gyro_block_p(gyro_t *g)
+{
+  rate_channel_t *rc = &g->rate;
+  /* The hold first (only rate_channel_update_p reads it): P is held while not LOCKED. */
+  rate_channel_hold_p(rc, g->sup.mode != GYRO_MODE_LOCKED);
+  /* (The layout for the worst of them, the thermometer checks: GYRO_COSTLY.) */
+  if (GYRO_UNLIKELY(rate_channel_p_update_now(rc))) {
+    p_low_pass(g); /* the new P_f's tick: no other job (a job still waiting runs after it) */
+  } else if (GYRO_COSTLY(rc->p_new)) {
+    p_thermo(g);
+  } else if (rc->filters_due != 0u) {
+    p_filters(g);
+  } else if (g->valid.slew_due != 0u) {
+    p_slew(g);
+  } else if (g->valid.shadow_phase != 0u) {
+    p_shadow(g);
+  } else if (rc->comp_due != 0u) {
+    p_refresh(g);
+  } else {
+    p_low_pass(g);
+  }
 }
 
 GYRO_RAMFUNC void gyro_block_p_selftest(gyro_t *g)
@@ -420,7 +462,7 @@ GYRO_RAMFUNC void gyro_block_p_selftest(gyro_t *g)
   selftest_update(&g->design->selftest, &g->selftest, locked, g->rate.rate_raw);
   /* The test force disturbs the rate output: its filters settle again afterwards. */
   rate_valid_disturb(&g->valid);
-  gyro_block_p(g, !locked);
+  gyro_block_p(g);
 }
 
 /* The snapshot for telemetry and status, at fs / GYRO_BLOCK (5 kHz: the telemetry's

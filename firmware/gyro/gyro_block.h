@@ -76,9 +76,9 @@ void gyro_block_phase_judge(gyro_t *g);
 /* GYRO_SLOT_RATE: the continuous self-test's notch on the rate axis, the rate's output
  * filter, scale and compensation, its range check. */
 void gyro_block_rate(gyro_t *g);
-/* GYRO_SLOT_P: P's hold and low-pass (hold: not LOCKED); the thermometer checks of the
- * P_f the last block made. */
-void gyro_block_p(gyro_t *g, int hold);
+/* GYRO_SLOT_P: P's hold (while not LOCKED) and low-pass, and one of the jobs between two
+ * P_f (the thermometer checks of the P_f the last block made, the compensation's steps). */
+void gyro_block_p(gyro_t *g);
 /* GYRO_SLOT_P while a self-test runs: its sequence on the block's projection, then P's
  * hold and low-pass. */
 void gyro_block_p_selftest(gyro_t *g);
@@ -133,7 +133,7 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
     if (selftest_running(&g->selftest)) {
       gyro_block_p_selftest(g);
     } else {
-      gyro_block_p(g, g->sup.mode != GYRO_MODE_LOCKED);
+      gyro_block_p(g);
     }
     break;
   default: /* GYRO_SLOT_OUTPUT */ gyro_block_output(g, u1_v, u2_v); break;

@@ -227,7 +227,8 @@ static inline void rate_channel_comp_restart(rate_channel_t *rc)
  * low-pass and no other job of the thermometer (gyro_block_p). */
 static inline int rate_channel_p_update_now(const rate_channel_t *rc)
 {
-  return rc->p_hold == 0u && rc->p_count + 1u == RATE_P_BLOCKS;
+  /* & rather than &&: both are words at hand, and the P slot's path stays branch-free */
+  return (rc->p_hold == 0u) & (rc->p_count + 1u == RATE_P_BLOCKS);
 }
 
 /* The compensation's filters take P_f's latest step (filters_due, from

@@ -33,6 +33,7 @@ static void make(void)
   v.rate_p_range_deg = 30.0f;
   assert_int_equal(gyro_design(&v, &d), 0);
   assert_int_equal(gyro_init_from_design(&g, &d), 0);
+  g.sup.mode = GYRO_MODE_LOCKED; /* P not held: gyro_block_p holds it while not LOCKED */
 }
 
 /* The compensation's bias against the one the temperature alone makes, in deg/s: P_c
@@ -79,7 +80,7 @@ static double worst_valid_error_noisy(double r_deg_s, double dp_deg, double dur_
     const int in_dist = t >= t_dist_s && t < t_dist_s + dur_s;
     const double p_deg = p0_deg + r_deg_s * t + (in_dist ? dp_deg : 0.0) + sd_deg * gauss();
     g.drive.p_eq_rad = (float)(p_deg * M_PI / 180.0);
-    gyro_block_p(&g, 0);
+    gyro_block_p(&g);
     *slew_seen |= g.valid.thermo & RATE_INVALID_THERMO_SLEW;
     if (t > 10.0 * (TAU_G_S + TAU_C_S)) {
       judged++;
@@ -202,6 +203,7 @@ static void make_fast(void)
   v.rate_p_range_deg = 30.0f;
   assert_int_equal(gyro_design(&v, &d), 0);
   assert_int_equal(gyro_init_from_design(&g, &d), 0);
+  g.sup.mode = GYRO_MODE_LOCKED; /* P not held: gyro_block_p holds it while not LOCKED */
 }
 
 static double worst_valid_bias_error(double r_deg_s, double dp_deg, double dur_s, double t_dist_s,
@@ -219,7 +221,7 @@ static double worst_valid_bias_error(double r_deg_s, double dp_deg, double dur_s
     const int in_dist = t >= t_dist_s && t < t_dist_s + dur_s;
     const double p_deg = p0_deg + r_deg_s * t + (in_dist ? dp_deg : 0.0);
     g.drive.p_eq_rad = (float)(p_deg * M_PI / 180.0);
-    gyro_block_p(&g, 0);
+    gyro_block_p(&g);
     *slew_seen |= g.valid.thermo & RATE_INVALID_THERMO_SLEW;
     if (t >= t_dist_s) *fast_w_max = fmax(*fast_w_max, (double)g.rate.comp_fast_w);
     if (t > 300.0 && g.valid.thermo == 0u) {
