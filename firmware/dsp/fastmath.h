@@ -26,6 +26,12 @@ static inline int fm_isfinite(float x)
 
 static inline float fm_absf(float x) { return x < 0.0f ? -x : x; }
 
+/* |x| where only a comparison reads it: one VABS (fm_absf's compare, flag move and
+ * conditional negate are four instructions). It clears the sign of -0 and of a NaN,
+ * which fm_absf keeps: no comparison can tell them apart (-0 == +0, and a NaN compares
+ * false either way), so either gives the same verdict. */
+static inline float fm_absf_cmp(float x) { return __builtin_fabsf(x); }
+
 static inline float fm_clampf(float x, float lo, float hi)
 {
   return x < lo ? lo : (x > hi ? hi : x);

@@ -58,7 +58,7 @@ GYRO_RAMFUNC static float synth_wrap_turns(drive_synth_t *ds, float p_rad)
    * block) drives nothing rather than a rail voltage; a P still outside the +-2 pi that
    * the phase conversion needs (NaN included: the comparison fails) is replaced by 0
    * and the turns are forgotten. */
-  if (!(fm_absf(p_rad) < SINCOS_HALF_RAD_MAX_F)) {
+  if (!(fm_absf_cmp(p_rad) < SINCOS_HALF_RAD_MAX_F)) {
     p_rad = 0.0f;
     ds->p_turn_rad = 0.0f;
   }
@@ -71,9 +71,9 @@ GYRO_RAMFUNC void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad
   ds->p_set_rad = p_rad;
   p_rad -= ds->p_turn_rad;
   /* Within 1.5 pi of the turns (the common case) it is also within the conversion's
-   * +-2 pi: one compare of the magnitude decides (VABS, exact; a NaN fails the compare
-   * and takes the rare path too). */
-  if (GYRO_UNLIKELY(!(__builtin_fabsf(p_rad) <= 1.5f * FM_PI_F))) {
+   * +-2 pi: one compare of the magnitude decides (a NaN fails it and takes the rare
+   * path too). */
+  if (GYRO_UNLIKELY(!(fm_absf_cmp(p_rad) <= 1.5f * FM_PI_F))) {
     p_rad = synth_wrap_turns(ds, p_rad);
   }
   /* A positive finite force, else none: 0 < f < infinity as one unsigned compare of the

@@ -69,8 +69,8 @@ GYRO_RAMFUNC void rate_valid_settling(const rate_valid_cfg_t *restrict cfg,
   rv->x_quad += RATE_VALID_INPUT_K * (quad_raw - rv->x_quad);
   if (rv->settled != 0u) return;
   const float tol = cfg->tol_dps;
-  const int inside = fm_absf(rate_unc_dps - scale_dps * rv->x_rate) <= tol &&
-                     fm_absf(quad_dps - scale_dps * rv->x_quad) <= tol;
+  const int inside = fm_absf_cmp(rate_unc_dps - scale_dps * rv->x_rate) <= tol &&
+                     fm_absf_cmp(quad_dps - scale_dps * rv->x_quad) <= tol;
   rv->settle_run = inside ? rv->settle_run + 1u : 0u;
   if (rv->settle_run >= RATE_VALID_SETTLE_BLOCKS) rv->settled = 1u;
 }
@@ -97,7 +97,7 @@ GYRO_RAMFUNC void rate_valid_thermo(const rate_valid_cfg_t *restrict c, rate_val
     rv->slew_due = 1u;
     rv->p_dev_window_deg = p_dev_deg;
     rv->p_updates = 0u;
-  } else if (!(fm_absf(p_dev_deg - rv->p_dev_window_deg) <= c->p_window_max_deg)) {
+  } else if (!(fm_absf_cmp(p_dev_deg - rv->p_dev_window_deg) <= c->p_window_max_deg)) {
     /* The window is over its cap before its end: THERMO_SLEW now, not a window later
      * (rate_valid_slew judges the whole window at its end). A kick of P moves the
      * compensation's fast path within that time (rate_channel_comp_refresh). */
@@ -115,13 +115,13 @@ GYRO_RAMFUNC void rate_valid_thermo(const rate_valid_cfg_t *restrict c, rate_val
    * again) ends it. */
   rv->trend_p_deg += rv->trend_step_deg;
   if (rv->filters_held != 0u ||
-      lag_error_dps(c, fm_absf(p_dev_deg - rv->trend_p_deg)) <= 0.5f * c->tol_dps)
+      lag_error_dps(c, fm_absf_cmp(p_dev_deg - rv->trend_p_deg)) <= 0.5f * c->tol_dps)
     rv->displaced = 0u;
   if (rv->displaced != 0u) r |= RATE_INVALID_THERMO_SLEW;
-  if (!(fm_absf(p_dev_deg + c->p_range_off_deg) <= c->p_range_deg))
+  if (!(fm_absf_cmp(p_dev_deg + c->p_range_off_deg) <= c->p_range_deg))
     r |= RATE_INVALID_THERMO_RANGE;
   /* |P_f - P| <= w / (1 - w) |P_held - P_f|, compared without the divide. */
-  const float gap = lag_error_dps(c, p_held_w * fm_absf(p_held_dev_deg - p_dev_deg));
+  const float gap = lag_error_dps(c, p_held_w * fm_absf_cmp(p_held_dev_deg - p_dev_deg));
   if (!(gap <= c->tol_dps * (1.0f - p_held_w))) r |= RATE_INVALID_THERMO_SETTLE;
   rv->thermo = r;
 }
@@ -142,7 +142,7 @@ GYRO_RAMFUNC static inline float spur_error_dps(const rate_valid_cfg_t *restrict
 
 GYRO_RAMFUNC int rate_valid_slew(const rate_valid_cfg_t *restrict c, rate_valid_t *restrict rv)
 {
-  const float move = rv->p_window_change_deg, change = fm_absf(move);
+  const float move = rv->p_window_change_deg, change = fm_absf_cmp(move);
   const int over_cap = !(change <= c->p_window_max_deg);
   const int slewing = over_cap || rv->restart_armed != 0u ||
                       !(lag_error_dps(c, change * c->p_lag_per_deg) <= c->tol_dps);
@@ -330,8 +330,8 @@ GYRO_RAMFUNC void rate_valid_drive(const rate_valid_cfg_t *restrict c, rate_vali
   /* The lock tolerance on the 100 Hz error; the quadrature it rotates into the rate on
    * its lasting part. */
   rv->phase_err_lp_rad += RATE_VALID_PHASE_K * (phase_err_rad - rv->phase_err_lp_rad);
-  const float pe = fm_absf(phase_err_rad);
-  const float leak_dps = fm_absf(rv->phase_err_lp_rad) * fm_absf(quad_dps);
+  const float pe = fm_absf_cmp(phase_err_rad);
+  const float leak_dps = fm_absf_cmp(rv->phase_err_lp_rad) * fm_absf_cmp(quad_dps);
   uint32_t r = 0u;
   if (!(pe <= c->phase_tol_rad && leak_dps <= c->tol_dps)) r |= RATE_INVALID_PHASE;
   if (!(sense_v2 <= c->sense_max_v2)) r |= RATE_INVALID_SENSE_RANGE;

@@ -152,8 +152,8 @@ GYRO_RAMFUNC static int step_driving(const supervisor_cfg_t *restrict c,
   sv->primed = 1u;
   sv->amp_err_f = ea;
   sv->phase_err_f = ep;
-  const float ae = fm_absf(ea);
-  const float pe = fm_absf(ep);
+  const float ae = fm_absf_cmp(ea); /* (both only compared) */
+  const float pe = fm_absf_cmp(ep);
   sv->win_blocks = in->freq_at_limit ? sv->win_blocks + 1u : 0u;
   if (sv->win_blocks >= c->lost_hold_blocks) return trip(sv, GYRO_FAULT_FREQ_WINDOW);
   if (mode == GYRO_MODE_LOCKED) {
