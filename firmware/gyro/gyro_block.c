@@ -368,15 +368,16 @@ GYRO_RAMFUNC void gyro_block_track_judge(gyro_t *g)
                                      g->sup.mode == GYRO_MODE_LOCKED);
 }
 
+GYRO_RAMFUNC void gyro_block_rate_clear(gyro_t *g)
+{
+  g->rate_clear_due = 0u;
+  rate_channel_reset(&g->design->rate, &g->rate, g->design->rate.p_ref_deg);
+  gyro_track_restart(g); /* the clear's tracking-drive half, within this tick's budget */
+}
+
 GYRO_RAMFUNC void gyro_block_rate(gyro_t *g)
 {
   rate_channel_t *rc = &g->rate;
-  if (GYRO_UNLIKELY(g->rate_clear_due != 0u)) {
-    g->rate_clear_due = 0u;
-    rate_channel_reset(&g->design->rate, rc, g->design->rate.p_ref_deg);
-    gyro_track_restart(g); /* the clear's tracking-drive half, within this tick's budget */
-    return;
-  }
   selftest_cont_notch(&g->design->selftest, &g->selftest, 0u, &rc->rate_raw);
   rate_channel_filter_rate(&g->design->rate, rc);
   rate_valid_range(&g->design->valid, &g->valid, rc->rate_dps);

@@ -25,8 +25,8 @@
  * the NCO already is, unless a sweep ended without its hand-over). */
 static inline void gyro_track_restart(gyro_t *g)
 {
-  drive_track_reset(&g->track);
   g->nco.half_step = g->design->nco_half_step;
+  drive_track_reset(&g->track); /* last: a tail call */
 }
 
 /* GYRO_SLOT_AMP: the first half of the finiteness check (the LMSD weights), then |Z|
@@ -76,6 +76,9 @@ void gyro_block_phase_judge(gyro_t *g);
 /* GYRO_SLOT_RATE: the continuous self-test's notch on the rate axis, the rate's output
  * filter, scale and compensation, its range check. */
 void gyro_block_rate(gyro_t *g);
+/* GYRO_SLOT_RATE after the loop state's clear (gyro_block_clear, rate_clear_due): its
+ * rate-channel half instead, the rate channel's reset (and the tracking drive's). */
+void gyro_block_rate_clear(gyro_t *g);
 /* GYRO_SLOT_P: P's hold (while not LOCKED) and low-pass, and one of the jobs between two
  * P_f (the thermometer checks of the P_f the last block made, the compensation's steps). */
 void gyro_block_p(gyro_t *g);
@@ -127,7 +130,13 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
       gyro_block_project(g);
     }
     break;
-  case GYRO_SLOT_RATE: gyro_block_rate(g); break;
+  case GYRO_SLOT_RATE:
+    if (GYRO_UNLIKELY(g->rate_clear_due != 0u)) {
+      gyro_block_rate_clear(g);
+    } else {
+      gyro_block_rate(g);
+    }
+    break;
   case GYRO_SLOT_QUAD: gyro_block_quad(g); break;
   case GYRO_SLOT_P:
     if (selftest_running(&g->selftest)) {
