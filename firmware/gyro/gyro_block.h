@@ -4,9 +4,11 @@
  *
  * A job runs at the end of its tick, after the DAC frame is written: gyro_tick ends in
  * gyro_block_run, which ends in one call of a job, compiled as a tail call. The sample
- * path itself then calls nothing before its frame, keeps its values in the caller-saved
- * registers (it saves three core registers on entry, no FP register) and a job pays
- * only for its own registers. The jobs that are more than a call into a module are
+ * path itself then calls nothing before its frame, keeps its floats in the caller-saved
+ * registers (it saves no FP register, and its few core registers once) and a job pays
+ * only for its own registers; a job with a rare or alternative part (the P slot's,
+ * the clear's rate half) has each part a function of its own, so that only the part
+ * that runs saves registers. The jobs that are more than a call into a module are
  * functions of their own here (a separate translation unit, so they stay out of
  * gyro_tick's register allocation); a job that would need a call before its last one
  * is split by the switch instead (the self-test in GYRO_SLOT_P), so that the common

@@ -17,7 +17,8 @@
  *
  *   slot  job                                             uses (slot it comes from)
  *   0     arg Z (fm_atan2f: one divide); the drive half   drive LMSD
- *         of the output snapshot                          drive loop (1, 2, last block)
+ *         of the output snapshot; the analog rate         drive loop (1, 2, last block)
+ *         output's code into the DAC frame                rate code (9, last block)
  *         tracking drive: wrapped error and its notch     arg Z
  *   1     phase loop: wrapped error, PI -> P (P held      arg Z (0), |Z| (2, last block)
  *         while |Z| < 10 % of its setpoint; a whole
@@ -47,7 +48,7 @@
  *   6     the continuous self-test's notch (rate axis);   projection (5), modulation (5)
  *         rate: output filter, scale, compensation;       its refresh (8, a block before)
  *         its range check (or, after a clear, the rate
- *         channel's reset)
+ *         channel's and the tracking drive's reset)
  *   7     finiteness check, second half (loop and rate    weights' half (2)
  *         outputs) and verdict; the continuous            projection (5)
  *         self-test's notch (quadrature axis),
