@@ -28,8 +28,9 @@ firmware's generic defaults:
    the firmware marks valid where the input is held: scale factor over the thesis's
    range, the slope over every sub-range of at least lincal.SUBRANGE_MIN_DPS, bias at
    rest, never a valid rate off by more than VERIFY_MAX_ERR_DPS, then the on-demand
-   self-test at rest passes; other chamber plateaus, a heating ramp, a fast transient
-   and the noise with the compensation (thermcal: limits in thermcal.LIMITS).
+   self-test at rest passes; other chamber plateaus, a heating ramp, a fast transient,
+   a cold start (the warm-up) and the noise with the compensation (thermcal: limits in
+   thermcal.LIMITS).
 """
 
 from __future__ import annotations
@@ -556,6 +557,10 @@ def _thermal_runs(part, cal_path):
             {"description": "verification of a thermal calibration: a fast transient (heat "
                             "gun, then the room)"}, proto),
             4, lambda log: thermcal.verify_transient(log, proto))),
+        ("warmup", lambda: run("verify_warmup", thermcal.warmup_scenario(
+            {"description": "verification of a thermal calibration: a cold start at rest "
+                            "(IEEE 1431 12.6 warm-up time)"}, proto),
+            5, lambda log: thermcal.verify_warmup(log, proto))),
     ]
 
 
