@@ -56,17 +56,32 @@ static void bench_move(cli_t *cli, const sim_bench_t *b, plant_input_t which, ui
   cli_emit_ok(cli);
 }
 
+/* `emu cold`: the part as after a long power-off (the flow then restarts the drive). */
+static void bench_cold(cli_t *cli, const sim_bench_t *b)
+{
+  if (plant_cold_soak(b->plant) != 0) {
+    cli_err(cli, "STATE", "cold: the thermal network refused the ambient");
+    return;
+  }
+  cli_put(cli, "cold t_s ");
+  cli_put_f32(cli, (float)t_now_s(b->plant));
+  cli_emit_ok(cli);
+}
+
 static void cmd_emu(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
 {
   const sim_bench_t *b = ctx;
   if (argc == 1u) {
     bench_figures(cli, b);
+  } else if (argc == 2u && strcmp(argv[1], "cold") == 0) {
+    bench_cold(cli, b);
   } else if ((argc == 3u || argc == 4u) && strcmp(argv[1], "rate") == 0) {
     bench_move(cli, b, PLANT_INPUT_RATE, argc, argv);
   } else if ((argc == 3u || argc == 4u) && strcmp(argv[1], "ambient") == 0) {
     bench_move(cli, b, PLANT_INPUT_AMBIENT, argc, argv);
   } else {
-    cli_err(cli, "ARGS", "usage: emu | emu rate DPS [EDGE_S] | emu ambient DEGC [EDGE_S]");
+    cli_err(cli, "ARGS",
+            "usage: emu | emu rate DPS [EDGE_S] | emu ambient DEGC [EDGE_S] | emu cold");
   }
 }
 
@@ -74,8 +89,9 @@ int sim_bench_register(sim_bench_t *b, cli_t *cli, plant_t *plant, double pace)
 {
   b->plant = plant;
   b->pace = pace;
-  const cli_cmd_t row = {"emu", "[rate DPS [EDGE_S] | ambient DEGC [EDGE_S]]",
-                         "simulated bench: the rate table and the chamber", cmd_emu, b};
+  const cli_cmd_t row = {"emu", "[rate DPS [EDGE_S] | ambient DEGC [EDGE_S] | cold]",
+                         "simulated bench: the rate table, the chamber, a cold part", cmd_emu,
+                         b};
   b->row = row;
   return cli_register(cli, &b->row);
 }

@@ -23,7 +23,9 @@ typedef struct {
 /* Registers `emu` on cli for the plant: `emu` (the bench's figures: t_s, rate_dps,
  * ambient_c, pace), `emu rate DPS [EDGE_S]`, `emu ambient DEGC [EDGE_S]` (a move from the
  * value now along a linear edge, then held; the reply gives the gyro time t_s at which it
- * starts). A bad value is refused with the reason and changes nothing. Returns cli's. */
+ * starts), `emu cold` (every thermal node at the ambient, as after a long power-off:
+ * plant_cold_soak). A bad value is refused with the reason and changes nothing. Returns
+ * cli's. */
 int sim_bench_register(sim_bench_t *b, cli_t *cli, plant_t *plant, double pace);
 
 #endif /* SIM_BENCH_H */

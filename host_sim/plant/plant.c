@@ -474,6 +474,12 @@ double plant_input_now(const plant_t *p, plant_input_t which)
                       NULL);
 }
 
+int plant_cold_soak(plant_t *p)
+{
+  const thermal_cfg_t cfg = p->thermal.cfg;
+  return thermal_init_cold(&p->thermal, &cfg, plant_input_now(p, PLANT_INPUT_AMBIENT));
+}
+
 int plant_move_input(plant_t *p, plant_input_t which, double to, double edge_s)
 {
   const int rate = which == PLANT_INPUT_RATE;

@@ -562,6 +562,10 @@ typedef enum { PLANT_INPUT_RATE = 0, PLANT_INPUT_AMBIENT = 1 } plant_input_t;
 int plant_move_input(plant_t *p, plant_input_t which, double to, double edge_s);
 /* The input's value now (deg/s or K). */
 double plant_input_now(const plant_t *p, plant_input_t which);
+/* The part after a long power-off at the ambient now: every thermal node at the ambient
+ * (as plant.cold_start at power-on), from which its own dissipation warms it again (the
+ * simulated bench's power cycle; the firmware's restart is the caller's). Returns 0. */
+int plant_cold_soak(plant_t *p);
 
 /* One sample (see the top of this file). dac: the frame on the converter outputs over
  * this interval; a frame with an out-of-range code is rejected (counted, the previous

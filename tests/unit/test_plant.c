@@ -533,6 +533,11 @@ static void test_move_input(void **state)
     assert_non_null(strstr(plant_error(&p), "move to"));
     assert_memory_equal(&p.prof, &before, sizeof before);
   }
+  /* a long power-off at the ambient now: every node there, warming again from it */
+  assert_true(plant_truth(&p)->circuit_k > c.temp_k + 1.0); /* its own dissipation */
+  assert_int_equal(plant_cold_soak(&p), 0);
+  for (int i = 0; i < THERMAL_NODES; i++)
+    assert_float_equal(thermal_temp(&p.thermal, i), c.temp_k + 10.0, 0.0);
 }
 
 static void test_cold_start(void **state)
