@@ -930,9 +930,9 @@ static int run(const cli_args_t *a, const sim_scenario_t *sc, const bench_figs_t
                     "into the command line: one or the other\n");
     return 2;
   }
-  const sim_opts_t so = {csv_path, sc->csv_rate_hz,
-                         !a->quiet && isatty(2) && sc->duration_s > 2.0, a->uart_pty,
-                         a->uart_pty_link, a->pace};
+  const sim_opts_t so = {
+      csv_path,    sc->csv_rate_hz,  !a->quiet && isatty(2) && sc->duration_s > 2.0,
+      a->uart_pty, a->uart_pty_link, a->pace};
   static sim_result_t res;
   static sim_sweep_t sweep;
   static sim_square_t sq;

@@ -91,7 +91,7 @@ typedef struct {
   int progress;              /* progress bar on stderr */
   int uart_pty;              /* expose the tuning UART as a pty, run paced */
   const char *uart_pty_link; /* optional symlink to the pty */
-  double pace;               /* with uart_pty: simulated s per wall s (1 real time, 0 unpaced) */
+  double pace; /* with uart_pty: simulated s per wall s (1 real time, 0 unpaced) */
 } sim_opts_t;
 
 /* Every parameter a scenario or --set takes, with its default, range, unit and doc:

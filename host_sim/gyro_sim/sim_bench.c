@@ -36,15 +36,17 @@ static void bench_move(cli_t *cli, const sim_bench_t *b, plant_input_t which, ui
   if (arg_f32(argc, argv, 2u, 0.0f, &v) != 0 ||
       arg_f32(argc, argv, 3u, (float)(rate ? SIM_BENCH_RATE_EDGE_S : SIM_BENCH_AMBIENT_EDGE_S),
               &edge_s) != 0) {
-    cli_err(cli, "VALUE", rate ? "rate DPS [EDGE_S]: numbers, deg/s and s"
-                               : "ambient DEGC [EDGE_S]: numbers, degC and s");
+    cli_err(cli, "VALUE",
+            rate ? "rate DPS [EDGE_S]: numbers, deg/s and s"
+                 : "ambient DEGC [EDGE_S]: numbers, degC and s");
     return;
   }
   const double to = rate ? (double)v : (double)v + PLANT_K_AT_0_C;
   const double t_s = t_now_s(b->plant);
   if (plant_move_input(b->plant, which, to, (double)edge_s) != 0) {
-    cli_err(cli, "RANGE", rate ? "rate: |DPS| <= 10000, 0 < EDGE_S <= 1e5"
-                               : "ambient: -123.15..176.85 degC, 0 < EDGE_S <= 1e5");
+    cli_err(cli, "RANGE",
+            rate ? "rate: |DPS| <= 10000, 0 < EDGE_S <= 1e5"
+                 : "ambient: -123.15..176.85 degC, 0 < EDGE_S <= 1e5");
     return;
   }
   cli_put(cli, rate ? "rate " : "ambient ");
@@ -90,8 +92,7 @@ int sim_bench_register(sim_bench_t *b, cli_t *cli, plant_t *plant, double pace)
   b->plant = plant;
   b->pace = pace;
   const cli_cmd_t row = {"emu", "[rate DPS [EDGE_S] | ambient DEGC [EDGE_S] | cold]",
-                         "simulated bench: the rate table, the chamber, a cold part", cmd_emu,
-                         b};
+                         "simulated bench: the rate table, the chamber, a cold part", cmd_emu, b};
   b->row = row;
   return cli_register(cli, &b->row);
 }

@@ -16,7 +16,7 @@
 
 typedef struct {
   plant_t *plant;
-  double pace; /* simulated seconds per wall second, 0: unpaced */
+  double pace;   /* simulated seconds per wall second, 0: unpaced */
   cli_cmd_t row; /* the CLI keeps rows by pointer */
 } sim_bench_t;
 

@@ -30,6 +30,13 @@
                                         noise the flow's verification never saw) for 640 s,
                                         the Allan deviation of rate_dps within 1.1x that of
                                         rate_unc_dps at 1 s and at 10 s (thermcal.verify_noise)
+  check_calibration.py port_quick GYRO_SIM   the flow over a UART: the default part
+                                        behind gyro-sim --uart-pty --pace 0, calibrated by
+                                        tools/calibrate --port --bench emu --quick (the
+                                        simulated bench moving its table and chamber):
+                                        verified, its part id recorded, and the
+                                        calibration right at 25 degC on a gyro-sim run of
+                                        its own (a profile and noise it never saw)
   check_calibration.py commands GYRO_SIM  a scenario's "commands" (what the flow's
                                         self-test stage uses) reach the command line at
                                         their times; one due after the run has no reply
@@ -236,6 +243,35 @@ def quick(sim):
     return quick_part(sim, QUICK_PART, 0, 0.0)
 
 
+def port_quick(sim):
+    with tempfile.TemporaryDirectory() as d:
+        pty = os.path.join(d, "gyro.pty")
+        proc = subprocess.Popen([sim, "--scenario", os.path.join(ROOT, "host_sim", "scenarios",
+                                                                 "startup.json"),
+                                 "--duration", "1000000", "--quiet", "--pace", "0",
+                                 f"--uart-pty={pty}"], stdout=subprocess.PIPE, text=True)
+        try:
+            proc.stdout.readline()
+            out = os.path.join(d, "cal")
+            r = run(["--port", pty, "--bench", "emu", "--part-id", "7", "--quick",
+                     "--out", out])
+        finally:
+            proc.terminate()
+            proc.wait(timeout=30)
+        print(r.stdout + r.stderr)
+        if r.returncode != 0:
+            print(f"FAIL: exit {r.returncode}")
+            return 1
+        cal = os.path.join(out, "calibration.json")
+        pid = paramset.read(cal).values()["cal.part_id"]
+        inside = plateau(sim, cal, 25.0, d)
+    if inside is None:
+        return 1
+    ok = plateau_ok(inside, 25.0)
+    print(f"{'ok  ' if pid == 7 else 'FAIL'} cal.part_id {pid} (expected 7)")
+    return 0 if ok and pid == 7 else 1
+
+
 def quick_vacuum(sim):
     return quick_part(sim, VACUUM_PART, 1, 20.0)
 
@@ -322,7 +358,7 @@ def noise(sim):
 if __name__ == "__main__":
     modes = {"regen": regen, "usage": usage, "commands": commands, "defaults": tool_defaults,
              "tempcomp": tempcomp_out_of_sample, "quick": quick, "quick_vacuum": quick_vacuum,
-             "brownian_highq": brownian_highq, "noise": noise}
+             "brownian_highq": brownian_highq, "noise": noise, "port_quick": port_quick}
     if len(sys.argv) != 3 or sys.argv[1] not in modes:
         print(__doc__, file=sys.stderr)
         sys.exit(2)

@@ -525,8 +525,8 @@ static void test_move_input(void **state)
   const struct {
     plant_input_t which;
     double to, edge_s;
-  } bad[] = {{PLANT_INPUT_RATE, 2e4, 0.1}, {PLANT_INPUT_RATE, NAN, 0.1},
-             {PLANT_INPUT_RATE, 10.0, 0.0}, {PLANT_INPUT_RATE, 10.0, NAN},
+  } bad[] = {{PLANT_INPUT_RATE, 2e4, 0.1},      {PLANT_INPUT_RATE, NAN, 0.1},
+             {PLANT_INPUT_RATE, 10.0, 0.0},     {PLANT_INPUT_RATE, 10.0, NAN},
              {PLANT_INPUT_AMBIENT, 100.0, 1.0}, {PLANT_INPUT_AMBIENT, 300.0, 2e5}};
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     assert_int_equal(plant_move_input(&p, bad[i].which, bad[i].to, bad[i].edge_s), -1);

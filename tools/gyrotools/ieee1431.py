@@ -60,8 +60,7 @@ NEED = {
     "verify_noise.csv": ("rate_dps", "rate_unc_dps"),
     "verify_plateaus.csv": ("rate_dps", "rate_true_dps", "rate_valid", "p_f_deg"),
     "verify_ramp.csv": ("rate_dps", "rate_true_dps", "rate_valid"),
-    "verify_warmup.csv": ("rate_dps", "rate_unc_dps", "rate_true_dps", "rate_valid",
-                          "t_struct_c"),
+    "verify_warmup.csv": ("rate_dps", "rate_unc_dps", "rate_true_dps", "rate_valid"),
 }
 WANT = figures.TEMPERATURES + ("t_circuit_c",)  # the circuit's: warm_up.png, when logged
 FILES = ("turn_on.png", "warm_up.png", "scale_factor.png", "drift.png", "temperature.png",

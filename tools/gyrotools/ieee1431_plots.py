@@ -70,7 +70,8 @@ def warm_up(ctx, log, figs, run):
                                          "degC (IEEE 1431 12.6)", run),
                     ylabel="1 s mean of the rate [deg/s]")
     late = log["t_s"] >= 0.5 * thermcal.BIN_S
-    for col, color, name in (("t_struct_c", "C1", "structure"), ("t_circuit_c", "C4", "circuit")):
+    for col, color, name in (("t_struct_c", "C1", "structure"), ("t_circuit_c", "C4", "circuit"),
+                             ("t_ambient_c", "C7", "ambient")):
         if col in log:
             a2.plot(log["t_s"][late], log[col][late], lw=0.9, color=color, label=name + " (logged)")
     plotting.finish(a2, xlabel="time since power-on [s]", ylabel="temperature [degC]")

@@ -256,7 +256,8 @@ def plateau_points(log, n, dwell_s, out="rate_unc_dps"):
         rows.append({"p_deg": float(np.mean(pf[rest])),
                      "p_turn_deg_per_dps": float((p_pos - np.mean(pf[neg]))
                                                  / (2 * STEP_RATE_DPS)),
-                     "t_struct_c": float(np.mean(log["t_struct_c"][rest])),
+                     "t_struct_c": (float(np.mean(log["t_struct_c"][rest]))
+                                    if "t_struct_c" in log else float("nan")),
                      "bias_dps": float(np.mean(u[rest])),
                      "gain": float((u_pos - np.mean(u[neg])) / (2 * STEP_RATE_DPS)),
                      "valid": float(np.mean(log["rate_valid"][rest | pos | neg | pos2]))})
@@ -537,7 +538,8 @@ def verify_warmup(log, proto=FULL):
             / WARMUP_FINAL_S, "raw_settled_in_run": bool(raw_settled),
             "raw_change_dps": float(final - unc[int(WARMUP_EARLY_S / BIN_S)]),
             "worst_valid_1s_dps": worst, "valid_fraction": frac,
-            "t_struct_c": [float(log["t_struct_c"][0]), float(log["t_struct_c"][-1])],
+            "t_struct_c": ([float(log["t_struct_c"][0]), float(log["t_struct_c"][-1])]
+                           if "t_struct_c" in log else None),
             "ok": bool(t_warm is not None and frac >= LIMITS["valid_fraction"] and
                        np.isfinite(worst) and worst <= LIMITS["warmup_worst_dps"])}
 
