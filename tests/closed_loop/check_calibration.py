@@ -217,15 +217,23 @@ VACUUM_PART = ("plant.q_drive=20000", "plant.q_sense=2000", "plant.q_temp_law=2"
                "plant.pick_sense_gain_v_per_m=46350000")
 
 
+def calibration_of(r, out):
+    """The calibration tools/calibrate wrote into out, its output printed; None (and why)
+    when it did not exit 0."""
+    print(r.stdout + r.stderr)
+    if r.returncode != 0:
+        print(f"FAIL: exit {r.returncode}")
+        return None
+    return os.path.join(out, "calibration.json")
+
+
 def quick_part(sim, part, track, lead_s):
     with tempfile.TemporaryDirectory() as d:
         sets = [a for s in part for a in ("--set", s)]
-        r = run(["--sim", "--quick", "--seed", "7", "--out", d, "--gyro-sim", sim] + sets)
-        print(r.stdout + r.stderr)
-        if r.returncode != 0:
-            print(f"FAIL: exit {r.returncode}")
+        cal = calibration_of(run(["--sim", "--quick", "--seed", "7", "--out", d, "--gyro-sim",
+                                  sim] + sets), d)
+        if cal is None:
             return 1
-        cal = os.path.join(d, "calibration.json")
         mode = paramset.read(cal).values()["cal.ref_track"]
         inside = plateau(sim, cal, 25.0, d, part, lead_s)
         outside = plateau(sim, cal, 60.0, d, part, lead_s)
@@ -258,11 +266,9 @@ def port_quick(sim):
         finally:
             proc.terminate()
             proc.wait(timeout=30)
-        print(r.stdout + r.stderr)
-        if r.returncode != 0:
-            print(f"FAIL: exit {r.returncode}")
+        cal = calibration_of(r, out)
+        if cal is None:
             return 1
-        cal = os.path.join(out, "calibration.json")
         pid = paramset.read(cal).values()["cal.part_id"]
         inside = plateau(sim, cal, 25.0, d)
     if inside is None:
