@@ -1,0 +1,320 @@
+"""Three thermometers for the temperature compensation: the drive phase P, a board
+temperature sensor, and a model-based fusion of both (tools/board_thermometer_study,
+docs/compensation-noise.md, "Thermal couplings, board sensor, fusion").
+
+An offline study: the firmware has no board-temperature input. For each thermometer the
+compensation is refitted on the calibration run's log exactly as the flow fits P
+(thermcal.fit with the full protocol's filter: three first-order stages of 15 s, the 5 s
+fast path and its blend, the gradient term's time constant from thermcal.TAU_GRID_S, the
+output linearised first as calflow.thermal does), with the thermometer's reading in place
+of P_f, and applied as the firmware would (compstudy.compensate) to the verification logs
+the fit never saw. The judgements are the flow's own (thermcal.verify_ramp,
+verify_transient, verify_plateaus; the noise ratio as thermcal.verify_noise forms it,
+read at 1, 10, 100 and 1000 s on a long run at 25 degC). The rate_valid column of each log
+is the firmware's (its P-based monitors) for all three thermometers.
+
+The board sensor (BoardSensor, sensor_reading): a TI TMP117 on the board's I2C bus, read
+by the simulator's board node t_board_c. Chosen over an ADT7420-class part (16 bit,
+0.0078 degC as well, but +-0.25 degC and no averaging) for its accuracy and its
+on-chip averaging. Datasheet facts (TI SNOSD82D, "TMP117 High-Accuracy, Low-Power,
+Digital Temperature Sensor With SMBus- and I2C-Compatible Interface", June 2018, revised
+September 2022): 16-bit result, 1 LSB = 7.8125 mdegC (7.3.3); accuracy +-0.1 degC from
+-20 to 50 degC, +-0.15 degC from -40 to 70 degC, +-0.2 degC from -40 to 100 degC (1); one
+conversion takes 15.5 ms and the result of AVG = 8 is the mean of eight (124 ms); the
+repeatability is about +-3 LSB without averaging and +-1 LSB with eight averages
+(7.3.2, the noise histograms); the factory setting is eight averages every 1 s. The model:
+a conversion every `cycle_s` (1 s) at a phase drawn from the seed, the mean of the board
+node over its 124 ms of active conversion, plus the accuracy error (an offset within
++-0.1 degC and a slope error that keeps it within +-0.2 degC over -40..85 degC, drawn from
+the seed: a smooth error of the reading, which the fit's cubic in the reading takes out as
+it takes out any thermometer's offset and scale), plus the repeatability as Gaussian noise
+(+-3 LSB read as +-2 sigma: 1.5 LSB per conversion, 1.5 / sqrt(8) = 0.53 LSB averaged),
+rounded to 1 LSB and held until the next conversion. The sensor's self-heating and its
+long-term drift are not modelled (3.5 uA at 1 Hz; the drift is over months, the runs
+hours).
+
+The fusion (fit_board_to_p, fused_thermometer): the board reading through a transfer
+fitted on the calibration log to P, for the slow part, and P for the fast. In a thermal
+network of lumped nodes driven by one input (the surroundings; host_sim/plant/thermal.h)
+every node is a rational transfer of that input with the network's poles, so the
+structure's temperature is the board's through N_s(s) / N_b(s): two zeros over two poles
+for three nodes, whatever the couplings. The model is that transfer, of unit DC gain,
+(1 + s z1)(1 + s z2) / ((1 + s p1)(1 + s p2)), followed by a cubic in its output (a
+Wiener model; the cubic absorbs P's curvature in temperature, the board's self-heating
+offset and the sensor's accuracy error); its four time constants and the cubic are
+fitted by least squares to the 1 s means of P_f at rest on the calibration log (scipy
+least_squares on the time constants, the cubic linear within). The fused thermometer is
+
+    P_fused = P - LP_T(P - M(board)),
+
+P less the low-passed disagreement between P and the board's model of P: P's own above
+1 / (2 pi T), the model's below, so the drive pickoff's phase flicker (1/f, the 1.9x at
+100..1000 s) is replaced by the sensor's noise through the model at long times while a
+transient the model misses is still read by P within T. T (`crossover_s`) is a design
+choice made before the verification logs are read.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+from scipy import optimize, signal
+
+from . import compstudy, lincal, tempcomp, thermcal
+
+TAUS_S = compstudy.TAUS_S
+THERMOMETERS = ("P", "board", "fusion")
+# The fused thermometer's crossover (s): the excess noise of P's flicker is at 100 s and
+# beyond (docs/compensation-noise.md); a first-order crossover of 100 s leaves P's share
+# at 100 s and takes it out at 1000 s; shorter ones lean harder on the model's transient.
+CROSSOVER_S = 100.0
+# The model's fit starts after the calibration log's first plateau has had this long (the
+# run starts in the steady state of 25 degC, the model's filter at the first reading).
+MODEL_START_S = 120.0
+
+
+@dataclasses.dataclass(frozen=True)
+class BoardSensor:
+    """A TMP117 (TI SNOSD82D) as the study reads it (module doc)."""
+    lsb_c: float = 0.0078125          # 7.3.3
+    averages: int = 8                  # AVG = 01 (factory setting)
+    conversion_s: float = 0.0155       # one active conversion, 7.3.2
+    cycle_s: float = 1.0               # conversion cycle (factory setting: 1 s)
+    sigma_single_lsb: float = 1.5      # repeatability +-3 LSB, read as +-2 sigma
+    offset_max_c: float = 0.1          # accuracy, -20..50 degC
+    accuracy_max_c: float = 0.2        # accuracy, -40..100 degC
+    span_c: tuple = (-40.0, 85.0)      # the product's temperature range
+
+    @property
+    def sigma_c(self):
+        """The repeatability of one averaged result (degC, before rounding)."""
+        return self.sigma_single_lsb * self.lsb_c / np.sqrt(self.averages)
+
+
+TMP117 = BoardSensor()
+
+
+def accuracy_error(sensor, seed):
+    """(offset degC, slope degC/degC about 25 degC) of one sensor, drawn from the seed
+    within the datasheet's accuracy: the offset within offset_max_c, the slope so that
+    offset + slope (T - 25) stays within accuracy_max_c over span_c."""
+    rng = np.random.default_rng([seed, 1])
+    off = rng.uniform(-sensor.offset_max_c, sensor.offset_max_c)
+    reach = max(abs(s - 25.0) for s in sensor.span_c)
+    slope = rng.uniform(-1.0, 1.0) * (sensor.accuracy_max_c - abs(off)) / reach
+    return float(off), float(slope)
+
+
+def sensor_reading(t_s, t_board_c, sensor=TMP117, seed=0, part_seed=0):
+    """The sensor's reading at each of a log's rows (degC): its last finished conversion
+    (module doc); the conversions' phase and noise drawn from seed, the part's accuracy
+    error from part_seed (one sensor, many runs). The node is smooth, so the mean over a
+    conversion's active time is the node's value at its middle."""
+    t = np.asarray(t_s, dtype=float)
+    tb = np.asarray(t_board_c, dtype=float)
+    rng = np.random.default_rng([seed, 0])
+    phase = rng.uniform(0.0, sensor.cycle_s)
+    t_conv = np.arange(t[0] + phase, t[-1] + sensor.cycle_s, sensor.cycle_s)
+    active = sensor.averages * sensor.conversion_s
+    true = np.interp(t_conv - 0.5 * active, t, tb)
+    off, slope = accuracy_error(sensor, part_seed)
+    raw = true + off + slope * (true - 25.0) + sensor.sigma_c * rng.standard_normal(t_conv.size)
+    code = np.round(raw / sensor.lsb_c) * sensor.lsb_c
+    k = np.searchsorted(t_conv, t, side="right") - 1
+    return code[np.maximum(k, 0)]
+
+
+def _lead_lag(tc_s, dt_s):
+    """(b, a) of (1 + s z1)(1 + s z2) / ((1 + s p1)(1 + s p2)) at dt_s (Tustin);
+    tc_s = (z1, z2, p1, p2) in seconds."""
+    z1, z2, p1, p2 = tc_s
+    num = np.polymul([z1, 1.0], [z2, 1.0])
+    den = np.polymul([p1, 1.0], [p2, 1.0])
+    b, a, _ = signal.cont2discrete((num, den), dt_s, method="bilinear")
+    return np.ravel(b), np.ravel(a)
+
+
+def lead_lag(t_s, x, tc_s):
+    """x through the unit-DC-gain lead-lag of tc_s, starting in its steady state."""
+    t = np.asarray(t_s, dtype=float)
+    x = np.asarray(x, dtype=float)
+    b, a = _lead_lag(tc_s, float(np.median(np.diff(t))))
+    y, _ = signal.lfilter(b, a, x, zi=signal.lfilter_zi(b, a) * x[0])
+    return y
+
+
+@dataclasses.dataclass
+class BoardModel:
+    """The board reading's model of P: the lead-lag tc_s, then the cubic c (in the
+    lead-lag's output less ref_c)."""
+    tc_s: tuple
+    c: np.ndarray
+    ref_c: float
+    rms_deg: float
+
+    def __call__(self, t_s, board_c):
+        return tempcomp.poly_eval(self.c, lead_lag(t_s, board_c, self.tc_s) - self.ref_c)
+
+
+def _bins(t, cols):
+    return tempcomp.bin_average(t, cols, thermcal.BIN_S)
+
+
+def fit_board_to_p(t_s, board_c, p_deg, rest, start_s=MODEL_START_S,
+                   guess_s=(300.0, 30.0, 600.0, 60.0)):
+    """The board reading's model of P (module doc), fitted on 1 s means: the lead-lag
+    runs over every bin, the residual is taken over the bins at rest after start_s."""
+    t = np.asarray(t_s, dtype=float)
+    b = _bins(t, {"b": np.asarray(board_c, float), "p": np.asarray(p_deg, float),
+                  "r": np.asarray(rest, float)})
+    use = (b["r"] > 0.999) & (b["t_s"] >= start_s)
+    ref = float(np.mean(b["b"][use]))
+
+    def cubic(tc):
+        u = lead_lag(b["t_s"], b["b"], tc)[use] - ref
+        a = np.column_stack([np.ones_like(u), u, u * u, u ** 3])
+        c, *_ = np.linalg.lstsq(a, b["p"][use], rcond=None)
+        return c, b["p"][use] - a @ c
+
+    res = optimize.least_squares(lambda q: cubic(np.exp(q))[1], np.log(guess_s),
+                                 bounds=(np.log(1.0), np.log(1e5)), x_scale=1.0)
+    tc = tuple(float(v) for v in np.exp(res.x))
+    c, r = cubic(tc)
+    return BoardModel(tc, c, ref, float(np.sqrt(np.mean(r ** 2))))
+
+
+def fused_thermometer(t_s, p_deg, board_c, model, crossover_s=CROSSOVER_S):
+    """P - LP_T(P - M(board)): P above the crossover, the board's model of it below. The
+    low-pass starts at thermcal.START_S, as the firmware's thermometer filters do."""
+    p = np.asarray(p_deg, dtype=float)
+    d = p - model(t_s, board_c)
+    return p - thermcal.comp_thermometer(t_s, d, crossover_s, 1)
+
+
+# The verification logs a study reads (the flow's work folder) and the columns it needs.
+VERIFY_LOGS = ("verify_plateaus", "verify_ramp", "verify_transient")
+COLUMNS = ("rate_true_dps", "rate_valid", "rate_unc_dps", "p_f_deg", "t_struct_c", "t_board_c")
+# The sensor's noise seed of each log: its own, as each verification run has its own.
+SENSOR_SEEDS = {"thermal": 11, "verify_plateaus": 12, "verify_ramp": 13,
+                "verify_transient": 14, "noise": 15}
+
+
+def linearised(log, values):
+    """The uncompensated output as the compensation sees it: L(u) (calflow.thermal)."""
+    return lincal.linearise(log["rate_unc_dps"], values.get("rate.lin_c2_per_dps", 0.0),
+                            values.get("rate.lin_c3_per_dps2", 0.0))
+
+
+def view(log, thermometer, u):
+    """A log as thermcal reads it, with the thermometer's reading as p_f_deg and the
+    linearised output as rate_unc_dps."""
+    d = compstudy._View({n: np.asarray(log[n]) for n in ("t_s", "rate_true_dps", "rate_valid",
+                                                          "t_struct_c")})
+    d["p_f_deg"] = np.asarray(thermometer, dtype=float)
+    d["rate_unc_dps"] = np.asarray(u, dtype=float)
+    return d
+
+
+def fit(cal_view, proto=thermcal.FULL):
+    """The compensation for a thermometer, fitted as the flow fits P (thermcal.fit with
+    the protocol's filters and fast path): (values, figures)."""
+    v, _, figs = thermcal.fit(cal_view, proto.cal_plateaus_c, proto.dwell_s,
+                              proto.span_from_data, comp_tau_s=proto.comp_tau_s,
+                              comp_stages=proto.comp_stages,
+                              comp_fast_tau_s=proto.comp_fast_tau_s)
+    return v, figs
+
+
+def compensated(lview, v, proto=thermcal.FULL):
+    """The firmware's output on a log view for the values v."""
+    out = view(lview, lview["p_f_deg"], lview["rate_unc_dps"])
+    out["rate_dps"] = compstudy.compensate(lview, v, proto.comp_tau_s, proto.comp_stages)
+    return out
+
+
+def noise_ratio(lview, v, proto=thermcal.FULL, taus=TAUS_S):
+    """Allan deviation of the compensated output against the uncompensated (both
+    linearised, as the firmware's) at taus, the first START_S left out: (ratios,
+    compensated deg/h, uncompensated deg/h); nan beyond what the record holds."""
+    t = lview["t_s"]
+    m = t >= thermcal.START_S
+    fs = 1.0 / float(np.median(np.diff(t)))
+    a_c = compstudy.adev_at(compstudy.compensate(lview, v, proto.comp_tau_s,
+                                                 proto.comp_stages)[m], fs, taus)
+    a_u = compstudy.adev_at(np.asarray(lview["rate_unc_dps"])[m], fs, taus)
+    return [c / u for c, u in zip(a_c, a_u)], a_c, a_u
+
+
+def judge(views, v, proto=thermcal.FULL):
+    """The flow's verdicts for the values v on the verification views (plateaus, ramp,
+    transient, and noise when present)."""
+    pl = thermcal.verify_plateaus(compensated(views["verify_plateaus"], v, proto),
+                                  proto.verify_plateaus_c, proto.dwell_s)
+    ramp = thermcal.verify_ramp(compensated(views["verify_ramp"], v, proto), proto)
+    tr = thermcal.verify_transient(compensated(views["verify_transient"], v, proto), proto)
+    worst = max(pl, key=lambda r: abs(r["bias_dps"]))
+    res = {"plateau_bias_dps": [r["bias_dps"] for r in pl],
+           "plateau_worst_dps": worst["bias_dps"], "plateau_worst_c": worst["ambient_c"],
+           "plateaus_ok": all(r["ok"] for r in pl),
+           "ramp_std_dps": ramp["bias_1s_std_dps"], "ramp_max_dps": ramp["bias_1s_max_abs_dps"],
+           "ramp_ok": ramp["ok"], "transient_std_dps": tr["bias_1s_std_dps"],
+           "transient_pp_dps": tr["bias_1s_pp_dps"], "transient_ok": tr["ok"]}
+    if "noise" in views:
+        r, a_c, a_u = noise_ratio(views["noise"], v, proto)
+        lim = thermcal.LIMITS["noise_ratio"]
+        res.update({"taus_s": list(TAUS_S), "noise_ratio": r, "adev_compensated_dph": a_c,
+                    "adev_uncompensated_dph": a_u,
+                    "noise_ok": bool(r[0] <= lim and r[1] <= lim)})
+    return res
+
+
+def thermometer_readings(logs, model=None, sensor=TMP117, part_seed=1,
+                         crossover_s=CROSSOVER_S):
+    """Per log name, the three thermometers' readings: P_f, the board sensor's reading
+    (its noise seeded per log, SENSOR_SEEDS; its accuracy error per part) and, with a
+    model, the fused thermometer."""
+    out = {}
+    for n, lg in logs.items():
+        board = sensor_reading(lg["t_s"], lg["t_board_c"], sensor,
+                               SENSOR_SEEDS.get(n, 16), part_seed)
+        out[n] = {"P": np.asarray(lg["p_f_deg"], dtype=float), "board": board}
+        if model is not None:
+            out[n]["fusion"] = fused_thermometer(lg["t_s"], lg["p_f_deg"], board, model,
+                                                 crossover_s)
+    return out
+
+
+def board_model(cal_log, board_c):
+    """The board reading's model of P on the calibration log (fit_board_to_p)."""
+    t = cal_log["t_s"]
+    rest = (np.abs(cal_log["rate_true_dps"]) < 1e-9) & (t >= thermcal.START_S)
+    return fit_board_to_p(t, board_c, cal_log["p_f_deg"], rest)
+
+
+def study(logs, values, sensor=TMP117, part_seed=1, crossover_s=CROSSOVER_S,
+          proto=thermcal.FULL):
+    """One part: logs (name -> columns: "thermal", the VERIFY_LOGS, "noise", optionally
+    "warmup"), values (its lin coefficients). For each thermometer the fit on "thermal"
+    and the flow's verdicts on the others. Returns {"model": ..., thermometer: results}."""
+    board_cal = sensor_reading(logs["thermal"]["t_s"], logs["thermal"]["t_board_c"], sensor,
+                               SENSOR_SEEDS["thermal"], part_seed)
+    model = board_model(logs["thermal"], board_cal)
+    reads = thermometer_readings(logs, model, sensor, part_seed, crossover_s)
+    res = {"model": {"tc_s": list(model.tc_s), "cubic": model.c.tolist(),
+                     "ref_c": model.ref_c, "rms_deg": model.rms_deg},
+           "crossover_s": crossover_s}
+    for name in THERMOMETERS:
+        views = {n: view(lg, reads[n][name], linearised(lg, values)) for n, lg in logs.items()}
+        v, figs = fit(views["thermal"], proto)
+        r = judge(views, v, proto)
+        if "warmup" in views:
+            w = thermcal.verify_warmup(compensated(views["warmup"], v, proto), proto)
+            r.update({"warmup_time_s": w["warmup_time_s"],
+                      "warmup_worst_dps": w["worst_valid_1s_dps"], "warmup_ok": w["ok"]})
+        r.update({"fit_rms_1s_dps": figs["fit_rms_1s_dps"], "grad_tau_s": v["rate.grad_tau_s"],
+                  "values": {k: v[k] for k in sorted(v)}})
+        r["ok"] = bool(r["plateaus_ok"] and r["ramp_ok"] and r["transient_ok"]
+                       and r.get("noise_ok", True))
+        res[name] = r
+    return res
