@@ -48,10 +48,11 @@ least_squares on the time constants, the cubic linear within). The fused thermom
     P_fused = P - LP_T(P - M(board)),
 
 P less the low-passed disagreement between P and the board's model of P: P's own above
-1 / (2 pi T), the model's below, so the drive pickoff's phase flicker (1/f, the 1.9x at
-100..1000 s) is replaced by the sensor's noise through the model at long times while a
-transient the model misses is still read by P within T. T (`crossover_s`) is a design
-choice made before the verification logs are read.
+1 / (2 pi T), the model's below (the steady-state Kalman filter of a model error that
+wanders as a random walk under white measurement noise has this form), so the drive
+pickoff's phase flicker (1/f, the 1.9x at 100..1000 s) is replaced by the sensor's noise
+through the model at long times while a change the model misses is still read by P
+within T. T (`crossover_s`, CROSSOVER_S) is the one free choice.
 """
 
 from __future__ import annotations
@@ -65,10 +66,19 @@ from . import compstudy, lincal, tempcomp, thermcal
 
 TAUS_S = compstudy.TAUS_S
 THERMOMETERS = ("P", "board", "fusion")
-# The fused thermometer's crossover (s): the excess noise of P's flicker is at 100 s and
-# beyond (docs/compensation-noise.md); a first-order crossover of 100 s leaves P's share
-# at 100 s and takes it out at 1000 s; shorter ones lean harder on the model's transient.
-CROSSOVER_S = 100.0
+# The fused thermometer's crossover (s). The drive pickoff's phase flicker is in excess
+# from 10 s on (1.09x there with the flow's three 15 s stages, 1.9x at 100..1000 s); to
+# keep it out of every band from 10 s up the crossover lies well below: 3 s, 53 mHz. P's
+# share is then what changes faster than the model follows, which the compensation's own
+# filters (15 s stages, the 5 s fast path) mostly take out: at this crossover the fused
+# thermometer is nearly the board's model of P, and an error of the model slower than a
+# few seconds is not corrected by P (tools/board_thermometer_study --scan shows the trade).
+CROSSOVER_S = 3.0
+# After a cold start the board's own dissipation warms it for minutes (a second heat input
+# the model, fitted on a chamber run that starts warm, does not have): the fusion then
+# holds its disagreement with P only from this long after power-on, five of the default
+# network's slowest thermal mode (306 s, tools/thermal_warmup.py), P alone before.
+FUSION_COLD_START_S = 1500.0
 # The model's fit starts after the calibration log's first plateau has had this long (the
 # run starts in the steady state of 25 degC, the model's filter at the first reading).
 MODEL_START_S = 120.0
@@ -184,12 +194,17 @@ def fit_board_to_p(t_s, board_c, p_deg, rest, start_s=MODEL_START_S,
     return BoardModel(tc, c, ref, float(np.sqrt(np.mean(r ** 2))))
 
 
-def fused_thermometer(t_s, p_deg, board_c, model, crossover_s=CROSSOVER_S):
+def fused_thermometer(t_s, p_deg, board_c, model, crossover_s=CROSSOVER_S,
+                      start_s=thermcal.START_S):
     """P - LP_T(P - M(board)): P above the crossover, the board's model of it below. The
-    low-pass starts at thermcal.START_S, as the firmware's thermometer filters do."""
+    low-pass starts at thermcal.START_S (as the firmware's thermometer filters do) at the
+    disagreement of that moment; with a later start_s (after a cold start,
+    FUSION_COLD_START_S) it reads nothing before start_s, so the fused thermometer is P
+    alone until then and the model's within a few crossovers after."""
+    t = np.asarray(t_s, dtype=float)
     p = np.asarray(p_deg, dtype=float)
-    d = p - model(t_s, board_c)
-    return p - thermcal.comp_thermometer(t_s, d, crossover_s, 1)
+    d = np.where(t >= start_s, p - model(t, board_c), 0.0)
+    return p - thermcal.comp_thermometer(t, d, crossover_s, 1)
 
 
 # The verification logs a study reads (the flow's work folder) and the columns it needs.
@@ -292,11 +307,30 @@ def board_model(cal_log, board_c):
     return fit_board_to_p(t, board_c, cal_log["p_f_deg"], rest)
 
 
+def evaluate(logs, readings, values, proto=thermcal.FULL):
+    """One thermometer: readings (log name -> its reading) in place of P_f, the
+    compensation fitted on "thermal" as the flow fits P, the flow's verdicts on the
+    others (and the cold start's when "warmup" is there)."""
+    views = {n: view(lg, readings[n], linearised(lg, values)) for n, lg in logs.items()}
+    v, figs = fit(views["thermal"], proto)
+    r = judge(views, v, proto)
+    if "warmup" in views:
+        w = thermcal.verify_warmup(compensated(views["warmup"], v, proto), proto)
+        r.update({"warmup_time_s": w["warmup_time_s"],
+                  "warmup_worst_dps": w["worst_valid_1s_dps"], "warmup_ok": w["ok"]})
+    r.update({"fit_rms_1s_dps": figs["fit_rms_1s_dps"], "grad_tau_s": v["rate.grad_tau_s"],
+              "values": {k: v[k] for k in sorted(v)}})
+    r["ok"] = bool(r["plateaus_ok"] and r["ramp_ok"] and r["transient_ok"]
+                   and r.get("noise_ok", True))
+    return r
+
+
 def study(logs, values, sensor=TMP117, part_seed=1, crossover_s=CROSSOVER_S,
-          proto=thermcal.FULL):
+          proto=thermcal.FULL, scan_s=()):
     """One part: logs (name -> columns: "thermal", the VERIFY_LOGS, "noise", optionally
     "warmup"), values (its lin coefficients). For each thermometer the fit on "thermal"
-    and the flow's verdicts on the others. Returns {"model": ..., thermometer: results}."""
+    and the flow's verdicts on the others; the fusion again for each crossover of scan_s.
+    Returns {"model": ..., thermometer: results, "scan": [...]}."""
     board_cal = sensor_reading(logs["thermal"]["t_s"], logs["thermal"]["t_board_c"], sensor,
                                SENSOR_SEEDS["thermal"], part_seed)
     model = board_model(logs["thermal"], board_cal)
@@ -305,16 +339,20 @@ def study(logs, values, sensor=TMP117, part_seed=1, crossover_s=CROSSOVER_S,
                      "ref_c": model.ref_c, "rms_deg": model.rms_deg},
            "crossover_s": crossover_s}
     for name in THERMOMETERS:
-        views = {n: view(lg, reads[n][name], linearised(lg, values)) for n, lg in logs.items()}
-        v, figs = fit(views["thermal"], proto)
-        r = judge(views, v, proto)
-        if "warmup" in views:
-            w = thermcal.verify_warmup(compensated(views["warmup"], v, proto), proto)
-            r.update({"warmup_time_s": w["warmup_time_s"],
-                      "warmup_worst_dps": w["worst_valid_1s_dps"], "warmup_ok": w["ok"]})
-        r.update({"fit_rms_1s_dps": figs["fit_rms_1s_dps"], "grad_tau_s": v["rate.grad_tau_s"],
-                  "values": {k: v[k] for k in sorted(v)}})
-        r["ok"] = bool(r["plateaus_ok"] and r["ramp_ok"] and r["transient_ok"]
-                       and r.get("noise_ok", True))
-        res[name] = r
+        res[name] = evaluate(logs, {n: r[name] for n, r in reads.items()}, values, proto)
+    if "warmup" in logs:
+        lg = logs["warmup"]
+        fused = fused_thermometer(lg["t_s"], lg["p_f_deg"], reads["warmup"]["board"], model,
+                                  crossover_s, FUSION_COLD_START_S)
+        w = thermcal.verify_warmup(compensated(view(lg, fused, linearised(lg, values)),
+                                               res["fusion"]["values"], proto), proto)
+        res["fusion_cold_start"] = {"start_s": FUSION_COLD_START_S,
+                                    "warmup_time_s": w["warmup_time_s"],
+                                    "warmup_worst_dps": w["worst_valid_1s_dps"],
+                                    "warmup_ok": w["ok"]}
+    res["scan"] = []
+    for x in scan_s:
+        fused = {n: fused_thermometer(lg["t_s"], lg["p_f_deg"], reads[n]["board"], model, x)
+                 for n, lg in logs.items()}
+        res["scan"].append(dict(evaluate(logs, fused, values, proto), crossover_s=x))
     return res

@@ -137,6 +137,10 @@ def test_fused_thermometer_keeps_p_fast_and_the_model_slow():
     assert f2[i + 1000] - fused[i + 1000] == pytest.approx(0.3 * keep ** 1001, abs=1e-9)
     # an endless crossover is P itself, less the disagreement held from the start
     assert np.ptp(boardstudy.fused_thermometer(t, p, truth, Perfect(), 1e9) - p) < 1e-6
+    # a late start (after a cold start): P alone before it, the model's soon after
+    late_start = boardstudy.fused_thermometer(t, p, truth, Perfect(), 20.0, start_s=2000.0)
+    np.testing.assert_array_equal(late_start[t < 2000.0], p[t < 2000.0])
+    np.testing.assert_allclose(late_start[t > 2200.0], fused[t > 2200.0], atol=1e-3)
 
 
 def _chamber_log(proto):
