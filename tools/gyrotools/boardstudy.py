@@ -212,7 +212,10 @@ VERIFY_LOGS = ("verify_plateaus", "verify_ramp", "verify_transient")
 COLUMNS = ("rate_true_dps", "rate_valid", "rate_unc_dps", "p_f_deg", "t_struct_c", "t_board_c")
 # The sensor's noise seed of each log: its own, as each verification run has its own.
 SENSOR_SEEDS = {"thermal": 11, "verify_plateaus": 12, "verify_ramp": 13,
-                "verify_transient": 14, "noise": 15}
+                "verify_transient": 14, "noise": 15, "warmup": 16, "noise_long": 17}
+# The noise ratio at this tau and beyond is read on the long run ("noise_long") when there
+# is one: the flow's 1200 s run holds 100 s on a dozen windows and 1000 s not at all.
+LONG_TAU_S = 100.0
 
 
 def linearised(log, values):
@@ -276,7 +279,14 @@ def judge(views, v, proto=thermcal.FULL):
            "ramp_ok": ramp["ok"], "transient_std_dps": tr["bias_1s_std_dps"],
            "transient_pp_dps": tr["bias_1s_pp_dps"], "transient_ok": tr["ok"]}
     if "noise" in views:
+        # 1 and 10 s on the flow's own noise run (as it judges them), 100 and 1000 s on
+        # the long run when there is one
         r, a_c, a_u = noise_ratio(views["noise"], v, proto)
+        if "noise_long" in views:
+            long = noise_ratio(views["noise_long"], v, proto)
+            for k, tau in enumerate(TAUS_S):
+                if tau >= LONG_TAU_S:
+                    r[k], a_c[k], a_u[k] = long[0][k], long[1][k], long[2][k]
         lim = thermcal.LIMITS["noise_ratio"]
         res.update({"taus_s": list(TAUS_S), "noise_ratio": r, "adev_compensated_dph": a_c,
                     "adev_uncompensated_dph": a_u,
@@ -327,9 +337,10 @@ def evaluate(logs, readings, values, proto=thermcal.FULL):
 
 def study(logs, values, sensor=TMP117, part_seed=1, crossover_s=CROSSOVER_S,
           proto=thermcal.FULL, scan_s=()):
-    """One part: logs (name -> columns: "thermal", the VERIFY_LOGS, "noise", optionally
-    "warmup"), values (its lin coefficients). For each thermometer the fit on "thermal"
-    and the flow's verdicts on the others; the fusion again for each crossover of scan_s.
+    """One part: logs (name -> columns: "thermal", the VERIFY_LOGS, "noise" (the flow's
+    verify_noise), optionally "noise_long" and "warmup"), values (its lin coefficients).
+    For each thermometer the fit on "thermal" and the flow's verdicts on the others; the
+    fusion again for each crossover of scan_s.
     Returns {"model": ..., thermometer: results, "scan": [...]}."""
     board_cal = sensor_reading(logs["thermal"]["t_s"], logs["thermal"]["t_board_c"], sensor,
                                SENSOR_SEEDS["thermal"], part_seed)
