@@ -33,26 +33,34 @@ rounded to 1 LSB and held until the next conversion. The sensor's self-heating a
 long-term drift are not modelled (3.5 uA at 1 Hz; the drift is over months, the runs
 hours).
 
-The fusion (fit_board_to_p, fused_thermometer): the board reading through a transfer
-fitted on the calibration log to P, for the slow part, and P for the fast. In a thermal
-network of lumped nodes driven by one input (the surroundings; host_sim/plant/thermal.h)
-every node is a rational transfer of that input with the network's poles, so the
-structure's temperature is the board's through N_s(s) / N_b(s): two zeros over two poles
-for three nodes, whatever the couplings. The model is that transfer, of unit DC gain,
-(1 + s z1)(1 + s z2) / ((1 + s p1)(1 + s p2)), followed by a cubic in its output (a
-Wiener model; the cubic absorbs P's curvature in temperature, the board's self-heating
-offset and the sensor's accuracy error); its four time constants and the cubic are
-fitted by least squares to the 1 s means of P_f at rest on the calibration log (scipy
-least_squares on the time constants, the cubic linear within). The fused thermometer is
-
-    P_fused = P - LP_T(P - M(board)),
-
-P less the low-passed disagreement between P and the board's model of P: P's own above
-1 / (2 pi T), the model's below (the steady-state Kalman filter of a model error that
-wanders as a random walk under white measurement noise has this form), so the drive
-pickoff's phase flicker (1/f, the 1.9x at 100..1000 s) is replaced by the sensor's noise
-through the model at long times while a change the model misses is still read by P
-within T. T (`crossover_s`, CROSSOVER_S) is the one free choice.
+The fusions (fit_board_model, fused_thermometer): the board reading through a transfer
+fitted on the calibration log, for the slow part, and P for the fast. In a thermal network
+of lumped nodes driven by one input (the surroundings; host_sim/plant/thermal.h) every
+node is a rational transfer of that input with the network's poles, so any node's
+temperature, and any linear mix of them, is the board's through N(s) / N_b(s): two zeros
+over two poles for three nodes, whatever the couplings. The model is that transfer, of
+unit DC gain, (1 + s z1)(1 + s z2) / ((1 + s p1)(1 + s p2)), followed by a cubic in its
+output (a Wiener model: the cubic takes the target's curvature in temperature, the
+board's self-heating offset and the sensor's accuracy error); its four time constants
+and the cubic are fitted by least squares to the target's 1 s means at rest on the
+calibration log (scipy least_squares on the time constants, the cubic linear within).
+Two targets:
+- "fusion_p": P_f. The fused thermometer is P - LP_T(P - M(board)), P less the
+  low-passed disagreement between P and the board's model of it, in P's units;
+- "fusion_bias": the linearised output at rest, i.e. the bias itself, which weighs the
+  structure and the circuit as the part does (P reads the structure only). P enters as the
+  bias its own compensation's cubic reads (p_as_bias, the P fit's values), and the fused
+  thermometer, in deg/s, is P_b - LP_T(P_b - M(board)).
+Either is then a thermometer like P: the flow's fit (cubic, gradient term, filters, fast
+path) is made on it. Above 1 / (2 pi T) it is P's, below the model's (the steady-state
+Kalman filter of a model error that wanders as a random walk under white measurement
+noise has this form), so the drive pickoff's phase flicker (1/f, the 1.9x at 100..1000 s)
+is replaced by the sensor's noise through the model at long times, while a change the
+model misses is still read by P within T. T (`crossover_s`, CROSSOVER_S) is the one free
+choice. The model assumes the surroundings are the only heat input that changes: after a
+power-on the board's own dissipation is a second one: the study then takes the output of
+P's own compensation for FUSION_COLD_START_S and hands over to the fusion's over
+FUSION_FADE_S (handed_over), as a firmware running both would.
 """
 
 from __future__ import annotations
@@ -65,7 +73,8 @@ from scipy import optimize, signal
 from . import compstudy, lincal, tempcomp, thermcal
 
 TAUS_S = compstudy.TAUS_S
-THERMOMETERS = ("P", "board", "fusion")
+FUSIONS = ("fusion_p", "fusion_bias")
+THERMOMETERS = ("P", "board") + FUSIONS
 # The fused thermometer's crossover (s). The drive pickoff's phase flicker is in excess
 # from 10 s on (1.09x there with the flow's three 15 s stages, 1.9x at 100..1000 s); to
 # keep it out of every band from 10 s up the crossover lies well below: 3 s, 53 mHz. P's
@@ -75,10 +84,11 @@ THERMOMETERS = ("P", "board", "fusion")
 # few seconds is not corrected by P (tools/board_thermometer_study --scan shows the trade).
 CROSSOVER_S = 3.0
 # After a cold start the board's own dissipation warms it for minutes (a second heat input
-# the model, fitted on a chamber run that starts warm, does not have): the fusion then
-# holds its disagreement with P only from this long after power-on, five of the default
-# network's slowest thermal mode (306 s, tools/thermal_warmup.py), P alone before.
+# the model, fitted on a chamber run that starts warm, does not have): the output is P's
+# own compensation's for this long after power-on, five of the default network's slowest
+# thermal mode (306 s, tools/thermal_warmup.py), then hands over to the fusion's.
 FUSION_COLD_START_S = 1500.0
+FUSION_FADE_S = 300.0
 # The model's fit starts after the calibration log's first plateau has had this long (the
 # run starts in the steady state of 25 degC, the model's filter at the first reading).
 MODEL_START_S = 120.0
@@ -156,12 +166,13 @@ def lead_lag(t_s, x, tc_s):
 
 @dataclasses.dataclass
 class BoardModel:
-    """The board reading's model of P: the lead-lag tc_s, then the cubic c (in the
-    lead-lag's output less ref_c)."""
+    """The board reading's model of a target (P, or the bias): the lead-lag tc_s, then
+    the cubic c (in the lead-lag's output less ref_c); rms its residual on the fit's 1 s
+    means, in the target's unit."""
     tc_s: tuple
     c: np.ndarray
     ref_c: float
-    rms_deg: float
+    rms: float
 
     def __call__(self, t_s, board_c):
         return tempcomp.poly_eval(self.c, lead_lag(t_s, board_c, self.tc_s) - self.ref_c)
@@ -171,12 +182,13 @@ def _bins(t, cols):
     return tempcomp.bin_average(t, cols, thermcal.BIN_S)
 
 
-def fit_board_to_p(t_s, board_c, p_deg, rest, start_s=MODEL_START_S,
-                   guess_s=(300.0, 30.0, 600.0, 60.0)):
-    """The board reading's model of P (module doc), fitted on 1 s means: the lead-lag
-    runs over every bin, the residual is taken over the bins at rest after start_s."""
+def fit_board_model(t_s, board_c, target, rest, start_s=MODEL_START_S,
+                    guess_s=(300.0, 30.0, 600.0, 60.0)):
+    """The board reading's model of target (module doc), fitted on 1 s means: the
+    lead-lag runs over every bin, the residual is taken over the bins at rest after
+    start_s."""
     t = np.asarray(t_s, dtype=float)
-    b = _bins(t, {"b": np.asarray(board_c, float), "p": np.asarray(p_deg, float),
+    b = _bins(t, {"b": np.asarray(board_c, float), "p": np.asarray(target, float),
                   "r": np.asarray(rest, float)})
     use = (b["r"] > 0.999) & (b["t_s"] >= start_s)
     ref = float(np.mean(b["b"][use]))
@@ -194,17 +206,23 @@ def fit_board_to_p(t_s, board_c, p_deg, rest, start_s=MODEL_START_S,
     return BoardModel(tc, c, ref, float(np.sqrt(np.mean(r ** 2))))
 
 
-def fused_thermometer(t_s, p_deg, board_c, model, crossover_s=CROSSOVER_S,
-                      start_s=thermcal.START_S):
+def fused_thermometer(t_s, p_deg, board_c, model, crossover_s=CROSSOVER_S):
     """P - LP_T(P - M(board)): P above the crossover, the board's model of it below. The
     low-pass starts at thermcal.START_S (as the firmware's thermometer filters do) at the
-    disagreement of that moment; with a later start_s (after a cold start,
-    FUSION_COLD_START_S) it reads nothing before start_s, so the fused thermometer is P
-    alone until then and the model's within a few crossovers after."""
+    disagreement of that moment."""
     t = np.asarray(t_s, dtype=float)
     p = np.asarray(p_deg, dtype=float)
-    d = np.where(t >= start_s, p - model(t, board_c), 0.0)
-    return p - thermcal.comp_thermometer(t, d, crossover_s, 1)
+    return p - thermcal.comp_thermometer(t, p - model(t, board_c), crossover_s, 1)
+
+
+def handed_over(t_s, out_p, out_fused, start_s=None, fade_s=None):
+    """After a power-on: the output of P's own compensation until start_s
+    (FUSION_COLD_START_S), then a linear hand-over to the fusion's output over fade_s
+    (FUSION_FADE_S), so that what the two still disagree by then is not a step."""
+    start_s = FUSION_COLD_START_S if start_s is None else start_s
+    fade_s = FUSION_FADE_S if fade_s is None else fade_s
+    w = np.clip((np.asarray(t_s, dtype=float) - start_s) / fade_s, 0.0, 1.0)
+    return (1.0 - w) * np.asarray(out_p) + w * np.asarray(out_fused)
 
 
 # The verification logs a study reads (the flow's work folder) and the columns it needs.
@@ -294,27 +312,38 @@ def judge(views, v, proto=thermcal.FULL):
     return res
 
 
-def thermometer_readings(logs, model=None, sensor=TMP117, part_seed=1,
-                         crossover_s=CROSSOVER_S):
-    """Per log name, the three thermometers' readings: P_f, the board sensor's reading
-    (its noise seeded per log, SENSOR_SEEDS; its accuracy error per part) and, with a
-    model, the fused thermometer."""
-    out = {}
-    for n, lg in logs.items():
-        board = sensor_reading(lg["t_s"], lg["t_board_c"], sensor,
-                               SENSOR_SEEDS.get(n, 16), part_seed)
-        out[n] = {"P": np.asarray(lg["p_f_deg"], dtype=float), "board": board}
-        if model is not None:
-            out[n]["fusion"] = fused_thermometer(lg["t_s"], lg["p_f_deg"], board, model,
-                                                 crossover_s)
-    return out
+def board_readings(logs, sensor=TMP117, part_seed=1):
+    """Per log name, the board sensor's reading (its noise seeded per log, SENSOR_SEEDS;
+    its accuracy error per part)."""
+    return {n: sensor_reading(lg["t_s"], lg["t_board_c"], sensor, SENSOR_SEEDS.get(n, 18),
+                              part_seed) for n, lg in logs.items()}
 
 
-def board_model(cal_log, board_c):
-    """The board reading's model of P on the calibration log (fit_board_to_p)."""
+def board_model(cal_log, board_c, target):
+    """The board reading's model of target (P_f, or the linearised output: the bias) on
+    the calibration log at rest (fit_board_model)."""
     t = cal_log["t_s"]
     rest = (np.abs(cal_log["rate_true_dps"]) < 1e-9) & (t >= thermcal.START_S)
-    return fit_board_to_p(t, board_c, cal_log["p_f_deg"], rest)
+    return fit_board_model(t, board_c, target, rest)
+
+
+def p_as_bias(p_deg, v):
+    """P through the P compensation's static cubic (values v): the bias P alone reads,
+    deg/s; the fast part of the fusion with the board's model of the bias."""
+    return compstudy._bias(v, np.asarray(p_deg, dtype=float) - v["cal.ref_p_deg"])
+
+
+def fused_readings(logs, board, models, v_p, crossover_s):
+    """Per fusion (FUSIONS) and log name, the fused thermometer: P with the board's model
+    of P ("fusion_p", deg), or P's bias with the board's model of the bias ("fusion_bias",
+    deg/s)."""
+    out = {}
+    for name, model in models.items():
+        out[name] = {}
+        for n, lg in logs.items():
+            p = lg["p_f_deg"] if name == "fusion_p" else p_as_bias(lg["p_f_deg"], v_p)
+            out[name][n] = fused_thermometer(lg["t_s"], p, board[n], model, crossover_s)
+    return out
 
 
 def evaluate(logs, readings, values, proto=thermcal.FULL):
@@ -335,35 +364,53 @@ def evaluate(logs, readings, values, proto=thermcal.FULL):
     return r
 
 
+def _model_doc(m):
+    return {"tc_s": list(m.tc_s), "cubic": m.c.tolist(), "ref_c": m.ref_c, "rms": m.rms}
+
+
+def _cold_start_held(logs, fused, res, values, proto):
+    """The fusions on the cold start, handed over from P's compensation after power-on
+    (handed_over)."""
+    lg = logs["warmup"]
+    u = linearised(lg, values)
+    out_p = compensated(view(lg, lg["p_f_deg"], u), res["P"]["values"], proto)
+    out = {}
+    for name in FUSIONS:
+        lv = compensated(view(lg, fused[name]["warmup"], u), res[name]["values"], proto)
+        lv["rate_dps"] = handed_over(lg["t_s"], out_p["rate_dps"], lv["rate_dps"])
+        w = thermcal.verify_warmup(lv, proto)
+        out[name] = {"start_s": FUSION_COLD_START_S, "fade_s": FUSION_FADE_S,
+                     "warmup_time_s": w["warmup_time_s"],
+                     "warmup_worst_dps": w["worst_valid_1s_dps"], "warmup_ok": w["ok"]}
+    return out
+
+
 def study(logs, values, sensor=TMP117, part_seed=1, crossover_s=CROSSOVER_S,
           proto=thermcal.FULL, scan_s=()):
     """One part: logs (name -> columns: "thermal", the VERIFY_LOGS, "noise" (the flow's
     verify_noise), optionally "noise_long" and "warmup"), values (its lin coefficients).
-    For each thermometer the fit on "thermal" and the flow's verdicts on the others; the
-    fusion again for each crossover of scan_s.
-    Returns {"model": ..., thermometer: results, "scan": [...]}."""
-    board_cal = sensor_reading(logs["thermal"]["t_s"], logs["thermal"]["t_board_c"], sensor,
-                               SENSOR_SEEDS["thermal"], part_seed)
-    model = board_model(logs["thermal"], board_cal)
-    reads = thermometer_readings(logs, model, sensor, part_seed, crossover_s)
-    res = {"model": {"tc_s": list(model.tc_s), "cubic": model.c.tolist(),
-                     "ref_c": model.ref_c, "rms_deg": model.rms_deg},
-           "crossover_s": crossover_s}
-    for name in THERMOMETERS:
-        res[name] = evaluate(logs, {n: r[name] for n, r in reads.items()}, values, proto)
+    For each thermometer (THERMOMETERS) the fit on "thermal" and the flow's verdicts on
+    the others; the fusions again for each crossover of scan_s, and held after power-on
+    on the cold start. Returns {"models": ..., thermometer: results, "scan": [...],
+    "cold_start_held": ...}."""
+    board = board_readings(logs, sensor, part_seed)
+    cal = logs["thermal"]
+    res = {"crossover_s": crossover_s,
+           "P": evaluate(logs, {n: lg["p_f_deg"] for n, lg in logs.items()}, values, proto),
+           "board": evaluate(logs, board, values, proto)}
+    models = {"fusion_p": board_model(cal, board["thermal"], cal["p_f_deg"]),
+              "fusion_bias": board_model(cal, board["thermal"], linearised(cal, values))}
+    res["models"] = {k: _model_doc(m) for k, m in models.items()}
+    v_p = res["P"]["values"]
+    fused = fused_readings(logs, board, models, v_p, crossover_s)
+    for name in FUSIONS:
+        res[name] = evaluate(logs, fused[name], values, proto)
     if "warmup" in logs:
-        lg = logs["warmup"]
-        fused = fused_thermometer(lg["t_s"], lg["p_f_deg"], reads["warmup"]["board"], model,
-                                  crossover_s, FUSION_COLD_START_S)
-        w = thermcal.verify_warmup(compensated(view(lg, fused, linearised(lg, values)),
-                                               res["fusion"]["values"], proto), proto)
-        res["fusion_cold_start"] = {"start_s": FUSION_COLD_START_S,
-                                    "warmup_time_s": w["warmup_time_s"],
-                                    "warmup_worst_dps": w["worst_valid_1s_dps"],
-                                    "warmup_ok": w["ok"]}
+        res["cold_start_held"] = _cold_start_held(logs, fused, res, values, proto)
     res["scan"] = []
     for x in scan_s:
-        fused = {n: fused_thermometer(lg["t_s"], lg["p_f_deg"], reads[n]["board"], model, x)
-                 for n, lg in logs.items()}
-        res["scan"].append(dict(evaluate(logs, fused, values, proto), crossover_s=x))
+        fused = fused_readings(logs, board, models, v_p, x)
+        for name in FUSIONS:
+            res["scan"].append(dict(evaluate(logs, fused[name], values, proto),
+                                    crossover_s=x, fusion=name))
     return res
