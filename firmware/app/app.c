@@ -131,7 +131,7 @@ int app_init_with(app_t *a, const param_values_t *values)
     return -2;
   }
   gyro_attach_lost_counter(&a->gyro, hal_sample_lost_counter());
-  gyro_attach_dac_frame(&a->gyro, &a->dac); /* the nulling electrodes' channels */
+  gyro_attach_dac_frame(&a->gyro, &a->dac); /* the frame every tick writes */
   a->applied = view.derived;
 
   const cli_cfg_t cc = {&a->params, &a->store,        cli_write,
@@ -169,14 +169,15 @@ static void take_request(app_t *a, uint32_t req)
   }
 }
 
-GYRO_RAMFUNC void app_sample_isr(void *ctx)
+/* ISR: what a tick takes on at its start besides the frame, rarely: a new design (the
+ * bank's block published since the last tick), then one queued request. Out of line, so
+ * that the tick's path keeps nothing but the application across its calls; in flash,
+ * like gyro_apply and the requests' calls (linker/check_ramfunc.py, OFF_PATH). */
+GYRO_NOINLINE static void take_changes(app_t *a, const void *derived)
 {
-  app_t *a = ctx;
-
-  const params_view_t view = params_isr_acquire(&a->params);
-  if (view.derived != a->applied) {
-    gyro_apply(&a->gyro, view.derived);
-    a->applied = view.derived;
+  if (derived != a->applied) {
+    gyro_apply(&a->gyro, derived);
+    a->applied = derived;
   }
   const uint32_t tail = a->req_tail;
   if (tail != a->req_head) {
@@ -184,14 +185,26 @@ GYRO_RAMFUNC void app_sample_isr(void *ctx)
     take_request(a, a->req_word[tail % APP_REQ_QUEUE]);
     a->req_tail = tail + 1u;
   }
+}
 
-  hal_adc_frame_t adc;
-  hal_adc_read_frame(&adc);
-  gyro_tick(&a->gyro, &adc, &a->dac);
-  hal_dac_write_frame(&a->dac);
+GYRO_RAMFUNC void app_sample_isr(void *ctx)
+{
+  app_t *a = ctx;
+
+  const params_view_t view = params_isr_acquire(&a->params);
+  /* Both tests in one branch (| rather than ||: the tick's path falls through). */
+  if (GYRO_UNLIKELY((view.derived != a->applied) | (a->req_tail != a->req_head))) {
+    take_changes(a, view.derived);
+  }
+
+  hal_adc_read_frame(&a->adc);
+  gyro_tick(&a->gyro, &a->adc); /* into a->dac, attached at init */
   app_tlm_isr(&a->tlm, &a->gyro.out);
-
-  a->isr_ticks++; /* its cycles: the HAL measures the whole handler (hal_sample_isr_cycles) */
+  /* Last, as a tail call: the frame is sent at the DAC's slots late in the period, and
+   * what the telemetry takes of the tick does not touch it. Its ticks are the gyro's
+   * (app_ticks), its cycles the HAL's, which measures the whole handler
+   * (hal_sample_isr_cycles). */
+  hal_dac_write_frame(&a->dac);
 }
 
 void app_cli_feed(app_t *a, const uint8_t *data, size_t len) { cli_feed(&a->cli, data, len); }

@@ -2,8 +2,9 @@
  * the glue between them and the HAL. The same code runs on the board and on the host.
  *
  *   app_sample_isr (50 kHz, highest priority): take this tick's parameter view (apply a
- *     newly published design at the tick boundary), read the ADC frame, gyro_tick, write
- *     the DAC frame, measure its own cycles.
+ *     newly published design at the tick boundary) and at most one request, read the ADC
+ *     frame, gyro_tick, the telemetry's record, write the DAC frame (the HAL measures
+ *     the handler's cycles).
  *   app_poll (background loop): UART bytes -> command line -> parameter bank / store. A
  *     line is only executed when the TX ring has room for the longest reply
  *     (APP_TLM_TX_RESERVE, which telemetry leaves free): otherwise the loop waits for the

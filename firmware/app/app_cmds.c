@@ -108,7 +108,7 @@ static void put_selfcal(cli_t *cli, app_t *a)
     cli_putf(cli, "selfcal_why %s", s->why);
     cli_emit_data(cli);
   }
-  const uint32_t t = selfcal_running(s) ? a->isr_ticks - a->selfcal_t0_ticks : a->selfcal_ticks;
+  const uint32_t t = selfcal_running(s) ? app_ticks(a) - a->selfcal_t0_ticks : a->selfcal_ticks;
   cli_data_f32(cli, "selfcal_s", (float)t / (float)params_current(&a->params)->sys_fs_hz);
   if (s->f_coarse_hz > 0.0) cli_data_f32(cli, "selfcal_coarse_hz", (float)s->f_coarse_hz);
   if (s->rd_q > 0.0) {
@@ -285,7 +285,7 @@ static void put_board(cli_t *cli, app_t *a)
 
 /* The health counters and the other one-number figures of status. */
 static uint32_t fault_count(const app_t *a) { return a->gyro.sup.fault_count; }
-static uint32_t isr_ticks(const app_t *a) { return a->isr_ticks; }
+static uint32_t ticks(const app_t *a) { return app_ticks(a); }
 static uint32_t isr_cycles_last(const app_t *a)
 {
   (void)a;
@@ -331,7 +331,7 @@ static const status_row_t k_status_rows[] = {
     {"drive", NULL, put_drive},
     {"quad_null", NULL, put_quad_null},
     {"design", NULL, put_design},
-    {"ticks", isr_ticks, NULL},
+    {"ticks", ticks, NULL},
     {"isr_cycles_last", isr_cycles_last, NULL},
     {"isr_cycles_max", isr_cycles_max, NULL},
     {"rx_overflows", rx_overflows, NULL},

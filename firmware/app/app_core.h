@@ -37,10 +37,28 @@ typedef enum {
 typedef void (*app_status_fn)(cli_t *cli, void *ctx);
 
 typedef struct {
+  /* What the sample ISR touches on every tick first, each within one load's immediate
+   * offset of the instance (4 KB), so that it needs no address arithmetic: the bank
+   * (its published generation), the block it runs with, the request queue, the frames,
+   * the gyro and the telemetry's ISR side (app_tlm_t begins with it). */
   params_t params;
-  gyro_design_t derived[2]; /* the bank's derived blocks */
-  const void *applied;      /* derived block the ISR runs with */
+  const void *applied; /* derived block the ISR runs with */
+  /* Request queue: words written by the background before it advances req_head; the
+   * ISR takes req_word[req_tail % APP_REQ_QUEUE] and advances req_tail. */
+  volatile uint32_t req_word[APP_REQ_QUEUE];
+  volatile uint32_t req_head, req_tail;
+  /* The DAC frame handed to the HAL every tick, attached to the gyro, which writes each
+   * channel when its value changes (gyro_tick); the sense electrodes' channels keep the
+   * mid-scale (0 V) of app_init until a loop drives them (issue 19 item 3). Kept here
+   * rather than rebuilt on the stack because four constant stores a tick were 5 of the
+   * interrupt's cycles. */
+  hal_dac_frame_t dac;
+  /* The ADC frame of the tick, here rather than on the ISR's stack, so that the ISR
+   * ends in a tail call (the HAL's DAC write). */
+  hal_adc_frame_t adc;
   gyro_t gyro;
+  app_tlm_t tlm;            /* telemetry stream and its commands (app_tlm.c) */
+  gyro_design_t derived[2]; /* the bank's derived blocks */
   param_store_t store;
   param_store_status_t store_status; /* result of the boot-time load */
   /* Stored values the boot could not design with the rest, set back to their defaults
@@ -52,27 +70,20 @@ typedef struct {
   /* Bytes read from the UART, fed to the command line a line at a time (app_poll). */
   uint8_t rx_buf[64];
   uint32_t rx_len, rx_pos;
-  /* Request queue: words written by the background before it advances req_head; the
-   * ISR takes req_word[req_tail % APP_REQ_QUEUE] and advances req_tail. */
-  volatile uint32_t req_word[APP_REQ_QUEUE];
-  volatile uint32_t req_head, req_tail;
   bool sweep_owns_drive;     /* the sequencer, not a command, decides the drive's next mode */
   bool handing_over;         /* the sweep's hand-over commits its values: the loops are off
                               * in SWEEP and start from them, so drive.track may change */
-  app_tlm_t tlm;             /* telemetry stream and its commands (app_tlm.c) */
   selfcal_t selfcal;         /* self-calibration sequencer (background, app_selfcal.c) */
-  uint32_t selfcal_t0_ticks; /* isr_ticks when the sweep was requested */
+  uint32_t selfcal_t0_ticks; /* app_ticks when the sweep was requested */
   uint32_t selfcal_ticks;    /* its length up to the hand-over */
-  /* Self-measurement of the sample ISR (DWT cycles on the board). */
-  uint32_t isr_ticks;
-  /* The DAC frame handed to the HAL every tick: gyro_tick rewrites the channels it drives,
-   * the sense electrodes' channels keep the mid-scale (0 V) of app_init until a loop
-   * drives them (issue 19 item 3). Kept here rather than rebuilt on the stack because
-   * four constant stores a tick were 5 of the interrupt's cycles. */
-  hal_dac_frame_t dac;
   /* Set by the image's main after app_init (NULL: nothing added, as on the host). */
   app_status_fn status_board;
 } app_t;
+
+/* The sample ISR's calls since app_init: the gyro's own count of its ticks (one per
+ * call, gyro_out_t.tick), which the ISR keeps anyway; a second counter of the same
+ * thing cost the interrupt 5 cycles. */
+static inline uint32_t app_ticks(const app_t *a) { return a->gyro.out.tick; }
 
 /* Boot: stored value i set back to its default because the stored set could not be
  * designed with it (status lists them). */

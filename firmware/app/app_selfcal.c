@@ -38,7 +38,7 @@ int app_selfcal_start(app_t *a)
   c.delay_s = 1.5 / c.fs_hz;
   if (selfcal_start(&a->selfcal, &c) != 0) return -1;
   (void)app_request(a, APP_REQ_SWEEP); /* room checked above */
-  a->selfcal_t0_ticks = a->isr_ticks;
+  a->selfcal_t0_ticks = app_ticks(a);
   a->selfcal_ticks = 0u;
   a->sweep_owns_drive = true;
   return 0;
@@ -82,7 +82,7 @@ static void hand_over(app_t *a)
     return;
   }
   selfcal_finish(s, 1, NULL);
-  a->selfcal_ticks = a->isr_ticks - a->selfcal_t0_ticks;
+  a->selfcal_ticks = app_ticks(a) - a->selfcal_t0_ticks;
   /* The design is published before the request (app_request's fence), and the ISR
    * applies a new block at the start of a tick before it takes a request. */
   a->sweep_owns_drive = false;
@@ -92,7 +92,7 @@ static void hand_over(app_t *a)
 void app_selfcal_poll(app_t *a)
 {
   selfcal_t *s = &a->selfcal;
-  selfcal_watch(s, a->isr_ticks);
+  selfcal_watch(s, app_ticks(a));
   /* The drive is judged once the ISR has taken every request, the sweep's own included;
    * then the queue is empty and the sequencer's request always fits. */
   if (app_requests_pending(a)) return;
@@ -103,7 +103,7 @@ void app_selfcal_poll(app_t *a)
   if (!selfcal_running(s) && a->sweep_owns_drive) {
     /* A failed sweep leaves the electrodes off (safe mode); status says why and how long
      * it ran (selfcal_s). */
-    a->selfcal_ticks = a->isr_ticks - a->selfcal_t0_ticks;
+    a->selfcal_ticks = app_ticks(a) - a->selfcal_t0_ticks;
     a->sweep_owns_drive = false;
     (void)app_request(a, APP_REQ_DRIVE_OFF);
   }

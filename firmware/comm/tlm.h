@@ -127,14 +127,15 @@ typedef struct {
 } tlm_isr_sel_t;
 
 typedef struct {
-  tlm_ring_t ring;
-  /* ISR side */
+  /* ISR side, first: the sample ISR loads isr_gen every tick, at a small offset from
+   * whatever holds the stream (the ring, 8 KB, follows). */
+  _Atomic uint32_t isr_gen; /* 0 = off, else g: selection isr_sel[g & 1]; background */
   const tlm_field_t *rows;  /* cfg.fields->row: one load fewer per record */
   tlm_isr_sel_t isr_sel[2]; /* written by the background, never the slot isr_gen names */
-  _Atomic uint32_t isr_gen; /* 0 = off, else g: selection isr_sel[g & 1]; background */
   uint32_t isr_seen;        /* last isr_gen the ISR acted on */
   uint32_t isr_count;       /* ticks to wait before the next record */
   _Atomic uint32_t isr_rec; /* records taken (pushed or lost), written by the ISR */
+  tlm_ring_t ring;
   /* background side */
   tlm_cfg_t cfg;
   tlm_plan_t plan;

@@ -1,4 +1,6 @@
-/* GYRO_RAMFUNC marks a function of the sample interrupt's path where it is defined.
+/* The code layout of the sample interrupt's path: GYRO_RAMFUNC marks a function of it
+ * where it is defined, GYRO_UNLIKELY a branch of it rarely taken, GYRO_NOINLINE a rare
+ * part of it kept out of its caller.
  *
  * On the target it puts the function into an input section of its own named
  * .ramfunc.<line>, which the linker script places in SRAM (no flash wait states, and it
@@ -20,6 +22,24 @@
 #define GYRO_RAMFUNC __attribute__((section(".ramfunc." GYRO_RAMFUNC_STR(__LINE__))))
 #else
 #define GYRO_RAMFUNC
+#endif
+
+/* A condition rarely true on the sample path: the compiler lays its branch out so that
+ * the common path falls through (a taken branch refills the pipeline). Block layout
+ * only, never what is computed. */
+/* GYRO_NOINLINE keeps a rarely run part of it out of its caller, so that the caller's
+ * common path saves no register for it. */
+/* GYRO_COSTLY marks the branch whose work sets the interrupt's worst tick, though not
+ * the common one (a feature that is off by default): laid out to fall through, since
+ * the budget is the worst tick's. */
+#if defined(__GNUC__)
+#define GYRO_UNLIKELY(x) __builtin_expect((x) != 0, 0)
+#define GYRO_COSTLY(x) __builtin_expect((x) != 0, 1)
+#define GYRO_NOINLINE __attribute__((noinline))
+#else
+#define GYRO_UNLIKELY(x) ((x) != 0)
+#define GYRO_COSTLY(x) ((x) != 0)
+#define GYRO_NOINLINE
 #endif
 
 #endif /* RAMFUNC_H */

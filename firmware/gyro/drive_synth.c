@@ -2,9 +2,12 @@
 
 #include <math.h> /* NAN (a constant, no call) */
 #include <stddef.h>
+#include <string.h>
 
 #include "dsp/fastmath.h"
 #include "dsp/ramfunc.h"
+
+#define SYNTH_INF_BITS 0x7F800000u /* +infinity's bit pattern */
 
 int drive_synth_init(drive_synth_t *ds, const drive_synth_cfg_t *cfg)
 {
@@ -39,11 +42,11 @@ float drive_synth_f_cmd_max(const drive_synth_t *ds)
   return ds->u_max_v * ds->u_max_v;
 }
 
-GYRO_RAMFUNC void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad)
+/* P less the turns taken off, kept within 1.5 pi of them: out of the command's tick (a P
+ * that has moved a turn, or a non-finite one), so that the common path of
+ * drive_synth_set compares once. */
+GYRO_RAMFUNC static float synth_wrap_turns(drive_synth_t *ds, float p_rad)
 {
-  ds->f_set_v2 = f_cmd_v2;
-  ds->p_set_rad = p_rad;
-  p_rad -= ds->p_turn_rad;
   if (p_rad > 1.5f * FM_PI_F) {
     ds->p_turn_rad += FM_TWO_PI_F;
     p_rad -= FM_TWO_PI_F;
@@ -59,7 +62,29 @@ GYRO_RAMFUNC void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad
     p_rad = 0.0f;
     ds->p_turn_rad = 0.0f;
   }
-  const float f = (f_cmd_v2 > 0.0f && fm_isfinite(f_cmd_v2)) ? f_cmd_v2 : 0.0f;
+  return p_rad;
+}
+
+GYRO_RAMFUNC void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad)
+{
+  ds->f_set_v2 = f_cmd_v2;
+  ds->p_set_rad = p_rad;
+  p_rad -= ds->p_turn_rad;
+  /* Within 1.5 pi of the turns (the common case) it is also within the conversion's
+   * +-2 pi: one compare of the magnitude decides (VABS, exact; a NaN fails the compare
+   * and takes the rare path too). */
+  if (GYRO_UNLIKELY(!(__builtin_fabsf(p_rad) <= 1.5f * FM_PI_F))) {
+    p_rad = synth_wrap_turns(ds, p_rad);
+  }
+  /* A positive finite force, else none: 0 < f < infinity as one unsigned compare of the
+   * bit pattern (the positive finite floats are the patterns 1 .. that of infinity less
+   * one), in a core register instead of two float compares; +0 by a mask, as a select
+   * would become a literal load of 0.0f again. */
+  uint32_t f_bits;
+  memcpy(&f_bits, &f_cmd_v2, sizeof f_bits);
+  f_bits &= 0u - (uint32_t)(f_bits - 1u < SYNTH_INF_BITS - 1u);
+  float f;
+  memcpy(&f, &f_bits, sizeof f);
   if (ds->scheme == GYRO_DRIVE_DC_AC) {
     /* Force phase P = twice the half-angle phase: exact modulo 2^32. */
     ds->off = 2u * sincos_half_rad_to_phase(p_rad);

@@ -7,7 +7,7 @@
 #include "gyro/gyro_block.h"
 #include "dsp/ramfunc.h"
 
-/* No frame attached (gyro_attach_dac_frame): the nulling electrodes' codes go here. */
+/* No frame attached (gyro_attach_dac_frame): the codes go here, where nothing reads them. */
 static hal_dac_frame_t s_no_frame;
 
 void gyro_attach_dac_frame(gyro_t *g, hal_dac_frame_t *frame)
@@ -166,11 +166,13 @@ int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d)
  * carrier cycle and never a long run, yet its demodulated phasor is wrong. */
 static inline void count_rails(gyro_t *g, const hal_adc_frame_t *adc)
 {
-  if (GYRO_UNLIKELY(adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN ||
-                    adc->sense == HAL_ADC_CODE_MAX || adc->sense == HAL_ADC_CODE_MIN)) {
+  const int drive_rail = adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN;
+  const int sense_rail = adc->sense == HAL_ADC_CODE_MAX || adc->sense == HAL_ADC_CODE_MIN;
+  /* One branch for both channels (| rather than ||: the tick's path falls through). */
+  if (GYRO_UNLIKELY(drive_rail | sense_rail)) {
     g->flags_acc |= GYRO_FLAG_ADC_RAIL;
     g->clip_count++;
-    if (adc->drive == HAL_ADC_CODE_MAX || adc->drive == HAL_ADC_CODE_MIN) g->clip_drive_count++;
+    if (drive_rail) g->clip_drive_count++;
   }
 }
 
@@ -178,9 +180,9 @@ static inline void count_rails(gyro_t *g, const hal_adc_frame_t *adc)
  * sets the excitation and the NCO's next step on every tick (selfcal_exec.h). The sense
  * channel and the self-test forces rest (the rate is not valid in SWEEP and the sweep
  * does not use it), so that the executive's step fits the tick's budget. */
-GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc,
-                                         hal_dac_frame_t *dac)
+GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc)
 {
+  hal_dac_frame_t *dac = g->dac_frame;
   nco_out_t ref;
   nco_step(&g->nco, &ref);
   lmsd_step(&g->lmsd_drive, (float)adc->drive * g->adc_v_per_code, ref.sin_wc, ref.cos_wc);
@@ -189,19 +191,24 @@ GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc,
   drive_synth_step(&g->synth, ref.phase, ref.half_phase, &u1, &u2);
   dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
-  dac->code[HAL_DAC_RATE_OUT] = g->rate_code;
   dac->code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID;
   g->out.tick++;
   const uint32_t slot = g->slot;
   g->slot = slot + 1u == GYRO_BLOCK ? 0u : slot + 1u;
-  gyro_block_sweep(g, slot, u1, u2);
+  if (slot == GYRO_SLOT_OUTPUT) {
+    /* The snapshot's drive voltages, here: its job (gyro_block_output_sweep) runs after
+     * the executive's step, across which they would have to be saved. */
+    g->out.u1_v = u1;
+    g->out.u2_v = u2;
+  }
+  gyro_block_sweep(g, slot);
 }
 
-GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
+GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc)
 {
   const gyro_mode_t mode = g->sup.mode;
   if (GYRO_UNLIKELY(mode == GYRO_MODE_SWEEP)) {
-    gyro_tick_sweep(g, adc, dac);
+    gyro_tick_sweep(g, adc);
     return;
   }
   nco_out_t ref;
@@ -215,15 +222,18 @@ GYRO_RAMFUNC void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame
   count_rails(g, adc);
 
   /* The waveform of the command the loops last set (ACQUIRE, LOCKED, once per block). */
-  float u1 = 0.0f, u2 = 0.0f;
-  if (mode == GYRO_MODE_ACQUIRE || mode == GYRO_MODE_LOCKED) {
+  float u1, u2;
+  if (GYRO_UNLIKELY(mode != GYRO_MODE_ACQUIRE && mode != GYRO_MODE_LOCKED)) {
+    u1 = u2 = 0.0f; /* the drive off: no force */
+  } else {
     drive_synth_step(&g->synth, ref.phase, ref.half_phase, &u1, &u2);
   }
+  hal_dac_frame_t *dac = g->dac_frame;
   dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
-  dac->code[HAL_DAC_RATE_OUT] = g->rate_code; /* the rate changes once per block */
+  /* (The rate output's code changes once per block: GYRO_SLOT_PHASE_MEAS writes it.) */
   /* Built-in self-test force on the sense feedback electrodes (selftest.h). */
-  dac->code[HAL_DAC_SPARE] = g->selftest.force_on != 0u
+  dac->code[HAL_DAC_SPARE] = GYRO_COSTLY(g->selftest.force_on)
                                  ? gyro_volts_to_dac(
                                        selftest_force(&g->selftest, ref.sin_wc, ref.cos_wc))
                                  : (uint16_t)HAL_DAC_CODE_MID;

@@ -40,18 +40,18 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d);
  * the drive off, the NCO retuned only when the drive frequency changes. */
 void gyro_apply(gyro_t *g, const gyro_design_t *d);
 
-/* One sample: ADC frame in, DAC frame out (latched by the HAL at the next tick). Writes the
- * channels the gyro drives (the drive pair, the rate output, the spare's self-test force);
- * the sense electrodes' channels (HAL_DAC_SENSE_FB_U2 .. HAL_DAC_TUNE) keep what the
- * caller's frame holds, so the frame must be the same one from tick to tick (the
- * application's, at mid-scale, 0 V, from its start): the quadrature-nulling loop writes
- * HAL_DAC_QUADNULL_V1, _V2 into the attached one (gyro_attach_dac_frame) only on its
- * updates (once per RATE_P_DECIM ticks) and when it stops; no loop drives the others yet. */
-void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac);
+/* One sample: ADC frame in, DAC frame out: the attached frame (gyro_attach_dac_frame),
+ * which the caller hands to the HAL after the tick (latched at the next tick). A channel
+ * is written when its value changes, so the frame is the same one from tick to tick (the
+ * application's, at mid-scale, 0 V, from its start): the drive pair and the spare's
+ * self-test force every tick, the rate output once per block (GYRO_SLOT_PHASE_MEAS), the
+ * quadrature-nulling electrodes HAL_DAC_QUADNULL_V1, _V2 on the loop's updates (once per
+ * RATE_P_DECIM ticks) and when it stops; no loop drives the other sense electrodes'
+ * channels (HAL_DAC_SENSE_FB_U2, HAL_DAC_TUNE) yet. */
+void gyro_tick(gyro_t *g, const hal_adc_frame_t *adc);
 
-/* The frame the caller passes to every tick (the application's): the quadrature-nulling
- * loop writes its electrodes' channels into it on its updates and when it stops, not on
- * every tick. NULL: none (the codes go nowhere). */
+/* The frame every tick writes (the application's, which it hands to the HAL). NULL:
+ * none (the codes go nowhere). */
 void gyro_attach_dac_frame(gyro_t *g, hal_dac_frame_t *frame);
 
 /* The HAL's count of lost samples (hal_sample_lost_counter), read once per block: a

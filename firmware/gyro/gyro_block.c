@@ -321,9 +321,10 @@ GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
   selftest_cont_advance(&g->design->selftest, &g->selftest);
 }
 
-GYRO_RAMFUNC void gyro_block_measure(gyro_t *g, int drive_on)
+GYRO_RAMFUNC void gyro_block_measure(gyro_t *g)
 {
-  if (drive_on) {
+  g->dac_frame->code[HAL_DAC_RATE_OUT] = g->rate_code;
+  if (supervisor_drive_enabled(&g->sup)) {
     drive_loop_measure_phase(&g->drive, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
     /* The tracking drive's error and its notch here, its PI next tick (the budget). */
     const gyro_design_t *d = g->design;
@@ -353,16 +354,16 @@ GYRO_RAMFUNC void gyro_block_supervise(gyro_t *g)
   (void)supervisor_step(&g->design->sup, &g->sup, &g->sup_in);
 }
 
-GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g, int drive_on)
+GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g)
 {
-  if (drive_on) gyro_block_phase(g);
+  if (supervisor_drive_enabled(&g->sup)) gyro_block_phase(g);
   g->cont_fail = selftest_cont_judge(&g->design->selftest, &g->selftest,
                                      g->sup.mode == GYRO_MODE_LOCKED);
 }
 
-GYRO_RAMFUNC void gyro_block_track_judge(gyro_t *g, int drive_on)
+GYRO_RAMFUNC void gyro_block_track_judge(gyro_t *g)
 {
-  if (drive_on) gyro_block_track(g);
+  if (supervisor_drive_enabled(&g->sup)) gyro_block_track(g);
   g->cont_fail = selftest_cont_judge(&g->design->selftest, &g->selftest,
                                      g->sup.mode == GYRO_MODE_LOCKED);
 }
@@ -471,7 +472,7 @@ GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
   g->flags_acc = 0u;
 }
 
-GYRO_RAMFUNC void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v)
+GYRO_RAMFUNC void gyro_block_output_sweep(gyro_t *g)
 {
   /* The rate channel rests in SWEEP (its outputs keep their last values): the verdict
    * (not valid: MODE) and what does change. */
@@ -481,8 +482,7 @@ GYRO_RAMFUNC void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v)
   o->rate_valid = 0u;
   o->rate_out_v = g->design->rate_fault_out_v;
   g->rate_code = g->design->rate_fault_code;
-  o->u1_v = u1_v;
-  o->u2_v = u2_v;
+  /* (u1_v, u2_v: written by the tick, gyro.c) */
   o->mode = (uint32_t)g->sup.mode;
   o->fault = g->sup.fault;
   o->flags = g->flags_acc |
@@ -491,19 +491,17 @@ GYRO_RAMFUNC void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v)
   g->flags_acc = 0u;
 }
 
-GYRO_RAMFUNC void gyro_block_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
+GYRO_RAMFUNC void gyro_block_sweep_idle(gyro_t *g)
+{
+  selfcal_exec_t *x = &g->cal;
+  drive_synth_follow(&g->synth, x->f_cmd_v2, x->p_rad);
+  selfcal_exec_take(x); /* a new job starts on a tick without a job of its own */
+}
+
+GYRO_RAMFUNC void gyro_block_sweep(gyro_t *g, uint32_t slot)
 {
   selfcal_exec_t *x = &g->cal;
   selfcal_exec_tick(x, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
   g->nco.half_step = x->half_step; /* from the next sample on, as the excitation */
-  /* A new force command (a job's start, a back-off) goes to the synthesis, and a newly
-   * posted job starts, on the block's next tick without a job of its own in SWEEP, at
-   * most four ticks (80 us) late: neither would fit beside the supervisor's or the
-   * snapshot's job, and every job settles for far longer than that. */
-  if (GYRO_SWEEP_IDLE_SLOT(slot)) {
-    drive_synth_follow(&g->synth, x->f_cmd_v2, x->p_rad);
-    selfcal_exec_take(x); /* a new job starts on a tick without a job of its own */
-    return;
-  }
-  gyro_block_run_sweep(g, slot, u1_v, u2_v);
+  gyro_block_run_sweep(g, slot);
 }

@@ -59,8 +59,10 @@ void gyro_quad_off(gyro_t *g);
  * NCO's step from the next tick on). */
 void gyro_block_phase(gyro_t *g);
 /* GYRO_SLOT_PHASE_MEAS: arg Z (drive on; the tracking drive's notched error), the drive
- * half of the output snapshot. */
-void gyro_block_measure(gyro_t *g, int drive_on);
+ * half of the output snapshot; the analog rate output's code of the block into the
+ * attached frame (GYRO_SLOT_OUTPUT made it on the block's last tick: the frame carries
+ * it from this tick on, as the ticks' own copy of it did). */
+void gyro_block_measure(gyro_t *g);
 /* GYRO_SLOT_SUPERVISE, in every mode: the last verdict's onsets into the history (rare),
  * then the supervisor. */
 void gyro_block_supervise(gyro_t *g);
@@ -69,8 +71,8 @@ void gyro_block_project(gyro_t *g);
 /* GYRO_SLOT_PHASE_PI: the phase loop (drive on, gyro_block_phase), or the tracking
  * drive's PLL (gyro_block_track), and the continuous self-test's verdict. */
 void gyro_block_track(gyro_t *g);
-void gyro_block_track_judge(gyro_t *g, int drive_on);
-void gyro_block_phase_judge(gyro_t *g, int drive_on);
+void gyro_block_track_judge(gyro_t *g);
+void gyro_block_phase_judge(gyro_t *g);
 /* GYRO_SLOT_RATE: the continuous self-test's notch on the rate axis, the rate's output
  * filter, scale and compensation, its range check. */
 void gyro_block_rate(gyro_t *g);
@@ -85,7 +87,7 @@ void gyro_block_p_selftest(gyro_t *g);
 void gyro_block_output(gyro_t *g, float u1_v, float u2_v);
 /* Every tick in SWEEP, instead of gyro_block_run: the self-calibration job's
  * excitation (from the next tick on) and NCO step, then the slot's job. */
-void gyro_block_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v);
+void gyro_block_sweep(gyro_t *g, uint32_t slot);
 
 /* GYRO_SLOT_PROJECT, in every mode: the rail codes of the ticks whose sense sum is
  * projected now (the verdict's and, drive channel only, the supervisor's evidence). */
@@ -97,17 +99,17 @@ static inline void gyro_block_take_rails(gyro_t *g)
   g->clip_drive_count = 0u;
 }
 
-/* The job of tick `slot` of the block. Every branch ends in one call (a tail call). */
+/* The job of tick `slot` of the block. Every branch ends in one call (a tail call); what
+ * only some jobs need (whether the drive runs) they find out themselves. */
 static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
 {
-  const int drive_on = supervisor_drive_enabled(&g->sup);
   switch (slot) {
-  case GYRO_SLOT_PHASE_MEAS: gyro_block_measure(g, drive_on); break;
+  case GYRO_SLOT_PHASE_MEAS: gyro_block_measure(g); break;
   case GYRO_SLOT_PHASE_PI:
     if (g->design->track != 0u) {
-      gyro_block_track_judge(g, drive_on);
+      gyro_block_track_judge(g);
     } else {
-      gyro_block_phase_judge(g, drive_on);
+      gyro_block_phase_judge(g);
     }
     break;
   case GYRO_SLOT_AMP: gyro_block_amp(g); break;
@@ -139,7 +141,7 @@ static inline void gyro_block_run(gyro_t *g, uint32_t slot, float u1_v, float u2
 }
 
 /* GYRO_SLOT_OUTPUT in SWEEP: the verdict and the snapshot of what SWEEP changes. */
-void gyro_block_output_sweep(gyro_t *g, float u1_v, float u2_v);
+void gyro_block_output_sweep(gyro_t *g);
 
 /* The finiteness check's second half (loop and rate outputs) and its verdict for the
  * supervisor (GYRO_SLOT_QUAD, in every mode). */
@@ -149,20 +151,22 @@ static inline void gyro_block_finite(gyro_t *g)
   g->sup_in.state_finite = g->weights_finite != 0u && fm_isfinite(sum);
 }
 
-/* The ticks of the block without a job in SWEEP (gyro_block_run_sweep): the drive loops'
- * and the rate channel's. */
-#define GYRO_SWEEP_IDLE_SLOT(slot) \
-  ((slot) == GYRO_SLOT_PHASE_PI || (slot) == GYRO_SLOT_RATE || (slot) == GYRO_SLOT_P)
+/* The ticks of the block without a job of their own in SWEEP (the drive loops' and the
+ * rate channel's, gyro_block_run_sweep): a new force command (a job's start, a back-off)
+ * goes to the synthesis, and a newly posted job starts, on the next of them, at most
+ * four ticks (80 us) late: neither would fit beside the supervisor's or the snapshot's
+ * job, and every job settles for far longer than that. */
+void gyro_block_sweep_idle(gyro_t *g);
 
 /* The jobs of a SWEEP tick, on top of the self-calibration executive's step: the rate
  * is not valid in SWEEP (rate_valid.h, MODE), so the rate channel's jobs (projection,
  * filters, P, the continuous self-test) wait for the loops to be back; the supervisor
  * with its evidence, the finiteness check, the rail counts and the output snapshot run
  * as in the other modes. */
-static inline void gyro_block_run_sweep(gyro_t *g, uint32_t slot, float u1_v, float u2_v)
+static inline void gyro_block_run_sweep(gyro_t *g, uint32_t slot)
 {
   switch (slot) {
-  case GYRO_SLOT_PHASE_MEAS: gyro_block_measure(g, 0); break;
+  case GYRO_SLOT_PHASE_MEAS: gyro_block_measure(g); break; /* the drive is off in SWEEP */
   case GYRO_SLOT_AMP: gyro_block_amp_measure(g); break;
   case GYRO_SLOT_COMMAND: gyro_block_command(g); break;
   case GYRO_SLOT_SUPERVISE: gyro_block_supervise(g); break;
@@ -171,8 +175,10 @@ static inline void gyro_block_run_sweep(gyro_t *g, uint32_t slot, float u1_v, fl
     if (g->sup.clear_req != 0u) gyro_block_clear(g);
     break;
   case GYRO_SLOT_QUAD: gyro_block_finite(g); break;
-  case GYRO_SLOT_OUTPUT: gyro_block_output_sweep(g, u1_v, u2_v); break;
-  default: /* the drive loops' and the rate channel's jobs */ break;
+  case GYRO_SLOT_OUTPUT: gyro_block_output_sweep(g); break;
+  default: /* GYRO_SLOT_PHASE_PI, _RATE, _P: the drive loops' and the rate channel's */
+    gyro_block_sweep_idle(g);
+    break;
   }
 }
 

@@ -18,6 +18,10 @@
 #define CM4_BOOT_TEXT __attribute__((section(".boot_text")))
 #endif
 
+/* A condition rarely true (an error, an overrun): the compiler lays out its branch so that
+ * the common path falls through (a taken branch refills the pipeline). */
+#define CM4_UNLIKELY(x) __builtin_expect((x) != 0, 0)
+
 #ifdef CM4_HOST_TEST
 static inline void cm4_dsb(void) {}
 static inline void cm4_isb(void) {}

@@ -422,7 +422,7 @@ static int selfcal_sweep(app_t *a, const plant_t *p, double fs, sim_selfcal_t *o
   out->f0_hz = s->fit.q > 0.0 ? s->fit.f0_hz : NAN;
   out->q = s->fit.q > 0.0 ? s->fit.q : NAN;
   out->s = (double)(s->state == SELFCAL_DONE ? a->selfcal_ticks
-                                             : a->isr_ticks - a->selfcal_t0_ticks) /
+                                             : app_ticks(a) - a->selfcal_t0_ticks) /
            fs;
   if (s->state == SELFCAL_DONE) return 0;
   if (s->state == SELFCAL_FAILED)

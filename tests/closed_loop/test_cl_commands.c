@@ -165,9 +165,9 @@ static void test_sweep_request_never_taken_times_out(void **state)
 {
   (void)state;
   start();
-  /* no tick runs: the background's first look starts the clock at isr_ticks = 0 */
+  /* no tick runs: the background's first look starts the clock at app_ticks = 0 */
   assert_string_equal(cmd("sweep\n"), "ok sweep started\r\n");
-  assert_int_equal(app.isr_ticks, 0u);
+  assert_int_equal(app_ticks(&app), 0u);
   selfcal_watch(&app.selfcal, 4900u);
   assert_int_equal(app.selfcal.state, SELFCAL_WAIT_SWEEP);
   selfcal_watch(&app.selfcal, 5100u);

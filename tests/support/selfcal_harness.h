@@ -38,7 +38,7 @@ static inline double sweep_report(uint64_t t0);
  * request (app.selfcal_t0_ticks). */
 static inline double sweep_wait(void)
 {
-  return sweep_report(plant_truth(&plant)->sample - (app.isr_ticks - app.selfcal_t0_ticks));
+  return sweep_report(plant_truth(&plant)->sample - (app_ticks(&app) - app.selfcal_t0_ticks));
 }
 
 static inline double sweep(void)

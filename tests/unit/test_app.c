@@ -127,7 +127,7 @@ static void test_isr_cycles(void **state)
   (void)state;
   setup_app();
   hal_host_run(100u);
-  assert_int_equal(app.isr_ticks, 100u);
+  assert_int_equal(app_ticks(&app), 100u);
   uint32_t last = 1u, max = 1u;
   hal_sample_isr_cycles(&last, &max);
   assert_int_equal(last, 0u);

@@ -13,14 +13,19 @@
 #define DAC_A_STREAM 2u /* DMA2 stream 2 channel 7: TIM8_CH1 (RM0090 table 43) */
 #define DAC_B_STREAM 3u /* DMA2 stream 3 channel 7: TIM8_CH2 */
 
-/* SRAM, read by DMA (half-words): converter A's words, then B's (each stream reads its
- * half). The interrupt writes them two at a time (the 32-bit view). */
-static volatile union {
-  uint16_t h[HAL_DAC_NUM_CHANNELS];
-  uint32_t pair[HAL_DAC_NUM_CHANNELS / 2];
-} s_words;
-static volatile uint32_t s_late;
-static volatile uint32_t s_deadline = 0xFFFFFFFFu;
+/* The frame's state in one block, so that the interrupt reaches all of it from one base
+ * address (one literal load instead of three): the deadline, the count of late frames
+ * and the words the DMA streams read (half-words), converter A's, then B's (each stream
+ * reads its half), which the interrupt writes two at a time (the 32-bit view). In SRAM
+ * (.data), where DMA reaches, deliberately not in the CCM (stm32f4_sample.c). */
+static struct {
+  volatile uint32_t deadline;
+  volatile uint32_t late;
+  volatile union {
+    uint16_t h[HAL_DAC_NUM_CHANNELS];
+    uint32_t pair[HAL_DAC_NUM_CHANNELS / 2];
+  } words;
+} s_dac = {0xFFFFFFFFu, 0u, {{0u}}};
 
 /* SPI2 or SPI3: transmit-only master (bidirectional mode, output enabled), 16-bit, mode 0,
  * BR = 000: PCLK1 / 2 = 21 MHz; a write to DR (by DMA) sends one word. */
@@ -52,14 +57,14 @@ void stm32f4_dac_init(void)
   RCC->APB1ENR |= RCC_APB1ENR_SPI2EN | RCC_APB1ENR_SPI3EN;
   RCC->APB2ENR |= RCC_APB2ENR_TIM8EN;
   RCC->AHB1ENR |= RCC_AHB1ENR_DMA2EN;
-  s_late = 0u;
+  s_dac.late = 0u;
   for (uint32_t ch = 0u; ch < HAL_DAC_NUM_CHANNELS; ++ch) {
-    s_words.h[ch] = stm32f4_dac_word(ch, (uint16_t)HAL_DAC_CODE_MID);
+    s_dac.words.h[ch] = stm32f4_dac_word(ch, (uint16_t)HAL_DAC_CODE_MID);
   }
   dac_spi_init(SPI2);
   dac_spi_init(SPI3);
-  dac_stream_init(DAC_A_STREAM, SPI2, &s_words.h[0]);
-  dac_stream_init(DAC_B_STREAM, SPI3, &s_words.h[STM32F4_DAC_PER_CONVERTER]);
+  dac_stream_init(DAC_A_STREAM, SPI2, &s_dac.words.h[0]);
+  dac_stream_init(DAC_B_STREAM, SPI3, &s_dac.words.h[STM32F4_DAC_PER_CONVERTER]);
 
   /* TIM8: one-pulse, RCR = 3 -> four periods then stop; CH1 PWM2 active low (CS high
    * while CNT < CCR1), CC1 raises converter A's DMA request and CC2, at the same count
@@ -109,19 +114,19 @@ static inline uint32_t word_pair(const hal_dac_frame_t *frame, uint32_t ch)
  * README "Fit in the 20 us period"). */
 CM4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame)
 {
-  if (TIM1->CNT > s_deadline) {
-    ++s_late;
+  if (TIM1->CNT > s_dac.deadline) {
+    ++s_dac.late;
     return;
   }
   for (uint32_t ch = 0u; ch < HAL_DAC_NUM_CHANNELS; ch += 2u) {
-    s_words.pair[ch / 2u] = word_pair(frame, ch);
+    s_dac.words.pair[ch / 2u] = word_pair(frame, ch);
   }
 }
 
-void stm32f4_dac_set_deadline(uint32_t tim1_count) { s_deadline = tim1_count; }
+void stm32f4_dac_set_deadline(uint32_t tim1_count) { s_dac.deadline = tim1_count; }
 
-uint32_t stm32f4_dac_late(void) { return s_late; }
+uint32_t stm32f4_dac_late(void) { return s_dac.late; }
 
 #ifdef STM32F4_HOST_TEST
-volatile uint16_t *stm32f4_dac_host_words(void) { return s_words.h; }
+volatile uint16_t *stm32f4_dac_host_words(void) { return s_dac.words.h; }
 #endif

@@ -1,5 +1,8 @@
 #include "stm32f4_sample.h"
 
+#include <stddef.h>
+#include <string.h>
+
 #include "hal/hal_adc.h"
 #include "hal/hal_sample_timer.h"
 #include "stm32f4_core.h"
@@ -15,7 +18,16 @@
 /* DMA sources and targets live in SRAM (.bss/.data), deliberately not const: the DMA
  * streams cannot reach the CCM, and a DMA read from flash would stall for the whole of
  * a parameter-sector erase, stopping the sample chain. */
-static volatile int16_t s_adc_rx[2];
+/* The ADC frame: the two conversions in the order SPI1 reads them, drive first, which is
+ * hal_adc_frame_t's layout; the interrupt copies both in one 32-bit load and store. */
+static volatile union {
+  int16_t code[2];
+  uint32_t both;
+} s_adc_rx;
+_Static_assert(sizeof(hal_adc_frame_t) == sizeof(uint32_t) &&
+                   offsetof(hal_adc_frame_t, drive) == 0u &&
+                   offsetof(hal_adc_frame_t, sense) == sizeof(int16_t),
+               "hal_adc_frame_t is the DMA's two half-words, drive first");
 static volatile uint16_t s_adc_tx_dummy = 0u;
 
 /* The chain's state in one block: the interrupt reaches all of it from one base
@@ -23,7 +35,6 @@ static volatile uint16_t s_adc_tx_dummy = 0u;
 static struct {
   hal_sample_isr_fn isr;
   void *ctx;
-  volatile uint32_t ticks;
   volatile uint32_t overruns;
   volatile uint32_t dma_errors;
   volatile uint32_t isr_cycles_last;
@@ -122,7 +133,6 @@ int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
   hal_sample_timer_stop();
   s_chain.isr = isr;
   s_chain.ctx = ctx;
-  s_chain.ticks = 0u;
   s_chain.overruns = 0u;
   s_chain.dma_errors = 0u;
   s_chain.isr_cycles_last = 0u;
@@ -139,7 +149,7 @@ int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
 
   /* Stream 0: SPI1 RX -> frame, circular (re-arms itself), interrupt on completion. */
   DMA2->S[ADC_RX_STREAM].PAR = (uint32_t)(uintptr_t)&SPI1->DR;
-  DMA2->S[ADC_RX_STREAM].M0AR = (uint32_t)(uintptr_t)s_adc_rx;
+  DMA2->S[ADC_RX_STREAM].M0AR = (uint32_t)(uintptr_t)s_adc_rx.code;
   DMA2->S[ADC_RX_STREAM].NDTR = 2u;
   DMA2->S[ADC_RX_STREAM].CR = CHSEL(3) | DMA_SXCR_PL_VERY_HIGH | DMA_SXCR_MSIZE_16 |
                               DMA_SXCR_PSIZE_16 | DMA_SXCR_MINC | DMA_SXCR_CIRC |
@@ -195,12 +205,12 @@ CM4_RAMFUNC void DMA2_Stream0_IRQHandler(void)
   const uint32_t c0 = DWT->CYCCNT; /* self-measurement: inline, not through a call */
   const uint32_t flags = stm32f4_dma_flags(DMA2, ADC_RX_STREAM);
   stm32f4_dma_clear(DMA2, ADC_RX_STREAM, flags);
-  if ((flags & (DMA_FLAG_TEIF | DMA_FLAG_DMEIF)) != 0u) ++s_chain.dma_errors;
-  if ((flags & DMA_FLAG_TCIF) == 0u) return;
+  /* The rare cases out of line: the tick's path falls through every branch. */
+  if (CM4_UNLIKELY(flags & (DMA_FLAG_TEIF | DMA_FLAG_DMEIF))) ++s_chain.dma_errors;
+  if (CM4_UNLIKELY((flags & DMA_FLAG_TCIF) == 0u)) return;
 
-  ++s_chain.ticks;
   s_chain.isr(s_chain.ctx);
-  if ((stm32f4_dma_flags(DMA2, ADC_RX_STREAM) & DMA_FLAG_TCIF) != 0u) ++s_chain.overruns;
+  if (CM4_UNLIKELY(stm32f4_dma_flags(DMA2, ADC_RX_STREAM) & DMA_FLAG_TCIF)) ++s_chain.overruns;
   const uint32_t dc = DWT->CYCCNT - c0;
   s_chain.isr_cycles_last = dc;
   if (dc > s_chain.isr_cycles_max) s_chain.isr_cycles_max = dc;
@@ -214,8 +224,8 @@ void hal_sample_isr_cycles(uint32_t *last, uint32_t *max)
 
 CM4_RAMFUNC void hal_adc_read_frame(hal_adc_frame_t *frame)
 {
-  frame->drive = s_adc_rx[0];
-  frame->sense = s_adc_rx[1];
+  const uint32_t both = s_adc_rx.both;
+  memcpy(frame, &both, sizeof both);
 }
 
 const volatile uint32_t *hal_sample_lost_counter(void) { return &s_chain.overruns; }
@@ -223,11 +233,10 @@ const volatile uint32_t *hal_sample_lost_counter(void) { return &s_chain.overrun
 void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
 {
   if (stats == 0) return;
-  stats->ticks = s_chain.ticks;
   stats->overruns = s_chain.overruns;
   stats->dma_errors = s_chain.dma_errors;
 }
 
 #ifdef STM32F4_HOST_TEST
-volatile int16_t *stm32f4_sample_host_rx(void) { return s_adc_rx; }
+volatile int16_t *stm32f4_sample_host_rx(void) { return s_adc_rx.code; }
 #endif

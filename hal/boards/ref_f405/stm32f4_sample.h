@@ -59,9 +59,9 @@ typedef struct {
  * interrupt the longest compute window. Returns 0, or -1 (plan unchanged). */
 int stm32f4_sample_plan(uint32_t tim_hz, uint32_t rate_hz, stm32f4_sample_plan_t *plan);
 
-/* Diagnostics of the running chain. */
+/* Diagnostics of the running chain. (The ticks served are the application's count, not
+ * kept a second time here.) */
 typedef struct {
-  uint32_t ticks;      /* sample interrupts served */
   uint32_t overruns;   /* a new frame landed before the ISR returned */
   uint32_t dma_errors; /* transfer-error flags seen on the ADC streams */
 } stm32f4_sample_stats_t;

@@ -59,6 +59,7 @@ static kfd_t s_kfd;
 static multdemod_t s_md;
 static gyro_t s_gyro;
 static gyro_design_t s_design; /* the gyro runs with it by pointer */
+static hal_dac_frame_t s_dac;  /* the frame its ticks write (attached) */
 static bench_plant_t s_plant;
 static int s_ready;
 
@@ -112,10 +113,7 @@ BK_OPAQUE static void e_sincos(uint32_t phase, float *s, float *c)
   (void)phase, (void)s, (void)c;
 }
 BK_OPAQUE static void e_nco(nco_t *nco, nco_out_t *out) { (void)nco, (void)out; }
-BK_OPAQUE static void e_tick(gyro_t *g, const hal_adc_frame_t *adc, hal_dac_frame_t *dac)
-{
-  (void)g, (void)adc, (void)dac;
-}
+BK_OPAQUE static void e_tick(gyro_t *g, const hal_adc_frame_t *adc) { (void)g, (void)adc; }
 
 /* ---- runners: identical loops for the kernel and its empty call ---- */
 
@@ -183,19 +181,17 @@ BK_RUNNER static void run_nco(void (*fn)(nco_t *, nco_out_t *), nco_t *nco, uint
 
 /* The gyro: each iteration makes the plant's frame for this tick (not counted), then
  * the tick. Returns 1 if the gyro was LOCKED after every tick. */
-BK_RUNNER static uint32_t run_tick(void (*fn)(gyro_t *, const hal_adc_frame_t *,
-                                              hal_dac_frame_t *),
-                                   uint32_t n, bk_stat_t *st)
+BK_RUNNER static uint32_t run_tick(void (*fn)(gyro_t *, const hal_adc_frame_t *), uint32_t n,
+                                   bk_stat_t *st)
 {
   hal_adc_frame_t adc;
-  hal_dac_frame_t dac;
   uint32_t locked = 1u;
   for (uint32_t i = 0u; i < n; i++) {
     bench_plant_frame(&s_plant, &s_gyro, &adc);
     const uint32_t t0 = bk_now();
-    fn(&s_gyro, &adc, &dac);
+    fn(&s_gyro, &adc);
     const uint32_t t1 = bk_now();
-    s_sink_u = dac.code[0];
+    s_sink_u = s_dac.code[0];
     if (s_gyro.sup.mode != GYRO_MODE_LOCKED) locked = 0u;
     if (st != NULL) bk_stat_add(st, t1 - t0);
   }
@@ -263,13 +259,14 @@ static int setup_gyro(void)
       bench_plant_init(&s_plant, &s_design, &v) != 0) {
     return -1;
   }
+  hal_dac_frame_midscale(&s_dac);
+  gyro_attach_dac_frame(&s_gyro, &s_dac);
   gyro_start(&s_gyro);
   hal_adc_frame_t adc;
-  hal_dac_frame_t dac;
   uint32_t settled = 0u;
   for (uint32_t i = 0u; i < BK_WARMUP_MAX_TICKS && settled < BK_SETTLE_TICKS; i++) {
     bench_plant_frame(&s_plant, &s_gyro, &adc);
-    gyro_tick(&s_gyro, &adc, &dac);
+    gyro_tick(&s_gyro, &adc);
     settled = s_gyro.sup.mode == GYRO_MODE_LOCKED ? settled + 1u : 0u;
   }
   return settled >= BK_SETTLE_TICKS ? 0 : -2;

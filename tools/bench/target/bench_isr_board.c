@@ -12,8 +12,8 @@ stm32f4_dma_t bench_fake_dma2;
 
 void bench_board_set_frame(const hal_adc_frame_t *frame)
 {
-  s_adc_rx[0] = frame->drive;
-  s_adc_rx[1] = frame->sense;
+  s_adc_rx.code[0] = frame->drive;
+  s_adc_rx.code[1] = frame->sense;
 }
 
 void bench_board_arm(void) { bench_fake_dma2.LISR = DMA_FLAG_TCIF; /* stream 0: shift 0 */ }

@@ -50,7 +50,6 @@ static stm32f4_board_info_t s_info;
 static hal_sample_isr_fn s_isr;
 static void *s_ctx;
 static volatile uint32_t s_wraps;
-static volatile uint32_t s_ticks;
 #ifdef STM32F4_QEMU_PLANT
 static stm32f4_qemu_tick_stats_t s_tick;
 static uint32_t s_t_prev_ns;         /* TIM2 at the previous handler entry */
@@ -103,7 +102,6 @@ int hal_sample_timer_start(uint32_t rate_hz, hal_sample_isr_fn isr, void *ctx)
   hal_sample_timer_stop();
   s_isr = isr;
   s_ctx = ctx;
-  s_ticks = 0u;
 #ifdef STM32F4_QEMU_PLANT
   s_tick = (stm32f4_qemu_tick_stats_t){0};
   s_tick.stretch = STM32F4_QEMU_TICK_STRETCH;
@@ -152,7 +150,6 @@ CM4_RAMFUNC void SysTick_Handler(void)
   const uint32_t t0 = TIM2->CNT;
   (void)SYSTICK->CTRL; /* clears COUNTFLAG, set by the wrap that raised this tick */
   s_wraps = s_wraps + 1u;
-  s_ticks = s_ticks + 1u;
   const uint32_t c0 = hal_cycles_now();
   if (s_isr != 0) s_isr(s_ctx);
   note_isr_cycles(hal_cycles_now() - c0);
@@ -205,7 +202,6 @@ int stm32f4_qemu_set_stretch(uint32_t stretch)
 CM4_RAMFUNC void SysTick_Handler(void)
 {
   s_wraps = s_wraps + 1u;
-  s_ticks = s_ticks + 1u;
   const uint32_t c0 = hal_cycles_now();
   if (s_isr != 0) s_isr(s_ctx);
   note_isr_cycles(hal_cycles_now() - c0);
@@ -249,7 +245,6 @@ CM4_RAMFUNC void hal_dac_write_frame(const hal_dac_frame_t *frame) { s_dac = *fr
 void stm32f4_sample_stats(stm32f4_sample_stats_t *stats)
 {
   if (stats == 0) return;
-  stats->ticks = s_ticks;
 #ifdef STM32F4_QEMU_PLANT
   stats->overruns = s_tick.overruns;
 #else
