@@ -343,6 +343,6 @@ const char *rate_valid_reason_name(uint32_t kind)
   static const char *const names[RATE_INVALID_KINDS] = {
       "MODE",          "SELFTEST", "SETTLING",     "CLIP",        "SENSE_RANGE",
       "OVER_RANGE",    "PHASE",    "THERMO_RANGE", "THERMO_SLEW", "THERMO_SETTLE",
-      "CONT_SELFTEST", "TRACKING", "UNCALIBRATED", "QUAD_NULL"};
+      "CONT_SELFTEST", "TRACKING", "UNCALIBRATED", "QUAD_NULL",   "SENSE_FR"};
   return kind < RATE_INVALID_KINDS ? names[kind] : "?";
 }

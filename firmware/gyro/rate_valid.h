@@ -62,6 +62,11 @@
  *                 the electrodes (none fitted or wired: they stay at 0 V). While the
  *                 quadrature moves by hundreds of deg/s, a demodulation phase error of
  *                 a tenth of a degree puts a moving deg/s into the rate
+ *   SENSE_FR      force rebalance is on (sense.mode 1) and its loop has not balanced the
+ *                 sense axis: not running (not LOCKED yet), its residual not yet within
+ *                 sense.fr_settle_dps for sense.fr_settle_s, or its force at the
+ *                 feedback electrodes' limit (a Coriolis or quadrature force they cannot
+ *                 cancel: the force read as the rate is then not the Coriolis force)
  * Each check is a few multiplies and compares per block; no divide, no libm. */
 #ifndef RATE_VALID_H
 #define RATE_VALID_H
@@ -85,7 +90,8 @@
 #define RATE_INVALID_TRACKING (1u << 11)
 #define RATE_INVALID_UNCALIBRATED (1u << 12)
 #define RATE_INVALID_QUAD_NULL (1u << 13)
-#define RATE_INVALID_KINDS 14u
+#define RATE_INVALID_SENSE_FR (1u << 14)
+#define RATE_INVALID_KINDS 15u
 
 /* Blocks in a row inside the settling tolerance (2 ms): longer than the noise's
  * correlation time at the filters' 100 Hz, far shorter than their settling. */
