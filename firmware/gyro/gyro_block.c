@@ -315,7 +315,7 @@ void gyro_quad_off(gyro_t *g)
 /* Force rebalance (sense_fr.h), one step at the start of five jobs (gyro_slots.h). The
  * loop runs while LOCKED: it starts from zero force on the first block of a lock and
  * halts (zero force, not balanced) on the first block without one. */
-void gyro_fr_off(gyro_t *g)
+GYRO_RAMFUNC void gyro_fr_off(gyro_t *g)
 {
   sense_fr_reset(&g->fr);
   drive_synth_silence(&g->fb_synth); /* a_v 0: no force (DC+AC: the bias alone) */
@@ -361,16 +361,20 @@ GYRO_RAMFUNC void gyro_fr_polar(gyro_t *g)
 }
 
 /* The Coriolis force is in phase with the drive velocity, which at the drive's resonance
- * is in phase with the drive force cos(phi + P) (6-12): the feedback force's frame turns
- * with the drive loop's P (the tracking drive's p_eq), temperature included, and
+ * is in phase with the drive force cos(phi + P) (6-12), through the mode's lag 2Q/wn
+ * (6-17): the feedback force's frame turns with LP_tau(P) as the rate channel forms it
+ * for its reference (P - its lag still to come, rate_channel.h; the tracking drive's p_eq
+ * the same way), temperature included, not with P's own jitter (at 1500 deg/s of
+ * rebalanced quadrature 0.02 deg of it is 0.5 deg/s of rate), and
  * sense.fb_phase_deg holds what differs between the two electrodes' paths and the
  * drive's distance from its resonance phase. */
 GYRO_RAMFUNC void gyro_fr_synth(gyro_t *g)
 {
   const sense_fr_t *fr = &g->fr;
+  const rate_channel_t *rc = &g->rate;
   if (fr->run != 0u && fr->skip == 0u)
     drive_synth_set(&g->fb_synth, fr->f_mag_v2,
-                    fr->f_arg_rad + g->drive.p_eq_rad + g->design->fb_theta_rad);
+                    fr->f_arg_rad + (rc->p_last_rad - rc->p_lag_rad) + g->design->fb_theta_rad);
 }
 
 GYRO_RAMFUNC void gyro_block_project(gyro_t *g)

@@ -93,7 +93,7 @@ int sense_fr_design(const sense_fr_cfg_t *cfg, sense_fr_design_t *d)
   return 0;
 }
 
-void sense_fr_reset(sense_fr_t *fr)
+GYRO_RAMFUNC void sense_fr_reset(sense_fr_t *fr)
 {
   fr->run = 0u;
   fr->e_re = fr->e_im = 0.0f;
