@@ -76,6 +76,17 @@ static float p_poly_off_deg(const param_values_t *v)
  * THERMO_SLEW's shadow mirrors) and the analog fault level. The fault level
  * must lie outside the span full scale x out_v_per_dps (with 10 % for the output
  * stage's gain and offset), or a failed gyro could read as a rate. */
+/* A low-pass of the settling check per block, 1 - exp(-2 pi f T_block), with force
+ * rebalance (rate_valid.h: its reference at RATE_VALID_INPUT_RATIO times the output
+ * filter's corner, its difference at RATE_VALID_SETTLE_DIFF_HZ); open loop the 100 Hz
+ * filter's reference (RATE_VALID_INPUT_K) and no low-pass of the difference (1). */
+static float settle_k(const param_values_t *v, double f_hz)
+{
+  if (v->sense_mode != 1u) return f_hz == RATE_VALID_SETTLE_DIFF_HZ ? 1.0f : RATE_VALID_INPUT_K;
+  const double f_block_hz = (double)v->sys_fs_hz / (double)RATE_DECIM;
+  return (float)(1.0 - exp(-2.0 * FM_PI * f_hz / f_block_hz));
+}
+
 static gyro_design_status_t design_validity(const param_values_t *v, gyro_design_t *t)
 {
   const float span_v = v->rate_full_scale_dps * fm_absf(v->rate_out_v_per_dps);
@@ -97,7 +108,9 @@ static gyro_design_status_t design_validity(const param_values_t *v, gyro_design
                               fm_absf(v->rate_grad_fast_dps_per_deg),
                               t->rate.grad_a,
                               t->rate.comp_fast_a > 0.0f ? 1u : 0u,
-                              {0.0f}};
+                              {0.0f},
+                              settle_k(v, (double)(v->sense_fr_lpf_hz * RATE_VALID_INPUT_RATIO)),
+                              settle_k(v, RATE_VALID_SETTLE_DIFF_HZ)};
   t->valid = c;
   rate_valid_spur_matrix(t->rate.comp_a, t->rate.grad_a, t->rate.comp_stages,
                          t->rate.comp_fast_a, t->valid.spur_m);

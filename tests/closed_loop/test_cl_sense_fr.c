@@ -85,37 +85,53 @@ typedef struct {
   double final_dps;  /* mean over the last 20 ms */
   int valid_wrong;   /* a valid block more than 1 % of the step from the plant's rate */
   long valid_blocks; /* valid blocks in all */
+  long valid_before; /* of the VALID_SPAN blocks before the step */
+  long valid_tail;   /* of the last VALID_SPAN blocks */
 } step_t;
 
 #define BLOCK_S ((double)GYRO_BLOCK / 50000.0)
-#define N_AFTER 500 /* 0.1 s of blocks after the step */
+#define N_AFTER 500    /* 0.1 s of blocks after the step */
+#define VALID_SPAN 250 /* 50 ms of blocks */
 
-/* Runs to the step, steps, runs N_AFTER blocks; the rate of every block after it. */
+/* Runs to the step, steps, runs N_AFTER blocks; the rate of every block after it.
+ * Valid and wrong is judged against the plant's rate times the loop's own scale (the
+ * final value over the step): the model-made scale of start() is off by its accuracy
+ * (0.9 %), which a calibration takes out, and that is no failure of the monitors. */
 static step_t run_step(void)
 {
-  step_t r = {0.0, -1e9, 0.0, 0, 0};
-  static float rate[N_AFTER];
+  step_t r = {0.0, -1e9, 0.0, 0, 0, 0, 0};
+  static float rate[N_AFTER + VALID_SPAN];
+  static double truth[N_AFTER + VALID_SPAN];
+  static uint8_t valid[N_AFTER + VALID_SPAN];
   const long before = (long)(T_STEP_S / BLOCK_S);
   for (long n = 0; n < before + N_AFTER; n++) {
     if (n == before) set_rate(STEP_DPS);
     hal_host_run(GYRO_BLOCK);
     const gyro_out_t *o = &app.gyro.out;
-    const double truth = plant_truth(&plant)->rate_dps;
-    /* valid and wrong: off the plant's rate by 1 % of the step, outside the 10 ms the
-     * step takes to pass any output filter */
-    const int in_step = n >= before && n < before + (long)(0.010 / BLOCK_S);
-    if (o->rate_valid != 0u) {
-      r.valid_blocks++;
-      if (!in_step && fabs((double)o->rate_dps - truth) > 0.01 * STEP_DPS) r.valid_wrong = 1;
+    r.valid_blocks += o->rate_valid != 0u;
+    if (n >= before - VALID_SPAN) {
+      const long i = n - (before - VALID_SPAN);
+      rate[i] = o->rate_dps;
+      truth[i] = plant_truth(&plant)->rate_dps;
+      valid[i] = o->rate_valid != 0u;
     }
-    if (n >= before) rate[n - before] = o->rate_dps;
   }
   const int tail = (int)(0.020 / BLOCK_S);
-  for (int i = N_AFTER - tail; i < N_AFTER; i++) r.final_dps += (double)rate[i] / tail;
+  const float *after = rate + VALID_SPAN;
+  for (int i = N_AFTER - tail; i < N_AFTER; i++) r.final_dps += (double)after[i] / tail;
+  const double gain = r.final_dps / STEP_DPS;
+  for (int i = 0; i < N_AFTER + VALID_SPAN; i++) {
+    /* outside the 10 ms the step takes to pass any output filter */
+    const int in_step = i >= VALID_SPAN && i < VALID_SPAN + (int)(0.010 / BLOCK_S);
+    if (valid[i] && !in_step && fabs((double)rate[i] - gain * truth[i]) > 0.01 * STEP_DPS)
+      r.valid_wrong = 1;
+    r.valid_before += i < VALID_SPAN && valid[i];
+    r.valid_tail += i >= N_AFTER && valid[i];
+  }
   for (int i = 0; i < N_AFTER; i++) {
-    if (fabs((double)rate[i] - r.final_dps) > 0.01 * STEP_DPS)
+    if (fabs((double)after[i] - r.final_dps) > 0.01 * STEP_DPS)
       r.settle_ms = (i + 1) * BLOCK_S * 1e3;
-    if (rate[i] > r.peak_dps) r.peak_dps = rate[i];
+    if (after[i] > r.peak_dps) r.peak_dps = after[i];
   }
   return r;
 }
@@ -128,14 +144,19 @@ static void test_step_settles_within_10_ms(void **state)
   const sense_fr_t *fr = &app.gyro.fr;
   printf("# force rebalance, Q 1e4, 110 Hz split, 1500 deg/s quadrature: 0 -> 100 deg/s "
          "settles to 1 %% in %.1f ms, peak %.2f, final %.2f deg/s (true %.1f); force I %.2f "
-         "Q %.2f V^2, settled %u, at limit %u; valid blocks %ld, valid and wrong %d, "
-         "reasons 0x%x\n",
+         "Q %.2f V^2, settled %u, at limit %u; valid blocks %ld (50 ms before the step %ld, "
+         "last 50 ms %ld), valid and wrong %d, reasons 0x%x\n",
          r.settle_ms, r.peak_dps, r.final_dps, plant_truth(&plant)->rate_dps, (double)fr->f_re,
-         (double)fr->f_im, fr->settled, fr->at_limit, r.valid_blocks, r.valid_wrong,
-         app.gyro.out.rate_invalid);
+         (double)fr->f_im, fr->settled, fr->at_limit, r.valid_blocks, r.valid_before,
+         r.valid_tail, r.valid_wrong, app.gyro.out.rate_invalid);
   assert_true(r.settle_ms <= 10.0);
   assert_true(fabs(r.final_dps - STEP_DPS) <= 0.02 * STEP_DPS); /* the model's scale */
   assert_false(r.valid_wrong);
+  /* valid with the loop closed: at rest before the step, and once the step has settled
+   * (the settling monitor judges the wide output band's difference through its own
+   * low-pass, rate_valid.h) */
+  assert_int_equal(r.valid_before, VALID_SPAN);
+  assert_int_equal(r.valid_tail, VALID_SPAN);
   assert_true(fr->run != 0u && fr->settled != 0u && fr->at_limit == 0u);
   assert_int_equal(app.gyro.out.rate_invalid & RATE_INVALID_SENSE_FR, 0u);
   assert_int_equal(app.gyro.sup.fault_count, 0u);
