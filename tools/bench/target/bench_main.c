@@ -429,6 +429,7 @@ static void trace_force_rebalance(void)
   s_app.gyro.valid.p_updates = RATE_VALID_SLEW_UPDATES - 1u;
   put_state("isr_fr");
   irq_case_n("isr_fr", bench_cb, BENCH_N_TRACE);
+  gyro_apply(&s_app.gyro, &s_track_design); /* the fault and SWEEP traced as before */
 }
 
 /* The rarer ticks (trace mode): a fault and its clear, then SWEEP's jobs. */
