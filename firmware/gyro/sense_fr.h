@@ -59,6 +59,7 @@
 
 #include "dsp/fastmath.h"
 #include "dsp/ramfunc.h"
+#include "gyro/settle_count.h"
 
 typedef struct {
   float bw_hz;       /* w / 2 pi, the closed loop's natural frequency; > 0 */
@@ -182,11 +183,8 @@ GYRO_RAMFUNC static inline void sense_fr_settle(const sense_fr_design_t *d, sens
   fr->ef_re += k * (fr->e_re - fr->ef_re);
   fr->ef_im += k * (fr->e_im - fr->ef_im);
   const float e2 = fr->ef_re * fr->ef_re + fr->ef_im * fr->ef_im;
-  uint32_t n = 0u;
-  if (e2 <= d->settle2 && !fr->at_limit) {
-    n = fr->in_band;
-    if (n < d->settle_blocks) n++;
-  }
+  const uint32_t n = settle_count(fr->in_band, e2 <= d->settle2 && !fr->at_limit,
+                                  d->settle_blocks);
   fr->in_band = n;
   fr->settled = n >= d->settle_blocks ? 1u : 0u;
 }
