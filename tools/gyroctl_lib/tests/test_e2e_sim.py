@@ -162,8 +162,10 @@ def test_the_simulated_bench_turns_the_table_and_sets_the_chamber(sim, gyroctl, 
 
 
 def test_an_unpaced_session_runs_faster_than_real_time(gyro_sim, gyroctl, tmp_path):
-    """--pace 0: gyro time runs as fast as the simulator does (tens of times real time
-    on one core), and the session still answers."""
+    """--pace 0: gyro time runs as fast as the simulator does, and the session still
+    answers. The release build runs about 50x real time on one core; the sanitizer
+    build under a loaded CI read 2.9x, so faster than real time is judged as over 1.5x
+    (a paced session, --pace 1, stays at or under 1x)."""
     scen = os.path.join(os.environ.get("GYRO_SCENARIOS", ""), "startup.json")
     if not os.path.exists(scen):
         pytest.skip("GYRO_SCENARIOS not set")
@@ -178,7 +180,7 @@ def test_an_unpaced_session_runs_faster_than_real_time(gyro_sim, gyroctl, tmp_pa
         time.sleep(1.0)
         fig, _ = emu(gyroctl, link, "emu")
         assert float(fig["pace"]) == 0.0
-        assert (float(fig["t_s"]) - t0) / (time.time() - wall0) > 3.0
+        assert (float(fig["t_s"]) - t0) / (time.time() - wall0) > 1.5
     finally:
         proc.terminate()
         proc.wait(timeout=10)
