@@ -31,6 +31,7 @@ GROUP_TITLE = {
     "sup": "Supervisor (`sup.*`)",
     "selftest": "Self-test (`selftest.*`)",
     "quad": "Quadrature nulling (`quad.*`)",
+    "sense": "Sense axis: force rebalance (`sense.*`)",
     "tlm": "Telemetry (`tlm.*`)",
     "sys": "System (`sys.*`)",
 }

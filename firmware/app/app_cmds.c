@@ -258,6 +258,29 @@ static void put_quad_null(cli_t *cli, app_t *a)
   cli_data_f32(cli, "quad_v2_v", q->v2_v);
 }
 
+/* Force rebalance (sense.mode 1, sense_fr.h): whether it runs, balanced and at its
+ * limit, the force command in the rate channel's frame (V^2: Coriolis, quadrature) and
+ * the feedback pair's amplitude, its scale factor and the design's third root. */
+static void put_sense_fr(cli_t *cli, app_t *a)
+{
+  const sense_fr_t *fr = &a->gyro.fr;
+  const gyro_design_t *d = a->gyro.design;
+  cli_putf(cli, "sense_fr %s",
+           d->sense_mode == 0u ? "off"
+           : fr->run == 0u     ? "open"
+           : fr->settled       ? "balanced"
+                               : "settling");
+  cli_emit_data(cli);
+  cli_data_u32(cli, "sense_mode", d->sense_mode);
+  cli_data_u32(cli, "fr_settled", fr->settled);
+  cli_data_u32(cli, "fr_at_limit", fr->at_limit);
+  cli_data_f32(cli, "fr_force_i_v2", fr->f_re);
+  cli_data_f32(cli, "fr_force_q_v2", fr->f_im);
+  cli_data_f32(cli, "fr_force_v2", fr->f_mag_v2);
+  cli_data_f32(cli, "fr_scale_dps_per_v2", d->fr_scale_dps_per_v2);
+  cli_data_f32(cli, "fr_pole_c_re", d->fr.c_re);
+}
+
 static void put_store(cli_t *cli, app_t *a)
 {
   cli_putf(cli, "store %s", param_store_status_str(a->store_status));
@@ -330,6 +353,7 @@ static const status_row_t k_status_rows[] = {
     {"calibrated", NULL, put_calibration},
     {"drive", NULL, put_drive},
     {"quad_null", NULL, put_quad_null},
+    {"sense_fr", NULL, put_sense_fr},
     {"design", NULL, put_design},
     {"ticks", ticks, NULL},
     {"isr_cycles_last", isr_cycles_last, NULL},
@@ -393,6 +417,12 @@ static void cmd_selftest(cli_t *cli, void *ctx, uint32_t argc, const char *const
   }
   if (m != GYRO_MODE_LOCKED) {
     cli_err(cli, "BUSY", "the self-test needs the drive LOCKED");
+    return;
+  }
+  if (a->gyro.design->sense_mode != 0u) {
+    cli_err(cli, "STATE",
+            "the self-test's force would go past the force-rebalance loop: "
+            "sense.mode 0 first");
     return;
   }
   if (!queue_or_refuse(cli, a, APP_REQ_SELFTEST)) return;

@@ -42,7 +42,8 @@
   X(flags,           U32, "-") \
   X(tick,            U32, "-") \
   X(rate_valid,      U32, "-") \
-  X(f_drive_hz,      F32, "Hz")
+  X(f_drive_hz,      F32, "Hz") \
+  X(rate_invalid,    U32, "-")
 /* clang-format on */
 
 typedef enum {

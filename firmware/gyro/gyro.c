@@ -62,11 +62,33 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   gyro_attach_adc_frame(&t, NULL);
   t.quad_bits = d->quad_on != 0u ? RATE_INVALID_QUAD_NULL : 0u; /* not nulled yet */
   gyro_quad_reset(&t);
+  (void)drive_synth_init(&t.fb_synth, &d->fb_synth); /* accepted by gyro_design_complete */
+  t.fr_on = d->sense_mode;
+  t.fb_off_v = d->fb_off_v;
+  gyro_fr_off(&t);
   *g = t;
   if (d->autostart != 0u) {
     gyro_start(g);
   }
   return 0;
+}
+
+/* Force rebalance (sense.mode 1): turned on or off, or its electrodes' configuration
+ * changed, the loop starts again from zero force (on the next LOCKED block), and turned
+ * off, the feedback pair's second channel back to mid-scale (0 V; the first is written
+ * every tick). Other changes (the loop's design) carry the running loop on. */
+static void gyro_apply_fr(gyro_t *g, const gyro_design_t *d, const gyro_design_t *old)
+{
+  const int same_fb = d->sense_mode == old->sense_mode &&
+                      d->fb_synth.scheme == old->fb_synth.scheme &&
+                      d->fb_synth.dc_bias_v == old->fb_synth.dc_bias_v &&
+                      d->fb_synth.u_max_v == old->fb_synth.u_max_v;
+  if (same_fb) return;
+  (void)drive_synth_init(&g->fb_synth, &d->fb_synth);
+  g->fr_on = d->sense_mode;
+  g->fb_off_v = d->fb_off_v;
+  gyro_fr_off(g);
+  if (d->sense_mode == 0u) g->dac_frame->code[HAL_DAC_SENSE_FB_U2] = (uint16_t)HAL_DAC_CODE_MID;
 }
 
 void gyro_apply(gyro_t *g, const gyro_design_t *d)
@@ -129,6 +151,7 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   }
   g->quad_bits = d->quad_on != 0u && g->quad.settled == 0u ? RATE_INVALID_QUAD_NULL : 0u;
   if ((d->quad_on != 0u) != (old->quad_on != 0u)) gyro_quad_reset(g);
+  gyro_apply_fr(g, d, old);
 }
 
 void gyro_start(gyro_t *g) { supervisor_start(&g->sup); }
@@ -137,6 +160,7 @@ void gyro_stop(gyro_t *g)
 {
   supervisor_stop(&g->sup);
   if (g->quad.mode != QUAD_NULL_OFF) gyro_quad_off(g); /* its electrodes at 0 V */
+  if (g->fr.run != 0u) gyro_fr_off(g);                 /* no feedback force */
   drive_loop_reset(&g->design->drive, &g->drive);
   /* The drive starts again from the calibrated frequency, whatever moved the NCO (the
    * tracking drive, or a sweep that ended without its hand-over). */
@@ -245,11 +269,20 @@ GYRO_RAMFUNC void gyro_tick(gyro_t *g)
   dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
   /* (The rate output's code changes once per block: GYRO_SLOT_PHASE_MEAS writes it.) */
-  /* Built-in self-test force on the sense feedback electrodes (selftest.h). */
-  dac->code[HAL_DAC_SPARE] = GYRO_COSTLY(g->selftest.force_on)
-                                 ? gyro_volts_to_dac(
-                                       selftest_force(&g->selftest, ref.sin_wc, ref.cos_wc))
-                                 : (uint16_t)HAL_DAC_CODE_MID;
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) {
+    /* Force rebalance: its force on the feedback pair (the first channel is the spare's),
+     * the waveform of the command its loop last set (sense_fr.h). */
+    float u3, u4;
+    drive_synth_step(&g->fb_synth, ref.phase, ref.half_phase, &u3, &u4);
+    dac->code[HAL_DAC_SENSE_FB_U1] = gyro_volts_to_dac(u3 - g->fb_off_v);
+    dac->code[HAL_DAC_SENSE_FB_U2] = gyro_volts_to_dac(u4 - g->fb_off_v);
+  } else {
+    /* Built-in self-test force on the sense feedback electrodes (selftest.h). */
+    dac->code[HAL_DAC_SPARE] = GYRO_COSTLY(g->selftest.force_on)
+                                   ? gyro_volts_to_dac(
+                                         selftest_force(&g->selftest, ref.sin_wc, ref.cos_wc))
+                                   : (uint16_t)HAL_DAC_CODE_MID;
+  }
   g->out.tick++;
 
   /* Everything slower than the carrier: this tick's job of the block (gyro_block.h),

@@ -103,6 +103,7 @@ GYRO_RAMFUNC void gyro_block_phase(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_quad(gyro_t *g)
 {
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_integrate(g);
   gyro_block_finite(g);
   rate_channel_t *rc = &g->rate;
   selftest_cont_notch(&g->design->selftest, &g->selftest, 1u, &rc->quad_raw);
@@ -311,6 +312,71 @@ void gyro_quad_off(gyro_t *g)
   g->quad_bits = g->design->quad_on != 0u ? RATE_INVALID_QUAD_NULL : 0u;
 }
 
+/* Force rebalance (sense_fr.h), one step at the start of five jobs (gyro_slots.h). The
+ * loop runs while LOCKED: it starts from zero force on the first block of a lock and
+ * halts (zero force, not balanced) on the first block without one. */
+GYRO_RAMFUNC void gyro_fr_off(gyro_t *g)
+{
+  sense_fr_reset(&g->fr);
+  drive_synth_silence(&g->fb_synth); /* a_v 0: no force (DC+AC: the bias alone) */
+  g->fr_bits = g->fr_on != 0u ? RATE_INVALID_SENSE_FR : 0u;
+}
+
+GYRO_RAMFUNC void gyro_fr_take(gyro_t *g)
+{
+  sense_fr_t *fr = &g->fr;
+  if (g->sup.mode != GYRO_MODE_LOCKED) {
+    if (GYRO_UNLIKELY(fr->run != 0u)) gyro_fr_off(g);
+    return;
+  }
+  if (GYRO_UNLIKELY(fr->run == 0u)) {
+    sense_fr_reset(fr);
+    fr->run = 1u;
+  }
+  rate_channel_t *rc = &g->rate;
+  sense_fr_take(&g->design->fr, fr, rc->rate_raw, rc->quad_raw);
+  /* The rate channel reads the force from here on: -g F, the open loop's equivalent. */
+  rc->rate_raw = fr->out_re;
+  rc->quad_raw = fr->out_im;
+}
+
+GYRO_RAMFUNC void gyro_fr_integrate(gyro_t *g)
+{
+  if (g->fr.run != 0u && g->fr.skip == 0u) sense_fr_integrate(&g->design->fr, &g->fr);
+}
+
+GYRO_RAMFUNC void gyro_fr_limit(gyro_t *g)
+{
+  sense_fr_t *fr = &g->fr;
+  if (fr->run == 0u || fr->skip != 0u) return;
+  const sense_fr_design_t *d = &g->design->fr;
+  sense_fr_limit(d, fr);
+  sense_fr_settle(d, fr);
+  g->fr_bits = fr->settled != 0u ? 0u : RATE_INVALID_SENSE_FR; /* settled: not at the limit */
+}
+
+GYRO_RAMFUNC void gyro_fr_polar(gyro_t *g)
+{
+  if (g->fr.run != 0u && g->fr.skip == 0u) sense_fr_polar(&g->fr);
+}
+
+/* The Coriolis force is in phase with the drive velocity, which at the drive's resonance
+ * is in phase with the drive force cos(phi + P) (6-12), through the mode's lag 2Q/wn
+ * (6-17): the feedback force's frame turns with LP_tau(P) as the rate channel forms it
+ * for its reference (P - its lag still to come, rate_channel.h; the tracking drive's p_eq
+ * the same way), temperature included, not with P's own jitter (at 1500 deg/s of
+ * rebalanced quadrature 0.02 deg of it is 0.5 deg/s of rate), and
+ * sense.fb_phase_deg holds what differs between the two electrodes' paths and the
+ * drive's distance from its resonance phase. */
+GYRO_RAMFUNC void gyro_fr_synth(gyro_t *g)
+{
+  const sense_fr_t *fr = &g->fr;
+  const rate_channel_t *rc = &g->rate;
+  if (fr->run != 0u && fr->skip == 0u)
+    drive_synth_set(&g->fb_synth, fr->f_mag_v2,
+                    fr->f_arg_rad + (rc->p_last_rad - rc->p_lag_rad) + g->design->fb_theta_rad);
+}
+
 GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
 {
   rate_channel_project(&g->design->rate, &g->rate, g->lmsd_drive.w_i, g->lmsd_drive.w_q,
@@ -324,6 +390,7 @@ GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
 GYRO_RAMFUNC void gyro_block_measure(gyro_t *g)
 {
   g->dac_frame->code[HAL_DAC_RATE_OUT] = g->rate_code;
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_synth(g);
   if (supervisor_drive_enabled(&g->sup)) {
     drive_loop_measure_phase(&g->drive, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
     /* The tracking drive's error and its notch here, its PI next tick (the budget). */
@@ -377,6 +444,7 @@ GYRO_RAMFUNC void gyro_block_rate_clear(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_rate(gyro_t *g)
 {
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_take(g);
   rate_channel_t *rc = &g->rate;
   selftest_cont_notch(&g->design->selftest, &g->selftest, 0u, &rc->rate_raw);
   rate_channel_filter_rate(&g->design->rate, rc);
@@ -436,6 +504,7 @@ GYRO_RAMFUNC GYRO_NOINLINE static void p_refresh(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_p(gyro_t *g)
 {
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_limit(g);
   rate_channel_t *rc = &g->rate;
   /* The hold first (only rate_channel_update_p reads it): P is held while not LOCKED. */
   rate_channel_hold_p(rc, g->sup.mode != GYRO_MODE_LOCKED);
@@ -470,6 +539,7 @@ GYRO_RAMFUNC void gyro_block_p_selftest(gyro_t *g)
  * highest rate); flags hold what happened over the whole block. */
 GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
 {
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_polar(g);
   gyro_out_t *o = &g->out;
   const uint32_t block_bits = (g->sup.mode == GYRO_MODE_LOCKED ? 0u : RATE_INVALID_MODE) |
                               (selftest_running(&g->selftest) ? RATE_INVALID_SELFTEST : 0u) |
@@ -481,7 +551,8 @@ GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
                               /* the reference's wide start (rate_channel.h): it passes
                                * the acquisition's tail of the measured phase */
                               (g->rate.ref_wide_left != 0u ? RATE_INVALID_SETTLING : 0u) |
-                              g->quad_bits; /* nulling on and not (yet) nulled */
+                              g->quad_bits | /* nulling on and not (yet) nulled */
+                              g->fr_bits;    /* force rebalance on and not balanced */
   const uint32_t invalid = rate_valid_verdict(&g->valid, block_bits);
   /* Never a valid-looking wrong rate: the analog output goes to the fault level in the
    * same sample as the verdict, without a slew. */

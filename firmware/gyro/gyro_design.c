@@ -76,6 +76,17 @@ static float p_poly_off_deg(const param_values_t *v)
  * THERMO_SLEW's shadow mirrors) and the analog fault level. The fault level
  * must lie outside the span full scale x out_v_per_dps (with 10 % for the output
  * stage's gain and offset), or a failed gyro could read as a rate. */
+/* A low-pass of the settling check per block, 1 - exp(-2 pi f T_block), with force
+ * rebalance (rate_valid.h: its reference at RATE_VALID_INPUT_RATIO times the output
+ * filter's corner, its difference at RATE_VALID_SETTLE_DIFF_HZ); open loop the 100 Hz
+ * filter's reference (RATE_VALID_INPUT_K) and no low-pass of the difference (1). */
+static float settle_k(const param_values_t *v, double f_hz)
+{
+  if (v->sense_mode != 1u) return f_hz == RATE_VALID_SETTLE_DIFF_HZ ? 1.0f : RATE_VALID_INPUT_K;
+  const double f_block_hz = (double)v->sys_fs_hz / (double)RATE_DECIM;
+  return (float)(1.0 - exp(-2.0 * FM_PI * f_hz / f_block_hz));
+}
+
 static gyro_design_status_t design_validity(const param_values_t *v, gyro_design_t *t)
 {
   const float span_v = v->rate_full_scale_dps * fm_absf(v->rate_out_v_per_dps);
@@ -97,7 +108,9 @@ static gyro_design_status_t design_validity(const param_values_t *v, gyro_design
                               fm_absf(v->rate_grad_fast_dps_per_deg),
                               t->rate.grad_a,
                               t->rate.comp_fast_a > 0.0f ? 1u : 0u,
-                              {0.0f}};
+                              {0.0f},
+                              settle_k(v, (double)(v->sense_fr_lpf_hz * RATE_VALID_INPUT_RATIO)),
+                              settle_k(v, RATE_VALID_SETTLE_DIFF_HZ)};
   t->valid = c;
   rate_valid_spur_matrix(t->rate.comp_a, t->rate.grad_a, t->rate.comp_stages,
                          t->rate.comp_fast_a, t->valid.spur_m);
@@ -396,6 +409,75 @@ static gyro_design_status_t design_supervisor(const param_values_t *v, double ta
   return GYRO_DESIGN_OK;
 }
 
+/* Force rebalance (sense_fr.h): the feedback electrodes' synthesis and limit, and the
+ * loop's design from the sense model (sense.f0_hz, sense.q, sense.fb_gain_v_per_v2) in the
+ * rate channel's units: g = sense.fb_gain_v_per_v2 / drive.amp_set_v (R = S e^{-j psi} /
+ * A_set). The lag it is designed against: the demodulator's pole (1 / (mu fs), mu =
+ * sense.fr_mu) and the schedule's delay from the block mean's centre ((GYRO_BLOCK - 1) /
+ * 2 ticks before the projection) to the force (synthesis on SENSE_FR_SYNTH_SLOT, the
+ * waveform from the next tick, the DAC's latency of one) plus half the block the
+ * command is held. */
+static double fr_delay_ticks(void)
+{
+  const double centre = 0.5 * (double)(GYRO_BLOCK - 1u);
+  const double to_force = (double)((SENSE_FR_SYNTH_SLOT + GYRO_BLOCK - GYRO_SLOT_PROJECT) %
+                                   GYRO_BLOCK) +
+                          2.0;
+  return centre + to_force + 0.5 * (double)GYRO_BLOCK;
+}
+
+static gyro_design_status_t design_fb(const param_values_t *v, gyro_design_t *t)
+{
+  const double v_dac_max = (double)(HAL_DAC_CODE_MAX - HAL_DAC_CODE_MID) *
+                           (double)HAL_DAC_V_PER_CODE;
+  const int dc_ac = v->sense_fb_scheme == 1u;
+  t->fb_synth.scheme = dc_ac ? GYRO_DRIVE_DC_AC : GYRO_DRIVE_HALF_FREQ;
+  t->fb_synth.dc_bias_v = v->sense_fb_bias_v;
+  t->fb_synth.u_max_v = v->sense_fb_v_max_v;
+  t->fb_off_v = dc_ac ? v->sense_fb_bias_v : 0.0f;
+  drive_synth_t probe;
+  /* DC+AC: the converter carries the AC part only, at most v_max - Vb */
+  if (!((double)v->sense_fb_v_max_v <= v_dac_max) || drive_synth_init(&probe, &t->fb_synth) != 0)
+    return GYRO_DESIGN_SENSE_FB;
+  t->fb_theta_rad = v->sense_fb_phase_deg * FM_RAD_PER_DEG_F;
+  t->sense_mode = v->sense_mode;
+  const double fs = (double)v->sys_fs_hz;
+  const double scale = fabs((double)v->rate_scale_dps);
+  const double g = (double)v->sense_fb_gain_v_per_v2 / (double)v->drive_amp_set_v;
+  const sense_fr_cfg_t fc = {v->sense_fr_bw_hz,
+                             v->sense_fr_zeta,
+                             v->sense_f0_hz,
+                             v->sense_q,
+                             v->drive_freq_hz,
+                             (float)g,
+                             (float)(1.0 / ((double)v->sense_fr_mu * fs) + fr_delay_ticks() / fs),
+                             drive_synth_f_cmd_max(&probe),
+                             scale > 0.0 ? (float)((double)v->sense_fr_settle_dps / scale) : 0.0f,
+                             v->sense_fr_settle_s,
+                             (float)((double)GYRO_BLOCK / fs)};
+  if (sense_fr_design(&fc, &t->fr) != 0) return GYRO_DESIGN_SENSE_FR;
+  t->fr_scale_dps_per_v2 = (float)((double)v->rate_scale_dps * g);
+  /* The self-test's force would go onto the same electrodes, past the loop: the
+   * continuous one is refused, the on-demand one is refused by its command. */
+  if (v->sense_mode == 1u && v->selftest_continuous != 0u) return GYRO_DESIGN_SENSE_SELFTEST;
+  return GYRO_DESIGN_OK;
+}
+
+/* In force rebalance the demodulator sits inside the loop (sense.fr_mu) and the loop
+ * sets the bandwidth: the output filter is a 2nd-order Butterworth at sense.fr_lpf_hz
+ * instead of rate.lpf_* (sense_fr.h; open loop unchanged). */
+static gyro_design_status_t design_fr_rate(const param_values_t *v, gyro_design_t *t)
+{
+  if (v->sense_mode != 1u) return GYRO_DESIGN_OK;
+  const double fs = (double)v->sys_fs_hz;
+  t->lmsd_sense.mu = v->sense_fr_mu;
+  const int n = butter_design(BUTTER_LOWPASS, 2u, (double)v->sense_fr_lpf_hz, 0.0,
+                              fs / RATE_DECIM, t->rate.lpf, BIQUAD_MAX_SECTIONS);
+  if (n <= 0) return GYRO_DESIGN_SENSE_FR;
+  t->rate.lpf_sections = (uint32_t)n;
+  return GYRO_DESIGN_OK;
+}
+
 /* Each part in turn; the first that fails names the reason. */
 /* The demodulation phase, the scale and the compensation are measured at one drive
  * frequency: at another, the phase of the drive against its resonance, and with it P
@@ -434,6 +516,8 @@ static gyro_design_status_t design_parts(const param_values_t *v, gyro_design_t 
   if (s == GYRO_DESIGN_OK) s = design_validity(v, t);
   if (s == GYRO_DESIGN_OK) s = design_selftest(v, t);
   if (s == GYRO_DESIGN_OK) s = design_quad_null(v, t);
+  if (s == GYRO_DESIGN_OK) s = design_fb(v, t);
+  if (s == GYRO_DESIGN_OK) s = design_fr_rate(v, t);
   t->autostart = v->sys_autostart;
   t->cal_state = cal_state(v);
   t->track_uncal = v->drive_track != 0u && v->cal_ref_track == 0u ? 1u : 0u;
@@ -507,6 +591,16 @@ static const char *const k_reasons[GYRO_DESIGN_STATUS_COUNT] = {
     [GYRO_DESIGN_QUAD_NULL] = "quad.probe_v must not exceed quad.v_max_v, quad.v_max_v must lie "
                               "within the DAC's range (14.99 V), quad.bw_hz at most a tenth "
                               "of the 500 Hz update, quad.probe_avg_s at least one update (2 ms)",
+    [GYRO_DESIGN_SENSE_FB] = "sense.fb_v_max_v must lie within the DAC's range (14.99 V), and "
+                             "sense.fb_bias_v between 0 and sense.fb_v_max_v in DC+AC "
+                             "(sense.fb_scheme 1)",
+    [GYRO_DESIGN_SENSE_FR] = "the force-rebalance loop cannot be designed: sense.fb_gain_v_per_v2 "
+                             "must not be 0, sense.fr_bw_hz at most a twentieth of the block "
+                             "rate and 2 sense.fr_zeta sense.fr_bw_hz within the demodulator's "
+                             "lag (sense.fr_mu), sense.fr_lpf_hz below half the block rate, "
+                             "rate.scale_dps not 0",
+    [GYRO_DESIGN_SENSE_SELFTEST] = "selftest.continuous 1 needs the open sense loop: its force "
+                                   "goes onto the feedback electrodes (set sense.mode 0 first)",
     [GYRO_DESIGN_MODULE] = "a value outside its parameter's range: a module refused its part of "
                            "the design",
 };

@@ -16,6 +16,7 @@
 #include "gyro/quad_null.h"
 #include "gyro/rate_channel.h"
 #include "gyro/rate_valid.h"
+#include "gyro/sense_fr.h"
 #include "gyro/selftest.h"
 #include "gyro/supervisor.h"
 #include "params/params.h"
@@ -54,6 +55,18 @@ typedef struct {
    * quad_on is 1, at the thermometer's block rate (RATE_P_DECIM). */
   uint32_t quad_on;
   quad_null_design_t quad;
+  /* Force rebalance (sense.mode 1, sense_fr.h): its design is made in either mode (a bad
+   * configuration is refused even in open loop); the sample path runs it only when
+   * sense_mode is 1. fb_synth realises its force on the feedback electrodes (the drive
+   * synthesis's law, drive_synth.h); fb_theta_rad (sense.fb_phase_deg) turns the
+   * Coriolis direction's force phase from the drive force's P (gyro_fr_synth), fb_off_v what the board adds to the
+   * converters' voltages (DC+AC: its bias stage's sense.fb_bias_v; half-frequency: 0). */
+  uint32_t sense_mode;
+  drive_synth_cfg_t fb_synth;
+  float fb_theta_rad;
+  float fb_off_v;
+  float fr_scale_dps_per_v2; /* the loop's scale factor: rate.scale_dps x g, for status */
+  sense_fr_design_t fr;
 } gyro_design_t;
 
 /* gyro_design_t.cal_state */
@@ -94,6 +107,9 @@ typedef enum {
   GYRO_DESIGN_CONT_FREQ,      /* selftest.cont_freq_hz against rate.lpf_cutoff_hz */
   GYRO_DESIGN_CONT_EXPECT,    /* selftest.cont_expect_dps, selftest.tol_rel */
   GYRO_DESIGN_QUAD_NULL,      /* quad.* against each other, the update rate, the DAC */
+  GYRO_DESIGN_SENSE_FB, /* sense.fb_v_max_v, sense.fb_bias_v against the DAC, each other */
+  GYRO_DESIGN_SENSE_FR, /* sense.fr_*, sense.f0_hz, sense.q, sense.fb_gain_v_per_v2 */
+  GYRO_DESIGN_SENSE_SELFTEST, /* selftest.continuous with sense.mode 1 */
   GYRO_DESIGN_MODULE,         /* a module refused its part: a value outside its range */
   GYRO_DESIGN_STATUS_COUNT
 } gyro_design_status_t;

@@ -22,6 +22,7 @@
 #include "gyro/rate_valid.h"
 #include "gyro/selfcal_exec.h"
 #include "gyro/selftest.h"
+#include "gyro/sense_fr.h"
 #include "gyro/supervisor.h"
 #include "hal/hal_adc.h"
 #include "hal/hal_dac.h"
@@ -86,6 +87,9 @@ typedef struct gyro_s {
   uint32_t cont_fail;        /* the continuous self-test's verdict (GYRO_SLOT_PHASE_PI) */
   uint32_t quad_bits;        /* RATE_INVALID_QUAD_NULL while nulling is on and not settled */
   gyro_quad_step_t quad_job; /* the nulling loop's next step (GYRO_SLOT_COMMAND), or NULL */
+  uint32_t fr_on;   /* force rebalance (the design's sense_mode 1): its steps and waveform */
+  uint32_t fr_bits; /* RATE_INVALID_SENSE_FR while it is on and not balanced */
+  float fb_off_v;   /* what the board adds to the feedback converters' voltages (design) */
   uint32_t rate_clear_due; /* the loop-state clear's rate-channel half is due (GYRO_SLOT_RATE) */
   uint32_t flags_acc;      /* GYRO_FLAG_* seen since the last snapshot */
   supervisor_in_t sup_in;  /* the supervisor's evidence, gathered by the jobs before
@@ -105,6 +109,10 @@ typedef struct gyro_s {
   quad_null_t quad;
   hal_dac_frame_t *dac_frame; /* the frame every tick writes (the application's) */
   const volatile hal_adc_frame_t *adc_frame; /* the frame every tick reads (the HAL's) */
+  /* Force rebalance (sense.mode 1, sense_fr.h): the loop, one update per block in steps
+   * (gyro_slots.h), and the synthesis of its force on the feedback pair (every tick). */
+  drive_synth_t fb_synth;
+  sense_fr_t fr;
 } gyro_t;
 
 #endif /* GYRO_STATE_H */

@@ -48,6 +48,7 @@
 #include "dsp/fastmath.h"
 #include "dsp/pi.h"
 #include "dsp/ramfunc.h"
+#include "gyro/settle_count.h"
 
 typedef struct {
   float bw_hz;        /* f_c, the loop's crossover; > 0, under a tenth of the update rate */
@@ -292,11 +293,8 @@ GYRO_RAMFUNC static inline void quad_null_settle(const quad_null_design_t *d, qu
 {
   const float x = q->x_dps;
   const float a = x < 0.0f ? -x : x;
-  uint32_t n = 0u;
-  if (a <= d->settle_dps && !q->at_limit) {
-    n = q->in_band;
-    if (n < d->settle_updates) n++;
-  }
+  const uint32_t n = settle_count(q->in_band, a <= d->settle_dps && !q->at_limit,
+                                  d->settle_updates);
   q->in_band = n;
   q->settled = n >= d->settle_updates ? 1u : 0u;
 }

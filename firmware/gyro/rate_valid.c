@@ -65,12 +65,19 @@ GYRO_RAMFUNC void rate_valid_settling(const rate_valid_cfg_t *restrict cfg,
                                       rate_valid_t *restrict rv, float rate_raw, float quad_raw,
                                       float rate_unc_dps, float quad_dps, float scale_dps)
 {
-  rv->x_rate += RATE_VALID_INPUT_K * (rate_raw - rv->x_rate);
-  rv->x_quad += RATE_VALID_INPUT_K * (quad_raw - rv->x_quad);
+  rv->x_rate += cfg->settle_k * (rate_raw - rv->x_rate);
+  rv->x_quad += cfg->settle_k * (quad_raw - rv->x_quad);
+  float dr = rate_unc_dps - scale_dps * rv->x_rate;
+  float dq = quad_dps - scale_dps * rv->x_quad;
+  if (cfg->settle_diff_k < 1.0f) { /* a wide output band's noise averaged (rate_valid.h) */
+    rv->d_rate += cfg->settle_diff_k * (dr - rv->d_rate);
+    rv->d_quad += cfg->settle_diff_k * (dq - rv->d_quad);
+    dr = rv->d_rate;
+    dq = rv->d_quad;
+  }
   if (rv->settled != 0u) return;
   const float tol = cfg->tol_dps;
-  const int inside = fm_absf_cmp(rate_unc_dps - scale_dps * rv->x_rate) <= tol &&
-                     fm_absf_cmp(quad_dps - scale_dps * rv->x_quad) <= tol;
+  const int inside = fm_absf_cmp(dr) <= tol && fm_absf_cmp(dq) <= tol;
   rv->settle_run = inside ? rv->settle_run + 1u : 0u;
   if (rv->settle_run >= RATE_VALID_SETTLE_BLOCKS) rv->settled = 1u;
 }
@@ -343,6 +350,6 @@ const char *rate_valid_reason_name(uint32_t kind)
   static const char *const names[RATE_INVALID_KINDS] = {
       "MODE",          "SELFTEST", "SETTLING",     "CLIP",        "SENSE_RANGE",
       "OVER_RANGE",    "PHASE",    "THERMO_RANGE", "THERMO_SLEW", "THERMO_SETTLE",
-      "CONT_SELFTEST", "TRACKING", "UNCALIBRATED", "QUAD_NULL"};
+      "CONT_SELFTEST", "TRACKING", "UNCALIBRATED", "QUAD_NULL",   "SENSE_FR"};
   return kind < RATE_INVALID_KINDS ? names[kind] : "?";
 }

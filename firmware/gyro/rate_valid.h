@@ -62,6 +62,11 @@
  *                 the electrodes (none fitted or wired: they stay at 0 V). While the
  *                 quadrature moves by hundreds of deg/s, a demodulation phase error of
  *                 a tenth of a degree puts a moving deg/s into the rate
+ *   SENSE_FR      force rebalance is on (sense.mode 1) and its loop has not balanced the
+ *                 sense axis: not running (not LOCKED yet), its residual not yet within
+ *                 sense.fr_settle_dps for sense.fr_settle_s, or its force at the
+ *                 feedback electrodes' limit (a Coriolis or quadrature force they cannot
+ *                 cancel: the force read as the rate is then not the Coriolis force)
  * Each check is a few multiplies and compares per block; no divide, no libm. */
 #ifndef RATE_VALID_H
 #define RATE_VALID_H
@@ -85,7 +90,8 @@
 #define RATE_INVALID_TRACKING (1u << 11)
 #define RATE_INVALID_UNCALIBRATED (1u << 12)
 #define RATE_INVALID_QUAD_NULL (1u << 13)
-#define RATE_INVALID_KINDS 14u
+#define RATE_INVALID_SENSE_FR (1u << 14)
+#define RATE_INVALID_KINDS 15u
 
 /* Blocks in a row inside the settling tolerance (2 ms): longer than the noise's
  * correlation time at the filters' 100 Hz, far shorter than their settling. */
@@ -102,8 +108,18 @@
 #define RATE_VALID_PHASE_K 0.00126f
 /* Low-pass of the filters' inputs the settling is judged against: per block, a time
  * constant of 5 blocks (1 ms, a corner of about 160 Hz), faster than the 100 Hz
- * output filter it checks. */
+ * output filter it checks. With another output filter (force rebalance's,
+ * sense.fr_lpf_hz) the corner keeps that ratio, RATE_VALID_INPUT_RATIO times the
+ * filter's (gyro_design): a reference much slower than the filter would read the noise
+ * the wider filter passes as a transient, and the rate would never be judged settled. */
 #define RATE_VALID_INPUT_K 0.2f
+#define RATE_VALID_INPUT_RATIO 1.6f
+/* With force rebalance the output's band (sense.fr_lpf_hz, hundreds of Hz) passes a
+ * noise comparable to the tolerance (0.24 deg/s rms on the default part's noise at
+ * 500 Hz), which the difference of filter and reference carries too: the difference is
+ * judged through a low-pass of this corner, which leaves a filter transient (ms) and
+ * takes the noise down by the root of the bands' ratio. */
+#define RATE_VALID_SETTLE_DIFF_HZ 50.0
 /* A window's move of P_f beyond this many caps restarts the compensation's filters:
  * what they would carry of it outweighs the gradient the restart drops. */
 #define RATE_VALID_RESTART_CAPS 10.0f
@@ -134,21 +150,24 @@ typedef struct {
   float grad_a;                    /* the gradient term's 1 - exp(-T / tau) per P update */
   uint32_t fast_on;                /* the compensation has a fast path (comp_fast_a > 0) */
   float spur_m[RATE_VALID_SPUR_M]; /* the shadow's transition over a slew window */
+  float settle_k;      /* the settling reference's low-pass per block (RATE_VALID_INPUT_K) */
+  float settle_diff_k; /* the settling difference's low-pass per block, 1: none */
 } rate_valid_cfg_t;
 
 typedef struct {
-  uint32_t reasons;                  /* RATE_INVALID_* of the latest verdict */
-  uint32_t thermo;                   /* RATE_INVALID_THERMO_* of the latest P update */
-  uint32_t drive;                    /* RATE_INVALID_PHASE, _SENSE_RANGE of the latest block */
-  uint32_t range;                    /* RATE_INVALID_OVER_RANGE of the latest block */
-  uint32_t settled;                  /* nonzero once settled since the last disturbance */
-  uint32_t settle_run;               /* blocks in a row inside the settling tolerance */
-  uint32_t was_locked;               /* LOCKED at the previous verdict (entering it disturbs) */
-  float x_rate, x_quad;              /* fast low-passes of the filters' inputs (raw units) */
-  float p_dev_window_deg;            /* P_f - p_ref at the start of the slew window */
-  uint32_t p_updates;                /* P_f updates into the slew window */
-  uint32_t slew;                     /* RATE_INVALID_THERMO_SLEW of the latest window */
-  uint32_t slew_due;                 /* a window ended: rate_valid_slew judges it */
+  uint32_t reasons;       /* RATE_INVALID_* of the latest verdict */
+  uint32_t thermo;        /* RATE_INVALID_THERMO_* of the latest P update */
+  uint32_t drive;         /* RATE_INVALID_PHASE, _SENSE_RANGE of the latest block */
+  uint32_t range;         /* RATE_INVALID_OVER_RANGE of the latest block */
+  uint32_t settled;       /* nonzero once settled since the last disturbance */
+  uint32_t settle_run;    /* blocks in a row inside the settling tolerance */
+  uint32_t was_locked;    /* LOCKED at the previous verdict (entering it disturbs) */
+  float x_rate, x_quad;   /* fast low-passes of the filters' inputs (raw units) */
+  float d_rate, d_quad;   /* the settling differences, low-passed (settle_diff_k < 1), deg/s */
+  float p_dev_window_deg; /* P_f - p_ref at the start of the slew window */
+  uint32_t p_updates;     /* P_f updates into the slew window */
+  uint32_t slew;          /* RATE_INVALID_THERMO_SLEW of the latest window */
+  uint32_t slew_due;      /* a window ended: rate_valid_slew judges it */
   float p_window_change_deg;         /* change of P_f over the window that ended */
   float spur_deg[RATE_VALID_SPUR_N]; /* the shadow: the moves beyond the cap in P_f,
                                       * and in the compensation's filters (their mid

@@ -40,7 +40,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 14u
+#define PARAM_LAYOUT_VERSION 15u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -329,6 +329,55 @@
    * stops rather than integrate its own noise */ \
   X(quad_min_step_dps, 0x0909u, "quad.min_step_dps", F32, "deg/s", 0.001f, 1000.0f, 5.0f, 0u, \
     PF_PERSIST | PF_LIVE, "the probe's smallest credible effect: less means no working electrodes (the loop stops)") \
+  /* open loop: every part runs as before, bit for bit (gyro/sense_fr.h). Not live: the
+   * loop, the sense demodulator's step and the output filter change together */ \
+  X(sense_mode, 0x0A01u, "sense.mode", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
+    PF_PERSIST, "sense axis: 0 open loop, 1 force rebalance (the rate read from the feedback force)") \
+  /* the thesis's half-frequency scheme (6-18) for the feedback pair (plant fb_mode 3);
+   * DC+AC puts the AC voltage on the pair's first channel and the board's bias stage adds
+   * sense.fb_bias_v (plant fb_mode 2) */ \
+  X(sense_fb_scheme, 0x0A02u, "sense.fb_scheme", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
+    PF_PERSIST, "feedback electrodes: 0 half-frequency pair (U3, U4 at wc/2), 1 DC+AC (the board's bias +- AC)") \
+  /* the second converter's output stage (board.h: +-15 V) less the rail's headroom */ \
+  X(sense_fb_v_max_v, 0x0A03u, "sense.fb_v_max_v", F32, "V", 0.1f, 15.0f, 10.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "limit of each feedback electrode's voltage; the loop at it makes the rate not valid") \
+  /* the board's bias stage of the DC+AC scheme: the force is 4 Ks Vb u */ \
+  X(sense_fb_bias_v, 0x0A04u, "sense.fb_bias_v", F32, "V", 0.0f, 15.0f, 5.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "bias of the feedback electrodes in DC+AC (sense.fb_scheme 1), below sense.fb_v_max_v") \
+  /* 0: in phase with the drive force (at the drive's resonance its velocity, and so the
+   * Coriolis force, is); what the two electrodes' paths differ by moves it (a part's) */ \
+  X(sense_fb_phase_deg, 0x0A05u, "sense.fb_phase_deg", F32, "deg", -180.0f, 180.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "phase of the feedback force in the Coriolis direction, against the drive force's (P)") \
+  /* a placeholder of the family's size: a part's value is its own (identified or from
+   * its design: the sense mode's gain at the drive frequency times the electrode's Ks) */ \
+  X(sense_fb_gain_v_per_v2, 0x0A06u, "sense.fb_gain_v_per_v2", F32, "V/V^2", -100.0f, 100.0f, 0.01f, 0u, \
+    PF_PERSIST | PF_LIVE, "sense pickoff's static response (Coriolis axis, V) per V^2 of feedback force at wc; not 0") \
+  /* the family's design sense resonance and Q (thesis §2.4.2), not a part's */ \
+  X(sense_f0_hz, 0x0A07u, "sense.f0_hz", F32, "Hz", 100.0f, 20000.0f, 2000.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "sense resonance of the model the force-rebalance loop is designed from") \
+  X(sense_q, 0x0A08u, "sense.q", F32, "-", 0.5f, 1.0e6f, 3.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "sense quality factor of that model") \
+  /* 120 Hz, damping 0.85, the output filter below: a step settles to 1 % in about 8 ms
+   * and the -3 dB bandwidth is above 100 Hz (sense_fr.h; measured in README) */ \
+  X(sense_fr_bw_hz, 0x0A09u, "sense.fr_bw_hz", F32, "Hz", 1.0f, 1000.0f, 120.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "natural frequency of the force-rebalance loop's closed-loop poles") \
+  X(sense_fr_zeta, 0x0A0Au, "sense.fr_zeta", F32, "-", 0.3f, 2.0f, 0.85f, 0u, \
+    PF_PERSIST | PF_LIVE, "damping of those poles") \
+  /* inside the loop the demodulator is a lag: 0.15 puts its pole at 1.2 kHz, so that the
+   * loop can reach 120 Hz (demod.mu_sense stays the open loop's) */ \
+  X(sense_fr_mu, 0x0A0Bu, "sense.fr_mu", F32, "-", 0.0001f, 0.49f, 0.15f, 0u, \
+    PF_PERSIST | PF_LIVE, "LMS step size of the sense demodulator in force rebalance (sense.mode 1)") \
+  /* the loop sets the bandwidth; the filter takes the noise above it: 2nd order at 500 Hz
+   * costs about 0.5 ms of the step's settling (the open loop's 100 Hz 4th order: 17 ms) */ \
+  X(sense_fr_lpf_hz, 0x0A0Cu, "sense.fr_lpf_hz", F32, "Hz", 10.0f, 2000.0f, 500.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "cut-off of the rate's 2nd-order Butterworth output filter in force rebalance (replaces rate.lpf_*)") \
+  /* the residual's low-pass at a fifth of the loop's frequency still carries about
+   * 0.5 deg/s of the demodulator's noise on a part in air */ \
+  X(sense_fr_settle_dps, 0x0A0Du, "sense.fr_settle_dps", F32, "deg/s", 0.001f, 100.0f, 2.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "the loop's residual (rate and quadrature equivalent) below this counts as settled") \
+  /* 25 blocks: longer than the loop's own time constant */ \
+  X(sense_fr_settle_s, 0x0A0Eu, "sense.fr_settle_s", F32, "s", 0.0f, 10.0f, 0.005f, 0u, \
+    PF_PERSIST | PF_LIVE, "the residual within sense.fr_settle_dps this long before the loop counts as settled") \
   /* 0: no calibration. The compensation, the demodulation phase and the scale hold at
    * the drive frequency they were measured at: another one (a sweep, a hand change)
    * makes them stale. Equal within 2e-7 (two float steps), so that a value that went

@@ -4,7 +4,7 @@
  *
  *   gyro-sim --scenario FILE [--duration S] [--seed N] [--csv FILE] [--csv-rate HZ]
  *            [--json FILE] [--out DIR] [--set plant.KEY=V | firmware.NAME=V ...]
- *            [--no-analysis] [--quiet] [--uart-pty[=LINK]] [--selfcal]
+ *            [--no-analysis] [--quiet] [--uart-pty[=LINK]] [--pace X] [--selfcal]
  *            [--firmware-params FILE] [--save-params FILE]
  *   gyro-sim --list-params
  */
@@ -35,7 +35,7 @@ static void usage(FILE *f)
   fputs("usage: gyro-sim --scenario FILE [--duration S] [--seed N] [--csv FILE]\n"
         "                [--csv-rate HZ] [--json FILE] [--out DIR]\n"
         "                [--set plant.KEY=VALUE | --set firmware.NAME=VALUE ...]\n"
-        "                [--no-analysis] [--quiet] [--uart-pty[=LINK]] [--selfcal]\n"
+        "                [--no-analysis] [--quiet] [--uart-pty[=LINK]] [--pace X] [--selfcal]\n"
         "                [--firmware-params FILE] [--save-params FILE]\n"
         "       gyro-sim --list-params\n"
         "Runs a scenario (host_sim/scenarios/*.json) of the plant with the firmware in\n"
@@ -43,6 +43,10 @@ static void usage(FILE *f)
         "tool outputs; --set overrides any plant or firmware parameter. --uart-pty runs\n"
         "in real time with the tuning UART on a pseudo-terminal (path printed as\n"
         "'pty PATH'; optional symlink LINK) for gyroctl; SIGINT/SIGTERM end the run.\n"
+        "Its command line has `emu`, the simulated bench: `emu rate DPS [EDGE_S]` turns\n"
+        "the rate table, `emu ambient DEGC [EDGE_S]` sets the chamber (a linear move\n"
+        "from the value now, then held). --pace X runs the session at X times real time\n"
+        "(0: as fast as it runs; default 1).\n"
         "--isr-figures adds the Cortex-M4F interrupt cost that tools/bench/run-bench\n"
         "--json measured to the figures (isr_instructions_per_tick, ...).\n"
         "--selfcal (scenario key \"selfcal\": true; closed loop only) first runs the\n"
@@ -119,6 +123,7 @@ typedef struct {
   long long seed;                 /* < 0: the scenario's */
   int quiet, analysis, uart_pty, selfcal;
   const char *uart_pty_link;
+  double pace; /* --pace: with --uart-pty, simulated s per wall s */
   const char *isr_json;
   const char *fw_params;   /* --firmware-params */
   const char *save_params; /* --save-params */
@@ -145,6 +150,7 @@ static int parse_args(int argc, char **argv, cli_args_t *a)
                                      {"list-params", no_argument, 0, 'L'},
                                      {"help", no_argument, 0, 'h'},
                                      {"uart-pty", optional_argument, 0, 'u'},
+                                     {"pace", required_argument, 0, 'p'},
                                      {"isr-figures", required_argument, 0, 'i'},
                                      {"selfcal", no_argument, 0, 'C'},
                                      {"firmware-params", required_argument, 0, 'P'},
@@ -157,6 +163,7 @@ static int parse_args(int argc, char **argv, cli_args_t *a)
   a->csv_rate_hz = -1.0;
   a->seed = -1;
   a->analysis = 1;
+  a->pace = 1.0;
   int opt;
   char *end;
   while ((opt = getopt_long(argc, argv, "", lo, NULL)) != -1) {
@@ -201,6 +208,15 @@ static int parse_args(int argc, char **argv, cli_args_t *a)
     case 'u':
       a->uart_pty = 1;
       a->uart_pty_link = optarg;
+      break;
+    case 'p':
+      errno = 0;
+      a->pace = strtod(optarg, &end);
+      if (*end || errno || !(a->pace >= 0.0) || a->pace > 1e4) {
+        fprintf(stderr, "gyro-sim: --pace: '%s' is not a factor of real time in [0, 1e4]\n",
+                optarg);
+        return 2;
+      }
       break;
     case 'n': a->analysis = 0; break;
     case 'i': a->isr_json = optarg; break;
@@ -914,9 +930,9 @@ static int run(const cli_args_t *a, const sim_scenario_t *sc, const bench_figs_t
                     "into the command line: one or the other\n");
     return 2;
   }
-  const sim_opts_t so = {csv_path, sc->csv_rate_hz,
-                         !a->quiet && isatty(2) && sc->duration_s > 2.0, a->uart_pty,
-                         a->uart_pty_link};
+  const sim_opts_t so = {
+      csv_path,    sc->csv_rate_hz,  !a->quiet && isatty(2) && sc->duration_s > 2.0,
+      a->uart_pty, a->uart_pty_link, a->pace};
   static sim_result_t res;
   static sim_sweep_t sweep;
   static sim_square_t sq;

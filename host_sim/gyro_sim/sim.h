@@ -89,8 +89,9 @@ typedef struct {
   const char *csv_path; /* NULL: no trace */
   double csv_rate_hz;
   int progress;              /* progress bar on stderr */
-  int uart_pty;              /* expose the tuning UART as a pty, run paced in real time */
+  int uart_pty;              /* expose the tuning UART as a pty, run paced */
   const char *uart_pty_link; /* optional symlink to the pty */
+  double pace; /* with uart_pty: simulated s per wall s (1 real time, 0 unpaced) */
 } sim_opts_t;
 
 /* Every parameter a scenario or --set takes, with its default, range, unit and doc:

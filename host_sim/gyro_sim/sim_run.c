@@ -16,6 +16,7 @@
 #include "sim_out.h"
 #include "slip.h"
 #include "sim/uart_pty.h"
+#include "sim_bench.h"
 
 #include <errno.h>
 #include <poll.h>
@@ -195,6 +196,7 @@ typedef struct {
   sim_csv_t csv;
   uart_pty_t pty;
   cl_truth_t truth;
+  sim_bench_t bench; /* the pty session's `emu` command */
 } cl_run_t;
 
 static void cl_release(cl_run_t *r)
@@ -216,6 +218,10 @@ static int cl_open_pty(cl_run_t *r, const sim_opts_t *opt, char *err, size_t err
   if (uart_pty_open(&r->pty, path, sizeof path) != 0 ||
       (opt->uart_pty_link != NULL && uart_pty_link(&r->pty, opt->uart_pty_link) != 0)) {
     snprintf(err, err_len, "--uart-pty: %s", strerror(errno));
+    return -1;
+  }
+  if (sim_bench_register(&r->bench, &r->app->cli, r->plant, opt->pace) != 0) {
+    snprintf(err, err_len, "--uart-pty: the bench command could not be registered");
     return -1;
   }
   stop_requested = 0;
@@ -290,13 +296,14 @@ static int cl_start(cl_run_t *r, const sim_scenario_t *sc, const sim_opts_t *opt
   return 0;
 }
 
-/* Paced run: the firmware meets a person or a tool in real time. Sleeps on the pty until
- * the simulated time t_sim_s has caught up with the wall clock. Returns 1 when a signal
+/* Paced run: the firmware meets a person or a tool in real time (pace 1), or a tool
+ * faster (pace times real time; 0: as fast as it runs). Sleeps on the pty until the wall
+ * clock has caught up with the simulated time t_sim_s / pace. Returns 1 when a signal
  * asked to stop. */
-static int cl_pace(cl_run_t *r, double t_sim_s, double t_wall0)
+static int cl_pace(cl_run_t *r, double t_sim_s, double t_wall0, double pace)
 {
   uart_pty_pump(&r->pty);
-  const double ahead = t_sim_s - (wall_now() - t_wall0);
+  const double ahead = pace > 0.0 ? t_sim_s / pace - (wall_now() - t_wall0) : 0.0;
   if (ahead > 0.0) {
     struct pollfd pfd = {uart_pty_fd(&r->pty), POLLIN, 0};
     (void)poll(&pfd, 1, (int)(ahead * 1000.0));
@@ -542,7 +549,7 @@ int sim_run_closed_loop(const sim_scenario_t *sc, const sim_opts_t *opt, sim_res
     if ((k & 1023u) == 0u) {
       app_poll(r.app);
       progress_update(&pr, (double)k / fs, 0);
-      if (opt->uart_pty && cl_pace(&r, (double)(k + 1u) / fs, t_wall0)) {
+      if (opt->uart_pty && cl_pace(&r, (double)(k + 1u) / fs, t_wall0, opt->pace)) {
         n_ticks = k + 1u;
         break;
       }

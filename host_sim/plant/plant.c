@@ -467,6 +467,36 @@ int plant_set_profiles(plant_t *p, const plant_profiles_t *prof)
   return 0;
 }
 
+double plant_input_now(const plant_t *p, plant_input_t which)
+{
+  const double t_s = (double)p->k * p->T;
+  return profile_eval(which == PLANT_INPUT_RATE ? &p->prof.rate_dps : &p->prof.ambient_k, t_s,
+                      NULL);
+}
+
+int plant_cold_soak(plant_t *p)
+{
+  const thermal_cfg_t cfg = p->thermal.cfg;
+  return thermal_init_cold(&p->thermal, &cfg, plant_input_now(p, PLANT_INPUT_AMBIENT));
+}
+
+int plant_move_input(plant_t *p, plant_input_t which, double to, double edge_s)
+{
+  const int rate = which == PLANT_INPUT_RATE;
+  const double lo = rate ? -1e4 : 150.0, hi = rate ? 1e4 : 450.0; /* plant.h rate_dps, temp_k */
+  if (!(to >= lo && to <= hi) || !(edge_s > 0.0 && edge_s <= 1e5)) {
+    set_err(p, "%s move to %g over %g s: the value within %g..%g, the edge within (0, 1e5] s",
+            rate ? "rate" : "ambient", to, edge_s, lo, hi);
+    return -1;
+  }
+  const double t_s = (double)p->k * p->T;
+  const double from = plant_input_now(p, which);
+  plant_profiles_t next = p->prof;
+  profile_ramp(rate ? &next.rate_dps : &next.ambient_k, from, (to - from) / edge_s, t_s,
+               t_s + edge_s);
+  return plant_set_profiles(p, &next);
+}
+
 /* ------------------------------------------------------------------ step ------ */
 
 /* Thermal update over [t0, t0 + dt): ambient at mid-interval (thermal.h). The new

@@ -553,6 +553,20 @@ const char *plant_error(const plant_t *p);
  * thermal nodes are not reset. */
 int plant_set_profiles(plant_t *p, const plant_profiles_t *prof);
 
+/* An input moved while the plant runs: the rate table's rate (deg/s) or the chamber's
+ * ambient (K) goes from its value now to `to` along a linear edge of edge_s, then holds
+ * (the emulated board's `emu rate`, gyro-sim's bench commands on its pty). Returns 0, or
+ * -1 with nothing changed (a value outside the plant's rate_dps or temp_k range, an edge
+ * not in (0, 1e5] s; reason in plant_error). */
+typedef enum { PLANT_INPUT_RATE = 0, PLANT_INPUT_AMBIENT = 1 } plant_input_t;
+int plant_move_input(plant_t *p, plant_input_t which, double to, double edge_s);
+/* The input's value now (deg/s or K). */
+double plant_input_now(const plant_t *p, plant_input_t which);
+/* The part after a long power-off at the ambient now: every thermal node at the ambient
+ * (as plant.cold_start at power-on), from which its own dissipation warms it again (the
+ * simulated bench's power cycle; the firmware's restart is the caller's). Returns 0. */
+int plant_cold_soak(plant_t *p);
+
 /* One sample (see the top of this file). dac: the frame on the converter outputs over
  * this interval; a frame with an out-of-range code is rejected (counted, the previous
  * frame held). adc: the frame sampled at the end of the interval. */

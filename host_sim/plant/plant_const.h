@@ -9,5 +9,6 @@
 #define PLANT_TWO_PI 6.28318530717958647692 /* exactly 2 * PLANT_PI in double */
 #define PLANT_RAD_PER_DEG (PLANT_PI / 180.0)
 #define PLANT_DEG_PER_RAD (180.0 / PLANT_PI)
+#define PLANT_K_AT_0_C 273.15 /* kelvin at 0 degC */
 
 #endif /* PLANT_CONST_H */

@@ -30,6 +30,13 @@
                                         noise the flow's verification never saw) for 640 s,
                                         the Allan deviation of rate_dps within 1.1x that of
                                         rate_unc_dps at 1 s and at 10 s (thermcal.verify_noise)
+  check_calibration.py port_quick GYRO_SIM   the flow over a UART: the default part
+                                        behind gyro-sim --uart-pty --pace 0, calibrated by
+                                        tools/calibrate --port --bench emu --quick (the
+                                        simulated bench moving its table and chamber):
+                                        verified, its part id recorded, and the
+                                        calibration right at 25 degC on a gyro-sim run of
+                                        its own (a profile and noise it never saw)
   check_calibration.py commands GYRO_SIM  a scenario's "commands" (what the flow's
                                         self-test stage uses) reach the command line at
                                         their times; one due after the run has no reply
@@ -210,15 +217,23 @@ VACUUM_PART = ("plant.q_drive=20000", "plant.q_sense=2000", "plant.q_temp_law=2"
                "plant.pick_sense_gain_v_per_m=46350000")
 
 
+def calibration_of(r, out):
+    """The calibration tools/calibrate wrote into out, its output printed; None (and why)
+    when it did not exit 0."""
+    print(r.stdout + r.stderr)
+    if r.returncode != 0:
+        print(f"FAIL: exit {r.returncode}")
+        return None
+    return os.path.join(out, "calibration.json")
+
+
 def quick_part(sim, part, track, lead_s):
     with tempfile.TemporaryDirectory() as d:
         sets = [a for s in part for a in ("--set", s)]
-        r = run(["--sim", "--quick", "--seed", "7", "--out", d, "--gyro-sim", sim] + sets)
-        print(r.stdout + r.stderr)
-        if r.returncode != 0:
-            print(f"FAIL: exit {r.returncode}")
+        cal = calibration_of(run(["--sim", "--quick", "--seed", "7", "--out", d, "--gyro-sim",
+                                  sim] + sets), d)
+        if cal is None:
             return 1
-        cal = os.path.join(d, "calibration.json")
         mode = paramset.read(cal).values()["cal.ref_track"]
         inside = plateau(sim, cal, 25.0, d, part, lead_s)
         outside = plateau(sim, cal, 60.0, d, part, lead_s)
@@ -234,6 +249,33 @@ def quick_part(sim, part, track, lead_s):
 
 def quick(sim):
     return quick_part(sim, QUICK_PART, 0, 0.0)
+
+
+def port_quick(sim):
+    with tempfile.TemporaryDirectory() as d:
+        pty = os.path.join(d, "gyro.pty")
+        proc = subprocess.Popen([sim, "--scenario", os.path.join(ROOT, "host_sim", "scenarios",
+                                                                 "startup.json"),
+                                 "--duration", "1000000", "--quiet", "--pace", "0",
+                                 f"--uart-pty={pty}"], stdout=subprocess.PIPE, text=True)
+        try:
+            proc.stdout.readline()
+            out = os.path.join(d, "cal")
+            r = run(["--port", pty, "--bench", "emu", "--part-id", "7", "--quick",
+                     "--out", out])
+        finally:
+            proc.terminate()
+            proc.wait(timeout=30)
+        cal = calibration_of(r, out)
+        if cal is None:
+            return 1
+        pid = paramset.read(cal).values()["cal.part_id"]
+        inside = plateau(sim, cal, 25.0, d)
+    if inside is None:
+        return 1
+    ok = plateau_ok(inside, 25.0)
+    print(f"{'ok  ' if pid == 7 else 'FAIL'} cal.part_id {pid} (expected 7)")
+    return 0 if ok and pid == 7 else 1
 
 
 def quick_vacuum(sim):
@@ -322,7 +364,7 @@ def noise(sim):
 if __name__ == "__main__":
     modes = {"regen": regen, "usage": usage, "commands": commands, "defaults": tool_defaults,
              "tempcomp": tempcomp_out_of_sample, "quick": quick, "quick_vacuum": quick_vacuum,
-             "brownian_highq": brownian_highq, "noise": noise}
+             "brownian_highq": brownian_highq, "noise": noise, "port_quick": port_quick}
     if len(sys.argv) != 3 or sys.argv[1] not in modes:
         print(__doc__, file=sys.stderr)
         sys.exit(2)

@@ -120,13 +120,14 @@ static void test_list_fields(void **state)
 {
   (void)state;
   const uint32_t before = got.lines;
-  assert_string_equal(cmd("stream\n"), "ok 18 fields; usage: stream FIELD...|all [@RATE_HZ]");
-  assert_int_equal(got.lines - before, 19u);
+  assert_string_equal(cmd("stream\n"), "ok 19 fields; usage: stream FIELD...|all [@RATE_HZ]");
+  assert_int_equal(got.lines - before, 20u);
   assert_string_equal(got.line[before], "- rate_dps f32 deg/s");
   assert_string_equal(got.line[before + 12u], "- mode u32 -");
   assert_string_equal(got.line[before + 15u], "- tick u32 -");
   assert_string_equal(got.line[before + 16u], "- rate_valid u32 -");
   assert_string_equal(got.line[before + 17u], "- f_drive_hz f32 Hz");
+  assert_string_equal(got.line[before + 18u], "- rate_invalid u32 -");
 }
 
 /* Every bad request is refused with a clear err and starts nothing. */
@@ -149,7 +150,7 @@ static void test_errors_change_nothing(void **state)
       {"stream rate_dps @50001\n", "err RANGE"},
       {"stream rate_dps @0.5\n", "err RANGE"},
       {"stream all @1000\n",
-       "err BANDWIDTH 18 fields at 1000 Hz need 77541 B/s, over 70% of the link (64512 of 92160 B/s)"},
+       "err BANDWIDTH 19 fields at 1000 Hz need 81555 B/s, over 70% of the link (64512 of 92160 B/s)"},
       {"stream tick @50000\n", "err BANDWIDTH"},
       {"stop now\n", "err ARGS"},
   };
@@ -213,7 +214,7 @@ static void test_rate_rounding_and_default(void **state)
   assert_null(strstr(r, "rounded"));
   assert_true(strncmp(cmd("set tlm.rate_hz 250\n"), "ok", 2u) == 0);
   r = cmd("stream all\n");
-  assert_true(strncmp(r, "ok stream 3 250 Hz decim 200 fields 18 ", 39u) == 0);
+  assert_true(strncmp(r, "ok stream 3 250 Hz decim 200 fields 19 ", 39u) == 0);
   run_ms(100u);
   assert_string_equal(got.layout.name[15], "tick");
   assert_string_equal(got.layout.name[16], "rate_valid");

@@ -73,6 +73,29 @@ static void amp_set_over_adc(param_values_t *v) { v->drive_amp_set_v = 4.9f; }
 static void amp_trip_low(param_values_t *v) { v->sup_amp_trip_rel = 1.05f; }
 static void bias_slope_huge(param_values_t *v) { v->rate_bias_c1_dps_per_deg = 1e35f; }
 static void clip_count_zero(param_values_t *v) { v->sup_clip_count = 0u; }
+static void fb_bias_over_limit(param_values_t *v)
+{
+  v->sense_fb_scheme = 1u;
+  v->sense_fb_bias_v = 12.0f;
+}
+static void fb_gain_zero(param_values_t *v) { v->sense_fb_gain_v_per_v2 = 0.0f; }
+/* 2 zeta w beyond the demodulator's lag: the third root in the right half plane */
+static void fr_bw_beyond_lag(param_values_t *v)
+{
+  v->sense_q = 1.0e4f;
+  v->sense_fr_bw_hz = 240.0f;
+}
+static void fr_slow_demod(param_values_t *v)
+{
+  v->sense_q = 1.0e4f;
+  v->sense_fr_mu = 0.01f;
+}
+static void fr_cont_selftest(param_values_t *v)
+{
+  v->sense_mode = 1u;
+  v->selftest_continuous = 1u;
+  v->selftest_cont_expect_dps = 1.0f;
+}
 
 static const refusal_t k_refusals[] = {
     {GYRO_DESIGN_FS, "sys.fs_hz", fs_zero},
@@ -94,6 +117,11 @@ static const refusal_t k_refusals[] = {
     {GYRO_DESIGN_BIAS_SLOPE, "rate.bias_c1_dps_per_deg", bias_slope_huge},
     {GYRO_DESIGN_CONT_FREQ, "selftest.cont_freq_hz", cont_freq_in_band},
     {GYRO_DESIGN_CONT_EXPECT, "selftest.cont_expect_dps", cont_expect_zero},
+    {GYRO_DESIGN_SENSE_FB, "sense.fb_bias_v", fb_bias_over_limit},
+    {GYRO_DESIGN_SENSE_FR, "sense.fb_gain_v_per_v2", fb_gain_zero},
+    {GYRO_DESIGN_SENSE_FR, "sense.fr_bw_hz", fr_bw_beyond_lag},
+    {GYRO_DESIGN_SENSE_FR, "sense.fr_mu", fr_slow_demod},
+    {GYRO_DESIGN_SENSE_SELFTEST, "selftest.continuous", fr_cont_selftest},
     {GYRO_DESIGN_QUAD_NULL, "quad.probe_v", quad_probe_over_limit},
     {GYRO_DESIGN_QUAD_NULL, "quad.v_max_v", quad_limit_beyond_dac},
     {GYRO_DESIGN_QUAD_NULL, "quad.bw_hz", quad_bw_over_rate},

@@ -590,12 +590,13 @@ static void test_loads_image_of_earlier_firmware(void **state)
    * linearisation; rate.p_rate_c1_per_dps, rate.p_rate2_deg_per_dps2 0; cal.ref_track
    * 0: the fixed drive; rate.comp_stages 1: one stage, as that firmware had;
    * rate.comp_fast_tau_s 0: no fast path, its rate.grad_fast_dps_per_deg and
-   * rate.comp_blend_dps; quad.null 0: no quadrature nulling, and its eight quad.*).
+   * rate.comp_blend_dps; quad.null 0: no quadrature nulling, and its eight quad.*;
+   * sense.mode 0: the open sense loop, and its thirteen sense.*).
    * Without a calibration record the part then says `calibrated no` and its rate is not
    * valid until its calibration is confirmed (set cal.ref_freq_hz, save): an image of
    * before the record cannot tell a calibration from values set by hand. */
   assert_int_equal(rep.dropped + rep.rejected, 0);
-  assert_int_equal(rep.defaulted, 29);
+  assert_int_equal(rep.defaulted, 43);
   param_values_defaults(&want);
   /* The image holds every persistent value: those it did not change are that
    * firmware's defaults, some of which were the default part's and are generic now. */

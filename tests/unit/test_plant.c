@@ -497,6 +497,49 @@ static void test_temperature_plumbing(void **state)
  * pickoffs start at the ambient and warm as the thermal network alone does from there
  * (thermal_init_cold); off (the default), they start in the steady state as before. The
  * switch takes 0 or 1 only, and a refused value changes nothing. */
+/* A table or chamber moved while the plant runs: a linear edge from the value at that
+ * moment, then held; a bad move changes nothing. */
+static void test_move_input(void **state)
+{
+  (void)state;
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  quiet(&c);
+  static plant_t p;
+  assert_int_equal(plant_init(&p, &c, 3u), 0);
+  const hal_dac_frame_t dac = {0};
+  hal_adc_frame_t adc;
+  const uint64_t n_100ms = (uint64_t)llround(0.1 * c.fs_hz);
+  for (uint64_t k = 0; k < n_100ms; k++) plant_step(&p, &dac, &adc);
+  assert_int_equal(plant_move_input(&p, PLANT_INPUT_RATE, 50.0, 0.2), 0);
+  for (uint64_t k = 0; k < n_100ms; k++) plant_step(&p, &dac, &adc); /* half the edge */
+  assert_float_equal(plant_input_now(&p, PLANT_INPUT_RATE), 25.0, 1e-6);
+  for (uint64_t k = 0; k < 2u * n_100ms; k++) plant_step(&p, &dac, &adc);
+  assert_float_equal(plant_input_now(&p, PLANT_INPUT_RATE), 50.0, 0.0);
+  /* back down from where it is, the ambient on its own */
+  assert_int_equal(plant_move_input(&p, PLANT_INPUT_AMBIENT, c.temp_k + 10.0, 0.1), 0);
+  for (uint64_t k = 0; k < n_100ms; k++) plant_step(&p, &dac, &adc);
+  assert_float_equal(plant_input_now(&p, PLANT_INPUT_AMBIENT), c.temp_k + 10.0, 1e-9);
+  assert_float_equal(plant_input_now(&p, PLANT_INPUT_RATE), 50.0, 0.0);
+  const plant_profiles_t before = p.prof;
+  const struct {
+    plant_input_t which;
+    double to, edge_s;
+  } bad[] = {{PLANT_INPUT_RATE, 2e4, 0.1},      {PLANT_INPUT_RATE, NAN, 0.1},
+             {PLANT_INPUT_RATE, 10.0, 0.0},     {PLANT_INPUT_RATE, 10.0, NAN},
+             {PLANT_INPUT_AMBIENT, 100.0, 1.0}, {PLANT_INPUT_AMBIENT, 300.0, 2e5}};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    assert_int_equal(plant_move_input(&p, bad[i].which, bad[i].to, bad[i].edge_s), -1);
+    assert_non_null(strstr(plant_error(&p), "move to"));
+    assert_memory_equal(&p.prof, &before, sizeof before);
+  }
+  /* a long power-off at the ambient now: every node there, warming again from it */
+  assert_true(plant_truth(&p)->circuit_k > c.temp_k + 1.0); /* its own dissipation */
+  assert_int_equal(plant_cold_soak(&p), 0);
+  for (int i = 0; i < THERMAL_NODES; i++)
+    assert_float_equal(thermal_temp(&p.thermal, i), c.temp_k + 10.0, 0.0);
+}
+
 static void test_cold_start(void **state)
 {
   (void)state;
@@ -648,7 +691,7 @@ int main(void)
       cmocka_unit_test(test_table_7_1_square_law), cmocka_unit_test(test_table_7_4_slopes),
       cmocka_unit_test(test_adc_budget),           cmocka_unit_test(test_temperature_plumbing),
       cmocka_unit_test(test_cold_start),           cmocka_unit_test(test_law_warnings),
-      cmocka_unit_test(test_board_seed),
+      cmocka_unit_test(test_board_seed),           cmocka_unit_test(test_move_input),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -22,7 +22,9 @@ static rate_valid_cfg_t cfg(void)
                         .phase_tol_rad = 0.01745f,
                         .bias_slope_dps_per_deg = 0.0f,
                         .grad_k_abs_dps_per_deg = 0.0f,
-                        .spur_m = {0.0f}};
+                        .spur_m = {0.0f},
+                        .settle_k = RATE_VALID_INPUT_K,
+                        .settle_diff_k = 1.0f};
   rate_valid_spur_matrix(4e-4f, 1e-4f, 1u, 0.0f,
                          c.spur_m); /* P_c over 5 s, the gradient over 20 s */
   return c;

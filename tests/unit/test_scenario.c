@@ -392,7 +392,7 @@ static void test_open_loop_frames_taken(void **state)
   static sim_result_t res;
   static sim_sweep_t sw;
   static sim_square_t sq;
-  const sim_opts_t opt = {NULL, 100.0, 0, 0, NULL};
+  const sim_opts_t opt = {NULL, 100.0, 0, 0, NULL, 1.0};
   assert_int_equal(sim_run_open_loop(sc, &opt, &res, &sw, &sq, err, sizeof err), 0);
   assert_int_equal(sw.n, 3);
   print_message("open-loop sweep: %llu frames refused, amplitude %.4f V at %.0f Hz\n",

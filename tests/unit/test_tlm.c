@@ -84,7 +84,8 @@ static int truth(const char *name, uint32_t k, uint32_t *w)
            {"flags", offsetof(gyro_out_t, flags), 1},
            {"tick", offsetof(gyro_out_t, tick), 1},
            {"rate_valid", offsetof(gyro_out_t, rate_valid), 1},
-           {"f_drive_hz", offsetof(gyro_out_t, f_drive_hz), 0}};
+           {"f_drive_hz", offsetof(gyro_out_t, f_drive_hz), 0},
+           {"rate_invalid", offsetof(gyro_out_t, rate_invalid), 1}};
   for (size_t i = 0; i < sizeof m / sizeof m[0]; i++) {
     if (strcmp(m[i].name, name) == 0) {
       const uint8_t *b = (const uint8_t *)&o;
@@ -240,16 +241,16 @@ static void test_link_budget_by_hand(void **state)
   assert_int_equal(p.rec_per_frame, 4u);
   assert_int_equal(p.bytes_per_s, 50u * 80u + 73u);
   assert_int_equal(p.link_bytes_per_s, 92160u);
-  /* all 18 at 1 kHz: N = min(20, 240/72) = 3, raw 13 + 12 * 18 = 229, wire 232,
-   * 1000/3 frames = 77333.3 -> 77334; header names 138 bytes + 36 + 30 = 204 -> 207 B:
-   * 77541 B/s > 70 % of 92160 = 64512 */
+  /* all 19 at 1 kHz: N = min(20, 240/76) = 3, raw 13 + 12 * 19 = 241, wire 244,
+   * 1000/3 frames = 81333.3 -> 81334; header names 150 bytes + 38 + 30 = 218 -> 221 B:
+   * 81555 B/s > 70 % of 92160 = 64512 */
   assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, TLM_FIELD_MASK_ALL, 1000.0f, &p),
                    TLM_ERR_BANDWIDTH);
   assert_int_equal(p.rec_per_frame, 3u);
-  assert_int_equal(p.bytes_per_s, 77334u + 207u);
-  /* all 18 at 500 Hz: 38666.7 -> 38667 + 207 */
+  assert_int_equal(p.bytes_per_s, 81334u + 221u);
+  /* all 19 at 500 Hz: 40666.7 -> 40667 + 221 */
   assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, TLM_FIELD_MASK_ALL, 500.0f, &p), TLM_OK);
-  assert_int_equal(p.bytes_per_s, 38667u + 207u);
+  assert_int_equal(p.bytes_per_s, 40667u + 221u);
   /* 12 f32 (the twelve floats) at 1 kHz: N = 5, raw 253, wire 256, 200 frames/s */
   assert_int_equal(tlm_plan(&app_tlm_fields, FS, BAUD, 0x0FFFu, 1000.0f, &p), TLM_OK);
   assert_int_equal(p.rec_per_frame, 5u);

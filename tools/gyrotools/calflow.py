@@ -28,8 +28,9 @@ firmware's generic defaults:
    the firmware marks valid where the input is held: scale factor over the thesis's
    range, the slope over every sub-range of at least lincal.SUBRANGE_MIN_DPS, bias at
    rest, never a valid rate off by more than VERIFY_MAX_ERR_DPS, then the on-demand
-   self-test at rest passes; other chamber plateaus, a heating ramp, a fast transient
-   and the noise with the compensation (thermcal: limits in thermcal.LIMITS).
+   self-test at rest passes; other chamber plateaus, a heating ramp, a fast transient,
+   a cold start (the warm-up) and the noise with the compensation (thermcal: limits in
+   thermcal.LIMITS).
 """
 
 from __future__ import annotations
@@ -101,6 +102,7 @@ class SimPart:
     seed: int
     work: str       # folder for the stages' files
     protocol: thermcal.Protocol = thermcal.FULL  # the thermal profiles (--quick: QUICK)
+    port: object = None  # a calport.PortTarget: the stages run on a part behind a UART
 
 
 def shown_path(path):
@@ -137,6 +139,11 @@ def _scenario(part, name, doc):
 def selfcal(part):
     """Stage 1: the firmware's sweep from its generic defaults -> a param set."""
     out = os.path.join(part.work, "selfcal_params.json")
+    if part.port is not None:
+        f = part.port.selfcal(out)
+        return out, {"command": part.port.describe("sweep"), "f0_hz": f["selfcal_f0_hz"],
+                     "q": f["selfcal_q"], "s": f["selfcal_s"], "true_f0_hz": None,
+                     "true_q": None}
     figs = os.path.join(part.work, "selfcal.json")
     scen = _scenario(part, "calibrate_selfcal", {
         "description": "a fresh part's self-calibration from the firmware's generic defaults",
@@ -175,18 +182,34 @@ def choose_drive(part, sc_path, drive, q):
 
 
 LOG_COLUMNS = ["rate_dps", "quad_dps", "rate_true_dps", "rate_valid", "rate_invalid"]
-THERMAL_COLUMNS = LOG_COLUMNS + ["rate_unc_dps", "p_f_deg", "t_struct_c"]
+THERMAL_COLUMNS = LOG_COLUMNS + ["rate_unc_dps", "p_f_deg"]
+# The simulator's truth, read where logged (a part on a port has none of it).
+TRUTH_COLUMNS = ("t_struct_c",)
+
+
+def _on_port(part, params, scenario, name, csv, columns):
+    """One run of a part on a port (calport): as _sim."""
+    with open(scenario, encoding="utf-8") as fh:
+        scen = json.load(fh)
+    log_path = os.path.join(part.work, name + ".csv")
+    replies = part.port.run(params, scen, log_path)
+    log = csvlog.read_log(log_path, need=columns or LOG_COLUMNS, want=TRUTH_COLUMNS,
+                          purpose=name) if csv else None
+    return log, replies, part.port.describe(f"{shown_path(scenario)} from {shown_path(params)}")
 
 
 def _sim(part, params, scenario, seed, name, csv=False, columns=None):
     """One gyro-sim run from the param set `params`: (its CSV log or None, the replies to
     the scenario's "commands", the command line)."""
+    if part.port is not None:
+        return _on_port(part, params, scenario, name, csv, columns)
     js = os.path.join(part.work, name + ".json")
     args = ["--scenario", scenario, "--firmware-params", params, "--seed", str(seed),
             "--no-analysis", "--quiet", "--json", js]
     log_path = os.path.join(part.work, name + ".csv")
     cmd = _run(part, args + (["--csv", log_path] if csv else []), name)
-    log = csvlog.read_log(log_path, need=columns or LOG_COLUMNS, purpose=name) if csv else None
+    log = csvlog.read_log(log_path, need=columns or LOG_COLUMNS, want=TRUTH_COLUMNS,
+                          purpose=name) if csv else None
     with open(js, encoding="utf-8") as fh:
         replies = [c["reply"] for c in json.load(fh).get("commands", [])]
     return log, replies, " ".join(cmd)
@@ -419,13 +442,14 @@ def part_id(sets):
     return zlib.crc32(("\n".join(sorted(sets)) + "\n").encode())
 
 
-def record(values, sets, date=None):
-    """Stage 3: the calibration record on top of the identified values."""
+def record(values, sets, date=None, part_no=None):
+    """Stage 3: the calibration record on top of the identified values; the part's id is
+    part_no (a board's serial) or, for a simulated part, part_id of its settings."""
     v = dict(values)
     v["cal.ref_freq_hz"] = v["drive.freq_hz"]
     v["cal.ref_phase_set_deg"] = v["drive.phase_set_deg"]
     v["cal.ref_track"] = v["drive.track"]  # the mode the sweep chose and the stages ran in
-    v["cal.part_id"] = part_id(sets)
+    v["cal.part_id"] = part_id(sets) if part_no is None else part_no
     d = date or datetime.date.today()
     v["cal.date"] = d.year * 10000 + d.month * 100 + d.day
     return v
@@ -556,6 +580,10 @@ def _thermal_runs(part, cal_path):
             {"description": "verification of a thermal calibration: a fast transient (heat "
                             "gun, then the room)"}, proto),
             4, lambda log: thermcal.verify_transient(log, proto))),
+        ("warmup", lambda: run("verify_warmup", thermcal.warmup_scenario(
+            {"description": "verification of a thermal calibration: a cold start at rest "
+                            "(IEEE 1431 12.6 warm-up time)"}, proto),
+            5, lambda log: thermcal.verify_warmup(log, proto))),
     ]
 
 
@@ -563,7 +591,7 @@ def verify_all(part, cal_path, workers=None):
     """Every verification run side by side (one gyro-sim process each): a dict of their
     figures, each with "ok" or "passed"."""
     jobs = [("rate", lambda: verify(part, cal_path))] + _thermal_runs(part, cal_path)
-    n = workers or os.cpu_count() or 1
+    n = 1 if part.port is not None else workers or os.cpu_count() or 1  # one part, one bench
     with concurrent.futures.ThreadPoolExecutor(max_workers=n) as pool:
         futs = {name: pool.submit(fn) for name, fn in jobs}
         return {name: f.result() for name, f in futs.items()}

@@ -135,6 +135,7 @@ def verification(doc):
     v = doc["verify"]
     r, pl, ramp, nz = v["rate"], v["thermal_plateaus"]["plateaus"], v["thermal_ramp"], v["noise"]
     tr = v.get("thermal_transient")  # a calibration verified before the transient had none
+    wu = v.get("warmup")  # nor the warm-up
     return {
         "command": doc["command"],
         "seeds": [r["seed"], v["thermal_plateaus"]["seed"], ramp["seed"], nz["seed"]],
@@ -150,8 +151,11 @@ def verification(doc):
         "transient": None if tr is None else {
             k: tr[k] for k in ("base_c", "hot_c", "heat_s", "bias_1s_std_dps", "bias_1s_pp_dps",
                                "valid_fraction", "seed")},
+        "warmup": None if wu is None else {
+            k: wu[k] for k in ("ambient_c", "bound_dps", "warmup_time_s", "raw_settle_time_s",
+                               "raw_change_dps", "worst_valid_1s_dps", "seed")},
         "passed": bool(r["passed"] and v["thermal_plateaus"]["ok"] and ramp["ok"] and nz["ok"]
-                       and (tr is None or tr["ok"])),
+                       and (tr is None or tr["ok"]) and (wu is None or wu["ok"])),
     }
 
 
@@ -181,7 +185,20 @@ def verification_rows(part, vf):
                      f"{fmt(tr['bias_1s_std_dps'], 2)} deg/s ({fmt(tr['bias_1s_pp_dps'], 2)}), "
                      f"valid {100 * tr['valid_fraction']:.1f} %",
                      "0.462 deg/s over its cool-down (in sample)"))
+    wu = vf.get("warmup")
+    if wu is not None:
+        rows.append((f"flow verification: warm-up from a cold start at {wu['ambient_c']:g} degC "
+                     f"(seed {wu['seed']}; IEEE 1431 12.6): 1 s means of the bias within "
+                     f"{wu['bound_dps']:g} deg/s for good; the raw output's own settling",
+                     f"{_secs(wu['warmup_time_s'])}; raw "
+                     f"{_secs(wu['raw_settle_time_s'], 'not within the run')} "
+                     f"(moves {wu['raw_change_dps']:+.2f} deg/s); worst valid 1 s mean "
+                     f"{fmt(wu['worst_valid_1s_dps'], 2)} deg/s", ""))
     return [Row(f, v, t, part, "yes", OUT, src) for f, v, t in rows]
+
+
+def _secs(t_s, none="never"):
+    return none if t_s is None else f"{t_s:.0f} s"
 
 
 def drive_rows(F):

@@ -9,9 +9,14 @@ From DIR/report.json's "verify" section and the verification runs' logs in DIR/w
   after which rate_valid stays 1 until the input first moves (or the self-test starts);
   the time to the error bound is the time to the first sample after which
   |rate_dps - rate_true_dps| stays within the verification's bound (its worst valid
-  error, 1 deg/s) over the same rest, whether the output is marked valid or not.
-  12.6's warm-up time is not measured: the simulated part starts at its own thermal
-  equilibrium (the start's and the end's structure temperature are reported);
+  error, 1 deg/s) over the same rest, whether the output is marked valid or not (this
+  run starts at the part's own thermal equilibrium: the start's and the end's
+  structure temperature are reported);
+- warm_up.png (12.6 warm-up time), from verify_warmup.csv, a cold start at rest (every
+  node of the thermal network at the ambient at power-on, the part's own dissipation
+  warming it): thermcal.verify_warmup's figures, the time from power-on after which the
+  1 s means of the valid output stay within the compensation's bound (0.2 deg/s), and
+  the raw output's own settling to its final level, for comparison;
 - scale_factor.png (12.9 scale factor test series), from verify.csv: the held rates'
   means, each rate against the rests around it (the verification's rate transfer test,
   lincal.bias_between_rests), valid samples only, before the self-test; scale factor,
@@ -55,9 +60,11 @@ NEED = {
     "verify_noise.csv": ("rate_dps", "rate_unc_dps"),
     "verify_plateaus.csv": ("rate_dps", "rate_true_dps", "rate_valid", "p_f_deg"),
     "verify_ramp.csv": ("rate_dps", "rate_true_dps", "rate_valid"),
+    "verify_warmup.csv": ("rate_dps", "rate_unc_dps", "rate_true_dps", "rate_valid"),
 }
-WANT = figures.TEMPERATURES
-FILES = ("turn_on.png", "scale_factor.png", "drift.png", "temperature.png", "ieee1431.json")
+WANT = figures.TEMPERATURES + ("t_circuit_c",)  # the circuit's: warm_up.png, when logged
+FILES = ("turn_on.png", "warm_up.png", "scale_factor.png", "drift.png", "temperature.png",
+         "ieee1431.json")
 
 
 @dataclasses.dataclass
@@ -167,6 +174,21 @@ def turn_on_series(ctx):
             "png": ctx.rel(png), "definitions": DEFINITIONS, **figs}
 
 
+def warm_up_series(ctx):
+    plots = _plots()
+    log = ctx.log("verify_warmup.csv")
+    run = series_run(ctx, "warmup")
+    figs = thermcal.verify_warmup(log, ctx.protocol)
+    png = plots.warm_up(ctx, log, figs, run)
+    return {"clause": "IEEE 1431 12.6 warm-up time", **run, "log": ctx.rel(log.path),
+            "png": ctx.rel(png),
+            "how": "a cold start at rest (plant.cold_start: every thermal node at the ambient "
+                   "at power-on); warm-up time: the start of the first 1 s bin from power-on "
+                   "after which every bin's mean of the valid rate_dps lies within bound_dps "
+                   "of the input; raw_settle_time_s: the same for rate_unc_dps against its "
+                   "own final level (its last 60 s)", **figs}
+
+
 def scale_factor_series(ctx):
     plots = _plots()
     log = ctx.log("verify.csv")
@@ -230,6 +252,7 @@ def temperature_series(ctx):
 
 
 SECTIONS = (("turn_on", turn_on_series, ("verify.csv",)),
+            ("warm_up", warm_up_series, ("verify_warmup.csv",)),
             ("scale_factor", scale_factor_series, ("verify.csv",)),
             ("drift", drift_series, ("verify_noise.csv",)),
             ("temperature", temperature_series, ("verify_plateaus.csv", "verify_ramp.csv")))
@@ -258,8 +281,9 @@ def write(out_dir, calibration=None):
     InputError only when DIR/report.json is missing or no verification's."""
     clear(out_dir)
     ctx = load(out_dir)
-    doc = {"standard": "shaped after IEEE Std 1431-2004 clause 12 (turn-on time, scale factor, "
-                       "drift rate and operating temperature test series); noise coefficients "
+    doc = {"standard": "shaped after IEEE Std 1431-2004 clause 12 (turn-on time, warm-up time, "
+                       "scale factor, drift rate and operating temperature test series); noise "
+                       "coefficients "
                        "after IEEE Std 952-1997",
            "part": ctx.part(), "sets": ctx.sets(),
            "calibration": calibration or ctx.report.get("verify_only"), "protocol": ctx.protocol.name,
@@ -285,6 +309,11 @@ def summary(doc):
         out.append(f"turn-on time {_f(t['turn_on_time_s'], '.3g')} s (valid for good), within "
                    f"{t['error_bound_dps']:g} deg/s of the input at "
                    f"{_f(t['time_to_error_bound_s'], '.3g')} s")
+    w = doc.get("warm_up", {})
+    if "error" not in w:
+        out.append(f"warm-up time {_f(w['warmup_time_s'], '.3g')} s from a cold start (1 s means "
+                   f"within {w['bound_dps']:g} deg/s for good; the raw output "
+                   f"{_f(w['raw_settle_time_s'], '.3g')} s)")
     s = doc.get("scale_factor", {})
     if "error" not in s:
         out.append(f"scale factor {s['scale_factor_error_ppm']:+.0f} ppm over +-"

@@ -8,7 +8,7 @@ import textwrap
 
 import numpy as np
 
-from . import allan, plotting, scalefactor
+from . import allan, plotting, scalefactor, thermcal
 
 WRAP = 95  # characters of the command per title line (a 7 in figure at 10 pt)
 
@@ -47,6 +47,35 @@ def turn_on(ctx, log, mask, figs, run):
     a2.set_ylim(-0.1, 1.1)
     plotting.finish(a2, xlabel="time since power-on [s]", ylabel="rate_valid [0/1]")
     return plotting.save(fig, ctx.folder, "turn_on.png")
+
+
+def warm_up(ctx, log, figs, run):
+    """A cold start's 1 s means, compensated and raw, against the time since power-on (a
+    log axis: the compensated output warms in seconds, the raw one in many minutes), with
+    the bound and both settling times; the structure's temperature under them."""
+    m = thermcal.warmup_means(log)
+    t, b = m["t_s"] + 0.5 * thermcal.BIN_S, figs["bound_dps"]
+    fig, (a1, a2) = plotting.figure(2, 1, height_in=3.2, sharex=True, height_ratios=(3, 1))
+    a1.axhspan(-b, b, color="C2", alpha=0.2, label=f"input +-{b:g} deg/s")
+    a1.plot(t, m["rate_dps"], lw=0.9, color="C0", label="rate_dps (compensated, valid samples)")
+    a1.plot(t, m["rate_unc_dps"] - figs["raw_final_dps"], lw=0.9, color="C7",
+            label=f"rate_unc_dps less its final level {figs['raw_final_dps']:+.3f} deg/s")
+    for key, what, color in (("warmup_time_s", "warm-up time", "C3"),
+                             ("raw_settle_time_s", "raw output settled", "C1")):
+        _mark((a1, a2), figs[key], what + (" n/a" if figs[key] is None else f" {figs[key]:.0f} s"),
+              color)
+    a1.set_xscale("log")
+    a1.set_xlim(0.5 * thermcal.BIN_S, t[-1])
+    plotting.finish(a1, title=title(ctx, f"Warm-up from a cold start at {figs['ambient_c']:g} "
+                                         "degC (IEEE 1431 12.6)", run),
+                    ylabel="1 s mean of the rate [deg/s]")
+    late = log["t_s"] >= 0.5 * thermcal.BIN_S
+    for col, color, name in (("t_struct_c", "C1", "structure"), ("t_circuit_c", "C4", "circuit"),
+                             ("t_ambient_c", "C7", "ambient")):
+        if col in log:
+            a2.plot(log["t_s"][late], log[col][late], lw=0.9, color=color, label=name + " (logged)")
+    plotting.finish(a2, xlabel="time since power-on [s]", ylabel="temperature [degC]")
+    return plotting.save(fig, ctx.folder, "warm_up.png")
 
 
 def scale_factor(ctx, res, run):

@@ -42,6 +42,7 @@ CAL_FIGURES = {
     "cal.ramp_bias_std_dps": ("verify", "thermal_ramp", "bias_1s_std_dps"),
     "cal.transient_bias_std_dps": ("verify", "thermal_transient", "bias_1s_std_dps"),
     "cal.noise_ratio_1s": ("verify", "noise", "ratio"),
+    "cal.warmup_time_s": ("verify", "warmup", "warmup_time_s"),
 }
 
 

@@ -35,7 +35,8 @@ stored reference (cal.ref_p_deg), whatever Q.
 Verification on profiles the fit never saw, each with its own noise seed: other plateaus
 (VERIFY_PLATEAUS_C, with rate steps: bias and SF there), a heating ramp 25 -> 65 degC at
 2 K/min (the 1 s means of the bias), a fast transient (TRANSIENT: a heat gun and the room,
-the 1 s means of the bias), and the output noise at constant temperature with
+the 1 s means of the bias), a cold start (WARMUP: the warm-up time, verify_warmup), and
+the output noise at constant temperature with
 the compensation against without it (Allan deviation at 1 s and 10 s of rate_dps and
 rate_unc_dps of the same run, verify_noise).
 """
@@ -48,6 +49,7 @@ import numpy as np
 from scipy.signal import lfilter
 
 from . import allan, tempcomp
+from .errors import InputError
 
 CAL_PLATEAUS_C = (25.0, -40.0, -10.0, 10.0, 40.0, 60.0, 85.0)
 VERIFY_PLATEAUS_C = (-25.0, 0.0, 20.0, 50.0, 70.0)
@@ -118,6 +120,17 @@ NOISE_S = 1200.0
 # heating: what a slow thermometer lags. (base degC, hot degC, lead s, heat s, tau_heat s,
 # tau_cool s, total s)
 TRANSIENT = (25.0, 65.0, 120.0, 600.0, 90.0, 45.0, 2400.0)
+# A cold start (IEEE 1431 12.6, warm-up time): power-on after a long power-off, every node
+# of the thermal network at the ambient (plant.cold_start), at rest at a constant ambient;
+# the part's own dissipation then warms the circuit and the structure over minutes (the
+# default part's slowest thermal mode: 306 s, tools/thermal_warmup.py). (ambient degC,
+# run s)
+WARMUP = (25.0, 1800.0)
+# The uncompensated output's final level: its mean over the run's last this many seconds.
+WARMUP_FINAL_S = 60.0
+# The raw output's warm-up change is reported from its level this long after power-on (the
+# drive locked, P's fast start over).
+WARMUP_EARLY_S = 10.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -135,6 +148,7 @@ class Protocol:
     comp_stages: int = COMP_STAGES
     comp_fast_tau_s: float = COMP_FAST_TAU_S  # its fast path (0: none)
     transient: tuple = TRANSIENT
+    warmup: tuple = WARMUP
 
 
 FULL = Protocol("full", CAL_PLATEAUS_C, CAL_DWELL_S, VERIFY_PLATEAUS_C,
@@ -154,11 +168,12 @@ FULL = Protocol("full", CAL_PLATEAUS_C, CAL_DWELL_S, VERIFY_PLATEAUS_C,
 # the span it fits (22 -> 29 degC of surroundings).
 QUICK = Protocol("quick", (25.0, 15.0, 35.0), 400.0, (20.0, 30.0),
                  (22.0, 28.0, 2.0, 60.0, 120.0), 120.0, "15..35 degC only", True, 5.0, 1,
-                 0.0, (22.0, 29.0, 60.0, 300.0, 60.0, 30.0, 1200.0))
+                 0.0, (22.0, 29.0, 60.0, 300.0, 60.0, 30.0, 1200.0), (25.0, 600.0))
 # The transient is held to the ramp's limit: the 1 s means of the bias within 0.2 deg/s
 # std (the thesis: 0.462 deg/s over its cool-down, in sample).
 LIMITS = {"ramp_bias_std_dps": 0.2, "plateau_bias_dps": 0.2, "sf_ppm": 500.0,
-          "noise_ratio": 1.1, "valid_fraction": 0.9, "transient_bias_std_dps": 0.2}
+          "noise_ratio": 1.1, "valid_fraction": 0.9, "transient_bias_std_dps": 0.2,
+          "warmup_bias_dps": 0.2, "warmup_worst_dps": 1.0}
 
 
 def _plateau_profiles(temps_c, dwell_s):
@@ -193,6 +208,12 @@ def transient_scenario(doc, proto=FULL):
                 ambient_c={"kind": "heat_cool", "value": base, "hot_value": hot,
                            "t_start_s": lead, "heat_s": heat, "tau_heat_s": tau_h,
                            "tau_cool_s": tau_c})
+
+
+def warmup_scenario(doc, proto=FULL):
+    ambient_c, total = proto.warmup
+    return dict(doc, duration_s=total, csv_rate_hz=10, plant={"cold_start": True},
+                ambient_c={"kind": "const", "value": ambient_c})
 
 
 def noise_scenario(doc, proto=FULL):
@@ -235,7 +256,8 @@ def plateau_points(log, n, dwell_s, out="rate_unc_dps"):
         rows.append({"p_deg": float(np.mean(pf[rest])),
                      "p_turn_deg_per_dps": float((p_pos - np.mean(pf[neg]))
                                                  / (2 * STEP_RATE_DPS)),
-                     "t_struct_c": float(np.mean(log["t_struct_c"][rest])),
+                     "t_struct_c": (float(np.mean(log["t_struct_c"][rest]))
+                                    if "t_struct_c" in log else float("nan")),
                      "bias_dps": float(np.mean(u[rest])),
                      "gain": float((u_pos - np.mean(u[neg])) / (2 * STEP_RATE_DPS)),
                      "valid": float(np.mean(log["rate_valid"][rest | pos | neg | pos2]))})
@@ -446,6 +468,80 @@ def verify_transient(log, proto=FULL):
             "valid_fraction": valid,
             "ok": bool(np.isfinite(std) and std <= LIMITS["transient_bias_std_dps"] and
                        valid >= LIMITS["valid_fraction"])}
+
+
+def settled_time(t, ok):
+    """The time of the first sample after which ok holds to the end of t; None when the
+    last sample does not hold."""
+    if t.size == 0 or not ok[-1]:
+        return None
+    bad = np.flatnonzero(~ok)
+    return float(t[0 if bad.size == 0 else bad[-1] + 1])
+
+
+def _bins_from_zero(log, mask, column):
+    """Means of `column` over the samples in mask, in BIN_S bins from power-on: (bin
+    starts, means; NaN where a bin has none)."""
+    t = log["t_s"]
+    k = np.floor(t / BIN_S).astype(np.int64)
+    n = int(k[-1]) + 1
+    cnt = np.bincount(k[mask], minlength=n)
+    tot = np.bincount(k[mask], weights=log[column][mask], minlength=n)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.arange(n) * BIN_S, np.where(cnt > 0, tot / np.maximum(cnt, 1), np.nan)
+
+
+def warmup_means(log):
+    """A cold start's 1 s means from power-on, at rest: "t_s" (bin starts), "rate_dps" (its
+    valid samples; NaN where a bin has none), "rate_unc_dps" (every sample)."""
+    rest = np.abs(log["rate_true_dps"]) < 1e-9
+    t_bin, comp = _bins_from_zero(log, rest & (log["rate_valid"] > 0.5), "rate_dps")
+    return {"t_s": t_bin, "rate_dps": comp,
+            "rate_unc_dps": _bins_from_zero(log, rest, "rate_unc_dps")[1]}
+
+
+def verify_warmup(log, proto=FULL):
+    """A cold start at rest (warmup_scenario), IEEE 1431 12.6: the warm-up time is the
+    start of the first 1 s bin from power-on after which every bin's mean of the valid
+    output lies within LIMITS["warmup_bias_dps"] of the input (0: a bin with no valid
+    sample is not warm); the raw output's own settling (within the same bound of its
+    final level, the mean of its last WARMUP_FINAL_S; None when it still moves at the end
+    of the run) says what the compensation saves.
+    Judged: the output ends warm, is valid for LIMITS["valid_fraction"] of the run after
+    its first valid sample, and no valid 1 s mean is off by more than
+    LIMITS["warmup_worst_dps"] (a wrong rate the product would stand behind)."""
+    ambient_c, total = proto.warmup
+    t, bound = log["t_s"], LIMITS["warmup_bias_dps"]
+    if t.size < 2 or t[-1] < 2.0 * WARMUP_FINAL_S:
+        raise InputError(f"{log.path}: {t[-1] if t.size else 0:.3g} s from power-on: too short "
+                         f"for a warm-up time (at least {2.0 * WARMUP_FINAL_S:g} s)")
+    valid = log["rate_valid"] > 0.5
+    m = warmup_means(log)
+    t_bin, comp, unc = m["t_s"], m["rate_dps"], m["rate_unc_dps"]
+    end = t_bin[-1] + BIN_S
+    final = float(np.nanmean(unc[t_bin >= end - WARMUP_FINAL_S]))
+    before = float(np.nanmean(unc[(t_bin >= end - 2 * WARMUP_FINAL_S) &
+                                  (t_bin < end - WARMUP_FINAL_S)]))
+    warm = np.isfinite(comp) & (np.abs(comp) <= bound)
+    t_warm = settled_time(t_bin, warm)
+    # Still moving at the end (its last minute against the one before by more than a
+    # quarter of the bound): the run is shorter than the raw output's warm-up.
+    raw_settled = abs(final - before) <= 0.25 * bound
+    t_raw = settled_time(t_bin, np.abs(unc - final) <= bound) if raw_settled else None
+    first = np.flatnonzero(valid)
+    after = t >= t[first[0]] if first.size else np.zeros_like(valid)
+    frac = float(np.mean(valid[after])) if np.any(after) else 0.0
+    worst = float(np.nanmax(np.abs(comp))) if np.any(np.isfinite(comp)) else float("nan")
+    return {"ambient_c": ambient_c, "run_s": float(t[-1]), "bound_dps": bound,
+            "warmup_time_s": t_warm, "raw_settle_time_s": t_raw,
+            "raw_final_dps": final, "raw_end_drift_dps_per_min": (final - before) * 60.0
+            / WARMUP_FINAL_S, "raw_settled_in_run": bool(raw_settled),
+            "raw_change_dps": float(final - unc[int(WARMUP_EARLY_S / BIN_S)]),
+            "worst_valid_1s_dps": worst, "valid_fraction": frac,
+            "t_struct_c": ([float(log["t_struct_c"][0]), float(log["t_struct_c"][-1])]
+                           if "t_struct_c" in log else None),
+            "ok": bool(t_warm is not None and frac >= LIMITS["valid_fraction"] and
+                       np.isfinite(worst) and worst <= LIMITS["warmup_worst_dps"])}
 
 
 # The noise ratio is judged at 1 s and, on a record of at least this many times 10 s, at

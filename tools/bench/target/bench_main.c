@@ -29,6 +29,8 @@
  *   isr_track           the same drive switched to the tracking drive (drive.track 1:
  *                       its PLL, the position-form amplitude PI and their notches),
  *                       BENCH_N_TRACE interrupts
+ *   isr_fr              force rebalance added (sense.mode 1; the continuous self-test
+ *                       off, as its design requires), BENCH_N_TRACE interrupts
  *   isr_fault           a NaN planted in the drive demodulator: the fault's tick, the
  *                       loop state's clear and the ticks after it
  *   isr_sweep_chirp     SWEEP: the self-calibration executive (selfcal_exec.h) on a
@@ -407,6 +409,30 @@ static void trace_tracking(void)
   irq_case_n("isr_track", bench_cb, BENCH_N_TRACE);
 }
 
+/* Force rebalance (sense.mode 1) on the tracking drive with quadrature nulling, every
+ * closed-sense loop built so far: the feedback pair's waveform each tick and the loop's
+ * update steps over the block. The continuous self-test is off (the design refuses it
+ * with the loop closed). The sense model is the closed-loop test's part (Q 1e4 at
+ * 1600 Hz); the bench's plant has no feedback electrodes, so the loop runs to its
+ * limit, its costlier path. */
+static gyro_design_t s_fr_design;
+static void trace_force_rebalance(void)
+{
+  param_values_t v = *params_current(&s_app.params);
+  v.drive_track = 1u;
+  v.sense_mode = 1u;
+  v.selftest_continuous = 0u;
+  v.sense_f0_hz = 1600.0f;
+  v.sense_q = 1.0e4f;
+  v.sense_fb_gain_v_per_v2 = 0.46f;
+  if (gyro_design(&v, &s_fr_design) != GYRO_DESIGN_OK) fail("fr_design", -1);
+  gyro_apply(&s_app.gyro, &s_fr_design);
+  s_app.gyro.valid.p_updates = RATE_VALID_SLEW_UPDATES - 1u;
+  put_state("isr_fr");
+  irq_case_n("isr_fr", bench_cb, BENCH_N_TRACE);
+  gyro_apply(&s_app.gyro, &s_track_design); /* the fault and SWEEP traced as before */
+}
+
 /* The rarer ticks (trace mode): a fault and its clear, then SWEEP's jobs. */
 static void trace_other_modes(void)
 {
@@ -467,6 +493,7 @@ static void bench_app(uint32_t settle, int trace)
     put_state("isr_app_cb");
     irq_case("isr_app_cb", bench_cb);
     trace_tracking();
+    trace_force_rebalance();
     trace_other_modes();
     s_each = 0;
     direct_case("cb_wrap", bench_cb_empty);

@@ -121,3 +121,66 @@ def test_gain_changes_the_loop(sim, gyroctl):
     assert done < 1.0 - math.exp(-(elapsed + 0.2) / 3.2) + 0.1
     assert done < 0.8
     assert status(gyroctl, sim)["fault_count"] == "0"
+
+
+def emu(gyroctl, port, line):
+    """One `emu` line through the shell: (its `- key value` data as a dict, its final
+    line). The shell exits 1 after an err reply."""
+    r = subprocess.run(gyroctl + ["--port", port, "shell"], input=line + "\n",
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode in (0, 1) and "Traceback" not in r.stderr, r.stderr
+    lines = r.stdout.splitlines()
+    data = dict(ln[2:].split(" ", 1) for ln in lines if ln.startswith("- "))
+    return data, next(ln for ln in lines if ln.startswith(("ok", "err")))
+
+
+def test_the_simulated_bench_turns_the_table_and_sets_the_chamber(sim, gyroctl, tmp_path):
+    """`emu rate` moves the plant's input rate, which the rate output then reads; `emu
+    ambient` moves the chamber along its edge; a bad move is refused and changes
+    nothing."""
+    wait_locked(gyroctl, sim)
+    _, ok = emu(gyroctl, sim, "emu rate 30 0.05")
+    assert ok.startswith("ok rate 30 edge_s 0.05 t_s ")
+    _, ok = emu(gyroctl, sim, "emu ambient 35 1000")
+    t_move = float(ok.split()[-1])
+    for bad, code in (("emu rate 20000", "err RANGE"), ("emu ambient x", "err VALUE"),
+                      ("emu rate 10 0", "err RANGE"), ("emu tilt 3", "err ARGS")):
+        assert emu(gyroctl, sim, bad)[1].startswith(code), bad
+    time.sleep(0.3)
+    out = tmp_path / "table.csv"
+    r = ctl(gyroctl, sim, "log", "rate_dps", "rate_valid", "--rate", "100", "--duration", "0.5",
+            "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    rows = [row for row in csv.reader(ln for ln in open(out) if not ln.startswith("#"))][1:]
+    rates = [float(x[1]) for x in rows if x[2] == "1"]
+    assert len(rates) > 40 and abs(sum(rates) / len(rates) / 30.0 - 1.0) < 0.01
+    fig, _ = emu(gyroctl, sim, "emu")
+    assert float(fig["rate_dps"]) == 30.0
+    # 25 -> 35 degC over 1000 s: at 1/100 K per second of the session since the move.
+    moved = float(fig["ambient_c"]) - 25.0
+    assert moved == pytest.approx((float(fig["t_s"]) - t_move) / 100.0, abs=1e-3)
+
+
+def test_an_unpaced_session_runs_faster_than_real_time(gyro_sim, gyroctl, tmp_path):
+    """--pace 0: gyro time runs as fast as the simulator does, and the session still
+    answers. The release build runs about 50x real time on one core; the sanitizer
+    build under a loaded CI read 2.9x, so faster than real time is judged as over 1.5x
+    (a paced session, --pace 1, stays at or under 1x)."""
+    scen = os.path.join(os.environ.get("GYRO_SCENARIOS", ""), "startup.json")
+    if not os.path.exists(scen):
+        pytest.skip("GYRO_SCENARIOS not set")
+    link = str(tmp_path / "gyro.pty")
+    proc = subprocess.Popen([gyro_sim, "--scenario", scen, "--duration", "3600", "--quiet",
+                             "--pace", "0", f"--uart-pty={link}"], stdout=subprocess.PIPE,
+                            text=True)
+    try:
+        assert proc.stdout.readline().startswith("pty ")
+        t0 = float(emu(gyroctl, link, "emu")[0]["t_s"])
+        wall0 = time.time()
+        time.sleep(1.0)
+        fig, _ = emu(gyroctl, link, "emu")
+        assert float(fig["pace"]) == 0.0
+        assert (float(fig["t_s"]) - t0) / (time.time() - wall0) > 1.5
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)

@@ -75,6 +75,77 @@ def test_turn_on_never_valid_says_so():
     assert f["turn_on_time_s"] is None and "not valid for good" in f["turn_on_note"]
 
 
+# --- 12.6 warm-up ---------------------------------------------------------------------
+
+WARM_TAU_S, RAW_STEP_DPS, RAW_TAU_S = 15.0, -3.8, 300.0
+
+
+def warmup_log(seconds=1800.0, dt=0.1, comp_end_dps=0.0, spike_dps=0.3, seed=11):
+    """A cold start at rest: the raw output settles as RAW_STEP exp(-t/RAW_TAU) (within
+    0.2 deg/s of its end from RAW_TAU ln(3.8/0.2) = 883 s), the compensated one as
+    0.5 exp(-t/WARM_TAU) (within 0.2 from WARM_TAU ln 2.5 = 13.7 s) with a valid spike of
+    spike_dps at 40..41 s and an invalid 2 deg/s one at 60..60.5 s; valid from 0.5 s."""
+    t = np.arange(0.0, seconds, dt)
+    rng = np.random.default_rng(seed)
+    noise = 0.02 * rng.standard_normal(t.size)  # 1 s means: 0.006 deg/s sd
+    raw = RAW_STEP_DPS * np.exp(-t / RAW_TAU_S) + noise
+    comp = comp_end_dps + 0.5 * np.exp(-t / WARM_TAU_S) + noise
+    comp[(t >= 40.0) & (t < 41.0)] += spike_dps
+    bad = (t >= 60.0) & (t < 60.5)
+    comp[bad] += 2.0
+    valid = (t >= 0.5) & ~bad
+    return mklog(t_s=t, rate_dps=comp, rate_unc_dps=raw, rate_true_dps=np.zeros_like(t),
+                 rate_valid=valid.astype(float), rate_invalid=np.where(valid, 0, 4),
+                 t_struct_c=25.0 + 1.3 * (1.0 - np.exp(-t / 400.0)))
+
+
+def test_warm_up_time_is_after_the_last_valid_excursion_and_the_raw_settling_is_timed():
+    f = thermcal.verify_warmup(warmup_log())
+    # The 0.3 deg/s spike fills the 40 s bin: warm from the next bin. The invalid 2 deg/s
+    # one is not the product's output (the rate says it is not valid): the 60 s bin is the
+    # mean of its valid half.
+    assert f["warmup_time_s"] == 41.0
+    # 883 s: a 1 s bin straddling the crossing moves it by under a bin; the noise of the
+    # means (0.006 deg/s sd) against the curve's slope there (0.2/300 deg/s per s) by about
+    # 4 sd = 36 s.
+    assert f["raw_settle_time_s"] == pytest.approx(RAW_TAU_S * math.log(3.8 / 0.2), abs=40.0)
+    assert f["raw_change_dps"] == pytest.approx(3.8 * math.exp(-10.0 / RAW_TAU_S), abs=0.05)
+    assert f["worst_valid_1s_dps"] == pytest.approx(0.5 * math.exp(-0.5 / WARM_TAU_S), abs=0.05)
+    assert f["valid_fraction"] == pytest.approx(1.0 - 0.5 / 1799.5, abs=1e-4)
+    assert f["ok"]
+
+
+def test_warm_up_without_the_spike_is_the_decay_crossing_the_bound():
+    f = thermcal.verify_warmup(warmup_log(spike_dps=0.0))
+    assert f["warmup_time_s"] == pytest.approx(WARM_TAU_S * math.log(2.5), abs=1.0)
+
+
+def test_warm_up_fails_when_the_output_ends_off_or_a_valid_mean_is_wrong():
+    off = thermcal.verify_warmup(warmup_log(comp_end_dps=0.25))
+    assert off["warmup_time_s"] is None and not off["ok"]
+    wrong = thermcal.verify_warmup(warmup_log(spike_dps=1.5))
+    assert wrong["worst_valid_1s_dps"] > 1.0 and not wrong["ok"]
+    assert wrong["warmup_time_s"] == 41.0  # warm after it all the same
+    log = warmup_log()
+    log.data["rate_valid"][(log["t_s"] >= 100.0) & (log["t_s"] < 101.0)] = 0.0
+    # A whole second the product does not stand behind is not warm.
+    assert thermcal.verify_warmup(log)["warmup_time_s"] == 101.0
+
+
+def test_a_raw_output_still_moving_at_the_end_has_no_settling_time():
+    # 600 s: the raw output moves 3.8 exp(-540/300) (1 - exp(-60/300)) = 0.11 deg/s
+    # between its last two minutes, over a quarter of the 0.2 deg/s bound.
+    f = thermcal.verify_warmup(warmup_log(seconds=600.0))
+    assert f["raw_settle_time_s"] is None and not f["raw_settled_in_run"]
+    assert f["raw_end_drift_dps_per_min"] == pytest.approx(0.11, abs=0.02)
+    assert f["warmup_time_s"] == 41.0 and f["ok"]
+
+
+def test_a_too_short_warm_up_log_is_an_input_error():
+    with pytest.raises(InputError, match="too short for a warm-up time"):
+        thermcal.verify_warmup(warmup_log(seconds=100.0))
+
+
 # --- 12.9 scale factor ----------------------------------------------------------------
 
 DWELL, REST, FS_TABLE = 2.0, 1.5, 200.0
@@ -267,8 +338,9 @@ def made(tmp_path_factory):
     _write(work / "verify_noise.csv", noise_log(30.0, 20.0, seconds=45.0))
     _write(work / "verify_plateaus.csv", plateau_log(), every=10)
     _write(work / "verify_ramp.csv", ramp_log(), every=5)
+    _write(work / "verify_warmup.csv", warmup_log(seconds=600.0), every=2)
     run = {k: {"command": f"gyro-sim --seed {1001 + i}", "seed": 1001 + i}
-           for i, k in enumerate(("rate", "thermal_plateaus", "thermal_ramp", "noise"))}
+           for i, k in enumerate(("rate", "thermal_plateaus", "thermal_ramp", "noise", "warmup"))}
     run["rate"]["limits"] = {"worst_valid_error_dps": 1.0}
     (d / "report.json").write_text(json.dumps({
         "tool": "calibrate", "command": "tools/calibrate --sim --quick --verify-only X --out D",
@@ -298,10 +370,11 @@ def test_report_folder_holds_every_series(written):
     assert problems == []
     folder = d / "ieee1431"
     assert path == str(folder / "ieee1431.json")
-    for name in ("turn_on", "scale_factor", "drift", "temperature"):
+    for name in ("turn_on", "warm_up", "scale_factor", "drift", "temperature"):
         assert (folder / doc[name]["png"]).is_file()
         assert not os.path.isabs(doc[name]["png"])
-    assert ieee1431.pngs(doc) == ["turn_on.png", "scale_factor.png", "drift.png", "temperature.png"]
+    assert ieee1431.pngs(doc) == ["turn_on.png", "warm_up.png", "scale_factor.png", "drift.png",
+                                  "temperature.png"]
 
 
 def test_report_json_names_each_runs_command_seed_and_log(written):
@@ -310,6 +383,7 @@ def test_report_json_names_each_runs_command_seed_and_log(written):
     assert doc["drift"]["seed"] == 1004 and doc["drift"]["command"] == "gyro-sim --seed 1004"
     assert doc["temperature"]["ramp"]["seed"] == 1003
     assert doc["temperature"]["plateaus"]["seed"] == 1002
+    assert doc["warm_up"]["seed"] == 1005 and doc["warm_up"]["warmup_time_s"] == 41.0
     assert doc["part"] == "part plant.q_drive=40" and doc["report"] == os.path.join("..", "report.json")
 
 
@@ -377,7 +451,8 @@ def _verify_only(tmp_path, monkeypatch, capsys):
 def test_calibrate_names_each_missing_log_and_keeps_the_verdict(tmp_path, monkeypatch, capsys):
     code, out, err = _verify_only(tmp_path, monkeypatch, capsys)
     assert code == 0 and "Traceback" not in err
-    for name in ("verify.csv", "verify_noise.csv", "verify_plateaus.csv", "verify_ramp.csv"):
+    for name in ("verify.csv", "verify_noise.csv", "verify_plateaus.csv", "verify_ramp.csv",
+                 "verify_warmup.csv"):
         assert any(name in ln and "cannot open" in ln and "WARNING" in ln
                    for ln in err.splitlines()), name
     assert "IEEE 1431 report: wrote" in out and "ieee1431.json" in out

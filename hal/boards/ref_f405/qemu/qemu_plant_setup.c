@@ -15,13 +15,7 @@ int qemu_plant_setup(plant_t *p, plant_profiles_t *prof)
 
 int qemu_plant_rate_ramp(plant_t *p, plant_profiles_t *prof, double rate_dps)
 {
-  if (!(rate_dps >= -1e4 && rate_dps <= 1e4)) return -1; /* plant_cfg rate_dps range */
-  const double t_s = (double)p->k * p->T;
-  const double from_dps = profile_eval(&prof->rate_dps, t_s, 0);
-  plant_profiles_t next = *prof;
-  profile_ramp(&next.rate_dps, from_dps, (rate_dps - from_dps) / QEMU_PLANT_EDGE_S, t_s,
-               t_s + QEMU_PLANT_EDGE_S);
-  if (plant_set_profiles(p, &next) != 0) return -1;
-  *prof = next;
+  if (plant_move_input(p, PLANT_INPUT_RATE, rate_dps, QEMU_PLANT_EDGE_S) != 0) return -1;
+  *prof = p->prof;
   return 0;
 }

@@ -1,0 +1,121 @@
+#include "gyro/sense_fr.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#include "dsp/math_const.h"
+
+static int pos_finite(float x) { return isfinite(x) && x > 0.0f; }
+
+static int cfg_ok(const sense_fr_cfg_t *c)
+{
+  return pos_finite(c->bw_hz) && pos_finite(c->zeta) && pos_finite(c->f_sense_hz) &&
+         isfinite(c->q_sense) && c->q_sense >= 0.5f && pos_finite(c->f_drive_hz) &&
+         isfinite(c->gain_per_v2) && c->gain_per_v2 != 0.0f && pos_finite(c->lag_s) &&
+         pos_finite(c->f_max_v2) && pos_finite(c->settle_r) && isfinite(c->settle_s) &&
+         c->settle_s >= 0.0f && pos_finite(c->dt_s) &&
+         c->bw_hz * c->dt_s <= 0.05f; /* the integrator's Euler step: w T well under 1 */
+}
+
+/* Complex numbers of the design (background, double; no <complex.h> on every target). */
+typedef struct {
+  double re, im;
+} cplx_t;
+
+static cplx_t c_mul(cplx_t a, cplx_t b)
+{
+  const cplx_t r = {a.re * b.re - a.im * b.im, a.re * b.im + a.im * b.re};
+  return r;
+}
+
+static cplx_t c_div(cplx_t a, cplx_t b)
+{
+  const double m = b.re * b.re + b.im * b.im;
+  const cplx_t r = {(a.re * b.re + a.im * b.im) / m, (a.im * b.re - a.re * b.im) / m};
+  return r;
+}
+
+/* The plant's slow root p = -sigma + j (wd - wc) (sense_fr.h), rad/s. */
+static cplx_t plant_pole(const sense_fr_cfg_t *c)
+{
+  const double ws = 2.0 * FM_PI * (double)c->f_sense_hz;
+  const double sigma = ws / (2.0 * (double)c->q_sense);
+  const double wd = sqrt(ws * ws - sigma * sigma); /* Q >= 0.5: real */
+  const cplx_t p = {-sigma, wd - 2.0 * FM_PI * (double)c->f_drive_hz};
+  return p;
+}
+
+/* s (s - p)(s + a) + b a (Kp s + Ki) = (s + c)(s^2 + 2 zeta w s + w^2), b = -p g, by the
+ * powers of s: s^2: a - p = c + 2 zeta w; s: -p a + b a Kp = 2 zeta w c + w^2;
+ * 1: b a Ki = c w^2. Returns 0, or -1 when c is not in the left half plane. */
+static int place(const sense_fr_cfg_t *cfg, cplx_t p, cplx_t *c, cplx_t *kp, cplx_t *ki)
+{
+  const double a = 1.0 / (double)cfg->lag_s;
+  const double w = 2.0 * FM_PI * (double)cfg->bw_hz;
+  const double zw2 = 2.0 * (double)cfg->zeta * w;
+  const cplx_t cc = {a - p.re - zw2, -p.im};
+  if (!(cc.re > 0.0)) return -1;
+  const cplx_t ba = {-p.re * (double)cfg->gain_per_v2 * a, -p.im * (double)cfg->gain_per_v2 * a};
+  if (!(ba.re * ba.re + ba.im * ba.im > 0.0)) return -1; /* undamped, at the carrier */
+  const cplx_t num = {zw2 * cc.re + w * w + p.re * a, zw2 * cc.im + p.im * a};
+  const cplx_t cw2 = {cc.re * w * w, cc.im * w * w};
+  *c = cc;
+  *kp = c_div(num, ba);
+  *ki = c_div(cw2, ba);
+  return 0;
+}
+
+int sense_fr_design(const sense_fr_cfg_t *cfg, sense_fr_design_t *d)
+{
+  if (cfg == NULL || d == NULL || !cfg_ok(cfg)) return -1;
+  const cplx_t p = plant_pole(cfg);
+  cplx_t c, kp, ki;
+  if (place(cfg, p, &c, &kp, &ki) != 0) return -1;
+  const cplx_t dt = {(double)cfg->dt_s, 0.0};
+  const cplx_t ki_t = c_mul(ki, dt);
+  const double settle = (double)cfg->settle_r;
+  const double blocks = (double)cfg->settle_s / (double)cfg->dt_s;
+  if (!isfinite(kp.re + kp.im + ki_t.re + ki_t.im) || !(blocks < 4.0e9)) return -1;
+  d->kp_re = (float)kp.re;
+  d->kp_im = (float)kp.im;
+  d->kit_re = (float)ki_t.re;
+  d->kit_im = (float)ki_t.im;
+  d->gain_per_v2 = cfg->gain_per_v2;
+  d->f_max_v2 = cfg->f_max_v2;
+  d->f_max2_v4 = cfg->f_max_v2 * cfg->f_max_v2;
+  d->settle2 = (float)(settle * settle);
+  d->settle_blocks = (uint32_t)blocks;
+  d->settle_k = (float)(1.0 - exp(-2.0 * FM_PI * 0.2 * (double)cfg->bw_hz * (double)cfg->dt_s));
+  d->p_re = (float)p.re;
+  d->p_im = (float)p.im;
+  d->c_re = (float)c.re;
+  d->c_im = (float)c.im;
+  return 0;
+}
+
+GYRO_RAMFUNC void sense_fr_reset(sense_fr_t *fr)
+{
+  fr->run = 0u;
+  fr->e_re = fr->e_im = 0.0f;
+  fr->ef_re = fr->ef_im = 0.0f;
+  fr->i_re = fr->i_im = 0.0f;
+  fr->f_re = fr->f_im = 0.0f;
+  fr->m2_v4 = 0.0f;
+  fr->f_mag_v2 = 0.0f;
+  fr->f_arg_rad = 0.0f;
+  fr->out_re = fr->out_im = 0.0f;
+  fr->in_band = 0u;
+  fr->settled = 0u;
+  fr->at_limit = 0u;
+  fr->skip = 0u;
+}
+
+void sense_fr_update(const sense_fr_design_t *d, sense_fr_t *fr, float r_re, float r_im)
+{
+  sense_fr_take(d, fr, r_re, r_im);
+  if (fr->skip != 0u) return;
+  sense_fr_integrate(d, fr);
+  sense_fr_limit(d, fr);
+  sense_fr_settle(d, fr);
+  sense_fr_polar(fr);
+}

@@ -1,0 +1,198 @@
+/* Force rebalance of the sense mode (sense.mode 1): the sense phasor -> a feedback force
+ * at the drive frequency that cancels the Coriolis (and quadrature) force, so that the
+ * sense motion stays near zero and the rate is read from the force.
+ *
+ * The model (2-22), sense axis, per unit mass: x'' + (ws/Q) x' + ws^2 x = f_c + f_fb,
+ * both forces at the carrier wc. In the rate channel's frame (rate_channel.h: R = S e^{-j
+ * psi} / A_set, Coriolis on the real axis, quadrature on the imaginary) the envelope of a
+ * mode driven at wc obeys, exactly for the linear mode,
+ *     R'' + (2 j wc + ws/Q) R' + (ws^2 - wc^2 + j wc ws/Q) R = c (F + F_c)
+ * whose slow root is p = -sigma + j (wd - wc), sigma = ws / (2Q), wd = sqrt(ws^2 -
+ * sigma^2) (the other lies 2 wc away, outside every bandwidth here). So the sense mode is,
+ * seen through the demodulator, a first-order complex plant
+ *     R = g (-p) / (s - p) (F + F_c),   g = R per V^2 of feedback force at DC,
+ * a pole turning at the split wd - wc and decaying at sigma: at Q = 10^4 and a 110 Hz
+ * split the open loop rings at 110 Hz for seconds (issue 19's measurement). g is the
+ * sense pickoff's static response to the feedback force (sense.fb_gain_v_per_v2, the
+ * sense mode's gain at wc times the electrode's Ks_fb and the pickoff's) over A_set; its
+ * sign and the force's phase against the Coriolis force (sense.fb_phase_deg) put a force
+ * in the Coriolis direction on the real axis of R, a force in phase with the drive
+ * displacement on the imaginary axis (the mapping is a complex scalar: the same mode and
+ * pickoff carry both).
+ *
+ * The demodulator's LMS lag (pole at mu fs, lmsd.h) and the schedule's delay (the block
+ * mean, the command's jobs, the DAC's latency and hold) add a lag, modelled as one pole
+ * at a = 1 / (1 / (mu fs) + delay). The controller is a PI with complex gains on the
+ * complex error R (a PI on each axis with cross-coupling), F = -(Kp R + Ki int R), and
+ * pole placement puts the closed loop of the model
+ *     s (s - p)(s + a) + g (-p) a (Kp s + Ki) = (s + c)(s^2 + 2 zeta w s + w^2)
+ * at the designed natural frequency w (sense.fr_bw_hz) and damping zeta, c = a - p -
+ * 2 zeta w the third root, which must lie in the left half plane: 2 zeta w < a + sigma
+ * (the design refuses a w beyond the lag's reach). Every root is placed, the mode's own
+ * pole included: the loop damps the ringing rather than cancelling it (a controller
+ * zero on p would leave the 110 Hz ringing undamped in the sense motion, out of sight
+ * of the force). The same design serves any split and Q: matched, the pole sits at
+ * -sigma and the proportional path carries the loop; at a low Q (the thesis's 3) the
+ * plant is fast already.
+ *
+ * The rate: in the steady state the force cancels the Coriolis force, F = -F_c, and the
+ * open-loop rate channel would have read R_c = g F_c = -g F. So the channel's input in
+ * sense.mode 1 is -g F (rate_raw its real part, quad_raw its imaginary part), and its scale
+ * (rate.scale_dps), compensation and output filter apply as in open loop. The force
+ * rebalance's scale factor is then rate.scale_dps g = Ks_fb / (2 A0 wc) per V^2 (the
+ * sense mode's gain cancels between the two, measured on the same part): from then on it
+ * no longer follows the sense resonance, only the electrode and the drive's momentum.
+ * Its accuracy is that of the two identifications (g and the scale) at the temperature
+ * they were made; the calibration flow refines rate.scale_dps on the closed loop.
+ *
+ * Limits: |F| <= f_max (the electrodes' voltage limit in the scheme used: v_max^2
+ * half-frequency, 4 D (v_max - D) DC+AC); a force at the limit is scaled back along its
+ * direction and the integrator held (F = -(Kp R + I) at the limit), at_limit set, and the
+ * loop never counts as settled. Settled: |R_f| <= settle (the residual the loop has not
+ * rebalanced, in R units, low-passed at a fifth of w) for settle_s without a break; the rate is not valid otherwise
+ * (rate_valid.h, SENSE_FR).
+ */
+#ifndef SENSE_FR_H
+#define SENSE_FR_H
+
+#include <stdint.h>
+
+#include "dsp/fastmath.h"
+#include "dsp/ramfunc.h"
+#include "gyro/settle_count.h"
+
+typedef struct {
+  float bw_hz;       /* w / 2 pi, the closed loop's natural frequency; > 0 */
+  float zeta;        /* its damping; > 0 */
+  float f_sense_hz;  /* the sense resonance of the model; > 0 */
+  float q_sense;     /* its quality factor; >= 0.5 */
+  float f_drive_hz;  /* the carrier wc / 2 pi; > 0 */
+  float gain_per_v2; /* g: R per V^2 of force in the Coriolis direction, static; != 0 */
+  float lag_s;       /* 1 / a: the demodulator's and the schedule's lag; > 0 */
+  float f_max_v2;    /* force limit; > 0 */
+  float settle_r;    /* |R| below this (the residual, in R's units) counts as
+                            balanced; > 0 */
+  float settle_s;    /* for this long; >= 0 */
+  float dt_s;        /* update period (a block); > 0 */
+} sense_fr_cfg_t;
+
+/* What the update uses, from sense_fr_design. */
+typedef struct {
+  float kp_re, kp_im;   /* Kp: V^2 per unit of R */
+  float kit_re, kit_im; /* Ki T */
+  float gain_per_v2;    /* g, for the readout -g F */
+  float f_max_v2, f_max2_v4;
+  float settle2;  /* settle_r^2: |R_f|^2 below it counts */
+  float settle_k; /* the residual's low-pass per update (sense_fr_settle) */
+  uint32_t settle_blocks;
+  /* What the design achieved, for status: the plant's pole p and the third root -c. */
+  float p_re, p_im, c_re, c_im;
+} sense_fr_design_t;
+
+typedef struct {
+  uint32_t run;         /* the loop is closed (LOCKED) */
+  float e_re, e_im;     /* this update's residual R */
+  float ef_re, ef_im;   /* its low-pass (the settling test) */
+  float i_re, i_im;     /* the integral term Ki int R, V^2 */
+  float f_re, f_im;     /* the force command in the frame of R, V^2 (after the limit) */
+  float m2_v4;          /* |F|^2 before the limit */
+  float f_mag_v2;       /* |F| */
+  float f_arg_rad;      /* arg F */
+  float out_re, out_im; /* -g F: the rate channel's input (rate_raw, quad_raw) */
+  uint32_t in_band;     /* consecutive updates with |R| <= settle */
+  uint8_t settled;
+  uint8_t at_limit;
+  uint8_t skip; /* the update's measurement was not finite */
+} sense_fr_t;
+
+/* Validates cfg (every value finite and in its range; the third root c in the left half
+ * plane) and derives the design. Returns 0, or -1 with *d unchanged. Background (double
+ * precision, libm). */
+int sense_fr_design(const sense_fr_cfg_t *cfg, sense_fr_design_t *d);
+
+/* The loop open, its state and force at zero (not settled). */
+void sense_fr_reset(sense_fr_t *fr);
+
+/* One update on the block's projection (R = rate_raw + j quad_raw), as the steps below in
+ * turn; the sample interrupt spreads them over the ticks of a block (gyro_block.c). */
+void sense_fr_update(const sense_fr_design_t *d, sense_fr_t *fr, float r_re, float r_im);
+
+/* The steps:
+ *   take       the measurement (skip when not finite: the loop holds, not settled); the
+ *              readout -g F of the force the plant felt over the block
+ *   integrate  Ki T R into the integral, F = -(Kp R + I)
+ *   limit      |F| against f_max: scaled back along its direction, the integral held
+ *   settle     the settling test
+ *   polar      |F| and arg F, for the synthesis (a square root, one divide) */
+GYRO_RAMFUNC static inline void sense_fr_take(const sense_fr_design_t *d, sense_fr_t *fr,
+                                              float r_re, float r_im)
+{
+  const float g = d->gain_per_v2;
+  fr->out_re = -g * fr->f_re;
+  fr->out_im = -g * fr->f_im;
+  if (!fm_isfinite(r_re + r_im)) {
+    fr->skip = 1u;
+    fr->in_band = 0u;
+    fr->settled = 0u;
+    return;
+  }
+  fr->skip = 0u;
+  fr->e_re = r_re;
+  fr->e_im = r_im;
+}
+
+GYRO_RAMFUNC static inline void sense_fr_integrate(const sense_fr_design_t *d, sense_fr_t *fr)
+{
+  const float er = fr->e_re, ei = fr->e_im;
+  const float ir = fr->i_re + (d->kit_re * er - d->kit_im * ei);
+  const float ii = fr->i_im + (d->kit_re * ei + d->kit_im * er);
+  fr->i_re = ir;
+  fr->i_im = ii;
+  const float fre = -(ir + (d->kp_re * er - d->kp_im * ei));
+  const float fim = -(ii + (d->kp_re * ei + d->kp_im * er));
+  fr->f_re = fre;
+  fr->f_im = fim;
+  fr->m2_v4 = fre * fre + fim * fim;
+}
+
+GYRO_RAMFUNC static inline void sense_fr_limit(const sense_fr_design_t *d, sense_fr_t *fr)
+{
+  if (fr->m2_v4 <= d->f_max2_v4) {
+    fr->at_limit = 0u;
+    return;
+  }
+  /* Along its direction back to the limit (rare: a square root and a divide); the
+   * integral takes what the proportional part leaves, so that it does not wind up. */
+  const float k = d->f_max_v2 / fm_sqrtf(fr->m2_v4);
+  const float fre = fr->f_re * k, fim = fr->f_im * k;
+  const float er = fr->e_re, ei = fr->e_im;
+  fr->f_re = fre;
+  fr->f_im = fim;
+  fr->i_re = -fre - (d->kp_re * er - d->kp_im * ei);
+  fr->i_im = -fim - (d->kp_re * ei + d->kp_im * er);
+  fr->m2_v4 = d->f_max2_v4;
+  fr->at_limit = 1u;
+}
+
+GYRO_RAMFUNC static inline void sense_fr_settle(const sense_fr_design_t *d, sense_fr_t *fr)
+{
+  /* The residual's mean is what the force has not taken yet; its noise (the demodulator's
+   * wide band inside the loop) averages out in the force: the test is on a first-order
+   * low-pass of R at a fifth of the loop's natural frequency. */
+  const float k = d->settle_k;
+  fr->ef_re += k * (fr->e_re - fr->ef_re);
+  fr->ef_im += k * (fr->e_im - fr->ef_im);
+  const float e2 = fr->ef_re * fr->ef_re + fr->ef_im * fr->ef_im;
+  const uint32_t n = settle_count(fr->in_band, e2 <= d->settle2 && !fr->at_limit,
+                                  d->settle_blocks);
+  fr->in_band = n;
+  fr->settled = n >= d->settle_blocks ? 1u : 0u;
+}
+
+GYRO_RAMFUNC static inline void sense_fr_polar(sense_fr_t *fr)
+{
+  fr->f_mag_v2 = fm_sqrtf(fr->m2_v4);
+  fr->f_arg_rad = fm_atan2f(fr->f_im, fr->f_re);
+}
+
+#endif /* SENSE_FR_H */

@@ -1,0 +1,192 @@
+/* Force rebalance (sense.mode 1, sense_fr.h, issue 19) through the whole firmware and the
+ * host HAL, on the default plant with a sense mode of Q = 10^4 at 1600 Hz (a 110 Hz split
+ * above the drive) and a half-frequency feedback pair (plant fb_mode 3): a 0 -> 100 deg/s
+ * step settles within 1 % of the step in at most 10 ms, with the part's 1500 deg/s
+ * quadrature rebalanced as well (open loop it would put 6 times the ADC's range on the
+ * sense pickoff), and the rate is never valid and wrong (against the plant's rate).
+ * Negative control: open loop (sense.mode 0) on the same part, its quadrature removed so
+ * that the pickoff does not clip, rings at the split for seconds.
+ *
+ * The part's model as its identification would give it, from the plant's own values:
+ * the demodulation phase and scale of the default part's calibration moved by the sense
+ * mode's static response at the drive frequency (the mode's phase and gain at wc, 2-24),
+ * and g from the electrode: the feedback force Ks_fb per V^2 balances 2 Omega A0 wc. The
+ * electrode and electronic noise sources are off, so that the 1 % band of the step (1
+ * deg/s) measures the loop and its filter, not the noise of a 500 Hz output. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "app_plant.h"
+
+#define F_SENSE_HZ 1600.0
+#define Q_SENSE 1.0e4
+#define KS_FB 0.1 /* (m/s^2)/V^2: 1500 deg/s of quadrature at 7 V */
+#define STEP_DPS 100.0
+#define T_STEP_S 0.5
+
+/* The sense mode's static response at the drive frequency, (2-24). */
+static void mode_response(double f_hz, double q, double wc, double *mag, double *arg)
+{
+  const double ws = 2.0 * FM_PI * f_hz;
+  const double re = ws * ws - wc * wc, im = wc * ws / q;
+  *mag = 1.0 / sqrt(re * re + im * im);
+  *arg = -atan2(im, re);
+}
+
+static void start(uint32_t sense_mode, double quad_dps)
+{
+  plant_cfg_t pc;
+  plant_default_cfg(&pc);
+  param_values_t v;
+  default_part_values(&v);
+  const double wc = 2.0 * FM_PI * (double)v.drive_freq_hz;
+  double m0, a0, m1, a1;
+  mode_response(pc.f_sense_hz, pc.q_sense, wc, &m0, &a0);
+  pc.f_sense_hz = F_SENSE_HZ;
+  pc.q_sense = Q_SENSE;
+  pc.fb_mode = 3;
+  pc.ks_fb_mps2_per_v2 = KS_FB;
+  pc.quad_dps = quad_dps;
+  pc.brownian = 0;
+  pc.pick_sense_noise_v_rthz = pc.pick_drive_noise_v_rthz = 0.0;
+  pc.drive_noise_white_v_rthz = pc.drive_noise_1hz_v_rthz = 0.0;
+  pc.fb_noise_white_v_rthz = pc.fb_noise_1hz_v_rthz = 0.0;
+  mode_response(F_SENSE_HZ, Q_SENSE, wc, &m1, &a1);
+  v.rate_demod_phase_deg += (float)((a1 - a0) * FM_DEG_PER_RAD);
+  v.rate_scale_dps = (float)((double)v.rate_scale_dps * m0 / m1);
+  /* g = rate per V^2 (Ks_fb / (2 A0 wc)) over the scale, in the pickoff's volts */
+  const double k_dps_per_v2 = KS_FB / (2.0 * pc.drive_amp_m * wc) * FM_DEG_PER_RAD;
+  v.sense_fb_gain_v_per_v2 = (float)(k_dps_per_v2 / (double)v.rate_scale_dps *
+                                     (double)v.drive_amp_set_v);
+  v.sense_f0_hz = (float)F_SENSE_HZ;
+  v.sense_q = (float)Q_SENSE;
+  v.sense_mode = sense_mode;
+  app_plant_start(&pc, 21u, &v);
+}
+
+static void set_rate(double dps)
+{
+  plant_profiles_t prof;
+  memset(&prof, 0, sizeof prof);
+  profile_const(&prof.rate_dps, dps);
+  profile_const(&prof.ambient_k, plant_truth(&plant)->ambient_k);
+  assert_int_equal(plant_set_profiles(&plant, &prof), 0);
+}
+
+typedef struct {
+  double settle_ms;  /* last block outside 1 % of the step, after the step */
+  double peak_dps;   /* the largest rate after the step */
+  double final_dps;  /* mean over the last 20 ms */
+  int valid_wrong;   /* a valid block more than 1 % of the step from the plant's rate */
+  long valid_blocks; /* valid blocks in all */
+  long valid_before; /* of the VALID_SPAN blocks before the step */
+  long valid_tail;   /* of the last VALID_SPAN blocks */
+} step_t;
+
+#define BLOCK_S ((double)GYRO_BLOCK / 50000.0)
+#define N_AFTER 500    /* 0.1 s of blocks after the step */
+#define VALID_SPAN 250 /* 50 ms of blocks */
+
+/* Runs to the step, steps, runs N_AFTER blocks; the rate of every block after it.
+ * Valid and wrong is judged against the plant's rate times the loop's own scale (the
+ * final value over the step): the model-made scale of start() is off by its accuracy
+ * (0.9 %), which a calibration takes out, and that is no failure of the monitors. */
+static step_t run_step(void)
+{
+  step_t r = {0.0, -1e9, 0.0, 0, 0, 0, 0};
+  static float rate[N_AFTER + VALID_SPAN];
+  static double truth[N_AFTER + VALID_SPAN];
+  static uint8_t valid[N_AFTER + VALID_SPAN];
+  const long before = (long)(T_STEP_S / BLOCK_S);
+  for (long n = 0; n < before + N_AFTER; n++) {
+    if (n == before) set_rate(STEP_DPS);
+    hal_host_run(GYRO_BLOCK);
+    const gyro_out_t *o = &app.gyro.out;
+    r.valid_blocks += o->rate_valid != 0u;
+    if (n >= before - VALID_SPAN) {
+      const long i = n - (before - VALID_SPAN);
+      rate[i] = o->rate_dps;
+      truth[i] = plant_truth(&plant)->rate_dps;
+      valid[i] = o->rate_valid != 0u;
+    }
+  }
+  const int tail = (int)(0.020 / BLOCK_S);
+  const float *after = rate + VALID_SPAN;
+  for (int i = N_AFTER - tail; i < N_AFTER; i++) r.final_dps += (double)after[i] / tail;
+  const double gain = r.final_dps / STEP_DPS;
+  for (int i = 0; i < N_AFTER + VALID_SPAN; i++) {
+    /* outside the 10 ms the step takes to pass any output filter */
+    const int in_step = i >= VALID_SPAN && i < VALID_SPAN + (int)(0.010 / BLOCK_S);
+    if (valid[i] && !in_step && fabs((double)rate[i] - gain * truth[i]) > 0.01 * STEP_DPS)
+      r.valid_wrong = 1;
+    r.valid_before += i < VALID_SPAN && valid[i];
+    r.valid_tail += i >= N_AFTER && valid[i];
+  }
+  for (int i = 0; i < N_AFTER; i++) {
+    if (fabs((double)after[i] - r.final_dps) > 0.01 * STEP_DPS)
+      r.settle_ms = (i + 1) * BLOCK_S * 1e3;
+    if (after[i] > r.peak_dps) r.peak_dps = after[i];
+  }
+  return r;
+}
+
+static void test_step_settles_within_10_ms(void **state)
+{
+  (void)state;
+  start(1u, 1500.0);
+  const step_t r = run_step();
+  const sense_fr_t *fr = &app.gyro.fr;
+  printf("# force rebalance, Q 1e4, 110 Hz split, 1500 deg/s quadrature: 0 -> 100 deg/s "
+         "settles to 1 %% in %.1f ms, peak %.2f, final %.2f deg/s (true %.1f); force I %.2f "
+         "Q %.2f V^2, settled %u, at limit %u; valid blocks %ld (50 ms before the step %ld, "
+         "last 50 ms %ld), valid and wrong %d, reasons 0x%x\n",
+         r.settle_ms, r.peak_dps, r.final_dps, plant_truth(&plant)->rate_dps, (double)fr->f_re,
+         (double)fr->f_im, fr->settled, fr->at_limit, r.valid_blocks, r.valid_before,
+         r.valid_tail, r.valid_wrong, app.gyro.out.rate_invalid);
+  assert_true(r.settle_ms <= 10.0);
+  assert_true(fabs(r.final_dps - STEP_DPS) <= 0.02 * STEP_DPS); /* the model's scale */
+  assert_false(r.valid_wrong);
+  /* valid with the loop closed: at rest before the step, and once the step has settled
+   * (the settling monitor judges the wide output band's difference through its own
+   * low-pass, rate_valid.h) */
+  assert_int_equal(r.valid_before, VALID_SPAN);
+  assert_int_equal(r.valid_tail, VALID_SPAN);
+  assert_true(fr->run != 0u && fr->settled != 0u && fr->at_limit == 0u);
+  assert_int_equal(app.gyro.out.rate_invalid & RATE_INVALID_SENSE_FR, 0u);
+  assert_int_equal(app.gyro.sup.fault_count, 0u);
+  /* the sense motion held near zero: the pickoff far inside the ADC's range */
+  assert_true(fabs(plant_truth(&plant)->sense_vel_m) < 1e-9);
+  const char *s = cmd("status\n");
+  assert_non_null(strstr(s, "sense_fr balanced"));
+}
+
+/* Open loop on the same part (its quadrature removed: open loop it would clip the ADC):
+ * the step rings at the 110 Hz split, far from 1 % 0.1 s later; the loop's reason is
+ * never set. */
+static void test_open_loop_rings(void **state)
+{
+  (void)state;
+  start(0u, 0.0);
+  const step_t r = run_step();
+  printf("# open loop, same part: after 100 ms still %.0f ms outside 1 %%, peak %.1f deg/s\n",
+         r.settle_ms, r.peak_dps);
+  assert_true(r.settle_ms >= 99.0);
+  assert_true(r.peak_dps > 1.5 * STEP_DPS);
+  assert_int_equal(app.gyro.out.rate_invalid & RATE_INVALID_SENSE_FR, 0u);
+  assert_int_equal(app.gyro.fr.run, 0u);
+}
+
+int main(void)
+{
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_step_settles_within_10_ms),
+      cmocka_unit_test(test_open_loop_rings),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
