@@ -276,7 +276,7 @@ static void put_sense_fr(cli_t *cli, app_t *a)
   cli_data_u32(cli, "fr_at_limit", fr->at_limit);
   cli_data_f32(cli, "fr_force_i_v2", fr->f_re);
   cli_data_f32(cli, "fr_force_q_v2", fr->f_im);
-  cli_data_f32(cli, "fr_force_v2", fr->f_mag_v2);
+  cli_data_f32(cli, "fr_force_v2", fm_sqrtf(fr->f_re * fr->f_re + fr->f_im * fr->f_im));
   cli_data_f32(cli, "fr_scale_dps_per_v2", d->fr_scale_dps_per_v2);
   cli_data_f32(cli, "fr_pole_c_re", d->fr.c_re);
 }

@@ -26,7 +26,7 @@ int drive_synth_init(drive_synth_t *ds, const drive_synth_cfg_t *cfg)
   ds->dc_bias_v = cfg->dc_bias_v;
   ds->u_max_v = cfg->u_max_v;
   ds->inv_4d = (cfg->scheme == GYRO_DRIVE_DC_AC) ? 0.25f / cfg->dc_bias_v : 0.0f;
-  ds->a_v = 0.0f;
+  ds->a_v = ds->b_v = 0.0f;
   ds->off = 0u;
   ds->f_set_v2 = ds->p_set_rad = NAN;
   ds->p_turn_rad = 0.0f;
@@ -65,17 +65,24 @@ GYRO_RAMFUNC static float synth_wrap_turns(drive_synth_t *ds, float p_rad)
   return p_rad;
 }
 
+/* P less the turns, ready for the half-angle conversion. Within 1.5 pi of the turns (the
+ * common case) it is also within the conversion's +-2 pi: one compare of the magnitude
+ * decides (a NaN fails it and takes the rare path too). */
+GYRO_RAMFUNC static inline float synth_turns_off(drive_synth_t *ds, float p_rad)
+{
+  p_rad -= ds->p_turn_rad;
+  if (GYRO_UNLIKELY(!(fm_absf_cmp(p_rad) <= 1.5f * FM_PI_F))) {
+    p_rad = synth_wrap_turns(ds, p_rad);
+  }
+  return p_rad;
+}
+
 GYRO_RAMFUNC void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad)
 {
   ds->f_set_v2 = f_cmd_v2;
   ds->p_set_rad = p_rad;
-  p_rad -= ds->p_turn_rad;
-  /* Within 1.5 pi of the turns (the common case) it is also within the conversion's
-   * +-2 pi: one compare of the magnitude decides (a NaN fails it and takes the rare
-   * path too). */
-  if (GYRO_UNLIKELY(!(fm_absf_cmp(p_rad) <= 1.5f * FM_PI_F))) {
-    p_rad = synth_wrap_turns(ds, p_rad);
-  }
+  ds->b_v = 0.0f;
+  p_rad = synth_turns_off(ds, p_rad);
   /* A positive finite force, else none: 0 < f < infinity as one unsigned compare of the
    * bit pattern (the positive finite floats are the patterns 1 .. that of infinity less
    * one), in a core register instead of two float compares; +0 by a mask, as a select
@@ -92,5 +99,50 @@ GYRO_RAMFUNC void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad
   } else {
     ds->off = sincos_half_rad_to_phase(p_rad);
     ds->a_v = fm_sqrtf(f);
+  }
+}
+
+/* x / 2, and 0 for a negative x: |F| - |Re F| is >= 0 but its rounding can leave an ulp
+ * below, whose root would be NaN. */
+GYRO_RAMFUNC static inline float half_nonneg(float x)
+{
+  x *= 0.5f;
+  return x > 0.0f ? x : 0.0f;
+}
+
+/* The force as a phasor F = |F| e^(j arg F) in a frame turned by frame_rad: the force
+ * |F| cos(phi + frame + arg F). Half-frequency: the voltage phasor is the square root of
+ * F, A e^(j arg F / 2) with A^2 = |F| (6-25), taken as the principal root,
+ *   Re sqrt(F) = sqrt((|F| + Re F) / 2),  Im sqrt(F) = sign(Im F) sqrt((|F| - Re F) / 2),
+ * two square roots and a divide, no arc tangent; where arg F crosses pi the root changes sign,
+ * and with it both voltages, which leaves U1^2 - U2^2, the force, unchanged (as a turn of
+ * P does). DC+AC: the AC amplitude phasor F / (4 D) (6-21), no root. A non-finite F
+ * drives nothing. */
+GYRO_RAMFUNC void drive_synth_set_phasor(drive_synth_t *ds, float f_re_v2, float f_im_v2,
+                                         float frame_rad)
+{
+  ds->f_set_v2 = ds->p_set_rad = NAN; /* not a (f_cmd, P) command: _follow sets again */
+  const float p_rad = synth_turns_off(ds, frame_rad);
+  if (!fm_isfinite(f_re_v2 + f_im_v2)) f_re_v2 = f_im_v2 = 0.0f;
+  if (ds->scheme == GYRO_DRIVE_DC_AC) {
+    ds->off = 2u * sincos_half_rad_to_phase(p_rad);
+    ds->a_v = f_re_v2 * ds->inv_4d;
+    ds->b_v = f_im_v2 * ds->inv_4d;
+    return;
+  }
+  ds->off = sincos_half_rad_to_phase(p_rad);
+  const float m = fm_sqrtf(f_re_v2 * f_re_v2 + f_im_v2 * f_im_v2);
+  /* The larger part from its root, the other as Im F / (2 x larger): the root of the
+   * difference of two near-equal numbers (|F| + Re F with Re F near -|F|) would keep
+   * none of its digits. The larger part is at least sqrt(|F| / 2), so the divide is
+   * safe except at F = 0. */
+  if (f_re_v2 >= 0.0f) {
+    const float a = fm_sqrtf(half_nonneg(m + f_re_v2));
+    ds->a_v = a;
+    ds->b_v = a > 0.0f ? f_im_v2 / (2.0f * a) : 0.0f;
+  } else {
+    const float b = fm_sqrtf(half_nonneg(m - f_re_v2));
+    ds->a_v = fm_absf(f_im_v2) / (2.0f * b);
+    ds->b_v = f_im_v2 < 0.0f ? -b : b;
   }
 }

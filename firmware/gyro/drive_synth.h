@@ -41,7 +41,8 @@ typedef struct {
   float u_max_v;   /* largest voltage magnitude on either electrode */
   float inv_4d;    /* 1 / (4 D) */
   /* The current command (drive_synth_set): */
-  float a_v;    /* A, the voltage amplitude */
+  float a_v;    /* A, the voltage amplitude (a phasor command: its real part) */
+  float b_v;    /* a phasor command's imaginary part (drive_synth_set_phasor), else 0 */
   uint32_t off; /* phase offset added to the NCO phase: P/2 (half-freq) or P (DC+AC) */
   float f_set_v2, p_set_rad; /* the command as last passed to drive_synth_set (NaN: none) */
   float p_turn_rad;          /* whole turns taken off P before the conversion (hysteresis) */
@@ -66,12 +67,18 @@ float drive_synth_f_cmd_max(const drive_synth_t *ds);
  * unchanged, (6-25)) happens once, not on every noise crossing. */
 void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad);
 
+/* A new force command as a phasor (f_re + j f_im, Ks*V^2) in a frame turned by
+ * frame_rad (the force f cos(phi + frame + arg F), |frame| as drive_synth_set's P): the
+ * command of a loop that computes its force as a complex number (sense_fr.h), without
+ * the arc tangent of arg F. Its waveform is drive_synth_step_phasor's. */
+void drive_synth_set_phasor(drive_synth_t *ds, float f_re_v2, float f_im_v2, float frame_rad);
+
 /* No force from the next sample on (amplitude 0; in DC+AC the bias alone), without the
  * square root and phase conversion of drive_synth_set: a fault's clear, on a tick near
  * its budget. The next drive_synth_set or _follow sets a command again. */
 static inline void drive_synth_silence(drive_synth_t *ds)
 {
-  ds->a_v = 0.0f;
+  ds->a_v = ds->b_v = 0.0f;
   ds->f_set_v2 = ds->p_set_rad = NAN;
 }
 
@@ -101,6 +108,25 @@ static inline void drive_synth_step(const drive_synth_t *ds, uint32_t phase,
     sincos_lut(half_phase + ds->off, &s, &c);
     *u1_v = ds->a_v * c;
     *u2_v = ds->a_v * s;
+  }
+}
+
+/* One sample of a phasor command's voltages (drive_synth_set_phasor; a drive_synth_set
+ * command too, with b_v 0): the amplitude phasor a + j b turns the table's unit phasor,
+ * two more multiplies than drive_synth_step. */
+static inline void drive_synth_step_phasor(const drive_synth_t *ds, uint32_t phase,
+                                           uint32_t half_phase, float *u1_v, float *u2_v)
+{
+  float s, c;
+  if (ds->scheme == GYRO_DRIVE_DC_AC) {
+    sincos_lut(phase + ds->off, &s, &c);
+    const float ac = ds->a_v * c - ds->b_v * s; /* Re((a + j b) e^(j (phi + off))) */
+    *u1_v = ds->dc_bias_v + ac;
+    *u2_v = ds->dc_bias_v - ac;
+  } else {
+    sincos_lut(half_phase + ds->off, &s, &c);
+    *u1_v = ds->a_v * c - ds->b_v * s;
+    *u2_v = ds->a_v * s + ds->b_v * c;
   }
 }
 

@@ -273,7 +273,7 @@ GYRO_RAMFUNC void gyro_tick(gyro_t *g)
     /* Force rebalance: its force on the feedback pair (the first channel is the spare's),
      * the waveform of the command its loop last set (sense_fr.h). */
     float u3, u4;
-    drive_synth_step(&g->fb_synth, ref.phase, ref.half_phase, &u3, &u4);
+    drive_synth_step_phasor(&g->fb_synth, ref.phase, ref.half_phase, &u3, &u4);
     dac->code[HAL_DAC_SENSE_FB_U1] = gyro_volts_to_dac(u3 - g->fb_off_v);
     dac->code[HAL_DAC_SENSE_FB_U2] = gyro_volts_to_dac(u4 - g->fb_off_v);
   } else {

@@ -348,16 +348,15 @@ GYRO_RAMFUNC void gyro_fr_integrate(gyro_t *g)
 GYRO_RAMFUNC void gyro_fr_limit(gyro_t *g)
 {
   sense_fr_t *fr = &g->fr;
-  if (fr->run == 0u || fr->skip != 0u) return;
-  const sense_fr_design_t *d = &g->design->fr;
-  sense_fr_limit(d, fr);
-  sense_fr_settle(d, fr);
-  g->fr_bits = fr->settled != 0u ? 0u : RATE_INVALID_SENSE_FR; /* settled: not at the limit */
+  if (fr->run != 0u && fr->skip == 0u) sense_fr_limit(&g->design->fr, fr);
 }
 
-GYRO_RAMFUNC void gyro_fr_polar(gyro_t *g)
+GYRO_RAMFUNC void gyro_fr_settle(gyro_t *g)
 {
-  if (g->fr.run != 0u && g->fr.skip == 0u) sense_fr_polar(&g->fr);
+  sense_fr_t *fr = &g->fr;
+  if (fr->run == 0u || fr->skip != 0u) return;
+  sense_fr_settle(&g->design->fr, fr);
+  g->fr_bits = fr->settled != 0u ? 0u : RATE_INVALID_SENSE_FR; /* settled: not at the limit */
 }
 
 /* The Coriolis force is in phase with the drive velocity, which at the drive's resonance
@@ -367,14 +366,15 @@ GYRO_RAMFUNC void gyro_fr_polar(gyro_t *g)
  * the same way), temperature included, not with P's own jitter (at 1500 deg/s of
  * rebalanced quadrature 0.02 deg of it is 0.5 deg/s of rate), and
  * sense.fb_phase_deg holds what differs between the two electrodes' paths and the
- * drive's distance from its resonance phase. */
+ * drive's distance from its resonance phase. The force goes to the synthesis as the
+ * loop's phasor, in that frame (drive_synth_set_phasor: no arc tangent). */
 GYRO_RAMFUNC void gyro_fr_synth(gyro_t *g)
 {
   const sense_fr_t *fr = &g->fr;
   const rate_channel_t *rc = &g->rate;
   if (fr->run != 0u && fr->skip == 0u)
-    drive_synth_set(&g->fb_synth, fr->f_mag_v2,
-                    fr->f_arg_rad + (rc->p_last_rad - rc->p_lag_rad) + g->design->fb_theta_rad);
+    drive_synth_set_phasor(&g->fb_synth, fr->f_re, fr->f_im,
+                           (rc->p_last_rad - rc->p_lag_rad) + g->design->fb_theta_rad);
 }
 
 GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
@@ -539,7 +539,7 @@ GYRO_RAMFUNC void gyro_block_p_selftest(gyro_t *g)
  * highest rate); flags hold what happened over the whole block. */
 GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
 {
-  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_polar(g);
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_settle(g);
   gyro_out_t *o = &g->out;
   const uint32_t block_bits = (g->sup.mode == GYRO_MODE_LOCKED ? 0u : RATE_INVALID_MODE) |
                               (selftest_running(&g->selftest) ? RATE_INVALID_SELFTEST : 0u) |

@@ -69,10 +69,11 @@
  * Force rebalance (sense.mode 1, sense_fr.h) adds one step of its update to the start of
  * five jobs, in order: on slot 6 (before the rate's filter) it takes the block's
  * projection as the residual and gives the rate channel the force's readout -g F in its
- * place; on 7 the PI; on 8 the force's limit and the settling test (the SENSE_FR reason);
- * on 9 |F| and arg F (a square root, an arc tangent); on 0 the feedback synthesis
- * (drive_synth_set on its own instance), whose waveform goes out every tick from the
- * next on, on the feedback pair's two channels. The force thus follows the block's mean
+ * place; on 7 the PI; on 8 the force's limit; on 9 the settling test (the SENSE_FR
+ * reason, before the verdict); on 0 the feedback synthesis of the force's phasor
+ * (drive_synth_set_phasor on its own instance: three square roots, no arc tangent),
+ * whose waveform goes out every tick from the next on, on the feedback pair's two
+ * channels. The force thus follows the block's mean
  * by (GYRO_BLOCK - 1) / 2 + 7 ticks, plus half a block of hold (gyro_design.c).
  *
  * The drive command thus reaches the DAC (COMMAND + 1 - slot) ticks after the sample
@@ -89,7 +90,7 @@
 #define GYRO_SLOT_QUAD 7u
 #define GYRO_SLOT_P 8u
 #define GYRO_SLOT_OUTPUT 9u
-/* The force-rebalance steps (above): take, PI, limit, polar, synthesis. */
+/* The force-rebalance steps (above): take, PI, limit, settling, synthesis. */
 #define SENSE_FR_TAKE_SLOT GYRO_SLOT_RATE
 #define SENSE_FR_SYNTH_SLOT GYRO_SLOT_PHASE_MEAS
 _Static_assert(GYRO_SLOT_PHASE_MEAS < GYRO_SLOT_PHASE_PI &&

@@ -101,8 +101,6 @@ GYRO_RAMFUNC void sense_fr_reset(sense_fr_t *fr)
   fr->i_re = fr->i_im = 0.0f;
   fr->f_re = fr->f_im = 0.0f;
   fr->m2_v4 = 0.0f;
-  fr->f_mag_v2 = 0.0f;
-  fr->f_arg_rad = 0.0f;
   fr->out_re = fr->out_im = 0.0f;
   fr->in_band = 0u;
   fr->settled = 0u;
@@ -117,5 +115,4 @@ void sense_fr_update(const sense_fr_design_t *d, sense_fr_t *fr, float r_re, flo
   sense_fr_integrate(d, fr);
   sense_fr_limit(d, fr);
   sense_fr_settle(d, fr);
-  sense_fr_polar(fr);
 }

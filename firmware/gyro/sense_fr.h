@@ -96,8 +96,6 @@ typedef struct {
   float i_re, i_im;     /* the integral term Ki int R, V^2 */
   float f_re, f_im;     /* the force command in the frame of R, V^2 (after the limit) */
   float m2_v4;          /* |F|^2 before the limit */
-  float f_mag_v2;       /* |F| */
-  float f_arg_rad;      /* arg F */
   float out_re, out_im; /* -g F: the rate channel's input (rate_raw, quad_raw) */
   uint32_t in_band;     /* consecutive updates with |R| <= settle */
   uint8_t settled;
@@ -123,7 +121,7 @@ void sense_fr_update(const sense_fr_design_t *d, sense_fr_t *fr, float r_re, flo
  *   integrate  Ki T R into the integral, F = -(Kp R + I)
  *   limit      |F| against f_max: scaled back along its direction, the integral held
  *   settle     the settling test
- *   polar      |F| and arg F, for the synthesis (a square root, one divide) */
+ * The synthesis takes F as it is, a phasor (drive_synth_set_phasor). */
 GYRO_RAMFUNC static inline void sense_fr_take(const sense_fr_design_t *d, sense_fr_t *fr,
                                               float r_re, float r_im)
 {
@@ -187,12 +185,6 @@ GYRO_RAMFUNC static inline void sense_fr_settle(const sense_fr_design_t *d, sens
                                   d->settle_blocks);
   fr->in_band = n;
   fr->settled = n >= d->settle_blocks ? 1u : 0u;
-}
-
-GYRO_RAMFUNC static inline void sense_fr_polar(sense_fr_t *fr)
-{
-  fr->f_mag_v2 = fm_sqrtf(fr->m2_v4);
-  fr->f_arg_rad = fm_atan2f(fr->f_im, fr->f_re);
 }
 
 #endif /* SENSE_FR_H */

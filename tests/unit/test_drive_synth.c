@@ -127,6 +127,59 @@ static void test_bad_phase_zeroes_phase_and_turns(void **state)
   assert_int_equal(ds.off, fresh.off);
 }
 
+/* A phasor command (drive_synth_set_phasor): U1^2 - U2^2 = |F| cos(phi + frame + arg F)
+ * for both schemes, with F turned once around the origin (arg F through +-pi, where the
+ * half-frequency root changes sign), Re F = 0 and an F that is all negative real; a
+ * non-finite F drives nothing. */
+static void check_phasor(gyro_drive_scheme_t scheme)
+{
+  drive_synth_t ds;
+  drive_synth_cfg_t c = {.scheme = scheme, .dc_bias_v = 7.0f, .u_max_v = 14.0f};
+  assert_int_equal(drive_synth_init(&ds, &c), 0);
+  nco_t nco;
+  nco_cfg_t nc = {.freq_hz = 1489.9, .fs_hz = 50000.0, .phase_rad = 0.0};
+  assert_int_equal(nco_init(&nco, &nc), 0);
+  double max_err = 0.0;
+  for (int n = 0; n < 100000; n++) {
+    nco_out_t o;
+    nco_step(&nco, &o);
+    const double a = -M_PI + 2.0 * M_PI * (double)n / 100000.0 + 1e-3;
+    const float mag = n % 7 == 0 ? 0.0f : 30.0f + 20.0f * (float)(n % 5);
+    float fr = (float)(mag * cos(a)), fi = (float)(mag * sin(a));
+    if (n % 11 == 0) fr = 0.0f;
+    if (n % 13 == 0) fi = 0.0f; /* on the branch cut when fr < 0 */
+    const float frame = 0.7f - 1.3f * (float)n / 100000.0f;
+    float u1, u2;
+    drive_synth_set_phasor(&ds, fr, fi, frame);
+    drive_synth_step_phasor(&ds, o.phase, o.half_phase, &u1, &u2);
+    const double phi = 2.0 * M_PI * (double)o.phase / 4294967296.0;
+    const double want = (double)fr * cos(phi + frame) - (double)fi * sin(phi + frame);
+    const double err = fabs((double)u1 * u1 - (double)u2 * u2 - want);
+    if (err > max_err) max_err = err;
+  }
+  print_message("# max error %.3g V^2\n", max_err);
+  assert_true(max_err < 150.0 * 2e-5);
+  float u1, u2;
+  drive_synth_set_phasor(&ds, NAN, 1.0f, 0.0f);
+  drive_synth_step_phasor(&ds, 0u, 0u, &u1, &u2);
+  assert_true(u1 == u2 && isfinite(u1)); /* no force: 0 V, or the bias alone in DC+AC */
+  drive_synth_set_phasor(&ds, 1.0f, INFINITY, 0.0f);
+  drive_synth_step_phasor(&ds, 0u, 0u, &u1, &u2);
+  assert_true(u1 == u2 && isfinite(u1));
+}
+
+static void test_phasor_half_frequency(void **state)
+{
+  (void)state;
+  check_phasor(GYRO_DRIVE_HALF_FREQ);
+}
+
+static void test_phasor_dc_ac(void **state)
+{
+  (void)state;
+  check_phasor(GYRO_DRIVE_DC_AC);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -135,6 +188,8 @@ int main(void)
       cmocka_unit_test(test_limits),
       cmocka_unit_test(test_bad_phase_zeroes_phase_and_turns),
       cmocka_unit_test(test_non_finite_command),
+      cmocka_unit_test(test_phasor_half_frequency),
+      cmocka_unit_test(test_phasor_dc_ac),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
