@@ -113,36 +113,44 @@ GYRO_RAMFUNC static inline float half_nonneg(float x)
 /* The force as a phasor F = |F| e^(j arg F) in a frame turned by frame_rad: the force
  * |F| cos(phi + frame + arg F). Half-frequency: the voltage phasor is the square root of
  * F, A e^(j arg F / 2) with A^2 = |F| (6-25), taken as the principal root,
- *   Re sqrt(F) = sqrt((|F| + Re F) / 2),  Im sqrt(F) = sign(Im F) sqrt((|F| - Re F) / 2),
- * two square roots and a divide, no arc tangent; where arg F crosses pi the root changes sign,
- * and with it both voltages, which leaves U1^2 - U2^2, the force, unchanged (as a turn of
- * P does). DC+AC: the AC amplitude phasor F / (4 D) (6-21), no root. A non-finite F
- * drives nothing. */
-GYRO_RAMFUNC void drive_synth_set_phasor(drive_synth_t *ds, float f_re_v2, float f_im_v2,
+ *   Re sqrt(F) = sqrt((|F| + Re F) / 2),  Im sqrt(F) = sign(Im F) sqrt((|F| - Re F) / 2):
+ * the larger of the two from its root, sqrt((|F| + |Re F|) / 2), the other as
+ * Im F / (2 x larger), since the root of the difference of two near-equal numbers
+ * (|F| - |Re F| with Im F small) would keep none of its digits; the larger part is at
+ * least sqrt(|F| / 2), so the divide is safe except at F = 0. Two square roots and a
+ * divide, no arc tangent. Where arg F crosses pi the root changes sign, and with it both
+ * voltages, which leaves U1^2 - U2^2, the force, unchanged (as a turn of P does). DC+AC:
+ * the AC amplitude phasor F / (4 D) (6-21), no root. A non-finite F drives nothing. */
+GYRO_RAMFUNC void drive_synth_phasor_root(const drive_synth_t *ds, drive_synth_phasor_t *ph,
+                                          float f_re_v2, float f_im_v2)
+{
+  if (!fm_isfinite(f_re_v2 + f_im_v2)) f_re_v2 = f_im_v2 = 0.0f;
+  ph->f_re_v2 = f_re_v2;
+  ph->f_im_v2 = f_im_v2;
+  if (ds->scheme == GYRO_DRIVE_DC_AC) return;
+  const float m = fm_sqrtf(f_re_v2 * f_re_v2 + f_im_v2 * f_im_v2);
+  ph->root_v = fm_sqrtf(half_nonneg(m + fm_absf(f_re_v2)));
+}
+
+GYRO_RAMFUNC void drive_synth_set_phasor(drive_synth_t *ds, const drive_synth_phasor_t *ph,
                                          float frame_rad)
 {
   ds->f_set_v2 = ds->p_set_rad = NAN; /* not a (f_cmd, P) command: _follow sets again */
   const float p_rad = synth_turns_off(ds, frame_rad);
-  if (!fm_isfinite(f_re_v2 + f_im_v2)) f_re_v2 = f_im_v2 = 0.0f;
+  const float f_re = ph->f_re_v2, f_im = ph->f_im_v2;
   if (ds->scheme == GYRO_DRIVE_DC_AC) {
     ds->off = 2u * sincos_half_rad_to_phase(p_rad);
-    ds->a_v = f_re_v2 * ds->inv_4d;
-    ds->b_v = f_im_v2 * ds->inv_4d;
+    ds->a_v = f_re * ds->inv_4d;
+    ds->b_v = f_im * ds->inv_4d;
     return;
   }
   ds->off = sincos_half_rad_to_phase(p_rad);
-  const float m = fm_sqrtf(f_re_v2 * f_re_v2 + f_im_v2 * f_im_v2);
-  /* The larger part from its root, the other as Im F / (2 x larger): the root of the
-   * difference of two near-equal numbers (|F| + Re F with Re F near -|F|) would keep
-   * none of its digits. The larger part is at least sqrt(|F| / 2), so the divide is
-   * safe except at F = 0. */
-  if (f_re_v2 >= 0.0f) {
-    const float a = fm_sqrtf(half_nonneg(m + f_re_v2));
-    ds->a_v = a;
-    ds->b_v = a > 0.0f ? f_im_v2 / (2.0f * a) : 0.0f;
-  } else {
-    const float b = fm_sqrtf(half_nonneg(m - f_re_v2));
-    ds->a_v = fm_absf(f_im_v2) / (2.0f * b);
-    ds->b_v = f_im_v2 < 0.0f ? -b : b;
+  const float t = ph->root_v;
+  if (f_re >= 0.0f) {
+    ds->a_v = t;
+    ds->b_v = t > 0.0f ? f_im / (2.0f * t) : 0.0f;
+  } else { /* t > 0: |Re F| > 0 */
+    ds->a_v = fm_absf(f_im) / (2.0f * t);
+    ds->b_v = f_im < 0.0f ? -t : t;
   }
 }

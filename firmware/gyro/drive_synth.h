@@ -67,11 +67,20 @@ float drive_synth_f_cmd_max(const drive_synth_t *ds);
  * unchanged, (6-25)) happens once, not on every noise crossing. */
 void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad);
 
-/* A new force command as a phasor (f_re + j f_im, Ks*V^2) in a frame turned by
- * frame_rad (the force f cos(phi + frame + arg F), |frame| as drive_synth_set's P): the
- * command of a loop that computes its force as a complex number (sense_fr.h), without
- * the arc tangent of arg F. Its waveform is drive_synth_step_phasor's. */
-void drive_synth_set_phasor(drive_synth_t *ds, float f_re_v2, float f_im_v2, float frame_rad);
+/* A force command as a phasor (f_re + j f_im, Ks*V^2) in a frame turned by frame_rad
+ * (the force |F| cos(phi + frame + arg F), |frame| as drive_synth_set's P), for a loop
+ * that computes its force as a complex number (sense_fr.h), without the arc tangent of
+ * arg F; in two steps, so that a sample interrupt can put them on two ticks: the root
+ * (drive_synth_phasor_root: its square roots), then the command
+ * (drive_synth_set_phasor: the divide, the phase), whose waveform is
+ * drive_synth_step_phasor's. */
+typedef struct {
+  float f_re_v2, f_im_v2; /* F (0 for a non-finite one) */
+  float root_v;           /* the larger part of sqrt(F) in magnitude (half-frequency) */
+} drive_synth_phasor_t;
+void drive_synth_phasor_root(const drive_synth_t *ds, drive_synth_phasor_t *ph, float f_re_v2,
+                             float f_im_v2);
+void drive_synth_set_phasor(drive_synth_t *ds, const drive_synth_phasor_t *ph, float frame_rad);
 
 /* No force from the next sample on (amplitude 0; in DC+AC the bias alone), without the
  * square root and phase conversion of drive_synth_set: a fault's clear, on a tick near

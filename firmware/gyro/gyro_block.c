@@ -359,6 +359,13 @@ GYRO_RAMFUNC void gyro_fr_settle(gyro_t *g)
   g->fr_bits = fr->settled != 0u ? 0u : RATE_INVALID_SENSE_FR; /* settled: not at the limit */
 }
 
+GYRO_RAMFUNC void gyro_fr_root(gyro_t *g)
+{
+  const sense_fr_t *fr = &g->fr;
+  if (fr->run != 0u && fr->skip == 0u)
+    drive_synth_phasor_root(&g->fb_synth, &g->fb_root, fr->f_re, fr->f_im);
+}
+
 /* The Coriolis force is in phase with the drive velocity, which at the drive's resonance
  * is in phase with the drive force cos(phi + P) (6-12), through the mode's lag 2Q/wn
  * (6-17): the feedback force's frame turns with LP_tau(P) as the rate channel forms it
@@ -373,12 +380,13 @@ GYRO_RAMFUNC void gyro_fr_synth(gyro_t *g)
   const sense_fr_t *fr = &g->fr;
   const rate_channel_t *rc = &g->rate;
   if (fr->run != 0u && fr->skip == 0u)
-    drive_synth_set_phasor(&g->fb_synth, fr->f_re, fr->f_im,
+    drive_synth_set_phasor(&g->fb_synth, &g->fb_root,
                            (rc->p_last_rad - rc->p_lag_rad) + g->design->fb_theta_rad);
 }
 
 GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
 {
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_settle(g);
   rate_channel_project(&g->design->rate, &g->rate, g->lmsd_drive.w_i, g->lmsd_drive.w_q,
                        g->drive.p_eq_rad, g->drive.phase_err_rad);
   /* The continuous self-test's modulation, for the ticks from here on and for its notch
@@ -390,7 +398,6 @@ GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
 GYRO_RAMFUNC void gyro_block_measure(gyro_t *g)
 {
   g->dac_frame->code[HAL_DAC_RATE_OUT] = g->rate_code;
-  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_synth(g);
   if (supervisor_drive_enabled(&g->sup)) {
     drive_loop_measure_phase(&g->drive, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
     /* The tracking drive's error and its notch here, its PI next tick (the budget). */
@@ -423,6 +430,7 @@ GYRO_RAMFUNC void gyro_block_supervise(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g)
 {
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_synth(g);
   if (supervisor_drive_enabled(&g->sup)) gyro_block_phase(g);
   g->cont_fail = selftest_cont_judge(&g->design->selftest, &g->selftest,
                                      g->sup.mode == GYRO_MODE_LOCKED);
@@ -430,6 +438,7 @@ GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_track_judge(gyro_t *g)
 {
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_synth(g);
   if (supervisor_drive_enabled(&g->sup)) gyro_block_track(g);
   g->cont_fail = selftest_cont_judge(&g->design->selftest, &g->selftest,
                                      g->sup.mode == GYRO_MODE_LOCKED);
@@ -539,7 +548,7 @@ GYRO_RAMFUNC void gyro_block_p_selftest(gyro_t *g)
  * highest rate); flags hold what happened over the whole block. */
 GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
 {
-  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_settle(g);
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_root(g);
   gyro_out_t *o = &g->out;
   const uint32_t block_bits = (g->sup.mode == GYRO_MODE_LOCKED ? 0u : RATE_INVALID_MODE) |
                               (selftest_running(&g->selftest) ? RATE_INVALID_SELFTEST : 0u) |

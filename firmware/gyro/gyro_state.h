@@ -112,6 +112,7 @@ typedef struct gyro_s {
   /* Force rebalance (sense.mode 1, sense_fr.h): the loop, one update per block in steps
    * (gyro_slots.h), and the synthesis of its force on the feedback pair (every tick). */
   drive_synth_t fb_synth;
+  drive_synth_phasor_t fb_root; /* the force's root, for the synthesis a block later */
   sense_fr_t fr;
 } gyro_t;
 
