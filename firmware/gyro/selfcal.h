@@ -64,11 +64,13 @@
  * rate.demod_phase_deg when the sweep runs: the calibration flow's later one needs the
  * sweep again. sense.cal_tune_ke_per_s2_per_v2 from S2.
  * A sense mode that cannot be identified (no resonance in the range, Q below 2 for the
- * stepped plan: the thesis's Q = 3 at 2 kHz is that broad that the plan would reach
- * below 1.3 kHz and the ring-down lasts 24 samples; a fit that does not fit; no response
- * at wc) ends the sense part with its reason (selfcal_sense_t.why) and the drive's
- * identification goes on: the sense.* values are then not staged (all four or none:
- * a loop designed from a mix would be neither part's), and status says why.
+ * stepped plan, points that do not fit a resonance, as on a part whose feedback pair is
+ * not the one sense.fb_scheme drives, no response at wc) ends the sense part with its
+ * reason (selfcal_sense_t.why) and the drive's identification goes on: the sense.*
+ * values are then not staged (all four or none: a loop designed from a mix would be
+ * neither part's), and status says why. The thesis's Q = 3 at 2 kHz is identified by
+ * the stepped fit (1.3..2.7 kHz), but its ring-down lasts 24 samples: S2 reports that
+ * and stages no tuning slope (tests/closed_loop/test_cl_sense_id.c).
  */
 #ifndef SELFCAL_H
 #define SELFCAL_H
