@@ -97,6 +97,49 @@ static void put_integrity(cli_t *cli, app_t *a)
   }
 }
 
+static const char *sense_id_name(selfcal_sense_state_t st)
+{
+  static const char *const names[] = {"off", "running", "f0", "identified", "failed"};
+  const unsigned i = (unsigned)st;
+  return i < sizeof names / sizeof names[0] ? names[i] : "?";
+}
+
+/* The sense mode's identification (sense.cal 1, selfcal.h): its state and time beside
+ * the drive's (selfcal_s is the whole sweep's, selfcal_drive_s the rest of it), what it
+ * found, and why not. While its chain runs (selfcal_phase sense) the chain's lines above
+ * are the sense mode's. */
+static void put_selfcal_sense(cli_t *cli, app_t *a, uint32_t t)
+{
+  const selfcal_t *s = &a->selfcal;
+  const selfcal_sense_t *m = &s->sense;
+  if (m->state == SELFCAL_SENSE_OFF) return;
+  const float fs = (float)params_current(&a->params)->sys_fs_hz;
+  cli_putf(cli, "selfcal_phase %s", s->sense_phase != 0u ? "sense" : "drive");
+  cli_emit_data(cli);
+  cli_putf(cli, "selfcal_sense %s", sense_id_name(m->state));
+  cli_emit_data(cli);
+  if (m->why != NULL) {
+    cli_putf(cli, "selfcal_sense_why %s", m->why);
+    cli_emit_data(cli);
+  }
+  cli_data_f32(cli, "selfcal_sense_s", (float)m->ticks / fs);
+  cli_data_f32(cli, "selfcal_drive_s", (float)(t - (t > m->ticks ? m->ticks : t)) / fs);
+  if (m->state == SELFCAL_SENSE_F0 || m->state == SELFCAL_SENSE_OK) {
+    cli_data_f32(cli, "selfcal_sense_f0_hz", (float)m->f0_hz);
+    cli_data_f32(cli, "selfcal_sense_q", (float)m->q);
+  }
+  if (m->state == SELFCAL_SENSE_OK && m->fb_gain_v_per_v2 != 0.0) {
+    cli_data_f32(cli, "selfcal_sense_fb_gain_v_per_v2", (float)m->fb_gain_v_per_v2);
+    cli_data_f32(cli, "selfcal_sense_fb_phase_deg", (float)(m->fb_phase_rad * FM_DEG_PER_RAD));
+  }
+  if (m->tune == SELFCAL_TUNE_OK) {
+    cli_data_f32(cli, "selfcal_tune_ke_per_s2_per_v2", (float)m->tune_ke_per_s2_per_v2);
+  } else if (m->tune == SELFCAL_TUNE_FAILED && m->tune_why != NULL) {
+    cli_putf(cli, "selfcal_tune_why %s", m->tune_why);
+    cli_emit_data(cli);
+  }
+}
+
 /* Self-calibration progress and result (the figures of the latest sweep). */
 static void put_selfcal(cli_t *cli, app_t *a)
 {
@@ -126,6 +169,7 @@ static void put_selfcal(cli_t *cli, app_t *a)
     }
     if (s->n_pts > 1u) cli_data_f32(cli, "selfcal_fit_rms_rel", (float)s->fit.rms_rel);
   }
+  put_selfcal_sense(cli, a, t);
 }
 
 /* Stored values the boot set back to their defaults, each with the reason. */

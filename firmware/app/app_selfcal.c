@@ -16,6 +16,19 @@
 /* First chirp force: 8 Ks*V^2 stays inside the ADC budget at Q = 600 with the default
  * actuator and pickoff gains; weaker responses raise it. */
 #define SC_F_CMD_START_V2 8.0
+/* The sense mode's search range (selfcal.h, S1): the family's drive range and the
+ * thesis's sense mode 510 Hz above its drive (2 kHz), with margin; a part's mode is
+ * matched or split by tens to hundreds of Hz from its drive. */
+#define SC_S_F_LO_HZ 1250.0
+#define SC_S_F_HI_HZ 2550.0
+/* First chirp force on the feedback pair: the sense pickoff is far more sensitive than
+ * the drive's (6.2e7 against 3.5e4 V/m on the thesis's part) and its Q spans 3..10^4, so
+ * the chain starts low and raises it (a response at the sense pickoff 2000 times the
+ * drive's per V^2 at Q 10^4 would clip at once at the drive's 8 V^2). */
+#define SC_S_F_CMD_START_V2 0.05
+/* The drive's ring-down before S1: five of its time constants from the stored model
+ * (drive.cal_*), at least SC_QUIET_S, at most this. */
+#define SC_S_QUIET_MAX_S 3.0
 
 int app_selfcal_start(app_t *a)
 {
@@ -36,6 +49,17 @@ int app_selfcal_start(app_t *a)
   c.track = v->drive_track;
   /* One sample of DAC latency plus half a sample of zero-order hold. */
   c.delay_s = 1.5 / c.fs_hz;
+  c.sense = v->sense_cal;
+  c.s_f_lo_hz = SC_S_F_LO_HZ;
+  c.s_f_hi_hz = SC_S_F_HI_HZ;
+  c.s_f_cmd_start_v2 = SC_S_F_CMD_START_V2;
+  c.s_f_cmd_max_v2 = (double)a->gyro.design->fr.f_max_v2;
+  const double tau_d = (double)v->drive_cal_q / (FM_PI * (double)v->drive_cal_f0_hz);
+  const double quiet = 5.0 * tau_d < SC_QUIET_S ? SC_QUIET_S : 5.0 * tau_d;
+  c.s_quiet_s = quiet > SC_S_QUIET_MAX_S ? SC_S_QUIET_MAX_S : quiet;
+  c.tune_probe_v = (double)v->sense_cal_tune_probe_v;
+  c.demod_phase_rad = (double)v->rate_demod_phase_deg * FM_PI / 180.0;
+  c.amp_clip_v = 0.95 * (double)HAL_ADC_FULL_SCALE_V;
   if (selfcal_start(&a->selfcal, &c) != 0) return -1;
   (void)app_request(a, APP_REQ_SWEEP); /* room checked above */
   a->selfcal_t0_ticks = app_ticks(a);
@@ -51,11 +75,30 @@ static param_status_t stage_f(app_t *a, param_idx_t i, double v)
   return params_stage(&a->params, i, pv);
 }
 
+/* The sense mode's model (selfcal.h): all four values or none (the reason stays in
+ * status), the tuning slope on its own. */
+static param_status_t stage_sense(app_t *a)
+{
+  const selfcal_sense_t *m = &a->selfcal.sense;
+  param_status_t st = PARAM_OK;
+  if (m->state == SELFCAL_SENSE_OK) {
+    st = stage_f(a, PARAM_sense_f0_hz, m->f0_hz);
+    if (st == PARAM_OK) st = stage_f(a, PARAM_sense_q, m->q);
+    if (st == PARAM_OK) st = stage_f(a, PARAM_sense_fb_gain_v_per_v2, m->fb_gain_v_per_v2);
+    if (st == PARAM_OK)
+      st = stage_f(a, PARAM_sense_fb_phase_deg, m->fb_phase_rad * 180.0 / FM_PI);
+  }
+  if (st == PARAM_OK && m->tune == SELFCAL_TUNE_OK)
+    st = stage_f(a, PARAM_sense_cal_tune_ke_per_s2_per_v2, m->tune_ke_per_s2_per_v2);
+  return st;
+}
+
 /* READY: stage and commit the identified model, then hand the drive to the loops. */
 static void hand_over(app_t *a)
 {
   selfcal_t *s = &a->selfcal;
-  param_status_t st = stage_f(a, PARAM_drive_freq_hz, (double)s->f0_hz_f);
+  param_status_t st = stage_sense(a);
+  if (st == PARAM_OK) st = stage_f(a, PARAM_drive_freq_hz, (double)s->f0_hz_f);
   if (st == PARAM_OK) st = stage_f(a, PARAM_drive_cal_f0_hz, (double)s->f0_hz_f);
   if (st == PARAM_OK) st = stage_f(a, PARAM_drive_cal_q, s->fit.q);
   if (st == PARAM_OK) st = stage_f(a, PARAM_drive_cal_gain_v_per_v2, s->fit.gain_v_per_v2);

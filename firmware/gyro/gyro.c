@@ -156,11 +156,22 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
 
 void gyro_start(gyro_t *g) { supervisor_start(&g->sup); }
 
+/* The sweep's sense jobs leave a command on the feedback pair's synthesis and may leave
+ * the tuning electrodes at a probe voltage (a failed sweep): both off whenever a sweep
+ * begins or ends, so that force rebalance starts from zero force (gyro_fr_take) and no
+ * tuning voltage outlives the sweep (no loop drives that channel yet). */
+static void gyro_sweep_electrodes_off(gyro_t *g)
+{
+  drive_synth_silence(&g->fb_synth);
+  g->dac_frame->code[HAL_DAC_TUNE] = (uint16_t)HAL_DAC_CODE_MID;
+}
+
 void gyro_stop(gyro_t *g)
 {
   supervisor_stop(&g->sup);
   if (g->quad.mode != QUAD_NULL_OFF) gyro_quad_off(g); /* its electrodes at 0 V */
   if (g->fr.run != 0u) gyro_fr_off(g);                 /* no feedback force */
+  gyro_sweep_electrodes_off(g);
   drive_loop_reset(&g->design->drive, &g->drive);
   /* The drive starts again from the calibrated frequency, whatever moved the NCO (the
    * tracking drive, or a sweep that ended without its hand-over). */
@@ -182,6 +193,7 @@ int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d)
   }
   drive_track_reset(&g->track);
   g->nco.half_step = d->nco_half_step;
+  gyro_sweep_electrodes_off(g);
   /* The sweep's last job held the vibration at the set point with (f_cmd, P): the
    * integrators continue from there instead of from zero force. */
   (void)pi_reset(&d->drive.amp, &g->drive.amp_pi, g->cal.f_cmd_v2, 0.0f);
@@ -209,12 +221,41 @@ static inline void count_rails(gyro_t *g, const hal_adc_frame_t *adc)
   }
 }
 
+/* A SWEEP tick of the sense mode's identification (a job with sense 1, selfcal_exec.h):
+ * the excitation on the feedback pair through its own synthesis, the sense LMSD's
+ * phasor to the executive; the drive electrodes at 0 V (no drive force: the sense
+ * pickoff carries no quadrature then, which on a part near its match is several times
+ * the ADC's range). The same cost as the drive's tick: one LMSD, one synthesis. */
+GYRO_RAMFUNC static void gyro_tick_sweep_sense(gyro_t *g, const hal_adc_frame_t *adc)
+{
+  hal_dac_frame_t *dac = g->dac_frame;
+  nco_out_t ref;
+  nco_step(&g->nco, &ref);
+  lmsd_step(&g->lmsd_sense, (float)adc->sense * g->adc_v_per_code, ref.sin_wc, ref.cos_wc);
+  count_rails(g, adc);
+  float u3, u4;
+  drive_synth_step(&g->fb_synth, ref.phase, ref.half_phase, &u3, &u4);
+  dac->code[HAL_DAC_DRIVE_U1] = (uint16_t)HAL_DAC_CODE_MID;
+  dac->code[HAL_DAC_DRIVE_U2] = (uint16_t)HAL_DAC_CODE_MID;
+  dac->code[HAL_DAC_SENSE_FB_U1] = gyro_volts_to_dac(u3 - g->fb_off_v);
+  dac->code[HAL_DAC_SENSE_FB_U2] = gyro_volts_to_dac(u4 - g->fb_off_v);
+  g->out.tick++;
+  const uint32_t slot = g->slot;
+  g->slot = slot + 1u == GYRO_BLOCK ? 0u : slot + 1u;
+  if (slot == GYRO_SLOT_OUTPUT) g->out.u1_v = g->out.u2_v = 0.0f;
+  gyro_block_sweep(g, slot);
+}
+
 /* A SWEEP tick: the self-calibration executive measures the drive LMSD's phasor and
  * sets the excitation and the NCO's next step on every tick (selfcal_exec.h). The sense
  * channel and the self-test forces rest (the rate is not valid in SWEEP and the sweep
  * does not use it), so that the executive's step fits the tick's budget. */
 GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc)
 {
+  if (GYRO_UNLIKELY(g->cal.sense != 0u)) {
+    gyro_tick_sweep_sense(g, adc);
+    return;
+  }
   hal_dac_frame_t *dac = g->dac_frame;
   nco_out_t ref;
   nco_step(&g->nco, &ref);
@@ -224,7 +265,8 @@ GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc)
   drive_synth_step(&g->synth, ref.phase, ref.half_phase, &u1, &u2);
   dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
-  dac->code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID;
+  dac->code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID; /* = HAL_DAC_SENSE_FB_U1 */
+  dac->code[HAL_DAC_SENSE_FB_U2] = (uint16_t)HAL_DAC_CODE_MID;
   g->out.tick++;
   const uint32_t slot = g->slot;
   g->slot = slot + 1u == GYRO_BLOCK ? 0u : slot + 1u;

@@ -617,14 +617,19 @@ GYRO_RAMFUNC void gyro_block_output_sweep(gyro_t *g)
 GYRO_RAMFUNC void gyro_block_sweep_idle(gyro_t *g)
 {
   selfcal_exec_t *x = &g->cal;
-  drive_synth_follow(&g->synth, x->f_cmd_v2, x->p_rad);
+  /* The job's channel: the drive pair, or the feedback pair (a sense job); the other's
+   * synthesis is not stepped meanwhile (its electrodes at 0 V, gyro.c). */
+  drive_synth_follow(GYRO_UNLIKELY(x->sense != 0u) ? &g->fb_synth : &g->synth, x->f_cmd_v2,
+                     x->p_rad);
+  g->dac_frame->code[HAL_DAC_TUNE] = x->tune_code;
   selfcal_exec_take(x); /* a new job starts on a tick without a job of its own */
 }
 
 GYRO_RAMFUNC void gyro_block_sweep(gyro_t *g, uint32_t slot)
 {
   selfcal_exec_t *x = &g->cal;
-  selfcal_exec_tick(x, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
+  const lmsd_t *m = GYRO_UNLIKELY(x->sense != 0u) ? &g->lmsd_sense : &g->lmsd_drive;
+  selfcal_exec_tick(x, m->w_i, m->w_q);
   g->nco.half_step = x->half_step; /* from the next sample on, as the excitation */
   gyro_block_run_sweep(g, slot);
 }

@@ -6,6 +6,7 @@
 
 #include "dsp/fastmath.h"
 #include "dsp/nco.h"
+#include "gyro/gyro_dac.h" /* the tuning electrodes' code (S2) */
 
 #define SC_MIN_PEAK_V 0.02 /* chirp peak below this: not resolved from the noise */
 #define SC_MAX_RETRIES 6u
@@ -41,11 +42,26 @@ static uint32_t ticks_of(double t_s, double fs_hz)
   return n < 1.0 ? 1u : (n > 4.0e9 ? 4000000000u : (uint32_t)n);
 }
 
+/* The search range and force of the mode the chain identifies now: the drive's, or the
+ * sense mode's through the feedback pair (S1, selfcal.h). */
+typedef struct {
+  double f_lo_hz, f_hi_hz, f_cmd_start_v2, f_cmd_max_v2;
+} sc_range_t;
+
+static sc_range_t rng(const selfcal_t *s)
+{
+  const selfcal_cfg_t *c = &s->cfg;
+  const sc_range_t d = {c->f_lo_hz, c->f_hi_hz, c->f_cmd_start_v2, c->f_cmd_max_v2};
+  const sc_range_t m = {c->s_f_lo_hz, c->s_f_hi_hz, c->s_f_cmd_start_v2, c->s_f_cmd_max_v2};
+  return s->sense_phase != 0u ? m : d;
+}
+
 const char *selfcal_state_name(selfcal_state_t st)
 {
-  static const char *const names[] = {
-      "IDLE", "WAIT_SWEEP", "QUIET_UP", "CHIRP_UP", "QUIET_DOWN", "CHIRP_DOWN", "RINGDOWN",
-      "FINE", "HOLD",       "READY",    "DONE",     "FAILED",     "REBURST"};
+  static const char *const names[] = {"IDLE",       "WAIT_SWEEP", "QUIET_UP",    "CHIRP_UP",
+                                      "QUIET_DOWN", "CHIRP_DOWN", "RINGDOWN",    "FINE",
+                                      "HOLD",       "READY",      "DONE",        "FAILED",
+                                      "REBURST",    "SENSE_TUNE", "SENSE_QUIET", "SENSE_WC"};
   const unsigned i = (unsigned)st;
   return i < sizeof names / sizeof names[0] ? names[i] : "?";
 }
@@ -75,6 +91,13 @@ int selfcal_start(selfcal_t *s, const selfcal_cfg_t *c)
       !(c->delay_s >= 0.0)) {
     return -1;
   }
+  if (c->sense != 0u && (!(c->s_f_lo_hz > 0.0) || !(c->s_f_hi_hz > c->s_f_lo_hz) ||
+                         !(c->s_f_hi_hz < 0.25 * c->fs_hz) || !(c->s_f_cmd_start_v2 > 0.0) ||
+                         !(c->s_f_cmd_max_v2 >= c->s_f_cmd_start_v2) ||
+                         !(c->s_quiet_s >= 0.0) || !(c->tune_probe_v >= 0.0) ||
+                         !isfinite(c->demod_phase_rad) || !(c->amp_clip_v >= c->amp_max_v))) {
+    return -1;
+  }
   selfcal_exec_t *x = s->x;
   memset(s, 0, sizeof *s);
   s->x = x;
@@ -85,8 +108,18 @@ int selfcal_start(selfcal_t *s, const selfcal_cfg_t *c)
   return 0;
 }
 
+static void drive_begin(selfcal_t *s);
+
 static void fail(selfcal_t *s, const char *why)
 {
+  if (s->sense_phase != 0u) {
+    /* S1 or S2 could not identify the sense mode: its reason, nothing of it staged, and
+     * the drive's identification goes on (selfcal.h). */
+    s->sense.state = SELFCAL_SENSE_FAILED;
+    s->sense.why = why;
+    drive_begin(s);
+    return;
+  }
   s->why = why;
   s->state = SELFCAL_FAILED;
 }
@@ -97,6 +130,8 @@ static void base_job(const selfcal_t *s, selfcal_job_t *j, selfcal_job_kind_t ki
   j->kind = (uint32_t)kind;
   j->amp_max_v = (float)s->cfg.amp_max_v;
   j->f_cmd_v2 = (float)s->f_cmd_v2;
+  j->sense = s->sense_phase;
+  j->tune_code = j->tune_ring_code = (uint16_t)HAL_DAC_CODE_MID;
 }
 
 /* The longest a job can run, samples: every phase it may have, each at its longest (a
@@ -120,24 +155,30 @@ static void post(selfcal_t *s, const selfcal_job_t *j, selfcal_state_t next)
   s->state = next;
 }
 
-static void post_quiet(selfcal_t *s, selfcal_state_t next)
+static void post_quiet_for(selfcal_t *s, selfcal_state_t next, double t_s)
 {
   selfcal_job_t j;
   base_job(s, &j, SELFCAL_JOB_QUIET);
   j.f_cmd_v2 = 0.0f;
-  j.half_step[0] = nco_half_step_of(s->cfg.f_lo_hz, s->cfg.fs_hz);
-  j.avg_ticks = ticks_of(s->cfg.quiet_s, s->cfg.fs_hz);
+  j.half_step[0] = nco_half_step_of(rng(s).f_lo_hz, s->cfg.fs_hz);
+  j.avg_ticks = ticks_of(t_s, s->cfg.fs_hz);
   post(s, &j, next);
+}
+
+static void post_quiet(selfcal_t *s, selfcal_state_t next)
+{
+  post_quiet_for(s, next, s->cfg.quiet_s);
 }
 
 static void post_chirp(selfcal_t *s, int up, selfcal_state_t next)
 {
   const selfcal_cfg_t *c = &s->cfg;
+  const sc_range_t m = rng(s);
   selfcal_job_t j;
   base_job(s, &j, SELFCAL_JOB_CHIRP);
-  const uint32_t lo = nco_half_step_of(c->f_lo_hz, c->fs_hz),
-                 hi = nco_half_step_of(c->f_hi_hz, c->fs_hz);
-  j.chirp_ticks = ticks_of((c->f_hi_hz - c->f_lo_hz) / c->chirp_hz_per_s, c->fs_hz);
+  const uint32_t lo = nco_half_step_of(m.f_lo_hz, c->fs_hz),
+                 hi = nco_half_step_of(m.f_hi_hz, c->fs_hz);
+  j.chirp_ticks = ticks_of((m.f_hi_hz - m.f_lo_hz) / c->chirp_hz_per_s, c->fs_hz);
   const int32_t d = (int32_t)((hi - lo) / j.chirp_ticks);
   j.chirp_delta = up ? d : -d;
   j.half_step[0] = up ? lo : hi;
@@ -155,8 +196,9 @@ static void post_steps(selfcal_t *s, double f_c, double hb, double tau_s, double
     return;
   }
   selfcal_job_t j;
+  const double f_max = rng(s).f_cmd_max_v2;
   double f_cmd = c->amp_meas_v / gain;
-  if (f_cmd > c->f_cmd_max_v2) f_cmd = c->f_cmd_max_v2;
+  if (f_cmd > f_max) f_cmd = f_max;
   s->f_cmd_v2 = f_cmd;
   base_job(s, &j, SELFCAL_JOB_STEPS);
   j.n_pts = SC_STEP_PTS;
@@ -252,10 +294,11 @@ static void post_burst_at(selfcal_t *s, double f_cmd)
 
 static int more_force(selfcal_t *s, double peak_v)
 {
-  if (s->f_cmd_v2 >= s->cfg.f_cmd_max_v2 || ++s->retries > SC_MAX_RETRIES) return -1;
+  const double f_max = rng(s).f_cmd_max_v2;
+  if (s->f_cmd_v2 >= f_max || ++s->retries > SC_MAX_RETRIES) return -1;
   double f = peak_v > 0.0 ? s->f_cmd_v2 * 4.0 * SC_MIN_PEAK_V / peak_v : s->f_cmd_v2 * 8.0;
   if (f < 2.0 * s->f_cmd_v2) f = 2.0 * s->f_cmd_v2;
-  s->f_cmd_v2 = f > s->cfg.f_cmd_max_v2 ? s->cfg.f_cmd_max_v2 : f;
+  s->f_cmd_v2 = f > f_max ? f_max : f;
   return 0;
 }
 
@@ -269,6 +312,7 @@ static int less_force(selfcal_t *s)
 static void on_chirp(selfcal_t *s, const selfcal_result_t *r, int up)
 {
   const selfcal_cfg_t *c = &s->cfg;
+  const sc_range_t m = rng(s);
   if (r->aborted != 0u) {
     if (less_force(s) != 0) fail(s, "amplitude over the ADC budget at the smallest force");
     else post_quiet(s, up ? SELFCAL_QUIET_UP : SELFCAL_QUIET_DOWN);
@@ -290,13 +334,13 @@ static void on_chirp(selfcal_t *s, const selfcal_result_t *r, int up)
   s->f_down_hz = f;
   if ((double)r->peak_amp_v > s->chirp_peak_v) s->chirp_peak_v = (double)r->peak_amp_v;
   s->f_coarse_hz = 0.5 * (s->f_up_hz + s->f_down_hz);
-  if (!(s->f_coarse_hz > c->f_lo_hz && s->f_coarse_hz < c->f_hi_hz)) {
+  if (!(s->f_coarse_hz > m.f_lo_hz && s->f_coarse_hz < m.f_hi_hz)) {
     fail(s, "resonance at the edge of the search range");
     return;
   }
   selfcal_job_t j;
   double f_cmd = s->f_cmd_v2 * c->amp_meas_v / s->chirp_peak_v;
-  s->f_cmd_v2 = f_cmd > c->f_cmd_max_v2 ? c->f_cmd_max_v2 : f_cmd;
+  s->f_cmd_v2 = f_cmd > m.f_cmd_max_v2 ? m.f_cmd_max_v2 : f_cmd;
   base_job(s, &j, SELFCAL_JOB_RINGDOWN);
   j.half_step[0] = nco_half_step_of(s->f_coarse_hz, c->fs_hz);
   j.amp_target_v = (float)c->amp_meas_v;
@@ -367,7 +411,7 @@ static void on_ringdown(selfcal_t *s, const selfcal_result_t *r)
   if (r->rd_f_cmd_v2 > 0.0f)
     s->rd_gain = amp0_v / ((double)r->rd_f_cmd_v2 * (grown > 0.05 ? grown : 0.05)) *
                  sqrt(1.0 + det * det);
-  if (!(s->rd_q > 0.5) || !(s->rd_f_hz > c->f_lo_hz && s->rd_f_hz < c->f_hi_hz) ||
+  if (!(s->rd_q > 0.5) || !(s->rd_f_hz > rng(s).f_lo_hz && s->rd_f_hz < rng(s).f_hi_hz) ||
       !isfinite(s->rd_gain)) {
     fail(s, "ring-down not consistent with a resonance");
     return;
@@ -379,6 +423,12 @@ static void on_ringdown(selfcal_t *s, const selfcal_result_t *r)
   post_decay(s, tau);
 }
 
+/* What follows the drive's identification (resume): the hold, one point at f0, or a
+ * burst; first S3 when the sense mode's f0 and Q are known (selfcal.h). */
+enum { SC_RESUME_HOLD = 1u, SC_RESUME_ONE = 2u, SC_RESUME_BURST = 3u };
+static void drive_next(selfcal_t *s, uint32_t resume);
+static void sense_identified(selfcal_t *s);
+
 /* High Q: the ring-down is the identification. The undamped resonance from the free
  * frequency, wd = wn sqrt(1 - 1/(4 Q^2)); a Q beyond the fixed drive's reach ends the
  * sweep with the reason, else one point at f0 for the hold. */
@@ -389,15 +439,16 @@ static void high_q_result(selfcal_t *s, double tau)
   s->fit.gain_v_per_v2 = 0.0; /* measured at f0 by post_one, within the reach */
   s->fit.rms_rel = 0.0;       /* no frequency-response fit */
   s->delay_s = s->cfg.delay_s;
+  if (s->sense_phase != 0u) {
+    sense_identified(s); /* (S1: the sense mode's gain at f0 is the ring-down's) */
+    return;
+  }
+  (void)tau;
   /* Beyond the fixed drive's reach (the limit the design refuses beyond, whatever the
    * identification's scatter), or with the tracking drive selected, the tracking drive
    * takes over, and its point is a burst: it needs no settled vibration to start from. */
   s->track = s->cfg.track != 0u || s->rd_q > SELFCAL_Q_FIXED_MAX ? 1u : 0u;
-  if (s->track != 0u) {
-    post_burst(s, tau);
-    return;
-  }
-  post_one(s, tau);
+  drive_next(s, s->track != 0u ? SC_RESUME_BURST : SC_RESUME_ONE);
 }
 
 /* The decay averaged at SC_DECAY_PTS times (the STEPS job, unexcited, at the free
@@ -444,9 +495,12 @@ static void on_decay(selfcal_t *s, const selfcal_result_t *r)
 }
 
 /* Hold at the identified resonance s->fit, at the loop's set point, for SC_HOLD_TAU. */
+static void sense_model(selfcal_t *s);
+
 static void post_hold(selfcal_t *s)
 {
   const selfcal_cfg_t *c = &s->cfg;
+  sense_model(s); /* the drive's arg H(wn) is final here */
   const double tau = 2.0 * s->fit.q / (2.0 * FM_PI * s->fit.f0_hz);
   s->f0_hz_f = (float)s->fit.f0_hz;
   s->hold_f_cmd_v2 = c->amp_set_v / s->fit.gain_v_per_v2;
@@ -553,7 +607,9 @@ static void on_steps(selfcal_t *s, const selfcal_result_t *r)
   const selfcal_cfg_t *c = &s->cfg;
   const selfcal_job_t *j = &s->x->job;
   selfcal_point_t pts[SELFCAL_MAX_PTS];
-  for (uint32_t i = 0; i < j->n_pts && s->n_pts < SELFCAL_EXPORT_MAX; i++) {
+  /* (`sweep points` exports the drive's: the sense mode's are not kept) */
+  for (uint32_t i = 0; s->sense_phase == 0u && i < j->n_pts && s->n_pts < SELFCAL_EXPORT_MAX;
+       i++) {
     selfcal_export_pt_t *e = &s->pts[s->n_pts++];
     e->half_step = j->half_step[i];
     e->z_re = r->z_re[i];
@@ -582,7 +638,7 @@ static void on_steps(selfcal_t *s, const selfcal_result_t *r)
    * identified with the model (selfcal_fit_delay). */
   if (selfcal_fit_delay(pts, j->n_pts, c->delay_s, c->delay_s + 8.0 / c->fs_hz, &fit,
                         &delay_s) != 0 ||
-      !(fit.rms_rel < 0.05) || !(fit.f0_hz > c->f_lo_hz && fit.f0_hz < c->f_hi_hz) ||
+      !(fit.rms_rel < 0.05) || !(fit.f0_hz > rng(s).f_lo_hz && fit.f0_hz < rng(s).f_hi_hz) ||
       !(fit.q >= 1.0 && fit.q < 1.0e6)) {
     fail(s, "frequency response does not fit a resonance");
     return;
@@ -597,7 +653,257 @@ static void on_steps(selfcal_t *s, const selfcal_result_t *r)
     post_steps(s, fit.f0_hz, hb, tau, fit.gain_v_per_v2);
     return;
   }
-  post_hold(s);
+  if (s->sense_phase != 0u) {
+    sense_identified(s);
+    return;
+  }
+  drive_next(s, SC_RESUME_HOLD);
+}
+
+/* ---- The sense mode (selfcal.h: S1-S3) ---- */
+
+/* S2: a tuning voltage's shift below this is no shift (no tuning electrodes): the free
+ * frequency of a decay followed for tau (at least 64 samples) is resolved far finer, and
+ * an electrode that can match a 110 Hz split moves it by tens of Hz at a few volts. */
+#define SC_TUNE_MIN_SHIFT_HZ 0.01
+#define SC_TUNE_MIN_RING_TICKS 64u
+/* S3: the drive's ring-down before the points at wc, in its time constants: the drive's
+ * steps left it at amp_meas (36 um on the thesis's part), whose 1500 deg/s quadrature is
+ * 20 times the sense ADC's range on a part near its match; e^-10 of it is far inside.
+ * And the sense mode's: the drive's chirps passed its resonance and the quadrature rang
+ * it up (at Q 10^4 for seconds). At least 0.1 s, at most a few seconds (a drive of Q
+ * 10^4 decays for 2 s per tau: what is left is a slow decay at wc, which the three means
+ * cancel, and the sense mode's ring, which their whole beats cancel). */
+#define SC_WC_QUIET_TAU 10.0
+#define SC_WC_QUIET_SENSE_TAU 3.0
+#define SC_WC_QUIET_MIN_S 0.1
+#define SC_WC_QUIET_MAX_S 3.0
+#define SC_WC_SETTLE_S 0.02
+#define SC_WC_SETTLE_MAX_S 1.0 /* waiting out the sense mode's ring: up to Q 700 at 1.6 kHz */
+#define SC_WC_PTS 3u
+#define SC_WC_OFF_MASK 0x5u /* the first and the last unexcited */
+_Static_assert(SC_WC_PTS <= SELFCAL_MAX_PTS, "the executive holds SELFCAL_MAX_PTS points");
+
+/* Back to the drive's chain (after S1/S2, identified or not): its state from the start. */
+static void drive_begin(selfcal_t *s)
+{
+  s->sense_phase = 0u;
+  s->f_cmd_v2 = s->cfg.f_cmd_start_v2;
+  s->f_up_hz = s->f_down_hz = s->f_coarse_hz = s->chirp_peak_v = 0.0;
+  s->rd_f_hz = s->rd_q = s->rd_gain = 0.0;
+  s->plan_f_hz = s->plan_hb_hz = 0.0;
+  memset(&s->fit, 0, sizeof s->fit);
+  s->delay_s = 0.0;
+  s->retries = s->refits = s->rd_passes = s->one_point = s->burst = 0u;
+  post_quiet(s, SELFCAL_QUIET_UP);
+}
+
+/* S2: a ring-down excited at the sense f0 (on resonance: the peak's force for amp_meas),
+ * its decay with the tuning electrodes at 0 V (pass 0) or at the probe voltage (1). */
+static void post_tune(selfcal_t *s)
+{
+  const selfcal_cfg_t *c = &s->cfg;
+  selfcal_job_t j;
+  double f_cmd = c->amp_meas_v / s->sense.gain_pk_v_per_v2;
+  s->f_cmd_v2 = f_cmd > c->s_f_cmd_max_v2 ? c->s_f_cmd_max_v2 : f_cmd;
+  base_job(s, &j, SELFCAL_JOB_RINGDOWN);
+  j.half_step[0] = nco_half_step_of(s->sense.f0_hz, c->fs_hz);
+  j.amp_target_v = (float)c->amp_meas_v;
+  j.settle_ticks = ticks_of(SC_EXCITE_MAX_S, c->fs_hz);
+  j.avg_ticks = ticks_of(SC_RING_MAX_S, c->fs_hz);
+  if (s->tune_pass != 0u) j.tune_ring_code = gyro_volts_to_dac((float)c->tune_probe_v);
+  post(s, &j, SELFCAL_SENSE_TUNE);
+}
+
+static void tune_done(selfcal_t *s, selfcal_tune_state_t st, const char *why)
+{
+  s->sense.tune = st;
+  s->sense.tune_why = why;
+  drive_begin(s);
+}
+
+/* S2's result: the free frequency of each decay (its rotation against the NCO, as
+ * on_ringdown), then ke = (wd0^2 - wd1^2) / Vt^2. */
+static void on_tune(selfcal_t *s, const selfcal_result_t *r)
+{
+  const double fs = s->cfg.fs_hz;
+  const double amp0 = sqrt((double)(r->rd_amp2_0_v2 > 0.0f ? r->rd_amp2_0_v2 : 0.0f));
+  if (amp0 < SC_MIN_PEAK_V || r->rd_ticks < SC_TUNE_MIN_RING_TICKS) {
+    tune_done(s, SELFCAL_TUNE_FAILED, "the sense ring-down too small or short to show a shift");
+    return;
+  }
+  const double t_ring = (double)r->rd_ticks / fs;
+  const double fd = nco_freq_of(s->x->job.half_step[0], fs) +
+                    (double)r->rd_phase_rad / (2.0 * FM_PI * t_ring);
+  if (s->tune_pass == 0u) {
+    s->sense.tune_fd0_hz = fd;
+    s->tune_pass = 1u;
+    post_tune(s);
+    return;
+  }
+  s->sense.tune_fd1_hz = fd;
+  const double w0 = 2.0 * FM_PI * s->sense.tune_fd0_hz, w1 = 2.0 * FM_PI * fd;
+  const double vt = s->cfg.tune_probe_v, shift = s->sense.tune_fd0_hz - fd;
+  s->sense.tune_ke_per_s2_per_v2 = 0.0;
+  if (fabs(shift) < SC_TUNE_MIN_SHIFT_HZ) {
+    tune_done(s, SELFCAL_TUNE_OK, NULL); /* no tuning electrodes: ke 0 */
+    return;
+  }
+  if (!(shift > 0.0) || !isfinite(shift)) {
+    tune_done(s, SELFCAL_TUNE_FAILED, "the tuning voltage raised the sense resonance");
+    return;
+  }
+  s->sense.tune_ke_per_s2_per_v2 = (w0 * w0 - w1 * w1) / (vt * vt);
+  tune_done(s, SELFCAL_TUNE_OK, NULL);
+}
+
+/* S1 done (f0, Q in s->fit): plausible, then S2 or the drive. */
+static void sense_identified(selfcal_t *s)
+{
+  selfcal_sense_t *m = &s->sense;
+  m->f0_hz = s->fit.f0_hz;
+  m->q = s->fit.q;
+  m->rms_rel = s->fit.rms_rel;
+  m->gain_pk_v_per_v2 = s->fit.gain_v_per_v2 > 0.0 ? s->fit.gain_v_per_v2 : s->rd_gain;
+  if (!(m->q >= 0.5 && m->q < 1.0e6) || !(m->gain_pk_v_per_v2 > 0.0) ||
+      !isfinite(m->gain_pk_v_per_v2)) {
+    fail(s, "sense resonance not consistent with a mode");
+    return;
+  }
+  m->state = SELFCAL_SENSE_F0;
+  if (s->cfg.tune_probe_v > 0.0) {
+    s->tune_pass = 0u;
+    post_tune(s);
+    return;
+  }
+  drive_begin(s);
+}
+
+static void drive_resume(selfcal_t *s)
+{
+  const double tau = s->fit.q / (FM_PI * s->fit.f0_hz);
+  switch (s->resume) {
+  case SC_RESUME_ONE: post_one(s, tau); break;
+  case SC_RESUME_BURST: post_burst(s, tau); break;
+  default: post_hold(s); break;
+  }
+}
+
+/* S3 first: the drive off until its vibration has decayed (the sense job's tick puts
+ * the drive electrodes at 0 V), the NCO at wc. */
+static void drive_next(selfcal_t *s, uint32_t resume)
+{
+  s->resume = resume;
+  if (s->sense.state != SELFCAL_SENSE_F0) {
+    drive_resume(s);
+    return;
+  }
+  const double tau = s->fit.q / (FM_PI * s->fit.f0_hz);
+  const double tau_s = s->sense.q / (FM_PI * s->sense.f0_hz);
+  double t = SC_WC_QUIET_TAU * tau;
+  if (t < SC_WC_QUIET_SENSE_TAU * tau_s) t = SC_WC_QUIET_SENSE_TAU * tau_s;
+  t = t < SC_WC_QUIET_MIN_S ? SC_WC_QUIET_MIN_S : (t > SC_WC_QUIET_MAX_S ? SC_WC_QUIET_MAX_S : t);
+  selfcal_job_t j;
+  base_job(s, &j, SELFCAL_JOB_QUIET);
+  j.sense = 1u;
+  j.f_cmd_v2 = 0.0f;
+  j.half_step[0] = nco_half_step_of((double)(float)s->fit.f0_hz, s->cfg.fs_hz);
+  j.avg_ticks = ticks_of(t, s->cfg.fs_hz);
+  post(s, &j, SELFCAL_SENSE_QUIET);
+}
+
+/* S3's three means at wc (the drive's resonance as the parameter will hold it). Off
+ * the sense resonance by more than a few half bandwidths, the switching's transient is
+ * the sense mode's free ring at its beat against wc: short settling, means over whole
+ * beats. Near it (a matched part) the response takes the sense mode's time to settle. */
+static void post_wc(selfcal_t *s)
+{
+  const selfcal_cfg_t *c = &s->cfg;
+  const selfcal_sense_t *m = &s->sense;
+  const double f_wc = (double)(float)s->fit.f0_hz;
+  const double hb = m->f0_hz / (2.0 * m->q), tau_s = m->q / (FM_PI * m->f0_hz);
+  const double fd = m->f0_hz * sqrt(1.0 - 0.25 / (m->q * m->q)), beat = fabs(fd - f_wc);
+  selfcal_job_t j;
+  /* the force for a quarter of amp_meas from the peak gain and the detuning (6-12):
+   * switching the force on or off starts the sense mode's free ring as large as the
+   * forced response, which at high Q outlasts the means (the sum must stay under the
+   * ADC budget, where a back-off would start another ring) */
+  const double det = (f_wc - m->f0_hz) / hb;
+  const double f_cmd = 0.25 * c->amp_meas_v * sqrt(1.0 + det * det) / m->gain_pk_v_per_v2;
+  s->f_cmd_v2 = f_cmd > c->s_f_cmd_max_v2 ? c->s_f_cmd_max_v2 : f_cmd;
+  base_job(s, &j, SELFCAL_JOB_STEPS);
+  /* The back-off near the ADC's range only: what is left of the sense mode's ring
+   * (above) may go over amp_max without the force's part, and a back-off would only
+   * start another ring; the means cancel it as long as nothing clips. */
+  j.amp_max_v = (float)c->amp_clip_v;
+  j.sense = 1u;
+  j.n_pts = SC_WC_PTS;
+  j.off_mask = SC_WC_OFF_MASK;
+  for (uint32_t i = 0; i < SC_WC_PTS; i++) j.half_step[i] = nco_half_step_of(f_wc, c->fs_hz);
+  /* A ring that decays within the mean is not cancelled by its whole beats (at Q 300,
+   * tau 60 ms, it turned the phase by 0.8 deg: 21 deg/s of the quadrature in the rate):
+   * it is waited out, SC_SETTLE_TAU of the sense mode's tau, when that is short. */
+  const int beats = beat > 4.0 * hb && SC_SETTLE_TAU * tau_s > SC_WC_SETTLE_MAX_S;
+  const double settle_s = beats ? SC_WC_SETTLE_S : SC_SETTLE_TAU * tau_s;
+  const double avg_s = beats ? ceil(SC_AVG_S * beat) / beat : SC_AVG_S;
+  j.settle_ticks = j.step_settle_ticks = ticks_of(settle_s, c->fs_hz);
+  j.avg_ticks = ticks_of(avg_s, c->fs_hz);
+  post(s, &j, SELFCAL_SENSE_WC);
+}
+
+static void sense_fail_wc(selfcal_t *s, const char *why)
+{
+  s->sense.state = SELFCAL_SENSE_FAILED;
+  s->sense.why = why;
+  drive_resume(s);
+}
+
+/* S3's result: H_s(wc) from the excited mean less the mean of the unexcited ones. */
+static void on_wc(selfcal_t *s, const selfcal_result_t *r)
+{
+  const double a2 = s->cfg.amp_clip_v * s->cfg.amp_clip_v;
+  const double z0r = (double)r->z_re[0], z0i = (double)r->z_im[0];
+  const double z2r = (double)r->z_re[2], z2i = (double)r->z_im[2];
+  const double f = (double)r->f_cmd_v2[1];
+  if (z0r * z0r + z0i * z0i > a2 || z2r * z2r + z2i * z2i > a2 ||
+      (r->backoffs != 0u && f == (double)s->x->job.f_cmd_v2)) {
+    sense_fail_wc(s, "the drive's vibration over the sense pickoff's budget at wc");
+    return;
+  }
+  const double dr = (double)r->z_re[1] - 0.5 * (z0r + z2r);
+  const double di = (double)r->z_im[1] - 0.5 * (z0i + z2i);
+  if (!(f > 0.0) || !(hypot(dr, di) >= SC_MIN_PEAK_V)) {
+    sense_fail_wc(s, "no response of the sense pickoff to the feedback force at wc");
+    return;
+  }
+  s->sense.h_re = dr / f;
+  s->sense.h_im = di / f;
+  s->sense.state = SELFCAL_SENSE_OK;
+  drive_resume(s);
+}
+
+/* The force-rebalance model's gain and phase (selfcal.h: theta = phi_dm + arg H_d(wc) -
+ * arg H_s(wc), within +-90 deg, the gain's sign the rest), once the drive's arg H is
+ * final; a gain outside sense.fb_gain_v_per_v2's range is no model. */
+static void sense_model(selfcal_t *s)
+{
+  selfcal_sense_t *m = &s->sense;
+  if (m->state != SELFCAL_SENSE_OK) return;
+  const double mag = hypot(m->h_re, m->h_im);
+  double th = remainder(s->cfg.demod_phase_rad + s->fit.phase_rad - atan2(m->h_im, m->h_re),
+                        2.0 * FM_PI);
+  double g = mag;
+  if (fabs(th) > 0.5 * FM_PI) {
+    th -= th > 0.0 ? FM_PI : -FM_PI;
+    g = -g;
+  }
+  if (!(mag >= 1.0e-6 && mag <= 100.0) || !isfinite(th)) {
+    m->state = SELFCAL_SENSE_FAILED;
+    m->why = "feedback gain at wc outside sense.fb_gain_v_per_v2's range";
+    return;
+  }
+  m->fb_gain_v_per_v2 = g;
+  m->fb_phase_rad = th;
 }
 
 selfcal_state_t selfcal_background(selfcal_t *s, int sweeping)
@@ -605,7 +911,15 @@ selfcal_state_t selfcal_background(selfcal_t *s, int sweeping)
   if (s == NULL) return SELFCAL_FAILED;
   if (!selfcal_running(s)) return s->state;
   if (s->state == SELFCAL_WAIT_SWEEP) {
-    if (sweeping) post_quiet(s, SELFCAL_QUIET_UP);
+    if (sweeping && s->cfg.sense != 0u) {
+      /* S1 first, after the drive's ring-down (selfcal.h) */
+      s->sense_phase = 1u;
+      s->sense.state = SELFCAL_SENSE_RUN;
+      s->f_cmd_v2 = s->cfg.s_f_cmd_start_v2;
+      post_quiet_for(s, SELFCAL_QUIET_UP, s->cfg.s_quiet_s);
+    } else if (sweeping) {
+      post_quiet(s, SELFCAL_QUIET_UP);
+    }
     return s->state;
   }
   if (!sweeping) {
@@ -616,6 +930,7 @@ selfcal_state_t selfcal_background(selfcal_t *s, int sweeping)
   selfcal_result_t r;
   if (!selfcal_exec_poll(s->x, &r)) return s->state;
   s->ticks += r.ticks;
+  if (s->x->job.sense != 0u) s->sense.ticks += r.ticks;
   switch (s->state) {
   case SELFCAL_QUIET_UP: post_chirp(s, 1, SELFCAL_CHIRP_UP); break;
   case SELFCAL_QUIET_DOWN: post_chirp(s, 0, SELFCAL_CHIRP_DOWN); break;
@@ -627,6 +942,9 @@ selfcal_state_t selfcal_background(selfcal_t *s, int sweeping)
     break;
   case SELFCAL_FINE: on_steps(s, &r); break;
   case SELFCAL_REBURST: post_burst_at(s, s->f_cmd_v2); break;
+  case SELFCAL_SENSE_TUNE: on_tune(s, &r); break;
+  case SELFCAL_SENSE_QUIET: post_wc(s); break;
+  case SELFCAL_SENSE_WC: on_wc(s, &r); break;
   case SELFCAL_HOLD:
     if (s->braked == 1u) {
       s->braked = 2u;

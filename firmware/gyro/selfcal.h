@@ -30,6 +30,47 @@
  * Then READY: the application stages drive.freq_hz = drive.cal_f0_hz = wn/2pi,
  * drive.cal_q, drive.cal_gain_v_per_v2, drive.p_init_deg through the parameter bank
  * and requests the hand-over (SWEEP -> ACQUIRE).
+ *
+ * The sense mode (cfg.sense 1, sense.cal): identified by the same chain before the drive's,
+ * through the feedback electrodes (their own synthesis, sense.fb_scheme) and the sense
+ * pickoff's LMSD, with the drive electrodes at 0 V. The drive rests because the sense
+ * excitation needs the NCO across the sense resonance, and because the drive's motion
+ * puts its quadrature on the sense pickoff: 1500 deg/s is several times the ADC's range
+ * on a part near its match (issue 19), which the identification would clip on.
+ *   S1. QUIET for the drive's ring-down (the stored drive model's tau, capped), then the
+ *       drive's steps 1-3 over the sense search range: chirps, ring-down, stepped points
+ *       and the fit of selfcal_fit.h (or, at high Q, the ring-down's f0 and Q). The
+ *       sense mode's gain at its resonance is not needed.
+ *   S2. Tuning slope (cfg.tune_probe_v > 0): two ring-downs excited at the sense f0,
+ *       their decays followed with the tuning electrodes at 0 V and at Vt. The tuning
+ *       pair softens the sense spring, ws^2 = ws0^2 - ke Vt^2 (issue 19; a parallel-plate
+ *       pair, 6-3), so ke = (wd0^2 - wd1^2) / Vt^2 (the damping term of wd^2 = wn^2 -
+ *       sigma^2 is the same in both). Applying Vt only during the decay needs no search
+ *       for the moved resonance: the free oscillation shows its own frequency.
+ *   S3. After the drive's resonance is identified (before its hold: the drive is again
+ *       at rest): the feedback force's response at the drive frequency, H_s(wc), from
+ *       three settled means at wc, unexcited, excited, unexcited (the drive's remaining
+ *       vibration, a slow decay at wc, cancels in the excited mean less the mean of the
+ *       others). The means last whole periods of the sense mode's beat against wc
+ *       (|fd_s - wc|): the transient of switching the force on or off rings at the
+ *       sense's own frequency and averages out.
+ * The force-rebalance model (sense_fr.h) then follows: sense.f0_hz, sense.q from S1;
+ * sense.fb_gain_v_per_v2 = +-|H_s(wc)| and sense.fb_phase_deg = theta such that a
+ * feedback command lands on the real axis of the rate frame R = S e^{-j psi} / A_set,
+ * psi = phase_set + phi_dm (rate_channel.h): the force at P + theta gives R =
+ * H_s e^{j (P + theta - psi)} / A_set with P = phase_set - arg H_d(wc) at lock, so
+ *     theta = phi_dm + arg H_d(wc) - arg H_s(wc),
+ * taken within +-90 deg (the Coriolis force's side; the gain carries the sign). phi_dm is
+ * rate.demod_phase_deg when the sweep runs: the calibration flow's later one needs the
+ * sweep again. sense.cal_tune_ke_per_s2_per_v2 from S2.
+ * A sense mode that cannot be identified (no resonance in the range, Q below 2 for the
+ * stepped plan, points that do not fit a resonance, as on a part whose feedback pair is
+ * not the one sense.fb_scheme drives, no response at wc) ends the sense part with its
+ * reason (selfcal_sense_t.why) and the drive's identification goes on: the sense.*
+ * values are then not staged (all four or none: a loop designed from a mix would be
+ * neither part's), and status says why. The thesis's Q = 3 at 2 kHz is identified by
+ * the stepped fit (1.3..2.7 kHz), but its ring-down lasts 24 samples: S2 reports that
+ * and stages no tuning slope (tests/closed_loop/test_cl_sense_id.c).
  */
 #ifndef SELFCAL_H
 #define SELFCAL_H
@@ -63,6 +104,15 @@ typedef struct {
   /* drive.track at the start: 1 keeps the tracking drive at any Q */ /* the amplitude loop's set point */
   double phase_set_rad; /* the phase loop's set point */
   double delay_s;       /* DAC latency + zero-order hold: 1.5 samples */
+  /* The sense mode's identification (header: S1-S3) */
+  uint32_t sense;              /* 1: identify the sense mode too */
+  double s_f_lo_hz, s_f_hi_hz; /* its search range */
+  double s_f_cmd_start_v2;     /* first chirp force on the feedback pair */
+  double s_f_cmd_max_v2;       /* what the feedback synthesis can deliver */
+  double s_quiet_s;            /* the drive's ring-down before S1 */
+  double tune_probe_v;         /* S2's tuning voltage; 0: no S2 */
+  double demod_phase_rad;      /* rate.demod_phase_deg, phi_dm (S3) */
+  double amp_clip_v;           /* S3's back-off threshold: near the ADC's range */
 } selfcal_cfg_t;
 
 typedef enum {
@@ -78,8 +128,41 @@ typedef enum {
   SELFCAL_READY,
   SELFCAL_DONE,
   SELFCAL_FAILED,
-  SELFCAL_REBURST /* a burst went over the ADC budget: the vibration decays, drive off */
+  SELFCAL_REBURST,     /* a burst went over the ADC budget: the vibration decays, drive off */
+  SELFCAL_SENSE_TUNE,  /* S2: a ring-down of the sense mode with or without Vt */
+  SELFCAL_SENSE_QUIET, /* S3: the drive's ring-down before the points at wc */
+  SELFCAL_SENSE_WC     /* S3: the three means at wc */
 } selfcal_state_t;
+
+/* The sense mode's identification (header: S1-S3). */
+typedef enum {
+  SELFCAL_SENSE_OFF = 0, /* not asked (cfg.sense 0) */
+  SELFCAL_SENSE_RUN,     /* S1 running */
+  SELFCAL_SENSE_F0,      /* S1 done: f0, Q; S3 to come */
+  SELFCAL_SENSE_OK,      /* all four model values identified */
+  SELFCAL_SENSE_FAILED   /* why: nothing staged */
+} selfcal_sense_state_t;
+
+typedef enum {
+  SELFCAL_TUNE_OFF = 0, /* not probed (tune_probe_v 0, or S1 failed) */
+  SELFCAL_TUNE_OK,      /* ke identified (0: the probe moved nothing: no electrodes) */
+  SELFCAL_TUNE_FAILED   /* tune_why: not staged */
+} selfcal_tune_state_t;
+
+typedef struct {
+  selfcal_sense_state_t state;
+  const char *why;
+  double f0_hz, q, rms_rel; /* S1 (rms_rel 0: the ring-down's identification) */
+  double gain_pk_v_per_v2;  /* S1: |H_s| at f0, for the forces of S2 and S3 */
+  double h_re, h_im;        /* S3: H_s(wc), sense phasor per V^2 at force phase 0 */
+  double fb_gain_v_per_v2;  /* +-|H_s(wc)| */
+  double fb_phase_rad;      /* theta */
+  selfcal_tune_state_t tune;
+  const char *tune_why;
+  double tune_fd0_hz, tune_fd1_hz; /* S2's free frequencies, tuning at 0 V and at Vt */
+  double tune_ke_per_s2_per_v2;
+  uint32_t ticks; /* the sense identification's length (its jobs), samples */
+} selfcal_sense_t;
 
 /* Every STEPS point of the latest sweep (both placements when the points were placed
  * again around a first fit), kept for export (`sweep points`): the drive LMSD phasor Z
@@ -122,6 +205,11 @@ typedef struct {
   uint32_t watch_t0, job_bound_ticks;
   selfcal_export_pt_t pts[SELFCAL_EXPORT_MAX];
   uint32_t n_pts;
+  /* The sense mode's identification: the chain above runs on the sense channel while
+   * sense_phase is 1 (S1); resume is the drive's step S3 interrupted (1 hold, 2 one
+   * point, 3 burst); tune_pass the S2 ring-down under way (0 at 0 V, 1 at Vt). */
+  uint32_t sense_phase, resume, tune_pass;
+  selfcal_sense_t sense;
 } selfcal_t;
 
 /* Bind to the ISR half. Returns 0, or -1 for NULL. State IDLE. */

@@ -5,6 +5,7 @@
 
 #include "dsp/fastmath.h"
 #include "dsp/ramfunc.h"
+#include "hal/hal_dac.h" /* HAL_DAC_CODE_MID: 0 V on the tuning electrodes */
 
 /* Sums of Z are formed in blocks of this many ticks, then the block sums are added:
  * a single float sum over 10^4..10^5 ticks would lose ~1e-4 of its value. */
@@ -33,6 +34,9 @@ void selfcal_exec_reset(selfcal_exec_t *x, uint32_t half_step)
   x->blk_re = x->blk_im = x->acc_re = x->acc_im = 0.0f;
   x->blk_n = 0u;
   x->z_prev_re = x->z_prev_im = x->phase_acc = 0.0f;
+  x->f_on_v2 = 0.0f;
+  x->sense = 0u;
+  x->tune_code = (uint16_t)HAL_DAC_CODE_MID;
 }
 
 GYRO_RAMFUNC static void begin_point(selfcal_exec_t *x)
@@ -40,6 +44,7 @@ GYRO_RAMFUNC static void begin_point(selfcal_exec_t *x)
   x->stage = ST_SETTLE;
   x->check_ticks = 0u;
   x->half_step = x->job.half_step[x->idx];
+  x->f_cmd_v2 = ((x->job.off_mask >> x->idx) & 1u) != 0u ? 0.0f : x->f_on_v2;
   x->blk_re = x->blk_im = x->acc_re = x->acc_im = 0.0f;
   x->blk_n = 0u;
 }
@@ -55,7 +60,10 @@ GYRO_RAMFUNC static void start_job(selfcal_exec_t *x)
   x->amp_max2 = j->amp_max_v * j->amp_max_v;
   x->amp_ref2 = 0.0f;
   x->f_cmd_v2 = j->f_cmd_v2;
+  x->f_on_v2 = j->f_cmd_v2;
   x->p_rad = j->p_rad;
+  x->sense = j->sense;
+  x->tune_code = j->tune_code;
   x->half_step = j->half_step[0];
   x->stage = ST_SETTLE;
   if (j->kind == SELFCAL_JOB_STEPS) {
@@ -80,11 +88,14 @@ GYRO_RAMFUNC static void tick_steps(selfcal_exec_t *x, float w_i, float w_q, flo
 {
   const selfcal_job_t *j = &x->job;
   if (amp2 > x->amp_max2) {
-    /* Over the ADC budget: back off and let the point settle again. */
-    x->f_cmd_v2 *= 0.5f;
+    /* Over the ADC budget: back off and let the point settle again; unexcited, there is
+     * no force to lower (counted only: the background judges the point). */
     x->res.backoffs++;
-    begin_point(x);
-    return;
+    if (x->f_cmd_v2 > 0.0f) {
+      x->f_on_v2 *= 0.5f;
+      begin_point(x);
+      return;
+    }
   }
   x->check_ticks++;
   if (x->stage == ST_SETTLE) {
@@ -149,6 +160,7 @@ GYRO_RAMFUNC static void tick_ringdown(selfcal_exec_t *x, float w_i, float w_q, 
     x->phase_acc = 0.0f;
     x->check_ticks = 0u;
     x->stage = ST_RING;
+    x->tune_code = j->tune_ring_code; /* the decay's tuning voltage (the idle ticks) */
     return;
   }
   const int end = amp2 < SC_INV_E2 * x->amp_ref2 || x->check_ticks >= j->avg_ticks;

@@ -10,6 +10,12 @@
  * chain the loops will see.
  *
  * Measured quantity: the drive LMSD phasor Z = w_i + j w_q, from its weights (gyro.h convention).
+ * A job with sense 1 identifies the sense mode instead (selfcal.h): the excitation goes
+ * to the feedback electrodes (their own synthesis, sense.fb_scheme), Z is the sense
+ * LMSD's phasor, and the drive electrodes rest at 0 V (gyro.c: gyro_tick_sweep).
+ * Every job holds the tuning electrodes at the DC code tune_code, a RINGDOWN's decay at
+ * tune_ring_code (the tuning slope: the free frequency with and without a tuning
+ * voltage, selfcal.c); the interrupt writes it on the sweep's idle ticks.
  *
  * Jobs:
  *   CHIRP     half_step[0] + k chirp_delta for chirp_ticks ticks; records the largest
@@ -24,7 +30,8 @@
  *             rotation of Z over it (the free frequency minus the NCO frequency).
  *   STEPS     for each point: settle (settle_ticks for the first, step_settle_ticks for
  *             the others), then average Z over avg_ticks. Over-amplitude halves f_cmd
- *             and restarts the point's settling (start low, back off).
+ *             and restarts the point's settling (start low, back off); on a point
+ *             unexcited (off_mask) it is only counted (backoffs): no force to lower.
  *   HOLD      excite at half_step[0] with (f_cmd, P) for avg_ticks, then report done
  *             and keep exciting (the drive loops take over from this state).
  *   QUIET     f_cmd = 0 for avg_ticks (let a previous vibration ring down).
@@ -64,6 +71,9 @@ typedef struct {
   float p_rad;
   float amp_max_v;    /* back-off threshold (ADC budget) */
   float amp_target_v; /* RINGDOWN: stop exciting above */
+  uint32_t sense;     /* 1: the sense channel (feedback electrodes, sense LMSD) */
+  uint32_t off_mask;  /* STEPS: bit i set, point i unexcited (f_cmd 0) */
+  uint16_t tune_code, tune_ring_code; /* tuning electrodes' DAC code; in a decay */
 } selfcal_job_t;
 
 typedef struct {
@@ -97,6 +107,9 @@ typedef struct {
   float blk_re, blk_im, acc_re, acc_im;
   uint32_t blk_n;
   float z_prev_re, z_prev_im, phase_acc;
+  float f_on_v2;      /* STEPS: the excited points' force (halved by a back-off) */
+  uint32_t sense;     /* the running job's channel (gyro.c reads it every tick) */
+  uint16_t tune_code; /* the tuning electrodes' code now (the sweep's idle ticks) */
 } selfcal_exec_t;
 
 /* ISR: entering SWEEP. Drops any running job, excitation off, at half_step. */

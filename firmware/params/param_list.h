@@ -40,7 +40,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 15u
+#define PARAM_LAYOUT_VERSION 16u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -378,6 +378,20 @@
   /* 25 blocks: longer than the loop's own time constant */ \
   X(sense_fr_settle_s, 0x0A0Eu, "sense.fr_settle_s", F32, "s", 0.0f, 10.0f, 0.005f, 0u, \
     PF_PERSIST | PF_LIVE, "the residual within sense.fr_settle_dps this long before the loop counts as settled") \
+  /* off: a sweep identifies the drive alone, as before (the default part's feedback
+   * electrodes are the self-test's biased pair, not the half-frequency pair of the
+   * default sense.fb_scheme: the sense identification would find nothing there). On, it
+   * identifies the sense mode first and stages sense.f0_hz, sense.q,
+   * sense.fb_gain_v_per_v2, sense.fb_phase_deg (gyro/selfcal.h) */ \
+  X(sense_cal, 0x0A20u, "sense.cal", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
+    PF_PERSIST | PF_LIVE, "self-calibration identifies the sense mode too (0 drive only, 1 sense and drive)") \
+  /* 3 V: a tenth of a part's reach at 10 V, so the decays stay within the sense
+   * demodulator's band (a shift of tens of Hz); 0 skips the probe */ \
+  X(sense_cal_tune_probe_v, 0x0A21u, "sense.cal_tune_probe_v", F32, "V", 0.0f, 15.0f, 3.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "tuning-electrode voltage of the sweep's tuning-slope probe (sense.cal 1); 0 none") \
+  /* 0 until a sweep with sense.cal 1 identifies it: the part's own, ws^2 = ws0^2 - ke Vt^2 */ \
+  X(sense_cal_tune_ke_per_s2_per_v2, 0x0A22u, "sense.cal_tune_ke_per_s2_per_v2", F32, "(1/s^2)/V^2", 0.0f, 1.0e8f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "identified tuning slope: the sense resonance's ws^2 falls by this x Vt^2 (0: no tuning electrodes)") \
   /* 0: no calibration. The compensation, the demodulation phase and the scale hold at
    * the drive frequency they were measured at: another one (a sweep, a hand change)
    * makes them stale. Equal within 2e-7 (two float steps), so that a value that went

@@ -591,12 +591,13 @@ static void test_loads_image_of_earlier_firmware(void **state)
    * 0: the fixed drive; rate.comp_stages 1: one stage, as that firmware had;
    * rate.comp_fast_tau_s 0: no fast path, its rate.grad_fast_dps_per_deg and
    * rate.comp_blend_dps; quad.null 0: no quadrature nulling, and its eight quad.*;
-   * sense.mode 0: the open sense loop, and its thirteen sense.*).
+   * sense.mode 0: the open sense loop, and its thirteen sense.*; sense.cal 0: the sweep
+   * identifies the drive alone, and its two sense.cal_*).
    * Without a calibration record the part then says `calibrated no` and its rate is not
    * valid until its calibration is confirmed (set cal.ref_freq_hz, save): an image of
    * before the record cannot tell a calibration from values set by hand. */
   assert_int_equal(rep.dropped + rep.rejected, 0);
-  assert_int_equal(rep.defaulted, 43);
+  assert_int_equal(rep.defaulted, 46);
   param_values_defaults(&want);
   /* The image holds every persistent value: those it did not change are that
    * firmware's defaults, some of which were the default part's and are generic now. */
