@@ -61,7 +61,11 @@ def warm_up(ctx, log, figs, run):
     a1.plot(t, m["rate_unc_dps"] - figs["raw_final_dps"], lw=0.9, color="C7",
             label=f"rate_unc_dps less its final level {figs['raw_final_dps']:+.3f} deg/s")
     for key, what, color in (("warmup_time_s", "warm-up time", "C3"),
+                             ("warmup_time_avg_s",
+                              f"warm-up time ({figs.get('warmup_avg_s', 0):g} s means)", "C5"),
                              ("raw_settle_time_s", "raw output settled", "C1")):
+        if key not in figs:  # a report made before the averaged figure
+            continue
         _mark((a1, a2), figs[key], what + (" n/a" if figs[key] is None else f" {figs[key]:.0f} s"),
               color)
     a1.set_xscale("log")

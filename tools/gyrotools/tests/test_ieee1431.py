@@ -132,6 +132,26 @@ def test_warm_up_fails_when_the_output_ends_off_or_a_valid_mean_is_wrong():
     assert thermcal.verify_warmup(log)["warmup_time_s"] == 101.0
 
 
+def test_warm_up_on_averaged_output_is_not_moved_by_a_late_one_second_excursion():
+    # A settled part's 1 s means scatter (0.03..0.05 deg/s sd on the default part, and the
+    # thermometer's phase flicker wanders the compensation by as much again): one of them
+    # beyond the bound late in the run moves the 1 s figure there (the same part read
+    # 31..566 s over ten noise seeds). The mean over the preceding WARMUP_AVG_S (10 s)
+    # is the warm-up's: 0.5 exp(-t/15) averaged over 10 s, 0.711 exp(-t/15), crosses
+    # 0.2 deg/s at 15 ln 3.55 = 19.0 s, whatever one second does at 1500 s.
+    log = warmup_log()
+    late = (log["t_s"] >= 1500.0) & (log["t_s"] < 1501.0)
+    log.data["rate_dps"][late] += 0.3
+    f = thermcal.verify_warmup(log)
+    assert f["warmup_time_s"] == 1501.0  # the 1 s figure, as defined (IEEE 1431 12.6)
+    assert f["warmup_avg_s"] == thermcal.WARMUP_AVG_S == 10.0
+    assert f["warmup_time_avg_s"] == pytest.approx(15.0 * math.log(0.7108 / 0.2), abs=1.5)
+    assert f["ok"]
+    # An output that ends off is not warm on either figure.
+    off = thermcal.verify_warmup(warmup_log(comp_end_dps=0.25))
+    assert off["warmup_time_avg_s"] is None
+
+
 def test_a_raw_output_still_moving_at_the_end_has_no_settling_time():
     # 600 s: the raw output moves 3.8 exp(-540/300) (1 - exp(-60/300)) = 0.11 deg/s
     # between its last two minutes, over a quarter of the 0.2 deg/s bound.
