@@ -45,14 +45,14 @@ static uint32_t ticks_of(double t_s, double fs_hz)
 /* The search range and force of the mode the chain identifies now: the drive's, or the
  * sense mode's through the feedback pair (S1, selfcal.h). */
 typedef struct {
-  double f_lo_hz, f_hi_hz, f_cmd_start_v2, f_cmd_max_v2;
+  double f_lo_hz, f_hi_hz, f_cmd_max_v2; /* (the first force: each chain's start) */
 } sc_range_t;
 
 static sc_range_t rng(const selfcal_t *s)
 {
   const selfcal_cfg_t *c = &s->cfg;
-  const sc_range_t d = {c->f_lo_hz, c->f_hi_hz, c->f_cmd_start_v2, c->f_cmd_max_v2};
-  const sc_range_t m = {c->s_f_lo_hz, c->s_f_hi_hz, c->s_f_cmd_start_v2, c->s_f_cmd_max_v2};
+  const sc_range_t d = {c->f_lo_hz, c->f_hi_hz, c->f_cmd_max_v2};
+  const sc_range_t m = {c->s_f_lo_hz, c->s_f_hi_hz, c->s_f_cmd_max_v2};
   return s->sense_phase != 0u ? m : d;
 }
 

@@ -23,21 +23,13 @@
 #include <cmocka.h>
 
 #include "app_plant.h"
+#include "sense_mode_model.h"
 
 #define F_SENSE_HZ 1600.0
 #define Q_SENSE 1.0e4
 #define KS_FB 0.1 /* (m/s^2)/V^2: 1500 deg/s of quadrature at 7 V */
 #define STEP_DPS 100.0
 #define T_STEP_S 0.5
-
-/* The sense mode's static response at the drive frequency, (2-24). */
-static void mode_response(double f_hz, double q, double wc, double *mag, double *arg)
-{
-  const double ws = 2.0 * FM_PI * f_hz;
-  const double re = ws * ws - wc * wc, im = wc * ws / q;
-  *mag = 1.0 / sqrt(re * re + im * im);
-  *arg = -atan2(im, re);
-}
 
 static void start(uint32_t sense_mode, double quad_dps)
 {

@@ -28,20 +28,12 @@
 #include <cmocka.h>
 
 #include "selfcal_harness.h"
+#include "sense_mode_model.h"
 
 #define F_SENSE_HZ 1600.0
 #define KS_FB 0.1     /* (m/s^2)/V^2, as test_cl_sense_fr.c */
 #define TUNE_KE 1.2e5 /* (1/s^2)/V^2: 3 V lowers 1600 Hz by 8.5 Hz, 10 V by 100 Hz */
 #define STEP_DPS 100.0
-
-/* The sense mode's response at the drive frequency, (2-24). */
-static void mode_response(double f_hz, double q, double wc, double *mag, double *arg)
-{
-  const double ws = 2.0 * FM_PI * f_hz;
-  const double re = ws * ws - wc * wc, im = wc * ws / q;
-  *mag = 1.0 / sqrt(re * re + im * im);
-  *arg = -atan2(im, re);
-}
 
 static plant_cfg_t part(double q_sense, double tune_ke)
 {

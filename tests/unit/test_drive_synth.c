@@ -8,16 +8,23 @@
 #include "dsp/nco.h"
 #include "gyro/drive_synth.h"
 
+/* A synthesiser of the scheme (D 7 V, u_max 14 V) and the real NCO at the drive's
+ * frequency. */
+static void start(gyro_drive_scheme_t scheme, drive_synth_t *ds, nco_t *nco)
+{
+  drive_synth_cfg_t c = {.scheme = scheme, .dc_bias_v = 7.0f, .u_max_v = 14.0f};
+  assert_int_equal(drive_synth_init(ds, &c), 0);
+  nco_cfg_t nc = {.freq_hz = 1489.9, .fs_hz = 50000.0, .phase_rad = 0.0};
+  assert_int_equal(nco_init(nco, &nc), 0);
+}
+
 /* (6-7) with (6-18..6-21): U1^2 - U2^2 = f cos(phi + P) for both schemes, at every
  * sample of a run of the real NCO through accumulator wraps. */
 static void check_force(gyro_drive_scheme_t scheme)
 {
   drive_synth_t ds;
-  drive_synth_cfg_t c = {.scheme = scheme, .dc_bias_v = 7.0f, .u_max_v = 14.0f};
-  assert_int_equal(drive_synth_init(&ds, &c), 0);
   nco_t nco;
-  nco_cfg_t nc = {.freq_hz = 1489.9, .fs_hz = 50000.0, .phase_rad = 0.0};
-  assert_int_equal(nco_init(&nco, &nc), 0);
+  start(scheme, &ds, &nco);
   const float f = 64.0f;
   double max_err = 0.0, prev_u1 = 0.0;
   double max_jump = 0.0;
@@ -134,11 +141,8 @@ static void test_bad_phase_zeroes_phase_and_turns(void **state)
 static void check_phasor(gyro_drive_scheme_t scheme)
 {
   drive_synth_t ds;
-  drive_synth_cfg_t c = {.scheme = scheme, .dc_bias_v = 7.0f, .u_max_v = 14.0f};
-  assert_int_equal(drive_synth_init(&ds, &c), 0);
   nco_t nco;
-  nco_cfg_t nc = {.freq_hz = 1489.9, .fs_hz = 50000.0, .phase_rad = 0.0};
-  assert_int_equal(nco_init(&nco, &nc), 0);
+  start(scheme, &ds, &nco);
   double max_err = 0.0;
   for (int n = 0; n < 100000; n++) {
     nco_out_t o;
