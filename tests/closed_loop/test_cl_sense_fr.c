@@ -6,6 +6,9 @@
  * sense pickoff), and the rate is never valid and wrong (against the plant's rate).
  * Negative control: open loop (sense.mode 0) on the same part, its quadrature removed so
  * that the pickoff does not clip, rings at the split for seconds.
+ * The same step on parts of sense Q 300 and 3 (the thesis's), the same split, force
+ * rebalance against open loop (issue 19 item 4's table; the README's force-rebalance
+ * section). A matched part needs the mode tuning, which does not exist yet.
  *
  * The part's model as its identification would give it, from the plant's own values:
  * the demodulation phase and scale of the default part's calibration moved by the sense
@@ -26,12 +29,12 @@
 #include "sense_mode_model.h"
 
 #define F_SENSE_HZ 1600.0
-#define Q_SENSE 1.0e4
 #define KS_FB 0.1 /* (m/s^2)/V^2: 1500 deg/s of quadrature at 7 V */
 #define STEP_DPS 100.0
 #define T_STEP_S 0.5
 
-static void start(uint32_t sense_mode, double quad_dps)
+/* The part with a sense mode of quality q_sense at F_SENSE_HZ, its model as above. */
+static void start_q(uint32_t sense_mode, double quad_dps, double q_sense)
 {
   plant_cfg_t pc;
   plant_default_cfg(&pc);
@@ -41,7 +44,7 @@ static void start(uint32_t sense_mode, double quad_dps)
   double m0, a0, m1, a1;
   mode_response(pc.f_sense_hz, pc.q_sense, wc, &m0, &a0);
   pc.f_sense_hz = F_SENSE_HZ;
-  pc.q_sense = Q_SENSE;
+  pc.q_sense = q_sense;
   pc.fb_mode = 3;
   pc.ks_fb_mps2_per_v2 = KS_FB;
   pc.quad_dps = quad_dps;
@@ -49,7 +52,7 @@ static void start(uint32_t sense_mode, double quad_dps)
   pc.pick_sense_noise_v_rthz = pc.pick_drive_noise_v_rthz = 0.0;
   pc.drive_noise_white_v_rthz = pc.drive_noise_1hz_v_rthz = 0.0;
   pc.fb_noise_white_v_rthz = pc.fb_noise_1hz_v_rthz = 0.0;
-  mode_response(F_SENSE_HZ, Q_SENSE, wc, &m1, &a1);
+  mode_response(F_SENSE_HZ, q_sense, wc, &m1, &a1);
   v.rate_demod_phase_deg += (float)((a1 - a0) * FM_DEG_PER_RAD);
   v.rate_scale_dps = (float)((double)v.rate_scale_dps * m0 / m1);
   /* g = rate per V^2 (Ks_fb / (2 A0 wc)) over the scale, in the pickoff's volts */
@@ -57,9 +60,14 @@ static void start(uint32_t sense_mode, double quad_dps)
   v.sense_fb_gain_v_per_v2 = (float)(k_dps_per_v2 / (double)v.rate_scale_dps *
                                      (double)v.drive_amp_set_v);
   v.sense_f0_hz = (float)F_SENSE_HZ;
-  v.sense_q = (float)Q_SENSE;
+  v.sense_q = (float)q_sense;
   v.sense_mode = sense_mode;
   app_plant_start(&pc, 21u, &v);
+}
+
+static void start(uint32_t sense_mode, double quad_dps)
+{
+  start_q(sense_mode, quad_dps, 1.0e4);
 }
 
 static void set_rate(double dps)
@@ -135,12 +143,14 @@ static void test_step_settles_within_10_ms(void **state)
   const step_t r = run_step();
   const sense_fr_t *fr = &app.gyro.fr;
   printf("# force rebalance, Q 1e4, 110 Hz split, 1500 deg/s quadrature: 0 -> 100 deg/s "
-         "settles to 1 %% in %.1f ms, peak %.2f, final %.2f deg/s (true %.1f); force I %.2f "
+         "settles to 1 %% in %.1f ms (overshoot %.1f %%), peak %.2f, final %.2f deg/s (true "
+         "%.1f); force I %.2f "
          "Q %.2f V^2, settled %u, at limit %u; valid blocks %ld (50 ms before the step %ld, "
          "last 50 ms %ld), valid and wrong %d, reasons 0x%x\n",
-         r.settle_ms, r.peak_dps, r.final_dps, plant_truth(&plant)->rate_dps, (double)fr->f_re,
-         (double)fr->f_im, fr->settled, fr->at_limit, r.valid_blocks, r.valid_before,
-         r.valid_tail, r.valid_wrong, app.gyro.out.rate_invalid);
+         r.settle_ms, 100.0 * (r.peak_dps - r.final_dps) / STEP_DPS, r.peak_dps, r.final_dps,
+         plant_truth(&plant)->rate_dps, (double)fr->f_re, (double)fr->f_im, fr->settled,
+         fr->at_limit, r.valid_blocks, r.valid_before, r.valid_tail, r.valid_wrong,
+         app.gyro.out.rate_invalid);
   assert_true(r.settle_ms <= 10.0);
   assert_true(fabs(r.final_dps - STEP_DPS) <= 0.02 * STEP_DPS); /* the model's scale */
   assert_false(r.valid_wrong);
@@ -174,11 +184,78 @@ static void test_open_loop_rings(void **state)
   assert_int_equal(app.gyro.fr.run, 0u);
 }
 
+/* Issue 19 item 4's step table: 0 -> 100 deg/s on each part (sense Q 3, the thesis's;
+ * 300; 10^4; all with the 110 Hz split), force rebalance against open loop. Prints the
+ * settling time to 1 % of the step (within the 100 ms looked at) and the overshoot. */
+static step_t step_row(uint32_t sense_mode, double q_sense)
+{
+  /* open loop without its quadrature, as test_open_loop_rings */
+  start_q(sense_mode, sense_mode != 0u ? 1500.0 : 0.0, q_sense);
+  const step_t r = run_step();
+  printf("# step table: sense Q %g, 110 Hz split, %s: settles to 1 %% in %s%.1f ms, overshoot "
+         "%.1f %%, final %.2f deg/s; valid and wrong %d\n",
+         q_sense, sense_mode != 0u ? "force rebalance" : "open loop",
+         r.settle_ms >= N_AFTER * BLOCK_S * 1e3 ? "more than " : "", r.settle_ms,
+         100.0 * (r.peak_dps - r.final_dps) / STEP_DPS, r.final_dps, r.valid_wrong);
+  return r;
+}
+
+/* Force rebalance settles each part within 10 ms (the issue's goal), at the model's
+ * scale, never valid and wrong. */
+static void check_fr_row(double q_sense)
+{
+  const step_t r = step_row(1u, q_sense);
+  assert_true(r.settle_ms <= 10.0);
+  assert_true(fabs(r.final_dps - STEP_DPS) <= 0.02 * STEP_DPS);
+  assert_false(r.valid_wrong);
+  assert_true(app.gyro.fr.settled != 0u && app.gyro.fr.at_limit == 0u);
+  assert_int_equal(app.gyro.sup.fault_count, 0u);
+}
+
+static void test_table_fr_q300(void **state)
+{
+  (void)state;
+  check_fr_row(300.0);
+}
+
+static void test_table_fr_q3(void **state)
+{
+  (void)state;
+  check_fr_row(3.0);
+}
+
+/* The controls, open loop on the same parts: at Q 300 the step rings at the split (55 %
+ * overshoot, still outside 1 % after the 100 ms looked at; the issue measured 0.26 s);
+ * at Q 3 the mode is fast but the open-loop output filter (100 Hz 4th-order Butterworth
+ * and the demodulator's pole) takes 17-18 ms: both miss the 10 ms goal. (Open loop the
+ * rate is also valid while it is more than 1 % from the plant's after the first 10 ms:
+ * the filter's lag at Q 3, the ringing at Q 300, which no monitor sees.) */
+static void test_table_open_q300(void **state)
+{
+  (void)state;
+  const step_t r = step_row(0u, 300.0);
+  assert_true(r.settle_ms >= 99.0);
+  assert_true(r.peak_dps - r.final_dps > 0.4 * STEP_DPS);
+  assert_int_equal(app.gyro.fr.run, 0u);
+}
+
+static void test_table_open_q3(void **state)
+{
+  (void)state;
+  const step_t r = step_row(0u, 3.0);
+  assert_true(r.settle_ms > 10.0 && r.settle_ms < 25.0);
+  assert_int_equal(app.gyro.fr.run, 0u);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_step_settles_within_10_ms),
       cmocka_unit_test(test_open_loop_rings),
+      cmocka_unit_test(test_table_fr_q300),
+      cmocka_unit_test(test_table_fr_q3),
+      cmocka_unit_test(test_table_open_q300),
+      cmocka_unit_test(test_table_open_q3),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
