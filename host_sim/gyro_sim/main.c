@@ -56,6 +56,15 @@ static void usage(FILE *f)
         "power-on with the stored values (t_s = 0 there; --duration counts the timeline).\n"
         "Figures selfcal_f0_hz, selfcal_q, selfcal_s (the firmware's sweep time) and the\n"
         "plant's selfcal_true_f0_hz, selfcal_true_q; a failed sweep says why, exit 1.\n"
+        "With firmware.sense.cal=1 the sweep identifies the sense mode too: figures\n"
+        "selfcal_sense_identified (else selfcal_sense_why), selfcal_sense_s (its share\n"
+        "of selfcal_s), selfcal_sense_f0_hz, _q, _fb_gain_v_per_v2, _fb_phase_deg,\n"
+        "_tune_ke_per_s2_per_v2 (else selfcal_sense_tune_why) beside the plant's\n"
+        "selfcal_true_sense_*: its resonance (2-32) and Q at the structure temperature,\n"
+        "its tuning slope; the feedback gain as the force Ks_fb per V^2 balancing\n"
+        "2 Omega A0 wc over the firmware's rate.scale_dps, phase 0 (the feedback pair's\n"
+        "path is the drive's): both hold when rate.scale_dps and rate.demod_phase_deg\n"
+        "are the part's.\n"
         "--firmware-params FILE (scenario key \"firmware_params\", relative to the\n"
         "scenario's folder; the option wins) loads a firmware parameter set\n"
         "(docs/param-set.md) onto the defaults, as if from flash, before the scenario's\n"
@@ -350,6 +359,45 @@ static void report_run(report_t *r, const char *isr_json, const bench_figs_t *is
   }
 }
 
+/* The sense mode's identification (firmware sense.cal 1): each value beside the plant's
+ * truth (sim.h), its share of the sweep's time, and why a value was not identified. */
+static void report_selfcal_sense(report_t *r)
+{
+  const sim_selfcal_t *c = &r->res->selfcal;
+  cJSON_AddBoolToObject(r->fig, "selfcal_sense_identified", c->sense_ok);
+  if (!c->sense_ok) cJSON_AddStringToObject(r->fig, "selfcal_sense_why", c->sense_why);
+  add_num(r->fig, "selfcal_sense_s", c->sense_s);
+  add_num(r->fig, "selfcal_sense_f0_hz", c->sense_f0_hz);
+  add_num(r->fig, "selfcal_sense_q", c->sense_q);
+  add_num(r->fig, "selfcal_sense_fb_gain_v_per_v2", c->sense_fb_gain_v_per_v2);
+  add_num(r->fig, "selfcal_sense_fb_phase_deg", c->sense_fb_phase_deg);
+  add_num(r->fig, "selfcal_sense_tune_ke_per_s2_per_v2", c->sense_tune_ke_per_s2_per_v2);
+  if (!c->tune_ok) cJSON_AddStringToObject(r->fig, "selfcal_sense_tune_why", c->tune_why);
+  add_num(r->fig, "selfcal_true_sense_f0_hz", c->true_sense_f0_hz);
+  add_num(r->fig, "selfcal_true_sense_q", c->true_sense_q);
+  add_num(r->fig, "selfcal_true_sense_fb_gain_v_per_v2", c->true_sense_fb_gain_v_per_v2);
+  add_num(r->fig, "selfcal_true_sense_fb_phase_deg", c->true_sense_fb_phase_deg);
+  add_num(r->fig, "selfcal_true_sense_tune_ke_per_s2_per_v2", c->true_tune_ke_per_s2_per_v2);
+}
+
+static void print_selfcal_sense(const sim_selfcal_t *c)
+{
+  if (!c->sense_ok) {
+    printf("  sense mode not identified in %.2f s: %s (plant %.4f Hz, Q %.4g)\n", c->sense_s,
+           c->sense_why, c->true_sense_f0_hz, c->true_sense_q);
+    return;
+  }
+  printf("  sense mode identified in %.2f s: f0 %.4f Hz, Q %.4g, fb gain %.5f V/V^2, phase "
+         "%+.2f deg (plant %.4f Hz, Q %.4g, model %.5f V/V^2, %+.2f deg); tuning slope ",
+         c->sense_s, c->sense_f0_hz, c->sense_q, c->sense_fb_gain_v_per_v2,
+         c->sense_fb_phase_deg, c->true_sense_f0_hz, c->true_sense_q,
+         c->true_sense_fb_gain_v_per_v2, c->true_sense_fb_phase_deg);
+  if (c->tune_ok)
+    printf("%.4g (plant %.4g) 1/s^2/V^2\n", c->sense_tune_ke_per_s2_per_v2,
+           c->true_tune_ke_per_s2_per_v2);
+  else printf("not identified: %s\n", c->tune_why);
+}
+
 /* The self-calibration before the timeline: the firmware's result and time, the plant's
  * truth during it. */
 static void report_selfcal(report_t *r)
@@ -360,10 +408,12 @@ static void report_selfcal(report_t *r)
   add_num(r->fig, "selfcal_s", c->s);
   add_num(r->fig, "selfcal_true_f0_hz", c->true_f0_hz);
   add_num(r->fig, "selfcal_true_q", c->true_q);
+  if (c->sense_ran) report_selfcal_sense(r);
   if (r->quiet) return;
   printf("  self-calibration (`sweep`) %s in %.2f s: f0 %.4f Hz, Q %.2f (plant %.4f Hz, Q %.2f)%s%s\n",
          c->ok ? "saved" : "FAILED", c->s, c->f0_hz, c->q, c->true_f0_hz, c->true_q,
          c->ok ? "" : ": ", c->ok ? "" : c->why);
+  if (c->sense_ran) print_selfcal_sense(c);
 }
 
 static void report_startup(report_t *r)

@@ -55,6 +55,26 @@ typedef struct {
   double true_q;        /* the drive Q at the structure temperature (plant.q_temp_law),
                            mean over the sweep */
   param_values_t saved; /* the parameters the timeline starts from (the store's) */
+  /* The sense mode's identification (firmware sense.cal 1, selfcal.h S1-S3): */
+  int sense_ran;               /* it was asked for */
+  int sense_ok;                /* all four model values identified */
+  char sense_why[160];         /* the reason, when not sense_ok */
+  double sense_f0_hz, sense_q; /* identified (NAN when not) */
+  double sense_fb_gain_v_per_v2, sense_fb_phase_deg;
+  int tune_ok;                        /* the tuning slope identified */
+  char tune_why[160];                 /* the reason, when probed and not tune_ok */
+  double sense_tune_ke_per_s2_per_v2; /* NAN when not identified */
+  double sense_s;                     /* its share of the sweep time */
+  double true_sense_f0_hz;            /* undamped sense resonance (2-32) without the electrodes'
+                              softening, mean over the sweep */
+  double true_sense_q; /* the sense Q at the structure temperature, mean over it */
+  double true_sense_fb_gain_v_per_v2; /* the model of test_cl_sense_fr.c: the feedback's
+                                         rate equivalent (plant_fb_rate_dps_per_v2, at
+                                         the plant's drive resonance and design
+                                         amplitude) over the firmware's rate.scale_dps,
+                                         times drive.amp_set_v */
+  double true_sense_fb_phase_deg;     /* 0: the feedback pair's path is the drive pair's */
+  double true_tune_ke_per_s2_per_v2;  /* the tuning electrodes' slope times their DAC gain */
 } sim_selfcal_t;
 
 /* Longest reply kept of a scenario command (the host UART stub holds less). */

@@ -387,6 +387,40 @@ static void first_line(const char *reply, char *out, size_t n)
   snprintf(out, n, "%.*s", (int)strcspn(reply, "\r\n"), reply);
 }
 
+/* The sense mode's identification (sense.cal 1) against the plant: what was identified
+ * or why not, its time; the truth of the feedback gain and phase as the closed-loop tests
+ * model them (test_cl_sense_fr.c): they hold when the firmware's rate.scale_dps and
+ * rate.demod_phase_deg are the part's. */
+static void selfcal_sense_result(const app_t *a, const plant_t *p, double fs, sim_selfcal_t *out)
+{
+  const selfcal_sense_t *m = &a->selfcal.sense;
+  const param_values_t *v = params_current(&a->params);
+  const plant_cfg_t *pc = &p->cfg;
+  out->sense_ran = m->state != SELFCAL_SENSE_OFF;
+  out->sense_ok = m->state == SELFCAL_SENSE_OK;
+  snprintf(out->sense_why, sizeof out->sense_why, "%s",
+           m->why != NULL  ? m->why
+           : out->sense_ok ? ""
+                           : "not finished");
+  const int f0 = m->state == SELFCAL_SENSE_F0 || out->sense_ok;
+  out->sense_f0_hz = f0 ? m->f0_hz : NAN;
+  out->sense_q = f0 ? m->q : NAN;
+  out->sense_fb_gain_v_per_v2 = out->sense_ok ? m->fb_gain_v_per_v2 : NAN;
+  out->sense_fb_phase_deg = out->sense_ok ? m->fb_phase_rad * PLANT_DEG_PER_RAD : NAN;
+  out->tune_ok = m->tune == SELFCAL_TUNE_OK;
+  snprintf(out->tune_why, sizeof out->tune_why, "%s",
+           m->tune_why != NULL ? m->tune_why
+           : out->tune_ok      ? ""
+                               : "not probed");
+  out->sense_tune_ke_per_s2_per_v2 = out->tune_ok ? m->tune_ke_per_s2_per_v2 : NAN;
+  out->sense_s = (double)m->ticks / fs;
+  const double k_dps_per_v2 = plant_fb_rate_dps_per_v2(pc, out->true_f0_hz, pc->drive_amp_m);
+  out->true_sense_fb_gain_v_per_v2 = k_dps_per_v2 / (double)v->rate_scale_dps *
+                                     (double)v->drive_amp_set_v;
+  out->true_sense_fb_phase_deg = 0.0;
+  out->true_tune_ke_per_s2_per_v2 = pc->tune_ke_per_s2_per_v2 * pc->dac_gain_tune;
+}
+
 /* `sweep` on the running application, then the background loop polled every
  * millisecond until the sequencer is done or failed. Sums the plant's true drive
  * resonance and Q (both at the structure temperature) over the sweep. Returns 0 when it
@@ -403,8 +437,8 @@ static int selfcal_sweep(app_t *a, const plant_t *p, double fs, sim_selfcal_t *o
   const uint64_t cap = (uint64_t)llround(SELFCAL_MAX_S * fs);
   /* the Q as its first value plus the mean deviation: exactly the plant's Q when its
    * law keeps it constant */
-  const double q0 = plant_truth(p)->q_drive;
-  double sum_wn = 0.0, sum_dq = 0.0;
+  const double q0 = plant_truth(p)->q_drive, qs0 = plant_truth(p)->q_sense;
+  double sum_wn = 0.0, sum_dq = 0.0, sum_wn2 = 0.0, sum_dqs = 0.0;
   uint64_t n = 0u;
   const selfcal_t *s = &a->selfcal;
   for (uint64_t k = 0; k < cap && s->state != SELFCAL_DONE && s->state != SELFCAL_FAILED;
@@ -413,8 +447,12 @@ static int selfcal_sweep(app_t *a, const plant_t *p, double fs, sim_selfcal_t *o
     app_poll(a);
     sum_wn += plant_truth(p)->wn_drive_rad_s;
     sum_dq += plant_truth(p)->q_drive - q0;
+    sum_wn2 += plant_truth(p)->wn_sense_rad_s;
+    sum_dqs += plant_truth(p)->q_sense - qs0;
     n++;
   }
+  out->true_sense_f0_hz = n ? sum_wn2 / (double)n / (2.0 * PLANT_PI) : NAN;
+  out->true_sense_q = n ? qs0 + sum_dqs / (double)n : NAN;
   out->true_f0_hz = n ? sum_wn / (double)n / (2.0 * PLANT_PI) : NAN;
   /* the drive Q at the structure temperature (its law, plant.q_temp_law), mean over the
    * sweep */
@@ -424,6 +462,7 @@ static int selfcal_sweep(app_t *a, const plant_t *p, double fs, sim_selfcal_t *o
   out->s = (double)(s->state == SELFCAL_DONE ? a->selfcal_ticks
                                              : app_ticks(a) - a->selfcal_t0_ticks) /
            fs;
+  selfcal_sense_result(a, p, fs, out);
   if (s->state == SELFCAL_DONE) return 0;
   if (s->state == SELFCAL_FAILED)
     snprintf(out->why, sizeof out->why, "%s", s->why != NULL ? s->why : "failed");
@@ -459,6 +498,7 @@ static int selfcal_run(const sim_scenario_t *sc, const plant_cfg_t *pc,
 {
   out->ran = 1;
   out->f0_hz = out->q = out->s = out->true_f0_hz = out->true_q = NAN;
+  out->true_sense_f0_hz = out->true_sense_q = NAN;
   plant_profiles_t held;
   initial_profiles(prof, &held);
   plant_t *p = calloc(1, sizeof *p);

@@ -54,6 +54,12 @@ double plant_fb_pair_softening(const plant_cfg_t *c)
   return 2.0 * c->ks_fb_mps2_per_v2 / c->fb_gap_m;
 }
 
+double plant_fb_rate_dps_per_v2(const plant_cfg_t *c, double f_drive_hz, double amp_m)
+{
+  if (!(f_drive_hz > 0.0) || !(amp_m > 0.0)) return 0.0;
+  return c->ks_fb_mps2_per_v2 / (2.0 * amp_m * 2.0 * PLANT_PI * f_drive_hz) * PLANT_DEG_PER_RAD;
+}
+
 double plant_fb_softening(const plant_cfg_t *c)
 {
   /* (6-3) per electrode: k_e = eps A V^2 / d^3 = 2 (Ks m) V^2 / d, with Ks m = eps A / (2 d^2)
@@ -314,6 +320,8 @@ static void truth_temps(plant_t *p, double ambient_k)
   t->board_k = thermal_temp(&p->thermal, THERMAL_BOARD);
   t->wn_drive_rad_s = mech_wn1(&p->mech);
   t->q_drive = mech_q1(&p->mech);
+  t->wn_sense_rad_s = mech_wn2(&p->mech);
+  t->q_sense = mech_q2(&p->mech);
 }
 
 /* The electrodes' part of the truth (plant_truth_t): the quadrature as an equivalent rate

@@ -396,6 +396,9 @@ typedef struct {
   double wn_drive_rad_s; /* drive resonance now (2-32), per second of the sample clock */
   double clock_ppm;      /* the sample clock's error now (+: fast; plant_cfg_t clock_*) */
   double q_drive;        /* drive quality factor now (q_temp_law) */
+  double wn_sense_rad_s; /* sense resonance now (2-32) without the electrostatic
+                              softening, per second of the sample clock */
+  double q_sense;        /* sense quality factor now (q_temp_law) */
   /* motion (state at t_s) */
   double y_m, vy_mps, x_m, vx_mps;
   /* phasors at the drive frequency (every truth_decim samples): */
@@ -603,6 +606,13 @@ double plant_fb_softening(const plant_cfg_t *cfg);
 /* k_e / m per V^2 of the feedback pair's softening in fb_mode 3, 2 ks_fb / fb_gap_m (the
  * sum U3^2 + U4^2 multiplies it); 0 in the other modes or with fb_gap_m = 0. */
 double plant_fb_pair_softening(const plant_cfg_t *cfg);
+
+/* The rate equivalent of the sense feedback force, deg/s per V^2 of force command: the
+ * force Ks_fb per V^2 (ks_fb_mps2_per_v2, per unit mass) balances the Coriolis force
+ * 2 Omega A0 wc (2-28) of a drive of amplitude amp_m at f_drive_hz. The force-rebalance
+ * scale factor rate.scale_dps g (sense_fr.h) is this when both are the part's. 0 for a
+ * non-positive amplitude or frequency. */
+double plant_fb_rate_dps_per_v2(const plant_cfg_t *cfg, double f_drive_hz, double amp_m);
 
 /* ------------------------------------------------------------ budgets -------- */
 
