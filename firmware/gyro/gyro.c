@@ -173,6 +173,11 @@ void gyro_stop(gyro_t *g)
   if (g->fr.run != 0u) gyro_fr_off(g);                 /* no feedback force */
   gyro_sweep_electrodes_off(g);
   drive_loop_reset(&g->design->drive, &g->drive);
+  /* No force is synthesised in OFF; the next start's first ticks (until its first
+   * command, GYRO_SLOT_COMMAND) would otherwise drive the resonator with the stopped
+   * run's last force, a kick a power-on does not give (the fault's clear silences it
+   * too, gyro_block_clear). */
+  drive_synth_silence(&g->synth);
   /* The drive starts again from the calibrated frequency, whatever moved the NCO (the
    * tracking drive, or a sweep that ended without its hand-over). */
   gyro_track_restart(g);
