@@ -154,7 +154,19 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   gyro_apply_fr(g, d, old);
 }
 
-void gyro_start(gyro_t *g) { supervisor_start(&g->sup); }
+void gyro_start(gyro_t *g)
+{
+  /* Out of OFF the thermometer and its checks start again as at power-on: P_f from the
+   * reference, the compensation's filters and the output filters at rest, no slew
+   * window, shadow, trend or THERMO_SLEW standing (rate_valid_restart), on the next rate
+   * slots (the clear's, gyro_block_rate_clear; not on this tick, which takes the
+   * request). While the drive was off P measured nothing: the P_f it held is the
+   * temperature at the stop, after an unknown time off (a night, a chamber change) no
+   * better a start than the calibrated reference; and a THERMO_SLEW of the P_f of before
+   * the stop held the compensation's fast path out for 45 s after the new lock. */
+  if (g->sup.mode == GYRO_MODE_OFF) g->rate_clear_due = GYRO_RATE_CLEAR_RESTART;
+  supervisor_start(&g->sup);
+}
 
 /* The sweep's sense jobs leave a command on the feedback pair's synthesis and may leave
  * the tuning electrodes at a probe voltage (a failed sweep): both off whenever a sweep

@@ -73,7 +73,8 @@ GYRO_RAMFUNC void gyro_block_clear(gyro_t *g)
   lmsd_reset(&g->lmsd_sense);
   drive_loop_reset(&g->design->drive, &g->drive);
   drive_synth_silence(&g->synth);
-  g->rate_clear_due = 1u; /* the rate channel's half, on the next tick (its budget) */
+  /* the rate channel's half, on the next tick (its budget) */
+  g->rate_clear_due = GYRO_RATE_CLEAR_CHANNEL;
 }
 
 /* The tracking drive's update (drive_track.h): the wrapped phase error moves the NCO's
@@ -446,6 +447,12 @@ GYRO_RAMFUNC void gyro_block_track_judge(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_rate_clear(gyro_t *g)
 {
+  if (g->rate_clear_due == GYRO_RATE_CLEAR_RESTART) {
+    /* A start from OFF (gyro_start): the checks' half first, on a slot of its own. */
+    rate_valid_restart(&g->valid);
+    g->rate_clear_due = GYRO_RATE_CLEAR_CHANNEL;
+    return;
+  }
   g->rate_clear_due = 0u;
   rate_channel_reset(&g->design->rate, &g->rate, g->design->rate.p_ref_deg);
   gyro_track_restart(g); /* the clear's tracking-drive half, within this tick's budget */
