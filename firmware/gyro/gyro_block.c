@@ -73,8 +73,9 @@ GYRO_RAMFUNC void gyro_block_clear(gyro_t *g)
   lmsd_reset(&g->lmsd_sense);
   drive_loop_reset(&g->design->drive, &g->drive);
   drive_synth_silence(&g->synth);
-  /* the rate channel's half, on the next tick (its budget) */
-  g->rate_clear_due = GYRO_RATE_CLEAR_CHANNEL;
+  /* The rate's half on the next rate slots (their budget): the thermometer's checks
+   * start again with P_f (rate_valid_restart), which starts from the reference. */
+  g->rate_clear_due = GYRO_RATE_CLEAR_RESTART;
 }
 
 /* The tracking drive's update (drive_track.h): the wrapped phase error moves the NCO's
@@ -448,7 +449,7 @@ GYRO_RAMFUNC void gyro_block_track_judge(gyro_t *g)
 GYRO_RAMFUNC void gyro_block_rate_clear(gyro_t *g)
 {
   if (g->rate_clear_due == GYRO_RATE_CLEAR_RESTART) {
-    /* A start from OFF (gyro_start): the checks' half first, on a slot of its own. */
+    /* The checks' half first, on a slot of its own (a fault's clear, a start from OFF). */
     rate_valid_restart(&g->valid);
     g->rate_clear_due = GYRO_RATE_CLEAR_CHANNEL;
     return;

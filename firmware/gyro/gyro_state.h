@@ -94,9 +94,9 @@ typedef struct gyro_s {
   uint32_t fr_on;   /* force rebalance (the design's sense_mode 1): its steps and waveform */
   uint32_t fr_bits; /* RATE_INVALID_SENSE_FR while it is on and not balanced */
   float fb_off_v;   /* what the board adds to the feedback converters' voltages (design) */
-  uint32_t rate_clear_due; /* the loop-state clear's rate-channel half is due (GYRO_SLOT_RATE):
-                            * GYRO_RATE_CLEAR_CHANNEL, or GYRO_RATE_CLEAR_RESTART (a start
-                            * from OFF: the validity checks first, then the channel) */
+  uint32_t rate_clear_due; /* the loop-state clear's rate half is due (GYRO_SLOT_RATE; a
+                            * fault's clear, a start from OFF): GYRO_RATE_CLEAR_RESTART,
+                            * the validity checks' on one slot, then CHANNEL on the next */
   uint32_t flags_acc;      /* GYRO_FLAG_* seen since the last snapshot */
   supervisor_in_t sup_in;  /* the supervisor's evidence, gathered by the jobs before
                            * GYRO_SLOT_SUPERVISE (slot table above) */
