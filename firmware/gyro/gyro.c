@@ -141,6 +141,10 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
     rate_valid_disturb(&g->valid);
   }
   rate_channel_rebase(&old->rate, &d->rate, &g->rate);
+  /* A new reference of P's low-pass (drive.p_init_deg) re-expresses P_f, no change of
+   * temperature: the checks' slew window and trend move with it, or the next window
+   * would read the change of reference as a slew. */
+  rate_valid_shift_p(&g->valid, old->rate.p_ref_deg - d->rate.p_ref_deg);
   g->design = d;
   /* Quadrature nulling turned off, or no longer LOCKED (a re-acquisition above): the
    * electrodes at 0 V now; turned on, not nulled until its loop says so, from the next

@@ -110,12 +110,15 @@ static void test_new_reference_moves_the_checks_with_p_f(void **state)
   (void)slew_over(2.0, p_deg); /* P_f's fast start, then at rest */
   assert_int_equal(slew_over(1.0, p_deg), 0u);
   const float f_before = g.rate.p_f_deg;
+  /* Each where it was from P_f, before and after. */
   const float held_gap_deg = g.rate.p_held_dev_deg - g.rate.p_dev_deg;
+  const float window_gap_deg = g.valid.p_dev_window_deg - g.rate.p_dev_deg;
+  const float trend_gap_deg = g.valid.trend_p_deg - g.rate.p_dev_deg;
   gyro_apply(&g, &d2);
   assert_true(g.rate.p_f_deg == f_before);
   assert_float_equal(g.rate.p_held_dev_deg - g.rate.p_dev_deg, held_gap_deg, 1e-4f);
-  assert_float_equal(g.valid.p_dev_window_deg, g.rate.p_dev_deg, 0.01f);
-  assert_float_equal(g.valid.trend_p_deg, g.rate.p_dev_deg, 0.01f);
+  assert_float_equal(g.valid.p_dev_window_deg - g.rate.p_dev_deg, window_gap_deg, 1e-4f);
+  assert_float_equal(g.valid.trend_p_deg - g.rate.p_dev_deg, trend_gap_deg, 1e-4f);
   assert_int_equal(slew_over(2.0, p_deg), 0u);
 }
 
