@@ -141,6 +141,10 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
     rate_valid_disturb(&g->valid);
   }
   rate_channel_rebase(&old->rate, &d->rate, &g->rate);
+  /* A new reference of P's low-pass (drive.p_init_deg) re-expresses P_f, no change of
+   * temperature: the checks' slew window and trend move with it, or the next window
+   * would read the change of reference as a slew. */
+  rate_valid_shift_p(&g->valid, old->rate.p_ref_deg - d->rate.p_ref_deg);
   g->design = d;
   /* Quadrature nulling turned off, or no longer LOCKED (a re-acquisition above): the
    * electrodes at 0 V now; turned on, not nulled until its loop says so, from the next
@@ -154,7 +158,19 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   gyro_apply_fr(g, d, old);
 }
 
-void gyro_start(gyro_t *g) { supervisor_start(&g->sup); }
+void gyro_start(gyro_t *g)
+{
+  /* Out of OFF the thermometer and its checks start again as at power-on: P_f from the
+   * reference, the compensation's filters and the output filters at rest, no slew
+   * window, shadow, trend or THERMO_SLEW standing (rate_valid_restart), on the next rate
+   * slots (the clear's, gyro_block_rate_clear; not on this tick, which takes the
+   * request). While the drive was off P measured nothing: the P_f it held is the
+   * temperature at the stop, after an unknown time off (a night, a chamber change) no
+   * better a start than the calibrated reference; and a THERMO_SLEW of the P_f of before
+   * the stop held the compensation's fast path out for 45 s after the new lock. */
+  if (g->sup.mode == GYRO_MODE_OFF) g->rate_clear_due = GYRO_RATE_CLEAR_RESTART;
+  supervisor_start(&g->sup);
+}
 
 /* The sweep's sense jobs leave a command on the feedback pair's synthesis and may leave
  * the tuning electrodes at a probe voltage (a failed sweep): both off whenever a sweep
@@ -173,6 +189,11 @@ void gyro_stop(gyro_t *g)
   if (g->fr.run != 0u) gyro_fr_off(g);                 /* no feedback force */
   gyro_sweep_electrodes_off(g);
   drive_loop_reset(&g->design->drive, &g->drive);
+  /* No force is synthesised in OFF; the next start's first ticks (until its first
+   * command, GYRO_SLOT_COMMAND) would otherwise drive the resonator with the stopped
+   * run's last force, a kick a power-on does not give (the fault's clear silences it
+   * too, gyro_block_clear). */
+  drive_synth_silence(&g->synth);
   /* The drive starts again from the calibrated frequency, whatever moved the NCO (the
    * tracking drive, or a sweep that ended without its hand-over). */
   gyro_track_restart(g);

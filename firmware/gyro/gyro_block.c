@@ -73,7 +73,9 @@ GYRO_RAMFUNC void gyro_block_clear(gyro_t *g)
   lmsd_reset(&g->lmsd_sense);
   drive_loop_reset(&g->design->drive, &g->drive);
   drive_synth_silence(&g->synth);
-  g->rate_clear_due = 1u; /* the rate channel's half, on the next tick (its budget) */
+  /* The rate's half on the next rate slots (their budget): the thermometer's checks
+   * start again with P_f (rate_valid_restart), which starts from the reference. */
+  g->rate_clear_due = GYRO_RATE_CLEAR_RESTART;
 }
 
 /* The tracking drive's update (drive_track.h): the wrapped phase error moves the NCO's
@@ -446,6 +448,12 @@ GYRO_RAMFUNC void gyro_block_track_judge(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_rate_clear(gyro_t *g)
 {
+  if (g->rate_clear_due == GYRO_RATE_CLEAR_RESTART) {
+    /* The checks' half first, on a slot of its own (a fault's clear, a start from OFF). */
+    rate_valid_restart(&g->valid);
+    g->rate_clear_due = GYRO_RATE_CLEAR_CHANNEL;
+    return;
+  }
   g->rate_clear_due = 0u;
   rate_channel_reset(&g->design->rate, &g->rate, g->design->rate.p_ref_deg);
   gyro_track_restart(g); /* the clear's tracking-drive half, within this tick's budget */

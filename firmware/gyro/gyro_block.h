@@ -92,8 +92,9 @@ void gyro_block_phase_judge(gyro_t *g);
 /* GYRO_SLOT_RATE: the continuous self-test's notch on the rate axis, the rate's output
  * filter, scale and compensation, its range check. */
 void gyro_block_rate(gyro_t *g);
-/* GYRO_SLOT_RATE after the loop state's clear (gyro_block_clear, rate_clear_due): its
- * rate-channel half instead, the rate channel's reset (and the tracking drive's). */
+/* GYRO_SLOT_RATE after the loop state's clear (gyro_block_clear, or a start from OFF:
+ * rate_clear_due): its rate half instead, on two blocks: the thermometer's checks
+ * (rate_valid_restart), then the rate channel's reset (and the tracking drive's). */
 void gyro_block_rate_clear(gyro_t *g);
 /* GYRO_SLOT_P: P's hold (while not LOCKED) and low-pass, and one of the jobs between two
  * P_f (the thermometer checks of the P_f the last block made, the compensation's steps). */

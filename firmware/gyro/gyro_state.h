@@ -27,6 +27,10 @@
 #include "hal/hal_adc.h"
 #include "hal/hal_dac.h"
 
+/* gyro_t.rate_clear_due: what is still to be cleared on the coming rate slots. */
+#define GYRO_RATE_CLEAR_CHANNEL 1u /* the rate channel (P_f from the reference) */
+#define GYRO_RATE_CLEAR_RESTART 2u /* the validity checks' thermometer state, then that */
+
 /* A snapshot of the outputs of the latest tick (telemetry, status, the simulator). */
 typedef struct {
   uint32_t tick;
@@ -90,7 +94,9 @@ typedef struct gyro_s {
   uint32_t fr_on;   /* force rebalance (the design's sense_mode 1): its steps and waveform */
   uint32_t fr_bits; /* RATE_INVALID_SENSE_FR while it is on and not balanced */
   float fb_off_v;   /* what the board adds to the feedback converters' voltages (design) */
-  uint32_t rate_clear_due; /* the loop-state clear's rate-channel half is due (GYRO_SLOT_RATE) */
+  uint32_t rate_clear_due; /* the loop-state clear's rate half is due (GYRO_SLOT_RATE; a
+                            * fault's clear, a start from OFF): GYRO_RATE_CLEAR_RESTART,
+                            * the validity checks' on one slot, then CHANNEL on the next */
   uint32_t flags_acc;      /* GYRO_FLAG_* seen since the last snapshot */
   supervisor_in_t sup_in;  /* the supervisor's evidence, gathered by the jobs before
                            * GYRO_SLOT_SUPERVISE (slot table above) */

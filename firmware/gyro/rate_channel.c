@@ -60,7 +60,9 @@ void rate_channel_rebase(const rate_channel_cfg_t *old, const rate_channel_cfg_t
     biquad_sections_reset(cfg->lpf, rc->lpf_rate, cfg->lpf_sections, 0.0f);
     biquad_sections_reset(cfg->lpf, rc->lpf_quad, cfg->lpf_sections, 0.0f);
   }
-  /* P_f is kept as it is, re-expressed around the new reference. */
+  /* P_f is kept as it is, re-expressed around the new reference, and so is the value
+   * its fast start began from (the same coordinates: THERMO_SETTLE's gap). */
+  rc->p_held_dev_deg += old->p_ref_deg - cfg->p_ref_deg;
   rc->p_dev_deg = rc->p_f_deg - cfg->p_ref_deg;
   rc->p_acc_deg = 0.0f;
   rc->p_count = 0u;

@@ -180,7 +180,8 @@ int rate_channel_init(const rate_channel_cfg_t *cfg, rate_channel_t *rc);
 
 /* A new configuration takes over from old (a design change, at a block boundary): the
  * filter memory is kept when the number of sections is unchanged, cleared otherwise;
- * P_f is kept as it is, re-expressed around the new reference, and P's average starts
+ * P_f is kept as it is, re-expressed around the new reference (the caller moves the
+ * thermometer checks' window with it, rate_valid_shift_p), and P's average starts
  * again. No libm. */
 void rate_channel_rebase(const rate_channel_cfg_t *old, const rate_channel_cfg_t *cfg,
                          rate_channel_t *rc);

@@ -33,15 +33,9 @@ int rate_valid_cfg_ok(const rate_valid_cfg_t *c)
          fm_isfinite(c->grad_fast_abs_dps_per_deg) && spur_m_ok(c->spur_m);
 }
 
-int rate_valid_init(const rate_valid_cfg_t *cfg, rate_valid_t *rv)
+GYRO_RAMFUNC void rate_valid_restart(rate_valid_t *rv)
 {
-  if (rv == NULL || !rate_valid_cfg_ok(cfg)) {
-    return -1;
-  }
-  rv->reasons = RATE_INVALID_MODE;
-  rv->thermo = rv->drive = rv->range = 0u;
-  rv->was_locked = 0u;
-  rv->x_rate = rv->x_quad = 0.0f;
+  rv->thermo = 0u;
   rv->p_dev_window_deg = 0.0f;
   rv->p_updates = 0u;
   rv->slew = rv->slew_due = rv->restart_armed = rv->spur = rv->displaced = 0u;
@@ -54,6 +48,18 @@ int rate_valid_init(const rate_valid_cfg_t *cfg, rate_valid_t *rv)
   rv->snap_fast_lag_deg = rv->snap_fast_hp_deg = 0.0f;
   rv->p_window_change_deg = 0.0f;
   for (uint32_t i = 0u; i < RATE_VALID_SPUR_N; i++) rv->spur_deg[i] = 0.0f;
+}
+
+int rate_valid_init(const rate_valid_cfg_t *cfg, rate_valid_t *rv)
+{
+  if (rv == NULL || !rate_valid_cfg_ok(cfg)) {
+    return -1;
+  }
+  rv->reasons = RATE_INVALID_MODE;
+  rate_valid_restart(rv);
+  rv->drive = rv->range = 0u;
+  rv->was_locked = 0u;
+  rv->x_rate = rv->x_quad = 0.0f;
   rv->phase_err_lp_rad = 0.0f;
   rv->blocks = 0u;
   rv->onsets_pending = rv->onset_block = 0u;

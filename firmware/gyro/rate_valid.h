@@ -206,6 +206,16 @@ int rate_valid_cfg_ok(const rate_valid_cfg_t *cfg);
  * configuration. */
 int rate_valid_init(const rate_valid_cfg_t *cfg, rate_valid_t *rv);
 
+/* The thermometer's checks start again as at power-on (rate_valid_init), with the rate
+ * channel's own start from the reference (rate_channel_reset: a start of the drive from
+ * OFF, a fault's clear): what they found about the P_f of before (a slew window, a move in
+ * the shadow, a restart armed, a trend, THERMO_SLEW itself) is of a thermometer that
+ * starts again from another value, and a THERMO_SLEW left standing would hold the
+ * compensation's fast path out (rate_channel_fast_hold) for its settling after the new
+ * lock. The verdict's history and the settling check are left alone (not LOCKED is MODE,
+ * and entering LOCKED disturbs). */
+void rate_valid_restart(rate_valid_t *rv);
+
 /* The filters must settle again before the rate is valid. */
 static inline void rate_valid_disturb(rate_valid_t *rv)
 {

@@ -262,6 +262,47 @@ static void test_fast_path_kicks_never_valid_and_wrong(void **state)
   kick_fast(0.014, -0.1, 5.0);
 }
 
+/* The loop state's clear after a fault (gyro_block_clear, then the rate slots): P_f starts
+ * again from the reference, and so do the thermometer's checks (rate_valid_restart), as
+ * at power-on. Before, they kept what they found about the P_f of before the fault (the
+ * slew window's start, a THERMO_SLEW, the shadow, the trend), which the new P_f, started
+ * elsewhere, does not have. */
+static void test_fault_clear_restarts_the_thermometer_checks(void **state)
+{
+  (void)state;
+  make();
+  uint32_t slew = 0u;
+  (void)worst_valid_error(0.0, 0.5, 0.05, 1.0, 1.1, &slew); /* ends in the kick's trace */
+  assert_int_not_equal(slew, 0u);
+  g.sup.clear_req = 1u;
+  gyro_block_run(&g, GYRO_SLOT_PROJECT, 0.0f, 0.0f);
+  for (int i = 0; i < 2 && g.rate_clear_due != 0u; i++) {
+    gyro_block_run(&g, GYRO_SLOT_RATE, 0.0f, 0.0f);
+  }
+  assert_int_equal(g.rate_clear_due, 0u);
+  assert_true(g.rate.p_dev_deg == 0.0f);
+  /* A fresh start's checks, but for what the verdict keeps (its history, the settling
+   * check, the phase error's low-pass: reset on entering LOCKED). */
+  rate_valid_t fresh;
+  assert_int_equal(rate_valid_init(&d.valid, &fresh), 0);
+  const rate_valid_t *v = &g.valid;
+  fresh.reasons = v->reasons;
+  fresh.drive = v->drive;
+  fresh.range = v->range;
+  fresh.settled = v->settled;
+  fresh.settle_run = v->settle_run;
+  fresh.was_locked = v->was_locked;
+  fresh.x_rate = v->x_rate;
+  fresh.x_quad = v->x_quad;
+  fresh.d_rate = v->d_rate;
+  fresh.d_quad = v->d_quad;
+  fresh.phase_err_lp_rad = v->phase_err_lp_rad;
+  fresh.blocks = v->blocks;
+  fresh.onsets_pending = v->onsets_pending;
+  fresh.onset_block = v->onset_block;
+  assert_memory_equal(&fresh, v, sizeof fresh);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -272,6 +313,7 @@ int main(void)
       cmocka_unit_test(test_noisy_ramp),
       cmocka_unit_test(test_lasting_move_never_valid_and_wrong),
       cmocka_unit_test(test_fast_path_kicks_never_valid_and_wrong),
+      cmocka_unit_test(test_fault_clear_restarts_the_thermometer_checks),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
