@@ -60,6 +60,7 @@ int rate_valid_init(const rate_valid_cfg_t *cfg, rate_valid_t *rv)
   rv->drive = rv->range = 0u;
   rv->was_locked = 0u;
   rv->x_rate = rv->x_quad = 0.0f;
+  rv->ring_ms = 0.0f;
   rv->phase_err_lp_rad = 0.0f;
   rv->blocks = 0u;
   rv->onsets_pending = rv->onset_block = 0u;
@@ -81,8 +82,23 @@ GYRO_RAMFUNC void rate_valid_settling(const rate_valid_cfg_t *restrict cfg,
     dr = rv->d_rate;
     dq = rv->d_quad;
   }
-  if (rv->settled != 0u) return;
   const float tol = cfg->tol_dps;
+  if (rv->settled != 0u) {
+    /* Settled: the quadrature axis's difference watched on, its mean square over about
+     * 13 ms (rate_valid.h, RATE_VALID_RING_TOLS). A lightly damped sense mode answers a
+     * change of rate or quadrature with its free response, a phasor turning at the split
+     * |f_sense - f_drive| that decays over 2Q / w_sense, as much on this axis as on the
+     * rate's; the output filter passes a beat near its corner, the fast reference more,
+     * so their difference holds it. A rate the part follows moves the rate axis alone. */
+    rv->ring_ms += RATE_VALID_RING_K * (dq * dq - rv->ring_ms);
+    const float ring_tol = RATE_VALID_RING_TOLS * tol;
+    if (!(rv->ring_ms <= ring_tol * ring_tol)) rate_valid_disturb(rv);
+    return;
+  }
+  /* Settling: the mean square starts from 0 once settled (settling is itself the
+   * difference within tol_dps for RATE_VALID_SETTLE_BLOCKS: a ringing then left is under
+   * the threshold), not from what the transient before it left. */
+  rv->ring_ms = 0.0f;
   const int inside = fm_absf_cmp(dr) <= tol && fm_absf_cmp(dq) <= tol;
   rv->settle_run = inside ? rv->settle_run + 1u : 0u;
   if (rv->settle_run >= RATE_VALID_SETTLE_BLOCKS) rv->settled = 1u;

@@ -9,7 +9,9 @@
  *                 (entering LOCKED, a change of the rate path's coefficients, the end
  *                 of a self-test, a rail code, a wrap of P): settled is measured, both
  *                 the rate and the quadrature filter outputs within tol_dps of a fast
- *                 low-pass of their inputs for RATE_VALID_SETTLE_BLOCKS blocks in a row
+ *                 low-pass of their inputs for RATE_VALID_SETTLE_BLOCKS blocks in a row;
+ *                 once settled, the quadrature's difference beyond RATE_VALID_RING_TOLS
+ *                 tolerances is a disturbance too (the sense mode ringing at the split)
  *   CLIP          an ADC rail code in the latest block (the demodulated phasors are
  *                 then wrong by an unknown amount)
  *   SENSE_RANGE   the sense pickoff amplitude above RATE_VALID_SENSE_FRAC of the ADC
@@ -96,6 +98,34 @@
 /* Blocks in a row inside the settling tolerance (2 ms): longer than the noise's
  * correlation time at the filters' 100 Hz, far shorter than their settling. */
 #define RATE_VALID_SETTLE_BLOCKS 10u
+/* Once settled, the quadrature filter's difference from its reference with an rms
+ * beyond this many tol_dps is a disturbance (settling again, SETTLING): the sense mode
+ * ringing. Open loop, a lightly damped sense mode (Q 300, 10^4, a 110 Hz split) answers
+ * a change of rate with its free response: after demodulation a phasor turning at the
+ * split, decaying with tau = 2Q / w_sense (60 ms at Q 300, 2 s at 10^4), on both axes
+ * alike. The rate's 100 Hz Butterworth passes a 110 Hz beat at 0.56, the 160 Hz
+ * reference at 0.82 and 35 degrees of lag: their difference carries 1.4 times the beat,
+ * 2.4 times what reaches the output, so an rms of 2 x 0.25 deg/s on the quadrature axis
+ * is a ringing of 0.3 deg/s amplitude on the rate's, under the integrity rule's 1 deg/s.
+ * Settling again needs the difference within tol_dps for RATE_VALID_SETTLE_BLOCKS, as at
+ * any disturbance: the ringing is then below 0.2 deg/s on the output.
+ * The quadrature axis alone is judged: a rate the part follows (a step, a sine in the
+ * band) moves the rate axis, whose output lags its reference by the filter's delay (tens
+ * of deg/s in a fast move), and such a lag is the band's, not an invalid rate. On a
+ * clean part the quadrature's difference is its noise, wide-band (0.14 deg/s rms on the
+ * default part, single blocks up to 0.58 deg/s in 4 s), and a slow move of the
+ * quadrature (the drive amplitude still settling after the first lock), whence a mean
+ * square rather than single blocks (a check of single blocks at 2 tol_dps tripped in the
+ * start-up): the noise's mean square is 0.019 (deg/s)^2, its low-pass's largest value
+ * 0.055-0.077 in 4 s over six noise seeds, under a third of the threshold's 0.25. */
+#define RATE_VALID_RING_TOLS 2.0f
+/* The mean square's low-pass per block: 64 blocks (12.8 ms). The difference's noise is
+ * a band of 100-300 Hz, a few independent values in 3 ms: over 16 blocks its mean square
+ * reached 7 times its mean in 4 s (0.14 against 0.019 (deg/s)^2), over 64 blocks 4 times
+ * (0.077), under a third of the threshold. Short beside a ringing's decay (60 ms at Q
+ * 300); and the step that starts a ringing puts its whole size on the difference at once
+ * (100 deg/s of step: some 10^4 (deg/s)^2), so it trips within a block or two. */
+#define RATE_VALID_RING_K 0.015625f
 /* P_f updates over which its slew is judged (0.1 s at 500 Hz): a slew of the
  * temperature, not the noise of P_f. */
 #define RATE_VALID_SLEW_UPDATES 50u
@@ -164,6 +194,8 @@ typedef struct {
   uint32_t was_locked;    /* LOCKED at the previous verdict (entering it disturbs) */
   float x_rate, x_quad;   /* fast low-passes of the filters' inputs (raw units) */
   float d_rate, d_quad;   /* the settling differences, low-passed (settle_diff_k < 1), deg/s */
+  float ring_ms;          /* the quadrature's difference's mean square (RATE_VALID_RING_K)
+                           * since settled */
   float p_dev_window_deg; /* P_f - p_ref at the start of the slew window */
   uint32_t p_updates;     /* P_f updates into the slew window */
   uint32_t slew;          /* RATE_INVALID_THERMO_SLEW of the latest window */

@@ -103,6 +103,36 @@ static void test_settling_measured(void **state)
   assert_int_not_equal(rate_valid_verdict(&rv, RATE_INVALID_CLIP) & RATE_INVALID_SETTLING, 0u);
 }
 
+/* Once settled: the quadrature's difference from its reference ringing at a 110 Hz split
+ * (the sense mode's free response, rate_valid.h RATE_VALID_RING_TOLS) is a disturbance
+ * once its rms is beyond 2 tol_dps (0.5 deg/s), and not under it; a lasting difference on
+ * the rate axis (a filter's lag in a fast move of the rate) is none. */
+static uint32_t ring(float amp_dps, float rate_diff_dps, int blocks)
+{
+  uint32_t r = 0u;
+  for (int i = 0; i < blocks; i++) {
+    const float beat = amp_dps * sinf(2.0f * 3.14159265f * 110.0f * 2e-4f * (float)i);
+    rate_valid_settling(&s_cfg, &rv, 0.0f, 10.0f, rate_diff_dps, 1500.0f + beat, 150.0f);
+    r |= rate_valid_verdict(&rv, 0u);
+  }
+  return r;
+}
+
+static void test_ringing_unsettles(void **state)
+{
+  (void)state;
+  assert_int_equal(settle(), 0u);
+  assert_int_equal(ring(0.6f, 5.0f, 2000), 0u); /* rms 0.42: valid */
+  assert_int_equal(settle(), 0u);
+  assert_int_equal(ring(0.8f, 0.0f, 2000) & RATE_INVALID_SETTLING, RATE_INVALID_SETTLING);
+  /* a step's ringing (100 deg/s) trips within two blocks */
+  assert_int_equal(settle(), 0u);
+  assert_int_equal(ring(100.0f, 0.0f, 2), RATE_INVALID_SETTLING);
+  /* gone, settled again as at any disturbance */
+  assert_int_equal(ring(0.0f, 0.0f, 20), RATE_INVALID_SETTLING);
+  assert_int_equal(ring(0.0f, 0.0f, 1), 0u);
+}
+
 static void test_over_range_and_sense(void **state)
 {
   (void)state;
@@ -356,6 +386,7 @@ int main(void)
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_bad_cfg),
       cmocka_unit_test(test_settling_measured),
+      cmocka_unit_test(test_ringing_unsettles),
       cmocka_unit_test(test_over_range_and_sense),
       cmocka_unit_test(test_phase_leak),
       cmocka_unit_test(test_thermo_settle_bound),
