@@ -30,35 +30,28 @@
 #include "app_plant.h"
 #include "sense_mode_model.h"
 
-#define F_SENSE_HZ 1600.0
-#define KS_FB 0.1 /* (m/s^2)/V^2: 1500 deg/s of quadrature at 7 V */
+#define F_SENSE_HZ SENSE_TEST_F_HZ
 #define STEP_DPS 100.0
 #define T_STEP_S 0.5
 
 /* The part with a sense mode of quality q_sense at F_SENSE_HZ, its model as above. */
 static void start_q(uint32_t sense_mode, double quad_dps, double q_sense)
 {
-  plant_cfg_t pc;
-  plant_default_cfg(&pc);
+  plant_cfg_t def, pc;
+  plant_default_cfg(&def);
+  sense_test_part(&pc, q_sense);
+  pc.quad_dps = quad_dps;
   param_values_t v;
   default_part_values(&v);
   const double wc = 2.0 * FM_PI * (double)v.drive_freq_hz;
   double m0, a0, m1, a1;
-  mode_response(pc.f_sense_hz, pc.q_sense, wc, &m0, &a0);
-  pc.f_sense_hz = F_SENSE_HZ;
-  pc.q_sense = q_sense;
-  pc.fb_mode = 3;
-  pc.ks_fb_mps2_per_v2 = KS_FB;
-  pc.quad_dps = quad_dps;
-  pc.brownian = 0;
-  pc.pick_sense_noise_v_rthz = pc.pick_drive_noise_v_rthz = 0.0;
-  pc.drive_noise_white_v_rthz = pc.drive_noise_1hz_v_rthz = 0.0;
-  pc.fb_noise_white_v_rthz = pc.fb_noise_1hz_v_rthz = 0.0;
+  mode_response(def.f_sense_hz, def.q_sense, wc, &m0, &a0);
   mode_response(F_SENSE_HZ, q_sense, wc, &m1, &a1);
   v.rate_demod_phase_deg += (float)((a1 - a0) * FM_DEG_PER_RAD);
   v.rate_scale_dps = (float)((double)v.rate_scale_dps * m0 / m1);
   /* g = rate per V^2 (Ks_fb / (2 A0 wc)) over the scale, in the pickoff's volts */
-  const double k_dps_per_v2 = KS_FB / (2.0 * pc.drive_amp_m * wc) * FM_DEG_PER_RAD;
+  const double k_dps_per_v2 = plant_fb_rate_dps_per_v2(&pc, (double)v.drive_freq_hz,
+                                                       pc.drive_amp_m);
   v.sense_fb_gain_v_per_v2 = (float)(k_dps_per_v2 / (double)v.rate_scale_dps *
                                      (double)v.drive_amp_set_v);
   v.sense_f0_hz = (float)F_SENSE_HZ;

@@ -30,33 +30,23 @@
 #include "selfcal_harness.h"
 #include "sense_mode_model.h"
 
-#define F_SENSE_HZ 1600.0
-#define KS_FB 0.1     /* (m/s^2)/V^2, as test_cl_sense_fr.c */
+#define F_SENSE_HZ SENSE_TEST_F_HZ
 #define TUNE_KE 1.2e5 /* (1/s^2)/V^2: 3 V lowers 1600 Hz by 8.5 Hz, 10 V by 100 Hz */
 #define STEP_DPS 100.0
 
 static plant_cfg_t part(double q_sense, double tune_ke)
 {
   plant_cfg_t pc;
-  plant_default_cfg(&pc);
-  pc.f_sense_hz = F_SENSE_HZ;
-  pc.q_sense = q_sense;
-  pc.fb_mode = 3;
-  pc.ks_fb_mps2_per_v2 = KS_FB;
+  sense_test_part(&pc, q_sense);
   pc.tune_ke_per_s2_per_v2 = tune_ke;
-  pc.brownian = 0;
-  pc.pick_sense_noise_v_rthz = pc.pick_drive_noise_v_rthz = 0.0;
-  pc.drive_noise_white_v_rthz = pc.drive_noise_1hz_v_rthz = 0.0;
-  pc.fb_noise_white_v_rthz = pc.fb_noise_1hz_v_rthz = 0.0;
-  pc.tune_noise_white_v_rthz = pc.tune_noise_1hz_v_rthz = 0.0;
   return pc;
 }
 
 /* The hand model of test_cl_sense_fr.c for this part: the feedback gain. */
 static double model_gain(const plant_cfg_t *pc, const param_values_t *v)
 {
-  const double wc = 2.0 * FM_PI * (double)v->drive_freq_hz;
-  const double k_dps_per_v2 = KS_FB / (2.0 * pc->drive_amp_m * wc) * FM_DEG_PER_RAD;
+  const double k_dps_per_v2 = plant_fb_rate_dps_per_v2(pc, (double)v->drive_freq_hz,
+                                                       pc->drive_amp_m);
   return k_dps_per_v2 / (double)v->rate_scale_dps * (double)v->drive_amp_set_v;
 }
 
