@@ -121,15 +121,18 @@ GYRO_RAMFUNC static inline float half_nonneg(float x)
  * divide, no arc tangent. Where arg F crosses pi the root changes sign, and with it both
  * voltages, which leaves U1^2 - U2^2, the force, unchanged (as a turn of P does). DC+AC:
  * the AC amplitude phasor F / (4 D) (6-21), no root. A non-finite F drives nothing. */
-GYRO_RAMFUNC void drive_synth_phasor_root(const drive_synth_t *ds, drive_synth_phasor_t *ph,
-                                          float f_re_v2, float f_im_v2)
+GYRO_RAMFUNC void drive_synth_phasor_mag(drive_synth_phasor_t *ph, float f_re_v2, float f_im_v2)
 {
   if (!fm_isfinite(f_re_v2 + f_im_v2)) f_re_v2 = f_im_v2 = 0.0f;
   ph->f_re_v2 = f_re_v2;
   ph->f_im_v2 = f_im_v2;
+  ph->mag_v2 = fm_sqrtf(f_re_v2 * f_re_v2 + f_im_v2 * f_im_v2);
+}
+
+GYRO_RAMFUNC void drive_synth_phasor_root(const drive_synth_t *ds, drive_synth_phasor_t *ph)
+{
   if (ds->scheme == GYRO_DRIVE_DC_AC) return;
-  const float m = fm_sqrtf(f_re_v2 * f_re_v2 + f_im_v2 * f_im_v2);
-  ph->root_v = fm_sqrtf(half_nonneg(m + fm_absf(f_re_v2)));
+  ph->root_v = fm_sqrtf(half_nonneg(ph->mag_v2 + fm_absf(ph->f_re_v2)));
 }
 
 GYRO_RAMFUNC void drive_synth_set_phasor(drive_synth_t *ds, const drive_synth_phasor_t *ph,

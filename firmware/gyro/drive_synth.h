@@ -70,16 +70,17 @@ void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad);
 /* A force command as a phasor (f_re + j f_im, Ks*V^2) in a frame turned by frame_rad
  * (the force |F| cos(phi + frame + arg F), |frame| as drive_synth_set's P), for a loop
  * that computes its force as a complex number (sense_fr.h), without the arc tangent of
- * arg F; in two steps, so that a sample interrupt can put them on two ticks: the root
- * (drive_synth_phasor_root: its square roots), then the command
- * (drive_synth_set_phasor: the divide, the phase), whose waveform is
- * drive_synth_step_phasor's. */
+ * arg F; in three steps, so that a sample interrupt can put them on three ticks, one
+ * long operation each: |F| (drive_synth_phasor_mag: a square root), the root
+ * (drive_synth_phasor_root: another), then the command (drive_synth_set_phasor: the
+ * divide, the phase), whose waveform is drive_synth_step_phasor's. */
 typedef struct {
   float f_re_v2, f_im_v2; /* F (0 for a non-finite one) */
+  float mag_v2;           /* |F| */
   float root_v;           /* the larger part of sqrt(F) in magnitude (half-frequency) */
 } drive_synth_phasor_t;
-void drive_synth_phasor_root(const drive_synth_t *ds, drive_synth_phasor_t *ph, float f_re_v2,
-                             float f_im_v2);
+void drive_synth_phasor_mag(drive_synth_phasor_t *ph, float f_re_v2, float f_im_v2);
+void drive_synth_phasor_root(const drive_synth_t *ds, drive_synth_phasor_t *ph);
 void drive_synth_set_phasor(drive_synth_t *ds, const drive_synth_phasor_t *ph, float frame_rad);
 
 /* No force from the next sample on (amplitude 0; in DC+AC the bias alone), without the

@@ -24,6 +24,7 @@ GYRO_RAMFUNC void gyro_block_amp_measure(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_amp(gyro_t *g)
 {
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_synth(g);
   gyro_block_amp_measure(g);
   /* The drive-phase and sense-range checks of the rate's validity, on evidence of the
    * last block (phase error: supervisor; quadrature: its filter). */
@@ -361,11 +362,16 @@ GYRO_RAMFUNC void gyro_fr_settle(gyro_t *g)
   g->fr_bits = fr->settled != 0u ? 0u : RATE_INVALID_SENSE_FR; /* settled: not at the limit */
 }
 
+GYRO_RAMFUNC void gyro_fr_mag(gyro_t *g)
+{
+  const sense_fr_t *fr = &g->fr;
+  if (fr->run != 0u && fr->skip == 0u) drive_synth_phasor_mag(&g->fb_root, fr->f_re, fr->f_im);
+}
+
 GYRO_RAMFUNC void gyro_fr_root(gyro_t *g)
 {
   const sense_fr_t *fr = &g->fr;
-  if (fr->run != 0u && fr->skip == 0u)
-    drive_synth_phasor_root(&g->fb_synth, &g->fb_root, fr->f_re, fr->f_im);
+  if (fr->run != 0u && fr->skip == 0u) drive_synth_phasor_root(&g->fb_synth, &g->fb_root);
 }
 
 /* The Coriolis force is in phase with the drive velocity, which at the drive's resonance
@@ -400,6 +406,7 @@ GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
 GYRO_RAMFUNC void gyro_block_measure(gyro_t *g)
 {
   g->dac_frame->code[HAL_DAC_RATE_OUT] = g->rate_code;
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_root(g);
   if (supervisor_drive_enabled(&g->sup)) {
     drive_loop_measure_phase(&g->drive, g->lmsd_drive.w_i, g->lmsd_drive.w_q);
     /* The tracking drive's error and its notch here, its PI next tick (the budget). */
@@ -432,7 +439,6 @@ GYRO_RAMFUNC void gyro_block_supervise(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g)
 {
-  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_synth(g);
   if (supervisor_drive_enabled(&g->sup)) gyro_block_phase(g);
   g->cont_fail = selftest_cont_judge(&g->design->selftest, &g->selftest,
                                      g->sup.mode == GYRO_MODE_LOCKED);
@@ -440,7 +446,6 @@ GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_track_judge(gyro_t *g)
 {
-  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_synth(g);
   if (supervisor_drive_enabled(&g->sup)) gyro_block_track(g);
   g->cont_fail = selftest_cont_judge(&g->design->selftest, &g->selftest,
                                      g->sup.mode == GYRO_MODE_LOCKED);
@@ -556,7 +561,7 @@ GYRO_RAMFUNC void gyro_block_p_selftest(gyro_t *g)
  * highest rate); flags hold what happened over the whole block. */
 GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
 {
-  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_root(g);
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_mag(g);
   gyro_out_t *o = &g->out;
   const uint32_t block_bits = (g->sup.mode == GYRO_MODE_LOCKED ? 0u : RATE_INVALID_MODE) |
                               (selftest_running(&g->selftest) ? RATE_INVALID_SELFTEST : 0u) |

@@ -58,13 +58,14 @@ void gyro_quad_reset(gyro_t *g);
 void gyro_quad_off(gyro_t *g);
 /* Force rebalance's steps (sense.mode 1, gyro_slots.h), each at the start of its slot's
  * job while g->fr_on: take (GYRO_SLOT_RATE: starts the loop on LOCKED, halts it when
- * not), PI (GYRO_SLOT_QUAD), limit (GYRO_SLOT_P), the force's root (GYRO_SLOT_OUTPUT),
- * synthesis (GYRO_SLOT_PHASE_PI), settling (GYRO_SLOT_PROJECT, a block later: the verdict
- * of GYRO_SLOT_OUTPUT reads it). */
+ * not), PI (GYRO_SLOT_QUAD), limit (GYRO_SLOT_P), |F| (GYRO_SLOT_OUTPUT), the force's
+ * root (GYRO_SLOT_PHASE_MEAS), synthesis (GYRO_SLOT_AMP), settling (GYRO_SLOT_PROJECT, a
+ * block later: the verdict of GYRO_SLOT_OUTPUT reads it). */
 void gyro_fr_take(gyro_t *g);
 void gyro_fr_integrate(gyro_t *g);
 void gyro_fr_limit(gyro_t *g);
 void gyro_fr_settle(gyro_t *g);
+void gyro_fr_mag(gyro_t *g);
 void gyro_fr_root(gyro_t *g);
 void gyro_fr_synth(gyro_t *g);
 /* Its halt at once (not LOCKED, the drive's stop, sense.mode 0): the force to zero from

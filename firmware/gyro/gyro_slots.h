@@ -69,12 +69,13 @@
  * Force rebalance (sense.mode 1, sense_fr.h) adds one step of its update to the start of
  * five jobs, in order: on slot 6 (before the rate's filter) it takes the block's
  * projection as the residual and gives the rate channel the force's readout -g F in its
- * place; on 7 the PI; on 8 the force's limit; on 9 the root of the force's phasor (two
- * square roots); on 1 the feedback synthesis (drive_synth_set_phasor on its own
+ * place; on 7 the PI; on 8 the force's limit; the force's phasor to the synthesis in
+ * three steps, one long operation on each tick: on 9 |F| (a square root), on 0 the root
+ * of F (another), on 2 the feedback synthesis (drive_synth_set_phasor on its own
  * instance: a divide and the frame's phase; no arc tangent), whose waveform goes out
  * every tick from the next on, on the feedback pair's two channels; on 5, a block after
  * the limit, the settling test (the SENSE_FR reason the verdict of 9 reads). The force
- * thus follows the block's mean by (GYRO_BLOCK - 1) / 2 + 8 ticks, plus half a block of
+ * thus follows the block's mean by (GYRO_BLOCK - 1) / 2 + 9 ticks, plus half a block of
  * hold (gyro_design.c).
  *
  * The drive command thus reaches the DAC (COMMAND + 1 - slot) ticks after the sample
@@ -91,9 +92,9 @@
 #define GYRO_SLOT_QUAD 7u
 #define GYRO_SLOT_P 8u
 #define GYRO_SLOT_OUTPUT 9u
-/* The force-rebalance steps (above): take, PI, limit, root, synthesis, settling. */
+/* The force-rebalance steps (above): take, PI, limit, |F|, root, synthesis, settling. */
 #define SENSE_FR_TAKE_SLOT GYRO_SLOT_RATE
-#define SENSE_FR_SYNTH_SLOT GYRO_SLOT_PHASE_PI
+#define SENSE_FR_SYNTH_SLOT GYRO_SLOT_AMP
 _Static_assert(GYRO_SLOT_PHASE_MEAS < GYRO_SLOT_PHASE_PI &&
                    GYRO_SLOT_PHASE_PI < GYRO_SLOT_COMMAND && GYRO_SLOT_AMP < GYRO_SLOT_COMMAND &&
                    GYRO_SLOT_COMMAND < GYRO_SLOT_SUPERVISE &&

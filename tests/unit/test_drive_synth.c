@@ -155,7 +155,8 @@ static void check_phasor(gyro_drive_scheme_t scheme)
     const float frame = 0.7f - 1.3f * (float)n / 100000.0f;
     float u1, u2;
     drive_synth_phasor_t ph;
-    drive_synth_phasor_root(&ds, &ph, fr, fi);
+    drive_synth_phasor_mag(&ph, fr, fi);
+    drive_synth_phasor_root(&ds, &ph);
     drive_synth_set_phasor(&ds, &ph, frame);
     drive_synth_step_phasor(&ds, o.phase, o.half_phase, &u1, &u2);
     const double phi = 2.0 * M_PI * (double)o.phase / 4294967296.0;
@@ -167,11 +168,13 @@ static void check_phasor(gyro_drive_scheme_t scheme)
   assert_true(max_err < 150.0 * 2e-5);
   float u1, u2;
   drive_synth_phasor_t ph;
-  drive_synth_phasor_root(&ds, &ph, NAN, 1.0f);
+  drive_synth_phasor_mag(&ph, NAN, 1.0f);
+  drive_synth_phasor_root(&ds, &ph);
   drive_synth_set_phasor(&ds, &ph, 0.0f);
   drive_synth_step_phasor(&ds, 0u, 0u, &u1, &u2);
   assert_true(u1 == u2 && isfinite(u1)); /* no force: 0 V, or the bias alone in DC+AC */
-  drive_synth_phasor_root(&ds, &ph, 1.0f, INFINITY);
+  drive_synth_phasor_mag(&ph, 1.0f, INFINITY);
+  drive_synth_phasor_root(&ds, &ph);
   drive_synth_set_phasor(&ds, &ph, 0.0f);
   drive_synth_step_phasor(&ds, 0u, 0u, &u1, &u2);
   assert_true(u1 == u2 && isfinite(u1));
