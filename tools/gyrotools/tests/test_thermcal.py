@@ -169,3 +169,66 @@ def test_fast_path_follows_a_transient_the_slow_one_lags():
     np.testing.assert_array_equal(
         compstudy.compensate(rest, v, proto.comp_tau_s, proto.comp_stages),
         compstudy.compensate(rest, slow_only, proto.comp_tau_s, proto.comp_stages))
+
+
+# A part of known noise at 10 Hz: the uncompensated output white plus a slow first-order
+# (Gauss-Markov) wander, the compensation adding an independent wander of its own; each
+# term's Allan variance at 10 s is exact (from its autocovariance), so the part's true
+# 10 s ratio is set by the added wander's size.
+_FS, _M, _WANDER_S = 10.0, 100, 20.0
+
+
+def _ar1(rng, n, sd):
+    a = np.exp(-1.0 / (_FS * _WANDER_S))
+    lead = int(10 * _WANDER_S * _FS)  # dropped: a stationary wander
+    from scipy.signal import lfilter
+    return sd * lfilter([np.sqrt(1 - a * a)], [1, -a], rng.standard_normal(n + lead))[lead:]
+
+
+def _avar_ar1_10s(sd):
+    a = np.exp(-1.0 / (_FS * _WANDER_S))
+    h = np.arange(-(_M - 1), _M)
+    w = _M - np.abs(h)
+    return sd ** 2 * (np.sum(w * a ** np.abs(h)) - np.sum(w * a ** np.abs(_M + h))) / _M ** 2
+
+
+def _part_log(dur_s, true_ratio_10s, seed):
+    rng = np.random.default_rng(seed)
+    n = int(round(dur_s * _FS))
+    unc = 0.1 * rng.standard_normal(n) + _ar1(rng, n, 0.01)
+    avar_unc = 0.1 ** 2 / _M + _avar_ar1_10s(0.01)
+    sd_add = np.sqrt((true_ratio_10s ** 2 - 1) * avar_unc / _avar_ar1_10s(1.0))
+    return {"t_s": np.arange(n) / _FS, "rate_unc_dps": unc,
+            "rate_dps": unc + _ar1(rng, n, sd_add)}
+
+
+SEEDS = range(1, 25)
+
+
+def test_noise_ratio_at_10s_judged_on_a_record_that_tells_a_good_part_from_a_bad_one():
+    # On the 1200 s record a part whose true 10 s ratio is 1.07 (within the limit; the
+    # flow's parts measure 1.05..1.06 on average) failed on some noise seeds, as the
+    # quad -800 part did with seed 1004: the figure's scatter, not the part.
+    proto = thermcal.FULL
+    lim = thermcal.LIMITS["noise_ratio"]
+    dur = proto.noise_s + thermcal.START_S
+    good = [thermcal.verify_noise(_part_log(dur, 1.07, s), proto) for s in SEEDS]
+    assert all(r["ratio_10s_judged"] and r["ok"] for r in good), \
+        [round(r["ratio_10s"], 3) for r in good]
+    # The limit is not loosened: a part at 1.13 fails on every seed.
+    bad = [thermcal.verify_noise(_part_log(dur, 1.13, s), proto) for s in SEEDS]
+    assert not any(r["ok"] for r in bad), [round(r["ratio_10s"], 3) for r in bad]
+    assert all(r["ratio_10s"] > lim for r in bad)
+
+
+def test_noise_ratio_at_10s_reports_an_uncertainty_that_matches_its_scatter():
+    proto = thermcal.FULL
+    dur = proto.noise_s + thermcal.START_S
+    rs = [thermcal.verify_noise(_part_log(dur, 1.07, s), proto) for s in SEEDS]
+    sd = np.std([r["ratio_10s"] for r in rs], ddof=1)
+    u = np.array([r["ratio_10s_u"] for r in rs])
+    assert 0.5 < np.mean(u) / sd < 2.0
+    lo, hi = np.array([r["ratio_10s_ci"] for r in rs]).T
+    assert np.all(lo < np.array([r["ratio_10s"] for r in rs])) and np.all(hi > lo)
+    # its interval (68 %) holds the true ratio on about as many seeds as it should
+    assert 0.5 <= np.mean((lo <= 1.07) & (1.07 <= hi)) <= 0.95
