@@ -65,15 +65,6 @@ static void start(uint32_t sense_mode, double quad_dps)
   start_q(sense_mode, quad_dps, 1.0e4);
 }
 
-static void set_rate(double dps)
-{
-  plant_profiles_t prof;
-  memset(&prof, 0, sizeof prof);
-  profile_const(&prof.rate_dps, dps);
-  profile_const(&prof.ambient_k, plant_truth(&plant)->ambient_k);
-  assert_int_equal(plant_set_profiles(&plant, &prof), 0);
-}
-
 typedef struct {
   double settle_ms;  /* last block outside 1 % of the step, after the step */
   double peak_dps;   /* the largest rate after the step */
@@ -100,7 +91,7 @@ static step_t run_step(void)
   static uint8_t valid[N_AFTER + VALID_SPAN];
   const long before = (long)(T_STEP_S / BLOCK_S);
   for (long n = 0; n < before + N_AFTER; n++) {
-    if (n == before) set_rate(STEP_DPS);
+    if (n == before) app_plant_hold_rate(STEP_DPS);
     hal_host_run(GYRO_BLOCK);
     const gyro_out_t *o = &app.gyro.out;
     r.valid_blocks += o->rate_valid != 0u;

@@ -76,15 +76,6 @@ static double true_sense_f0(const plant_cfg_t *pc)
   return pc->f_sense_hz * (1.0 - 0.5 * pc->ket_per_k * (t - pc->temp_ref_k));
 }
 
-static void set_rate(double dps)
-{
-  plant_profiles_t prof;
-  memset(&prof, 0, sizeof prof);
-  profile_const(&prof.rate_dps, dps);
-  profile_const(&prof.ambient_k, plant_truth(&plant)->ambient_k);
-  assert_int_equal(plant_set_profiles(&plant, &prof), 0);
-}
-
 #define BLOCK_S ((double)GYRO_BLOCK / 50000.0)
 #define N_AFTER 500 /* 0.1 s of blocks */
 
@@ -101,7 +92,7 @@ static double step_settle_ms(double *final_dps, double *rest_dps)
     hal_host_run(GYRO_BLOCK);
     *rest_dps += (double)app.gyro.out.rate_dps / tail;
   }
-  set_rate(STEP_DPS);
+  app_plant_hold_rate(STEP_DPS);
   for (int n = 0; n < N_AFTER; n++) {
     hal_host_run(GYRO_BLOCK);
     rate[n] = app.gyro.out.rate_dps;

@@ -59,4 +59,15 @@ static inline const char *cmd(const char *line) { return app_cmd_line(&app, line
 /* s seconds of samples, the background loop not polled. */
 static inline void run_s(double s) { hal_host_run((uint64_t)(s * 50000.0)); }
 
+/* The plant's input rate held at dps from now on, the ambient where it is (the tests'
+ * rate steps). */
+static inline void app_plant_hold_rate(double dps)
+{
+  plant_profiles_t prof;
+  memset(&prof, 0, sizeof prof);
+  profile_const(&prof.rate_dps, dps);
+  profile_const(&prof.ambient_k, plant_truth(&plant)->ambient_k);
+  if (plant_set_profiles(&plant, &prof) != 0) fail_msg("plant: a constant profile refused");
+}
+
 #endif /* APP_PLANT_H */
