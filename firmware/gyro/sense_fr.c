@@ -76,11 +76,15 @@ int sense_fr_design(const sense_fr_cfg_t *cfg, sense_fr_design_t *d)
   const double settle = (double)cfg->settle_r;
   const double blocks = (double)cfg->settle_s / (double)cfg->dt_s;
   if (!isfinite(kp.re + kp.im + ki_t.re + ki_t.im) || !(blocks < 4.0e9)) return -1;
+  /* (c is in the right half plane's complement: place checked its real part > 0) */
   d->kp_re = (float)kp.re;
   d->kp_im = (float)kp.im;
   d->kit_re = (float)ki_t.re;
   d->kit_im = (float)ki_t.im;
   d->gain_per_v2 = cfg->gain_per_v2;
+  const cplx_t kr = c_div(ki, c); /* the readout's zero on -c (sense_fr.h) */
+  d->krg_re = (float)(kr.re * (double)cfg->gain_per_v2);
+  d->krg_im = (float)(kr.im * (double)cfg->gain_per_v2);
   d->f_max_v2 = cfg->f_max_v2;
   d->f_max2_v4 = cfg->f_max_v2 * cfg->f_max_v2;
   d->settle2 = (float)(settle * settle);

@@ -36,8 +36,16 @@
  * plant is fast already.
  *
  * The rate: in the steady state the force cancels the Coriolis force, F = -F_c, and the
- * open-loop rate channel would have read R_c = g F_c = -g F. So the channel's input in
- * sense.mode 1 is -g F (rate_raw its real part, quad_raw its imaginary part), and its scale
+ * open-loop rate channel would have read R_c = g F_c = -g F. The force itself, though,
+ * answers a step of F_c through the controller's zero, Kp s + Ki: -Ki / Kp lies below
+ * the placed roots (42 Hz against 130 Hz on a matched part, where the plant is nearly an
+ * integrator), and -g F overshot a matched part's step by 25 % (test_cl_sense_tune.c).
+ * The readout is instead g (I + Kr R) with Kr = Ki / c: in the steady state R = 0 and it
+ * is -g F; in a transient its zero, Kr s + Ki, sits on the third root -c and cancels it,
+ * so a step of the rate comes out through the placed pair (w, zeta) alone, at any split
+ * (the 110 Hz split's step: 9.4 ms with -g F, 8.0 with I alone; measured in README). So
+ * the channel's input in sense.mode 1 is that readout (rate_raw its real part, quad_raw
+ * its imaginary part), and its scale
  * (rate.scale_dps), compensation and output filter apply as in open loop. The force
  * rebalance's scale factor is then rate.scale_dps g = Ks_fb / (2 A0 wc) per V^2 (the
  * sense mode's gain cancels between the two, measured on the same part): from then on it
@@ -80,7 +88,8 @@ typedef struct {
 typedef struct {
   float kp_re, kp_im;   /* Kp: V^2 per unit of R */
   float kit_re, kit_im; /* Ki T */
-  float gain_per_v2;    /* g, for the readout -g F */
+  float gain_per_v2;    /* g, for the readout g (I + Kr R) */
+  float krg_re, krg_im; /* g Kr = g Ki / c: the readout's residual term */
   float f_max_v2, f_max2_v4;
   float settle2;  /* settle_r^2: |R_f|^2 below it counts */
   float settle_k; /* the residual's low-pass per update (sense_fr_settle) */
@@ -116,8 +125,8 @@ void sense_fr_reset(sense_fr_t *fr);
 void sense_fr_update(const sense_fr_design_t *d, sense_fr_t *fr, float r_re, float r_im);
 
 /* The steps:
- *   take       the measurement (skip when not finite: the loop holds, not settled); the
- *              readout -g F of the force the plant felt over the block
+ *   take       the measurement (skip when not finite: the loop holds, not settled, the
+ *              readout g I); the readout g (I + Kr R)
  *   integrate  Ki T R into the integral, F = -(Kp R + I)
  *   limit      |F| against f_max: scaled back along its direction, the integral held
  *   settle     the settling test
@@ -126,14 +135,16 @@ GYRO_RAMFUNC static inline void sense_fr_take(const sense_fr_design_t *d, sense_
                                               float r_re, float r_im)
 {
   const float g = d->gain_per_v2;
-  fr->out_re = -g * fr->f_re;
-  fr->out_im = -g * fr->f_im;
+  fr->out_re = g * fr->i_re;
+  fr->out_im = g * fr->i_im;
   if (!fm_isfinite(r_re + r_im)) {
     fr->skip = 1u;
     fr->in_band = 0u;
     fr->settled = 0u;
     return;
   }
+  fr->out_re += d->krg_re * r_re - d->krg_im * r_im;
+  fr->out_im += d->krg_re * r_im + d->krg_im * r_re;
   fr->skip = 0u;
   fr->e_re = r_re;
   fr->e_im = r_im;

@@ -115,9 +115,10 @@ def fw_value(exe, extra, name):
 
 
 def design_response(exe, extra, c_re):
-    """The design's rate response (sense_fr.h) as a function of frequency: the force's
-    closed loop from the Coriolis force, L / (1 + L), with the controller placed by the
-    design on its one-pole lag a, L(s) = (n s + c w^2) / (a s (s - p)) times the loop's
+    """The design's rate response (sense_fr.h) as a function of frequency: the readout's
+    closed loop from the Coriolis force, w^2 (s + c) G / (1 + L), with the controller
+    placed by the design on its one-pole lag a, L(s) = (n s + c w^2) G, G = 1 / (a s (s -
+    p)) times the loop's
     actual lag (the demodulator's pole at mu fs and the schedule's delay 1 / a - 1 / (mu
     fs), gyro_design.c); its real axis (the loop's gains are complex: a real input at +-w
     sees T(jw) and T(-jw)); then the output Butterworth."""
@@ -137,8 +138,10 @@ def design_response(exe, extra, c_re):
     wb = 2 * np.pi * v["sense.fr_lpf_hz"]
 
     def t(s):
-        loop = (n * s + c * w * w) / (a * s * (s - p)) * mu_fs / (s + mu_fs) * np.exp(-s * delay_s)
-        return loop / (1 + loop)
+        # the loop closes through the controller (n s + c w^2); the rate is read through
+        # the readout g (I + Kr R), Kr = Ki / c: its numerator w^2 (s + c) (sense_fr.h)
+        lag = mu_fs / (s + mu_fs) * np.exp(-s * delay_s) / (a * s * (s - p))
+        return w * w * (s + c) * lag / (1 + (n * s + c * w * w) * lag)
 
     def h(f):
         s = 2j * np.pi * np.asarray(f, dtype=float)

@@ -110,12 +110,37 @@ static void test_limit_and_settle(void **state)
   assert_int_equal(fr.skip, 1u);
   assert_int_equal(fr.settled, 0u);
   assert_true(fr.f_re == f_before);
-  /* the readout is -g F of the force the plant felt */
-  fr.f_re = 2.0f;
-  fr.f_im = -1.0f;
+  /* the readout is g (I + Kr R): g I with no residual (the steady state's -g F) */
+  fr.i_re = -2.0f;
+  fr.i_im = 1.0f;
   sense_fr_take(&d, &fr, 0.0f, 0.0f);
   assert_float_equal(fr.out_re, -2.6f, 1e-6f);
   assert_float_equal(fr.out_im, 1.3f, 1e-6f);
+  /* ... and with one, g Kr R on top; a residual that is not finite reads g I alone */
+  sense_fr_take(&d, &fr, 1.0f, 0.0f);
+  assert_float_equal(fr.out_re, -2.6f + d.krg_re, 1e-5f);
+  assert_float_equal(fr.out_im, 1.3f + d.krg_im, 1e-5f);
+  sense_fr_take(&d, &fr, NAN, 0.0f);
+  assert_float_equal(fr.out_re, -2.6f, 1e-6f);
+}
+
+/* The readout's zero, Kr s + Ki, lies on the third root -c (sense_fr.h): Kr c = Ki, with
+ * Kr = krg / g. The readout -g F had its zero at -Ki / Kp: a matched part's step
+ * overshot by 25 % and took 12 ms (test_cl_sense_tune.c, which failed first). */
+static void test_readout_zero_on_third_root(void **state)
+{
+  (void)state;
+  sense_fr_cfg_t c = cfg_q1e4();
+  for (int k = 0; k < 2; k++) {
+    if (k == 1) c.f_sense_hz = c.f_drive_hz; /* matched */
+    sense_fr_design_t d;
+    assert_int_equal(sense_fr_design(&c, &d), 0);
+    const double g = (double)c.gain_per_v2;
+    const double kr_re = d.krg_re / g, kr_im = d.krg_im / g;
+    const double ki_re = d.kit_re / (double)c.dt_s, ki_im = d.kit_im / (double)c.dt_s;
+    const double zr = kr_re * d.c_re - kr_im * d.c_im, zi = kr_re * d.c_im + kr_im * d.c_re;
+    assert_true(hypot(zr - ki_re, zi - ki_im) < 1e-5 * hypot(ki_re, ki_im));
+  }
 }
 
 int main(void)
@@ -124,6 +149,7 @@ int main(void)
       cmocka_unit_test(test_design_places_roots),
       cmocka_unit_test(test_refuses_bad_configuration),
       cmocka_unit_test(test_limit_and_settle),
+      cmocka_unit_test(test_readout_zero_on_third_root),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
