@@ -338,6 +338,7 @@ static gyro_design_status_t design_rate(const param_values_t *v, double tau_s, g
   t->rate.p_rate_deg_per_dps = v->rate_p_rate_deg_per_dps;
   t->rate.p_rate_c1_per_dps = v->rate_p_rate_c1_per_dps;
   t->rate.p_rate2_deg_per_dps2 = v->rate_p_rate2_deg_per_dps2;
+  t->rate.turn_max_dps = RATE_TURN_MAX_FS * v->rate_full_scale_dps;
   t->rate.comp_a = v->rate_comp_tau_s > 0.0f
                        ? (float)(1.0 -
                                  exp(-(double)RATE_P_DECIM / (fs * (double)v->rate_comp_tau_s)))

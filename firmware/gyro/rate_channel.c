@@ -28,7 +28,8 @@ int rate_channel_cfg_ok(const rate_channel_cfg_t *cfg)
          cfg->p_lpf_alpha <= 1.0f && cfg->min_drive_v > 0.0f &&
          fm_isfinite(cfg->grad_k_dps_per_deg) && cfg->grad_a > 0.0f && cfg->grad_a <= 1.0f &&
          fm_isfinite(cfg->p_rate_deg_per_dps) && fm_isfinite(cfg->p_rate_c1_per_dps) &&
-         fm_isfinite(cfg->p_rate2_deg_per_dps2) && cfg->comp_a > 0.0f && cfg->comp_a <= 1.0f &&
+         fm_isfinite(cfg->p_rate2_deg_per_dps2) && cfg->turn_max_dps > 0.0f &&
+         fm_isfinite(cfg->turn_max_dps) && cfg->comp_a > 0.0f && cfg->comp_a <= 1.0f &&
          cfg->comp_stages >= 1u && cfg->comp_stages <= COMP_STAGES_MAX &&
          cfg->comp_fast_a >= 0.0f && cfg->comp_fast_a <= 1.0f &&
          fm_isfinite(cfg->grad_fast_k_dps_per_deg) && cfg->blend_dps > 0.0f &&
@@ -281,9 +282,12 @@ GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
        * temperature P_c reads, and with the square of the rate's own), from the latest
        * output: 1 % of rate error is 1 % of a turn of thousandths of a degree. */
       const float x = rc->p_dev_deg - rc->p_comp_lag_deg + cfg->p_poly_off_deg;
+      const float m = cfg->turn_max_dps;
+      float r = rc->rate_unc_dps;
+      r = r <= m && r >= -m ? r : 0.0f; /* (NaN too) */
       const float turn = cfg->p_rate_deg_per_dps + cfg->p_rate_c1_per_dps * x +
-                         cfg->p_rate2_deg_per_dps2 * rc->rate_unc_dps;
-      const float mean = rc->p_acc_deg * (1.0f / (float)RATE_P_BLOCKS) - turn * rc->rate_unc_dps;
+                         cfg->p_rate2_deg_per_dps2 * r;
+      const float mean = rc->p_acc_deg * (1.0f / (float)RATE_P_BLOCKS) - turn * r;
       /* Fast start after a hold: the running mean of the means seen since the release
        * (the held value weighing as RATE_P_PRIOR of them) until its weight falls to the
        * low-pass's own, then the low-pass. */

@@ -93,6 +93,13 @@
 
 /* What the channel is told (the designer, gyro_design): constant while it runs. The
  * rate and the quadrature filters share the one set of output low-pass sections. */
+/* Within full scale the turn is the rate's; up to ten times it, a rate read through a
+ * stale demodulation phase (the 1500 deg/s quadrature turned into it), it is taken as
+ * well: dropping it there moved P_f by 0.05 deg while a phase setpoint was walked, which
+ * kept the rate not valid 39 s after the walk's return instead of 14.5
+ * (test_cl_integrity.c). */
+#define RATE_TURN_MAX_FS 10.0f
+
 typedef struct {
   float ref_re, ref_im; /* e^{j psi} / A_set */
   float scale_dps;      /* deg/s per unit of Re(R) */
@@ -100,15 +107,20 @@ typedef struct {
   float sf_c[5];        /* [0] unused: SF(x) = 1 + c1 x + .. + c4 x^4 */
   float lin_c2_per_dps; /* L(u) = u + c2 u^2 + c3 u^3 */
   float lin_c3_per_dps2;
-  float p_ref_deg;               /* P around which its low-pass works (the start value) */
-  float p_poly_off_deg;          /* p_ref - cal.ref_p_deg: x = p_dev + this at P_f, the
+  float p_ref_deg;            /* P around which its low-pass works (the start value) */
+  float p_poly_off_deg;       /* p_ref - cal.ref_p_deg: x = p_dev + this at P_f, the
                              * compensation polynomials' variable */
-  float p_lpf_alpha;             /* first-order low-pass of P at fs / RATE_P_DECIM */
-  float grad_k_dps_per_deg;      /* bias per degree of P_f's high-pass: the thermal gradient */
-  float grad_a;                  /* that high-pass's 1 - exp(-T / tau) per new P_f */
-  float p_rate_deg_per_dps;      /* P's turn per deg/s of rate, taken out of the thermometer */
-  float p_rate_c1_per_dps;       /* its change per degree of x (the compensation's variable) */
-  float p_rate2_deg_per_dps2;    /* P's turn per (deg/s)^2 of rate */
+  float p_lpf_alpha;          /* first-order low-pass of P at fs / RATE_P_DECIM */
+  float grad_k_dps_per_deg;   /* bias per degree of P_f's high-pass: the thermal gradient */
+  float grad_a;               /* that high-pass's 1 - exp(-T / tau) per new P_f */
+  float p_rate_deg_per_dps;   /* P's turn per deg/s of rate, taken out of the thermometer */
+  float p_rate_c1_per_dps;    /* its change per degree of x (the compensation's variable) */
+  float p_rate2_deg_per_dps2; /* P's turn per (deg/s)^2 of rate */
+  /* The largest rate that turn is taken for (RATE_TURN_MAX_FS times rate.full_scale_dps);
+   * beyond it the channel's rate is no rate at all (a scale stale by orders: 1.9e6 deg/s
+   * after a sweep that tuned the sense mode to the drive, whose square in the turn ran
+   * P_f away until the supervisor faulted) and P is taken as it is */
+  float turn_max_dps;
   float comp_a;                  /* P_c's low-pass of P_f: 1 - exp(-T / comp_tau) per new P_f */
   uint32_t comp_stages;          /* first-order stages of that low-pass, 1..COMP_STAGES_MAX */
   float comp_fast_a;             /* the fast path's one low-pass of P_f (0: no fast path) */

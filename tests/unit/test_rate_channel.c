@@ -37,7 +37,8 @@ static rate_channel_cfg_t base_cfg(biquad_coeffs_t *sec, float phi_dm)
                           .ref_wide_blocks = 0u,
                           .ref_narrow_k = 0.5f, /* narrow within a few blocks */
                           .lpf_sections = (uint32_t)n,
-                          .min_drive_v = 0.1f};
+                          .min_drive_v = 0.1f,
+                          .turn_max_dps = 300.0f};
   memcpy(c.lpf, sec, (size_t)n * sizeof sec[0]);
   return c;
 }
@@ -389,6 +390,26 @@ static void test_rate_taken_out_of_p(void **state)
   }
 }
 
+/* A rate far beyond full scale (a scale stale by orders: 1.9e6 deg/s after a sweep that
+ * tuned the sense mode to the drive, test_cl_sense_tune.c) is no rate: P is taken as it
+ * is, P_f stays at P. Failed before turn_max_dps: the square of that rate in the
+ * correction ran P_f to -3.6e5 deg within a second, and the supervisor faulted. */
+static void test_absurd_rate_leaves_p_alone(void **state)
+{
+  (void)state;
+  biquad_coeffs_t sec[BIQUAD_MAX_SECTIONS];
+  rate_channel_cfg_t c = base_cfg(sec, 0.0f);
+  c.p_lpf_alpha = 1.25e-2f;
+  c.p_rate_deg_per_dps = 1e-5f;
+  c.p_rate2_deg_per_dps2 = 1e-7f;
+  rate_channel_t rc;
+  assert_int_equal(rc_init(&rc, &c), 0);
+  rate_channel_reset(s_cfg, &rc, 0.3f);
+  const float r = 1.9e6f / 250.0f;
+  for (int n = 0; n < 25000; n++) block(&rc, 1.0f, 0.0f, r, 0.0f, (float)(0.3 * M_PI / 180.0));
+  assert_true(fabs((double)rc.p_f_deg - 0.3) < 1e-4);
+}
+
 /* Scale-factor linearity through the decimated output filter: the mean output over a
  * long window equals scale * level to 2e-6 relative (plus the noise of the mean) at
  * every level from 1e-3 to 0.5, with noise on the input as the LMSD delivers it. Run at
@@ -572,6 +593,7 @@ int main(void)
       cmocka_unit_test(test_p_lowpass_resolution),
       cmocka_unit_test(test_gradient_term),
       cmocka_unit_test(test_rate_taken_out_of_p),
+      cmocka_unit_test(test_absurd_rate_leaves_p_alone),
       cmocka_unit_test(test_compensation_thermometer_lowpass),
       cmocka_unit_test(test_compensation_thermometer_two_stages),
       cmocka_unit_test(test_compensation_thermometer_three_stages),
