@@ -11,6 +11,7 @@
 #include "hal/hal_uart.h"
 #include "app/app_cmds.h"
 #include "app/app_selfcal.h"
+#include "app/app_tune.h"
 #include "comm/cli_builtin.h"
 #include "dsp/ramfunc.h"
 
@@ -152,7 +153,7 @@ int app_init(app_t *a) { return app_init_with(a, NULL); }
 /* ISR: one request at the tick boundary. */
 static void take_request(app_t *a, uint32_t req)
 {
-  switch ((app_req_t)req) {
+  switch ((app_req_t)APP_REQ_KIND(req)) {
   case APP_REQ_DRIVE_ON:
     /* from a sweep or a fault's wait as well: the command takes the drive over now */
     if (!supervisor_drive_enabled(&a->gyro.sup)) gyro_stop(&a->gyro);
@@ -166,6 +167,10 @@ static void take_request(app_t *a, uint32_t req)
     break;
   case APP_REQ_SELFTEST: selftest_start(&a->gyro.selftest); break;
   case APP_REQ_CLEAR: supervisor_clear_fault(&a->gyro.sup); break;
+  case APP_REQ_TUNE:
+    gyro_set_tune(&a->gyro, APP_REQ_TUNE_CODE(req),
+                  APP_REQ_TUNE_INVALID(req) ? RATE_INVALID_TUNE : 0u);
+    break;
   case APP_REQ_DRIVE_OFF: gyro_stop(&a->gyro); break;
   case APP_REQ_NONE:
   default: break;
@@ -237,4 +242,5 @@ void app_poll(app_t *a)
   feed_lines(a);
   app_tlm_poll(&a->tlm);
   app_selfcal_poll(a);
+  app_tune_poll(a);
 }

@@ -104,6 +104,23 @@ static const char *sense_id_name(selfcal_sense_state_t st)
   return i < sizeof names / sizeof names[0] ? names[i] : "?";
 }
 
+/* S4, mode tuning (sense.tune 1 or 2 with sense.cal 1): where the tuned resonance went
+ * against its target, at which voltage and after how many ring-downs, or why not. */
+static void put_selfcal_match(cli_t *cli, const selfcal_sense_t *m)
+{
+  if (m->match == SELFCAL_TUNE_OFF) return;
+  cli_putf(cli, "selfcal_match %s", m->match == SELFCAL_TUNE_OK ? "tuned" : "failed");
+  cli_emit_data(cli);
+  if (m->match_why != NULL) {
+    cli_putf(cli, "selfcal_match_why %s", m->match_why);
+    cli_emit_data(cli);
+  }
+  cli_data_f32(cli, "selfcal_match_target_hz", (float)m->match_target_hz);
+  cli_data_f32(cli, "selfcal_match_fd_hz", (float)m->match_fd_hz);
+  cli_data_f32(cli, "selfcal_match_v", (float)m->match_v);
+  cli_data_u32(cli, "selfcal_match_passes", m->match_passes);
+}
+
 /* The sense mode's identification (sense.cal 1, selfcal.h): its state and time beside
  * the drive's (selfcal_s is the whole sweep's, selfcal_drive_s the rest of it), what it
  * found, and why not. While its chain runs (selfcal_phase sense) the chain's lines above
@@ -138,6 +155,7 @@ static void put_selfcal_sense(cli_t *cli, app_t *a, uint32_t t)
     cli_putf(cli, "selfcal_tune_why %s", m->tune_why);
     cli_emit_data(cli);
   }
+  put_selfcal_match(cli, m);
 }
 
 /* Self-calibration progress and result (the figures of the latest sweep). */
@@ -302,6 +320,21 @@ static void put_quad_null(cli_t *cli, app_t *a)
   cli_data_f32(cli, "quad_v2_v", q->v2_v);
 }
 
+/* Mode tuning (sense.tune, sense_tune.h): off, applied (ok), waiting for the lock, or
+ * why the target is out of reach; the target, the untuned resonance the temperature hold
+ * puts at the drive's frequency now, and the voltage. */
+static void put_sense_tune(cli_t *cli, app_t *a)
+{
+  const sense_tune_out_t *o = &a->tune;
+  const int waiting = o->state == SENSE_TUNE_OK && !a->tune_locked;
+  cli_putf(cli, "sense_tune %s", waiting ? "waiting" : sense_tune_state_name(o->state));
+  cli_emit_data(cli);
+  if (o->state == SENSE_TUNE_IS_OFF || o->state == SENSE_TUNE_UNCALIBRATED) return;
+  cli_data_f32(cli, "tune_target_hz", (float)o->target_hz);
+  cli_data_f32(cli, "tune_s0_hz", (float)o->s0_hz);
+  cli_data_f32(cli, "tune_v", (float)o->v_v);
+}
+
 /* Force rebalance (sense.mode 1, sense_fr.h): whether it runs, balanced and at its
  * limit, the force command in the rate channel's frame (V^2: Coriolis, quadrature) and
  * the feedback pair's amplitude, its scale factor and the design's third root. */
@@ -398,6 +431,7 @@ static const status_row_t k_status_rows[] = {
     {"drive", NULL, put_drive},
     {"quad_null", NULL, put_quad_null},
     {"sense_fr", NULL, put_sense_fr},
+    {"sense_tune", NULL, put_sense_tune},
     {"design", NULL, put_design},
     {"ticks", ticks, NULL},
     {"isr_cycles_last", isr_cycles_last, NULL},

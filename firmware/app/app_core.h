@@ -29,8 +29,17 @@ typedef enum {
   APP_REQ_SWEEP = 3u,          /* enter SWEEP: self-calibration (app_selfcal.h) */
   APP_REQ_SWEEP_HANDOVER = 4u, /* SWEEP -> ACQUIRE with the newly applied design */
   APP_REQ_SELFTEST = 5u,       /* run the built-in self-test (selftest.h) */
-  APP_REQ_CLEAR = 6u           /* clear the shown fault; its record stays (last_fault) */
+  APP_REQ_CLEAR = 6u,          /* clear the shown fault; its record stays (last_fault) */
+  APP_REQ_TUNE = 7u            /* the mode tuning's code and verdict (app_tune.h) */
 } app_req_t;
+
+/* A request word: the kind in the low byte; APP_REQ_TUNE carries the tuning channel's
+ * DAC code in bits 8..23 and its verdict (RATE_INVALID_TUNE set) in bit 31. */
+#define APP_REQ_KIND(w) ((w)&0xFFu)
+#define APP_REQ_TUNE_WORD(code, invalid) \
+  ((uint32_t)APP_REQ_TUNE | ((uint32_t)(code) << 8) | ((invalid) ? 0x80000000u : 0u))
+#define APP_REQ_TUNE_CODE(w) ((uint16_t)(((w) >> 8) & 0xFFFFu))
+#define APP_REQ_TUNE_INVALID(w) (((w)&0x80000000u) != 0u)
 
 /* Lines an image adds to the status reply (board figures: stack, sample clock), written
  * with cli_put / cli_emit_data before the final ok line; ctx is NULL. */
@@ -76,6 +85,8 @@ typedef struct {
   uint32_t selfcal_ticks;    /* its length up to the hand-over */
   /* Set by the image's main after app_init (NULL: nothing added, as on the host). */
   app_status_fn status_board;
+  sense_tune_out_t tune; /* mode tuning: the latest pass's target and voltage (app_tune.c) */
+  bool tune_locked;      /* ... and whether it could apply them (LOCKED) */
 } app_t;
 
 /* The sample ISR's calls since app_init: the gyro's own count of its ticks (one per
@@ -89,6 +100,8 @@ bool app_store_dropped(const app_t *a, param_idx_t i);
 
 /* Background: queue a request for the ISR. Returns 0, or -1 (nothing queued) when full. */
 int app_request(app_t *a, app_req_t r);
+/* The same with a whole request word (APP_REQ_TUNE_WORD). */
+int app_request_word(app_t *a, uint32_t w);
 /* Background: requests queued and not yet taken. */
 bool app_requests_pending(const app_t *a);
 

@@ -59,6 +59,11 @@ int app_selfcal_start(app_t *a)
   c.s_quiet_s = quiet > SC_S_QUIET_MAX_S ? SC_S_QUIET_MAX_S : quiet;
   c.tune_probe_v = (double)v->sense_cal_tune_probe_v;
   c.demod_phase_rad = (double)v->rate_demod_phase_deg * FM_PI / 180.0;
+  /* S4 with the sense identification only: without it the drive's sweep keeps the stored
+   * tuning, whose temperature hold scales from its own reference (sense_tune.h) */
+  c.tune_mode = v->sense_cal != 0u ? v->sense_tune : 0u;
+  c.tune_split_hz = (double)v->sense_tune_split_hz;
+  c.tune_v_max_v = (double)v->sense_tune_v_max_v;
   c.amp_clip_v = 0.95 * (double)HAL_ADC_FULL_SCALE_V;
   if (selfcal_start(&a->selfcal, &c) != 0) return -1;
   (void)app_request(a, APP_REQ_SWEEP); /* room checked above */
@@ -75,6 +80,20 @@ static param_status_t stage_f(app_t *a, param_idx_t i, double v)
   return params_stage(&a->params, i, pv);
 }
 
+/* Mode tuning's calibration (S4, sense_tune.h): the untuned resonance (the one that
+ * gives back S4's voltage, selfcal_match_s0_hz) and the drive's it was measured against; a tuning asked for and not achieved clears it, since the
+ * force-rebalance model staged with it was measured untuned (the rate then stays not
+ * valid, TUNE, and status gives S4's reason). */
+static param_status_t stage_match(app_t *a)
+{
+  const selfcal_sense_t *m = &a->selfcal.sense;
+  const int ok = m->match == SELFCAL_TUNE_OK && m->state == SELFCAL_SENSE_OK;
+  param_status_t st = stage_f(a, PARAM_sense_cal_s0_hz, ok ? selfcal_match_s0_hz(m) : 0.0);
+  if (st == PARAM_OK)
+    st = stage_f(a, PARAM_sense_cal_tune_ref_hz, ok ? (double)a->selfcal.f0_hz_f : 0.0);
+  return st;
+}
+
 /* The sense mode's model (selfcal.h): all four values or none (the reason stays in
  * status), the tuning slope on its own. */
 static param_status_t stage_sense(app_t *a)
@@ -89,7 +108,9 @@ static param_status_t stage_sense(app_t *a)
       st = stage_f(a, PARAM_sense_fb_phase_deg, m->fb_phase_rad * 180.0 / FM_PI);
   }
   if (st == PARAM_OK && m->tune == SELFCAL_TUNE_OK)
-    st = stage_f(a, PARAM_sense_cal_tune_ke_per_s2_per_v2, m->tune_ke_per_s2_per_v2);
+    st = stage_f(a, PARAM_sense_cal_tune_ke_per_s2_per_v2,
+                 m->match == SELFCAL_TUNE_OK ? m->match_ke : m->tune_ke_per_s2_per_v2);
+  if (st == PARAM_OK && a->selfcal.cfg.tune_mode != 0u) st = stage_match(a);
   return st;
 }
 

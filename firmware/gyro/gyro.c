@@ -66,6 +66,7 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   t.fr_on = d->sense_mode;
   t.fb_off_v = d->fb_off_v;
   gyro_fr_off(&t);
+  t.tune_bits = d->tune.mode != SENSE_TUNE_OFF ? RATE_INVALID_TUNE : 0u; /* not tuned yet */
   *g = t;
   if (d->autostart != 0u) {
     gyro_start(g);
@@ -156,6 +157,18 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   g->quad_bits = d->quad_on != 0u && g->quad.settled == 0u ? RATE_INVALID_QUAD_NULL : 0u;
   if ((d->quad_on != 0u) != (old->quad_on != 0u)) gyro_quad_reset(g);
   gyro_apply_fr(g, d, old);
+  /* Mode tuning turned on or off (sense.tune is not live: the drive is off): not tuned
+   * until the application says so, the electrodes at 0 V meanwhile. */
+  if (d->tune.mode != old->tune.mode)
+    gyro_set_tune(g, (uint16_t)HAL_DAC_CODE_MID,
+                  d->tune.mode != SENSE_TUNE_OFF ? RATE_INVALID_TUNE : 0u);
+}
+
+void gyro_set_tune(gyro_t *g, uint16_t code, uint32_t bits)
+{
+  g->tune_bits = bits & RATE_INVALID_TUNE;
+  if (g->sup.mode != GYRO_MODE_SWEEP && code <= HAL_DAC_CODE_MAX)
+    g->dac_frame->code[HAL_DAC_TUNE] = code;
 }
 
 void gyro_start(gyro_t *g)
@@ -175,7 +188,8 @@ void gyro_start(gyro_t *g)
 /* The sweep's sense jobs leave a command on the feedback pair's synthesis and may leave
  * the tuning electrodes at a probe voltage (a failed sweep): both off whenever a sweep
  * begins or ends, so that force rebalance starts from zero force (gyro_fr_take) and no
- * tuning voltage outlives the sweep (no loop drives that channel yet). */
+ * tuning voltage outlives the sweep or a stop (mode tuning applies its voltage again
+ * once LOCKED, app.c). */
 static void gyro_sweep_electrodes_off(gyro_t *g)
 {
   drive_synth_silence(&g->fb_synth);

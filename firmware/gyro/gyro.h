@@ -48,8 +48,9 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d);
  * application's, at mid-scale, 0 V, from its start): the drive pair and the spare's
  * self-test force every tick, the rate output once per block (GYRO_SLOT_PHASE_MEAS), the
  * quadrature-nulling electrodes HAL_DAC_QUADNULL_V1, _V2 on the loop's updates (once per
- * RATE_P_DECIM ticks) and when it stops; no loop drives the other sense electrodes'
- * channels (HAL_DAC_SENSE_FB_U2, HAL_DAC_TUNE) yet. */
+ * RATE_P_DECIM ticks) and when it stops, the feedback pair's second channel with force
+ * rebalance; the tuning electrodes (HAL_DAC_TUNE) by the sweep's jobs and, outside SWEEP,
+ * by gyro_set_tune only. */
 void gyro_tick(gyro_t *g);
 
 /* The frame every tick reads: the HAL's (hal_adc_frame), read once at the start of each
@@ -63,6 +64,13 @@ void gyro_attach_dac_frame(gyro_t *g, hal_dac_frame_t *frame);
 /* The HAL's count of lost samples (hal_sample_lost_counter), read once per block: a
  * change is a LOST_SAMPLE fault. NULL: none. */
 void gyro_attach_lost_counter(gyro_t *g, const volatile uint32_t *count);
+
+/* Mode tuning (sense.tune, sense_tune.h): the tuning electrodes' DAC code and the
+ * verdict (RATE_INVALID_TUNE or 0), from the application's request (ISR, at a tick
+ * boundary; the background computes both). Outside SWEEP the code goes to the frame's
+ * tuning channel; in SWEEP the sweep's jobs own that channel and only the verdict is
+ * taken. A code beyond the converter's is ignored. */
+void gyro_set_tune(gyro_t *g, uint16_t code, uint32_t bits);
 
 void gyro_start(gyro_t *g);
 void gyro_stop(gyro_t *g);

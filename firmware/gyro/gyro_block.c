@@ -574,7 +574,8 @@ GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
                                * the acquisition's tail of the measured phase */
                               (g->rate.ref_wide_left != 0u ? RATE_INVALID_SETTLING : 0u) |
                               g->quad_bits | /* nulling on and not (yet) nulled */
-                              g->fr_bits;    /* force rebalance on and not balanced */
+                              g->fr_bits |   /* force rebalance on and not balanced */
+                              g->tune_bits;  /* mode tuning on and not at its target */
   const uint32_t invalid = rate_valid_verdict(&g->valid, block_bits);
   /* Never a valid-looking wrong rate: the analog output goes to the fault level in the
    * same sample as the verdict, without a slew. */

@@ -479,11 +479,43 @@ static gyro_design_status_t design_fr_rate(const param_values_t *v, gyro_design_
   return GYRO_DESIGN_OK;
 }
 
+/* Mode tuning (sense_tune.h): matched only with the loop closed (open loop the rate's
+ * band would be the sense mode's, f0 / 2Q: 0.08 Hz at Q 1e4); with a calibration, its
+ * target reachable at the calibration's drive frequency. Not calibrated is allowed: the
+ * rate is then not valid (TUNE) until a sweep tunes the part. */
+static gyro_design_status_t design_tune(const param_values_t *v, gyro_design_t *t)
+{
+  const double v_dac_max = (double)(HAL_DAC_CODE_MAX - HAL_DAC_CODE_MID) *
+                           (double)HAL_DAC_V_PER_CODE;
+  sense_tune_cfg_t *c = &t->tune;
+  c->mode = v->sense_tune;
+  c->split_hz = (double)v->sense_tune_split_hz;
+  c->v_max_v = (double)v->sense_tune_v_max_v;
+  c->s0_hz = (double)v->sense_cal_s0_hz;
+  c->ref_hz = (double)v->sense_cal_tune_ref_hz;
+  c->ke_per_s2_per_v2 = (double)v->sense_cal_tune_ke_per_s2_per_v2;
+  if (!(c->v_max_v <= v_dac_max)) return GYRO_DESIGN_SENSE_TUNE;
+  if (c->mode == SENSE_TUNE_MATCHED && v->sense_mode != 1u) return GYRO_DESIGN_SENSE_TUNE;
+  sense_tune_out_t o;
+  sense_tune_at(c, c->ref_hz, &o);
+  return o.state == SENSE_TUNE_BELOW || o.state == SENSE_TUNE_LIMIT ? GYRO_DESIGN_SENSE_TUNE
+                                                                    : GYRO_DESIGN_OK;
+}
+
 /* Each part in turn; the first that fails names the reason. */
 /* The demodulation phase, the scale and the compensation are measured at one drive
  * frequency: at another, the phase of the drive against its resonance, and with it P
  * and the sense phasor's angle, are another (2Q df/f rad, 2-33). */
-static uint32_t cal_state(const param_values_t *v)
+/* The tuning voltage at the tuning's own reference (0 V untuned or not calibrated):
+ * what cal.ref_tune_v records. Within 0.6 of a code: the same code. */
+static int same_tuning(const param_values_t *v, const sense_tune_cfg_t *tune)
+{
+  sense_tune_out_t o;
+  sense_tune_at(tune, tune->ref_hz, &o);
+  return fabs(o.v_v - (double)v->cal_ref_tune_v) <= 0.6 * (double)HAL_DAC_V_PER_CODE;
+}
+
+static uint32_t cal_state(const param_values_t *v, const sense_tune_cfg_t *tune)
 {
   const double ref = (double)v->cal_ref_freq_hz;
   if (!(ref > 0.0)) return GYRO_CAL_NONE;
@@ -495,7 +527,8 @@ static uint32_t cal_state(const param_values_t *v)
   /* And the drive mode: the tracking drive's thermometer is the tracked frequency (p_eq,
    * drive_track.h), with the part's Q in its scale, where the fixed drive's is P. */
   const int same_mode = v->drive_track == v->cal_ref_track;
-  return same_phase && same_mode && fabs((double)v->drive_freq_hz - ref) <= GYRO_CAL_FREQ_REL * ref
+  return same_phase && same_mode && same_tuning(v, tune) &&
+                 fabs((double)v->drive_freq_hz - ref) <= GYRO_CAL_FREQ_REL * ref
              ? GYRO_CAL_OK
              : GYRO_CAL_STALE;
 }
@@ -519,8 +552,9 @@ static gyro_design_status_t design_parts(const param_values_t *v, gyro_design_t 
   if (s == GYRO_DESIGN_OK) s = design_quad_null(v, t);
   if (s == GYRO_DESIGN_OK) s = design_fb(v, t);
   if (s == GYRO_DESIGN_OK) s = design_fr_rate(v, t);
+  if (s == GYRO_DESIGN_OK) s = design_tune(v, t);
   t->autostart = v->sys_autostart;
-  t->cal_state = cal_state(v);
+  t->cal_state = cal_state(v, &t->tune);
   t->track_uncal = v->drive_track != 0u && v->cal_ref_track == 0u ? 1u : 0u;
   return s;
 }
@@ -602,6 +636,12 @@ static const char *const k_reasons[GYRO_DESIGN_STATUS_COUNT] = {
                              "rate.scale_dps not 0",
     [GYRO_DESIGN_SENSE_SELFTEST] = "selftest.continuous 1 needs the open sense loop: its force "
                                    "goes onto the feedback electrodes (set sense.mode 0 first)",
+    [GYRO_DESIGN_SENSE_TUNE] = "sense.tune 1 (matched) needs force rebalance (sense.mode 1); "
+                               "sense.tune_v_max_v must lie within the DAC's range (14.99 V); "
+                               "a tuned part's target (the drive's resonance, plus "
+                               "sense.tune_split_hz with sense.tune 2) must lie below its "
+                               "untuned sense resonance sense.cal_s0_hz (tuning only lowers "
+                               "it) and within sense.tune_v_max_v",
     [GYRO_DESIGN_MODULE] = "a value outside its parameter's range: a module refused its part of "
                            "the design",
 };

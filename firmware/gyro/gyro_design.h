@@ -18,6 +18,7 @@
 #include "gyro/rate_valid.h"
 #include "gyro/sense_fr.h"
 #include "gyro/selftest.h"
+#include "gyro/sense_tune.h"
 #include "gyro/supervisor.h"
 #include "params/params.h"
 
@@ -67,12 +68,17 @@ typedef struct {
   float fb_off_v;
   float fr_scale_dps_per_v2; /* the loop's scale factor: rate.scale_dps x g, for status */
   sense_fr_design_t fr;
+  /* Mode tuning (sense.tune, sense_tune.h): the background's (app.c), which applies its
+   * voltage through gyro_set_tune; the sample path reads none of it. */
+  sense_tune_cfg_t tune;
 } gyro_design_t;
 
 /* gyro_design_t.cal_state */
-#define GYRO_CAL_NONE 0u  /* no calibration: cal.ref_freq_hz 0 */
-#define GYRO_CAL_OK 1u    /* made at drive.freq_hz, drive.phase_set_deg and drive.track */
-#define GYRO_CAL_STALE 2u /* made at another drive frequency, phase setpoint or drive mode */
+#define GYRO_CAL_NONE 0u /* no calibration: cal.ref_freq_hz 0 */
+#define GYRO_CAL_OK 1u   /* made at drive.freq_hz, drive.phase_set_deg and drive.track */
+#define GYRO_CAL_STALE \
+  2u /* made at another drive frequency, phase setpoint, drive mode or
+                          * mode tuning (cal.ref_tune_v) */
 /* cal.ref_freq_hz and drive.freq_hz agree within this, relative: two steps of a float,
  * so that a value printed and set again through the command line still matches. */
 #define GYRO_CAL_FREQ_REL 2.0e-7
@@ -110,6 +116,7 @@ typedef enum {
   GYRO_DESIGN_SENSE_FB, /* sense.fb_v_max_v, sense.fb_bias_v against the DAC, each other */
   GYRO_DESIGN_SENSE_FR, /* sense.fr_*, sense.f0_hz, sense.q, sense.fb_gain_v_per_v2 */
   GYRO_DESIGN_SENSE_SELFTEST, /* selftest.continuous with sense.mode 1 */
+  GYRO_DESIGN_SENSE_TUNE,     /* sense.tune*, against sense.mode and its calibration */
   GYRO_DESIGN_MODULE,         /* a module refused its part: a value outside its range */
   GYRO_DESIGN_STATUS_COUNT
 } gyro_design_status_t;

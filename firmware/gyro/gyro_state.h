@@ -93,7 +93,10 @@ typedef struct gyro_s {
   gyro_quad_step_t quad_job; /* the nulling loop's next step (GYRO_SLOT_COMMAND), or NULL */
   uint32_t fr_on;   /* force rebalance (the design's sense_mode 1): its steps and waveform */
   uint32_t fr_bits; /* RATE_INVALID_SENSE_FR while it is on and not balanced */
-  float fb_off_v;   /* what the board adds to the feedback converters' voltages (design) */
+  /* RATE_INVALID_TUNE while mode tuning is on and not at its target: the background's
+   * verdict (app.c, sense_tune.h), set with the tuning voltage by gyro_set_tune */
+  uint32_t tune_bits;
+  float fb_off_v; /* what the board adds to the feedback converters' voltages (design) */
   uint32_t rate_clear_due; /* the loop-state clear's rate half is due (GYRO_SLOT_RATE; a
                             * fault's clear, a start from OFF): GYRO_RATE_CLEAR_RESTART,
                             * the validity checks' on one slot, then CHANNEL on the next */

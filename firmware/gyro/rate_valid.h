@@ -54,7 +54,8 @@
  *                 a part in the mode its sweep chose and records it (UNCALIBRATED too)
  *   UNCALIBRATED  the part has no calibration (cal.ref_freq_hz 0), or its calibration is
  *                 stale: made at another drive frequency than drive.freq_hz (a sweep, a
- *                 hand change), another phase setpoint or the other drive mode. The
+ *                 hand change), another phase setpoint, the other drive mode or another
+ *                 mode tuning (cal.ref_tune_v against the tuning's voltage). The
  *                 demodulation phase and scale are a part's own; measured valid without
  *                 them, a 1300 Hz part read its rate with the sign inverted
  *   QUAD_NULL     quadrature nulling is on (quad.null 1) and its loop has not nulled the
@@ -69,6 +70,13 @@
  *                 sense.fr_settle_dps for sense.fr_settle_s, or its force at the
  *                 feedback electrodes' limit (a Coriolis or quadrature force they cannot
  *                 cancel: the force read as the rate is then not the Coriolis force)
+ *   TUNE          mode tuning is on (sense.tune 1 or 2) and the sense resonance is not
+ *                 at its target: not yet tuned (before LOCKED, before the background
+ *                 applied the voltage), not calibrated (no sweep with sense.cal 1 has
+ *                 tuned the part), or the target out of the electrodes' reach at this
+ *                 temperature (below the untuned resonance, or beyond
+ *                 sense.tune_v_max_v): the force-rebalance model, and open loop the
+ *                 scale and demodulation phase, were measured on the tuned part
  * Each check is a few multiplies and compares per block; no divide, no libm. */
 #ifndef RATE_VALID_H
 #define RATE_VALID_H
@@ -93,7 +101,8 @@
 #define RATE_INVALID_UNCALIBRATED (1u << 12)
 #define RATE_INVALID_QUAD_NULL (1u << 13)
 #define RATE_INVALID_SENSE_FR (1u << 14)
-#define RATE_INVALID_KINDS 15u
+#define RATE_INVALID_TUNE (1u << 15)
+#define RATE_INVALID_KINDS 16u
 
 /* Blocks in a row inside the settling tolerance (2 ms): longer than the noise's
  * correlation time at the filters' 100 Hz, far shorter than their settling. */

@@ -6,7 +6,8 @@
 
 #include "dsp/fastmath.h"
 #include "dsp/nco.h"
-#include "gyro/gyro_dac.h" /* the tuning electrodes' code (S2) */
+#include "gyro/gyro_dac.h" /* the tuning electrodes' code (S2, S4) */
+#include "gyro/sense_tune.h"
 
 #define SC_MIN_PEAK_V 0.02 /* chirp peak below this: not resolved from the noise */
 #define SC_MAX_RETRIES 6u
@@ -58,10 +59,10 @@ static sc_range_t rng(const selfcal_t *s)
 
 const char *selfcal_state_name(selfcal_state_t st)
 {
-  static const char *const names[] = {"IDLE",       "WAIT_SWEEP", "QUIET_UP",    "CHIRP_UP",
-                                      "QUIET_DOWN", "CHIRP_DOWN", "RINGDOWN",    "FINE",
-                                      "HOLD",       "READY",      "DONE",        "FAILED",
-                                      "REBURST",    "SENSE_TUNE", "SENSE_QUIET", "SENSE_WC"};
+  static const char *const names[] = {
+      "IDLE",     "WAIT_SWEEP", "QUIET_UP",    "CHIRP_UP", "QUIET_DOWN", "CHIRP_DOWN",
+      "RINGDOWN", "FINE",       "HOLD",        "READY",    "DONE",       "FAILED",
+      "REBURST",  "SENSE_TUNE", "SENSE_QUIET", "SENSE_WC", "SENSE_MATCH"};
   const unsigned i = (unsigned)st;
   return i < sizeof names / sizeof names[0] ? names[i] : "?";
 }
@@ -98,11 +99,18 @@ int selfcal_start(selfcal_t *s, const selfcal_cfg_t *c)
                          !isfinite(c->demod_phase_rad) || !(c->amp_clip_v >= c->amp_max_v))) {
     return -1;
   }
+  if (c->tune_mode > SENSE_TUNE_SPLIT ||
+      (c->tune_mode != SENSE_TUNE_OFF &&
+       (!(c->tune_split_hz >= 0.0 && c->tune_split_hz < c->s_f_hi_hz) ||
+        !(c->tune_v_max_v > 0.0 && c->tune_v_max_v <= 15.0)))) {
+    return -1;
+  }
   selfcal_exec_t *x = s->x;
   memset(s, 0, sizeof *s);
   s->x = x;
   s->cfg = *c;
   s->f_cmd_v2 = c->f_cmd_start_v2;
+  s->match_code = (uint16_t)HAL_DAC_CODE_MID;
   s->state = SELFCAL_WAIT_SWEEP;
   s->watch_state = SELFCAL_IDLE; /* the first watch starts the clock of WAIT_SWEEP */
   return 0;
@@ -832,6 +840,7 @@ static void post_wc(selfcal_t *s)
   const double f_cmd = 0.25 * c->amp_meas_v * sqrt(1.0 + det * det) / m->gain_pk_v_per_v2;
   s->f_cmd_v2 = f_cmd > c->s_f_cmd_max_v2 ? c->s_f_cmd_max_v2 : f_cmd;
   base_job(s, &j, SELFCAL_JOB_STEPS);
+  j.tune_code = j.tune_ring_code = s->match_code; /* S4's voltage, or 0 V */
   /* The back-off near the ADC's range only: what is left of the sense mode's ring
    * (above) may go over amp_max without the force's part, and a back-off would only
    * start another ring; the means cancel it as long as nothing clips. */
@@ -849,6 +858,134 @@ static void post_wc(selfcal_t *s)
   j.settle_ticks = j.step_settle_ticks = ticks_of(settle_s, c->fs_hz);
   j.avg_ticks = ticks_of(avg_s, c->fs_hz);
   post(s, &j, SELFCAL_SENSE_WC);
+}
+
+/* ---- S4: mode tuning (selfcal.h) ---- */
+
+/* At most this many ring-downs at a tuning voltage: the secant on Vt^2 is exact for the
+ * parallel-plate law, so the second lands within the ring-down's own resolution. */
+#define SC_MATCH_PASSES 4u
+/* Within this fraction of the sense half-bandwidth f0 / 2Q of the target: the sense
+ * gain at wc within 3 % of the matched peak (1 / sqrt(1 + 0.25^2)). */
+#define SC_MATCH_TOL_HB 0.25
+
+static void match_done(selfcal_t *s, selfcal_tune_state_t st, const char *why)
+{
+  selfcal_sense_t *m = &s->sense;
+  m->match = st;
+  m->match_why = why;
+  if (st != SELFCAL_TUNE_OK) {
+    s->match_code = (uint16_t)HAL_DAC_CODE_MID;
+  } else {
+    /* From here on the model is the tuned mode's (S3 and the staged sense.f0_hz, sense.q):
+     * the undamped resonance from the free one, the damping unchanged, so Q goes as f0. */
+    const double f0 = m->match_fd_hz / sqrt(1.0 - 0.25 / (m->q * m->q));
+    m->q *= f0 / m->f0_hz;
+    m->f0_hz = f0;
+  }
+  post_wc(s);
+}
+
+/* A ring-down at the target with the tuning voltage v held through it. */
+static void post_match(selfcal_t *s, double v)
+{
+  const selfcal_cfg_t *c = &s->cfg;
+  selfcal_sense_t *m = &s->sense;
+  if (!(v >= 0.0)) {
+    match_done(s, SELFCAL_TUNE_FAILED,
+               "the sense resonance is at or below the tuning target (tuning only lowers it)");
+    return;
+  }
+  if (v > c->tune_v_max_v) {
+    match_done(s, SELFCAL_TUNE_FAILED, "the tuning target needs more than sense.tune_v_max_v");
+    return;
+  }
+  if (m->match_passes >= SC_MATCH_PASSES) {
+    match_done(s, SELFCAL_TUNE_FAILED, "the tuned resonance did not converge on its target");
+    return;
+  }
+  m->match_passes++;
+  s->match_code = gyro_volts_to_dac((float)v);
+  m->match_v = (double)((int32_t)s->match_code - (int32_t)HAL_DAC_CODE_MID) *
+               (double)HAL_DAC_V_PER_CODE;
+  const double f_cmd = c->amp_meas_v / m->gain_pk_v_per_v2;
+  s->f_cmd_v2 = f_cmd > c->s_f_cmd_max_v2 ? c->s_f_cmd_max_v2 : f_cmd;
+  selfcal_job_t j;
+  base_job(s, &j, SELFCAL_JOB_RINGDOWN);
+  j.sense = 1u;
+  j.half_step[0] = nco_half_step_of(m->match_target_hz, c->fs_hz);
+  j.amp_target_v = (float)c->amp_meas_v;
+  j.settle_ticks = ticks_of(SC_EXCITE_MAX_S, c->fs_hz);
+  j.avg_ticks = ticks_of(SC_RING_MAX_S, c->fs_hz);
+  j.tune_code = j.tune_ring_code = s->match_code;
+  post(s, &j, SELFCAL_SENSE_MATCH);
+}
+
+/* S4's start (S3's quiet is over): the voltage for the target from S2's slope. */
+static void post_match_first(selfcal_t *s)
+{
+  selfcal_sense_t *m = &s->sense;
+  m->match_target_hz = s->fit.f0_hz +
+                       (s->cfg.tune_mode == SENSE_TUNE_SPLIT ? s->cfg.tune_split_hz : 0.0);
+  m->match_ke = m->tune_ke_per_s2_per_v2;
+  if (m->tune != SELFCAL_TUNE_OK || !(m->match_ke > 0.0)) {
+    match_done(s, SELFCAL_TUNE_FAILED,
+               m->tune == SELFCAL_TUNE_OK ? "no tuning electrodes (S2 saw no shift)"
+                                          : "no tuning slope identified (S2)");
+    return;
+  }
+  post_match(s, sense_tune_volts(m->tune_fd0_hz, m->match_target_hz, m->match_ke));
+}
+
+/* S4's ring-down: its free frequency (as on_tune's), then done or the next voltage. */
+static void on_match(selfcal_t *s, const selfcal_result_t *r)
+{
+  selfcal_sense_t *m = &s->sense;
+  const double fs = s->cfg.fs_hz;
+  const double amp0 = sqrt((double)(r->rd_amp2_0_v2 > 0.0f ? r->rd_amp2_0_v2 : 0.0f));
+  if (amp0 < SC_MIN_PEAK_V || r->rd_ticks < SC_TUNE_MIN_RING_TICKS) {
+    match_done(s, SELFCAL_TUNE_FAILED, "the tuned sense ring-down too small or short");
+    return;
+  }
+  const double t_ring = (double)r->rd_ticks / fs;
+  m->match_fd_hz = nco_freq_of(s->x->job.half_step[0], fs) +
+                   (double)r->rd_phase_rad / (2.0 * FM_PI * t_ring);
+  const double w0 = 2.0 * FM_PI * m->tune_fd0_hz, w1 = 2.0 * FM_PI * m->match_fd_hz;
+  const double v = m->match_v;
+  /* one code's move of the resonance: d(ws^2) = -2 ke Vt dVt, so df = ke Vt dVt / (4 pi^2 f) */
+  const double code_hz = m->match_ke * v * (double)HAL_DAC_V_PER_CODE /
+                         (4.0 * FM_PI * FM_PI * m->match_target_hz);
+  const double hb = m->f0_hz / (2.0 * m->q);
+  double tol = SC_MATCH_TOL_HB * hb;
+  if (tol < 0.6 * code_hz) tol = 0.6 * code_hz;
+  const double ke = v > 0.0 ? (w0 * w0 - w1 * w1) / (v * v) : 0.0;
+  if (!(ke > 0.0) || !isfinite(ke)) {
+    match_done(s, SELFCAL_TUNE_FAILED, "the tuning voltage did not lower the sense resonance");
+    return;
+  }
+  m->match_ke = ke;
+  if (fabs(m->match_fd_hz - m->match_target_hz) <= tol) {
+    match_done(s, SELFCAL_TUNE_OK, NULL);
+    return;
+  }
+  post_match(s, sense_tune_volts(m->tune_fd0_hz, m->match_target_hz, ke));
+}
+
+double selfcal_match_s0_hz(const selfcal_sense_t *m)
+{
+  if (m->match != SELFCAL_TUNE_OK) return 0.0;
+  const double ft = m->match_target_hz;
+  return sqrt(ft * ft + m->match_ke * m->match_v * m->match_v / (4.0 * FM_PI * FM_PI));
+}
+
+/* S3's quiet is over: S4 first when tuning is asked for. */
+static void after_wc_quiet(selfcal_t *s)
+{
+  if (s->cfg.tune_mode != SENSE_TUNE_OFF) {
+    post_match_first(s);
+    return;
+  }
+  post_wc(s);
 }
 
 static void sense_fail_wc(selfcal_t *s, const char *why)
@@ -897,7 +1034,7 @@ static void sense_model(selfcal_t *s)
     th -= th > 0.0 ? FM_PI : -FM_PI;
     g = -g;
   }
-  if (!(mag >= 1.0e-6 && mag <= 100.0) || !isfinite(th)) {
+  if (!(mag >= 1.0e-6 && mag <= 1.0e5) || !isfinite(th)) {
     m->state = SELFCAL_SENSE_FAILED;
     m->why = "feedback gain at wc outside sense.fb_gain_v_per_v2's range";
     return;
@@ -943,8 +1080,9 @@ selfcal_state_t selfcal_background(selfcal_t *s, int sweeping)
   case SELFCAL_FINE: on_steps(s, &r); break;
   case SELFCAL_REBURST: post_burst_at(s, s->f_cmd_v2); break;
   case SELFCAL_SENSE_TUNE: on_tune(s, &r); break;
-  case SELFCAL_SENSE_QUIET: post_wc(s); break;
+  case SELFCAL_SENSE_QUIET: after_wc_quiet(s); break;
   case SELFCAL_SENSE_WC: on_wc(s, &r); break;
+  case SELFCAL_SENSE_MATCH: on_match(s, &r); break;
   case SELFCAL_HOLD:
     if (s->braked == 1u) {
       s->braked = 2u;

@@ -54,6 +54,18 @@
  *       others). The means last whole periods of the sense mode's beat against wc
  *       (|fd_s - wc|): the transient of switching the force on or off rings at the
  *       sense's own frequency and averages out.
+ *   S4. Mode tuning (cfg.tune_mode 1 or 2, sense_tune.h), after S3's quiet and before its
+ *       means: the voltage that puts the untuned free frequency (S2's at 0 V) at the
+ *       drive's resonance (plus the split), from S2's slope; a ring-down at that voltage
+ *       (held through the excitation and the decay) shows where the resonance went; the
+ *       slope is refined from it (a secant on Vt^2, since ws^2 is linear in Vt^2) and the
+ *       voltage recomputed, until the free frequency is within a quarter of the sense
+ *       half-bandwidth of the target, or of one DAC code's move when that is coarser
+ *       (at most SC_MATCH_PASSES ring-downs). S3 then measures H_s(wc) at that voltage,
+ *       and sense.f0_hz, sense.q are the tuned mode's. A target at or above the untuned
+ *       resonance (tuning only lowers it), a voltage beyond cfg.tune_v_max_v, no slope
+ *       (no electrodes, or S2 failed) or no convergence: S4 fails with its reason
+ *       (match_why), S3 runs untuned and nothing of the tuning is staged.
  * The force-rebalance model (sense_fr.h) then follows: sense.f0_hz, sense.q from S1;
  * sense.fb_gain_v_per_v2 = +-|H_s(wc)| and sense.fb_phase_deg = theta such that a
  * feedback command lands on the real axis of the rate frame R = S e^{-j psi} / A_set,
@@ -112,6 +124,9 @@ typedef struct {
   double s_quiet_s;            /* the drive's ring-down before S1 */
   double tune_probe_v;         /* S2's tuning voltage; 0: no S2 */
   double demod_phase_rad;      /* rate.demod_phase_deg, phi_dm (S3) */
+  uint32_t tune_mode;          /* S4: sense.tune (0 none, 1 matched, 2 split); sense 1 only */
+  double tune_split_hz;        /* S4: sense.tune_split_hz */
+  double tune_v_max_v;         /* S4: sense.tune_v_max_v */
   double amp_clip_v;           /* S3's back-off threshold: near the ADC's range */
 } selfcal_cfg_t;
 
@@ -131,7 +146,8 @@ typedef enum {
   SELFCAL_REBURST,     /* a burst went over the ADC budget: the vibration decays, drive off */
   SELFCAL_SENSE_TUNE,  /* S2: a ring-down of the sense mode with or without Vt */
   SELFCAL_SENSE_QUIET, /* S3: the drive's ring-down before the points at wc */
-  SELFCAL_SENSE_WC     /* S3: the three means at wc */
+  SELFCAL_SENSE_WC,    /* S3: the three means at wc */
+  SELFCAL_SENSE_MATCH  /* S4: a ring-down of the sense mode at the tuning voltage */
 } selfcal_state_t;
 
 /* The sense mode's identification (header: S1-S3). */
@@ -161,7 +177,15 @@ typedef struct {
   const char *tune_why;
   double tune_fd0_hz, tune_fd1_hz; /* S2's free frequencies, tuning at 0 V and at Vt */
   double tune_ke_per_s2_per_v2;
-  uint32_t ticks; /* the sense identification's length (its jobs), samples */
+  /* S4 (cfg.tune_mode): the sense resonance tuned to its target */
+  selfcal_tune_state_t match; /* OFF: not asked; FAILED: match_why, nothing of it staged */
+  const char *match_why;
+  double match_target_hz; /* the drive's resonance, plus the split */
+  double match_v;         /* the tuning voltage (its DAC code's) */
+  double match_fd_hz;     /* the last ring-down's free frequency at match_v */
+  double match_ke;        /* the slope refined by the ring-downs (secant on Vt^2) */
+  uint32_t match_passes;  /* ring-downs at a tuning voltage */
+  uint32_t ticks;         /* the sense identification's length (its jobs), samples */
 } selfcal_sense_t;
 
 /* Every STEPS point of the latest sweep (both placements when the points were placed
@@ -209,6 +233,7 @@ typedef struct {
    * sense_phase is 1 (S1); resume is the drive's step S3 interrupted (1 hold, 2 one
    * point, 3 burst); tune_pass the S2 ring-down under way (0 at 0 V, 1 at Vt). */
   uint32_t sense_phase, resume, tune_pass;
+  uint16_t match_code; /* S4: the tuning voltage's DAC code the jobs hold (S3 too) */
   selfcal_sense_t sense;
 } selfcal_t;
 
@@ -236,5 +261,12 @@ int selfcal_running(const selfcal_t *s);
 uint32_t selfcal_export_count(const selfcal_t *s);
 double selfcal_export_f_hz(const selfcal_t *s, uint32_t i);
 const char *selfcal_state_name(selfcal_state_t st);
+/* S4's calibration of the temperature hold (sense_tune.h): the untuned resonance that,
+ * with the refined slope, gives back S4's own voltage for the target,
+ * sqrt(f_t^2 + ke Vt^2 / (4 pi^2)). Not the measured one: the hold must reproduce, at the
+ * reference, the very voltage (DAC code) the force-rebalance model was measured at (S3),
+ * since one code moves a matched resonance by most of a half-bandwidth at Q 1e4
+ * (test_cl_sense_tune.c). 0 unless S4 tuned the part. */
+double selfcal_match_s0_hz(const selfcal_sense_t *m);
 
 #endif /* SELFCAL_H */

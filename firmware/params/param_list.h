@@ -40,7 +40,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 16u
+#define PARAM_LAYOUT_VERSION 17u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -349,8 +349,10 @@
   X(sense_fb_phase_deg, 0x0A05u, "sense.fb_phase_deg", F32, "deg", -180.0f, 180.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "phase of the feedback force in the Coriolis direction, against the drive force's (P)") \
   /* a placeholder of the family's size: a part's value is its own (identified or from
-   * its design: the sense mode's gain at the drive frequency times the electrode's Ks) */ \
-  X(sense_fb_gain_v_per_v2, 0x0A06u, "sense.fb_gain_v_per_v2", F32, "V/V^2", -100.0f, 100.0f, 0.01f, 0u, \
+   * its design: the sense mode's gain at the drive frequency times the electrode's Ks).
+   * The range spans a matched mode of Q 1e5 (sense.tune 1): the gain at wc is then Q
+   * times the static one, 1400 times a 110 Hz split's at Q 1e4 */ \
+  X(sense_fb_gain_v_per_v2, 0x0A06u, "sense.fb_gain_v_per_v2", F32, "V/V^2", -1.0e5f, 1.0e5f, 0.01f, 0u, \
     PF_PERSIST | PF_LIVE, "sense pickoff's static response (Coriolis axis, V) per V^2 of feedback force at wc; not 0") \
   /* the family's design sense resonance and Q (thesis §2.4.2), not a part's */ \
   X(sense_f0_hz, 0x0A07u, "sense.f0_hz", F32, "Hz", 100.0f, 20000.0f, 2000.0f, 0u, \
@@ -395,6 +397,23 @@
   /* 0 until a sweep with sense.cal 1 identifies it: the part's own, ws^2 = ws0^2 - ke Vt^2 */ \
   X(sense_cal_tune_ke_per_s2_per_v2, 0x0A22u, "sense.cal_tune_ke_per_s2_per_v2", F32, "(1/s^2)/V^2", 0.0f, 1.0e8f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "identified tuning slope: the sense resonance's ws^2 falls by this x Vt^2 (0: no tuning electrodes)") \
+  /* off: the tuning electrodes at 0 V, as before. Not live: the force-rebalance model
+   * (sense.f0_hz .. sense.fb_phase_deg) is measured at the tuning (gyro/sense_tune.h) */ \
+  X(sense_tune, 0x0A10u, "sense.tune", ENUM, "-", 0u, 2u, 0u, \
+    PARAM_CHOICE(0) | PARAM_CHOICE(1) | PARAM_CHOICE(2), \
+    PF_PERSIST, "mode tuning: 0 off, 1 sense resonance on the drive's (matched), 2 that + sense.tune_split_hz") \
+  /* a design choice, not a part's: 20 Hz keeps a split part's open-loop band (f/2Q) apart
+   * from the drive's while giving it five times the 110 Hz split's sense gain */ \
+  X(sense_tune_split_hz, 0x0A11u, "sense.tune_split_hz", F32, "Hz", 0.0f, 1000.0f, 20.0f, 0u, \
+    PF_PERSIST, "sense.tune 2: the sense resonance's target above the drive's") \
+  /* the board's tuning driver (board.h: +-15 V) less the rail's headroom */ \
+  X(sense_tune_v_max_v, 0x0A12u, "sense.tune_v_max_v", F32, "V", 0.1f, 15.0f, 10.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "limit of the tuning voltage; a target that needs more makes the rate not valid") \
+  /* 0 until a sweep with sense.cal 1 and sense.tune 1 or 2 tunes the part */ \
+  X(sense_cal_s0_hz, 0x0A23u, "sense.cal_s0_hz", F32, "Hz", 0.0f, 20000.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "identified untuned sense resonance (tuning at 0 V) at sense.cal_tune_ref_hz") \
+  X(sense_cal_tune_ref_hz, 0x0A24u, "sense.cal_tune_ref_hz", F32, "Hz", 0.0f, 20000.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "drive resonance when the part was tuned: the tuning's temperature hold scales from it") \
   /* 0: no calibration. The compensation, the demodulation phase and the scale hold at
    * the drive frequency they were measured at: another one (a sweep, a hand change)
    * makes them stale. Equal within 2e-7 (two float steps), so that a value that went
@@ -421,6 +440,13 @@
    * tracked frequency's p_eq, drive_track.h), and so do their demodulation phases */ \
   X(cal_ref_track, 0x0806u, "cal.ref_track", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
     PF_PERSIST | PF_LIVE, "drive.track the calibration was made with: with the other it is stale") \
+  /* Written by the calibration flow (gyro/sense_tune.h's voltage at the tuning's own
+   * reference; 0 untuned); 0 until then. The tuned sense mode's response at the drive
+   * frequency is in the demodulation phase and the scale: one DAC code of the tuning
+   * moves a matched Q 1e4 resonance by most of its half-bandwidth, so another tuning
+   * (a sweep that tuned again, sense.tune or its calibration changed) makes it stale */ \
+  X(cal_ref_tune_v, 0x0807u, "cal.ref_tune_v", F32, "V", 0.0f, 15.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "mode tuning's voltage the calibration was made with (0 untuned): with another it is stale") \
   /* start the drive at power-on */ \
   X(sys_autostart, 0x0602u, "sys.autostart", ENUM, "-", 0u, 1u, 1u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
     PF_PERSIST | PF_RESTART, "start acquiring at power-on") \

@@ -90,6 +90,17 @@ static void fr_slow_demod(param_values_t *v)
   v->sense_q = 1.0e4f;
   v->sense_fr_mu = 0.01f;
 }
+static void tune_matched_open_loop(param_values_t *v) { v->sense_tune = 1u; }
+/* a tuning calibration whose target (the drive's resonance) is above the untuned sense
+ * resonance: tuning only lowers it */
+static void tune_target_above(param_values_t *v)
+{
+  v->sense_mode = 1u;
+  v->sense_tune = 1u;
+  v->sense_cal_s0_hz = v->drive_freq_hz - 10.0f;
+  v->sense_cal_tune_ref_hz = v->drive_freq_hz;
+  v->sense_cal_tune_ke_per_s2_per_v2 = 1.0e5f;
+}
 static void fr_cont_selftest(param_values_t *v)
 {
   v->sense_mode = 1u;
@@ -122,6 +133,8 @@ static const refusal_t k_refusals[] = {
     {GYRO_DESIGN_SENSE_FR, "sense.fr_bw_hz", fr_bw_beyond_lag},
     {GYRO_DESIGN_SENSE_FR, "sense.fr_mu", fr_slow_demod},
     {GYRO_DESIGN_SENSE_SELFTEST, "selftest.continuous", fr_cont_selftest},
+    {GYRO_DESIGN_SENSE_TUNE, "sense.tune", tune_matched_open_loop},
+    {GYRO_DESIGN_SENSE_TUNE, "sense.cal_s0_hz", tune_target_above},
     {GYRO_DESIGN_QUAD_NULL, "quad.probe_v", quad_probe_over_limit},
     {GYRO_DESIGN_QUAD_NULL, "quad.v_max_v", quad_limit_beyond_dac},
     {GYRO_DESIGN_QUAD_NULL, "quad.bw_hz", quad_bw_over_rate},

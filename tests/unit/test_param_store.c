@@ -592,12 +592,14 @@ static void test_loads_image_of_earlier_firmware(void **state)
    * rate.comp_fast_tau_s 0: no fast path, its rate.grad_fast_dps_per_deg and
    * rate.comp_blend_dps; quad.null 0: no quadrature nulling, and its eight quad.*;
    * sense.mode 0: the open sense loop, and its thirteen sense.*; sense.cal 0: the sweep
-   * identifies the drive alone, and its two sense.cal_*).
+   * identifies the drive alone, and its two sense.cal_*; sense.tune 0: no mode tuning,
+   * its sense.tune_split_hz, sense.tune_v_max_v, sense.cal_s0_hz and
+   * sense.cal_tune_ref_hz, and cal.ref_tune_v 0: made untuned).
    * Without a calibration record the part then says `calibrated no` and its rate is not
    * valid until its calibration is confirmed (set cal.ref_freq_hz, save): an image of
    * before the record cannot tell a calibration from values set by hand. */
   assert_int_equal(rep.dropped + rep.rejected, 0);
-  assert_int_equal(rep.defaulted, 46);
+  assert_int_equal(rep.defaulted, 52);
   param_values_defaults(&want);
   /* The image holds every persistent value: those it did not change are that
    * firmware's defaults, some of which were the default part's and are generic now. */

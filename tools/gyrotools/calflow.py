@@ -39,6 +39,7 @@ import concurrent.futures
 import dataclasses
 import datetime
 import json
+import math
 import os
 import subprocess
 import zlib
@@ -279,6 +280,11 @@ def rate_table(part, params_path):
                        "lock_s": lock_s})
         values["rate.demod_phase_deg"] = res.phase_deg
         values["rate.scale_dps"] = res.scale_dps
+        if int(values.get("sense.mode", 0)) == 1:
+            # Force rebalance reads the rate from the force, whose frame is the feedback
+            # phase's (firmware/gyro/sense_fr.h): the readout turns with it as it turns
+            # with the demodulation phase open loop, and the loop's frame follows.
+            values["sense.fb_phase_deg"] = wrap_deg(values["sense.fb_phase_deg"] + res.alpha_deg)
         # The thermometer's reading of the rate (rate.p_rate_deg_per_dps, and with its
         # square rate.p_rate2_deg_per_dps2), on top of what the firmware already took
         # out: P against the table's rate.
@@ -442,6 +448,25 @@ def part_id(sets):
     return zlib.crc32(("\n".join(sorted(sets)) + "\n").encode())
 
 
+def wrap_deg(a):
+    """An angle in degrees within [-180, 180)."""
+    return (a + 180.0) % 360.0 - 180.0
+
+
+def tune_volts(v):
+    """The mode tuning's voltage at its own reference (firmware/gyro/sense_tune.h), V: what
+    cal.ref_tune_v records, so that another tuning makes the calibration stale. 0 untuned
+    (sense.tune 0) or not calibrated; the electrodes' limit when the target needs more."""
+    mode = int(v.get("sense.tune", 0))
+    s0, ref = v.get("sense.cal_s0_hz", 0.0), v.get("sense.cal_tune_ref_hz", 0.0)
+    ke = v.get("sense.cal_tune_ke_per_s2_per_v2", 0.0)
+    if mode == 0 or not (s0 > 0 and ref > 0 and ke > 0):
+        return 0.0
+    target = ref + (v.get("sense.tune_split_hz", 0.0) if mode == 2 else 0.0)
+    v2 = ((2 * math.pi * s0) ** 2 - (2 * math.pi * target) ** 2) / ke
+    return min(math.sqrt(v2), v.get("sense.tune_v_max_v", 10.0)) if v2 > 0 else 0.0
+
+
 def record(values, sets, date=None, part_no=None):
     """Stage 3: the calibration record on top of the identified values; the part's id is
     part_no (a board's serial) or, for a simulated part, part_id of its settings."""
@@ -449,6 +474,7 @@ def record(values, sets, date=None, part_no=None):
     v["cal.ref_freq_hz"] = v["drive.freq_hz"]
     v["cal.ref_phase_set_deg"] = v["drive.phase_set_deg"]
     v["cal.ref_track"] = v["drive.track"]  # the mode the sweep chose and the stages ran in
+    v["cal.ref_tune_v"] = tune_volts(v)  # the tuning the stages ran with
     v["cal.part_id"] = part_id(sets) if part_no is None else part_no
     d = date or datetime.date.today()
     v["cal.date"] = d.year * 10000 + d.month * 100 + d.day

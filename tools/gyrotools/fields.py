@@ -19,7 +19,7 @@ ALIASES = {"drive_amp": "drive_amp_v", "drive_amp_v": "drive_amp"}
 # and `status`); tests/test_fields.py holds them to the header.
 RATE_INVALID = ("MODE", "SELFTEST", "SETTLING", "CLIP", "SENSE_RANGE", "OVER_RANGE", "PHASE",
                 "THERMO_RANGE", "THERMO_SLEW", "THERMO_SETTLE", "CONT_SELFTEST", "TRACKING",
-                "UNCALIBRATED", "QUAD_NULL", "SENSE_FR")
+                "UNCALIBRATED", "QUAD_NULL", "SENSE_FR", "TUNE")
 
 
 def invalid_time_s(t_s, rate_invalid):

@@ -1,0 +1,44 @@
+"""The calibration record (calflow.record): cal.ref_tune_v is the mode tuning's voltage at
+its own reference, the firmware's (firmware/gyro/sense_tune.h), so that another tuning
+makes the calibration stale; untuned it is 0."""
+import math
+
+from gyrotools import calflow
+
+BASE = {"drive.freq_hz": 1489.86, "drive.phase_set_deg": 0.0, "drive.track": 0}
+
+
+def tuned(mode, split_hz=0.0, v_max=10.0):
+    v = dict(BASE)
+    v.update({"sense.tune": mode, "sense.tune_split_hz": split_hz, "sense.tune_v_max_v": v_max,
+              "sense.cal_s0_hz": 1600.0, "sense.cal_tune_ref_hz": 1489.86,
+              "sense.cal_tune_ke_per_s2_per_v2": 2.4e5})
+    return v
+
+
+def volts(s0, target, ke):
+    return math.sqrt(((2 * math.pi * s0) ** 2 - (2 * math.pi * target) ** 2) / ke)
+
+
+def test_untuned_records_zero():
+    assert calflow.record(dict(BASE), ["x=1"])["cal.ref_tune_v"] == 0.0
+    assert calflow.record(tuned(0), ["x=1"])["cal.ref_tune_v"] == 0.0
+
+
+def test_matched_and_split_record_the_firmware_law():
+    assert math.isclose(calflow.record(tuned(1), [])["cal.ref_tune_v"],
+                        volts(1600.0, 1489.86, 2.4e5), rel_tol=1e-12)
+    assert math.isclose(calflow.record(tuned(2, 20.0), [])["cal.ref_tune_v"],
+                        volts(1600.0, 1509.86, 2.4e5), rel_tol=1e-12)
+
+
+def test_a_target_out_of_reach_records_what_the_firmware_applies():
+    assert calflow.record(tuned(1, v_max=5.0), [])["cal.ref_tune_v"] == 5.0
+    below = tuned(1)
+    below["sense.cal_s0_hz"] = 1480.0
+    assert calflow.record(below, [])["cal.ref_tune_v"] == 0.0
+
+
+def test_fr_phase_wraps():
+    assert calflow.wrap_deg(190.0) == -170.0
+    assert calflow.wrap_deg(-180.0) == -180.0
