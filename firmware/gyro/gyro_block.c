@@ -365,7 +365,10 @@ GYRO_RAMFUNC void gyro_fr_settle(gyro_t *g)
 GYRO_RAMFUNC void gyro_fr_mag(gyro_t *g)
 {
   const sense_fr_t *fr = &g->fr;
-  if (fr->run != 0u && fr->skip == 0u) drive_synth_phasor_mag(&g->fb_root, fr->f_re, fr->f_im);
+  /* the continuous self-test's force on the Coriolis axis (selftest.h; 0 when off) */
+  const float t = g->design->selftest.cont_fr_v2 * g->selftest.cont_c;
+  if (fr->run != 0u && fr->skip == 0u)
+    drive_synth_phasor_mag(&g->fb_root, fr->f_re + t, fr->f_im);
 }
 
 GYRO_RAMFUNC void gyro_fr_root(gyro_t *g)

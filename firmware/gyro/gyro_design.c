@@ -146,6 +146,7 @@ static gyro_design_status_t design_selftest(const param_values_t *v, gyro_design
   st.meas_blocks = v->sys_fs_hz / (5u * GYRO_BLOCK);    /* 0.2 s */
   st.cont_on = v->selftest_continuous;
   st.cont_amp_v = v->selftest_cont_amp_v;
+  st.cont_fr_v2 = st.cont_on != 0u && v->sense_mode == 1u ? v->selftest_cont_fr_v2 : 0.0f;
   const double f_m = (double)v->selftest_cont_freq_hz;
   if (st.cont_on != 0u && !(f_m >= 1.5 * (double)v->rate_lpf_cutoff_hz && f_m <= block_hz / 4.0)) {
     return GYRO_DESIGN_CONT_FREQ;
@@ -459,8 +460,11 @@ static gyro_design_status_t design_fb(const param_values_t *v, gyro_design_t *t)
   if (sense_fr_design(&fc, &t->fr) != 0) return GYRO_DESIGN_SENSE_FR;
   t->fr_scale_dps_per_v2 = (float)((double)v->rate_scale_dps * g);
   /* The self-test's force would go onto the same electrodes, past the loop: the
-   * continuous one is refused, the on-demand one is refused by its command. */
-  if (v->sense_mode == 1u && v->selftest_continuous != 0u) return GYRO_DESIGN_SENSE_SELFTEST;
+   * continuous one goes into the loop's command (selftest.h), a small part of what the
+   * electrodes can give; the on-demand one is refused by its command. */
+  if (v->sense_mode == 1u && v->selftest_continuous != 0u &&
+      !((double)v->selftest_cont_fr_v2 <= 0.25 * (double)drive_synth_f_cmd_max(&probe)))
+    return GYRO_DESIGN_SENSE_SELFTEST;
   return GYRO_DESIGN_OK;
 }
 
@@ -634,8 +638,9 @@ static const char *const k_reasons[GYRO_DESIGN_STATUS_COUNT] = {
                              "rate and 2 sense.fr_zeta sense.fr_bw_hz within the demodulator's "
                              "lag (sense.fr_mu), sense.fr_lpf_hz below half the block rate, "
                              "rate.scale_dps not 0",
-    [GYRO_DESIGN_SENSE_SELFTEST] = "selftest.continuous 1 needs the open sense loop: its force "
-                                   "goes onto the feedback electrodes (set sense.mode 0 first)",
+    [GYRO_DESIGN_SENSE_SELFTEST] = "selftest.continuous 1 with force rebalance (sense.mode 1) "
+                                   "needs selftest.cont_fr_v2 within a quarter of the "
+                                   "feedback electrodes' force (sense.fb_v_max_v)",
     [GYRO_DESIGN_SENSE_TUNE] = "sense.tune 1 (matched) needs force rebalance (sense.mode 1); "
                                "sense.tune_v_max_v must lie within the DAC's range (14.99 V); "
                                "a tuned part's target (the drive's resonance, plus "

@@ -115,7 +115,7 @@ typedef enum {
   GYRO_DESIGN_QUAD_NULL,      /* quad.* against each other, the update rate, the DAC */
   GYRO_DESIGN_SENSE_FB, /* sense.fb_v_max_v, sense.fb_bias_v against the DAC, each other */
   GYRO_DESIGN_SENSE_FR, /* sense.fr_*, sense.f0_hz, sense.q, sense.fb_gain_v_per_v2 */
-  GYRO_DESIGN_SENSE_SELFTEST, /* selftest.continuous with sense.mode 1 */
+  GYRO_DESIGN_SENSE_SELFTEST, /* selftest.cont_fr_v2 with sense.mode 1 */
   GYRO_DESIGN_SENSE_TUNE,     /* sense.tune*, against sense.mode and its calibration */
   GYRO_DESIGN_MODULE,         /* a module refused its part: a value outside its range */
   GYRO_DESIGN_STATUS_COUNT

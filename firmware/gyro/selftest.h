@@ -27,6 +27,17 @@
  * the drive amplitude setpoint ref_amp_v: the rate channel normalises by the setpoint,
  * so a response in deg/s scales as ref_amp_v / amp_set_v (the designer applies it to
  * both tests).
+ *
+ * With force rebalance (sense.mode 1) the feedback electrodes carry the loop's force, so
+ * the continuous test's force goes into the loop's command instead, A_c cos(2 pi f_m t)
+ * on its Coriolis axis (cont_fr_v2, in the command's V^2; gyro_fr_mag): the loop cancels
+ * it as it cancels the Coriolis force, and its readout carries the tone as a rate (its
+ * closed-loop response at f_m, about a third at 250 Hz against the loop's 145), which
+ * the same LMS measures and takes out. It proves the loop alive end to end: a dead sense
+ * pickoff leaves the residual at zero, the loop "balanced" and its readout frozen, and
+ * the tone then vanishes (test_cl_sense_fr.c). It cannot check the feedback's scale: the
+ * test force goes through the same electrodes as the loop's, so a change of their gain
+ * scales the force and its cancellation alike.
  */
 #ifndef SELFTEST_H
 #define SELFTEST_H
@@ -47,13 +58,14 @@ typedef enum {
 } selftest_state_t;
 
 typedef struct {
-  float amp_v;                 /* force voltage amplitude A on the spare DAC channel */
-  uint32_t cont_on;            /* continuous self-test */
-  float cont_amp_v;            /* its force amplitude A_c */
-  uint32_t cont_step;          /* its modulation's phase step per block (2^32 per turn) */
-  float cont_mu;               /* its LMS step size per block */
-  float cont_gain;             /* 1 - mu / 2: the notch's pass-band gain undone */
-  float cont_lo2, cont_hi2;    /* bounds of the response's squared magnitude (raw rate units) */
+  float amp_v;              /* force voltage amplitude A on the spare DAC channel */
+  uint32_t cont_on;         /* continuous self-test */
+  float cont_amp_v;         /* its force amplitude A_c */
+  float cont_fr_v2;         /* force rebalance: A_c in the loop's command (V^2), 0 open loop */
+  uint32_t cont_step;       /* its modulation's phase step per block (2^32 per turn) */
+  float cont_mu;            /* its LMS step size per block */
+  float cont_gain;          /* 1 - mu / 2: the notch's pass-band gain undone */
+  float cont_lo2, cont_hi2; /* bounds of the response's squared magnitude (raw rate units) */
   uint32_t cont_settle_blocks; /* blocks LOCKED before the response is judged */
   float expect_dps;            /* response expected on the rate axis (calibrated on the part) */
   float tol_rel;               /* pass band, relative */

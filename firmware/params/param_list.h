@@ -40,7 +40,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 17u
+#define PARAM_LAYOUT_VERSION 18u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -290,6 +290,11 @@
    * switched on without it) */ \
   X(selftest_cont_expect_dps, 0x0707u, "selftest.cont_expect_dps", F32, "deg/s", 0.0f, 1000.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "continuous self-test: expected amplitude of the response tone") \
+  /* force rebalance (sense.mode 1): the test force goes into the loop's command, on the
+   * Coriolis axis, and the loop reads it back (selftest.h); 0.2 V^2 is 6 deg/s on the
+   * closed-loop tests' part at the readout, a few percent of the feedback's 100 V^2 */ \
+  X(selftest_cont_fr_v2, 0x0709u, "selftest.cont_fr_v2", F32, "V^2", 0.001f, 100.0f, 0.2f, 0u, \
+    PF_PERSIST | PF_LIVE, "continuous self-test in force rebalance: test force amplitude in the loop's command") \
   /* the default setpoint, at which the expectations above were measured */ \
   X(selftest_ref_amp_v, 0x0708u, "selftest.ref_amp_v", F32, "V", 0.01f, 4.5f, 0.349f, 0u, \
     PF_PERSIST | PF_LIVE, "drive amplitude setpoint at which the self-test expectations were measured") \

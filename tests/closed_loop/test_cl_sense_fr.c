@@ -10,7 +10,8 @@
  * rate_valid.h RATE_VALID_RING_TOLS).
  * The same step on parts of sense Q 300 and 3 (the thesis's), the same split, force
  * rebalance against open loop (issue 19 item 4's table; the README's force-rebalance
- * section). A matched part needs the mode tuning, which does not exist yet.
+ * section); a matched part is test_cl_sense_tune.c's. The continuous self-test with the
+ * loop closed, and what it catches (a dead sense pickoff).
  *
  * The part's model as its identification would give it, from the plant's own values:
  * the demodulation phase and scale of the default part's calibration moved by the sense
@@ -292,10 +293,107 @@ static void test_table_open_q3(void **state)
   assert_int_equal(app.gyro.fr.run, 0u);
 }
 
+/* `set`, retried while the sample loop has not taken the previous change. */
+static void set_ok(const char *line)
+{
+  const char *r = cmd(line);
+  for (int i = 0; i < 100 && strstr(r, "PENDING") != NULL; i++) {
+    hal_host_run(50u);
+    r = cmd(line);
+  }
+  if (strncmp(r, "ok", 2) != 0) fail_msg("%s -> %s", line, r);
+}
+
+/* The blocks of s seconds at which the rate is valid and off the plant's by more than
+ * 1 deg/s (integrity_judge.h's floor) plus the model-made scale's 2 % (start_q), after
+ * the 10 ms a step takes to pass the output filter (run_step's rule). */
+static long valid_wrong_blocks(double s)
+{
+  long wrong = 0;
+  hal_host_run((uint64_t)(0.010 * 50000.0));
+  for (long n = 0; n < (long)(s / BLOCK_S); n++) {
+    hal_host_run(GYRO_BLOCK);
+    const gyro_out_t *o = &app.gyro.out;
+    const double truth = plant_truth(&plant)->rate_dps;
+    wrong += o->rate_valid != 0u && fabs((double)o->rate_dps - truth) > 1.0 + 0.02 * fabs(truth);
+  }
+  return wrong;
+}
+
+/* The sense pickoff dies (its preamplifier's gain to 0, as an open input would): force
+ * rebalance sees no residual, calls itself balanced and its readout freezes. */
+static void kill_sense_pickoff(void)
+{
+  plant.pick[1].cfg.gain_v_per_m = 0.0;
+  plant.pick[1].gain_now = 0.0;
+}
+
+/* The continuous self-test with the loop closed (selftest.h): its force goes into the
+ * loop's command and the readout carries the tone, measured and taken out; with its
+ * expectation calibrated (status selftest_cont_dps, as the calibration flow takes it),
+ * the rate is valid and right through a step; then a dead sense pickoff: the tone
+ * vanishes and the rate is not valid (CONT_SELFTEST) within 0.1 s, and stays so while the
+ * rate moves; without the test the frozen readout stays valid and wrong (the control,
+ * printed: nothing else sees it). */
+static void test_cont_selftest_closed_loop(void **state)
+{
+  (void)state;
+  for (int with_test = 1; with_test >= 0; with_test--) {
+    start(1u, 1500.0);
+    if (with_test) {
+      set_ok("set selftest.cont_expect_dps 1\n"); /* any, to switch it on */
+      set_ok("set selftest.continuous 1\n");
+      hal_host_run(50000u);
+      float tone = 0.0f;
+      const char *r = strstr(cmd("status\n"), "selftest_cont_dps ");
+      assert_non_null(r);
+      assert_int_equal(sscanf(r, "selftest_cont_dps %f", &tone), 1);
+      char line[80];
+      snprintf(line, sizeof line, "set selftest.cont_expect_dps %.4f\n", (double)tone);
+      set_ok(line);
+      hal_host_run(50000u);
+      printf("# continuous self-test, loop closed: tone %.3f deg/s at the readout, rate "
+             "invalid 0x%x\n",
+             (double)tone, app.gyro.out.rate_invalid);
+      assert_true(tone > 1.0f);
+      assert_int_equal(app.gyro.out.rate_invalid, 0u);
+      app_plant_hold_rate(STEP_DPS);
+      assert_int_equal(valid_wrong_blocks(0.5), 0);
+      assert_int_equal(app.gyro.out.rate_invalid, 0u);
+    } else {
+      hal_host_run(50000u);
+      app_plant_hold_rate(STEP_DPS);
+      hal_host_run(25000u);
+    }
+    /* the pickoff dies; the time to the verdict (the tone's mean falls out of its band),
+     * then the rate moves: never valid and wrong from the verdict on */
+    kill_sense_pickoff();
+    long blocks = 0;
+    while (app.gyro.out.rate_valid != 0u && blocks < (long)(2.0 / BLOCK_S)) {
+      hal_host_run(GYRO_BLOCK);
+      blocks++;
+    }
+    app_plant_hold_rate(0.0);
+    const long wrong = valid_wrong_blocks(2.0);
+    printf("# dead sense pickoff, continuous self-test %s: not valid %.1f ms after it "
+           "(%s); then 100 -> 0 deg/s: %ld valid blocks off by more than 1 deg/s in 2 s, "
+           "rate %.1f deg/s (true 0), reasons 0x%x\n",
+           with_test ? "on" : "off", (double)blocks * BLOCK_S * 1e3,
+           app.gyro.out.rate_valid ? "still valid" : "flagged", wrong,
+           (double)app.gyro.out.rate_dps, app.gyro.out.rate_invalid);
+    if (with_test) {
+      assert_true((double)blocks * BLOCK_S <= 0.1);
+      assert_int_equal(wrong, 0);
+      assert_true((app.gyro.out.rate_invalid & RATE_INVALID_CONT_SELFTEST) != 0u);
+    }
+  }
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_step_settles_within_10_ms),
+      cmocka_unit_test(test_cont_selftest_closed_loop),
       cmocka_unit_test(test_open_loop_rings),
       cmocka_unit_test(test_table_fr_q300),
       cmocka_unit_test(test_table_fr_q3),

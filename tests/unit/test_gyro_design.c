@@ -106,6 +106,7 @@ static void fr_cont_selftest(param_values_t *v)
   v->sense_mode = 1u;
   v->selftest_continuous = 1u;
   v->selftest_cont_expect_dps = 1.0f;
+  v->selftest_cont_fr_v2 = 30.0f; /* over a quarter of the electrodes' 100 V^2 */
 }
 
 static const refusal_t k_refusals[] = {
@@ -132,7 +133,7 @@ static const refusal_t k_refusals[] = {
     {GYRO_DESIGN_SENSE_FR, "sense.fb_gain_v_per_v2", fb_gain_zero},
     {GYRO_DESIGN_SENSE_FR, "sense.fr_bw_hz", fr_bw_beyond_lag},
     {GYRO_DESIGN_SENSE_FR, "sense.fr_mu", fr_slow_demod},
-    {GYRO_DESIGN_SENSE_SELFTEST, "selftest.continuous", fr_cont_selftest},
+    {GYRO_DESIGN_SENSE_SELFTEST, "selftest.cont_fr_v2", fr_cont_selftest},
     {GYRO_DESIGN_SENSE_TUNE, "sense.tune", tune_matched_open_loop},
     {GYRO_DESIGN_SENSE_TUNE, "sense.cal_s0_hz", tune_target_above},
     {GYRO_DESIGN_QUAD_NULL, "quad.probe_v", quad_probe_over_limit},
