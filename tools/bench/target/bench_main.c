@@ -30,7 +30,7 @@
  *                       its PLL, the position-form amplitude PI and their notches),
  *                       BENCH_N_TRACE interrupts
  *   isr_fr              force rebalance added (sense.mode 1; the continuous self-test
- *                       off, as its design requires), BENCH_N_TRACE interrupts
+ *                       on, its force in the loop's command), BENCH_N_TRACE interrupts
  *   isr_fault           a NaN planted in the drive demodulator: the fault's tick, the
  *                       loop state's clear and the ticks after it
  *   isr_sweep_chirp     SWEEP: the self-calibration executive (selfcal_exec.h) on a
@@ -409,10 +409,11 @@ static void trace_tracking(void)
   irq_case_n("isr_track", bench_cb, BENCH_N_TRACE);
 }
 
-/* Force rebalance (sense.mode 1) on the tracking drive with quadrature nulling, every
- * closed-sense loop built so far: the feedback pair's waveform each tick and the loop's
- * update steps over the block. The continuous self-test is off (the design refuses it
- * with the loop closed). The sense model is the closed-loop test's part (Q 1e4 at
+/* Force rebalance (sense.mode 1) on the tracking drive with quadrature nulling and the
+ * continuous self-test (its force in the loop's command, selftest.h), every closed-sense
+ * loop built so far: the feedback pair's waveform each tick and the loop's update steps
+ * over the block. (Mode tuning costs the sample path nothing: its voltage comes as a
+ * request, app_tune.h.) The sense model is the closed-loop test's part (Q 1e4 at
  * 1600 Hz); the bench's plant has no feedback electrodes, so the loop runs to its
  * limit, its costlier path. */
 static gyro_design_t s_fr_design;
@@ -421,12 +422,13 @@ static void trace_force_rebalance(void)
   param_values_t v = *params_current(&s_app.params);
   v.drive_track = 1u;
   v.sense_mode = 1u;
-  v.selftest_continuous = 0u;
+  v.selftest_continuous = 1u;
   v.sense_f0_hz = 1600.0f;
   v.sense_q = 1.0e4f;
   v.sense_fb_gain_v_per_v2 = 0.46f;
   if (gyro_design(&v, &s_fr_design) != GYRO_DESIGN_OK) fail("fr_design", -1);
   gyro_apply(&s_app.gyro, &s_fr_design);
+  s_app.gyro.selftest.cont_blocks = s_fr_design.selftest.cont_settle_blocks;
   s_app.gyro.valid.p_updates = RATE_VALID_SLEW_UPDATES - 1u;
   put_state("isr_fr");
   irq_case_n("isr_fr", bench_cb, BENCH_N_TRACE);
