@@ -38,18 +38,12 @@
 /* The part with a sense mode of quality q_sense at F_SENSE_HZ, its model as above. */
 static void start_q(uint32_t sense_mode, double quad_dps, double q_sense)
 {
-  plant_cfg_t def, pc;
-  plant_default_cfg(&def);
+  plant_cfg_t pc;
   sense_test_part(&pc, q_sense);
   pc.quad_dps = quad_dps;
   param_values_t v;
   default_part_values(&v);
-  const double wc = 2.0 * FM_PI * (double)v.drive_freq_hz;
-  double m0, a0, m1, a1;
-  mode_response(def.f_sense_hz, def.q_sense, wc, &m0, &a0);
-  mode_response(F_SENSE_HZ, q_sense, wc, &m1, &a1);
-  v.rate_demod_phase_deg += (float)((a1 - a0) * FM_DEG_PER_RAD);
-  v.rate_scale_dps = (float)((double)v.rate_scale_dps * m0 / m1);
+  sense_test_cal_moved(&v, F_SENSE_HZ, q_sense);
   /* g = rate per V^2 (Ks_fb / (2 A0 wc)) over the scale, in the pickoff's volts */
   const double k_dps_per_v2 = plant_fb_rate_dps_per_v2(&pc, (double)v.drive_freq_hz,
                                                        pc.drive_amp_m);

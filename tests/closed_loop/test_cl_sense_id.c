@@ -55,15 +55,8 @@ static double model_gain(const plant_cfg_t *pc, const param_values_t *v)
  * model: the sweep replaces it), no autostart: the sweep runs from power-on. */
 static void part_values(const plant_cfg_t *pc, param_values_t *v)
 {
-  plant_cfg_t def;
-  plant_default_cfg(&def);
   default_part_values(v);
-  const double wc = 2.0 * FM_PI * (double)v->drive_freq_hz;
-  double m0, a0, m1, a1;
-  mode_response(def.f_sense_hz, def.q_sense, wc, &m0, &a0);
-  mode_response(pc->f_sense_hz, pc->q_sense, wc, &m1, &a1);
-  v->rate_demod_phase_deg += (float)((a1 - a0) * FM_DEG_PER_RAD);
-  v->rate_scale_dps = (float)((double)v->rate_scale_dps * m0 / m1);
+  sense_test_cal_moved(v, pc->f_sense_hz, pc->q_sense);
   v->sys_autostart = 0u;
   v->sense_cal = 1u;
   v->sense_mode = 1u;

@@ -45,15 +45,8 @@ static plant_cfg_t part(double f_sense_hz)
  * sense identification and force rebalance on, tuning `mode` (split_hz), no autostart. */
 static void part_values(const plant_cfg_t *pc, uint32_t mode, double split_hz, param_values_t *v)
 {
-  plant_cfg_t def;
-  plant_default_cfg(&def);
   default_part_values(v);
-  const double wc = 2.0 * FM_PI * (double)v->drive_freq_hz;
-  double m0, a0, m1, a1;
-  mode_response(def.f_sense_hz, def.q_sense, wc, &m0, &a0);
-  mode_response(pc->f_sense_hz, pc->q_sense, wc, &m1, &a1);
-  v->rate_demod_phase_deg += (float)((a1 - a0) * FM_DEG_PER_RAD);
-  v->rate_scale_dps = (float)((double)v->rate_scale_dps * m0 / m1);
+  sense_test_cal_moved(v, pc->f_sense_hz, pc->q_sense);
   v->sys_autostart = 0u;
   v->sense_cal = 1u;
   v->sense_mode = 1u;
@@ -98,15 +91,11 @@ static void set_ok(const char *line)
 static void calibrate_tuned(const plant_cfg_t *pc, double f_tuned_hz)
 {
   const param_values_t *p = params_current(&app.params);
-  plant_cfg_t def;
-  plant_default_cfg(&def);
   param_values_t d;
   default_part_values(&d);
-  const double wc = 2.0 * FM_PI * (double)p->drive_freq_hz;
-  double m0, a0, m1, a1;
-  mode_response(def.f_sense_hz, def.q_sense, 2.0 * FM_PI * (double)d.drive_freq_hz, &m0, &a0);
-  mode_response(f_tuned_hz, pc->q_sense, wc, &m1, &a1);
-  const double phi = (double)d.rate_demod_phase_deg + (a1 - a0) * FM_DEG_PER_RAD;
+  d.drive_freq_hz = p->drive_freq_hz; /* the sweep's */
+  sense_test_cal_moved(&d, f_tuned_hz, pc->q_sense);
+  const double phi = (double)d.rate_demod_phase_deg;
   const double dphi = remainder(phi - (double)p->rate_demod_phase_deg, 360.0);
   char line[160];
   snprintf(line, sizeof line, "set rate.demod_phase_deg %.6f\n", remainder(phi, 360.0));
@@ -114,7 +103,7 @@ static void calibrate_tuned(const plant_cfg_t *pc, double f_tuned_hz)
   snprintf(line, sizeof line, "set sense.fb_phase_deg %.6f\n",
            remainder((double)p->sense_fb_phase_deg + dphi, 360.0));
   set_ok(line);
-  snprintf(line, sizeof line, "set rate.scale_dps %.6f\n", (double)d.rate_scale_dps * m0 / m1);
+  snprintf(line, sizeof line, "set rate.scale_dps %.6f\n", (double)d.rate_scale_dps);
   set_ok(line);
   snprintf(line, sizeof line, "set cal.ref_freq_hz %.6f\n", (double)p->drive_freq_hz);
   set_ok(line);

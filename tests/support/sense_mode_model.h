@@ -7,6 +7,7 @@
 #include <math.h>
 
 #include "dsp/math_const.h"
+#include "params/params.h"
 #include "plant/plant.h"
 
 #define SENSE_TEST_F_HZ 1600.0 /* 110 Hz above the default drive */
@@ -19,6 +20,22 @@ static inline void mode_response(double f_hz, double q, double wc, double *mag, 
   const double re = ws * ws - wc * wc, im = wc * ws / q;
   *mag = 1.0 / sqrt(re * re + im * im);
   *arg = -atan2(im, re);
+}
+
+/* The rate channel's calibration of v (the default part's, its demodulation phase and
+ * scale) moved from the default plant's sense mode to a mode at f_hz of quality q, as the
+ * calibration flow would find it on that part: the mode's phase and gain at v's drive
+ * frequency (2-24). */
+static inline void sense_test_cal_moved(param_values_t *v, double f_hz, double q)
+{
+  plant_cfg_t def;
+  plant_default_cfg(&def);
+  const double wc = 2.0 * FM_PI * (double)v->drive_freq_hz;
+  double m0, a0, m1, a1;
+  mode_response(def.f_sense_hz, def.q_sense, wc, &m0, &a0);
+  mode_response(f_hz, q, wc, &m1, &a1);
+  v->rate_demod_phase_deg += (float)((a1 - a0) * FM_DEG_PER_RAD);
+  v->rate_scale_dps = (float)((double)v->rate_scale_dps * m0 / m1);
 }
 
 /* The default plant with its sense mode at SENSE_TEST_F_HZ of quality q_sense, the
