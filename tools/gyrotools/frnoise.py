@@ -8,7 +8,7 @@ the Brownian force), then: the feedback scheme (half-frequency or DC+AC), the
 feedthrough of the feedback channel into the sense pickoff (plant.pick_sense_ft_spare at
 the preset's 1e-3 V/V, or 0), and for the "electrode" study the feedback electrodes'
 voltage noise at the plant's defaults (fb_noise_white_v_rthz, fb_noise_1hz_v_rthz: white
-and 1/f on each electrode). The record: zero rate, then +100 / -100 / 0 deg/s for 10 s
+and 1/f on each electrode). The record: zero rate (or a constant one), then +100 / -100 / 0 deg/s for 10 s
 each, which give the scale factor that refers the output to the input (as the
 brownian_only scenario does).
 
@@ -63,9 +63,9 @@ def case_plant(study, ft_on, defaults):
     return p
 
 
-def scenario(duration_s, seed, cal_path):
-    """The run: duration_s of zero rate, then the scale factor's steps."""
-    steps = [[duration_s, 0], [STEP_S, 100], [STEP_S, -100], [STEP_S, 0]]
+def scenario(duration_s, seed, cal_path, rate_dps=0.0):
+    """The run: duration_s at rate_dps (0: at rest), then the scale factor's steps."""
+    steps = [[duration_s, rate_dps], [STEP_S, 100], [STEP_S, -100], [STEP_S, 0]]
     return {"name": "fr_noise", "duration_s": duration_s + 3 * STEP_S, "seed": seed,
             "mode": "closed_loop", "firmware_params": os.path.abspath(cal_path),
             "csv_rate_hz": CSV_RATE_HZ,
