@@ -12,6 +12,10 @@
  * rebalance against open loop (issue 19 item 4's table; the README's force-rebalance
  * section); a matched part is test_cl_sense_tune.c's. The continuous self-test with the
  * loop closed, and what it catches (a dead sense pickoff).
+ * The DC+AC scheme (sense.fb_scheme 1, plant fb_mode 2: a 5 V bias +- the AC voltage) on
+ * the same part: the same step, the same figures. With parallel-plate electrodes (a gap)
+ * the bias softens the sense spring (6-3); the model's f0 is then the softened resonance,
+ * and a model that leaves the softening out misses the 10 ms (a control).
  *
  * The part's model as its identification would give it, from the plant's own values:
  * the demodulation phase and scale of the default part's calibration moved by the sense
@@ -35,24 +39,61 @@
 #define STEP_DPS 100.0
 #define T_STEP_S 0.5
 
-/* The part with a sense mode of quality q_sense at F_SENSE_HZ, its model as above. */
-static void start_q(uint32_t sense_mode, double quad_dps, double q_sense)
+/* A part of the step test: its sense mode, its feedback electrodes and the model the
+ * firmware gets of them. fb_scheme 0 is the half-frequency pair (plant fb_mode 3,
+ * sense.fb_scheme 0); 1 is DC+AC (plant fb_mode 2: the plant's bias fb_bias_v +- the spare
+ * converter's AC voltage, sense.fb_bias_v the same 5 V, sense.fb_scheme 1). */
+typedef struct {
+  uint32_t sense_mode;
+  double quad_dps, q_sense;
+  uint32_t fb_scheme;
+  double gap_m;       /* the feedback electrodes' gap (plant.fb_gap_m), 0: no softening */
+  double f_sense_hz;  /* the plant's sense resonance, before any softening */
+  int model_softened; /* the model's f0 with the DC bias's softening (1), or without (0) */
+} fr_part_t;
+
+/* The sense resonance the loop sees: under DC+AC with a gap the bias softens the sense
+ * spring by k_e / m = 4 Ks Vb^2 / gap ((6-3), plant_fb_softening), so the mode rings at
+ * sqrt(ws^2 - k_e / m); without a gap, or with no DC on the electrodes, at ws. */
+static double softened_f_hz(const plant_cfg_t *pc)
+{
+  const double ws = 2.0 * FM_PI * pc->f_sense_hz;
+  return sqrt(ws * ws - plant_fb_softening(pc)) / (2.0 * FM_PI);
+}
+
+/* The part fp, its model as above: the mode's response at wc (phase, scale) and sense.f0_hz
+ * from the resonance the loop sees (the softened one) unless fp says otherwise. */
+static void start_part(const fr_part_t *fp)
 {
   plant_cfg_t pc;
-  sense_test_part(&pc, q_sense);
-  pc.quad_dps = quad_dps;
+  sense_test_part(&pc, fp->q_sense);
+  pc.quad_dps = fp->quad_dps;
+  pc.f_sense_hz = fp->f_sense_hz;
+  pc.fb_gap_m = fp->gap_m;
+  if (fp->fb_scheme == 1u) pc.fb_mode = 2;
+  const double f0 = fp->model_softened ? softened_f_hz(&pc) : pc.f_sense_hz;
   param_values_t v;
   default_part_values(&v);
-  sense_test_cal_moved(&v, F_SENSE_HZ, q_sense);
-  /* g = rate per V^2 (Ks_fb / (2 A0 wc)) over the scale, in the pickoff's volts */
+  sense_test_cal_moved(&v, f0, fp->q_sense);
+  /* g = rate per V^2 (Ks_fb / (2 A0 wc)) over the scale, in the pickoff's volts: the same
+   * in both schemes, whose synthesis makes the same force of the same command */
   const double k_dps_per_v2 = plant_fb_rate_dps_per_v2(&pc, (double)v.drive_freq_hz,
                                                        pc.drive_amp_m);
   v.sense_fb_gain_v_per_v2 = (float)(k_dps_per_v2 / (double)v.rate_scale_dps *
                                      (double)v.drive_amp_set_v);
-  v.sense_f0_hz = (float)F_SENSE_HZ;
-  v.sense_q = (float)q_sense;
-  v.sense_mode = sense_mode;
+  v.sense_f0_hz = (float)f0;
+  v.sense_q = (float)fp->q_sense;
+  v.sense_mode = fp->sense_mode;
+  v.sense_fb_scheme = fp->fb_scheme;
+  v.sense_fb_bias_v = (float)pc.fb_bias_v;
   app_plant_start(&pc, 21u, &v);
+}
+
+/* The part with a sense mode of quality q_sense at F_SENSE_HZ, the half-frequency pair. */
+static void start_q(uint32_t sense_mode, double quad_dps, double q_sense)
+{
+  const fr_part_t fp = {sense_mode, quad_dps, q_sense, 0u, 0.0, F_SENSE_HZ, 1};
+  start_part(&fp);
 }
 
 static void start(uint32_t sense_mode, double quad_dps)
@@ -152,20 +193,21 @@ static double invalid_after_step_ms(double max_s, int *wrong)
   return ms;
 }
 
-static void test_step_settles_within_10_ms(void **state)
+/* The step with the loop closed on the part started: settles within 10 ms at the model's
+ * scale, valid before the step and after settling, never valid and wrong, the loop
+ * balanced and the sense motion held near zero. Returns the step's figures. */
+static step_t check_closed_step(const char *what)
 {
-  (void)state;
-  start(1u, 1500.0);
   const step_t r = run_step();
   const sense_fr_t *fr = &app.gyro.fr;
-  printf("# force rebalance, Q 1e4, 110 Hz split, 1500 deg/s quadrature: 0 -> 100 deg/s "
+  printf("# force rebalance, %s, Q 1e4, 110 Hz split, 1500 deg/s quadrature: 0 -> 100 deg/s "
          "settles to 1 %% in %.1f ms (overshoot %.1f %%), peak %.2f, final %.2f deg/s (true "
          "%.1f); force I %.2f "
          "Q %.2f V^2, settled %u, at limit %u; valid blocks %ld (50 ms before the step %ld, "
          "last 50 ms %ld), valid and wrong %d, reasons 0x%x\n",
-         r.settle_ms, 100.0 * (r.peak_dps - r.final_dps) / STEP_DPS, r.peak_dps, r.final_dps,
-         plant_truth(&plant)->rate_dps, (double)fr->f_re, (double)fr->f_im, fr->settled,
-         fr->at_limit, r.valid_blocks, r.valid_before, r.valid_tail, r.valid_wrong,
+         what, r.settle_ms, 100.0 * (r.peak_dps - r.final_dps) / STEP_DPS, r.peak_dps,
+         r.final_dps, plant_truth(&plant)->rate_dps, (double)fr->f_re, (double)fr->f_im,
+         fr->settled, fr->at_limit, r.valid_blocks, r.valid_before, r.valid_tail, r.valid_wrong,
          app.gyro.out.rate_invalid);
   assert_true(r.settle_ms <= 10.0);
   assert_true(fabs(r.final_dps - STEP_DPS) <= 0.02 * STEP_DPS); /* the model's scale */
@@ -182,6 +224,67 @@ static void test_step_settles_within_10_ms(void **state)
   assert_true(fabs(plant_truth(&plant)->sense_vel_m) < 1e-9);
   const char *s = cmd("status\n");
   assert_non_null(strstr(s, "sense_fr balanced"));
+  return r;
+}
+
+static void test_step_settles_within_10_ms(void **state)
+{
+  (void)state;
+  start(1u, 1500.0);
+  (void)check_closed_step("half-frequency pair");
+}
+
+/* The DC+AC scheme (sense.fb_scheme 1, plant fb_mode 2: 5 V of bias +- the AC voltage, the
+ * force 4 Ks Vb u (6-20)) on the same part: the same step, the same figures. Its synthesis
+ * makes the same force of the same command (drive_synth.h), so the loop's design and the
+ * model's g are the half-frequency case's. The AC voltage for the 1500 deg/s of quadrature
+ * is |F| / (4 Vb) = 2.5 V on the 5 V bias. */
+static void test_dcac_step_settles_within_10_ms(void **state)
+{
+  (void)state;
+  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, 0.0, F_SENSE_HZ, 1};
+  start_part(&fp);
+  (void)check_closed_step("DC+AC");
+  assert_int_equal(app.gyro.fb_synth.scheme, GYRO_DRIVE_DC_AC);
+}
+
+/* DC+AC on parallel-plate electrodes (a gap of 2 um): the 5 V bias softens the sense
+ * spring by 4 Ks Vb^2 / gap = 5e6 1/s^2 ((6-3), plant_fb_softening), 40 Hz at 1600 Hz.
+ * The part is made so that the mode the loop sees is the step test's (the plant's own
+ * resonance sqrt(1600^2 + 4 Ks Vb^2 / (gap (2 pi)^2)) = 1639.1 Hz, softened to 1600 Hz);
+ * the model's f0 is the softened resonance (an identification with the bias on measures
+ * it so): the step settles as on the unsoftened part. The control: a model at the
+ * unsoftened resonance (the bias left out) sees a 149 Hz split where the loop has 110 Hz,
+ * and misses the 10 ms. */
+#define GAP_M 2e-6
+static double unsoftened_f_hz(void)
+{
+  const double ke = 4.0 * SENSE_TEST_KS_FB * 5.0 * 5.0 / GAP_M; /* the 5 V plant bias */
+  const double ws = 2.0 * FM_PI * F_SENSE_HZ;
+  return sqrt(ws * ws + ke) / (2.0 * FM_PI);
+}
+
+static void test_dcac_softened_model(void **state)
+{
+  (void)state;
+  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, GAP_M, unsoftened_f_hz(), 1};
+  start_part(&fp);
+  /* the model's split, wd - wc of its pole (sense_fr.h), is the step test's 110 Hz */
+  assert_true(fabs((double)app.gyro.design->fr.p_im / (2.0 * FM_PI) - 110.1) < 0.5);
+  (void)check_closed_step("DC+AC, 2 um gap, model at the softened resonance");
+}
+
+static void test_dcac_unsoftened_model_misses(void **state)
+{
+  (void)state;
+  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, GAP_M, unsoftened_f_hz(), 0};
+  start_part(&fp);
+  const step_t r = run_step();
+  printf("# force rebalance, DC+AC, 2 um gap, model at the unsoftened %.1f Hz (the loop sees "
+         "%.1f Hz): settles to 1 %% in %.1f ms, final %.2f deg/s, valid and wrong %d\n",
+         unsoftened_f_hz(), F_SENSE_HZ, r.settle_ms, r.final_dps, r.valid_wrong);
+  assert_true(r.settle_ms > 10.0);
+  assert_false(r.valid_wrong);
 }
 
 /* Open loop on the same part (its quadrature removed: open loop it would clip the ADC):
@@ -388,6 +491,9 @@ int main(void)
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_step_settles_within_10_ms),
       cmocka_unit_test(test_cont_selftest_closed_loop),
+      cmocka_unit_test(test_dcac_step_settles_within_10_ms),
+      cmocka_unit_test(test_dcac_softened_model),
+      cmocka_unit_test(test_dcac_unsoftened_model_misses),
       cmocka_unit_test(test_open_loop_rings),
       cmocka_unit_test(test_table_fr_q300),
       cmocka_unit_test(test_table_fr_q3),

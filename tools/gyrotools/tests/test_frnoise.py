@@ -1,0 +1,63 @@
+"""tools/fr-noise and its library: bad options are refused (exit 2, nothing run); the
+read-offs are right on constructed records (N of a white rate noise, the scale factor of
+the steps); the force-rebalance part's model puts f0 at the resonance the loop sees
+(the DC bias's softening taken off, as tests/closed_loop/test_cl_sense_fr.c does)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from gyrotools import frnoise, frpart
+
+
+@pytest.mark.parametrize("args, why", [
+    (["--schemes", "half,x"], "--schemes"),
+    (["--ft", "maybe"], "--ft"),
+    (["--duration", "10"], "--duration"),
+    (["--q-sense", "0.1"], "--q-sense"),
+    (["--gyro-sim", "/nonexistent/gyro-sim"], "not an executable"),
+])
+def test_bad_options_refused(run_script, tmp_path, args, why):
+    code, out, err = run_script("fr-noise", args + ["--out", str(tmp_path / "o")])
+    assert code == 2 and why in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_arw_of_white_noise():
+    """A white rate noise of N deg/h/rtHz (two-sided) at 100 Hz reads back within 5 %."""
+    n_dph = 7.0
+    fs = frnoise.AVG_RATE_HZ
+    rng = np.random.default_rng(1)
+    x = rng.standard_normal(200000) * n_dph / 3600.0 * math.sqrt(fs)
+    tau, ad = frnoise.adev(x, fs, np.logspace(-2, 2, 21))
+    assert abs(frnoise.arw_coeff(tau, ad) / n_dph - 1.0) < 0.05
+    assert frnoise.at_tau(tau, ad, 1000.0) is None
+    assert abs(frnoise.at_tau(tau, ad, 10.0) / (n_dph / math.sqrt(10.0)) - 1.0) < 0.2
+
+
+def test_scale_factor_of_the_steps():
+    t = np.arange(0.0, 130.0, 0.01)
+    true = np.where((t >= 100) & (t < 110), 100.0, np.where((t >= 110) & (t < 120), -100.0, 0.0))
+    rate = 1.008 * true + 0.3
+    assert frnoise.scale_factor(t, rate, true, 100.0) == pytest.approx(1.008, rel=1e-9)
+
+
+def test_model_at_the_softened_resonance():
+    """DC+AC with a 2 um gap: 4 Ks Vb^2 / gap = 5e6 1/s^2 takes 1639.10 Hz down to 1600 Hz; the
+    half-frequency pair (fb_mode 3) has no DC and keeps its resonance."""
+    p = {"f_sense_hz": 1639.1008, "q_sense": 1e4, "fb_mode": 2, "fb_gap_m": 2e-6,
+         "ks_fb_mps2_per_v2": 0.1, "fb_bias_v": 5.0, "drive_amp_m": 1e-5,
+         "pick_sense_gain_v_per_m": 6.18e7}
+    assert frpart.softened_f_hz(p) == pytest.approx(1600.0, abs=0.01)
+    assert frpart.softened_f_hz({**p, "fb_mode": 3}) == pytest.approx(1639.1008)
+    cal = {"drive.freq_hz": 1489.86, "rate.scale_dps": 100.0, "rate.demod_phase_deg": 60.0,
+           "drive.amp_set_v": 0.35}
+    base = {**p, "f_sense_hz": 2000.0, "q_sense": 3.0}
+    fw = frpart.model_values(cal, base, p)
+    assert fw["sense.f0_hz"] == pytest.approx(1600.0, abs=0.01)
+    # the scale moves with the mode's gain at the drive frequency, (2-24)
+    wc = 2 * math.pi * 1489.86
+    m0, _ = frpart.mode_response(2000.0, 3.0, wc)
+    m1, _ = frpart.mode_response(1600.0, 1e4, wc)
+    assert fw["rate.scale_dps"] == pytest.approx(100.0 * m0 / m1, rel=1e-6)
