@@ -25,11 +25,17 @@ CASE
            CSV), save refused while the drive runs, then save, set, load and the
            saved value back (the board's flash driver against the emulator's model
            of the parameter sectors; see hal/boards/ref_f405/README.md).
+  fr       force rebalance on the emulated board: `emu part fr` (a part with the
+           half-frequency feedback pair, qemu_plant_setup.h), the model set over the
+           command line from the plant's values (--sim GYRO_SIM, tools/gyrotools/
+           frpart.py), the drive on: LOCKED, the loop balanced, the rate valid and
+           following rates applied, within RATE_TOL_DPS + FR_RATE_TOL_REL x the rate.
 
 Exit codes: 0 pass, 1 fail, 77 skip (image or twin not built: build the target preset).
 """
 import argparse
 import csv
+import json
 import os
 import statistics
 import subprocess
@@ -50,7 +56,7 @@ EQUIV_REL = 1e-4
 EQUIV_STRETCH = 3      # x 20000 instructions per tick under -icount shift=0
 AUTO_NS_PER_INSN = 8   # -icount shift=auto settles at shift 3 here (plant_ns / instructions)
 STRETCH_MARGIN = 0.6   # worst tick's share of the period
-ICOUNT = {"boot": "auto", "equiv": "0", "gyroctl": "auto"}
+ICOUNT = {"boot": "auto", "equiv": "0", "gyroctl": "auto", "fr": "auto"}
 STEP_DPS = 100.0       # hal/boards/ref_f405/qemu/qemu_plant_setup.h QEMU_PLANT_STEP_DPS
 GYROCTL_RATE_DPS = 80.0
 TRACE_LEN = 1000       # QEMU_TRACE_LEN
@@ -137,6 +143,84 @@ def case_boot(emu, args):
     # on the deterministic instruction counts.
     print(f"     note: {em['tick_overruns']} ticks overran, {em['ticks_lost']} periods lost "
           f"of {em['ticks']} (stretch {em['stretch']}; 0 expected on an unloaded host)")
+
+
+FR_SETS = ["plant.f_sense_hz=1600", "plant.q_sense=10000", "plant.fb_mode=3",
+           "plant.ks_fb_mps2_per_v2=0.1"]  # qemu_plant_setup.h QEMU_PART_FR
+FR_RATE_TOL_REL = 0.02  # the model-made scale's accuracy (test_cl_sense_fr.c)
+
+
+def wait_mode(emu, mode, timeout_s):
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < timeout_s:
+        st = emu.status()
+        if st["mode"] == mode:
+            return st
+        time.sleep(0.2)
+    return emu.status()
+
+
+def fr_model(sim):
+    """The firmware's model of the emulator's force-rebalance part from the plant's own
+    values (tools/gyrotools/frpart.py, as the closed-loop tests make it)."""
+    sys.path.insert(0, os.path.join(ROOT, "tools"))
+    from gyrotools import frpart
+    part = os.path.join(ROOT, "host_sim", "parts", "default", "calibration.json")
+    with open(part, encoding="utf-8") as f:
+        cal = {e["name"]: e["value"] for e in json.load(f)["params"]}
+    return frpart.model_values(cal, frpart.plant_values(sim), frpart.plant_values(sim, FR_SETS))
+
+
+def case_fr(emu, args):
+    """Force rebalance on the emulated board: the part with a feedback pair put in the
+    socket (`emu part fr`), the model set over the command line, the drive on: LOCKED,
+    the loop balanced, the rate valid and following rates applied to the plant."""
+    if not args.sim:
+        check(False, "the fr case needs --sim GYRO_SIM (the plant's values for the model)")
+        return
+    model = fr_model(args.sim)
+    st = wait_locked(emu, 60.0)
+    check(st["mode"] == "LOCKED", f"the default part locks first (mode {st['mode']})")
+    check(emu.command("drive off").ok, "drive off")
+    check(wait_mode(emu, "OFF", 10.0)["mode"] == "OFF", "the drive is off")
+    r = emu.command("emu part fr")
+    check(r.ok, f"emu part fr accepted ({r.final})")
+    emu.wait_ticks(10)
+    for k, v in model.items():
+        r = emu.command(f"set {k} {v:.9g}")
+        for _ in range(50):  # the sample loop takes one change at a time
+            if r.ok or "PENDING" not in r.final:
+                break
+            emu.wait_ticks(2)
+            r = emu.command(f"set {k} {v:.9g}")
+        check(r.ok, f"set {k} {v:.9g} ({r.final})")
+    check(emu.command("drive on").ok, "drive on")
+    st = wait_locked(emu, 60.0)
+    check(st["mode"] == "LOCKED", f"force rebalance locks (mode {st['mode']}, fault "
+          f"{st['fault']})")
+    if st["mode"] != "LOCKED":
+        return
+    emu.wait_ticks(SETTLE_TICKS)
+    st = emu.status()
+    check(st.get("sense_fr") == "balanced" and st.get("rate_valid") == "1",
+          f"the loop balanced and the rate valid (sense_fr {st.get('sense_fr')}, "
+          f"rate_invalid {st.get('rate_invalid')}, force {st.get('fr_force_v2')} V^2)")
+    points = []
+    for rate in (60.0, -120.0):
+        check(emu.command(f"emu rate {rate:g}").ok, f"emu rate {rate:g} accepted")
+        emu.wait_ticks(1500)
+        m, sd = mean_rate(emu, FS_HZ // 20, reads=5)
+        tol = RATE_TOL_DPS + FR_RATE_TOL_REL * abs(rate)
+        check(abs(m - rate) <= tol, f"rate output {m:.4f} deg/s (sd {sd:.4f}) for {rate:g} "
+              f"applied, within {tol:.2f}")
+        points.append((rate, m))
+    sf = (points[0][1] - points[1][1]) / (points[0][0] - points[1][0])
+    print(f"     force rebalance's scale factor {sf:.5f} (the model-made scale)")
+    st, em = print_figures(emu)
+    check(st["mode"] == "LOCKED" and st["fault_count"] == "0" and st.get("rate_valid") == "1",
+          f"still locked, no fault, valid (rate_invalid {st.get('rate_invalid')})")
+    print(f"     note: {em['tick_overruns']} ticks overran (one is the part change's), "
+          f"{em['ticks_lost']} periods lost of {em['ticks']}")
 
 
 def read_trace(emu):
@@ -281,7 +365,8 @@ def case_gyroctl(emu, args):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("case", choices=("boot", "equiv", "gyroctl"))
+    ap.add_argument("case", choices=("boot", "equiv", "gyroctl", "fr"))
+    ap.add_argument("--sim", help="gyro-sim, for the fr case's model of the part")
     ap.add_argument("--qemu", default="qemu-system-arm")
     ap.add_argument("--elf", required=True)
     ap.add_argument("--twin")
@@ -295,7 +380,8 @@ def main():
     try:
         with Emulator(args.qemu, args.elf, icount=args.icount or ICOUNT[args.case]) as emu:
             print(f"     booted in {emu.boot_s:.1f} s (plant and loop design on the target)")
-            {"boot": case_boot, "equiv": case_equiv, "gyroctl": case_gyroctl}[args.case](emu, args)
+            {"boot": case_boot, "equiv": case_equiv, "gyroctl": case_gyroctl,
+             "fr": case_fr}[args.case](emu, args)
     except SystemExit:
         raise
     except Exception as e:  # noqa: BLE001 - report and fail

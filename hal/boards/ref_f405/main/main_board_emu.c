@@ -53,6 +53,30 @@ static void emu_rate(cli_t *cli, const char *arg)
   cli_emit_ok(cli);
 }
 
+/* `emu part default|fr`: another part in the emulator's socket (the drive off first: the
+ * loops would otherwise see the old part's motion vanish as a fault). */
+static void emu_part(cli_t *cli, app_t *a, const char *arg)
+{
+  const int part = strcmp(arg, "default") == 0 ? QEMU_PART_DEFAULT
+                   : strcmp(arg, "fr") == 0    ? QEMU_PART_FR
+                                               : -1;
+  if (part < 0) {
+    cli_err(cli, "VALUE", "part: default or fr");
+    return;
+  }
+  if (a->gyro.sup.mode != GYRO_MODE_OFF) {
+    cli_err(cli, "STATE", "part: drive off first");
+    return;
+  }
+  if (stm32f4_qemu_plant_set_part(part) != 0) {
+    cli_err(cli, "BUSY", "the previous part change has not been taken yet");
+    return;
+  }
+  cli_put(cli, "part ");
+  cli_put(cli, arg);
+  cli_emit_ok(cli);
+}
+
 static void emu_stretch(cli_t *cli, const char *arg)
 {
   uint32_t n;
@@ -86,8 +110,9 @@ static void emu_trace(cli_t *cli, const char *arg)
 
 static void cmd_emu(cli_t *cli, void *ctx, uint32_t argc, const char *const *argv)
 {
-  (void)ctx;
-  if (argc == 1u) {
+  if (argc == 3u && strcmp(argv[1], "part") == 0) {
+    emu_part(cli, ctx, argv[2]);
+  } else if (argc == 1u) {
     emu_figures(cli);
   } else if (argc == 3u && strcmp(argv[1], "rate") == 0) {
     emu_rate(cli, argv[2]);
@@ -96,7 +121,8 @@ static void cmd_emu(cli_t *cli, void *ctx, uint32_t argc, const char *const *arg
   } else if (argc == 3u && strcmp(argv[1], "trace") == 0) {
     emu_trace(cli, argv[2]);
   } else {
-    cli_err(cli, "ARGS", "usage: emu | emu rate DPS | emu stretch N | emu trace FROM");
+    cli_err(cli, "ARGS",
+            "usage: emu | emu rate DPS | emu part default|fr | emu stretch N | emu trace FROM");
   }
 }
 
@@ -104,9 +130,9 @@ static cli_cmd_t s_emu_cmd; /* the CLI keeps rows by pointer */
 
 int main_board_emu_init(app_t *a)
 {
-  const cli_cmd_t row = {"emu", "[rate DPS | stretch N | trace FROM]",
-                         "emulator: tick and plant figures, input rate, rate trace", cmd_emu,
-                         NULL};
+  const cli_cmd_t row = {"emu", "[rate DPS | part default|fr | stretch N | trace FROM]",
+                         "emulator: tick and plant figures, input rate, part, rate trace",
+                         cmd_emu, a};
   s_emu_cmd = row;
   stm32f4_qemu_plant_trace_from(&a->gyro.out.rate_dps);
   return cli_register(&a->cli, &s_emu_cmd);

@@ -6,6 +6,9 @@
  *                         stm32f4_qemu.h), plant_rate_dps, trace n/len/every   ok emu
  *   emu rate DPS        ok rate DPS: move the plant's input rate to DPS (a 10 ms
  *                         rate-table ramp from the next tick); err VALUE / RANGE / BUSY
+ *   emu part NAME       ok part NAME: another part in the emulator's socket from the next
+ *                         tick, `default` or `fr` (qemu_plant_setup.h: a part force
+ *                         rebalance can run on), the drive off; err VALUE / STATE / BUSY
  *   emu stretch N       ok stretch N: SysTick period of N sample periods from the next
  *                         tick (stm32f4_qemu_set_stretch); err RANGE
  *   emu trace FROM      - I VALUE for up to 16 entries of the rate-output trace from

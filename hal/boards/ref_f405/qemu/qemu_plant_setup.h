@@ -29,6 +29,21 @@
  * Returns 0, or the plant's error code (-1/-2; reason in plant_error(p)). */
 int qemu_plant_setup(plant_t *p, plant_profiles_t *prof);
 
+/* The emulator's parts (`emu part NAME`): the default one above, and the closed-loop
+ * sense tests' (tests/support/sense_mode_model.h): the default plant with its sense mode
+ * at 1600 Hz (a 110 Hz split above the drive) of Q 1e4 and the half-frequency feedback
+ * pair (fb_mode 3, Ks_fb 0.1 (m/s^2)/V^2), its noise sources on, so that force
+ * rebalance (sense.mode 1) can run on the emulated board. */
+#define QEMU_PART_DEFAULT 0
+#define QEMU_PART_FR 1
+#define QEMU_PART_FR_F_SENSE_HZ 1600.0
+#define QEMU_PART_FR_Q_SENSE 1.0e4
+#define QEMU_PART_FR_KS_FB 0.1
+
+/* plant_init with part's configuration (QEMU_PART_*) at rest: zero rate, the ambient
+ * constant. Returns 0, -3 for an unknown part, or the plant's error code. */
+int qemu_plant_setup_part(plant_t *p, plant_profiles_t *prof, int part);
+
 /* Replace the rate profile by a linear ramp from the rate at the plant's current time
  * to rate_dps over QEMU_PLANT_EDGE_S, then held (a rate-table move). Returns 0, or -1
  * (rate out of the profile's range; nothing changed). */

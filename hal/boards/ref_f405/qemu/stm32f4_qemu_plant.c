@@ -17,6 +17,7 @@ static uint64_t s_samples;
 static uint32_t s_ticks;               /* ticks of the sample clock (trace index) */
 static volatile double s_rate_req_dps; /* written by the background before s_rate_req is set */
 static volatile uint32_t s_rate_req;
+static volatile int32_t s_part_req = -1; /* a part asked for (QEMU_PART_*), taken by a tick */
 static const volatile float *s_trace_src;
 static float s_trace[QEMU_TRACE_LEN];
 static volatile uint32_t s_trace_n;
@@ -39,6 +40,11 @@ void stm32f4_qemu_plant_tick(void)
     (void)qemu_plant_rate_ramp(&s_plant, &s_prof, s_rate_req_dps); /* range checked */
     s_rate_req = 0u;
   }
+  if (s_part_req >= 0) {
+    /* another part in the emulator's socket: a tick of its own (it overruns, counted) */
+    (void)qemu_plant_setup_part(&s_plant, &s_prof, (int)s_part_req); /* checked */
+    s_part_req = -1;
+  }
   plant_step(&s_plant, &s_active, &s_adc);
   s_active = s_pending;
   s_samples++;
@@ -59,6 +65,14 @@ int stm32f4_qemu_plant_set_rate(double rate_dps)
   if (s_rate_req != 0u) return -2;
   s_rate_req_dps = rate_dps;
   s_rate_req = 1u;
+  return 0;
+}
+
+int stm32f4_qemu_plant_set_part(int part)
+{
+  if (part != QEMU_PART_DEFAULT && part != QEMU_PART_FR) return -1;
+  if (s_part_req >= 0) return -2;
+  s_part_req = part;
   return 0;
 }
 

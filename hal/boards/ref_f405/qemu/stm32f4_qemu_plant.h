@@ -37,6 +37,10 @@ double stm32f4_qemu_plant_rate_dps(void);
 int stm32f4_qemu_plant_set_rate(double rate_dps);
 
 /* The rate output to trace: the firmware's (read once per tick after its ISR). */
+/* Background: the emulated plant replaced by part QEMU_PART_* (qemu_plant_setup.h) at
+ * the next tick. Returns 0, -1 (unknown part) or -2 (a request not yet taken). */
+int stm32f4_qemu_plant_set_part(int part);
+
 void stm32f4_qemu_plant_trace_from(const volatile float *rate_dps);
 
 /* Entries recorded so far (0..QEMU_TRACE_LEN), and entry i (0 if i is past them). */
