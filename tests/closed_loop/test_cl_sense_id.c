@@ -29,6 +29,7 @@
 
 #include "selfcal_harness.h"
 #include "sense_mode_model.h"
+#include "sense_step.h"
 
 #define F_SENSE_HZ SENSE_TEST_F_HZ
 #define TUNE_KE 1.2e5 /* (1/s^2)/V^2: 3 V lowers 1600 Hz by 8.5 Hz, 10 V by 100 Hz */
@@ -67,36 +68,6 @@ static double true_sense_f0(const plant_cfg_t *pc)
 {
   const double t = plant_truth(&plant)->struct_k;
   return pc->f_sense_hz * (1.0 - 0.5 * pc->ket_per_k * (t - pc->temp_ref_k));
-}
-
-#define BLOCK_S ((double)GYRO_BLOCK / 50000.0)
-#define N_AFTER 500 /* 0.1 s of blocks */
-
-/* 0 -> STEP_DPS: the last block outside 1 % of the step around the final value (the
- * mean of the last 20 ms), ms after the step; *final_dps that mean, *rest_dps the mean
- * of the 20 ms before the step (the bias: the quadrature a feedback phase error turns
- * into the rate). */
-static double step_settle_ms(double *final_dps, double *rest_dps)
-{
-  static float rate[N_AFTER];
-  const int tail = (int)(0.020 / BLOCK_S);
-  *rest_dps = 0.0;
-  for (int n = 0; n < tail; n++) {
-    hal_host_run(GYRO_BLOCK);
-    *rest_dps += (double)app.gyro.out.rate_dps / tail;
-  }
-  app_plant_hold_rate(STEP_DPS);
-  for (int n = 0; n < N_AFTER; n++) {
-    hal_host_run(GYRO_BLOCK);
-    rate[n] = app.gyro.out.rate_dps;
-  }
-  double fin = 0.0;
-  for (int i = N_AFTER - tail; i < N_AFTER; i++) fin += (double)rate[i] / tail;
-  double settle_ms = 0.0;
-  for (int i = 0; i < N_AFTER; i++)
-    if (fabs((double)rate[i] - fin) > 0.01 * STEP_DPS) settle_ms = (i + 1) * BLOCK_S * 1e3;
-  *final_dps = fin;
-  return settle_ms;
 }
 
 typedef struct {
@@ -152,7 +123,7 @@ static void check_case(const case_t *k, double f_sense_hz)
   assert_int_equal(app.gyro.sup.mode, GYRO_MODE_LOCKED);
   assert_true(app.gyro.fr.run != 0u && app.gyro.fr.settled != 0u);
   double fin = 0.0, rest = 0.0;
-  const double settle_ms = step_settle_ms(&fin, &rest);
+  const double settle_ms = sense_step_settle_ms(STEP_DPS, &fin, &rest);
   printf("# force rebalance from the identified model: 0 -> 100 deg/s settles to 1 %% in "
          "%.1f ms, at rest %.2f deg/s, final %.2f deg/s (step %.2f); settled %u, at limit %u, "
          "faults %u\n",

@@ -26,11 +26,11 @@
 
 #include "selfcal_harness.h"
 #include "sense_mode_model.h"
+#include "sense_step.h"
 
 #define TUNE_KE 2.4e5 /* (1/s^2)/V^2: the 110 Hz split matched at 7.5 V */
 #define STEP_DPS 100.0
-#define BLOCK_S ((double)GYRO_BLOCK / 50000.0)
-#define N_AFTER 500 /* 0.1 s of blocks */
+#define BLOCK_S SENSE_STEP_BLOCK_S
 
 static plant_cfg_t part(double f_sense_hz)
 {
@@ -150,31 +150,6 @@ static void flow_rate_table(void)
   set_ok(line);
 }
 
-/* 0 -> STEP_DPS: the last block outside 1 % of the step around the final value (the
- * mean of the last 20 ms), ms after the step; *step_dps the final less the rest. */
-static double step_settle_ms(double *step_dps)
-{
-  static float rate[N_AFTER];
-  const int tail = (int)(0.020 / BLOCK_S);
-  double rest = 0.0;
-  for (int n = 0; n < tail; n++) {
-    hal_host_run(GYRO_BLOCK);
-    rest += (double)app.gyro.out.rate_dps / tail;
-  }
-  app_plant_hold_rate(STEP_DPS);
-  for (int n = 0; n < N_AFTER; n++) {
-    hal_host_run(GYRO_BLOCK);
-    rate[n] = app.gyro.out.rate_dps;
-  }
-  double fin = 0.0;
-  for (int i = N_AFTER - tail; i < N_AFTER; i++) fin += (double)rate[i] / tail;
-  double settle_ms = 0.0;
-  for (int i = 0; i < N_AFTER; i++)
-    if (fabs((double)rate[i] - fin) > 0.01 * STEP_DPS) settle_ms = (i + 1) * BLOCK_S * 1e3;
-  *step_dps = fin - rest;
-  return settle_ms;
-}
-
 /* The sweep tunes the part: S4 done, its resonance at the target within S4's tolerance
  * (a quarter of the half-bandwidth, or 0.6 of one code's move), the calibration staged. */
 static void check_tuned(const plant_cfg_t *pc, double split_hz)
@@ -246,8 +221,9 @@ static void check_running(const plant_cfg_t *pc, double split_hz)
   assert_true(fabs(f_true - target) <= fmax(0.25 * hb, step_tol) + 0.005);
   assert_int_equal(app.gyro.tune_bits, 0u);
   assert_int_equal(app.gyro.out.rate_invalid, 0u);
-  double step = 0.0;
-  const double settle_ms = step_settle_ms(&step);
+  double fin = 0.0, rest0 = 0.0;
+  const double settle_ms = sense_step_settle_ms(STEP_DPS, &fin, &rest0);
+  const double step = fin - rest0;
   printf("# 0 -> 100 deg/s: to 1 %% in %.1f ms, step %.2f deg/s\n", settle_ms, step);
   assert_true(settle_ms <= 10.0);
   assert_true(fabs(step / STEP_DPS - 1.0) <= 0.03);
