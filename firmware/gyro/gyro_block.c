@@ -338,7 +338,8 @@ GYRO_RAMFUNC void gyro_fr_take(gyro_t *g)
   }
   rate_channel_t *rc = &g->rate;
   sense_fr_take(&g->design->fr, fr, rc->rate_raw, rc->quad_raw);
-  /* The rate channel reads the force from here on: -g F, the open loop's equivalent. */
+  /* The rate channel reads the force from here on: g (I + Kr R), the open loop's
+   * equivalent -g F in the steady state (sense_fr.h). */
   rc->rate_raw = fr->out_re;
   rc->quad_raw = fr->out_im;
 }

@@ -68,9 +68,10 @@
  *
  * Force rebalance (sense.mode 1, sense_fr.h) adds one step of its update to the start of
  * five jobs, in order: on slot 6 (before the rate's filter) it takes the block's
- * projection as the residual and gives the rate channel the force's readout -g F in its
- * place; on 7 the PI; on 8 the force's limit; the force's phasor to the synthesis in
- * three steps, one long operation on each tick: on 9 |F| (a square root), on 0 the root
+ * projection as the residual and gives the rate channel the loop's readout g (I + Kr R)
+ * in its place; on 7 the PI; on 8 the force's limit; the force's phasor to the synthesis
+ * in three steps, one long operation on each tick: on 9 |F| (a square root; F with the
+ * continuous self-test's force on its Coriolis axis, selftest.h), on 0 the root
  * of F (another), on 2 the feedback synthesis (drive_synth_set_phasor on its own
  * instance: a divide and the frame's phase; no arc tangent), whose waveform goes out
  * every tick from the next on, on the feedback pair's two channels; on 5, a block after

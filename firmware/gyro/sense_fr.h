@@ -43,7 +43,8 @@
  * The readout is instead g (I + Kr R) with Kr = Ki / c: in the steady state R = 0 and it
  * is -g F; in a transient its zero, Kr s + Ki, sits on the third root -c and cancels it,
  * so a step of the rate comes out through the placed pair (w, zeta) alone, at any split
- * (the 110 Hz split's step: 9.4 ms with -g F, 8.0 with I alone; measured in README). So
+ * (the 110 Hz split's step at 130 Hz: 9.4 ms with -g F, 8.0 with g I alone, 7.8 with
+ * g (I + Kr R); 6.6 at the 145 Hz it allowed; measured in README). So
  * the channel's input in sense.mode 1 is that readout (rate_raw its real part, quad_raw
  * its imaginary part), and its scale
  * (rate.scale_dps), compensation and output filter apply as in open loop. The force
@@ -105,7 +106,7 @@ typedef struct {
   float i_re, i_im;     /* the integral term Ki int R, V^2 */
   float f_re, f_im;     /* the force command in the frame of R, V^2 (after the limit) */
   float m2_v4;          /* |F|^2 before the limit */
-  float out_re, out_im; /* -g F: the rate channel's input (rate_raw, quad_raw) */
+  float out_re, out_im; /* g (I + Kr R): the rate channel's input (rate_raw, quad_raw) */
   uint32_t in_band;     /* consecutive updates with |R| <= settle */
   uint8_t settled;
   uint8_t at_limit;
