@@ -730,19 +730,26 @@ static void tune_done(selfcal_t *s, selfcal_tune_state_t st, const char *why)
   drive_begin(s);
 }
 
-/* S2's result: the free frequency of each decay (its rotation against the NCO, as
- * on_ringdown), then ke = (wd0^2 - wd1^2) / Vt^2. */
-static void on_tune(selfcal_t *s, const selfcal_result_t *r)
+/* The free frequency of a sense ring-down of S2 or S4 (its rotation against the NCO, as
+ * on_ringdown), or -1 when the decay is too small or too short to show it. */
+static double ring_free_hz(const selfcal_t *s, const selfcal_result_t *r)
 {
   const double fs = s->cfg.fs_hz;
   const double amp0 = sqrt((double)(r->rd_amp2_0_v2 > 0.0f ? r->rd_amp2_0_v2 : 0.0f));
-  if (amp0 < SC_MIN_PEAK_V || r->rd_ticks < SC_TUNE_MIN_RING_TICKS) {
+  if (amp0 < SC_MIN_PEAK_V || r->rd_ticks < SC_TUNE_MIN_RING_TICKS) return -1.0;
+  const double t_ring = (double)r->rd_ticks / fs;
+  return nco_freq_of(s->x->job.half_step[0], fs) +
+         (double)r->rd_phase_rad / (2.0 * FM_PI * t_ring);
+}
+
+/* S2's result: the free frequency of each decay, then ke = (wd0^2 - wd1^2) / Vt^2. */
+static void on_tune(selfcal_t *s, const selfcal_result_t *r)
+{
+  const double fd = ring_free_hz(s, r);
+  if (!(fd > 0.0)) {
     tune_done(s, SELFCAL_TUNE_FAILED, "the sense ring-down too small or short to show a shift");
     return;
   }
-  const double t_ring = (double)r->rd_ticks / fs;
-  const double fd = nco_freq_of(s->x->job.half_step[0], fs) +
-                    (double)r->rd_phase_rad / (2.0 * FM_PI * t_ring);
   if (s->tune_pass == 0u) {
     s->sense.tune_fd0_hz = fd;
     s->tune_pass = 1u;
@@ -937,19 +944,15 @@ static void post_match_first(selfcal_t *s)
   post_match(s, sense_tune_volts(m->tune_fd0_hz, m->match_target_hz, m->match_ke));
 }
 
-/* S4's ring-down: its free frequency (as on_tune's), then done or the next voltage. */
+/* S4's ring-down: its free frequency, then done or the next voltage. */
 static void on_match(selfcal_t *s, const selfcal_result_t *r)
 {
   selfcal_sense_t *m = &s->sense;
-  const double fs = s->cfg.fs_hz;
-  const double amp0 = sqrt((double)(r->rd_amp2_0_v2 > 0.0f ? r->rd_amp2_0_v2 : 0.0f));
-  if (amp0 < SC_MIN_PEAK_V || r->rd_ticks < SC_TUNE_MIN_RING_TICKS) {
+  m->match_fd_hz = ring_free_hz(s, r);
+  if (!(m->match_fd_hz > 0.0)) {
     match_done(s, SELFCAL_TUNE_FAILED, "the tuned sense ring-down too small or short");
     return;
   }
-  const double t_ring = (double)r->rd_ticks / fs;
-  m->match_fd_hz = nco_freq_of(s->x->job.half_step[0], fs) +
-                   (double)r->rd_phase_rad / (2.0 * FM_PI * t_ring);
   const double w0 = 2.0 * FM_PI * m->tune_fd0_hz, w1 = 2.0 * FM_PI * m->match_fd_hz;
   const double v = m->match_v;
   /* one code's move of the resonance: d(ws^2) = -2 ke Vt dVt, so df = ke Vt dVt / (4 pi^2 f) */
