@@ -22,8 +22,11 @@ less 10 % or the issue's 100 Hz, or above the output filter's own cut-off; if th
 delay is not the design's within 10 %; or if the DC gain is off by more than 2 % (the
 model-made scale's accuracy, test_cl_sense_fr.c).
 
-Arguments after the gyro-sim path (and --fr) go to every gyro-sim run (for instance
---set firmware.selftest.continuous=1)."""
+--fr-matched: the same part with tuning electrodes (2.4e5 (1/s^2)/V^2) matched to its
+drive (sense.tune 1, its calibration as a sweep stages it), the model at the resonance
+the tuning voltage's DAC code gives; judged as --fr.
+Arguments after the gyro-sim path (and --fr or --fr-matched) go to every gyro-sim run
+(for instance --set firmware.selftest.continuous=1)."""
 import json
 import os
 import subprocess
@@ -75,27 +78,56 @@ def plant_defaults(exe):
     return vals
 
 
-def fr_args(exe):
+def fr_args(exe, f_model_hz=FR_F_SENSE_HZ, q_model=FR_Q_SENSE, plant=None, firmware=None):
     """gyro-sim --set arguments of the force-rebalance part: the plant keys, and the
     default part's calibration moved by the sense mode's static response at the drive
-    frequency, g from the electrode (test_cl_sense_fr.c start())."""
+    frequency, g from the electrode (test_cl_sense_fr.c start()); the model's mode at
+    f_model_hz of quality q_model (the plant's own unless tuned); plant and firmware: more
+    keys (name -> value)."""
     pdef = plant_defaults(exe)
     cal = {p["name"]: p["value"] for p in json.load(open(PART))["params"]}
     wc = 2 * np.pi * cal["drive.freq_hz"]
     m0, a0 = mode_response(pdef["f_sense_hz"], pdef["q_sense"], wc)
-    m1, a1 = mode_response(FR_F_SENSE_HZ, FR_Q_SENSE, wc)
+    m1, a1 = mode_response(f_model_hz, q_model, wc)
     scale = cal["rate.scale_dps"] * m0 / m1
     k_dps_per_v2 = FR_KS_FB / (2 * pdef["drive_amp_m"] * wc) * 180 / np.pi
     fw = {"rate.demod_phase_deg": cal["rate.demod_phase_deg"] + np.degrees(a1 - a0),
           "rate.scale_dps": scale,
           "sense.fb_gain_v_per_v2": k_dps_per_v2 / scale * cal["drive.amp_set_v"],
-          "sense.f0_hz": FR_F_SENSE_HZ, "sense.q": FR_Q_SENSE, "sense.mode": 1}
+          "sense.f0_hz": f_model_hz, "sense.q": q_model, "sense.mode": 1, **(firmware or {})}
     args = []
-    for k, v in FR_PLANT.items():
+    for k, v in {**FR_PLANT, **(plant or {})}.items():
         args += ["--set", f"plant.{k}={v:.9g}"]
     for k, v in fw.items():
         args += ["--set", f"firmware.{k}={v:.9g}"]
     return args
+
+
+# Mode tuning (sense.tune 1, firmware/gyro/sense_tune.h) of the same part: tuning
+# electrodes of test_cl_sense_tune.c's 2.4e5 (1/s^2)/V^2, their calibration as the sweep
+# stages it, the model at the resonance the DAC's code puts the mode at.
+TUNE_KE = 2.4e5
+DAC_V_PER_CODE = 30.0 / 16384  # board.h: 14 bits over +-15 V
+
+
+def fr_matched_args(exe):
+    """The force-rebalance part tuned to its drive: the tuning calibration at the drive
+    frequency of the default part's calibration, both resonances at the run's structure
+    temperature by the same factor (2-32: the calibration's drive frequency over the
+    plant's); the model's f0 and Q at the resonance the tuning voltage's code gives
+    (the damping stays, so Q goes as f0)."""
+    pdef = plant_defaults(exe)
+    cal = {p["name"]: p["value"] for p in json.load(open(PART))["params"]}
+    f_ref = cal["drive.freq_hz"]
+    s0 = FR_F_SENSE_HZ * f_ref / pdef["f_drive_hz"]
+    w0, wt = 2 * np.pi * s0, 2 * np.pi * f_ref
+    v = np.sqrt((w0 * w0 - wt * wt) / TUNE_KE)
+    vq = np.round(v / DAC_V_PER_CODE) * DAC_V_PER_CODE
+    f_t = np.sqrt(w0 * w0 - TUNE_KE * vq * vq) / (2 * np.pi)
+    return fr_args(exe, f_t, FR_Q_SENSE * f_t / s0, plant={"tune_ke_per_s2_per_v2": TUNE_KE},
+                   firmware={"sense.tune": 1, "sense.cal_s0_hz": s0,
+                             "sense.cal_tune_ref_hz": f_ref,
+                             "sense.cal_tune_ke_per_s2_per_v2": TUNE_KE, "cal.ref_tune_v": v})
 
 
 def fw_value(exe, extra, name):
@@ -206,11 +238,12 @@ def band(rows):
 
 def main():
     exe = sys.argv[1]
-    force_rebalance = len(sys.argv) > 2 and sys.argv[2] == "--fr"
+    mode = sys.argv[2] if len(sys.argv) > 2 and sys.argv[2] in ("--fr", "--fr-matched") else ""
+    force_rebalance = mode != ""
     extra = sys.argv[3 if force_rebalance else 2:]
     with tempfile.TemporaryDirectory() as d:
         if force_rebalance:
-            extra = fr_args(exe) + extra
+            extra = (fr_matched_args(exe) if mode == "--fr-matched" else fr_args(exe)) + extra
             freqs = [2.0, 5.0, 50.0, 100.0, 200.0, 300.0, 400.0, 500.0, 700.0]
         else:
             freqs = [2.0, 5.0, 20.0, 50.0, 80.0, 100.0, 120.0, 150.0]
