@@ -32,10 +32,10 @@
 #define STEP_DPS 100.0
 #define BLOCK_S SENSE_STEP_BLOCK_S
 
-static plant_cfg_t part(double f_sense_hz)
+static plant_cfg_t part(double f_sense_hz, double q_sense)
 {
   plant_cfg_t pc;
-  sense_test_part(&pc, 1.0e4);
+  sense_test_part(&pc, q_sense);
   pc.f_sense_hz = f_sense_hz;
   pc.tune_ke_per_s2_per_v2 = TUNE_KE;
   return pc;
@@ -234,7 +234,7 @@ static void check_running(const plant_cfg_t *pc, double split_hz)
 static void test_matched(void **state)
 {
   (void)state;
-  const plant_cfg_t pc = part(SENSE_TEST_F_HZ);
+  const plant_cfg_t pc = part(SENSE_TEST_F_HZ, 1.0e4);
   param_values_t v;
   part_values(&pc, SENSE_TUNE_MATCHED, 0.0, &v);
   start(&pc, &v);
@@ -245,12 +245,25 @@ static void test_matched(void **state)
 static void test_split_20(void **state)
 {
   (void)state;
-  const plant_cfg_t pc = part(SENSE_TEST_F_HZ);
+  const plant_cfg_t pc = part(SENSE_TEST_F_HZ, 1.0e4);
   param_values_t v;
   part_values(&pc, SENSE_TUNE_SPLIT, 20.0, &v);
   start(&pc, &v);
   check_tuned(&pc, 20.0);
   check_running(&pc, 20.0);
+}
+
+/* Another part: its sense mode at 1650 Hz (a 160 Hz split, 9.1 V to match) of Q 300,
+ * matched. */
+static void test_other_part_matched(void **state)
+{
+  (void)state;
+  const plant_cfg_t pc = part(1650.0, 300.0);
+  param_values_t v;
+  part_values(&pc, SENSE_TUNE_MATCHED, 0.0, &v);
+  start(&pc, &v);
+  check_tuned(&pc, 0.0);
+  check_running(&pc, 0.0);
 }
 
 /* A sense mode below the drive's (1450 Hz against 1490): tuning only lowers it, so S4
@@ -260,7 +273,7 @@ static void test_split_20(void **state)
 static void test_sense_below_drive(void **state)
 {
   (void)state;
-  const plant_cfg_t pc = part(1450.0);
+  const plant_cfg_t pc = part(1450.0, 1.0e4);
   param_values_t v;
   part_values(&pc, SENSE_TUNE_MATCHED, 0.0, &v);
   start(&pc, &v);
@@ -294,6 +307,7 @@ int main(void)
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_matched),
       cmocka_unit_test(test_split_20),
+      cmocka_unit_test(test_other_part_matched),
       cmocka_unit_test(test_sense_below_drive),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
