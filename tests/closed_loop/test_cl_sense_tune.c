@@ -2,7 +2,9 @@
  * firmware, the command line and the host plant: the sweep tunes the sense resonance to
  * the drive's (matched) or to a chosen split, the force-rebalance model is measured on
  * the tuned mode, the application applies the voltage once LOCKED, and the rate is not
- * valid (TUNE) while it is not applied or the target is out of reach.
+ * valid (TUNE) while it is not applied or the target is out of reach. From power-on with
+ * the matched part's calibration stored, LOCKED, tuned and the rate valid (with nulling
+ * electrodes, the quadrature within 1 deg/s) within 1 s.
  *
  * The part: test_cl_sense_id.c's (sense mode at 1600 Hz, a 110 Hz split above the drive,
  * Q 1e4, the half-frequency feedback pair, the noise off) with tuning electrodes of
@@ -231,6 +233,97 @@ static void check_running(const plant_cfg_t *pc, double split_hz)
   assert_int_equal(app.gyro.sup.fault_count, 0u);
 }
 
+/* Power-on of a tuned part whose calibration is stored: a fresh plant pc and the
+ * application on the values `stored` (what the sweep staged and the calibration flow
+ * set) with autostart on and quad.null `quad_null`, run for t_end_s with the background
+ * polled every millisecond, at rest. Each time is the first millisecond from which the
+ * state held to the end (-1: not held at the end): LOCKED, the tuning's voltage applied
+ * (TUNE clear), the part's true quadrature within 1 deg/s, the rate valid. */
+typedef struct {
+  double locked_s, tuned_s, quad_s, valid_s;
+  double valid_err_dps; /* the largest |rate| of a valid millisecond (at rest) */
+  double quad_end_dps;  /* the true quadrature at the end */
+  double df_end_hz;     /* the plant's sense resonance less the drive's at the end */
+} power_on_t;
+
+static void held_from(double *t_from, int now, double t)
+{
+  if (!now) {
+    *t_from = -1.0;
+  } else if (*t_from < 0.0) {
+    *t_from = t;
+  }
+}
+
+static power_on_t power_on(const plant_cfg_t *pc, const param_values_t *stored,
+                           uint32_t quad_null, double t_end_s)
+{
+  param_values_t v = *stored;
+  v.sys_autostart = 1u;
+  v.quad_null = quad_null;
+  start(pc, &v);
+  power_on_t r = {-1.0, -1.0, -1.0, -1.0, 0.0, 0.0, 0.0};
+  const long n = (long)(t_end_s * 1000.0 + 0.5);
+  for (long i = 1; i <= n; i++) {
+    hal_host_run(50u);
+    app_poll(&app);
+    const double t = (double)i * 1e-3;
+    const gyro_out_t *o = &app.gyro.out;
+    held_from(&r.locked_s, app.gyro.sup.mode == GYRO_MODE_LOCKED, t);
+    held_from(&r.tuned_s, app.gyro.tune_bits == 0u, t);
+    held_from(&r.quad_s, fabs(plant_truth(&plant)->quad_true_dps) <= 1.0, t);
+    held_from(&r.valid_s, o->rate_valid != 0u, t);
+    if (o->rate_valid != 0u) r.valid_err_dps = fmax(r.valid_err_dps, fabs((double)o->rate_dps));
+  }
+  r.quad_end_dps = plant_truth(&plant)->quad_true_dps;
+  r.df_end_hz = true_tuned_f(pc) - true_f0(pc);
+  return r;
+}
+
+/* The matched part's power-on with its calibration stored (issue 19: LOCKED and the rate
+ * valid with the quadrature within 1 deg/s within 1 s of power-on): the part as swept,
+ * its 1500 deg/s quadrature rebalanced by the force (quad.null 0), and the same part with
+ * quadrature-nulling electrodes of 20 (deg/s)/V^2 (test_cl_quadnull.c's; at 0 V they
+ * change nothing the calibration saw, and their noise is off as the part's other
+ * electrodes' is) nulling it (quad.null 1). */
+static void check_power_on(const plant_cfg_t *pc)
+{
+  const param_values_t stored = *params_current(&app.params);
+  const power_on_t fr = power_on(pc, &stored, 0u, 2.0);
+  printf("# power-on, quad.null 0: LOCKED from %.3f s, tuned from %.3f s (the sense "
+         "resonance %+.4f Hz from the drive's at 2 s), rate valid from %.3f s (valid at most "
+         "%.3f deg/s off), quadrature %.1f deg/s (rebalanced), faults %u\n",
+         fr.locked_s, fr.tuned_s, fr.df_end_hz, fr.valid_s, fr.valid_err_dps, fr.quad_end_dps,
+         (unsigned)app.gyro.sup.fault_count);
+  assert_int_equal(app.gyro.sup.fault_count, 0u);
+  assert_true(fr.locked_s >= 0.0 && fr.locked_s <= 1.0);
+  assert_true(fr.tuned_s >= 0.0 && fr.tuned_s <= 1.0);
+  assert_true(fr.valid_s >= 0.0 && fr.valid_s <= 1.0);
+  assert_true(fr.valid_err_dps <= 1.0);
+  assert_true(fabs(fr.df_end_hz) <= 0.5 * pc->f_sense_hz / (2.0 * pc->q_sense));
+  plant_cfg_t pn = *pc;
+  pn.quadnull_dps_per_v2 = 20.0;
+  pn.quadnull_noise_white_v_rthz = pn.quadnull_noise_1hz_v_rthz = 0.0;
+  const power_on_t qn = power_on(&pn, &stored, 1u, 2.0);
+  printf("# power-on, quad.null 1: LOCKED from %.3f s, tuned from %.3f s, quadrature within "
+         "1 deg/s from %.3f s (%.3f deg/s at 2 s), rate valid from %.3f s (valid at most %.3f "
+         "deg/s off), faults %u\n",
+         qn.locked_s, qn.tuned_s, qn.quad_s, qn.quad_end_dps, qn.valid_s, qn.valid_err_dps,
+         (unsigned)app.gyro.sup.fault_count);
+  assert_int_equal(app.gyro.sup.fault_count, 0u);
+  assert_true(qn.locked_s >= 0.0 && qn.locked_s <= 1.0);
+  assert_true(qn.tuned_s >= 0.0 && qn.tuned_s <= 1.0);
+  assert_true(qn.quad_s >= 0.0 && qn.quad_s <= 1.0);
+  assert_true(qn.valid_s >= 0.0 && qn.valid_s <= 1.0);
+  assert_true(qn.valid_err_dps <= 1.0);
+  /* and it reads a rate: 100 deg/s held */
+  double r100 = 0.0, q100 = 0.0;
+  held_mean(STEP_DPS, &r100, &q100);
+  printf("# then 100 deg/s held: %.3f deg/s, valid %u\n", r100,
+         (unsigned)app.gyro.out.rate_valid);
+  assert_true(fabs(r100 - STEP_DPS) <= 1.0 && app.gyro.out.rate_valid != 0u);
+}
+
 static void test_matched(void **state)
 {
   (void)state;
@@ -240,6 +333,7 @@ static void test_matched(void **state)
   start(&pc, &v);
   check_tuned(&pc, 0.0);
   check_running(&pc, 0.0);
+  check_power_on(&pc);
 }
 
 static void test_split_20(void **state)
