@@ -12,6 +12,13 @@ and 1/f on each electrode). The record: zero rate (or a constant one), then +100
 each, which give the scale factor that refers the output to the input (as the
 brownian_only scenario does).
 
+The matched part (--matched): the same part with tuning electrodes tuned onto the drive
+(sense.tune 1, frpart.matched_values: the tuning calibration a sweep stages, the model at
+the resonance the tuning's code gives), then the calibration flow's rate-table stage run
+on each case as tests/closed_loop/test_cl_sense_tune.c runs it, twice (rate_table: at a
+matched resonance the mode's phase at the drive frequency moves steeply with a small
+error of the model, and the readout's frame with it).
+
 Sampling: the loop's output band is 500 Hz (sense.fr_lpf_hz, a 2nd-order Butterworth);
 a point sample of it every 5 ms (brownian_only's 200 Hz CSV) folds the band between 100
 and 500 Hz onto the low frequencies and more than doubles the Allan deviation at short
@@ -32,12 +39,17 @@ import threading
 
 import numpy as np
 
-from . import frpart
+from . import demodcal, frpart
 
 CSV_RATE_HZ = 2000.0
 AVG_RATE_HZ = 100.0
 STEP_S = 10.0  # each of the scale factor's steps
 EDGE_S = 0.1
+# the rate table's run: at rest (the loop settles), then +100 and -100 deg/s; each mean
+# after RT_SETTLE_S of its step
+RT_STEPS = [[1.0, 0.0], [0.6, 100.0], [0.6, -100.0]]
+RT_SETTLE_S = 0.3
+RT_CSV_HZ = 1000.0
 KB_J_PER_K = 1.380649e-23
 
 # brownian_only.json's plant settings: the ideal preset, every electronic noise off
@@ -193,17 +205,65 @@ def analyse(t, rate, true, run, duration_s, settle_s):
             "tau_s": tau.tolist(), "adev_dph": ad.tolist()}
 
 
-def case_args(exe, cal_path, scheme, study, ft_on, q_sense, extra):
-    """gyro-sim --set arguments of a case (frpart.fr_args on the ideal preset, then the
-    case's plant settings, then extra)."""
+def case_args(exe, cal_path, scheme, study, ft_on, q_sense, extra, matched=False):
+    """gyro-sim --set arguments of a case (frpart.fr_args on the ideal preset, matched or
+    not, then the case's plant settings, then extra)."""
     defaults = frpart.plant_values(exe)
     plant = case_plant(study, ft_on, defaults)
     plant.pop("preset")
     args = frpart.fr_args(exe, cal_path, scheme, q_sense=q_sense, plant=plant,
-                          base=["plant.preset=ideal"])
+                          base=["plant.preset=ideal"], matched=matched)
     for s in extra:
         args += ["--set", s]
     return args
+
+
+def wrap_deg(x):
+    return (x + 180.0) % 360.0 - 180.0
+
+
+def rate_table(exe, args, cal_path, seed, passes=2, log=print):
+    """The calibration flow's rate-table stage (calflow.py rate_table, demodcal.py) on a
+    case, as tests/closed_loop/test_cl_sense_tune.c's flow_rate_table: from power-on at
+    rest, +100 and -100 deg/s (RT_STEPS); the response's angle alpha turns
+    rate.demod_phase_deg and sense.fb_phase_deg (the readout's frame), its length the
+    scale. passes times, each on the last one's values. Returns the --set arguments that
+    carry the result (to follow args) and each pass's figures."""
+    extra, passes_out = [], []
+    duration = sum(d for d, _ in RT_STEPS)
+    for _ in range(passes):
+        with tempfile.TemporaryDirectory() as tmp:
+            scen = {"name": "fr_rate_table", "duration_s": duration, "seed": seed,
+                    "mode": "closed_loop", "firmware_params": os.path.abspath(cal_path),
+                    "csv_rate_hz": RT_CSV_HZ,
+                    "rate_dps": {"kind": "steps", "edge_s": 0.0, "steps": RT_STEPS}}
+            sc_path, csv = os.path.join(tmp, "rt.json"), os.path.join(tmp, "rt.csv")
+            saved = os.path.join(tmp, "values.json")
+            with open(sc_path, "w", encoding="utf-8") as f:
+                json.dump(scen, f)
+            cmd = [exe, "--scenario", sc_path, "--csv", csv, "--no-analysis", "--quiet",
+                   "--save-params", saved] + list(args) + extra
+            log("# " + shlex.join(cmd))
+            r = subprocess.run(cmd, capture_output=True, text=True)
+            if r.returncode != 0:
+                raise RuntimeError(f"gyro-sim failed ({r.returncode}): {r.stderr.strip()}")
+            import pandas as pd
+            log_ = pd.read_csv(csv, usecols=["t_s", "rate_true_dps", "rate_dps", "quad_dps"])
+            with open(saved, encoding="utf-8") as f:
+                values = {e["name"]: e["value"] for e in json.load(f)["params"]}
+        res = demodcal.analyse(log_["t_s"], log_["rate_dps"], log_["quad_dps"],
+                               values["rate.demod_phase_deg"], values["rate.scale_dps"],
+                               rate_true_dps=log_["rate_true_dps"], settle_s=RT_SETTLE_S,
+                               min_avg_s=0.2)
+        fb = wrap_deg(values["sense.fb_phase_deg"] + res.alpha_deg)
+        extra = ["--set", f"firmware.rate.demod_phase_deg={res.phase_deg:.9g}",
+                 "--set", f"firmware.rate.scale_dps={res.scale_dps:.9g}",
+                 "--set", f"firmware.sense.fb_phase_deg={fb:.9g}"]
+        passes_out.append({"alpha_deg": res.alpha_deg, "gain": res.gain,
+                           "rate.demod_phase_deg": res.phase_deg,
+                           "rate.scale_dps": res.scale_dps, "sense.fb_phase_deg": fb})
+        log(f"# rate table: alpha {res.alpha_deg:+.3f} deg, gain {res.gain:.4f}")
+    return extra, passes_out
 
 
 def plot(cases, out_dir, title):

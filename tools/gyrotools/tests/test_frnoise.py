@@ -61,3 +61,34 @@ def test_model_at_the_softened_resonance():
     m0, _ = frpart.mode_response(2000.0, 3.0, wc)
     m1, _ = frpart.mode_response(1600.0, 1e4, wc)
     assert fw["rate.scale_dps"] == pytest.approx(100.0 * m0 / m1, rel=1e-6)
+
+
+def test_matched_part_staged_on_the_drive():
+    """--matched: the tuning calibration a sweep stages puts the sense resonance on the
+    calibration's drive frequency within half of one DAC code's move; the voltage is a
+    code's; the model's mode is that tuned resonance, its Q lowered with it (the damping
+    stays)."""
+    p = {"f_sense_hz": 1600.0, "q_sense": 1e4, "fb_mode": 3, "f_drive_hz": 1490.0,
+         "tune_ke_per_s2_per_v2": frpart.TUNE_KE, "ks_fb_mps2_per_v2": 0.1,
+         "drive_amp_m": 1e-5, "pick_sense_gain_v_per_m": 6.18e7}
+    cal = {"drive.freq_hz": 1489.8561, "rate.scale_dps": 100.0, "rate.demod_phase_deg": 60.0,
+           "drive.amp_set_v": 0.35}
+    staged, f_t, q_t = frpart.matched_values(cal, p)
+    s0 = 1600.0 * 1489.8561 / 1490.0
+    assert staged["sense.tune"] == 1
+    assert staged["sense.cal_s0_hz"] == pytest.approx(s0)
+    assert staged["sense.cal_tune_ref_hz"] == 1489.8561
+    assert staged["sense.cal_tune_ke_per_s2_per_v2"] == frpart.TUNE_KE
+    v = staged["cal.ref_tune_v"]
+    assert 7.0 < v < 8.0 and v / frpart.DAC_V_PER_CODE == pytest.approx(
+        round(v / frpart.DAC_V_PER_CODE), abs=1e-9)
+    # one code's move of the resonance: d f = ke v dv / (4 pi^2 f)
+    code_hz = frpart.TUNE_KE * v * frpart.DAC_V_PER_CODE / (4 * math.pi ** 2 * f_t)
+    assert abs(f_t - 1489.8561) <= 0.5 * code_hz + 1e-9
+    assert q_t == pytest.approx(1e4 * f_t / s0)
+    fw = frpart.model_values(cal, {**p, "q_sense": 3.0}, p, f_t, q_t)
+    assert fw["sense.f0_hz"] == f_t and fw["sense.q"] == q_t
+    with pytest.raises(ValueError):
+        frpart.matched_values(cal, {**p, "f_sense_hz": 1450.0})
+    with pytest.raises(ValueError):
+        frpart.matched_values(cal, {**p, "tune_ke_per_s2_per_v2": 0.0})
