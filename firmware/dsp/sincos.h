@@ -38,7 +38,7 @@ extern const float sincos_table[SINCOS_TABLE_SIZE + 1u];
 #define SINCOS_QUARTER_TURN 0x40000000u
 
 /* sin and cos of a phase (2^32 = 2*pi). Both pointers must be valid. Inline: it runs
- * twice per tick (NCO and drive synthesis) and a call costs a third of its body. */
+ * once per tick (the NCO, whose unit phasors every synthesis turns) and once per command, and a call costs a third of its body. */
 static inline void sincos_lut(uint32_t phase, float *sin_out, float *cos_out)
 {
   const uint32_t is = phase >> SINCOS_FRAC_BITS;

@@ -26,7 +26,7 @@ int drive_synth_init(drive_synth_t *ds, const drive_synth_cfg_t *cfg)
   ds->dc_bias_v = cfg->dc_bias_v;
   ds->u_max_v = cfg->u_max_v;
   ds->inv_4d = (cfg->scheme == GYRO_DRIVE_DC_AC) ? 0.25f / cfg->dc_bias_v : 0.0f;
-  ds->a_v = ds->b_v = 0.0f;
+  ds->re_v = ds->im_v = 0.0f;
   ds->off = 0u;
   ds->f_set_v2 = ds->p_set_rad = NAN;
   ds->p_turn_rad = 0.0f;
@@ -77,11 +77,21 @@ GYRO_RAMFUNC static inline float synth_turns_off(drive_synth_t *ds, float p_rad)
   return p_rad;
 }
 
+/* The amplitude phasor a + j b turned by the phase offset off: the waveform's phasor
+ * (drive_synth_step), one table lookup per command instead of one per sample. */
+GYRO_RAMFUNC static inline void synth_turn(drive_synth_t *ds, uint32_t off, float a_v, float b_v)
+{
+  float s, c;
+  sincos_lut(off, &s, &c);
+  ds->off = off;
+  ds->re_v = a_v * c - b_v * s;
+  ds->im_v = a_v * s + b_v * c;
+}
+
 GYRO_RAMFUNC void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad)
 {
   ds->f_set_v2 = f_cmd_v2;
   ds->p_set_rad = p_rad;
-  ds->b_v = 0.0f;
   p_rad = synth_turns_off(ds, p_rad);
   /* A positive finite force, else none: 0 < f < infinity as one unsigned compare of the
    * bit pattern (the positive finite floats are the patterns 1 .. that of infinity less
@@ -92,13 +102,12 @@ GYRO_RAMFUNC void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad
   f_bits &= 0u - (uint32_t)(f_bits - 1u < SYNTH_INF_BITS - 1u);
   float f;
   memcpy(&f, &f_bits, sizeof f);
+  const uint32_t half = sincos_half_rad_to_phase(p_rad);
   if (ds->scheme == GYRO_DRIVE_DC_AC) {
     /* Force phase P = twice the half-angle phase: exact modulo 2^32. */
-    ds->off = 2u * sincos_half_rad_to_phase(p_rad);
-    ds->a_v = f * ds->inv_4d;
+    synth_turn(ds, 2u * half, f * ds->inv_4d, 0.0f);
   } else {
-    ds->off = sincos_half_rad_to_phase(p_rad);
-    ds->a_v = fm_sqrtf(f);
+    synth_turn(ds, half, fm_sqrtf(f), 0.0f);
   }
 }
 
@@ -118,7 +127,7 @@ GYRO_RAMFUNC static inline float half_nonneg(float x)
  * Im F / (2 x larger), since the root of the difference of two near-equal numbers
  * (|F| - |Re F| with Im F small) would keep none of its digits; the larger part is at
  * least sqrt(|F| / 2), so the divide is safe except at F = 0. Two square roots and a
- * divide, no arc tangent. Where arg F crosses pi the root changes sign, and with it both
+ * divide (drive_synth_phasor_parts), no arc tangent. Where arg F crosses pi the root changes sign, and with it both
  * voltages, which leaves U1^2 - U2^2, the force, unchanged (as a turn of P does). DC+AC:
  * the AC amplitude phasor F / (4 D) (6-21), no root. A non-finite F drives nothing. */
 GYRO_RAMFUNC void drive_synth_phasor_mag(drive_synth_phasor_t *ph, float f_re_v2, float f_im_v2)
@@ -135,25 +144,29 @@ GYRO_RAMFUNC void drive_synth_phasor_root(const drive_synth_t *ds, drive_synth_p
   ph->root_v = fm_sqrtf(half_nonneg(ph->mag_v2 + fm_absf(ph->f_re_v2)));
 }
 
+GYRO_RAMFUNC void drive_synth_phasor_parts(const drive_synth_t *ds, drive_synth_phasor_t *ph)
+{
+  const float f_re = ph->f_re_v2, f_im = ph->f_im_v2;
+  if (ds->scheme == GYRO_DRIVE_DC_AC) {
+    ph->a_v = f_re * ds->inv_4d;
+    ph->b_v = f_im * ds->inv_4d;
+    return;
+  }
+  const float t = ph->root_v;
+  if (f_re >= 0.0f) {
+    ph->a_v = t;
+    ph->b_v = t > 0.0f ? f_im / (2.0f * t) : 0.0f;
+  } else { /* t > 0: |Re F| > 0 */
+    ph->a_v = fm_absf(f_im) / (2.0f * t);
+    ph->b_v = f_im < 0.0f ? -t : t;
+  }
+}
+
 GYRO_RAMFUNC void drive_synth_set_phasor(drive_synth_t *ds, const drive_synth_phasor_t *ph,
                                          float frame_rad)
 {
   ds->f_set_v2 = ds->p_set_rad = NAN; /* not a (f_cmd, P) command: _follow sets again */
-  const float p_rad = synth_turns_off(ds, frame_rad);
-  const float f_re = ph->f_re_v2, f_im = ph->f_im_v2;
-  if (ds->scheme == GYRO_DRIVE_DC_AC) {
-    ds->off = 2u * sincos_half_rad_to_phase(p_rad);
-    ds->a_v = f_re * ds->inv_4d;
-    ds->b_v = f_im * ds->inv_4d;
-    return;
-  }
-  ds->off = sincos_half_rad_to_phase(p_rad);
-  const float t = ph->root_v;
-  if (f_re >= 0.0f) {
-    ds->a_v = t;
-    ds->b_v = t > 0.0f ? f_im / (2.0f * t) : 0.0f;
-  } else { /* t > 0: |Re F| > 0 */
-    ds->a_v = fm_absf(f_im) / (2.0f * t);
-    ds->b_v = f_im < 0.0f ? -t : t;
-  }
+  const uint32_t half = sincos_half_rad_to_phase(synth_turns_off(ds, frame_rad));
+  /* DC+AC: the frame's phase is twice the half-angle phase, exact modulo 2^32. */
+  synth_turn(ds, ds->scheme == GYRO_DRIVE_DC_AC ? 2u * half : half, ph->a_v, ph->b_v);
 }

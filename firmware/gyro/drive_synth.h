@@ -14,9 +14,10 @@
  * voltage phase stays continuous across the main accumulator's wrap.
  *
  * The command changes at the drive loops' rate (fs / GYRO_BLOCK), the waveform every
- * sample: drive_synth_set() turns (f_cmd, P) into an amplitude and a phase offset (the
- * square root and the radian-to-phase conversion, once per command), and
- * drive_synth_step() is one table lookup and two multiplies per sample.
+ * sample: drive_synth_set() turns (f_cmd, P) into an amplitude phasor, A turned by the
+ * phase offset (the square root, the radian-to-phase conversion and one table lookup,
+ * once per command), and drive_synth_step() turns the NCO's unit phasor by it: four
+ * multiplies per sample, no table lookup (the NCO's one lookup serves every synthesis).
  */
 #ifndef DRIVE_SYNTH_H
 #define DRIVE_SYNTH_H
@@ -24,6 +25,7 @@
 #include <math.h> /* NAN (a constant, no call) */
 #include <stdint.h>
 
+#include "dsp/nco.h"
 #include "dsp/sincos.h"
 
 typedef enum {
@@ -40,10 +42,11 @@ typedef struct {
   float dc_bias_v; /* D */
   float u_max_v;   /* largest voltage magnitude on either electrode */
   float inv_4d;    /* 1 / (4 D) */
-  /* The current command (drive_synth_set): */
-  float a_v;    /* A, the voltage amplitude (a phasor command: its real part) */
-  float b_v;    /* a phasor command's imaginary part (drive_synth_set_phasor), else 0 */
-  uint32_t off; /* phase offset added to the NCO phase: P/2 (half-freq) or P (DC+AC) */
+  /* The current command: its amplitude phasor (A, or a + j b of drive_synth_set_phasor)
+   * turned by its phase offset off, so that the waveform is
+   * (re + j im) e^(j theta) with theta the NCO's phase (DC+AC) or half phase: */
+  float re_v, im_v;
+  uint32_t off;              /* the phase offset: P/2 (half-freq) or P (DC+AC), 2^32 = 2 pi */
   float f_set_v2, p_set_rad; /* the command as last passed to drive_synth_set (NaN: none) */
   float p_turn_rad;          /* whole turns taken off P before the conversion (hysteresis) */
 } drive_synth_t;
@@ -70,17 +73,21 @@ void drive_synth_set(drive_synth_t *ds, float f_cmd_v2, float p_rad);
 /* A force command as a phasor (f_re + j f_im, Ks*V^2) in a frame turned by frame_rad
  * (the force |F| cos(phi + frame + arg F), |frame| as drive_synth_set's P), for a loop
  * that computes its force as a complex number (sense_fr.h), without the arc tangent of
- * arg F; in three steps, so that a sample interrupt can put them on three ticks, one
+ * arg F; in four steps, so that a sample interrupt can put them on four ticks, one
  * long operation each: |F| (drive_synth_phasor_mag: a square root), the root
- * (drive_synth_phasor_root: another), then the command (drive_synth_set_phasor: the
- * divide, the phase), whose waveform is drive_synth_step_phasor's. */
+ * (drive_synth_phasor_root: another), the voltage phasor a + j b in the frame
+ * (drive_synth_phasor_parts: the divide), then the command (drive_synth_set_phasor: the
+ * frame's phase and its turn of a + j b, a table lookup), whose waveform is
+ * drive_synth_step's. */
 typedef struct {
   float f_re_v2, f_im_v2; /* F (0 for a non-finite one) */
   float mag_v2;           /* |F| */
   float root_v;           /* the larger part of sqrt(F) in magnitude (half-frequency) */
+  float a_v, b_v;         /* the voltage phasor in the frame: sqrt(F), or F / (4 D) */
 } drive_synth_phasor_t;
 void drive_synth_phasor_mag(drive_synth_phasor_t *ph, float f_re_v2, float f_im_v2);
 void drive_synth_phasor_root(const drive_synth_t *ds, drive_synth_phasor_t *ph);
+void drive_synth_phasor_parts(const drive_synth_t *ds, drive_synth_phasor_t *ph);
 void drive_synth_set_phasor(drive_synth_t *ds, const drive_synth_phasor_t *ph, float frame_rad);
 
 /* No force from the next sample on (amplitude 0; in DC+AC the bias alone), without the
@@ -88,7 +95,7 @@ void drive_synth_set_phasor(drive_synth_t *ds, const drive_synth_phasor_t *ph, f
  * its budget. The next drive_synth_set or _follow sets a command again. */
 static inline void drive_synth_silence(drive_synth_t *ds)
 {
-  ds->a_v = ds->b_v = 0.0f;
+  ds->re_v = ds->im_v = 0.0f;
   ds->f_set_v2 = ds->p_set_rad = NAN;
 }
 
@@ -103,40 +110,20 @@ static inline void drive_synth_follow(drive_synth_t *ds, float f_cmd_v2, float p
   }
 }
 
-/* One sample of the electrode voltages for the current command. phase: NCO phase at wc
- * of this sample; half_phase: its half-rate companion. */
-static inline void drive_synth_step(const drive_synth_t *ds, uint32_t phase,
-                                    uint32_t half_phase, float *u1_v, float *u2_v)
+/* One sample of the electrode voltages for the current command (drive_synth_set or
+ * drive_synth_set_phasor), from the NCO's output at this sample: the command's phasor
+ * turns the unit phasor at the half phase (half-frequency: U1 + j U2 is the voltage
+ * phasor, (6-25)) or at the phase (DC+AC: its real part is the AC voltage, (6-20)). */
+static inline void drive_synth_step(const drive_synth_t *ds, const nco_out_t *ref, float *u1_v,
+                                    float *u2_v)
 {
-  float s, c;
   if (ds->scheme == GYRO_DRIVE_DC_AC) {
-    sincos_lut(phase + ds->off, &s, &c);
-    *u1_v = ds->dc_bias_v + ds->a_v * c;
-    *u2_v = ds->dc_bias_v - ds->a_v * c;
-  } else {
-    /* (6-25): the voltage phase is half the force phase. */
-    sincos_lut(half_phase + ds->off, &s, &c);
-    *u1_v = ds->a_v * c;
-    *u2_v = ds->a_v * s;
-  }
-}
-
-/* One sample of a phasor command's voltages (drive_synth_set_phasor; a drive_synth_set
- * command too, with b_v 0): the amplitude phasor a + j b turns the table's unit phasor,
- * two more multiplies than drive_synth_step. */
-static inline void drive_synth_step_phasor(const drive_synth_t *ds, uint32_t phase,
-                                           uint32_t half_phase, float *u1_v, float *u2_v)
-{
-  float s, c;
-  if (ds->scheme == GYRO_DRIVE_DC_AC) {
-    sincos_lut(phase + ds->off, &s, &c);
-    const float ac = ds->a_v * c - ds->b_v * s; /* Re((a + j b) e^(j (phi + off))) */
+    const float ac = ds->re_v * ref->cos_wc - ds->im_v * ref->sin_wc;
     *u1_v = ds->dc_bias_v + ac;
     *u2_v = ds->dc_bias_v - ac;
   } else {
-    sincos_lut(half_phase + ds->off, &s, &c);
-    *u1_v = ds->a_v * c - ds->b_v * s;
-    *u2_v = ds->a_v * s + ds->b_v * c;
+    *u1_v = ds->re_v * ref->cos_half - ds->im_v * ref->sin_half;
+    *u2_v = ds->re_v * ref->sin_half + ds->im_v * ref->cos_half;
   }
 }
 

@@ -269,7 +269,7 @@ GYRO_RAMFUNC static void gyro_tick_sweep_sense(gyro_t *g, const hal_adc_frame_t 
   lmsd_step(&g->lmsd_sense, (float)adc->sense * g->adc_v_per_code, ref.sin_wc, ref.cos_wc);
   count_rails(g, adc);
   float u3, u4;
-  drive_synth_step(&g->fb_synth, ref.phase, ref.half_phase, &u3, &u4);
+  drive_synth_step(&g->fb_synth, &ref, &u3, &u4);
   dac->code[HAL_DAC_DRIVE_U1] = (uint16_t)HAL_DAC_CODE_MID;
   dac->code[HAL_DAC_DRIVE_U2] = (uint16_t)HAL_DAC_CODE_MID;
   dac->code[HAL_DAC_SENSE_FB_U1] = gyro_volts_to_dac(u3 - g->fb_off_v);
@@ -297,7 +297,7 @@ GYRO_RAMFUNC static void gyro_tick_sweep(gyro_t *g, const hal_adc_frame_t *adc)
   lmsd_step(&g->lmsd_drive, (float)adc->drive * g->adc_v_per_code, ref.sin_wc, ref.cos_wc);
   count_rails(g, adc);
   float u1, u2;
-  drive_synth_step(&g->synth, ref.phase, ref.half_phase, &u1, &u2);
+  drive_synth_step(&g->synth, &ref, &u1, &u2);
   dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
   dac->code[HAL_DAC_DRIVE_U2] = gyro_volts_to_dac(u2);
   dac->code[HAL_DAC_SPARE] = (uint16_t)HAL_DAC_CODE_MID; /* = HAL_DAC_SENSE_FB_U1 */
@@ -340,7 +340,7 @@ GYRO_RAMFUNC void gyro_tick(gyro_t *g)
   if (GYRO_UNLIKELY(mode != GYRO_MODE_ACQUIRE && mode != GYRO_MODE_LOCKED)) {
     u1 = u2 = 0.0f; /* the drive off: no force */
   } else {
-    drive_synth_step(&g->synth, ref.phase, ref.half_phase, &u1, &u2);
+    drive_synth_step(&g->synth, &ref, &u1, &u2);
   }
   hal_dac_frame_t *dac = g->dac_frame;
   dac->code[HAL_DAC_DRIVE_U1] = gyro_volts_to_dac(u1);
@@ -350,7 +350,7 @@ GYRO_RAMFUNC void gyro_tick(gyro_t *g)
     /* Force rebalance: its force on the feedback pair (the first channel is the spare's),
      * the waveform of the command its loop last set (sense_fr.h). */
     float u3, u4;
-    drive_synth_step_phasor(&g->fb_synth, ref.phase, ref.half_phase, &u3, &u4);
+    drive_synth_step(&g->fb_synth, &ref, &u3, &u4);
     dac->code[HAL_DAC_SENSE_FB_U1] = gyro_volts_to_dac(u3 - g->fb_off_v);
     dac->code[HAL_DAC_SENSE_FB_U2] = gyro_volts_to_dac(u4 - g->fb_off_v);
   } else {

@@ -378,6 +378,12 @@ GYRO_RAMFUNC void gyro_fr_root(gyro_t *g)
   if (fr->run != 0u && fr->skip == 0u) drive_synth_phasor_root(&g->fb_synth, &g->fb_root);
 }
 
+GYRO_RAMFUNC void gyro_fr_parts(gyro_t *g)
+{
+  const sense_fr_t *fr = &g->fr;
+  if (fr->run != 0u && fr->skip == 0u) drive_synth_phasor_parts(&g->fb_synth, &g->fb_root);
+}
+
 /* The Coriolis force is in phase with the drive velocity, which at the drive's resonance
  * is in phase with the drive force cos(phi + P) (6-12), through the mode's lag 2Q/wn
  * (6-17): the feedback force's frame turns with LP_tau(P) as the rate channel forms it
@@ -398,7 +404,6 @@ GYRO_RAMFUNC void gyro_fr_synth(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_project(gyro_t *g)
 {
-  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_settle(g);
   rate_channel_project(&g->design->rate, &g->rate, g->lmsd_drive.w_i, g->lmsd_drive.w_q,
                        g->drive.p_eq_rad, g->drive.phase_err_rad);
   /* The continuous self-test's modulation, for the ticks from here on and for its notch
@@ -434,6 +439,7 @@ GYRO_RAMFUNC void gyro_block_measure(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_supervise(gyro_t *g)
 {
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_settle(g);
   /* The last verdict's onsets into the history, on this lighter tick. */
   if (GYRO_UNLIKELY(g->valid.onsets_pending != 0u)) {
     rate_valid_count_onsets(&g->valid, &g->valid_history);
@@ -443,6 +449,7 @@ GYRO_RAMFUNC void gyro_block_supervise(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g)
 {
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_parts(g);
   if (supervisor_drive_enabled(&g->sup)) gyro_block_phase(g);
   g->cont_fail = selftest_cont_judge(&g->design->selftest, &g->selftest,
                                      g->sup.mode == GYRO_MODE_LOCKED);
@@ -450,6 +457,7 @@ GYRO_RAMFUNC void gyro_block_phase_judge(gyro_t *g)
 
 GYRO_RAMFUNC void gyro_block_track_judge(gyro_t *g)
 {
+  if (GYRO_UNLIKELY(g->fr_on != 0u)) gyro_fr_parts(g);
   if (supervisor_drive_enabled(&g->sup)) gyro_block_track(g);
   g->cont_fail = selftest_cont_judge(&g->design->selftest, &g->selftest,
                                      g->sup.mode == GYRO_MODE_LOCKED);

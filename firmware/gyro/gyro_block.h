@@ -59,14 +59,16 @@ void gyro_quad_off(gyro_t *g);
 /* Force rebalance's steps (sense.mode 1, gyro_slots.h), each at the start of its slot's
  * job while g->fr_on: take (GYRO_SLOT_RATE: starts the loop on LOCKED, halts it when
  * not), PI (GYRO_SLOT_QUAD), limit (GYRO_SLOT_P), |F| (GYRO_SLOT_OUTPUT), the force's
- * root (GYRO_SLOT_PHASE_MEAS), synthesis (GYRO_SLOT_AMP), settling (GYRO_SLOT_PROJECT, a
- * block later: the verdict of GYRO_SLOT_OUTPUT reads it). */
+ * root (GYRO_SLOT_PHASE_MEAS), the voltage phasor (GYRO_SLOT_PHASE_PI), synthesis
+ * (GYRO_SLOT_AMP), settling (GYRO_SLOT_SUPERVISE, a block later: the verdict of
+ * GYRO_SLOT_OUTPUT reads it). */
 void gyro_fr_take(gyro_t *g);
 void gyro_fr_integrate(gyro_t *g);
 void gyro_fr_limit(gyro_t *g);
 void gyro_fr_settle(gyro_t *g);
 void gyro_fr_mag(gyro_t *g);
 void gyro_fr_root(gyro_t *g);
+void gyro_fr_parts(gyro_t *g);
 void gyro_fr_synth(gyro_t *g);
 /* Its halt at once (not LOCKED, the drive's stop, sense.mode 0): the force to zero from
  * the next tick, the loop open and not balanced. */
@@ -80,8 +82,8 @@ void gyro_block_phase(gyro_t *g);
  * attached frame (GYRO_SLOT_OUTPUT made it on the block's last tick: the frame carries
  * it from this tick on, as the ticks' own copy of it did). */
 void gyro_block_measure(gyro_t *g);
-/* GYRO_SLOT_SUPERVISE, in every mode: the last verdict's onsets into the history (rare),
- * then the supervisor. */
+/* GYRO_SLOT_SUPERVISE, in every mode: force rebalance's settling test (sense.mode 1), the
+ * last verdict's onsets into the history (rare), then the supervisor. */
 void gyro_block_supervise(gyro_t *g);
 /* GYRO_SLOT_PROJECT: the block's projection and the continuous self-test's modulation. */
 void gyro_block_project(gyro_t *g);

@@ -70,11 +70,12 @@
  * five jobs, in order: on slot 6 (before the rate's filter) it takes the block's
  * projection as the residual and gives the rate channel the loop's readout g (I + Kr R)
  * in its place; on 7 the PI; on 8 the force's limit; the force's phasor to the synthesis
- * in three steps, one long operation on each tick: on 9 |F| (a square root; F with the
+ * in four steps, one long operation on each tick: on 9 |F| (a square root; F with the
  * continuous self-test's force on its Coriolis axis, selftest.h), on 0 the root
- * of F (another), on 2 the feedback synthesis (drive_synth_set_phasor on its own
- * instance: a divide and the frame's phase; no arc tangent), whose waveform goes out
- * every tick from the next on, on the feedback pair's two channels; on 5, a block after
+ * of F (another), on 1 the voltage phasor in the force's frame (a divide), on 2 the
+ * feedback synthesis (drive_synth_set_phasor on its own instance: the frame's phase and
+ * its turn of the phasor, a table lookup; no arc tangent), whose waveform goes out
+ * every tick from the next on, on the feedback pair's two channels; on 4, a block after
  * the limit, the settling test (the SENSE_FR reason the verdict of 9 reads). The force
  * thus follows the block's mean by (GYRO_BLOCK - 1) / 2 + 9 ticks, plus half a block of
  * hold (gyro_design.c).
@@ -93,7 +94,7 @@
 #define GYRO_SLOT_QUAD 7u
 #define GYRO_SLOT_P 8u
 #define GYRO_SLOT_OUTPUT 9u
-/* The force-rebalance steps (above): take, PI, limit, |F|, root, synthesis, settling. */
+/* The force-rebalance steps (above): take, PI, limit, |F|, root, phasor, synthesis, settling. */
 #define SENSE_FR_TAKE_SLOT GYRO_SLOT_RATE
 #define SENSE_FR_SYNTH_SLOT GYRO_SLOT_AMP
 _Static_assert(GYRO_SLOT_PHASE_MEAS < GYRO_SLOT_PHASE_PI &&

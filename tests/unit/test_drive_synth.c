@@ -10,6 +10,14 @@
 
 /* A synthesiser of the scheme (D 7 V, u_max 14 V) and the real NCO at the drive's
  * frequency. */
+/* The NCO's output at a half phase (one sample's worth, for the steps' inputs). */
+static const nco_out_t *at(uint32_t half_phase)
+{
+  static nco_out_t o;
+  nco_out_at(half_phase, &o);
+  return &o;
+}
+
 static void start(gyro_drive_scheme_t scheme, drive_synth_t *ds, nco_t *nco)
 {
   drive_synth_cfg_t c = {.scheme = scheme, .dc_bias_v = 7.0f, .u_max_v = 14.0f};
@@ -34,7 +42,7 @@ static void check_force(gyro_drive_scheme_t scheme)
     const float p = -2.0f + 4.0f * (float)n / 200000.0f; /* sweep P through +-2 rad */
     float u1, u2;
     drive_synth_set(&ds, f, p);
-    drive_synth_step(&ds, o.phase, o.half_phase, &u1, &u2);
+    drive_synth_step(&ds, &o, &u1, &u2);
     const double phi = 2.0 * M_PI * (double)o.phase / 4294967296.0; /* the NCO's own phase */
     const double force = (double)u1 * u1 - (double)u2 * u2;
     const double err = fabs(force - f * cos(phi + p));
@@ -75,7 +83,7 @@ static void test_limits(void **state)
   assert_true(fabsf(drive_synth_f_cmd_max(&ds) - 196.0f) < 1e-4f);
   float u1, u2;
   drive_synth_set(&ds, 196.0f, 0.0f);
-  drive_synth_step(&ds, 0u, 0u, &u1, &u2);
+  drive_synth_step(&ds, at(0u), &u1, &u2);
   assert_true(u1 <= 14.0f + 1e-4f && u2 >= -1e-4f);
   c.dc_bias_v = 14.0f; /* no room for AC */
   assert_int_equal(drive_synth_init(&ds, &c), -1);
@@ -99,13 +107,13 @@ static void test_non_finite_command(void **state)
         drive_synth_set(&ds, bad[i], j == 0 ? 0.3f : bad[j]);
         for (uint32_t ph = 0u; ph < 0xF0000000u; ph += 0x10000000u) {
           float u1, u2;
-          drive_synth_step(&ds, ph, ph / 2u, &u1, &u2);
+          drive_synth_step(&ds, at(ph / 2u), &u1, &u2);
           const float rest = schemes[m] == GYRO_DRIVE_DC_AC ? 7.0f : 0.0f;
           assert_true(u1 == rest && u2 == rest);
         }
         drive_synth_set(&ds, 64.0f, bad[i]); /* finite force, bad phase: bounded */
         float u1, u2;
-        drive_synth_step(&ds, 123u, 45u, &u1, &u2);
+        drive_synth_step(&ds, at(45u), &u1, &u2);
         assert_true(isfinite(u1) && isfinite(u2) && fabsf(u1) <= 14.0f && fabsf(u2) <= 14.0f);
       }
     }
@@ -157,8 +165,9 @@ static void check_phasor(gyro_drive_scheme_t scheme)
     drive_synth_phasor_t ph;
     drive_synth_phasor_mag(&ph, fr, fi);
     drive_synth_phasor_root(&ds, &ph);
+    drive_synth_phasor_parts(&ds, &ph);
     drive_synth_set_phasor(&ds, &ph, frame);
-    drive_synth_step_phasor(&ds, o.phase, o.half_phase, &u1, &u2);
+    drive_synth_step(&ds, &o, &u1, &u2);
     const double phi = 2.0 * M_PI * (double)o.phase / 4294967296.0;
     const double want = (double)fr * cos(phi + frame) - (double)fi * sin(phi + frame);
     const double err = fabs((double)u1 * u1 - (double)u2 * u2 - want);
@@ -170,13 +179,15 @@ static void check_phasor(gyro_drive_scheme_t scheme)
   drive_synth_phasor_t ph;
   drive_synth_phasor_mag(&ph, NAN, 1.0f);
   drive_synth_phasor_root(&ds, &ph);
+  drive_synth_phasor_parts(&ds, &ph);
   drive_synth_set_phasor(&ds, &ph, 0.0f);
-  drive_synth_step_phasor(&ds, 0u, 0u, &u1, &u2);
+  drive_synth_step(&ds, at(0u), &u1, &u2);
   assert_true(u1 == u2 && isfinite(u1)); /* no force: 0 V, or the bias alone in DC+AC */
   drive_synth_phasor_mag(&ph, 1.0f, INFINITY);
   drive_synth_phasor_root(&ds, &ph);
+  drive_synth_phasor_parts(&ds, &ph);
   drive_synth_set_phasor(&ds, &ph, 0.0f);
-  drive_synth_step_phasor(&ds, 0u, 0u, &u1, &u2);
+  drive_synth_step(&ds, at(0u), &u1, &u2);
   assert_true(u1 == u2 && isfinite(u1));
 }
 
