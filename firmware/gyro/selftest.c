@@ -26,6 +26,7 @@ static void cont_reset(selftest_t *st)
   st->w_avg[0] = st->w_avg[1] = 0.0f;
   st->cont_blocks = 0u;
   st->cont_fail = 0u;
+  st->cont_settle_bits = 0u;
 }
 
 void selftest_cfg_derive(selftest_cfg_t *cfg)
@@ -112,19 +113,24 @@ GYRO_RAMFUNC uint32_t selftest_cont_judge(const selftest_cfg_t *restrict c,
   if (c->cont_on == 0u || !locked) {
     st->cont_blocks = 0u;
     st->cont_fail = 0u;
+    st->cont_settle_bits = 0u;
     return 0u;
-  }
-  if (st->cont_blocks < c->cont_settle_blocks) {
-    st->cont_blocks++;
-    return st->cont_fail;
   }
   /* The rate axis only: the force's feedthrough into the sense pickoff (a voltage with
    * no response of the resonance) lands mostly on the quadrature axis, and a test of the rate path
    * is what the rate's validity needs. A rate (DC at the notch's input) makes the weights
    * ripple at f_m by mu x rate / (2 pi f_m / f_block), as large as the response itself
-   * at full scale: their 2 Hz low-pass takes it out (-42 dB at 250 Hz). */
+   * at full scale: their 2 Hz low-pass takes it out (-42 dB at 250 Hz). The low-pass runs
+   * through the LMS's settling, so that it has caught up with the response when the
+   * verdict starts (from zero it would take a fifth of a second, flagged all along). */
   st->w_avg[0] += SELFTEST_CONT_AVG_K * (st->w[0] - st->w_avg[0]);
   st->w_avg[1] += SELFTEST_CONT_AVG_K * (st->w[1] - st->w_avg[1]);
+  if (st->cont_blocks < c->cont_settle_blocks) {
+    st->cont_blocks++;
+    st->cont_settle_bits = c->cont_gate_bits;
+    return st->cont_fail;
+  }
+  st->cont_settle_bits = 0u;
   const float m2 = st->w_avg[0] * st->w_avg[0] + st->w_avg[1] * st->w_avg[1];
   st->cont_fail = (m2 >= c->cont_lo2 && m2 <= c->cont_hi2) ? 0u : 1u;
   return st->cont_fail;

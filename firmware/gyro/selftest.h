@@ -66,7 +66,11 @@ typedef struct {
   float cont_mu;            /* its LMS step size per block */
   float cont_gain;          /* 1 - mu / 2: the notch's pass-band gain undone */
   float cont_lo2, cont_hi2; /* bounds of the response's squared magnitude (raw rate units) */
+  float cont_expect;        /* the response expected (raw rate units; status) */
   uint32_t cont_settle_blocks; /* blocks LOCKED before the response is judged */
+  uint32_t cont_gate_bits;     /* the rate's reasons while it settles: where the output band
+                                * passes the tone (force rebalance's), the notch must have
+                                * converged before the rate is valid; 0 elsewhere */
   float expect_dps;            /* response expected on the rate axis (calibrated on the part) */
   float tol_rel;               /* pass band, relative */
   float ref_c, ref_s;          /* cos, sin of the drive phase setpoint */
@@ -88,12 +92,13 @@ typedef struct {
   uint32_t force_on;
   float a_c, a_s;
   /* Continuous self-test. */
-  uint32_t cont_phase;  /* modulation phase */
-  float cont_c, cont_s; /* cos, sin of the modulation of the current block */
-  float w[4];           /* LMS weights: rate (cos, sin), quadrature (cos, sin) */
-  float w_avg[2];       /* the rate axis's weights through SELFTEST_CONT_AVG_K */
-  uint32_t cont_blocks; /* blocks LOCKED since the LMS started */
-  uint32_t cont_fail;   /* the response is judged and out of its band */
+  uint32_t cont_phase;       /* modulation phase */
+  float cont_c, cont_s;      /* cos, sin of the modulation of the current block */
+  float w[4];                /* LMS weights: rate (cos, sin), quadrature (cos, sin) */
+  float w_avg[2];            /* the rate axis's weights through SELFTEST_CONT_AVG_K */
+  uint32_t cont_blocks;      /* blocks LOCKED since the LMS started */
+  uint32_t cont_fail;        /* the response is judged and out of its band */
+  uint32_t cont_settle_bits; /* cfg's cont_gate_bits while the LMS settles, else 0 */
 } selftest_t;
 
 /* The derived fields of cfg from the others (background). */
