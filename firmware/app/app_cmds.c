@@ -373,8 +373,9 @@ static void put_selftest(cli_t *cli, app_t *a)
    * a calibration takes as selftest.cont_expect_dps. */
   if (a->gyro.design->selftest.cont_on != 0u) {
     const float *w = a->gyro.selftest.w_avg;
-    cli_data_f32(cli, "selftest_cont_dps",
-                 fm_sqrtf(w[0] * w[0] + w[1] * w[1]) * fm_absf(a->gyro.design->rate.scale_dps));
+    const float scale = fm_absf(a->gyro.design->rate.scale_dps);
+    cli_data_f32(cli, "selftest_cont_dps", fm_sqrtf(w[0] * w[0] + w[1] * w[1]) * scale);
+    cli_data_f32(cli, "selftest_cont_expect_dps", a->gyro.design->selftest.cont_expect * scale);
   }
 }
 

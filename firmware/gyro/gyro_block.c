@@ -579,6 +579,7 @@ GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
                               (selftest_running(&g->selftest) ? RATE_INVALID_SELFTEST : 0u) |
                               (g->clip_block != 0u ? RATE_INVALID_CLIP : 0u) |
                               (g->cont_fail != 0u ? RATE_INVALID_CONT_SELFTEST : 0u) |
+                              g->selftest.cont_settle_bits | /* its notch settling */
                               (g->design->track_uncal != 0u ? RATE_INVALID_TRACKING : 0u) |
                               (g->design->cal_state != GYRO_CAL_OK ? RATE_INVALID_UNCALIBRATED
                                                                    : 0u) |

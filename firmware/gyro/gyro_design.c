@@ -144,7 +144,9 @@ static gyro_design_status_t design_selftest(const param_values_t *v, gyro_design
   st.base_blocks = v->sys_fs_hz / (5u * GYRO_BLOCK);    /* 0.2 s */
   st.settle_blocks = v->sys_fs_hz / (10u * GYRO_BLOCK); /* 0.1 s */
   st.meas_blocks = v->sys_fs_hz / (5u * GYRO_BLOCK);    /* 0.2 s */
-  st.cont_on = v->selftest_continuous;
+  /* Force rebalance always runs it: without it a dead sense pickoff leaves the loop
+   * "balanced" and its readout frozen, valid and wrong (selftest.h). */
+  st.cont_on = v->selftest_continuous != 0u || v->sense_mode == 1u ? 1u : 0u;
   st.cont_amp_v = v->selftest_cont_amp_v;
   st.cont_fr_v2 = st.cont_on != 0u && v->sense_mode == 1u ? v->selftest_cont_fr_v2 : 0.0f;
   const double f_m = (double)v->selftest_cont_freq_hz;
@@ -158,7 +160,10 @@ static gyro_design_status_t design_selftest(const param_values_t *v, gyro_design
   const double scale = fabs((double)v->rate_scale_dps);
   const double e = scale > 0.0 ? (double)v->selftest_cont_expect_dps * amp_k / scale : 0.0;
   const double tol = (double)v->selftest_tol_rel;
-  if (st.cont_on != 0u && !(e > 0.0 && tol < 1.0)) return GYRO_DESIGN_CONT_EXPECT;
+  /* (force rebalance: the expectation is the loop model's, design_fb) */
+  if (st.cont_on != 0u && v->sense_mode != 1u && !(e > 0.0 && tol < 1.0))
+    return GYRO_DESIGN_CONT_EXPECT;
+  st.cont_expect = (float)e;
   st.cont_lo2 = (float)(e * e * (1.0 - tol) * (1.0 - tol));
   st.cont_hi2 = (float)(e * e * (1.0 + tol) * (1.0 + tol));
   t->selftest = st;
@@ -459,10 +464,26 @@ static gyro_design_status_t design_fb(const param_values_t *v, gyro_design_t *t)
                              (float)((double)GYRO_BLOCK / fs)};
   if (sense_fr_design(&fc, &t->fr) != 0) return GYRO_DESIGN_SENSE_FR;
   t->fr_scale_dps_per_v2 = (float)((double)v->rate_scale_dps * g);
+  /* The continuous self-test with the loop closed: its expectation is the loop model's
+   * (selftest.h), the open loop's calibrated selftest.cont_expect_dps does not apply. */
+  if (v->sense_mode == 1u && t->selftest.cont_on != 0u) {
+    const sense_fr_lag_t lag = {(double)v->sense_fr_mu * fs, fr_delay_ticks() / fs};
+    const double e = sense_fr_tone_gain(&fc, &lag, (double)v->selftest_cont_freq_hz) *
+                     (double)v->selftest_cont_fr_v2;
+    const double tol = (double)v->selftest_tol_rel;
+    if (!(e > 0.0) || !(tol < 1.0)) return GYRO_DESIGN_SENSE_SELFTEST;
+    selftest_cfg_t *st = &t->selftest;
+    /* The output filter (sense.fr_lpf_hz) passes the tone: not valid before the notch
+     * has taken it out. */
+    st->cont_gate_bits = RATE_INVALID_SETTLING;
+    st->cont_expect = (float)e;
+    st->cont_lo2 = (float)(e * e * (1.0 - tol) * (1.0 - tol));
+    st->cont_hi2 = (float)(e * e * (1.0 + tol) * (1.0 + tol));
+  }
   /* The self-test's force would go onto the same electrodes, past the loop: the
    * continuous one goes into the loop's command (selftest.h), a small part of what the
    * electrodes can give; the on-demand one is refused by its command. */
-  if (v->sense_mode == 1u && v->selftest_continuous != 0u &&
+  if (v->sense_mode == 1u &&
       !((double)v->selftest_cont_fr_v2 <= 0.25 * (double)drive_synth_f_cmd_max(&probe)))
     return GYRO_DESIGN_SENSE_SELFTEST;
   return GYRO_DESIGN_OK;

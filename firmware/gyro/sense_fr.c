@@ -35,6 +35,12 @@ static cplx_t c_div(cplx_t a, cplx_t b)
   return r;
 }
 
+static cplx_t c_add(cplx_t a, cplx_t b)
+{
+  const cplx_t r = {a.re + b.re, a.im + b.im};
+  return r;
+}
+
 /* The plant's slow root p = -sigma + j (wd - wc) (sense_fr.h), rad/s. */
 static cplx_t plant_pole(const sense_fr_cfg_t *c)
 {
@@ -95,6 +101,40 @@ int sense_fr_design(const sense_fr_cfg_t *cfg, sense_fr_design_t *d)
   d->c_re = (float)c.re;
   d->c_im = (float)c.im;
   return 0;
+}
+
+/* Y / T at s = j w (sense_fr_tone_gain): with the plant G = g (-p) / (s - p) seen through
+ * the demodulator's pole and the delay, and C = Kp + Ki / s, R = G T / (1 + G C) and
+ * Y = g (Ki / s + Kr) R. */
+static cplx_t tone_h(const sense_fr_cfg_t *cfg, const sense_fr_lag_t *lag, cplx_t p,
+                     const cplx_t k[3], double w)
+{
+  const cplx_t kp = k[0], ki = k[1], kr = k[2];
+  const double g = (double)cfg->gain_per_v2, b = lag->demod_pole_per_s;
+  const cplx_t one = {1.0, 0.0}, s_p = {-p.re, w - p.im}, s_b = {b, w}, s = {0.0, w};
+  const cplx_t gp = {-p.re * g * b, -p.im * g * b};
+  const cplx_t delay = {cos(w * lag->delay_s), -sin(w * lag->delay_s)};
+  const cplx_t plant = c_mul(c_div(gp, c_mul(s_p, s_b)), delay);
+  const cplx_t ki_s = c_div(ki, s);
+  const cplx_t gr = {g, 0.0};
+  const cplx_t y = c_mul(gr, c_mul(c_add(ki_s, kr), plant));
+  return c_div(y, c_add(one, c_mul(plant, c_add(kp, ki_s))));
+}
+
+double sense_fr_tone_gain(const sense_fr_cfg_t *cfg, const sense_fr_lag_t *lag, double f_hz)
+{
+  if (cfg == NULL || lag == NULL || !cfg_ok(cfg) || !isfinite(f_hz) || !(f_hz > 0.0) ||
+      !(lag->demod_pole_per_s > 0.0) || !(lag->delay_s >= 0.0) || !isfinite(lag->delay_s))
+    return -1.0;
+  const cplx_t p = plant_pole(cfg);
+  cplx_t c, kp, ki;
+  if (place(cfg, p, &c, &kp, &ki) != 0) return -1.0;
+  const double w = 2.0 * FM_PI * f_hz;
+  const cplx_t k[3] = {kp, ki, c_div(ki, c)};
+  /* A real tone T = A cos(w t) = A (e^(j w t) + e^(-j w t)) / 2 on the real axis: the
+   * real part of the response is A Re((H(jw) + conj(H(-jw))) e^(j w t)) / 2. */
+  const cplx_t hp = tone_h(cfg, lag, p, k, w), hn = tone_h(cfg, lag, p, k, -w);
+  return 0.5 * hypot(hp.re + hn.re, hp.im - hn.im);
 }
 
 GYRO_RAMFUNC void sense_fr_reset(sense_fr_t *fr)

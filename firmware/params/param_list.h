@@ -279,7 +279,7 @@
   /* off: the product's figures are measured without it; on, it costs no noise or
    * bandwidth within the measured scatter (README, output integrity) */ \
   X(selftest_continuous, 0x0704u, "selftest.continuous", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
-    PF_PERSIST | PF_LIVE, "continuous self-test: a test force modulated out of the rate band, measured and taken out") \
+    PF_PERSIST | PF_LIVE, "continuous self-test, a tone force measured and taken out (always on with sense.mode 1)") \
   /* as the on-demand test's force */ \
   X(selftest_cont_amp_v, 0x0705u, "selftest.cont_amp_v", F32, "V", 0.001f, 5.0f, 0.1f, 0u, \
     PF_PERSIST | PF_LIVE, "continuous self-test: force voltage amplitude on the sense feedback electrodes") \
