@@ -19,6 +19,15 @@ on each case as tests/closed_loop/test_cl_sense_tune.c runs it, twice (rate_tabl
 matched resonance the mode's phase at the drive frequency moves steeply with a small
 error of the model, and the readout's frame with it).
 
+Quadrature nulling (--quad-null): the part with nulling electrodes of QN_DPS_PER_V2
+(tests/closed_loop/test_cl_quadnull.c's and check_quadnull_temp.py's; their voltage noise
+off with every other source, BROWNIAN_ONLY) and the firmware's quad.null 1 for the record,
+so that every loop is closed and the feedback force rebalances what the nulling leaves
+rather than the part's 1500 deg/s. The rate table of --matched runs before, on the part
+with its electrodes at 0 V, as test_cl_sense_tune.c's calibration does. The record is
+judged on the plant's truth (nulled): from the analysis's start on, the quadrature left
+(quad_true_dps) within QN_TOL_DPS and the rate valid throughout (quadnull_check).
+
 Sampling: the loop's output band is 500 Hz (sense.fr_lpf_hz, a 2nd-order Butterworth);
 a point sample of it every 5 ms (brownian_only's 200 Hz CSV) folds the band between 100
 and 500 Hz onto the low frequencies and more than doubles the Allan deviation at short
@@ -51,6 +60,12 @@ RT_STEPS = [[1.0, 0.0], [0.6, 100.0], [0.6, -100.0]]
 RT_SETTLE_S = 0.3
 RT_CSV_HZ = 1000.0
 KB_J_PER_K = 1.380649e-23
+# the nulling electrodes of test_cl_quadnull.c: 1500 deg/s at 8.7 V on one set
+QN_DPS_PER_V2 = 20.0
+QN_TOL_DPS = 1.0  # the nulled quadrature (plant truth), as test_cl_quadnull.c judges it
+QUAD_NULL_FW = ["--set", "firmware.quad.null=1"]
+# the CSV's columns the record keeps (block means; rate_valid's is the valid fraction)
+COLUMNS = ["t_s", "rate_dps", "rate_true_dps", "quad_dps", "quad_true_dps", "rate_valid"]
 
 # brownian_only.json's plant settings: the ideal preset, every electronic noise off
 BROWNIAN_ONLY = {"preset": "ideal",
@@ -63,12 +78,15 @@ BROWNIAN_ONLY = {"preset": "ideal",
 FT_SPARE = 1e-3  # the presets' feedthrough of the feedback channel into the sense pickoff
 
 
-def case_plant(study, ft_on, defaults):
+def case_plant(study, ft_on, defaults, quad_null=False):
     """The plant settings of a case beyond frpart's: brownian_only's noise settings, the
     feedthrough, and in the electrode study the feedback electrodes' default noise
-    (defaults: the default part's plant values by name)."""
+    (defaults: the default part's plant values by name); quad_null: the nulling
+    electrodes of QN_DPS_PER_V2 (their noise stays off)."""
     p = dict(BROWNIAN_ONLY)
     p["pick_sense_ft_spare"] = FT_SPARE if ft_on else 0.0
+    if quad_null:
+        p["quadnull_dps_per_v2"] = QN_DPS_PER_V2
     if study == "electrode":
         for k in ("fb_noise_white_v_rthz", "fb_noise_1hz_v_rthz", "fb_noise_fmin_hz"):
             p[k] = defaults[k]
@@ -89,37 +107,36 @@ def _cat(parts):
 
 
 class _Averager:
-    """Reads the CSV from a FIFO as gyro-sim writes it: the means of t_s, rate_dps and
-    rate_true_dps over blocks of n rows."""
+    """Reads the CSV from a FIFO as gyro-sim writes it: the means of COLUMNS over blocks
+    of n rows."""
 
     def __init__(self, path, n):
         self.path, self.n = path, n
-        self.t, self.rate, self.true = [], [], []
+        self.parts = []
         self.error = None
 
     def run(self):
         try:
             import pandas as pd
-            cols = ["t_s", "rate_dps", "rate_true_dps"]
-            rest = np.empty((0, 3))
-            for chunk in pd.read_csv(self.path, usecols=cols, chunksize=200000):
-                a = np.vstack([rest, chunk[cols].to_numpy(dtype=float)])
+            k_cols = len(COLUMNS)
+            rest = np.empty((0, k_cols))
+            for chunk in pd.read_csv(self.path, usecols=COLUMNS, chunksize=200000):
+                a = np.vstack([rest, chunk[COLUMNS].to_numpy(dtype=float)])
                 k = len(a) // self.n * self.n
-                m = a[:k].reshape(-1, self.n, 3).mean(axis=1)
-                self.t.append(m[:, 0])
-                self.rate.append(m[:, 1])
-                self.true.append(m[:, 2])
+                self.parts.append(a[:k].reshape(-1, self.n, k_cols).mean(axis=1))
                 rest = a[k:]
         except Exception as e:  # reported by the caller: a thread cannot raise
             self.error = e
 
     def arrays(self):
-        return _cat(self.t), _cat(self.rate), _cat(self.true)
+        """The block means by column name."""
+        a = np.vstack(self.parts) if self.parts else np.empty((0, len(COLUMNS)))
+        return {c: a[:, i] for i, c in enumerate(COLUMNS)}
 
 
 def run_case(exe, args, scen, log=print):
     """Runs gyro-sim on scen with args (the --set list), its CSV averaged through a FIFO.
-    Returns (t_s, rate_dps, rate_true_dps, the run's JSON, the command line)."""
+    Returns (the block means of COLUMNS by name, the run's JSON, the command line)."""
     with tempfile.TemporaryDirectory() as tmp:
         sc_path = os.path.join(tmp, "fr_noise.json")
         with open(sc_path, "w", encoding="utf-8") as f:
@@ -140,7 +157,7 @@ def run_case(exe, args, scen, log=print):
             raise RuntimeError(f"reading the CSV: {avg.error}")
         with open(js, encoding="utf-8") as f:
             run = json.load(f)
-    return (*avg.arrays(), run, cmd)
+    return avg.arrays(), run, cmd
 
 
 def scale_factor(t, rate, true, t0):
@@ -186,9 +203,30 @@ def at_tau(tau, ad_dph, t0):
     return float(ad_dph[np.argmin(np.abs(np.log(tau / t0)))])
 
 
-def analyse(t, rate, true, run, duration_s, settle_s):
-    """The case's figures from its averaged record: scale factor, N against the floor,
-    the Allan deviation at 10, 100 and 1000 s, and the curve."""
+def quadnull_check(rec, duration_s, settle_s):
+    """Whether the nulling had settled when the analysis starts (settle_s) and held to the
+    record's end (duration_s), on the block means rec: the quadrature left (plant truth)
+    within QN_TOL_DPS and the rate valid on every block; the time from which both held,
+    and the quadrature left and read (the firmware's quad_dps) over the record."""
+    t = rec["t_s"]
+    rec_sel = t < duration_s
+    ok = (np.abs(rec["quad_true_dps"]) <= QN_TOL_DPS) & (rec["rate_valid"] >= 1.0)
+    bad = np.nonzero(~ok & rec_sel)[0]
+    t_held = float(t[bad[-1] + 1]) if len(bad) else float(t[0])
+    sel = rec_sel & (t >= settle_s)
+    qt, qf = rec["quad_true_dps"][sel], rec["quad_dps"][sel]
+    return {"nulled": bool(t_held <= settle_s) and bool(sel.any()),
+            "nulled_and_valid_from_s": t_held, "tol_dps": QN_TOL_DPS,
+            "quad_true_mean_dps": float(qt.mean()), "quad_true_max_abs_dps":
+            float(np.abs(qt).max()), "quad_true_std_dps": float(qt.std()),
+            "quad_fw_mean_dps": float(qf.mean()), "quad_fw_std_dps": float(qf.std()),
+            "rate_valid_fraction": float(rec["rate_valid"][sel].mean())}
+
+
+def analyse(rec, run, duration_s, settle_s):
+    """The case's figures from its averaged record (COLUMNS by name): scale factor, N
+    against the floor, the Allan deviation at 10, 100 and 1000 s, and the curve."""
+    t, rate, true = rec["t_s"], rec["rate_dps"], rec["rate_true_dps"]
     sf = scale_factor(t, rate, true, duration_s)
     sel = (t >= settle_s) & (t < duration_s)
     x = rate[sel] / sf
@@ -205,11 +243,14 @@ def analyse(t, rate, true, run, duration_s, settle_s):
             "tau_s": tau.tolist(), "adev_dph": ad.tolist()}
 
 
-def case_args(exe, cal_path, scheme, study, ft_on, q_sense, extra, matched=False):
+def case_args(exe, cal_path, scheme, study, ft_on, q_sense, extra, matched=False,
+              quad_null=False):
     """gyro-sim --set arguments of a case (frpart.fr_args on the ideal preset, matched or
-    not, then the case's plant settings, then extra)."""
+    not, then the case's plant settings, then extra). quad_null: the part with nulling
+    electrodes (case_plant); the firmware's quad.null 1 is QUAD_NULL_FW, for the caller
+    to add after the calibration."""
     defaults = frpart.plant_values(exe)
-    plant = case_plant(study, ft_on, defaults)
+    plant = case_plant(study, ft_on, defaults, quad_null)
     plant.pop("preset")
     args = frpart.fr_args(exe, cal_path, scheme, q_sense=q_sense, plant=plant,
                           base=["plant.preset=ideal"], matched=matched)

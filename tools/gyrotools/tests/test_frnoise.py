@@ -1,7 +1,9 @@
 """tools/fr-noise and its library: bad options are refused (exit 2, nothing run); the
 read-offs are right on constructed records (N of a white rate noise, the scale factor of
-the steps); the force-rebalance part's model puts f0 at the resonance the loop sees
-(the DC bias's softening taken off, as tests/closed_loop/test_cl_sense_fr.c does)."""
+the steps, the nulling's check); the force-rebalance part's model puts f0 at the
+resonance the loop sees (the DC bias's softening taken off, as
+tests/closed_loop/test_cl_sense_fr.c does); --quad-null gives the part its nulling
+electrodes, their noise off, and the firmware quad.null 1."""
 
 import math
 
@@ -92,3 +94,59 @@ def test_matched_part_staged_on_the_drive():
         frpart.matched_values(cal, {**p, "f_sense_hz": 1450.0})
     with pytest.raises(ValueError):
         frpart.matched_values(cal, {**p, "tune_ke_per_s2_per_v2": 0.0})
+
+
+def test_quad_null_part_and_firmware():
+    """--quad-null: the plant gets test_cl_quadnull.c's 20 (deg/s)/V^2 electrodes with their
+    voltage noise off (brownian_only's conditions), in both studies; without it the part has
+    none; the firmware setting turns the nulling loop on."""
+    defaults = {"fb_noise_white_v_rthz": 2e-7, "fb_noise_1hz_v_rthz": 2e-6,
+                "fb_noise_fmin_hz": 1e-3}
+    for study in ("brownian", "electrode"):
+        p = frnoise.case_plant(study, False, defaults, quad_null=True)
+        assert p["quadnull_dps_per_v2"] == 20.0 == frnoise.QN_DPS_PER_V2
+        assert p["quadnull_noise_white_v_rthz"] == 0 and p["quadnull_noise_1hz_v_rthz"] == 0
+    assert "quadnull_dps_per_v2" not in frnoise.case_plant("brownian", True, defaults)
+    assert frnoise.QUAD_NULL_FW == ["--set", "firmware.quad.null=1"]
+
+
+def test_quad_null_option_parsed(run_script, tmp_path):
+    """--quad-null is an option of fr-noise (a bad value elsewhere still refuses the run)."""
+    code, out, err = run_script("fr-noise", ["--quad-null", "--ft", "maybe",
+                                             "--out", str(tmp_path / "o")])
+    assert code == 2 and "--ft" in err and "unrecognized" not in err
+    code, out, err = run_script("fr-noise", ["--quad-nul1", "--out", str(tmp_path / "o")])
+    assert code == 2 and "unrecognized" in err
+    assert not (tmp_path / "o").exists()
+
+
+def _record(quad_true, valid, t_end=100.0):
+    t = np.arange(0.0, t_end + 30.0, 0.01)
+    return {"t_s": t, "rate_dps": np.zeros_like(t), "rate_true_dps": np.zeros_like(t),
+            "quad_dps": 0.5 * quad_true(t), "quad_true_dps": quad_true(t),
+            "rate_valid": valid(t).astype(float)}
+
+
+def test_quadnull_check():
+    """Nulled: within 1 deg/s and valid from 0.7 s, the analysis from 5 s; not nulled: the
+    quadrature beyond 1 deg/s after the analysis's start, or the rate invalid there; after
+    the record (the scale factor's steps) nothing counts."""
+    def nulled(t):
+        return np.where(t < 0.7, 1500.0, 0.3 * np.sin(t))
+
+    def valid(t):
+        return t >= 0.7
+
+    r = frnoise.quadnull_check(_record(nulled, valid), 100.0, 5.0)
+    assert r["nulled"] and r["nulled_and_valid_from_s"] == pytest.approx(0.7)
+    assert r["quad_true_max_abs_dps"] <= 0.3 and r["rate_valid_fraction"] == 1.0
+    assert r["quad_fw_std_dps"] == pytest.approx(0.5 * r["quad_true_std_dps"])
+    late = frnoise.quadnull_check(_record(nulled, lambda t: t >= 6.0), 100.0, 5.0)
+    assert not late["nulled"] and late["nulled_and_valid_from_s"] == pytest.approx(6.0)
+    bump = frnoise.quadnull_check(
+        _record(lambda t: np.where((t > 50) & (t < 50.5), 2.0, nulled(t)), valid), 100.0, 5.0)
+    assert not bump["nulled"]
+    after = frnoise.quadnull_check(
+        _record(lambda t: np.where(t > 105, 2.0, nulled(t)), lambda t: (t >= 0.7) & (t < 110)),
+        100.0, 5.0)
+    assert after["nulled"]
