@@ -552,7 +552,11 @@ static uint32_t cal_state(const param_values_t *v, const sense_tune_cfg_t *tune)
   /* And the drive mode: the tracking drive's thermometer is the tracked frequency (p_eq,
    * drive_track.h), with the part's Q in its scale, where the fixed drive's is P. */
   const int same_mode = v->drive_track == v->cal_ref_track;
-  return same_phase && same_mode && same_tuning(v, tune) &&
+  /* And the sense configuration: force rebalance's rate is the force's, nulling takes
+   * away the quadrature that would leak into the rate as the thermometer moves. */
+  const int same_sense = v->sense_mode == v->cal_ref_sense_mode &&
+                         v->quad_null == v->cal_ref_quad_null;
+  return same_phase && same_mode && same_sense && same_tuning(v, tune) &&
                  fabs((double)v->drive_freq_hz - ref) <= GYRO_CAL_FREQ_REL * ref
              ? GYRO_CAL_OK
              : GYRO_CAL_STALE;

@@ -40,7 +40,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 18u
+#define PARAM_LAYOUT_VERSION 19u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -452,6 +452,15 @@
    * (a sweep that tuned again, sense.tune or its calibration changed) makes it stale */ \
   X(cal_ref_tune_v, 0x0807u, "cal.ref_tune_v", F32, "V", 0.0f, 15.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "mode tuning's voltage the calibration was made with (0 untuned): with another it is stale") \
+  /* Written by the calibration flow (sense.mode and quad.null when it ran); 0, open loop
+   * without nulling, until then and in images of before it. Force rebalance reads the
+   * rate from the force, nulling takes away the quadrature that leaks into the rate
+   * with the thermometer: the compensation, demodulation phase and scale of the one
+   * configuration are not the other's */ \
+  X(cal_ref_sense_mode, 0x0808u, "cal.ref_sense_mode", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
+    PF_PERSIST | PF_LIVE, "sense.mode the calibration was made with: with the other it is stale") \
+  X(cal_ref_quad_null, 0x0809u, "cal.ref_quad_null", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
+    PF_PERSIST | PF_LIVE, "quad.null the calibration was made with: with the other it is stale") \
   /* start the drive at power-on */ \
   X(sys_autostart, 0x0602u, "sys.autostart", ENUM, "-", 0u, 1u, 1u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
     PF_PERSIST | PF_RESTART, "start acquiring at power-on") \

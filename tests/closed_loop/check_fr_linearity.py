@@ -39,7 +39,9 @@ DWELL_S = {"force rebalance": 2.0, "open loop": 12.0}
 def mode_args(exe, mode):
     args = fr_args(exe)
     if mode == "open loop":
-        args = [a.replace("firmware.sense.mode=1", "firmware.sense.mode=0") for a in args]
+        args = [a.replace("firmware.sense.mode=1", "firmware.sense.mode=0")
+                .replace("firmware.cal.ref_sense_mode=1", "firmware.cal.ref_sense_mode=0")
+                for a in args]
         args += ["--set", "plant.quad_dps=0"]
     return args + THERMAL
 

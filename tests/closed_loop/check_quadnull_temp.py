@@ -29,7 +29,9 @@ SCENARIO = {"name": "quadnull_temp", "description": "ambient -40 -> 85 degC at 2
             "duration_s": 420.0, "seed": 7, "mode": "closed_loop", "csv_rate_hz": 20,
             "ambient_c": {"kind": "ramp", "value": -40, "slope_per_s": 125.0 / 300.0,
                           "t_start_s": 30, "t_end_s": 330}}
-SETS = ["plant.quadnull_dps_per_v2=20", "firmware.quad.null=1", "plant.tau_struct_s=20",
+SETS = ["plant.quadnull_dps_per_v2=20", "firmware.quad.null=1",
+        "firmware.cal.ref_quad_null=1",  # the calibration declared the nulling's
+        "plant.tau_struct_s=20",
         "plant.tau_circuit_s=20"]
 MAX_DPS = 1.0
 V_MAX = 10.0

@@ -94,7 +94,8 @@ def fr_args(exe, f_model_hz=FR_F_SENSE_HZ, q_model=FR_Q_SENSE, plant=None, firmw
     fw = {"rate.demod_phase_deg": cal["rate.demod_phase_deg"] + np.degrees(a1 - a0),
           "rate.scale_dps": scale,
           "sense.fb_gain_v_per_v2": k_dps_per_v2 / scale * cal["drive.amp_set_v"],
-          "sense.f0_hz": f_model_hz, "sense.q": q_model, "sense.mode": 1, **(firmware or {})}
+          "sense.f0_hz": f_model_hz, "sense.q": q_model, "sense.mode": 1,
+          "cal.ref_sense_mode": 1, **(firmware or {})}
     args = []
     for k, v in {**FR_PLANT, **(plant or {})}.items():
         args += ["--set", f"plant.{k}={v:.9g}"]

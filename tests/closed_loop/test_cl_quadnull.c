@@ -29,6 +29,7 @@ static void start(double quadnull_dps_per_v2, uint32_t quad_null)
   param_values_t v;
   default_part_values(&v);
   v.quad_null = quad_null;
+  v.cal_ref_quad_null = quad_null; /* the calibration declared the nulling's */
   app_plant_start(&pc, 19u, &v);
 }
 

@@ -84,6 +84,7 @@ static void start_part(const fr_part_t *fp)
   v.sense_f0_hz = (float)f0;
   v.sense_q = (float)fp->q_sense;
   v.sense_mode = fp->sense_mode;
+  v.cal_ref_sense_mode = fp->sense_mode; /* the model's calibration is this mode's */
   v.sense_fb_scheme = fp->fb_scheme;
   v.sense_fb_bias_v = (float)pc.fb_bias_v;
   app_plant_start(&pc, 21u, &v);

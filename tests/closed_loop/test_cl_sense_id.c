@@ -61,6 +61,7 @@ static void part_values(const plant_cfg_t *pc, param_values_t *v)
   v->sys_autostart = 0u;
   v->sense_cal = 1u;
   v->sense_mode = 1u;
+  v->cal_ref_sense_mode = 1u; /* the model's calibration is force rebalance's */
 }
 
 /* The plant's sense resonance now, (2-32) at the structure temperature. */

@@ -52,6 +52,7 @@ static void part_values(const plant_cfg_t *pc, uint32_t mode, double split_hz, p
   v->sys_autostart = 0u;
   v->sense_cal = 1u;
   v->sense_mode = 1u;
+  v->cal_ref_sense_mode = 1u; /* the model's calibration is force rebalance's */
   v->sense_tune = mode;
   v->sense_tune_split_hz = (float)split_hz;
 }
@@ -261,6 +262,7 @@ static power_on_t power_on(const plant_cfg_t *pc, const param_values_t *stored,
   param_values_t v = *stored;
   v.sys_autostart = 1u;
   v.quad_null = quad_null;
+  v.cal_ref_quad_null = quad_null; /* as the flow would record a calibration with it */
   start(pc, &v);
   power_on_t r = {-1.0, -1.0, -1.0, -1.0, 0.0, 0.0, 0.0};
   const long n = (long)(t_end_s * 1000.0 + 0.5);

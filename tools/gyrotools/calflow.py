@@ -21,7 +21,8 @@ firmware's generic defaults:
    at the drive setpoint (selftest.ref_amp_v);
 6. the calibration record: every value the firmware holds for this part, with
    cal.ref_freq_hz (the drive frequency it was made at), cal.ref_track (the drive mode
-   it was made in), cal.part_id and cal.date,
+   it was made in), cal.ref_sense_mode and cal.ref_quad_null (the sense configuration),
+   cal.part_id and cal.date,
    written as a param set (gyrotools.paramset);
 7. verification on profiles the fit never saw, each with its own noise seed, run side by
    side: another rate schedule (+-30..270 deg/s, other dwell), judged on the rate output
@@ -475,6 +476,9 @@ def record(values, sets, date=None, part_no=None):
     v["cal.ref_phase_set_deg"] = v["drive.phase_set_deg"]
     v["cal.ref_track"] = v["drive.track"]  # the mode the sweep chose and the stages ran in
     v["cal.ref_tune_v"] = tune_volts(v)  # the tuning the stages ran with
+    # the sense configuration the stages ran in (force rebalance, nulling)
+    v["cal.ref_sense_mode"] = v.get("sense.mode", 0)
+    v["cal.ref_quad_null"] = v.get("quad.null", 0)
     v["cal.part_id"] = part_id(sets) if part_no is None else part_no
     d = date or datetime.date.today()
     v["cal.date"] = d.year * 10000 + d.month * 100 + d.day

@@ -63,7 +63,8 @@ KB_J_PER_K = 1.380649e-23
 # the nulling electrodes of test_cl_quadnull.c: 1500 deg/s at 8.7 V on one set
 QN_DPS_PER_V2 = 20.0
 QN_TOL_DPS = 1.0  # the nulled quadrature (plant truth), as test_cl_quadnull.c judges it
-QUAD_NULL_FW = ["--set", "firmware.quad.null=1"]
+# nulling on, and the model-made calibration declared nulling's (else it is stale)
+QUAD_NULL_FW = ["--set", "firmware.quad.null=1", "--set", "firmware.cal.ref_quad_null=1"]
 # the CSV's columns the record keeps (block means; rate_valid's is the valid fraction)
 COLUMNS = ["t_s", "rate_dps", "rate_true_dps", "quad_dps", "quad_true_dps", "rate_valid"]
 

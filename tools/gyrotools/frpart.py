@@ -111,7 +111,10 @@ def model_values(cal, p_base, p, f0=None, q=None):
     return {"rate.demod_phase_deg": cal["rate.demod_phase_deg"] + math.degrees(a1 - a0),
             "rate.scale_dps": scale,
             "sense.fb_gain_v_per_v2": k_dps_per_v2 / scale * cal["drive.amp_set_v"],
-            "sense.f0_hz": f0, "sense.q": q, "sense.mode": 1}
+            "sense.f0_hz": f0, "sense.q": q, "sense.mode": 1,
+            # the calibration moved by the model is force rebalance's (gyro_design.c:
+            # another sense configuration's is stale)
+            "cal.ref_sense_mode": 1}
 
 
 def fr_args(exe, cal_path, scheme="half", f_sense_hz=1600.0, q_sense=1e4, plant=None,

@@ -42,3 +42,14 @@ def test_a_target_out_of_reach_records_what_the_firmware_applies():
 def test_fr_phase_wraps():
     assert calflow.wrap_deg(190.0) == -170.0
     assert calflow.wrap_deg(-180.0) == -180.0
+
+
+def test_the_record_names_its_sense_configuration():
+    """cal.ref_sense_mode and cal.ref_quad_null are the configuration the stages ran in:
+    the firmware holds a calibration of another one stale (gyro_design.c)."""
+    r = calflow.record(dict(BASE), [])
+    assert r["cal.ref_sense_mode"] == 0 and r["cal.ref_quad_null"] == 0
+    v = dict(BASE)
+    v.update({"sense.mode": 1, "quad.null": 1})
+    r = calflow.record(v, [])
+    assert r["cal.ref_sense_mode"] == 1 and r["cal.ref_quad_null"] == 1

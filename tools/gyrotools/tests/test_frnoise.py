@@ -107,7 +107,8 @@ def test_quad_null_part_and_firmware():
         assert p["quadnull_dps_per_v2"] == 20.0 == frnoise.QN_DPS_PER_V2
         assert p["quadnull_noise_white_v_rthz"] == 0 and p["quadnull_noise_1hz_v_rthz"] == 0
     assert "quadnull_dps_per_v2" not in frnoise.case_plant("brownian", True, defaults)
-    assert frnoise.QUAD_NULL_FW == ["--set", "firmware.quad.null=1"]
+    assert frnoise.QUAD_NULL_FW == ["--set", "firmware.quad.null=1",
+                                    "--set", "firmware.cal.ref_quad_null=1"]
 
 
 def test_quad_null_option_parsed(run_script, tmp_path):
