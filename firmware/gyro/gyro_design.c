@@ -474,8 +474,10 @@ static gyro_design_status_t design_fb(const param_values_t *v, gyro_design_t *t)
     if (!(e > 0.0) || !(tol < 1.0)) return GYRO_DESIGN_SENSE_SELFTEST;
     selftest_cfg_t *st = &t->selftest;
     /* The output filter (sense.fr_lpf_hz) passes the tone: not valid before the notch
-     * has taken it out. */
+     * has taken it out, three of its time constants (e^-3 of the tone left, 0.12 deg/s of
+     * the default's 2.5). */
     st->cont_gate_bits = RATE_INVALID_SETTLING;
+    st->cont_gate_blocks = (uint32_t)(3.0 * GYRO_CONT_TAU_S * fs / GYRO_BLOCK);
     st->cont_expect = (float)e;
     st->cont_lo2 = (float)(e * e * (1.0 - tol) * (1.0 - tol));
     st->cont_hi2 = (float)(e * e * (1.0 + tol) * (1.0 + tol));

@@ -127,7 +127,7 @@ GYRO_RAMFUNC uint32_t selftest_cont_judge(const selftest_cfg_t *restrict c,
   st->w_avg[1] += SELFTEST_CONT_AVG_K * (st->w[1] - st->w_avg[1]);
   if (st->cont_blocks < c->cont_settle_blocks) {
     st->cont_blocks++;
-    st->cont_settle_bits = c->cont_gate_bits;
+    st->cont_settle_bits = st->cont_blocks < c->cont_gate_blocks ? c->cont_gate_bits : 0u;
     return st->cont_fail;
   }
   st->cont_settle_bits = 0u;

@@ -68,13 +68,15 @@ typedef struct {
   float cont_lo2, cont_hi2; /* bounds of the response's squared magnitude (raw rate units) */
   float cont_expect;        /* the response expected (raw rate units; status) */
   uint32_t cont_settle_blocks; /* blocks LOCKED before the response is judged */
-  uint32_t cont_gate_bits;     /* the rate's reasons while it settles: where the output band
-                                * passes the tone (force rebalance's), the notch must have
-                                * converged before the rate is valid; 0 elsewhere */
-  float expect_dps;            /* response expected on the rate axis (calibrated on the part) */
-  float tol_rel;               /* pass band, relative */
-  float ref_c, ref_s;          /* cos, sin of the drive phase setpoint */
-  float scale_dps;             /* rate channel scale: deg/s per unit of the unfiltered rate */
+  uint32_t cont_gate_bits;     /* the rate's reasons for the first cont_gate_blocks LOCKED:
+                                * where the output band passes the tone (force
+                                * rebalance's), the notch must have converged before the
+                                * rate is valid; 0 elsewhere */
+  uint32_t cont_gate_blocks;
+  float expect_dps;   /* response expected on the rate axis (calibrated on the part) */
+  float tol_rel;      /* pass band, relative */
+  float ref_c, ref_s; /* cos, sin of the drive phase setpoint */
+  float scale_dps;    /* rate channel scale: deg/s per unit of the unfiltered rate */
   uint32_t base_blocks, settle_blocks, meas_blocks;
   /* Derived (selftest_cfg_derive): 1 / base_blocks, 1 / meas_blocks, 1 / expect_dps (0
    * where the divisor is 0), so that the verdict's block divides nothing (its tick's
@@ -98,7 +100,7 @@ typedef struct {
   float w_avg[2];            /* the rate axis's weights through SELFTEST_CONT_AVG_K */
   uint32_t cont_blocks;      /* blocks LOCKED since the LMS started */
   uint32_t cont_fail;        /* the response is judged and out of its band */
-  uint32_t cont_settle_bits; /* cfg's cont_gate_bits while the LMS settles, else 0 */
+  uint32_t cont_settle_bits; /* cfg's cont_gate_bits while the notch converges, else 0 */
 } selftest_t;
 
 /* The derived fields of cfg from the others (background). */

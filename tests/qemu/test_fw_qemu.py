@@ -50,6 +50,7 @@ FS_HZ = 50000
 RATE_TOL_DPS = 0.5     # the rate output's turn-on (within 0.5 deg/s of its final error from
                        # 0.07 s, gyro-sim's rate_settle_s) + noise of a 50 ms mean
 SETTLE_TICKS = 10000   # rates are applied from 0.2 s of gyro time on
+FR_GATE_TICKS = 10000  # force rebalance's rate waits 0.3 s after LOCKED for the self-test's notch
 RATE_TOL_REL = 0.005   # scale-factor error of the default calibration, with margin
 SF_TOL = 0.005
 EQUIV_REL = 1e-4
@@ -200,7 +201,7 @@ def case_fr(emu, args):
           f"{st['fault']})")
     if st["mode"] != "LOCKED":
         return
-    emu.wait_ticks(SETTLE_TICKS)
+    emu.wait_ticks(SETTLE_TICKS + FR_GATE_TICKS)
     st = emu.status()
     check(st.get("sense_fr") == "balanced" and st.get("rate_valid") == "1",
           f"the loop balanced and the rate valid (sense_fr {st.get('sense_fr')}, "
