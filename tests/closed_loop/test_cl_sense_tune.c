@@ -288,6 +288,16 @@ static power_on_t power_on(const plant_cfg_t *pc, const param_values_t *stored,
  * quadrature-nulling electrodes of 20 (deg/s)/V^2 (test_cl_quadnull.c's; at 0 V they
  * change nothing the calibration saw, and their noise is off as the part's other
  * electrodes' is) nulling it (quad.null 1). */
+/* What both power-ons must do within 1 s: locked, tuned, the rate valid and right. */
+static void assert_power_on_in_time(const power_on_t *r)
+{
+  assert_int_equal(app.gyro.sup.fault_count, 0u);
+  assert_true(r->locked_s >= 0.0 && r->locked_s <= 1.0);
+  assert_true(r->tuned_s >= 0.0 && r->tuned_s <= 1.0);
+  assert_true(r->valid_s >= 0.0 && r->valid_s <= 1.0);
+  assert_true(r->valid_err_dps <= 1.0);
+}
+
 static void check_power_on(const plant_cfg_t *pc)
 {
   const param_values_t stored = *params_current(&app.params);
@@ -297,11 +307,7 @@ static void check_power_on(const plant_cfg_t *pc)
          "%.3f deg/s off), quadrature %.1f deg/s (rebalanced), faults %u\n",
          fr.locked_s, fr.tuned_s, fr.df_end_hz, fr.valid_s, fr.valid_err_dps, fr.quad_end_dps,
          (unsigned)app.gyro.sup.fault_count);
-  assert_int_equal(app.gyro.sup.fault_count, 0u);
-  assert_true(fr.locked_s >= 0.0 && fr.locked_s <= 1.0);
-  assert_true(fr.tuned_s >= 0.0 && fr.tuned_s <= 1.0);
-  assert_true(fr.valid_s >= 0.0 && fr.valid_s <= 1.0);
-  assert_true(fr.valid_err_dps <= 1.0);
+  assert_power_on_in_time(&fr);
   assert_true(fabs(fr.df_end_hz) <= 0.5 * pc->f_sense_hz / (2.0 * pc->q_sense));
   plant_cfg_t pn = *pc;
   pn.quadnull_dps_per_v2 = 20.0;
@@ -312,12 +318,8 @@ static void check_power_on(const plant_cfg_t *pc)
          "deg/s off), faults %u\n",
          qn.locked_s, qn.tuned_s, qn.quad_s, qn.quad_end_dps, qn.valid_s, qn.valid_err_dps,
          (unsigned)app.gyro.sup.fault_count);
-  assert_int_equal(app.gyro.sup.fault_count, 0u);
-  assert_true(qn.locked_s >= 0.0 && qn.locked_s <= 1.0);
-  assert_true(qn.tuned_s >= 0.0 && qn.tuned_s <= 1.0);
+  assert_power_on_in_time(&qn);
   assert_true(qn.quad_s >= 0.0 && qn.quad_s <= 1.0);
-  assert_true(qn.valid_s >= 0.0 && qn.valid_s <= 1.0);
-  assert_true(qn.valid_err_dps <= 1.0);
   /* and it reads a rate: 100 deg/s held */
   double r100 = 0.0, q100 = 0.0;
   held_mean(STEP_DPS, &r100, &q100);
