@@ -32,8 +32,7 @@ typedef struct {
   float rate_out_v_per_dps;
   float rate_fault_out_v;   /* analog rate output while the rate is not valid */
   uint16_t rate_fault_code; /* its DAC code (derived) */
-  nco_cfg_t nco;
-  uint32_t nco_half_step; /* the NCO's step at the drive frequency: the NCO's start */
+  uint32_t nco_half_step;   /* the NCO's step at the drive frequency: the NCO's start */
   lmsd_cfg_t lmsd_drive, lmsd_sense;
   drive_synth_cfg_t synth;
   drive_loop_design_out_t amp_design, phase_design; /* what the designer achieved */
@@ -71,14 +70,18 @@ typedef struct {
   /* Mode tuning (sense.tune, sense_tune.h): the background's (app.c), which applies its
    * voltage through gyro_set_tune; the sample path reads none of it. */
   sense_tune_cfg_t tune;
+  /* Last: the NCO's configuration is the background's (three doubles); before the sample
+   * path's parts it pushed force rebalance's settling test past the 1020-byte reach of a
+   * VLDR's offset (an extra address computation on a tick at its budget). */
+  nco_cfg_t nco;
 } gyro_design_t;
 
 /* gyro_design_t.cal_state */
 #define GYRO_CAL_NONE 0u /* no calibration: cal.ref_freq_hz 0 */
 #define GYRO_CAL_OK 1u   /* made at drive.freq_hz, drive.phase_set_deg and drive.track */
 #define GYRO_CAL_STALE \
-  2u /* made at another drive frequency, phase setpoint, drive mode or
-                          * mode tuning (cal.ref_tune_v) */
+  2u /* made at another drive frequency, phase setpoint, drive mode, mode tuning
+      * (cal.ref_tune_v) or sense configuration (cal.ref_sense_mode, cal.ref_quad_null) */
 /* cal.ref_freq_hz and drive.freq_hz agree within this, relative: two steps of a float,
  * so that a value printed and set again through the command line still matches. */
 #define GYRO_CAL_FREQ_REL 2.0e-7
