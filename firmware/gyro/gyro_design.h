@@ -77,8 +77,10 @@ typedef struct {
 } gyro_design_t;
 
 /* gyro_design_t.cal_state */
+/* GYRO_CAL_OK: made at drive.freq_hz, drive.phase_set_deg, drive.track, the tuning,
+ * sense.mode and quad.null now in force */
 #define GYRO_CAL_NONE 0u /* no calibration: cal.ref_freq_hz 0 */
-#define GYRO_CAL_OK 1u   /* made at drive.freq_hz, drive.phase_set_deg and drive.track */
+#define GYRO_CAL_OK 1u
 #define GYRO_CAL_STALE \
   2u /* made at another drive frequency, phase setpoint, drive mode, mode tuning
       * (cal.ref_tune_v) or sense configuration (cal.ref_sense_mode, cal.ref_quad_null) */

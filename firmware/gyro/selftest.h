@@ -35,9 +35,12 @@
  * closed-loop response at f_m, about a third at 250 Hz against the loop's 145), which
  * the same LMS measures and takes out. It proves the loop alive end to end: a dead sense
  * pickoff leaves the residual at zero, the loop "balanced" and its readout frozen, and
- * the tone then vanishes (test_cl_sense_fr.c). It cannot check the feedback's scale: the
- * test force goes through the same electrodes as the loop's, so a change of their gain
- * scales the force and its cancellation alike.
+ * the tone then vanishes (test_cl_sense_fr.c), so force rebalance always runs it
+ * (whatever cont_on's parameter says: gyro_design.c). Its expectation is the loop
+ * model's (sense_fr_tone_gain), not a calibration's, and the rate waits cont_gate_blocks
+ * after LOCKED for the notch: the loop's 500 Hz output filter passes the tone. It cannot
+ * check the feedback's scale: the test force goes through the same electrodes as the
+ * loop's, so a change of their gain scales the force and its cancellation alike.
  */
 #ifndef SELFTEST_H
 #define SELFTEST_H
@@ -59,7 +62,7 @@ typedef enum {
 
 typedef struct {
   float amp_v;              /* force voltage amplitude A on the spare DAC channel */
-  uint32_t cont_on;         /* continuous self-test */
+  uint32_t cont_on;         /* continuous self-test (always with force rebalance) */
   float cont_amp_v;         /* its force amplitude A_c */
   float cont_fr_v2;         /* force rebalance: A_c in the loop's command (V^2), 0 open loop */
   uint32_t cont_step;       /* its modulation's phase step per block (2^32 per turn) */
