@@ -355,7 +355,9 @@ GYRO_RAMFUNC void gyro_fr_limit(gyro_t *g)
   if (fr->run != 0u && fr->skip == 0u) sense_fr_limit(&g->design->fr, fr);
 }
 
-GYRO_RAMFUNC void gyro_fr_settle(gyro_t *g)
+/* Inline in the supervisor's job, its only caller: a call and the reload of the loop's
+ * state cost that tick 10 of the cycles it has least of (tools/bench/README.md). */
+GYRO_RAMFUNC static inline void gyro_fr_settle(gyro_t *g)
 {
   sense_fr_t *fr = &g->fr;
   if (fr->run == 0u || fr->skip != 0u) return;

@@ -61,11 +61,10 @@ void gyro_quad_off(gyro_t *g);
  * not), PI (GYRO_SLOT_QUAD), limit (GYRO_SLOT_P), |F| (GYRO_SLOT_OUTPUT), the force's
  * root (GYRO_SLOT_PHASE_MEAS), the voltage phasor (GYRO_SLOT_PHASE_PI), synthesis
  * (GYRO_SLOT_AMP), settling (GYRO_SLOT_SUPERVISE, a block later: the verdict of
- * GYRO_SLOT_OUTPUT reads it). */
+ * GYRO_SLOT_OUTPUT reads it; inline in that job, gyro_block.c). */
 void gyro_fr_take(gyro_t *g);
 void gyro_fr_integrate(gyro_t *g);
 void gyro_fr_limit(gyro_t *g);
-void gyro_fr_settle(gyro_t *g);
 void gyro_fr_mag(gyro_t *g);
 void gyro_fr_root(gyro_t *g);
 void gyro_fr_parts(gyro_t *g);
