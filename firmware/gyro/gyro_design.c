@@ -123,6 +123,15 @@ static gyro_design_status_t design_validity(const param_values_t *v, gyro_design
  * is judged after five of them. */
 #define GYRO_CONT_TAU_S 0.1
 
+/* The continuous test's expected response e (raw rate units) and its band, relative tol,
+ * as the verdict compares them: squared magnitudes. */
+static void cont_band(selftest_cfg_t *st, double e, double tol)
+{
+  st->cont_expect = (float)e;
+  st->cont_lo2 = (float)(e * e * (1.0 - tol) * (1.0 - tol));
+  st->cont_hi2 = (float)(e * e * (1.0 + tol) * (1.0 + tol));
+}
+
 /* Both self-tests (selftest.h). Their expectations were measured at the setpoint
  * selftest.ref_amp_v; the rate channel divides by the setpoint, so a response in deg/s
  * scales as ref_amp_v / amp_set_v. The continuous test's tone must lie above the rate's
@@ -163,9 +172,7 @@ static gyro_design_status_t design_selftest(const param_values_t *v, gyro_design
   /* (force rebalance: the expectation is the loop model's, design_fb) */
   if (st.cont_on != 0u && v->sense_mode != 1u && !(e > 0.0 && tol < 1.0))
     return GYRO_DESIGN_CONT_EXPECT;
-  st.cont_expect = (float)e;
-  st.cont_lo2 = (float)(e * e * (1.0 - tol) * (1.0 - tol));
-  st.cont_hi2 = (float)(e * e * (1.0 + tol) * (1.0 + tol));
+  cont_band(&st, e, tol);
   t->selftest = st;
   return GYRO_DESIGN_OK;
 }
@@ -478,9 +485,7 @@ static gyro_design_status_t design_fb(const param_values_t *v, gyro_design_t *t)
      * the default's 2.5). */
     st->cont_gate_bits = RATE_INVALID_SETTLING;
     st->cont_gate_blocks = (uint32_t)(3.0 * GYRO_CONT_TAU_S * fs / GYRO_BLOCK);
-    st->cont_expect = (float)e;
-    st->cont_lo2 = (float)(e * e * (1.0 - tol) * (1.0 - tol));
-    st->cont_hi2 = (float)(e * e * (1.0 + tol) * (1.0 + tol));
+    cont_band(st, e, tol);
   }
   /* The self-test's force would go onto the same electrodes, past the loop: the
    * continuous one goes into the loop's command (selftest.h), a small part of what the

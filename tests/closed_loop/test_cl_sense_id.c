@@ -56,12 +56,7 @@ static double model_gain(const plant_cfg_t *pc, const param_values_t *v)
  * model: the sweep replaces it), no autostart: the sweep runs from power-on. */
 static void part_values(const plant_cfg_t *pc, param_values_t *v)
 {
-  default_part_values(v);
-  sense_test_cal_moved(v, pc->f_sense_hz, pc->q_sense);
-  v->sys_autostart = 0u;
-  v->sense_cal = 1u;
-  v->sense_mode = 1u;
-  v->cal_ref_sense_mode = 1u; /* the model's calibration is force rebalance's */
+  sense_test_fr_sweep_values(v, pc->f_sense_hz, pc->q_sense);
 }
 
 /* The plant's sense resonance now, (2-32) at the structure temperature. */

@@ -47,12 +47,7 @@ static plant_cfg_t part(double f_sense_hz, double q_sense)
  * sense identification and force rebalance on, tuning `mode` (split_hz), no autostart. */
 static void part_values(const plant_cfg_t *pc, uint32_t mode, double split_hz, param_values_t *v)
 {
-  default_part_values(v);
-  sense_test_cal_moved(v, pc->f_sense_hz, pc->q_sense);
-  v->sys_autostart = 0u;
-  v->sense_cal = 1u;
-  v->sense_mode = 1u;
-  v->cal_ref_sense_mode = 1u; /* the model's calibration is force rebalance's */
+  sense_test_fr_sweep_values(v, pc->f_sense_hz, pc->q_sense);
   v->sense_tune = mode;
   v->sense_tune_split_hz = (float)split_hz;
 }

@@ -6,6 +6,7 @@
 
 #include <math.h>
 
+#include "default_part.h"
 #include "dsp/math_const.h"
 #include "params/params.h"
 #include "plant/plant.h"
@@ -36,6 +37,20 @@ static inline void sense_test_cal_moved(param_values_t *v, double f_hz, double q
   mode_response(f_hz, q, wc, &m1, &a1);
   v->rate_demod_phase_deg += (float)((a1 - a0) * FM_DEG_PER_RAD);
   v->rate_scale_dps = (float)((double)v->rate_scale_dps * m0 / m1);
+}
+
+/* The default part's values, its rate calibration moved to a sense mode at f_hz of
+ * quality q (declared force rebalance's: a calibration of another sense configuration is
+ * stale), the sense identification and force rebalance on, no autostart: the sweep runs
+ * from power-on. */
+static inline void sense_test_fr_sweep_values(param_values_t *v, double f_hz, double q)
+{
+  default_part_values(v);
+  sense_test_cal_moved(v, f_hz, q);
+  v->sys_autostart = 0u;
+  v->sense_cal = 1u;
+  v->sense_mode = 1u;
+  v->cal_ref_sense_mode = 1u;
 }
 
 /* The default plant with its sense mode at SENSE_TEST_F_HZ of quality q_sense, the
