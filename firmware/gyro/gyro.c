@@ -74,6 +74,13 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   return 0;
 }
 
+/* The sense demodulator's step: the sweep's own in SWEEP (gyro_design.h sweep_mu_sense),
+ * the design's (open loop's or force rebalance's) otherwise. */
+static float gyro_sense_mu(const gyro_t *g, const gyro_design_t *d)
+{
+  return g->sup.mode == GYRO_MODE_SWEEP ? d->sweep_mu_sense : d->lmsd_sense.mu;
+}
+
 /* Force rebalance (sense.mode 1): turned on or off, or its electrodes' configuration
  * changed, the loop starts again from zero force (on the next LOCKED block), and turned
  * off, the feedback pair's second channel back to mid-scale (0 V; the first is written
@@ -122,7 +129,7 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
   /* The LMSDs' step sizes sit beside their weights (lmsd_t: the one coefficient the
    * per-sample step reads, within the same load). */
   (void)lmsd_set_mu(&g->lmsd_drive, d->lmsd_drive.mu);
-  (void)lmsd_set_mu(&g->lmsd_sense, d->lmsd_sense.mu);
+  (void)lmsd_set_mu(&g->lmsd_sense, gyro_sense_mu(g, d));
   drive_loop_reconfigure(&d->drive, &g->drive);
   if (d->track != 0u) {
     g->drive.p_rad = d->drive.p_init_rad; /* the tracking drive's force phase is p_init */
@@ -199,8 +206,9 @@ static void gyro_sweep_electrodes_off(gyro_t *g)
 void gyro_stop(gyro_t *g)
 {
   supervisor_stop(&g->sup);
-  if (g->quad.mode != QUAD_NULL_OFF) gyro_quad_off(g); /* its electrodes at 0 V */
-  if (g->fr.run != 0u) gyro_fr_off(g);                 /* no feedback force */
+  (void)lmsd_set_mu(&g->lmsd_sense, gyro_sense_mu(g, g->design)); /* a sweep's is over */
+  if (g->quad.mode != QUAD_NULL_OFF) gyro_quad_off(g);            /* its electrodes at 0 V */
+  if (g->fr.run != 0u) gyro_fr_off(g);                            /* no feedback force */
   gyro_sweep_electrodes_off(g);
   drive_loop_reset(&g->design->drive, &g->drive);
   /* No force is synthesised in OFF; the next start's first ticks (until its first
@@ -218,6 +226,7 @@ void gyro_sweep_begin(gyro_t *g)
   gyro_stop(g); /* the nulling electrodes at 0 V too: the sweep measures the part as it
                  * is, and the loop starts again, with its probe, after it */
   supervisor_enter_sweep(&g->sup);
+  (void)lmsd_set_mu(&g->lmsd_sense, gyro_sense_mu(g, g->design));
   selfcal_exec_reset(&g->cal, g->nco.half_step);
 }
 
@@ -239,6 +248,7 @@ int gyro_sweep_handover(gyro_t *g, const gyro_design_t *d)
   g->drive.p_eq_rad = g->drive.p_rad;
   supervisor_stop(&g->sup);
   supervisor_start(&g->sup);
+  (void)lmsd_set_mu(&g->lmsd_sense, gyro_sense_mu(g, d));
   return 0;
 }
 

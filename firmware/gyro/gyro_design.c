@@ -223,6 +223,7 @@ static gyro_design_status_t design_demod(const param_values_t *v, gyro_design_t 
   if (!(lmsd_bandwidth_hz((double)v->demod_mu_sense, fs) > 0.0)) return GYRO_DESIGN_MU_SENSE;
   t->lmsd_drive.mu = v->demod_mu_drive;
   t->lmsd_sense.mu = v->demod_mu_sense;
+  t->sweep_mu_sense = v->demod_mu_sense;
   return GYRO_DESIGN_OK;
 }
 

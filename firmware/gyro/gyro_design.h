@@ -70,6 +70,11 @@ typedef struct {
   /* Mode tuning (sense.tune, sense_tune.h): the background's (app.c), which applies its
    * voltage through gyro_set_tune; the sample path reads none of it. */
   sense_tune_cfg_t tune;
+  /* The sweep's sense demodulator step (demod.mu_sense, open loop's in every sense mode):
+   * its sense jobs' means and back-off threshold are designed for it, and force
+   * rebalance's sense.fr_mu (a pole at 1.2 kHz, for the loop) passes enough of the 2 wc
+   * ripple to trip the back-off at wc (gyro_sweep_begin). Off the sample path. */
+  float sweep_mu_sense;
   /* Last: the NCO's configuration is the background's (three doubles); before the sample
    * path's parts it pushed force rebalance's settling test past the 1020-byte reach of a
    * VLDR's offset (an extra address computation on a tick at its budget). */
