@@ -127,8 +127,9 @@ GYRO_RAMFUNC static inline float half_nonneg(float x)
  * Im F / (2 x larger), since the root of the difference of two near-equal numbers
  * (|F| - |Re F| with Im F small) would keep none of its digits; the larger part is at
  * least sqrt(|F| / 2), so the divide is safe except at F = 0. Two square roots and a
- * divide (drive_synth_phasor_parts), no arc tangent. Where arg F crosses pi the root changes sign, and with it both
- * voltages, which leaves U1^2 - U2^2, the force, unchanged (as a turn of P does). DC+AC:
+ * divide (drive_synth_phasor_parts), no arc tangent. Of the two roots +-sqrt(F) (both give
+ * the force: U1^2 - U2^2 is the same) it keeps the one nearer the last, so that the
+ * voltages do not flip where arg F crosses pi (the principal root's cut). DC+AC:
  * the AC amplitude phasor F / (4 D) (6-21), no root. A non-finite F drives nothing. */
 GYRO_RAMFUNC void drive_synth_phasor_mag(drive_synth_phasor_t *ph, float f_re_v2, float f_im_v2)
 {
@@ -153,13 +154,23 @@ GYRO_RAMFUNC void drive_synth_phasor_parts(const drive_synth_t *ds, drive_synth_
     return;
   }
   const float t = ph->root_v;
+  float a, b;
   if (f_re >= 0.0f) {
-    ph->a_v = t;
-    ph->b_v = t > 0.0f ? f_im / (2.0f * t) : 0.0f;
+    a = t;
+    b = t > 0.0f ? f_im / (2.0f * t) : 0.0f;
   } else { /* t > 0: |Re F| > 0 */
-    ph->a_v = fm_absf(f_im) / (2.0f * t);
-    ph->b_v = f_im < 0.0f ? -t : t;
+    a = fm_absf(f_im) / (2.0f * t);
+    b = f_im < 0.0f ? -t : t;
   }
+  /* Of the two roots, the one nearer the last: a force near the principal root's cut
+   * (Re F < 0, Im F ~ 0: a negative rate with the quadrature nulled, or none) would
+   * otherwise flip both voltages whenever noise moves Im F across 0. */
+  if (a * ph->a_v + b * ph->b_v < 0.0f) {
+    a = -a;
+    b = -b;
+  }
+  ph->a_v = a;
+  ph->b_v = b;
 }
 
 GYRO_RAMFUNC void drive_synth_set_phasor(drive_synth_t *ds, const drive_synth_phasor_t *ph,

@@ -50,6 +50,7 @@ typedef struct {
   double gap_m;       /* the feedback electrodes' gap (plant.fb_gap_m), 0: no softening */
   double f_sense_hz;  /* the plant's sense resonance, before any softening */
   int model_softened; /* the model's f0 with the DC bias's softening (1), or without (0) */
+  int pickoff_noise;  /* the default plant's sense pickoff noise and Brownian force on (1) */
 } fr_part_t;
 
 /* The sense resonance the loop sees: under DC+AC with a gap the bias softens the sense
@@ -71,6 +72,12 @@ static void start_part(const fr_part_t *fp)
   pc.f_sense_hz = fp->f_sense_hz;
   pc.fb_gap_m = fp->gap_m;
   if (fp->fb_scheme == 1u) pc.fb_mode = 2;
+  if (fp->pickoff_noise) {
+    plant_cfg_t d;
+    plant_default_cfg(&d);
+    pc.pick_sense_noise_v_rthz = d.pick_sense_noise_v_rthz;
+    pc.brownian = d.brownian;
+  }
   const double f0 = fp->model_softened ? softened_f_hz(&pc) : pc.f_sense_hz;
   param_values_t v;
   default_part_values(&v);
@@ -93,7 +100,7 @@ static void start_part(const fr_part_t *fp)
 /* The part with a sense mode of quality q_sense at F_SENSE_HZ, the half-frequency pair. */
 static void start_q(uint32_t sense_mode, double quad_dps, double q_sense)
 {
-  const fr_part_t fp = {sense_mode, quad_dps, q_sense, 0u, 0.0, F_SENSE_HZ, 1};
+  const fr_part_t fp = {sense_mode, quad_dps, q_sense, 0u, 0.0, F_SENSE_HZ, 1, 0};
   start_part(&fp);
 }
 
@@ -243,7 +250,7 @@ static void test_step_settles_within_10_ms(void **state)
 static void test_dcac_step_settles_within_10_ms(void **state)
 {
   (void)state;
-  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, 0.0, F_SENSE_HZ, 1};
+  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, 0.0, F_SENSE_HZ, 1, 0};
   start_part(&fp);
   (void)check_closed_step("DC+AC");
   assert_int_equal(app.gyro.fb_synth.scheme, GYRO_DRIVE_DC_AC);
@@ -268,7 +275,7 @@ static double unsoftened_f_hz(void)
 static void test_dcac_softened_model(void **state)
 {
   (void)state;
-  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, GAP_M, unsoftened_f_hz(), 1};
+  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, GAP_M, unsoftened_f_hz(), 1, 0};
   start_part(&fp);
   /* the model's split, wd - wc of its pole (sense_fr.h), is the step test's 110 Hz */
   assert_true(fabs((double)app.gyro.design->fr.p_im / (2.0 * FM_PI) - 110.1) < 0.5);
@@ -278,7 +285,7 @@ static void test_dcac_softened_model(void **state)
 static void test_dcac_unsoftened_model_misses(void **state)
 {
   (void)state;
-  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, GAP_M, unsoftened_f_hz(), 0};
+  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, GAP_M, unsoftened_f_hz(), 0, 0};
   start_part(&fp);
   const step_t r = run_step();
   printf("# force rebalance, DC+AC, 2 um gap, model at the unsoftened %.1f Hz (the loop sees "
@@ -507,10 +514,60 @@ static void test_cont_selftest_closed_loop(void **state)
   }
 }
 
+/* A part without quadrature (as a nulled one looks to the loop: quad.null moves it to the
+ * nulling electrodes), turning at +-200 deg/s: for one sign of the rate the force the
+ * loop commands lies on the negative real axis, where the half-frequency root's
+ * principal branch has its cut (drive_synth_phasor_parts). The pickoff's noise moves
+ * Im F across 0 every few blocks and each crossing turned both voltages by 180 degrees:
+ * before, here +200 read 203.0 deg/s, valid, sd 0.96 against -200's 0.06 (and in
+ * gyro-sim, on the part tools/calibrate --sense fr calibrated, whose feedback gain has
+ * the other sign, -200 read -201.4 deg/s, valid, 25 times the noise of +200; with
+ * quad.null the nulling flagged QUAD_NULL for most of every dwell of that sign). The
+ * two signs are judged against each other. */
+static void held_rate(double rate_dps, double *mean, double *sd, long *valid)
+{
+  app_plant_hold_rate(rate_dps);
+  hal_host_run((uint64_t)(0.3 * 50000.0));
+  const long n = (long)(0.5 / BLOCK_S);
+  double s = 0.0, s2 = 0.0;
+  *valid = 0;
+  for (long i = 0; i < n; i++) {
+    hal_host_run(GYRO_BLOCK);
+    const double r = (double)app.gyro.out.rate_dps;
+    s += r;
+    s2 += r * r;
+    *valid += app.gyro.out.rate_valid != 0u;
+  }
+  *mean = s / (double)n;
+  *sd = sqrt(fmax(s2 / (double)n - *mean * *mean, 0.0));
+}
+
+static void test_negative_rate_on_the_branch_cut(void **state)
+{
+  (void)state;
+  const fr_part_t fp = {1u, 0.0, 1.0e4, 0u, 0.0, F_SENSE_HZ, 1, 1};
+  start_part(&fp);
+  hal_host_run((uint64_t)(T_STEP_S * 50000.0));
+  double m_rest, sd_rest, m_pos, sd_pos, m_neg, sd_neg;
+  long v_rest, v_pos, v_neg;
+  held_rate(0.0, &m_rest, &sd_rest, &v_rest);
+  held_rate(200.0, &m_pos, &sd_pos, &v_pos);
+  held_rate(-200.0, &m_neg, &sd_neg, &v_neg);
+  printf("# no quadrature, pickoff noise on: at rest %.3f deg/s (sd %.3f), +200 deg/s reads "
+         "%.3f (sd %.3f, valid %ld), -200 reads %.3f (sd %.3f, valid %ld)\n",
+         m_rest, sd_rest, m_pos, sd_pos, v_pos, m_neg, sd_neg, v_neg);
+  /* the scale is the model's (0.9 %): the two signs agree about the bias at rest, each
+   * within its noise */
+  assert_true(fabs(m_pos + m_neg - 2.0 * m_rest) <= 0.05);
+  assert_true(fmax(sd_pos, sd_neg) <= 2.0 * fmin(sd_pos, sd_neg) + 0.01);
+  assert_int_equal(app.gyro.sup.fault_count, 0u);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_step_settles_within_10_ms),
+      cmocka_unit_test(test_negative_rate_on_the_branch_cut),
       cmocka_unit_test(test_cont_selftest_closed_loop),
       cmocka_unit_test(test_dcac_step_settles_within_10_ms),
       cmocka_unit_test(test_dcac_softened_model),
