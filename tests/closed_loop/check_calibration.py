@@ -94,6 +94,10 @@ def usage(sim):
         (["--sim", "--out", "X", "--gyro-sim", "/nonexistent/gyro-sim"], "no simulator"),
         (["--sim", "--seed", "-1", "--out", "X"], "--seed"),
         (["--out", "X"], "--sim"),
+        (["--sim", "--fb-scheme", "dcac", "--out", "X"], "needs --sense fr"),
+        (["--sim", "--tune", "matched", "--out", "X"], "needs --sense fr"),
+        (["--sim", "--sense", "closed", "--out", "X"], "invalid choice"),
+        (["--sim", "--sense", "fr", "--verify-only", CAL, "--out", "X"], "its own configuration"),
     ]
     bad = 0
     with tempfile.TemporaryDirectory() as d:

@@ -105,6 +105,52 @@ class SimPart:
     work: str       # folder for the stages' files
     protocol: thermcal.Protocol = thermcal.FULL  # the thermal profiles (--quick: QUICK)
     port: object = None  # a calport.PortTarget: the stages run on a part behind a UART
+    # the sense configuration calibrated (sense_config): firmware name -> value, set
+    # before the sweep; the later stages inherit it through the param sets
+    config: dict = dataclasses.field(default_factory=dict)
+
+
+# The sense configurations the flow calibrates (tools/calibrate --sense, --fb-scheme,
+# --quad-null, --tune): a calibration holds in the configuration it was made in only
+# (cal.ref_sense_mode, cal.ref_quad_null, cal.ref_tune_v; gyro_design.c).
+SENSE_MODES = {"open": 0, "fr": 1}
+FB_SCHEMES = {"half": 0, "dcac": 1}
+TUNE_MODES = {"off": 0, "matched": 1, "split": 2}
+
+
+def sense_config(sense="open", fb_scheme=None, quad_null=False, tune="off"):
+    """The firmware settings of a sense configuration, by name: force rebalance (with its
+    feedback scheme), quadrature nulling, mode tuning. The sweep identifies the sense
+    mode (sense.cal 1) whenever force rebalance or tuning needs its model. Raises
+    InputError for a combination the firmware refuses (matched tuning is force
+    rebalance's: open loop, a matched mode rings for seconds, issue 19)."""
+    if sense not in SENSE_MODES or tune not in TUNE_MODES or \
+            (fb_scheme is not None and fb_scheme not in FB_SCHEMES):
+        raise InputError(f"sense configuration {sense!r}, {fb_scheme!r}, {tune!r}: "
+                         f"--sense {'|'.join(SENSE_MODES)}, --fb-scheme "
+                         f"{'|'.join(FB_SCHEMES)}, --tune {'|'.join(TUNE_MODES)}")
+    if fb_scheme is not None and sense != "fr":
+        raise InputError("--fb-scheme chooses force rebalance's feedback electrodes: "
+                         "it needs --sense fr")
+    if tune == "matched" and sense != "fr":
+        raise InputError("--tune matched needs --sense fr (the firmware runs a matched "
+                         "part in force rebalance only)")
+    cfg = {}
+    if sense == "fr":
+        cfg["sense.mode"] = 1
+        cfg["sense.fb_scheme"] = FB_SCHEMES[fb_scheme or "half"]
+    if quad_null:
+        cfg["quad.null"] = 1
+    if tune != "off":
+        cfg["sense.tune"] = TUNE_MODES[tune]
+    if sense == "fr" or tune != "off":
+        cfg["sense.cal"] = 1
+    return cfg
+
+
+def force_rebalance(values):
+    """The values run force rebalance (sense.mode 1)."""
+    return int(values.get("sense.mode", 0)) == 1
 
 
 def shown_path(path):
@@ -142,7 +188,7 @@ def selfcal(part):
     """Stage 1: the firmware's sweep from its generic defaults -> a param set."""
     out = os.path.join(part.work, "selfcal_params.json")
     if part.port is not None:
-        f = part.port.selfcal(out)
+        f = part.port.selfcal(out, part.config)
         return out, {"command": part.port.describe("sweep"), "f0_hz": f["selfcal_f0_hz"],
                      "q": f["selfcal_q"], "s": f["selfcal_s"], "true_f0_hz": None,
                      "true_q": None}
@@ -150,13 +196,41 @@ def selfcal(part):
     scen = _scenario(part, "calibrate_selfcal", {
         "description": "a fresh part's self-calibration from the firmware's generic defaults",
         "duration_s": 0.2, "selfcal": True})
+    config = []
+    for k, v in part.config.items():
+        config += ["--set", f"firmware.{k}={v}"]
     cmd = _run(part, ["--scenario", scen, "--seed", str(part.seed), "--no-analysis", "--quiet",
-                      "--save-params", out, "--json", figs], "self-calibration")
+                      "--save-params", out, "--json", figs] + config, "self-calibration")
     with open(figs, encoding="utf-8") as fh:
         f = json.load(fh)["figures"]
-    return out, {"command": " ".join(cmd), "f0_hz": f.get("selfcal_f0_hz"),
-                 "q": f.get("selfcal_q"), "s": f.get("selfcal_s"),
-                 "true_f0_hz": f.get("selfcal_true_f0_hz"), "true_q": f.get("selfcal_true_q")}
+    res = {"command": " ".join(cmd), "f0_hz": f.get("selfcal_f0_hz"),
+           "q": f.get("selfcal_q"), "s": f.get("selfcal_s"),
+           "true_f0_hz": f.get("selfcal_true_f0_hz"), "true_q": f.get("selfcal_true_q")}
+    if part.config.get("sense.cal"):
+        res["sense"] = _sense_identified(f, part.config)
+    if part.config.get("sense.tune") and not paramset.read(out).values().get("sense.cal_s0_hz"):
+        raise FlowError("self-calibration: mode tuning asked for, but the sweep did not tune "
+                        "the part (its sense resonance at or below the target, or no match "
+                        "within the tuning electrodes' reach)")
+    return out, res
+
+
+def _sense_identified(f, config):
+    """The sweep's sense identification (sense.cal 1) from gyro-sim's figures, beside the
+    plant's truth; a configuration that needs the model fails the stage without it."""
+    keys = ("f0_hz", "q", "fb_gain_v_per_v2", "fb_phase_deg", "tune_ke_per_s2_per_v2")
+    res = {"identified": bool(f.get("selfcal_sense_identified")), "s": f.get("selfcal_sense_s")}
+    for k in keys:
+        res[k] = f.get("selfcal_sense_" + k)
+        res["true_" + k] = f.get("selfcal_true_sense_" + k)
+    if not res["identified"]:
+        raise FlowError("self-calibration: the sense mode was not identified ("
+                        f"{f.get('selfcal_sense_why') or 'no reason given'}); the "
+                        "configuration asked for needs its model")
+    if config.get("sense.tune") and not res["tune_ke_per_s2_per_v2"]:
+        raise FlowError("self-calibration: mode tuning asked for, but the sweep found no "
+                        f"tuning slope ({f.get('selfcal_sense_tune_why') or 'no reason given'})")
+    return res
 
 
 # The fixed drive's reach (gyro/selfcal.h SELFCAL_Q_FIXED_MAX): above it the sweep commits
@@ -417,10 +491,15 @@ def selftest(part, values, lock_s=0.0):
     """Stage 3: the self-test expectations, measured on the calibrated part at rest. The
     commands wait for the drive's lock (lock_s, as the rate table measured it: the fixed
     drive on a Q 3000 part locks after about 3 s, and a self-test asked at 1 s was refused:
-    'response 0 deg/s'); unchanged where it locks within half a second."""
+    'response 0 deg/s'); unchanged where it locks within half a second. Force rebalance
+    has no on-demand test (its force would go past the loop, onto the loop's electrodes)
+    and judges the continuous one against the loop model (gyro_design.c), nothing to
+    calibrate: the stage checks that the part answers the model (selftest_fr)."""
     path = os.path.join(part.work, "selftest_params.json")
     paramset.write(path, paramset.from_values(values, meta={"stage": "self-test"}))
     lead = float(np.ceil(lock_s)) if lock_s > 0.5 else 0.0
+    if force_rebalance(values):
+        return selftest_fr(part, path, values, lead)
     scen = _scenario(part, "calibrate_selftest", {
         "description": "the self-test's responses on the calibrated part at rest",
         "duration_s": 6.0 + lead, "commands": [
@@ -442,6 +521,37 @@ def selftest(part, values, lock_s=0.0):
     v["selftest.cont_expect_dps"] = cont
     v["selftest.ref_amp_v"] = v["drive.amp_set_v"]
     return v, {"command": cmd, "expect_dps": on_demand, "cont_expect_dps": cont}
+
+
+def cont_verdict(reply, tol_rel):
+    """The continuous self-test in a status reply against its expectation: (response,
+    expectation, within selftest.tol_rel of it), (None, None, False) when not shown."""
+    got = _status_value(reply, "selftest_cont_dps")
+    want = _status_value(reply, "selftest_cont_expect_dps")
+    if got is None or want is None:
+        return None, None, False
+    got, want = float(got), float(want)
+    return got, want, bool(want > 0.0 and abs(got - want) <= tol_rel * want)
+
+
+def selftest_fr(part, path, values, lead):
+    """Stage 3 in force rebalance: the continuous test's response on the calibrated part
+    at rest against the loop model's expectation (the firmware's own, `status`), within
+    the verdict's band; the set is unchanged."""
+    scen = _scenario(part, "calibrate_selftest", {
+        "description": "force rebalance's continuous self-test on the calibrated part at rest",
+        "duration_s": 4.0 + lead, "commands": [[3.9 + lead, "status"]]})
+    _, replies, cmd = _sim(part, path, scen, part.seed, "self-test")
+    tol = values.get("selftest.tol_rel", 0.1)
+    cont, model, ok = cont_verdict(replies[-1] if replies else None, tol)
+    if cont is None:
+        raise FlowError(f"self-test: no continuous response in the status reply ({cmd})")
+    if not ok:
+        raise FlowError(f"self-test: force rebalance's continuous response {cont:.4g} deg/s "
+                        f"against the loop model's {model:.4g}, beyond +-{100 * tol:g} %: the "
+                        "loop or its identified model is not the part's")
+    return dict(values), {"command": cmd, "expect_dps": None, "cont_expect_dps": model,
+                          "cont_dps": cont, "cont_model": True}
 
 
 def part_id(sets):
@@ -521,14 +631,20 @@ def verify(part, cal_path):
         VERIFY_RATES_DPS, VERIFY_DWELL_S, VERIFY_REST_S) + [[2.5, 0]]
     duration = sum(st[0] for st in steps)
     # The on-demand self-test in the last 1.2 s, at rest; the rate is judged before it.
+    # Force rebalance has none: its continuous test, against the loop model, at the end.
     t_selftest = duration - 1.2
+    cal = paramset.read(cal_path).values()
+    fr = force_rebalance(cal)
     scen = _scenario(part, "calibrate_verify", {
         "description": "verification of a calibration: rates and dwell the fit never saw",
         "duration_s": duration, "csv_rate_hz": 200,
         "rate_dps": {"kind": "steps", "edge_s": 0.1, "steps": steps},
-        "commands": [[t_selftest, "selftest"], [duration - 0.05, "status"]]})
+        "commands": ([] if fr else [[t_selftest, "selftest"]]) + [[duration - 0.05, "status"]]})
     log, replies, cmd = _sim(part, cal_path, scen, seed, "verify", csv=True)
     st_state = _status_value(replies[-1] if replies else None, "selftest")
+    if fr:
+        ok = cont_verdict(replies[-1] if replies else None, cal.get("selftest.tol_rel", 0.1))[2]
+        st_state = "continuous PASS" if ok else "continuous FAIL"
     t, out, truth = log["t_s"], log["rate_dps"], log["rate_true_dps"]
     valid = log["rate_valid"] > 0.5
     res = scalefactor.analyse(t, out, rate_true_dps=truth, settle_s=SETTLE_S,
@@ -561,7 +677,7 @@ def verify(part, cal_path):
         "bias_at_rest": bool(np.isfinite(bias) and abs(bias) <= VERIFY_BIAS_DPS),
         "valid_fraction": valid_frac >= VERIFY_VALID_FRAC,
         "no_valid_wrong_rate": worst <= VERIFY_MAX_ERR_DPS,
-        "selftest": st_state == "PASS",
+        "selftest": st_state in ("PASS", "continuous PASS"),
     }
     return {"command": cmd, "seed": seed, "rates_dps": list(VERIFY_RATES_DPS),
             "dwell_s": VERIFY_DWELL_S, "lead_s": lead, "scale_factor": sf, "scale_factor_ppm": sf_ppm,
@@ -636,4 +752,5 @@ def check_sets(sets):
         key = s.split("=", 1)[0]
         if "=" not in s or not key.startswith("plant."):
             raise InputError(f"--set {s}: only plant.KEY=V chooses the part (the firmware's "
-                             "values are what the flow finds)")
+                             "values are what the flow finds; its sense configuration is "
+                             "--sense, --fb-scheme, --quad-null and --tune)")

@@ -27,6 +27,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import sys
+import time
 
 import numpy as np
 
@@ -307,19 +308,29 @@ class PortTarget:
 
     @staticmethod
     def _cmd(link, line):
-        r = link.command(line)
+        """One command; PENDING (the sample loop has not yet taken the last change) is
+        retried as gyroctl load-params retries it; any other refusal raises."""
+        from gyroctl_lib import load_params
+        for _ in range(load_params.PENDING_RETRIES):
+            r = link.command(line)
+            if r.ok or r.code != "PENDING":
+                break
+            time.sleep(0.01)
         if not r.ok:
             raise PortError(f"the part refused `{line}`: {r.final}")
         return r
 
-    def selfcal(self, out_params):
-        """The firmware's sweep from its generic defaults, its result saved and read back
-        as a param set (the persistent values): the figures of `status`."""
+    def selfcal(self, out_params, config=None):
+        """The firmware's sweep from its generic defaults and the sense configuration
+        config (name -> value, calflow.sense_config), its result saved and read back as a
+        param set (the persistent values): the figures of `status`."""
         from gyroctl_lib import sweep
         link = self._link()
         try:
             for line in ("drive off", "defaults"):
                 self._cmd(link, line)
+            if config:
+                self._cmd(link, "set " + " ".join(f"{k} {v}" for k, v in config.items()))
             try:
                 st = sweep.run_and_wait(link, timeout_s=600.0)
             except sweep.SweepError as e:

@@ -1,9 +1,13 @@
 """The calibration record (calflow.record): cal.ref_tune_v is the mode tuning's voltage at
 its own reference, the firmware's (firmware/gyro/sense_tune.h), so that another tuning
-makes the calibration stale; untuned it is 0."""
+makes the calibration stale; untuned it is 0. The sense configuration the flow calibrates
+(calflow.sense_config) is the firmware settings it names, and the record carries it."""
 import math
 
+import pytest
+
 from gyrotools import calflow
+from gyrotools.errors import InputError
 
 BASE = {"drive.freq_hz": 1489.86, "drive.phase_set_deg": 0.0, "drive.track": 0}
 
@@ -53,3 +57,28 @@ def test_the_record_names_its_sense_configuration():
     v.update({"sense.mode": 1, "quad.null": 1})
     r = calflow.record(v, [])
     assert r["cal.ref_sense_mode"] == 1 and r["cal.ref_quad_null"] == 1
+
+
+def test_the_sense_configuration_is_the_firmware_settings_it_names():
+    sc = calflow.sense_config
+    assert sc() == {}
+    assert sc("fr") == {"sense.mode": 1, "sense.fb_scheme": 0, "sense.cal": 1}
+    assert sc("fr", "dcac", quad_null=True) == {"sense.mode": 1, "sense.fb_scheme": 1,
+                                                "quad.null": 1, "sense.cal": 1}
+    assert sc("fr", tune="matched") == {"sense.mode": 1, "sense.fb_scheme": 0,
+                                        "sense.tune": 1, "sense.cal": 1}
+    # a split tunes open loop too; nulling alone needs no sense model
+    assert sc(tune="split") == {"sense.tune": 2, "sense.cal": 1}
+    assert sc(quad_null=True) == {"quad.null": 1}
+
+
+@pytest.mark.parametrize("args", [("open", "half"), ("open", None, False, "matched"),
+                                  ("closed",), ("fr", "ac"), ("fr", None, False, "on")])
+def test_a_sense_configuration_the_firmware_refuses_is_refused(args):
+    with pytest.raises(InputError):
+        calflow.sense_config(*args)
+
+
+def test_the_record_of_a_force_rebalance_calibration_names_it():
+    v = calflow.record(dict(BASE, **calflow.sense_config("fr", quad_null=True)), [])
+    assert v["cal.ref_sense_mode"] == 1 and v["cal.ref_quad_null"] == 1
