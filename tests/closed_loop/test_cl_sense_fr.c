@@ -51,6 +51,7 @@ typedef struct {
   double f_sense_hz;  /* the plant's sense resonance, before any softening */
   int model_softened; /* the model's f0 with the DC bias's softening (1), or without (0) */
   int pickoff_noise;  /* the default plant's sense pickoff noise and Brownian force on (1) */
+  double dtemp_k;     /* the ambient (all nodes at steady state) this far from the model's */
 } fr_part_t;
 
 /* The sense resonance the loop sees: under DC+AC with a gap the bias softens the sense
@@ -72,6 +73,7 @@ static void start_part(const fr_part_t *fp)
   pc.f_sense_hz = fp->f_sense_hz;
   pc.fb_gap_m = fp->gap_m;
   if (fp->fb_scheme == 1u) pc.fb_mode = 2;
+  pc.temp_k += fp->dtemp_k;
   if (fp->pickoff_noise) {
     plant_cfg_t d;
     plant_default_cfg(&d);
@@ -100,7 +102,7 @@ static void start_part(const fr_part_t *fp)
 /* The part with a sense mode of quality q_sense at F_SENSE_HZ, the half-frequency pair. */
 static void start_q(uint32_t sense_mode, double quad_dps, double q_sense)
 {
-  const fr_part_t fp = {sense_mode, quad_dps, q_sense, 0u, 0.0, F_SENSE_HZ, 1, 0};
+  const fr_part_t fp = {sense_mode, quad_dps, q_sense, 0u, 0.0, F_SENSE_HZ, 1, 0, 0.0};
   start_part(&fp);
 }
 
@@ -250,7 +252,7 @@ static void test_step_settles_within_10_ms(void **state)
 static void test_dcac_step_settles_within_10_ms(void **state)
 {
   (void)state;
-  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, 0.0, F_SENSE_HZ, 1, 0};
+  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, 0.0, F_SENSE_HZ, 1, 0, 0.0};
   start_part(&fp);
   (void)check_closed_step("DC+AC");
   assert_int_equal(app.gyro.fb_synth.scheme, GYRO_DRIVE_DC_AC);
@@ -275,7 +277,7 @@ static double unsoftened_f_hz(void)
 static void test_dcac_softened_model(void **state)
 {
   (void)state;
-  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, GAP_M, unsoftened_f_hz(), 1, 0};
+  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, GAP_M, unsoftened_f_hz(), 1, 0, 0.0};
   start_part(&fp);
   /* the model's split, wd - wc of its pole (sense_fr.h), is the step test's 110 Hz */
   assert_true(fabs((double)app.gyro.design->fr.p_im / (2.0 * FM_PI) - 110.1) < 0.5);
@@ -285,7 +287,7 @@ static void test_dcac_softened_model(void **state)
 static void test_dcac_unsoftened_model_misses(void **state)
 {
   (void)state;
-  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, GAP_M, unsoftened_f_hz(), 0, 0};
+  const fr_part_t fp = {1u, 1500.0, 1.0e4, 1u, GAP_M, unsoftened_f_hz(), 0, 0, 0.0};
   start_part(&fp);
   const step_t r = run_step();
   printf("# force rebalance, DC+AC, 2 um gap, model at the unsoftened %.1f Hz (the loop sees "
@@ -545,7 +547,7 @@ static void held_rate(double rate_dps, double *mean, double *sd, long *valid)
 static void test_negative_rate_on_the_branch_cut(void **state)
 {
   (void)state;
-  const fr_part_t fp = {1u, 0.0, 1.0e4, 0u, 0.0, F_SENSE_HZ, 1, 1};
+  const fr_part_t fp = {1u, 0.0, 1.0e4, 0u, 0.0, F_SENSE_HZ, 1, 1, 0.0};
   start_part(&fp);
   hal_host_run((uint64_t)(T_STEP_S * 50000.0));
   double m_rest, sd_rest, m_pos, sd_pos, m_neg, sd_neg;
@@ -563,11 +565,51 @@ static void test_negative_rate_on_the_branch_cut(void **state)
   assert_int_equal(app.gyro.sup.fault_count, 0u);
 }
 
+/* The rebalanced quadrature over temperature, with the fixed drive: the Coriolis force
+ * follows the drive's velocity, which the phase loop holds to its setpoint; the force
+ * phase P does not (it is the thermometer: the resonance's phase at the fixed frequency
+ * moves with temperature, 6-12). A feedback frame turned with P turned the 1500 deg/s
+ * of rebalanced quadrature into rate at 1500 pi / 180 = 26.2 deg/s per degree of P:
+ * 0.84 deg of P between 25 and 45 degC, 22 deg/s of uncompensated bias (and a
+ * calibration's bias slope of 26.25 deg/s per degree of P: tools/calibrate --sense fr).
+ * The part started at two ambients (every node at steady state), the model made at the
+ * first: the uncompensated rate at rest moves by less than the sense mode's own
+ * temperature effects. */
+static double rest_unc_dps(double dtemp_k, double *p_deg)
+{
+  const fr_part_t fp = {1u, 1500.0, 1.0e4, 0u, 0.0, F_SENSE_HZ, 1, 0, dtemp_k};
+  start_part(&fp);
+  hal_host_run((uint64_t)(1.0 * 50000.0));
+  const long n = (long)(0.3 / BLOCK_S);
+  double s = 0.0, p = 0.0;
+  for (long i = 0; i < n; i++) {
+    hal_host_run(GYRO_BLOCK);
+    s += (double)app.gyro.out.rate_unc_dps;
+    p += (double)app.gyro.out.p_deg;
+  }
+  *p_deg = p / (double)n;
+  return s / (double)n;
+}
+
+static void test_rebalanced_quadrature_over_temperature(void **state)
+{
+  (void)state;
+  double p0, p1;
+  const double b0 = rest_unc_dps(0.0, &p0);
+  const double b1 = rest_unc_dps(20.0, &p1);
+  printf("# fixed drive, 1500 deg/s rebalanced: uncompensated rate at rest %.3f deg/s (P %.3f "
+         "deg), 20 K warmer %.3f deg/s (P %.3f deg): %+.3f deg/s over %+.3f deg of P\n",
+         b0, p0, b1, p1, b1 - b0, p1 - p0);
+  assert_true(fabs(p1 - p0) > 0.5); /* the thermometer moved */
+  assert_true(fabs(b1 - b0) <= 1.0);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_step_settles_within_10_ms),
       cmocka_unit_test(test_negative_rate_on_the_branch_cut),
+      cmocka_unit_test(test_rebalanced_quadrature_over_temperature),
       cmocka_unit_test(test_cont_selftest_closed_loop),
       cmocka_unit_test(test_dcac_step_settles_within_10_ms),
       cmocka_unit_test(test_dcac_softened_model),

@@ -68,3 +68,16 @@ def test_the_self_calibration_over_the_port_saves_a_loadable_set(port, tmp_path)
     assert figs["selfcal_q"] == pytest.approx(33.3, rel=0.05)
     v = paramset.read(str(out)).values()
     assert v["drive.freq_hz"] == pytest.approx(figs["selfcal_f0_hz"], abs=0.01)
+
+
+def test_the_self_calibration_over_the_port_runs_in_the_configuration_asked(port, tmp_path):
+    out = tmp_path / "selfcal.json"
+    calport.PortTarget(port, "emu").selfcal(str(out), {"quad.null": 1})
+    assert paramset.read(str(out)).values()["quad.null"] == 1
+
+
+def test_a_configuration_the_part_refuses_stops_the_self_calibration(port, tmp_path):
+    out = tmp_path / "selfcal.json"
+    with pytest.raises(calport.PortError, match="sense.mode 7"):
+        calport.PortTarget(port, "emu").selfcal(str(out), {"sense.mode": 7})
+    assert not out.exists()
