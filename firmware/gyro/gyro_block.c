@@ -386,24 +386,22 @@ GYRO_RAMFUNC void gyro_fr_parts(gyro_t *g)
   if (fr->run != 0u && fr->skip == 0u) drive_synth_phasor_parts(&g->fb_synth, &g->fb_root);
 }
 
-/* The Coriolis force is in phase with the drive velocity (2-22), which the phase loop
- * holds at its setpoint: the feedback force's frame is the drive motion's, theta = set +
- * delta as the rate channel forms it for its reference (rate_channel.h: the correction
- * delta carries the mode's lag of P's fast moves, not P's own jitter: at 1500 deg/s of
- * rebalanced quadrature 0.02 deg of it is 0.5 deg/s of rate). Not P itself: at the fixed
- * drive P is the thermometer (the resonance's phase at the fixed frequency, 6-12), and a
- * frame turned with it turned the rebalanced quadrature into rate at 1500 pi / 180 = 26
- * deg/s per degree of P (test_cl_sense_fr.c). The design's fb_theta_rad is
- * sense.fb_phase_deg plus drive.p_init_deg: the sweep identifies the feedback phase
- * against the drive force at lock (selfcal.h), P there being p_init, so that the frame
- * is the one it measured. The force goes to the synthesis as the loop's phasor, in that
- * frame (drive_synth_set_phasor: no arc tangent). */
+/* The Coriolis force is in phase with the drive velocity, which at the drive's resonance
+ * is in phase with the drive force cos(phi + P) (6-12), through the mode's lag 2Q/wn
+ * (6-17): the feedback force's frame turns with LP_tau(P) as the rate channel forms it
+ * for its reference (P - its lag still to come, rate_channel.h; the tracking drive's p_eq
+ * the same way), temperature included, not with P's own jitter (at 1500 deg/s of
+ * rebalanced quadrature 0.02 deg of it is 0.5 deg/s of rate), and
+ * sense.fb_phase_deg holds what differs between the two electrodes' paths and the
+ * drive's distance from its resonance phase. The force goes to the synthesis as the
+ * loop's phasor, in that frame (drive_synth_set_phasor: no arc tangent). */
 GYRO_RAMFUNC void gyro_fr_synth(gyro_t *g)
 {
   const sense_fr_t *fr = &g->fr;
+  const rate_channel_t *rc = &g->rate;
   if (fr->run != 0u && fr->skip == 0u)
     drive_synth_set_phasor(&g->fb_synth, &g->fb_root,
-                           g->rate.ref_dev_rad + g->design->fb_theta_rad);
+                           (rc->p_last_rad - rc->p_lag_rad) + g->design->fb_theta_rad);
 }
 
 GYRO_RAMFUNC void gyro_block_project(gyro_t *g)

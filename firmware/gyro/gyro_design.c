@@ -454,9 +454,7 @@ static gyro_design_status_t design_fb(const param_values_t *v, gyro_design_t *t)
   /* DC+AC: the converter carries the AC part only, at most v_max - Vb */
   if (!((double)v->sense_fb_v_max_v <= v_dac_max) || drive_synth_init(&probe, &t->fb_synth) != 0)
     return GYRO_DESIGN_SENSE_FB;
-  /* the frame's constant: the feedback phase against the drive force at lock (gyro_fr_synth) */
-  t->fb_theta_rad = (float)(((double)v->sense_fb_phase_deg + (double)v->drive_p_init_deg) *
-                            FM_PI / 180.0);
+  t->fb_theta_rad = v->sense_fb_phase_deg * FM_RAD_PER_DEG_F;
   t->sense_mode = v->sense_mode;
   const double fs = (double)v->sys_fs_hz;
   const double scale = fabs((double)v->rate_scale_dps);

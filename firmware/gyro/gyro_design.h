@@ -58,10 +58,9 @@ typedef struct {
   /* Force rebalance (sense.mode 1, sense_fr.h): its design is made in either mode (a bad
    * configuration is refused even in open loop); the sample path runs it only when
    * sense_mode is 1. fb_synth realises its force on the feedback electrodes (the drive
-   * synthesis's law, drive_synth.h); fb_theta_rad (sense.fb_phase_deg + drive.p_init_deg)
-   * is the Coriolis direction's force phase against the drive motion's frame
-   * (gyro_fr_synth), fb_off_v what the board adds to the converters' voltages (DC+AC:
-   * its bias stage's sense.fb_bias_v; half-frequency: 0). */
+   * synthesis's law, drive_synth.h); fb_theta_rad (sense.fb_phase_deg) turns the
+   * Coriolis direction's force phase from the drive force's P (gyro_fr_synth), fb_off_v what the board adds to the
+   * converters' voltages (DC+AC: its bias stage's sense.fb_bias_v; half-frequency: 0). */
   uint32_t sense_mode;
   drive_synth_cfg_t fb_synth;
   float fb_theta_rad;

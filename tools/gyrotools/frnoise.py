@@ -49,6 +49,7 @@ import threading
 import numpy as np
 
 from . import demodcal, frpart
+from .errors import InputError
 
 CSV_RATE_HZ = 2000.0
 AVG_RATE_HZ = 100.0
@@ -245,19 +246,49 @@ def analyse(rec, run, duration_s, settle_s):
 
 
 def case_args(exe, cal_path, scheme, study, ft_on, q_sense, extra, matched=False,
-              quad_null=False):
+              quad_null=False, own_cal=False):
     """gyro-sim --set arguments of a case (frpart.fr_args on the ideal preset, matched or
     not, then the case's plant settings, then extra). quad_null: the part with nulling
     electrodes (case_plant); the firmware's quad.null 1 is QUAD_NULL_FW, for the caller
-    to add after the calibration."""
+    to add after the calibration. own_cal: cal_path is the part's own calibration
+    (tools/calibrate on calibration_part's settings): the plant's arguments alone."""
     defaults = frpart.plant_values(exe)
     plant = case_plant(study, ft_on, defaults, quad_null)
     plant.pop("preset")
     args = frpart.fr_args(exe, cal_path, scheme, q_sense=q_sense, plant=plant,
-                          base=["plant.preset=ideal"], matched=matched)
+                          base=["plant.preset=ideal"], matched=matched, model=not own_cal)
     for s in extra:
         args += ["--set", s]
     return args
+
+
+# what a case's noise settings change and a calibration does not depend on: the part a
+# calibration for --cal is made on is the case's without them (calibration_part)
+NOISE_KEYS = tuple(k for k in BROWNIAN_ONLY if k not in ("preset", "brownian"))
+
+
+def calibration_part(q_sense=1e4, quad_null=False, scheme="half"):
+    """The plant settings (--set strings) of the part a case runs, for tools/calibrate:
+    the ideal preset's part with the case's sense mode, feedback pair and nulling
+    electrodes, its noise as the preset has it (the case's noise settings do not change
+    what a calibration measures)."""
+    fr = {"f_sense_hz": 1600.0, "q_sense": q_sense, "fb_mode": frpart.FB_MODE[scheme],
+          "ks_fb_mps2_per_v2": frpart.KS_FB}
+    if quad_null:
+        fr["quadnull_dps_per_v2"] = QN_DPS_PER_V2
+    return ["plant.preset=ideal"] + [f"plant.{k}={v:.9g}" for k, v in fr.items()]
+
+
+def check_own_cal(values, scheme, quad_null):
+    """A --cal set must be the case's configuration: force rebalance with its scheme and
+    nulling as asked. Raises InputError (why) otherwise."""
+    want = {"sense.mode": 1, "sense.fb_scheme": frpart.FB_SCHEME[scheme],
+            "quad.null": int(quad_null)}
+    bad = [f"{k} {values.get(k)} (the case needs {v})" for k, v in want.items()
+           if int(values.get(k, -1)) != v]
+    if bad:
+        raise InputError("--cal: not a calibration of this case's configuration: "
+                         + ", ".join(bad))
 
 
 def wrap_deg(x):

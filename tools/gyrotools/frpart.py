@@ -118,19 +118,22 @@ def model_values(cal, p_base, p, f0=None, q=None):
 
 
 def fr_args(exe, cal_path, scheme="half", f_sense_hz=1600.0, q_sense=1e4, plant=None,
-            base=(), matched=False):
+            base=(), matched=False, model=True):
     """gyro-sim --set arguments of the force-rebalance part: base (plant --set strings of
     the part the calibration cal_path was made on, its preset included), then the sense
     mode at f_sense_hz of quality q_sense, the feedback pair of scheme at KS_FB, then
     plant (name -> value, e.g. fb_gap_m, noise settings); the firmware's model from
     model_values. matched: with tuning electrodes of TUNE_KE, tuned onto the drive
-    (matched_values)."""
+    (matched_values). model=False: the plant's arguments alone (the part's own
+    calibration, e.g. from tools/calibrate --sense fr, supplies the firmware's values)."""
     if scheme not in FB_MODE:
         raise ValueError(f"scheme {scheme!r}: half or dcac")
     fr = {"f_sense_hz": f_sense_hz, "q_sense": q_sense, "fb_mode": FB_MODE[scheme],
           "ks_fb_mps2_per_v2": KS_FB,
           **({"tune_ke_per_s2_per_v2": TUNE_KE} if matched else {}), **(plant or {})}
     sets = list(base) + [f"plant.{k}={v:.9g}" for k, v in fr.items()]
+    if not model:
+        return [a for s in sets for a in ("--set", s)]
     p_base = plant_values(exe, base)
     p = plant_values(exe, sets)
     with open(cal_path, encoding="utf-8") as f:

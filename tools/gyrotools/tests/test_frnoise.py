@@ -6,11 +6,16 @@ tests/closed_loop/test_cl_sense_fr.c does); --quad-null gives the part its nulli
 electrodes, their noise off, and the firmware quad.null 1."""
 
 import math
+import os
 
 import numpy as np
 import pytest
 
 from gyrotools import frnoise, frpart
+from gyrotools.errors import InputError
+
+DEFAULT_CAL = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..",
+                           "host_sim", "parts", "default", "calibration.json")
 
 
 @pytest.mark.parametrize("args, why", [
@@ -19,6 +24,10 @@ from gyrotools import frnoise, frpart
     (["--duration", "10"], "--duration"),
     (["--q-sense", "0.1"], "--q-sense"),
     (["--gyro-sim", "/nonexistent/gyro-sim"], "not an executable"),
+    (["--cal", DEFAULT_CAL, "--schemes", "half"],
+     "not a calibration of this case's configuration"),
+    (["--cal", DEFAULT_CAL], "one --schemes"),
+    (["--cal", "/nonexistent/cal.json", "--schemes", "half"], "cal.json"),
 ])
 def test_bad_options_refused(run_script, tmp_path, args, why):
     code, out, err = run_script("fr-noise", args + ["--out", str(tmp_path / "o")])
@@ -151,3 +160,20 @@ def test_quadnull_check():
         _record(lambda t: np.where(t > 105, 2.0, nulled(t)), lambda t: (t >= 0.7) & (t < 110)),
         100.0, 5.0)
     assert after["nulled"]
+
+
+def test_the_part_an_own_calibration_is_made_on_is_the_cases_without_noise():
+    part = frnoise.calibration_part(q_sense=300.0, quad_null=True, scheme="dcac")
+    assert part[0] == "plant.preset=ideal"
+    assert "plant.q_sense=300" in part and "plant.fb_mode=2" in part
+    assert "plant.quadnull_dps_per_v2=20" in part
+    assert not any("noise" in s for s in part)
+
+
+def test_an_own_calibration_of_another_configuration_is_refused():
+    ok = {"sense.mode": 1, "sense.fb_scheme": 0, "quad.null": 1}
+    frnoise.check_own_cal(ok, "half", True)
+    for bad, scheme, qn in ((dict(ok, **{"sense.mode": 0}), "half", True),
+                            (ok, "dcac", True), (ok, "half", False)):
+        with pytest.raises(InputError, match="--cal"):
+            frnoise.check_own_cal(bad, scheme, qn)
