@@ -3,6 +3,24 @@
 #include "gyro/gyro_dac.h"
 #include "gyro/rate_valid.h"
 
+/* The lost-match monitor's pass (sense_tune.h), on the weights the continuous test's LMS
+ * keeps (the sample path does nothing more for it): fed while LOCKED with the notch
+ * converged, started again otherwise. True while the rate must wait for it or the match
+ * is lost. */
+static bool disc_invalid(app_t *a, bool locked)
+{
+  const gyro_t *g = &a->gyro;
+  const sense_tune_disc_cfg_t *c = &g->design->tune_disc;
+  if (c->on == 0u) return false;
+  const uint32_t now = app_ticks(a);
+  if (!locked || g->selftest.cont_blocks < g->design->selftest.cont_settle_blocks) {
+    sense_tune_disc_reset(&a->tune_disc, now);
+    return true;
+  }
+  sense_tune_disc_feed(c, &a->tune_disc, g->selftest.w, now);
+  return !sense_tune_disc_settled(&a->tune_disc) || a->tune_disc.lost != 0u;
+}
+
 void app_tune_poll(app_t *a)
 {
   const gyro_t *g = &a->gyro;
@@ -19,6 +37,7 @@ void app_tune_poll(app_t *a)
     if (a->tune_locked && reach) code = gyro_volts_to_dac((float)a->tune.v_v);
     invalid = !a->tune_locked || a->tune.state != SENSE_TUNE_OK;
   }
+  if (disc_invalid(a, a->tune_locked)) invalid = true;
   const bool was_invalid = g->tune_bits != 0u;
   if (code != a->dac.code[HAL_DAC_TUNE] || invalid != was_invalid)
     (void)app_request_word(a, APP_REQ_TUNE_WORD(code, invalid)); /* the queue is empty */

@@ -36,6 +36,37 @@ void sense_tune_at(const sense_tune_cfg_t *c, double f_drive_hz, sense_tune_out_
   o->v_v = v > c->v_max_v ? c->v_max_v : v;
 }
 
+void sense_tune_disc_reset(sense_tune_disc_t *s, uint32_t now_ticks)
+{
+  s->acc[0] = s->acc[1] = s->acc[2] = s->acc[3] = 0.0;
+  s->t0 = now_ticks;
+  s->windows = 0u;
+  s->det_hz = 0.0;
+  s->lost = 0u;
+}
+
+void sense_tune_disc_feed(const sense_tune_disc_cfg_t *c, sense_tune_disc_t *s,
+                          const float w[4], uint32_t now_ticks)
+{
+  for (int i = 0; i < 4; i++) s->acc[i] += (double)w[i];
+  if (now_ticks - s->t0 < c->window_ticks) return;
+  /* The window's tones as phasors a - j b (selftest.h: a cos + b sin), their ratio. */
+  const double rr = s->acc[0], ri = -s->acc[1], qr = s->acc[2], qi = -s->acc[3];
+  const double m2 = rr * rr + ri * ri;
+  s->acc[0] = s->acc[1] = s->acc[2] = s->acc[3] = 0.0;
+  s->t0 = now_ticks;
+  if (!(m2 > 0.0) || !isfinite(m2)) return; /* no tone: the continuous test says so */
+  const double xr = (qr * rr + qi * ri) / m2 - c->c0_re;
+  const double xi = (qi * rr - qr * ri) / m2 - c->c0_im;
+  const double u2 = c->u_re * c->u_re + c->u_im * c->u_im;
+  const double d = (xr * c->u_re + xi * c->u_im) / u2;
+  if (!isfinite(d)) return;
+  /* from the first window's value, not from 0: settled after a few windows */
+  s->det_hz = s->windows == 0u ? d : s->det_hz + c->k * (d - s->det_hz);
+  s->windows++;
+  s->lost = fabs(s->det_hz) > c->tol_hz ? 1u : 0u;
+}
+
 const char *sense_tune_state_name(sense_tune_state_t s)
 {
   static const char *const names[] = {"off", "ok", "uncalibrated", "below", "limit"};
