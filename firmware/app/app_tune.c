@@ -1,5 +1,7 @@
 #include "app/app_tune.h"
 
+#include <stdatomic.h>
+
 #include "gyro/gyro_dac.h"
 #include "gyro/rate_valid.h"
 
@@ -13,11 +15,24 @@ static bool disc_invalid(app_t *a, bool locked)
   const sense_tune_disc_cfg_t *c = &g->design->tune_disc;
   if (c->on == 0u) return false;
   const uint32_t now = app_ticks(a);
-  if (!locked || g->selftest.cont_blocks < g->design->selftest.cont_settle_blocks) {
+  /* A new design (another model, tone or loop) has another c0 and u: what the low-pass
+   * holds was measured against the old ones. */
+  const bool redesigned = a->tune_disc_design != (const void *)g->design;
+  a->tune_disc_design = g->design;
+  if (redesigned || !locked || g->selftest.cont_blocks < g->design->selftest.cont_settle_blocks) {
     sense_tune_disc_reset(&a->tune_disc, now);
     return true;
   }
-  sense_tune_disc_feed(c, &a->tune_disc, g->selftest.w, now);
+  /* The weights with the modulation's phase they go with: a sample the interrupt may
+   * have changed while it was read (a tick between the two reads of the tick count) is
+   * left out. */
+  const volatile uint32_t *tick = &g->out.tick;
+  const uint32_t t = *tick;
+  atomic_signal_fence(memory_order_seq_cst);
+  const uint32_t phase = g->selftest.cont_phase;
+  const float w[4] = {g->selftest.w[0], g->selftest.w[1], g->selftest.w[2], g->selftest.w[3]};
+  atomic_signal_fence(memory_order_seq_cst);
+  if (*tick == t) sense_tune_disc_feed(c, &a->tune_disc, w, phase, now);
   return !sense_tune_disc_settled(&a->tune_disc) || a->tune_disc.lost != 0u;
 }
 

@@ -81,24 +81,38 @@ double sense_tune_volts(double s0_hz, double target_hz, double ke_per_s2_per_v2)
  * The projection keeps what the other causes of a ratio put across u out of it: a phase
  * error of the loop (the feedback's or the demodulation's) turns the ratio by 0.027 per
  * degree nearly at right angles to u (the model: 0.4 % of it along u).
- * Measured on the matched Q 1e4 part (test_cl_sense_tune.c): u 0.0059 per Hz along the
- * model's within 6 %; the estimate off by -1.2..-1.4 Hz at the match (what the model
- * leaves out), its noise 0.1 Hz rms over 0.1 s. Its tolerance is the loop's, not the
- * half-bandwidth's (0.08 Hz at Q 1e4, under that model error): the detuning that moves a
- * root of the loop's placed pair by SENSE_TUNE_LOST_ROOT_FRAC of its natural frequency
- * (sense_fr_detune_tol_hz; 3.5 Hz for the default 145 Hz loop), beyond which the
- * force-rebalance loop is no longer the one designed (its step, its band, the
- * continuous test's expectation were all placed on the model's pole). Background only:
+ * Measured on the matched Q 1e4 part (test_cl_sense_tune.c): the ratio moves 0.0059 per
+ * Hz, along the model's u, 0.97 Hz read per Hz; the estimate off by -1.35 Hz at the
+ * match (-1.1 on a Q 300 part, -0.7 at a 20 Hz split: what the model leaves out), its
+ * spread 0.05 Hz rms. Its tolerance is the loop's, not the half-bandwidth's (0.08 Hz at Q
+ * 1e4, under that model error): the detuning that moves a root of the loop's placed pair
+ * by SENSE_TUNE_LOST_ROOT_FRAC of its natural frequency (sense_fr_detune_tol_hz; 3.7 Hz
+ * for the default 145 Hz loop), beyond which the force-rebalance loop is no longer the
+ * one designed (its step, its band, the continuous test's expectation were all placed
+ * on the model's pole). It is conservative: measured, the step still settled to 1 %
+ * within 6.6-7.0 ms at 11.5 Hz of detuning. Background only:
  * the ISR's LMS already measures both tones; the windows, the ratio and the projection
  * run in the application's background (app_tune.c). */
 #define SENSE_TUNE_LOST_ROOT_FRAC 0.05
-/* Windows of the LMS weights' mean (s), and the estimate's low-pass over them (s): the
- * weights' own time constant is 0.1 s (selftest.h), the estimate's noise 0.1 Hz rms per
- * window, 0.03 Hz through the low-pass. */
+/* Windows of the LMS weights' fit (s), and the estimate's low-pass over them (s): the
+ * weights' own time constant is 0.1 s (selftest.h). */
 #define SENSE_TUNE_DISC_WINDOW_S 0.1
 #define SENSE_TUNE_DISC_TAU_S 0.5
 /* Windows before the estimate counts as settled (the rate not valid before). */
 #define SENSE_TUNE_DISC_SETTLE_WINDOWS 2u
+/* The weights carry, besides the tone, a ripple at the modulation from whatever DC their
+ * axis has (selftest_cont_judge): the notch's LMS turns a constant x into mu x /
+ * (1 - e^(j w_m T)) e^(-j theta) on its weights, theta the modulation's phase. On the
+ * quadrature axis with force rebalance that DC is the rebalanced quadrature (1500 deg/s:
+ * a ripple of 19 deg/s against a tone of 0.7 deg/s there), on the rate axis the rate. A
+ * mean over samples the background takes whenever it runs keeps an unknown part of it.
+ * Each axis's weights, as a phasor W, are instead fitted over the window as W = T + C
+ * e^(-j theta) with theta known for each sample (selftest_t.cont_phase): least squares,
+ *     n T + conj(S) C = sum W,   S T + n C = sum W e^(j theta),   S = sum e^(j theta),
+ * so T = (n sum W - conj(S) sum W e^(j theta)) / (n^2 - |S|^2), whatever the moments
+ * the samples were taken at (a window whose phases do not spread, n^2 - |S|^2 under
+ * SENSE_TUNE_DISC_MIN_SPREAD n^2, gives no estimate). */
+#define SENSE_TUNE_DISC_MIN_SPREAD 0.25
 
 typedef struct {
   uint32_t on;           /* force rebalance with tuning on and its continuous test */
@@ -110,18 +124,23 @@ typedef struct {
 } sense_tune_disc_cfg_t;
 
 typedef struct {
-  double acc[4];    /* sums of the weights (rate cos, sin, quadrature cos, sin) */
-  uint32_t t0;      /* tick of the window's start */
-  uint32_t windows; /* windows since the monitor started */
-  double det_hz;    /* the detuning estimate d, low-passed */
-  uint32_t lost;    /* |det_hz| > tol_hz */
+  double n;          /* samples in the window */
+  double s_re, s_im; /* S = sum e^(j theta) */
+  double sw[2][2];   /* per axis (rate, quadrature) sum W (re, im) */
+  double swe[2][2];  /* per axis sum W e^(j theta) (re, im) */
+  uint32_t t0;       /* tick of the window's start */
+  uint32_t windows;  /* windows since the monitor started */
+  double det_hz;     /* the detuning estimate d, low-passed */
+  uint32_t lost;     /* |det_hz| > tol_hz */
 } sense_tune_disc_t;
 
-/* The monitor starts again (not settled): not LOCKED, the test's notch not converged. */
+/* The monitor starts again (not settled): not LOCKED, the test's notch not converged, a
+ * new design. */
 void sense_tune_disc_reset(sense_tune_disc_t *s, uint32_t now_ticks);
-/* One background pass with the test's weights w (selftest_t.w) at tick now_ticks. */
+/* One background pass with the test's weights w (selftest_t.w) and the modulation's
+ * phase they go with (selftest_t.cont_phase), read together, at tick now_ticks. */
 void sense_tune_disc_feed(const sense_tune_disc_cfg_t *c, sense_tune_disc_t *s,
-                          const float w[4], uint32_t now_ticks);
+                          const float w[4], uint32_t phase, uint32_t now_ticks);
 /* Settled: enough windows for an estimate. */
 static inline int sense_tune_disc_settled(const sense_tune_disc_t *s)
 {

@@ -180,6 +180,13 @@ static void check_tuned(const plant_cfg_t *pc, double split_hz)
   assert_non_null(strstr(cmd("status\n"), "selfcal_match tuned"));
 }
 
+/* The lost-match monitor's reading in status (tune_detune_hz; 0 without one). */
+static double status_detune_hz(void)
+{
+  const char *r = strstr(cmd("status\n"), "tune_detune_hz ");
+  return r != NULL ? atof(r + strlen("tune_detune_hz ")) : 0.0;
+}
+
 /* LOCKED: the voltage applied, the plant's resonance at the target, TUNE clear, and the
  * step settles within 10 ms. */
 static void check_running(const plant_cfg_t *pc, double split_hz)
@@ -213,9 +220,10 @@ static void check_running(const plant_cfg_t *pc, double split_hz)
   const double step_tol = 0.6 * (double)HAL_DAC_V_PER_CODE * TUNE_KE * app.tune.v_v /
                           (4.0 * FM_PI * FM_PI * target);
   printf("# running: %.4f V, the plant's sense resonance %.4f Hz against %.4f Hz (%+.4f; "
-         "half-band %.4f), rate_invalid 0x%x, fr settled %u\n",
-         app.tune.v_v, f_true, target, f_true - target, hb, app.gyro.out.rate_invalid,
-         app.gyro.fr.settled);
+         "half-band %.4f), the lost-match monitor reads %+.3f Hz, rate_invalid 0x%x, fr "
+         "settled %u\n",
+         app.tune.v_v, f_true, target, f_true - target, hb, status_detune_hz(),
+         app.gyro.out.rate_invalid, app.gyro.fr.settled);
   assert_non_null(strstr(r, "sense_tune ok"));
   assert_true(fabs(f_true - target) <= fmax(0.25 * hb, step_tol) + 0.005);
   assert_int_equal(app.gyro.tune_bits, 0u);
@@ -396,13 +404,6 @@ static void test_sense_below_drive(void **state)
   assert_true(params_current(&app.params)->sense_cal_s0_hz == 0.0f);
 }
 
-/* The lost-match monitor's reading in status (tune_detune_hz; 0 without one). */
-static double status_detune_hz(void)
-{
-  const char *r = strstr(cmd("status\n"), "tune_detune_hz ");
-  return r != NULL ? atof(r + strlen("tune_detune_hz ")) : 0.0;
-}
-
 /* The matched part tuned and calibrated as test_matched leaves it, running, the rate
  * valid. */
 static void matched_running(const plant_cfg_t *pc)
@@ -433,9 +434,39 @@ static void test_lost_match(void **state)
   const plant_cfg_t pc = part(SENSE_TEST_F_HZ, 1.0e4);
   matched_running(&pc);
   const double fd = (double)app.gyro.out.f_drive_hz;
-  printf("# matched: the sense resonance %+.4f Hz from the carrier, the monitor reads %+.3f "
-         "Hz\n",
-         true_tuned_f(&pc) - fd, status_detune_hz());
+  /* Its reading against the plant's detuning: matched, and the electrodes' gain -1 % and
+   * +1 % (the resonance 1.1 Hz up and down), each 2 s to settle, then read 20 times over
+   * 2 s (the reading's spread is its noise through the low-pass). */
+  const double gains[3] = {1.0, 0.99, 1.01};
+  double det[3], mean[3], spread = 0.0;
+  plant_cfg_t p = pc;
+  for (int i = 0; i < 3; i++) {
+    p.tune_ke_per_s2_per_v2 = TUNE_KE * gains[i];
+    plant.act.cfg.tune_ke_per_s2_per_v2 = p.tune_ke_per_s2_per_v2;
+    run_polled_s(2.0);
+    det[i] = true_tuned_f(&p) - fd;
+    double s1 = 0.0, s2 = 0.0;
+    for (int k = 0; k < 20; k++) {
+      run_polled_s(0.1);
+      const double r = status_detune_hz();
+      s1 += r;
+      s2 += r * r;
+    }
+    mean[i] = s1 / 20.0;
+    spread = fmax(spread, sqrt(fmax(s2 / 20.0 - mean[i] * mean[i], 0.0)));
+    assert_int_equal(app.gyro.out.rate_invalid, 0u);
+  }
+  const double slope = (mean[2] - mean[1]) / (det[2] - det[1]), bias = mean[0] - det[0];
+  const double tol = app.gyro.design->tune_disc.tol_hz;
+  printf("# the monitor against the plant: %+.3f, %+.3f, %+.3f Hz detuned read %+.3f, %+.3f, "
+         "%+.3f Hz: %.3f Hz per Hz, off by %+.3f Hz at the match, spread %.3f Hz rms; "
+         "tolerance %.3f Hz\n",
+         det[0], det[1], det[2], mean[0], mean[1], mean[2], slope, bias, spread, tol);
+  assert_true(slope > 0.9 && slope < 1.1);
+  assert_true(fabs(bias) < 0.5 * tol);
+  assert_true(spread < 0.1);
+  plant.act.cfg.tune_ke_per_s2_per_v2 = TUNE_KE;
+  run_polled_s(2.0);
   plant_cfg_t drifted = pc;
   double t_lost = -1.0;
   for (int ms = 1; ms <= 3000; ms++) {
@@ -481,6 +512,8 @@ static void test_match_held_over_temperature(void **state)
   pc.tau_struct_s = 4.0;
   matched_running(&pc);
   const double t0 = plant_truth(&plant)->struct_k, d0 = status_detune_hz();
+  const float *w = app.gyro.selftest.w_avg;
+  const double tone0 = hypot((double)w[0], (double)w[1]);
   assert_int_equal(
       plant_move_input(&plant, PLANT_INPUT_AMBIENT, plant_truth(&plant)->ambient_k + 20.0, 1.0),
       0);
@@ -495,10 +528,11 @@ static void test_match_held_over_temperature(void **state)
     if (ms % 100 == 0) far = fmax(far, fabs(status_detune_hz()));
   }
   printf("# the structure %+.2f K: the sense resonance at most %.4f Hz from the carrier, the "
-         "monitor read %+.3f Hz before, %+.3f Hz after, at most %.3f Hz (tolerance %.3f); ms "
-         "with TUNE %u of 8000, the reasons seen 0x%x\n",
+         "monitor read %+.3f Hz before, %+.3f Hz after, at most %.3f Hz (tolerance %.3f); the "
+         "test's tone on the rate axis %+.2f %%; ms with TUNE %u of 8000, the reasons seen "
+         "0x%x\n",
          plant_truth(&plant)->struct_k - t0, worst, d0, status_detune_hz(), far, tol,
-         (unsigned)tune_ms, reasons);
+         100.0 * (hypot((double)w[0], (double)w[1]) / tone0 - 1.0), (unsigned)tune_ms, reasons);
   assert_true(plant_truth(&plant)->struct_k - t0 >= 10.0);
   assert_true(far < tol);
   assert_int_equal(tune_ms, 0u);
