@@ -81,7 +81,8 @@ double sense_tune_volts(double s0_hz, double target_hz, double ke_per_s2_per_v2)
  * The projection keeps what the other causes of a ratio put across u out of it: a phase
  * error of the loop (the feedback's or the demodulation's) turns the ratio by 0.027 per
  * degree nearly at right angles to u (the model: 0.4 % of it along u).
- * Measured on the matched Q 1e4 part (test_cl_sense_tune.c, test_lost_match): 0.97 Hz
+ * Measured on the matched Q 1e4 part (test_cl_sense_tune.c, test_lost_match; the study
+ * tests/slow/test_tune_disc_study.c out to 11.5 Hz and with the part's noise): 0.97 Hz
  * read per Hz of the plant's detuning (the model's u: 0.0059 of ratio per Hz); the
  * estimate off by -1.35 Hz at the match (-1.1 on a Q 300 part, -0.7 at a 20 Hz split:
  * what the model leaves out), its spread 0.05 Hz rms. Its tolerance is the loop's, not
@@ -91,7 +92,7 @@ double sense_tune_volts(double s0_hz, double target_hz, double ke_per_s2_per_v2)
  * 145 Hz loop), beyond which the force-rebalance loop is no longer the one designed (its
  * step, its band, the continuous test's expectation were all placed on the model's
  * pole). It is conservative: measured, the step still settled to 1 % in 6.8 ms at
- * 5.75 Hz of detuning (7.0 ms matched). Background only: the ISR's LMS already measures
+ * 5.75 and 11.5 Hz of detuning (7.0 ms matched). Background only: the ISR's LMS already measures
  * both tones; the windows, the ratio and the projection run in the application's
  * background (app_tune.c). */
 #define SENSE_TUNE_LOST_ROOT_FRAC 0.05
