@@ -9,9 +9,10 @@
  *   - the monitor's reading (status tune_detune_hz) and its verdict;
  *   - the 0 -> 100 deg/s step's settling to 1 % (what the detuning does to the loop);
  * then the same on a part with the default part's noise sources (Brownian, pickoff and
- * electrode noise, feedthrough): the reading, and the rate's mean and noise at rest.
+ * electrode noise, feedthrough): the reading, and the rate's mean and noise at rest; and
+ * the matched part's reading with the continuous test's tone at 150 and 500 Hz.
  * Figures, not goals: printed, with a loose check of the reading's slope. Label slow
- * (opt-in): ctest --test-dir build/host -L slow -R tune_disc_study (about 2 min). */
+ * (opt-in): ctest --test-dir build/host -L slow -R tune_disc_study (about 3 min). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -147,11 +148,33 @@ static void test_noisy_part(void **state)
   }
 }
 
+/* The model behind c0 and u is the loop's above its band: how well it holds depends on
+ * the tone's frequency (selftest.cont_freq_hz). The matched part at 150 and 500 Hz: the
+ * monitor's reading, the continuous test's response against its expectation (the
+ * simpler tone model, sense_fr_tone_gain), and the reasons the rate is not valid for. */
+static void test_tone_frequency(void **state)
+{
+  (void)state;
+  const plant_cfg_t pc = part(SENSE_TEST_F_HZ, 1.0e4);
+  const double fm[2] = {150.0, 500.0};
+  for (int i = 0; i < 2; i++) {
+    matched_tuned(&pc, fm[i]);
+    run_polled_s(2.0);
+    const float *w = app.gyro.selftest.w_avg;
+    printf("# tone %.0f Hz: detuned %+.4f Hz, the monitor reads %+.3f Hz; the test's "
+           "response %.4g against %.4g expected; rate_invalid 0x%x\n",
+           fm[i], true_tuned_f(&pc) - (double)app.gyro.out.f_drive_hz, status_detune_hz(),
+           hypot((double)w[0], (double)w[1]), (double)app.gyro.design->selftest.cont_expect,
+           app.gyro.out.rate_invalid);
+  }
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_quiet_part),
       cmocka_unit_test(test_noisy_part),
+      cmocka_unit_test(test_tone_frequency),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

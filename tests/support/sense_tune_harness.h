@@ -171,12 +171,13 @@ static inline double status_detune_hz(void)
   return r != NULL ? atof(r + strlen("tune_detune_hz ")) : 0.0;
 }
 
-/* The matched part tuned and calibrated as test_matched leaves it, running, the rate
- * valid. */
-static inline void matched_running(const plant_cfg_t *pc)
+/* The matched part tuned and calibrated as test_matched leaves it, running, its continuous
+ * test's tone at cont_freq_hz (0: the default's). */
+static inline void matched_tuned(const plant_cfg_t *pc, double cont_freq_hz)
 {
   param_values_t v;
   part_values(pc, SENSE_TUNE_MATCHED, 0.0, &v);
+  if (cont_freq_hz > 0.0) v.selftest_cont_freq_hz = (float)cont_freq_hz;
   start(pc, &v);
   check_tuned(pc, 0.0);
   run_polled_s(0.5);
@@ -185,6 +186,12 @@ static inline void matched_running(const plant_cfg_t *pc)
   flow_rate_table();
   app_plant_hold_rate(0.0);
   run_polled_s(1.0);
+}
+
+/* ... with the default tone, the rate valid. */
+static inline void matched_running(const plant_cfg_t *pc)
+{
+  matched_tuned(pc, 0.0);
   assert_int_equal(app.gyro.out.rate_invalid, 0u);
 }
 
