@@ -333,6 +333,14 @@ static void put_sense_tune(cli_t *cli, app_t *a)
   cli_data_f32(cli, "tune_target_hz", (float)o->target_hz);
   cli_data_f32(cli, "tune_s0_hz", (float)o->s0_hz);
   cli_data_f32(cli, "tune_v", (float)o->v_v);
+  /* the lost-match monitor (force rebalance): the detuning it measures from the loop's
+   * model, its tolerance, and tune_match 0 (no estimate yet), 1 (matched) or 2 (lost) */
+  const sense_tune_disc_cfg_t *c = &a->gyro.design->tune_disc;
+  if (c->on == 0u) return;
+  const sense_tune_disc_t *m = &a->tune_disc;
+  cli_data_f32(cli, "tune_detune_hz", (float)m->det_hz);
+  cli_data_f32(cli, "tune_detune_tol_hz", (float)c->tol_hz);
+  cli_data_u32(cli, "tune_match", !sense_tune_disc_settled(m) ? 0u : m->lost != 0u ? 2u : 1u);
 }
 
 /* Force rebalance (sense.mode 1, sense_fr.h): whether it runs, balanced and at its

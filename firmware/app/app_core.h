@@ -87,6 +87,8 @@ typedef struct {
   app_status_fn status_board;
   sense_tune_out_t tune; /* mode tuning: the latest pass's target and voltage (app_tune.c) */
   bool tune_locked;      /* ... and whether it could apply them (LOCKED) */
+  sense_tune_disc_t tune_disc;  /* its lost-match monitor (sense_tune.h, app_tune.c) */
+  const void *tune_disc_design; /* the design it was fed under (a new one restarts it) */
 } app_t;
 
 /* The sample ISR's calls since app_init: the gyro's own count of its ticks (one per

@@ -11,7 +11,10 @@
  * lock, force rebalance is not running, and a sense mode tuned to the drive would ring up
  * on the quadrature to the ADC's rails (at Q 1e4 the matched response is 1400 times the
  * 110 Hz split's); not LOCKED, 0 V. The verdict (RATE_INVALID_TUNE) is set while the
- * voltage is not applied or the target is out of reach. In SWEEP, or while a sweep runs
+ * voltage is not applied or the target is out of reach, and with force rebalance while
+ * the lost-match monitor (sense_tune.h) has no estimate yet (LOCKED, the continuous
+ * test's notch converged, then SENSE_TUNE_DISC_SETTLE_WINDOWS windows) or finds the
+ * sense resonance beyond its tolerance from the model's. In SWEEP, or while a sweep runs
  * or a request waits, nothing is sent (the sweep's jobs own the channel). */
 void app_tune_poll(app_t *a);
 

@@ -441,6 +441,32 @@ static double fr_delay_ticks(void)
   return centre + to_force + 0.5 * (double)GYRO_BLOCK;
 }
 
+/* The lost-match monitor (sense_tune.h): the model's ratio of the continuous test's two
+ * axes at its own pole, its slope per Hz of detuning (a central difference over
+ * +-DISC_STEP_HZ, well inside its linear range: the ratio moved linearly over +-2.3 Hz,
+ * measured), and the loop's tolerance. */
+#define DISC_STEP_HZ 0.5
+static int design_tune_disc(const param_values_t *v, const sense_fr_cfg_t *fc,
+                            const sense_fr_lag_t *lag, sense_tune_disc_cfg_t *c)
+{
+  const double fs = (double)v->sys_fs_hz, fm = (double)v->selftest_cont_freq_hz;
+  double c0[2], cp[2], cn[2];
+  if (sense_fr_tone_cross(fc, lag, fs, fm, 0.0, c0) != 0 ||
+      sense_fr_tone_cross(fc, lag, fs, fm, DISC_STEP_HZ, cp) != 0 ||
+      sense_fr_tone_cross(fc, lag, fs, fm, -DISC_STEP_HZ, cn) != 0)
+    return -1;
+  c->c0_re = c0[0];
+  c->c0_im = c0[1];
+  c->u_re = (cp[0] - cn[0]) / (2.0 * DISC_STEP_HZ);
+  c->u_im = (cp[1] - cn[1]) / (2.0 * DISC_STEP_HZ);
+  c->tol_hz = sense_fr_detune_tol_hz(fc, SENSE_TUNE_LOST_ROOT_FRAC);
+  c->window_ticks = (uint32_t)(SENSE_TUNE_DISC_WINDOW_S * fs + 0.5);
+  c->k = 1.0 - exp(-SENSE_TUNE_DISC_WINDOW_S / SENSE_TUNE_DISC_TAU_S);
+  if (!(c->u_re * c->u_re + c->u_im * c->u_im > 0.0) || !(c->tol_hz > 0.0)) return -1;
+  c->on = 1u;
+  return 0;
+}
+
 static gyro_design_status_t design_fb(const param_values_t *v, gyro_design_t *t)
 {
   const double v_dac_max = (double)(HAL_DAC_CODE_MAX - HAL_DAC_CODE_MID) *
@@ -487,6 +513,8 @@ static gyro_design_status_t design_fb(const param_values_t *v, gyro_design_t *t)
     st->cont_gate_bits = RATE_INVALID_SETTLING;
     st->cont_gate_blocks = (uint32_t)(3.0 * GYRO_CONT_TAU_S * fs / GYRO_BLOCK);
     cont_band(st, e, tol);
+    if (v->sense_tune != SENSE_TUNE_OFF && design_tune_disc(v, &fc, &lag, &t->tune_disc) != 0)
+      return GYRO_DESIGN_SENSE_TUNE;
   }
   /* The self-test's force would go onto the same electrodes, past the loop: the
    * continuous one goes into the loop's command (selftest.h), a small part of what the

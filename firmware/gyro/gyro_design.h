@@ -70,6 +70,8 @@ typedef struct {
   /* Mode tuning (sense.tune, sense_tune.h): the background's (app.c), which applies its
    * voltage through gyro_set_tune; the sample path reads none of it. */
   sense_tune_cfg_t tune;
+  /* Its lost-match monitor (sense_tune.h): the background's too. */
+  sense_tune_disc_cfg_t tune_disc;
   /* The sweep's sense demodulator step (demod.mu_sense, open loop's in every sense mode):
    * its sense jobs' means and back-off threshold are designed for it, and force
    * rebalance's sense.fr_mu (a pole at 1.2 kHz, for the loop) passes enough of the 2 wc

@@ -76,7 +76,13 @@
  *                 tuned the part), or the target out of the electrodes' reach at this
  *                 temperature (below the untuned resonance, or beyond
  *                 sense.tune_v_max_v): the force-rebalance model, and open loop the
- *                 scale and demodulation phase, were measured on the tuned part
+ *                 scale and demodulation phase, were measured on the tuned part; and with
+ *                 force rebalance, the match lost: the lost-match monitor (sense_tune.h)
+ *                 has no estimate yet after LOCKED (the continuous test's notch
+ *                 converging, then two 0.1 s windows), or it finds the sense resonance
+ *                 farther from the loop's model than the loop's tolerance (the detuning
+ *                 that moves its placed roots by 5 % of its frequency): the law's
+ *                 voltage no longer puts the resonance where the loop was designed for
  * Each check is a few multiplies and compares per block; no divide, no libm. */
 #ifndef RATE_VALID_H
 #define RATE_VALID_H

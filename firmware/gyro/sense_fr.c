@@ -137,6 +137,106 @@ double sense_fr_tone_gain(const sense_fr_cfg_t *cfg, const sense_fr_lag_t *lag, 
   return 0.5 * hypot(hp.re + hn.re, hp.im - hn.im);
 }
 
+static cplx_t c_exp_j(double x)
+{
+  const cplx_t r = {cos(x), sin(x)};
+  return r;
+}
+
+/* The LMS demodulator's envelope response at w (sense_fr_tone_cross): mu per sample, the
+ * carrier wc and the sample period T. */
+static cplx_t lms_envelope(double mu, double wc, double t_s, double w)
+{
+  const cplx_t m = {mu, 0.0}, m2 = {mu * mu, 0.0};
+  cplx_t d = c_exp_j((w + 2.0 * wc) * t_s);
+  d.re += mu - 1.0;
+  cplx_t num = c_div(m, d);
+  num.re = 1.0 - num.re;
+  num.im = -num.im;
+  cplx_t den = c_exp_j(w * t_s);
+  den.re += mu - 1.0;
+  const cplx_t q = c_div(m2, d);
+  den.re -= q.re;
+  den.im -= q.im;
+  return c_div(c_mul(m, num), den);
+}
+
+/* The readout's response Y / T at s = j w with the plant's pole at pt (the model's moved)
+ * and its second root 2 wc away, through the LMS and the delay (sense_fr_tone_cross). */
+static cplx_t tone_h_full(const sense_fr_cfg_t *cfg, const sense_fr_lag_t *lag, double mu,
+                          double t_s, cplx_t p, cplx_t pt, const cplx_t k[3], double w)
+{
+  const cplx_t kp = k[0], ki = k[1], kr = k[2];
+  const double g = (double)cfg->gain_per_v2, wc = 2.0 * FM_PI * (double)cfg->f_drive_hz;
+  const cplx_t one = {1.0, 0.0}, s = {0.0, w};
+  const cplx_t gp = {-p.re * g, -p.im * g}; /* b: the model's, the coupling is fixed */
+  const cplx_t s_pt = {-pt.re, w - pt.im};
+  const cplx_t p2 = {pt.re, -2.0 * wc - pt.im}; /* the second root */
+  const cplx_t mp2 = {-p2.re, -p2.im}, s_p2 = {-p2.re, w - p2.im};
+  const cplx_t delay = {cos(w * lag->delay_s), -sin(w * lag->delay_s)};
+  cplx_t plant = c_mul(c_div(gp, s_pt), c_div(mp2, s_p2));
+  plant = c_mul(c_mul(plant, delay), lms_envelope(mu, wc, t_s, w));
+  const cplx_t ki_s = c_div(ki, s);
+  const cplx_t gr = {g, 0.0};
+  const cplx_t y = c_mul(gr, c_mul(c_add(ki_s, kr), plant));
+  return c_div(y, c_add(one, c_mul(plant, c_add(kp, ki_s))));
+}
+
+int sense_fr_tone_cross(const sense_fr_cfg_t *cfg, const sense_fr_lag_t *lag, double fs_hz,
+                        double f_hz, double det_hz, double cross[2])
+{
+  if (cfg == NULL || lag == NULL || cross == NULL || !cfg_ok(cfg) || !isfinite(f_hz) ||
+      !(f_hz > 0.0) || !isfinite(det_hz) || !(fs_hz > 0.0) || !(lag->demod_pole_per_s > 0.0) ||
+      !(lag->delay_s >= 0.0) || !isfinite(lag->delay_s))
+    return -1;
+  const cplx_t p = plant_pole(cfg);
+  cplx_t c, kp, ki;
+  if (place(cfg, p, &c, &kp, &ki) != 0) return -1;
+  const double mu = lag->demod_pole_per_s / fs_hz, t_s = 1.0 / fs_hz;
+  const double w = 2.0 * FM_PI * f_hz;
+  const cplx_t k[3] = {kp, ki, c_div(ki, c)};
+  const cplx_t pt = {p.re, p.im + 2.0 * FM_PI * det_hz};
+  /* A real tone A cos(w t) = A (e^(j w t) + e^(-j w t)) / 2 on the real axis: the
+   * response Y = (H(jw) e^(j w t) + H(-jw) e^(-j w t)) A / 2 has the real part Re(Ar e^(j
+   * w t)), Ar = (H(jw) + conj H(-jw)) / 2, and the imaginary part Re(Aq e^(j w t)),
+   * Aq = -j (H(jw) - conj H(-jw)) / 2. */
+  const cplx_t hp = tone_h_full(cfg, lag, mu, t_s, p, pt, k, w);
+  const cplx_t hn = tone_h_full(cfg, lag, mu, t_s, p, pt, k, -w);
+  const cplx_t ar = {0.5 * (hp.re + hn.re), 0.5 * (hp.im - hn.im)};
+  const cplx_t aq = {0.5 * (hp.im + hn.im), -0.5 * (hp.re - hn.re)};
+  if (!(ar.re * ar.re + ar.im * ar.im > 0.0)) return -1;
+  const cplx_t r = c_div(aq, ar);
+  cross[0] = r.re;
+  cross[1] = r.im;
+  return isfinite(r.re) && isfinite(r.im) ? 0 : -1;
+}
+
+double sense_fr_detune_tol_hz(const sense_fr_cfg_t *cfg, double frac)
+{
+  if (cfg == NULL || !cfg_ok(cfg) || !(frac > 0.0)) return -1.0;
+  const cplx_t p = plant_pole(cfg);
+  cplx_t c, kp, ki;
+  if (place(cfg, p, &c, &kp, &ki) != 0) return -1.0;
+  const double a = 1.0 / (double)cfg->lag_s, w = 2.0 * FM_PI * (double)cfg->bw_hz;
+  const double z = (double)cfg->zeta;
+  const cplx_t ba = {-p.re * (double)cfg->gain_per_v2 * a, -p.im * (double)cfg->gain_per_v2 * a};
+  const cplx_t bakp = c_mul(ba, kp);
+  double worst = 0.0;
+  for (int i = -1; i <= 1; i += 2) {
+    /* the placed pair, -zeta w +- j w sqrt(1 - zeta^2) (a real pair beyond zeta 1) */
+    const double im = z < 1.0 ? (double)i * w * sqrt(1.0 - z * z) : 0.0;
+    const double re = z < 1.0 ? -z * w : -w * (z + (double)i * sqrt(z * z - 1.0));
+    const cplx_t r = {re, im}, r_p = {re - p.re, im - p.im}, r_a = {re + a, im};
+    /* P'(r) = (r - p)(r + a) + r (r + a) + r (r - p) + b a Kp */
+    const cplx_t dp = c_add(c_add(c_mul(r_p, r_a), c_mul(r, r_a)), c_add(c_mul(r, r_p), bakp));
+    const cplx_t j_r_ra = {-c_mul(r, r_a).im, c_mul(r, r_a).re};
+    const cplx_t dr = c_div(j_r_ra, dp); /* per rad/s of detuning */
+    const double m = 2.0 * FM_PI * hypot(dr.re, dr.im);
+    if (m > worst) worst = m;
+  }
+  return worst > 0.0 ? frac * w / worst : -1.0;
+}
+
 GYRO_RAMFUNC void sense_fr_reset(sense_fr_t *fr)
 {
   fr->run = 0u;

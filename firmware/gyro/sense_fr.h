@@ -134,6 +134,37 @@ typedef struct {
 } sense_fr_lag_t;
 double sense_fr_tone_gain(const sense_fr_cfg_t *cfg, const sense_fr_lag_t *lag, double f_hz);
 
+/* The lost-match discriminator (sense_tune.h, sense_tune_disc_*): the same tone on the
+ * Coriolis axis also comes out on the readout's imaginary part (the quadrature axis) when
+ * the plant is not its own mirror image. A matched mode's envelope plant b / (s - p), p
+ * real, commutes with conjugation and so does the loop designed on it: a real tone in, a
+ * real tone out. Detuned by d, p = -sigma + j 2 pi d and the tone leaks into the
+ * quadrature axis in proportion to d, with its sign; the ratio of the two axes' tones
+ * (both measured by the continuous test's LMS) is then a frequency discriminator.
+ * Two other parts of the loop are not mirror images either and set the ratio at the
+ * match: the mode's second root, 2 wc away (the two sidebands wc +- w_m meet (ws + w) of
+ * different size: +-8 % at 250 Hz around 1.49 kHz), and the demodulator's LMS, whose
+ * update couples its estimate to its own conjugate at 2 wc (lmsd.h: the 2 wc ripple);
+ * exactly, for W(n+1) = W + 2 mu e e^(-j wc n) with e = x - Re(W e^(j wc n)), an envelope
+ * tone at w answers with
+ *     L(w) = mu (1 - mu / D) / (e^(j w T) - 1 + mu - mu^2 / D),  D = e^(j (w + 2 wc) T) - 1 + mu.
+ * Without them the model read a matched part 41 Hz off; with them 0.7-1.35 Hz (measured
+ * on three parts, test_cl_sense_tune.c). cross = the quadrature axis's tone over the rate
+ * axis's, both as phasors a - j b of their LMS weights (a cos + b sin), with the plant's
+ * pole moved by det_hz from the model's, the LMS's mu = demod_pole_per_s / fs_hz. Returns
+ * 0, or -1 as sense_fr_tone_gain refuses or for fs_hz not positive. Background (double). */
+int sense_fr_tone_cross(const sense_fr_cfg_t *cfg, const sense_fr_lag_t *lag, double fs_hz,
+                        double f_hz, double det_hz, double cross[2]);
+
+/* The detuning (Hz, of the plant's pole from the model's) that moves a root of the placed
+ * pair by frac of the loop's natural frequency w, to first order: with the plant b / (s -
+ * p) (b = g (-p) fixed: the envelope equation's force coupling over the other root's
+ * distance, 2 wc, which a detuning of a few Hz does not change),
+ * the characteristic polynomial P(s) = s (s - p)(s + a) + b a (Kp s + Ki) moves with p by
+ * dP/dp = -s (s + a), so a root r moves by dr = j r (r + a) / P'(r) per rad/s of
+ * detuning. -1 for a configuration sense_fr_design refuses. Background (double). */
+double sense_fr_detune_tol_hz(const sense_fr_cfg_t *cfg, double frac);
+
 /* The loop open, its state and force at zero (not settled). */
 void sense_fr_reset(sense_fr_t *fr);
 

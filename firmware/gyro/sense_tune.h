@@ -23,8 +23,8 @@
  * is a vacuum part, whose drive is tracked). Matched, the hold is Vt(T) = Vt_ref f_d(T) /
  * f_ref exactly; a split adds a small term. What the law does not know (the two modes'
  * tempcos differing, the gap's expansion changing ke, a drifting electrode gain) is not
- * followed: the match is held only as well as the law holds, without a discriminator
- * that would measure it running (a pilot tone or the quadrature's phase).
+ * followed by the law: the lost-match monitor below measures, running, where the sense
+ * resonance is, and makes the rate not valid when it has left the match.
  *
  * Background only (double precision); the voltage reaches the DAC through the
  * application's request (app.c), so the interrupt does nothing per sample for it. */
@@ -68,6 +68,86 @@ void sense_tune_at(const sense_tune_cfg_t *c, double f_drive_hz, sense_tune_out_
 /* The voltage that puts a resonance s0_hz (untuned) at target_hz with slope ke; -1 when
  * it cannot (target at or above s0, ke not positive, or not finite). */
 double sense_tune_volts(double s0_hz, double target_hz, double ke_per_s2_per_v2);
+
+/* The lost-match monitor (force rebalance, sense.mode 1, with tuning on; issue 19 item 5).
+ * The continuous self-test's tone, a force on the loop's Coriolis axis (selftest.h), comes
+ * out on the readout's quadrature axis too in proportion to the plant's detuning from the
+ * model the loop was designed on (sense_fr_tone_cross): matched, the plant is its own
+ * mirror image and the two axes do not mix. The ratio of the two axes' tones, each
+ * measured by the test's LMS (selftest_t.w: rate, quadrature), less the model's ratio at
+ * the model's pole c0, projected on the model's ratio per Hz of detuning u, is the
+ * detuning in Hz:
+ *     d = Re((r - c0) conj(u)) / |u|^2.
+ * The projection keeps what the other causes of a ratio put across u out of it: a phase
+ * error of the loop (the feedback's or the demodulation's) turns the ratio by 0.027 per
+ * degree nearly at right angles to u (the model: 0.4 % of it along u).
+ * Measured on the matched Q 1e4 part (test_cl_sense_tune.c, test_lost_match; the study
+ * tests/slow/test_tune_disc_study.c out to 11.5 Hz and with the part's noise): 0.97 Hz
+ * read per Hz of the plant's detuning (the model's u: 0.0059 of ratio per Hz); the
+ * estimate off by -1.35 Hz at the match (-1.1 on a Q 300 part, -0.7 at a 20 Hz split:
+ * what the model leaves out), its spread 0.05 Hz rms. Its tolerance is the loop's, not
+ * the half-bandwidth's (0.08 Hz at Q 1e4, under that model error): the detuning that
+ * moves a root of the loop's placed pair by SENSE_TUNE_LOST_ROOT_FRAC of its natural
+ * frequency (sense_fr_detune_tol_hz; 3.7 Hz for the matched part's model and the default
+ * 145 Hz loop), beyond which the force-rebalance loop is no longer the one designed (its
+ * step, its band, the continuous test's expectation were all placed on the model's
+ * pole). It is conservative: measured, the step still settled to 1 % in 6.8 ms at
+ * 5.75 and 11.5 Hz of detuning (7.0 ms matched). Background only: the ISR's LMS already measures
+ * both tones; the windows, the ratio and the projection run in the application's
+ * background (app_tune.c). */
+#define SENSE_TUNE_LOST_ROOT_FRAC 0.05
+/* Windows of the LMS weights' fit (s), and the estimate's low-pass over them (s): the
+ * weights' own time constant is 0.1 s (selftest.h). */
+#define SENSE_TUNE_DISC_WINDOW_S 0.1
+#define SENSE_TUNE_DISC_TAU_S 0.5
+/* Windows before the estimate counts as settled (the rate not valid before). */
+#define SENSE_TUNE_DISC_SETTLE_WINDOWS 2u
+/* The weights carry, besides the tone, a ripple at the modulation from whatever DC their
+ * axis has (selftest_cont_judge): the notch's LMS turns a constant x into mu x /
+ * (1 - e^(j w_m T)) e^(-j theta) on its weights, theta the modulation's phase. On the
+ * quadrature axis with force rebalance that DC is the rebalanced quadrature (1500 deg/s:
+ * a ripple of 19 deg/s against a tone of 0.7 deg/s there), on the rate axis the rate. A
+ * mean over samples the background takes whenever it runs keeps an unknown part of it.
+ * Each axis's weights, as a phasor W, are instead fitted over the window as W = T + C
+ * e^(-j theta) with theta known for each sample (selftest_t.cont_phase): least squares,
+ *     n T + conj(S) C = sum W,   S T + n C = sum W e^(j theta),   S = sum e^(j theta),
+ * so T = (n sum W - conj(S) sum W e^(j theta)) / (n^2 - |S|^2), whatever the moments
+ * the samples were taken at (a window whose phases do not spread, n^2 - |S|^2 under
+ * SENSE_TUNE_DISC_MIN_SPREAD n^2, gives no estimate). */
+#define SENSE_TUNE_DISC_MIN_SPREAD 0.25
+
+typedef struct {
+  uint32_t on;           /* force rebalance with tuning on and its continuous test */
+  double c0_re, c0_im;   /* the model's ratio at its own pole */
+  double u_re, u_im;     /* the ratio per Hz of detuning */
+  double tol_hz;         /* |d| beyond this: the match is lost */
+  uint32_t window_ticks; /* SENSE_TUNE_DISC_WINDOW_S in sample ticks */
+  double k;              /* the estimate's low-pass per window */
+} sense_tune_disc_cfg_t;
+
+typedef struct {
+  double n;          /* samples in the window */
+  double s_re, s_im; /* S = sum e^(j theta) */
+  double sw[2][2];   /* per axis (rate, quadrature) sum W (re, im) */
+  double swe[2][2];  /* per axis sum W e^(j theta) (re, im) */
+  uint32_t t0;       /* tick of the window's start */
+  uint32_t windows;  /* windows since the monitor started */
+  double det_hz;     /* the detuning estimate d, low-passed */
+  uint32_t lost;     /* |det_hz| > tol_hz */
+} sense_tune_disc_t;
+
+/* The monitor starts again (not settled): not LOCKED, the test's notch not converged, a
+ * new design. */
+void sense_tune_disc_reset(sense_tune_disc_t *s, uint32_t now_ticks);
+/* One background pass with the test's weights w (selftest_t.w) and the modulation's
+ * phase they go with (selftest_t.cont_phase), read together, at tick now_ticks. */
+void sense_tune_disc_feed(const sense_tune_disc_cfg_t *c, sense_tune_disc_t *s,
+                          const float w[4], uint32_t phase, uint32_t now_ticks);
+/* Settled: enough windows for an estimate. */
+static inline int sense_tune_disc_settled(const sense_tune_disc_t *s)
+{
+  return s->windows >= SENSE_TUNE_DISC_SETTLE_WINDOWS;
+}
 
 /* "off", "ok", "uncalibrated", "below", "limit" for status. */
 const char *sense_tune_state_name(sense_tune_state_t s);

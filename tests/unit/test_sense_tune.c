@@ -112,12 +112,69 @@ static void test_states(void **state)
   assert_string_equal(sense_tune_state_name((sense_tune_state_t)99), "?");
 }
 
+/* The lost-match monitor's arithmetic (sense_tune.h): weights whose quadrature tone is
+ * the rate tone times c0 + u d, with the ripple a DC of each axis puts on the notch's
+ * weights (mu x / (1 - e^(j w_m T)) e^(-j theta), far larger than the quadrature tone),
+ * sampled at irregular moments as a background would: the window's fit of tone and
+ * ripple takes the ripple out, and the estimate is d. */
+static void feed_tone(const sense_tune_disc_cfg_t *c, sense_tune_disc_t *s, double d_hz,
+                      double windows)
+{
+  const double rr = 2.5, ri = -1.0; /* the rate axis's tone a - j b */
+  const double kr = c->c0_re + c->u_re * d_hz, ki = c->c0_im + c->u_im * d_hz;
+  const double qr = rr * kr - ri * ki, qi = rr * ki + ri * kr;
+  const double step = 2.0 * M_PI / 20.0, mu = 0.004; /* 250 Hz at 5 kHz */
+  const double dc[2] = {30.0, 1500.0};               /* rate, quadrature (raw units) */
+  uint32_t tick = s->t0, lcg = 12345u;
+  const uint32_t end = s->t0 + (uint32_t)(windows * (double)c->window_ticks);
+  while (tick - s->t0 < end - s->t0 || tick < end) {
+    lcg = lcg * 1664525u + 1013904223u;
+    tick += 10u + (lcg >> 26); /* 10..73 ticks apart */
+    if ((int32_t)(tick - end) > 0) break;
+    const uint32_t blocks = tick / 10u;
+    const double th = fmod((double)blocks * step, 2.0 * M_PI);
+    /* the ripple's factor mu / (1 - e^(j w_m T)), times e^(-j theta) */
+    const double dr = 1.0 - cos(step), di = -sin(step), dm = dr * dr + di * di;
+    const double ar = mu * dr / dm, ai = -mu * di / dm;
+    const double er = ar * cos(th) + ai * sin(th), ei = ai * cos(th) - ar * sin(th);
+    const double tone[2][2] = {{rr, ri}, {qr, qi}};
+    float w[4];
+    for (int ax = 0; ax < 2; ax++) {
+      const double pr = tone[ax][0] + dc[ax] * er, pi = tone[ax][1] + dc[ax] * ei;
+      w[2 * ax] = (float)pr;        /* a */
+      w[2 * ax + 1] = (float)(-pi); /* b: the phasor is a - j b */
+    }
+    const uint32_t phase = (uint32_t)(th / (2.0 * M_PI) * 4294967296.0);
+    sense_tune_disc_feed(c, s, w, phase, tick);
+  }
+}
+
+static void test_disc(void **state)
+{
+  (void)state;
+  const sense_tune_disc_cfg_t c = {1u,       -0.095, 0.2325, 0.00263,
+                                   -0.00528, 3.7,    5000u,  1.0 - exp(-0.2)};
+  sense_tune_disc_t s;
+  const double d_hz[] = {0.0, 1.0, -2.0, 5.0};
+  for (size_t i = 0; i < sizeof d_hz / sizeof d_hz[0]; i++) {
+    sense_tune_disc_reset(&s, 1000u);
+    assert_false(sense_tune_disc_settled(&s));
+    feed_tone(&c, &s, d_hz[i], 40.0);
+    printf("# detuned %+.1f Hz: the monitor reads %+.4f Hz after %u windows, lost %u\n",
+           d_hz[i], s.det_hz, (unsigned)s.windows, (unsigned)s.lost);
+    assert_true(sense_tune_disc_settled(&s));
+    assert_true(fabs(s.det_hz - d_hz[i]) < 0.02);
+    assert_int_equal(s.lost, fabs(d_hz[i]) > c.tol_hz ? 1u : 0u);
+  }
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_hold_matched),
       cmocka_unit_test(test_hold_split),
       cmocka_unit_test(test_states),
+      cmocka_unit_test(test_disc),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
