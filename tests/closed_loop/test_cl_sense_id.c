@@ -218,13 +218,8 @@ static const selfcal_sense_t *generic_sweep(const plant_cfg_t *pc, uint32_t sens
 static void test_fresh_part_in_force_rebalance(void **state)
 {
   (void)state;
-  /* the default plant's noise on: the part as gyro-sim runs it */
   plant_cfg_t pc;
-  plant_default_cfg(&pc);
-  pc.f_sense_hz = F_SENSE_HZ;
-  pc.q_sense = 1.0e4;
-  pc.fb_mode = 3;
-  pc.ks_fb_mps2_per_v2 = SENSE_TEST_KS_FB;
+  sense_test_noisy_part(&pc, 1.0e4);
   const selfcal_sense_t open = *generic_sweep(&pc, 0u);
   const selfcal_sense_t *fr = generic_sweep(&pc, 1u);
   printf("# fresh part (generic defaults): open loop %s gain %.5f phase %+.3f deg; force "

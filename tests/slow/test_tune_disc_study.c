@@ -115,11 +115,7 @@ static void test_noisy_part(void **state)
 {
   (void)state;
   plant_cfg_t pc;
-  plant_default_cfg(&pc);
-  pc.f_sense_hz = SENSE_TEST_F_HZ;
-  pc.q_sense = 1.0e4;
-  pc.fb_mode = 3;
-  pc.ks_fb_mps2_per_v2 = SENSE_TEST_KS_FB;
+  sense_test_noisy_part(&pc, 1.0e4);
   pc.tune_ke_per_s2_per_v2 = TUNE_KE;
   matched_running(&pc);
   for (size_t i = 0; i < N_GAINS - 1u; i++) {

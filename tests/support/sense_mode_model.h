@@ -70,4 +70,14 @@ static inline void sense_test_part(plant_cfg_t *pc, double q_sense)
   pc->tune_noise_white_v_rthz = pc->tune_noise_1hz_v_rthz = 0.0;
 }
 
+/* The same part with the default plant's noise and imperfections on: as gyro-sim runs it. */
+static inline void sense_test_noisy_part(plant_cfg_t *pc, double q_sense)
+{
+  plant_default_cfg(pc);
+  pc->f_sense_hz = SENSE_TEST_F_HZ;
+  pc->q_sense = q_sense;
+  pc->fb_mode = 3;
+  pc->ks_fb_mps2_per_v2 = SENSE_TEST_KS_FB;
+}
+
 #endif /* SENSE_MODE_MODEL_H */
