@@ -460,6 +460,7 @@ static int design_tune_disc(const param_values_t *v, const sense_fr_cfg_t *fc,
   c->u_re = (cp[0] - cn[0]) / (2.0 * DISC_STEP_HZ);
   c->u_im = (cp[1] - cn[1]) / (2.0 * DISC_STEP_HZ);
   c->tol_hz = sense_fr_detune_tol_hz(fc, SENSE_TUNE_LOST_ROOT_FRAC);
+  c->zero_hz = (double)v->sense_tune_disc_zero_hz;
   c->window_ticks = (uint32_t)(SENSE_TUNE_DISC_WINDOW_S * fs + 0.5);
   c->k = 1.0 - exp(-SENSE_TUNE_DISC_WINDOW_S / SENSE_TUNE_DISC_TAU_S);
   if (!(c->u_re * c->u_re + c->u_im * c->u_im > 0.0) || !(c->tol_hz > 0.0)) return -1;

@@ -96,7 +96,7 @@ void sense_tune_disc_feed(const sense_tune_disc_cfg_t *c, sense_tune_disc_t *s,
   const double xr = (qr * rr + qi * ri) / m2 - c->c0_re;
   const double xi = (qi * rr - qr * ri) / m2 - c->c0_im;
   const double u2 = c->u_re * c->u_re + c->u_im * c->u_im;
-  const double d = (xr * c->u_re + xi * c->u_im) / u2;
+  const double d = (xr * c->u_re + xi * c->u_im) / u2 - c->zero_hz;
   if (!isfinite(d)) return;
   /* from the first window's value, not from 0: settled after a few windows */
   s->det_hz = s->windows == 0u ? d : s->det_hz + c->k * (d - s->det_hz);

@@ -85,7 +85,9 @@ double sense_tune_volts(double s0_hz, double target_hz, double ke_per_s2_per_v2)
  * tests/slow/test_tune_disc_study.c out to 11.5 Hz and with the part's noise): 0.97 Hz
  * read per Hz of the plant's detuning (the model's u: 0.0059 of ratio per Hz); the
  * estimate off by -1.35 Hz at the match (-1.1 on a Q 300 part, -0.7 at a 20 Hz split:
- * what the model leaves out), its spread 0.05 Hz rms. Its tolerance is the loop's, not
+ * what the model leaves out), its spread 0.05 Hz rms. That offset is the part's and the
+ * tone's: the calibration flow measures the reading on the tuned part and stores it
+ * (sense.tune_disc_zero_hz), which each reading is taken from. Its tolerance is the loop's, not
  * the half-bandwidth's (0.08 Hz at Q 1e4, under that model error): the detuning that
  * moves a root of the loop's placed pair by SENSE_TUNE_LOST_ROOT_FRAC of its natural
  * frequency (sense_fr_detune_tol_hz; 3.7 Hz for the matched part's model and the default
@@ -123,6 +125,7 @@ typedef struct {
   double tol_hz;         /* |d| beyond this: the match is lost */
   uint32_t window_ticks; /* SENSE_TUNE_DISC_WINDOW_S in sample ticks */
   double k;              /* the estimate's low-pass per window */
+  double zero_hz;        /* the reading on this part matched (sense.tune_disc_zero_hz) */
 } sense_tune_disc_cfg_t;
 
 typedef struct {

@@ -40,7 +40,7 @@
 
 #include "board.h" /* sys.fs_hz: the board's sample rate */
 
-#define PARAM_LAYOUT_VERSION 19u
+#define PARAM_LAYOUT_VERSION 20u
 
 #define PARAM_CHOICE(v) (1u << (v))
 
@@ -419,6 +419,10 @@
     PF_PERSIST | PF_LIVE, "identified untuned sense resonance (tuning at 0 V) at sense.cal_tune_ref_hz") \
   X(sense_cal_tune_ref_hz, 0x0A24u, "sense.cal_tune_ref_hz", F32, "Hz", 0.0f, 20000.0f, 0.0f, 0u, \
     PF_PERSIST | PF_LIVE, "drive resonance when the part was tuned: the tuning's temperature hold scales from it") \
+  /* 0 until the calibration flow measures it on the tuned part (tools/calibrate --tune):
+   * the monitor's loop model reads a matched part 0.7-1.35 Hz off (sense_tune.h). */ \
+  X(sense_tune_disc_zero_hz, 0x0A25u, "sense.tune_disc_zero_hz", F32, "Hz", -50.0f, 50.0f, 0.0f, 0u, \
+    PF_PERSIST | PF_LIVE, "the lost-match monitor's reading on this part matched: subtracted from its readings") \
   /* 0: no calibration. The compensation, the demodulation phase and the scale hold at
    * the drive frequency they were measured at: another one (a sweep, a hand change)
    * makes them stale. Equal within 2e-7 (two float steps), so that a value that went

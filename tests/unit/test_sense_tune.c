@@ -152,8 +152,8 @@ static void feed_tone(const sense_tune_disc_cfg_t *c, sense_tune_disc_t *s, doub
 static void test_disc(void **state)
 {
   (void)state;
-  const sense_tune_disc_cfg_t c = {1u,       -0.095, 0.2325, 0.00263,
-                                   -0.00528, 3.7,    5000u,  1.0 - exp(-0.2)};
+  const sense_tune_disc_cfg_t c = {1u,  -0.095, 0.2325,          0.00263, -0.00528,
+                                   3.7, 5000u,  1.0 - exp(-0.2), 0.0};
   sense_tune_disc_t s;
   const double d_hz[] = {0.0, 1.0, -2.0, 5.0};
   for (size_t i = 0; i < sizeof d_hz / sizeof d_hz[0]; i++) {
@@ -168,13 +168,33 @@ static void test_disc(void **state)
   }
 }
 
+/* The part's own zero (sense.tune_disc_zero_hz, measured by the flow on the tuned part):
+ * a matched part whose reading the model puts at -1.35 Hz reads 0, and the tolerance is
+ * symmetric about its match: 3.7 Hz of true detuning either way, not -2.3 and +5. */
+static void test_disc_zero(void **state)
+{
+  (void)state;
+  const double zero = -1.35;
+  const sense_tune_disc_cfg_t c = {1u,  -0.095, 0.2325,          0.00263, -0.00528,
+                                   3.7, 5000u,  1.0 - exp(-0.2), zero};
+  sense_tune_disc_t s;
+  const double d_hz[] = {0.0, -3.0, 3.0, -4.0, 4.0};
+  for (size_t i = 0; i < sizeof d_hz / sizeof d_hz[0]; i++) {
+    sense_tune_disc_reset(&s, 1000u);
+    feed_tone(&c, &s, zero + d_hz[i], 40.0);
+    printf("# zero %+.2f Hz, detuned %+.1f Hz: reads %+.4f Hz, lost %u\n", zero, d_hz[i],
+           s.det_hz, (unsigned)s.lost);
+    assert_true(fabs(s.det_hz - d_hz[i]) < 0.02);
+    assert_int_equal(s.lost, fabs(d_hz[i]) > c.tol_hz ? 1u : 0u);
+  }
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_hold_matched),
-      cmocka_unit_test(test_hold_split),
-      cmocka_unit_test(test_states),
-      cmocka_unit_test(test_disc),
+      cmocka_unit_test(test_hold_matched), cmocka_unit_test(test_hold_split),
+      cmocka_unit_test(test_states),       cmocka_unit_test(test_disc),
+      cmocka_unit_test(test_disc_zero),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -74,6 +74,10 @@ VERIFY_SEED_OFFSET = 1000
 # The self-test's response below this is no working self-test (the design's electrodes
 # give about 5.5 deg/s at selftest.amp_v 0.1 V; dead ones, their feedthrough, 0.05).
 SELFTEST_MIN_DPS = 1.0
+# The lost-match monitor's zero beyond this is no tuned part: the model's own offset
+# measured 0.7-1.35 Hz at the default 250 Hz tone, 6.8 Hz at a 500 Hz tone
+# (tests/slow/test_tune_disc_study.c); its tolerance about the zero is 3.7 Hz.
+DISC_ZERO_MAX_HZ = 10.0
 VERIFY_RATES_DPS = (30, -30, 70, -70, 110, -110, 150, -150, 190, -190, 230, -230, 270, -270)
 # The sub-range slopes are judged between the means of ~50 pairs, so their noise must
 # be a fraction of the limit; the part's bias wanders (flicker, drifts) by hundredths of
@@ -550,8 +554,28 @@ def selftest_fr(part, path, values, lead):
         raise FlowError(f"self-test: force rebalance's continuous response {cont:.4g} deg/s "
                         f"against the loop model's {model:.4g}, beyond +-{100 * tol:g} %: the "
                         "loop or its identified model is not the part's")
-    return dict(values), {"command": cmd, "expect_dps": None, "cont_expect_dps": model,
-                          "cont_dps": cont, "cont_model": True}
+    v, figs = dict(values), {"command": cmd, "expect_dps": None, "cont_expect_dps": model,
+                             "cont_dps": cont, "cont_model": True}
+    if int(values.get("sense.tune", 0)) != 0:
+        v["sense.tune_disc_zero_hz"] = disc_zero(replies[-1], values, cmd)
+        figs["tune_disc_zero_hz"] = v["sense.tune_disc_zero_hz"]
+    return v, figs
+
+
+def disc_zero(reply, values, cmd):
+    """The lost-match monitor's zero (sense.tune_disc_zero_hz): its reading on the tuned
+    part at rest (`status` tune_detune_hz, taken from the zero the run had), where the
+    sweep has just put the sense resonance on its target; the monitor's loop model alone
+    reads a matched part 0.7-1.35 Hz off (firmware/gyro/sense_tune.h)."""
+    got, match = _status_value(reply, "tune_detune_hz"), _status_value(reply, "tune_match")
+    if got is None or match in (None, "0"):
+        raise FlowError(f"self-test: the lost-match monitor gave no reading ({cmd})")
+    zero = values.get("sense.tune_disc_zero_hz", 0.0) + float(got)
+    if not abs(zero) <= DISC_ZERO_MAX_HZ:
+        raise FlowError(f"self-test: the lost-match monitor reads {zero:+.3f} Hz on the tuned "
+                        f"part, beyond +-{DISC_ZERO_MAX_HZ:g} Hz: the tuning or the loop's model "
+                        f"is not the part's ({cmd})")
+    return zero
 
 
 def part_id(sets):

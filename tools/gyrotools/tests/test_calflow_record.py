@@ -82,3 +82,20 @@ def test_a_sense_configuration_the_firmware_refuses_is_refused(args):
 def test_the_record_of_a_force_rebalance_calibration_names_it():
     v = calflow.record(dict(BASE, **calflow.sense_config("fr", quad_null=True)), [])
     assert v["cal.ref_sense_mode"] == 1 and v["cal.ref_quad_null"] == 1
+
+
+def _status(detune, match):
+    return f"ok status\r\n- tune_detune_hz {detune}\r\n- tune_match {match}\r\n"
+
+
+def test_the_lost_match_monitors_zero_is_its_reading_on_the_tuned_part():
+    assert calflow.disc_zero(_status(-1.94, 1), {}, "cmd") == pytest.approx(-1.94)
+    # read against the zero the run already had
+    assert calflow.disc_zero(_status(0.25, 1), {"sense.tune_disc_zero_hz": -1.5},
+                             "cmd") == pytest.approx(-1.25)
+
+
+@pytest.mark.parametrize("reply", [_status(-1.0, 0), "ok status\r\n", _status(-12.0, 2)])
+def test_no_reading_or_one_beyond_a_tuned_part_fails_the_stage(reply):
+    with pytest.raises(calflow.FlowError):
+        calflow.disc_zero(reply, {}, "cmd")
