@@ -103,22 +103,28 @@ int sense_fr_design(const sense_fr_cfg_t *cfg, sense_fr_design_t *d)
   return 0;
 }
 
-/* Y / T at s = j w (sense_fr_tone_gain): with the plant G = g (-p) / (s - p) seen through
- * the demodulator's pole and the delay, and C = Kp + Ki / s, R = G T / (1 + G C) and
- * Y = g (Ki / s + Kr) R. */
+/* The loop closed around a plant G at s = j w, the controller C = Kp + Ki / s (k: Kp,
+ * Ki, Kr): R = G T / (1 + G C) and the readout Y = g (Ki / s + Kr) R; returns Y / T. */
+static cplx_t closed_tone(const sense_fr_cfg_t *cfg, cplx_t plant, const cplx_t k[3], double w)
+{
+  const cplx_t kp = k[0], ki = k[1], kr = k[2];
+  const cplx_t one = {1.0, 0.0}, s = {0.0, w};
+  const cplx_t ki_s = c_div(ki, s);
+  const cplx_t gr = {(double)cfg->gain_per_v2, 0.0};
+  const cplx_t y = c_mul(gr, c_mul(c_add(ki_s, kr), plant));
+  return c_div(y, c_add(one, c_mul(plant, c_add(kp, ki_s))));
+}
+
+/* Y / T at s = j w (sense_fr_tone_gain): the plant G = g (-p) / (s - p) seen through the
+ * demodulator's pole and the delay. */
 static cplx_t tone_h(const sense_fr_cfg_t *cfg, const sense_fr_lag_t *lag, cplx_t p,
                      const cplx_t k[3], double w)
 {
-  const cplx_t kp = k[0], ki = k[1], kr = k[2];
   const double g = (double)cfg->gain_per_v2, b = lag->demod_pole_per_s;
-  const cplx_t one = {1.0, 0.0}, s_p = {-p.re, w - p.im}, s_b = {b, w}, s = {0.0, w};
+  const cplx_t s_p = {-p.re, w - p.im}, s_b = {b, w};
   const cplx_t gp = {-p.re * g * b, -p.im * g * b};
   const cplx_t delay = {cos(w * lag->delay_s), -sin(w * lag->delay_s)};
-  const cplx_t plant = c_mul(c_div(gp, c_mul(s_p, s_b)), delay);
-  const cplx_t ki_s = c_div(ki, s);
-  const cplx_t gr = {g, 0.0};
-  const cplx_t y = c_mul(gr, c_mul(c_add(ki_s, kr), plant));
-  return c_div(y, c_add(one, c_mul(plant, c_add(kp, ki_s))));
+  return closed_tone(cfg, c_mul(c_div(gp, c_mul(s_p, s_b)), delay), k, w);
 }
 
 double sense_fr_tone_gain(const sense_fr_cfg_t *cfg, const sense_fr_lag_t *lag, double f_hz)
@@ -166,9 +172,7 @@ static cplx_t lms_envelope(double mu, double wc, double t_s, double w)
 static cplx_t tone_h_full(const sense_fr_cfg_t *cfg, const sense_fr_lag_t *lag, double mu,
                           double t_s, cplx_t p, cplx_t pt, const cplx_t k[3], double w)
 {
-  const cplx_t kp = k[0], ki = k[1], kr = k[2];
   const double g = (double)cfg->gain_per_v2, wc = 2.0 * FM_PI * (double)cfg->f_drive_hz;
-  const cplx_t one = {1.0, 0.0}, s = {0.0, w};
   const cplx_t gp = {-p.re * g, -p.im * g}; /* b: the model's, the coupling is fixed */
   const cplx_t s_pt = {-pt.re, w - pt.im};
   const cplx_t p2 = {pt.re, -2.0 * wc - pt.im}; /* the second root */
@@ -176,10 +180,7 @@ static cplx_t tone_h_full(const sense_fr_cfg_t *cfg, const sense_fr_lag_t *lag, 
   const cplx_t delay = {cos(w * lag->delay_s), -sin(w * lag->delay_s)};
   cplx_t plant = c_mul(c_div(gp, s_pt), c_div(mp2, s_p2));
   plant = c_mul(c_mul(plant, delay), lms_envelope(mu, wc, t_s, w));
-  const cplx_t ki_s = c_div(ki, s);
-  const cplx_t gr = {g, 0.0};
-  const cplx_t y = c_mul(gr, c_mul(c_add(ki_s, kr), plant));
-  return c_div(y, c_add(one, c_mul(plant, c_add(kp, ki_s))));
+  return closed_tone(cfg, plant, k, w);
 }
 
 int sense_fr_tone_cross(const sense_fr_cfg_t *cfg, const sense_fr_lag_t *lag, double fs_hz,

@@ -53,24 +53,9 @@ static inline void sense_test_fr_sweep_values(param_values_t *v, double f_hz, do
   v->cal_ref_sense_mode = 1u;
 }
 
-/* The default plant with its sense mode at SENSE_TEST_F_HZ of quality q_sense, the
- * half-frequency feedback pair (fb_mode 3) at SENSE_TEST_KS_FB, every noise source off
- * (the figures are the loops', not the noise's). */
-static inline void sense_test_part(plant_cfg_t *pc, double q_sense)
-{
-  plant_default_cfg(pc);
-  pc->f_sense_hz = SENSE_TEST_F_HZ;
-  pc->q_sense = q_sense;
-  pc->fb_mode = 3;
-  pc->ks_fb_mps2_per_v2 = SENSE_TEST_KS_FB;
-  pc->brownian = 0;
-  pc->pick_sense_noise_v_rthz = pc->pick_drive_noise_v_rthz = 0.0;
-  pc->drive_noise_white_v_rthz = pc->drive_noise_1hz_v_rthz = 0.0;
-  pc->fb_noise_white_v_rthz = pc->fb_noise_1hz_v_rthz = 0.0;
-  pc->tune_noise_white_v_rthz = pc->tune_noise_1hz_v_rthz = 0.0;
-}
-
-/* The same part with the default plant's noise and imperfections on: as gyro-sim runs it. */
+/* The default plant with its sense mode at SENSE_TEST_F_HZ of quality q_sense and the
+ * half-frequency feedback pair (fb_mode 3) at SENSE_TEST_KS_FB, the default plant's noise
+ * and imperfections on: the part as gyro-sim runs it. */
 static inline void sense_test_noisy_part(plant_cfg_t *pc, double q_sense)
 {
   plant_default_cfg(pc);
@@ -78,6 +63,18 @@ static inline void sense_test_noisy_part(plant_cfg_t *pc, double q_sense)
   pc->q_sense = q_sense;
   pc->fb_mode = 3;
   pc->ks_fb_mps2_per_v2 = SENSE_TEST_KS_FB;
+}
+
+/* The same part with every noise source off (the figures are the loops', not the
+ * noise's). */
+static inline void sense_test_part(plant_cfg_t *pc, double q_sense)
+{
+  sense_test_noisy_part(pc, q_sense);
+  pc->brownian = 0;
+  pc->pick_sense_noise_v_rthz = pc->pick_drive_noise_v_rthz = 0.0;
+  pc->drive_noise_white_v_rthz = pc->drive_noise_1hz_v_rthz = 0.0;
+  pc->fb_noise_white_v_rthz = pc->fb_noise_1hz_v_rthz = 0.0;
+  pc->tune_noise_white_v_rthz = pc->tune_noise_1hz_v_rthz = 0.0;
 }
 
 #endif /* SENSE_MODE_MODEL_H */
