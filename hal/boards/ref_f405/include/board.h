@@ -7,7 +7,7 @@
  * The board: an STM32F405 (Cortex-M4F, 1 MB flash, 128 KB SRAM + 64 KB CCM), an AD7606
  * ADC on SPI1, two AD5554 DACs (SPI2: drive, rate output, sense feedback; SPI3: the sense
  * electrodes of the closed sense loop) behind x1.5 electrode driver stages, the tuning
- * port on USART1 (hal/boards/ref_f405/README.md: why these parts, the timing of a tick). */
+ * port on USART1, a TMP117 board temperature sensor on I2C1 (hal/boards/ref_f405/README.md: why these parts, the timing of a tick). */
 #ifndef BOARD_H
 #define BOARD_H
 
@@ -53,6 +53,15 @@
  * the application (app_tlm.h) is computed for this rate. */
 #define BOARD_UART_BAUD 921600u
 
+/* ---- Board temperature sensor ---------------------------------------------------------
+ * TI TMP117 (SNOSD82D) on I2C1, PB8/PB9, 400 kHz, address 0x48 (ADD0 to GND): 16-bit
+ * two's complement, 7.8125 mdegC per LSB (7.3.3); +-0.1 degC over -20..50 degC, +-0.2
+ * over -40..100 degC (6.5); its factory cycle, eight averages every 1 s (7.4), untouched.
+ * hal/include/hal/hal_board_temp.h. */
+#define BOARD_TEMP_LSB_C 0.0078125f
+#define BOARD_TEMP_CYCLE_S 1.0f
+#define BOARD_TEMP_I2C_ADDR 0x48u
+
 /* ---- Pins -----------------------------------------------------------------------------
  * (alternate functions from the STM32F405 data sheet, table 9; set up by
  * stm32f4_board_init, the sample chain by stm32f4_sample.c / stm32f4_dac.c)
@@ -73,6 +82,8 @@
  *   PC7   GPIO             -   in         ADC BUSY (diagnostics only)
  *   PB6   USART1_TX        7   out        tuning port TX
  *   PB7   USART1_RX        7   in         tuning port RX (pull-up)
+ *   PB8   I2C1_SCL         4   open-drain board temperature sensor (TMP117), 4.7 k pull-up
+ *   PB9   I2C1_SDA         4   open-drain board temperature sensor (TMP117), 4.7 k pull-up
  *
  * Strapped on the board: AD7606 PAR/SER/BYTE SEL high (serial), RANGE low (+-5 V),
  * OS[2:0] = 000 (no oversampling); both AD5554 MSB high (RS resets to mid-scale = 0 V). */
