@@ -11,6 +11,7 @@
 #include "hal/hal_uart.h"
 #include "app/app_cmds.h"
 #include "app/app_selfcal.h"
+#include "app/app_board.h"
 #include "app/app_tune.h"
 #include "comm/cli_builtin.h"
 #include "dsp/ramfunc.h"
@@ -137,6 +138,7 @@ int app_init_with(app_t *a, const param_values_t *values)
   gyro_attach_adc_frame(&a->gyro, hal_adc_frame()); /* and the one it reads */
   a->applied = view.derived;
   a->applied_gen = gen;
+  app_board_init(a);
 
   const cli_cfg_t cc = {&a->params, &a->store,        cli_write,
                         a,          cli_builtin_cmds, cli_builtin_count()};
@@ -170,6 +172,9 @@ static void take_request(app_t *a, uint32_t req)
   case APP_REQ_TUNE:
     gyro_set_tune(&a->gyro, APP_REQ_TUNE_CODE(req),
                   APP_REQ_TUNE_INVALID(req) ? RATE_INVALID_TUNE : 0u);
+    break;
+  case APP_REQ_BOARD:
+    gyro_set_board(&a->gyro, APP_REQ_BOARD_INVALID(req) ? RATE_INVALID_BOARD_TEMP : 0u);
     break;
   case APP_REQ_DRIVE_OFF: gyro_stop(&a->gyro); break;
   case APP_REQ_NONE:
@@ -243,4 +248,5 @@ void app_poll(app_t *a)
   app_tlm_poll(&a->tlm);
   app_selfcal_poll(a);
   app_tune_poll(a);
+  app_board_poll(a);
 }

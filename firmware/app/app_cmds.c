@@ -343,6 +343,25 @@ static void put_sense_tune(cli_t *cli, app_t *a)
   cli_data_u32(cli, "tune_match", !sense_tune_disc_settled(m) ? 0u : m->lost != 0u ? 2u : 1u);
 }
 
+/* The board thermometer (board.fuse, board_therm.h): its state (absent: the HAL says the
+ * board has no sensor), the sensor's latest reading and its counts; fused, the model's
+ * variable and bias, the hand-over's weight and the correction of the bias. */
+static void put_board_temp(cli_t *cli, app_t *a)
+{
+  const board_therm_t *b = &a->board;
+  cli_putf(cli, "board_temp %s",
+           b->absent != 0u && b->readings == 0u ? "absent" : board_therm_state_name(b->state));
+  cli_emit_data(cli);
+  if (b->readings > 0u) cli_data_f32(cli, "board_c", b->x_c);
+  cli_data_u32(cli, "board_readings", b->readings);
+  cli_data_u32(cli, "board_faults", b->faults);
+  if (a->gyro.design->board.on == 0u || b->have == 0u) return;
+  cli_data_f32(cli, "board_y_c", b->y_c);
+  cli_data_f32(cli, "board_model_dps", b->model_dps);
+  cli_data_f32(cli, "board_w", b->w);
+  cli_data_f32(cli, "board_corr_dps", b->corr_dps);
+}
+
 /* Force rebalance (sense.mode 1, sense_fr.h): whether it runs, balanced and at its
  * limit, the force command in the rate channel's frame (V^2: Coriolis, quadrature) and
  * the feedback pair's amplitude, its scale factor and the design's third root. */
@@ -441,6 +460,7 @@ static const status_row_t k_status_rows[] = {
     {"quad_null", NULL, put_quad_null},
     {"sense_fr", NULL, put_sense_fr},
     {"sense_tune", NULL, put_sense_tune},
+    {"board_temp", NULL, put_board_temp},
     {"design", NULL, put_design},
     {"ticks", ticks, NULL},
     {"isr_cycles_last", isr_cycles_last, NULL},

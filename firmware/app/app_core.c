@@ -33,6 +33,7 @@ static gyro_mode_t mode_after(gyro_mode_t m, uint32_t req)
   case APP_REQ_SELFTEST:
   case APP_REQ_CLEAR:
   case APP_REQ_TUNE:
+  case APP_REQ_BOARD:
   case APP_REQ_NONE:
   default: return m;
   }

@@ -30,7 +30,8 @@ typedef enum {
   APP_REQ_SWEEP_HANDOVER = 4u, /* SWEEP -> ACQUIRE with the newly applied design */
   APP_REQ_SELFTEST = 5u,       /* run the built-in self-test (selftest.h) */
   APP_REQ_CLEAR = 6u,          /* clear the shown fault; its record stays (last_fault) */
-  APP_REQ_TUNE = 7u            /* the mode tuning's code and verdict (app_tune.h) */
+  APP_REQ_TUNE = 7u,           /* the mode tuning's code and verdict (app_tune.h) */
+  APP_REQ_BOARD = 8u           /* the board thermometer's verdict (app_board.h) */
 } app_req_t;
 
 /* A request word: the kind in the low byte; APP_REQ_TUNE carries the tuning channel's
@@ -40,6 +41,9 @@ typedef enum {
   ((uint32_t)APP_REQ_TUNE | ((uint32_t)(code) << 8) | ((invalid) ? 0x80000000u : 0u))
 #define APP_REQ_TUNE_CODE(w) ((uint16_t)(((w) >> 8) & 0xFFFFu))
 #define APP_REQ_TUNE_INVALID(w) (((w)&0x80000000u) != 0u)
+/* APP_REQ_BOARD carries its verdict (RATE_INVALID_BOARD_TEMP set) in bit 31. */
+#define APP_REQ_BOARD_WORD(invalid) ((uint32_t)APP_REQ_BOARD | ((invalid) ? 0x80000000u : 0u))
+#define APP_REQ_BOARD_INVALID(w) (((w)&0x80000000u) != 0u)
 
 /* Lines an image adds to the status reply (board figures: stack, sample clock), written
  * with cli_put / cli_emit_data before the final ok line; ctx is NULL. */
@@ -89,6 +93,8 @@ typedef struct {
   bool tune_locked;      /* ... and whether it could apply them (LOCKED) */
   sense_tune_disc_t tune_disc;  /* its lost-match monitor (sense_tune.h, app_tune.c) */
   const void *tune_disc_design; /* the design it was fed under (a new one restarts it) */
+  board_therm_t board;          /* the board thermometer (board_therm.h, app_board.c) */
+  uint32_t board_tick;          /* app_ticks of its latest step */
 } app_t;
 
 /* The sample ISR's calls since app_init: the gyro's own count of its ticks (one per

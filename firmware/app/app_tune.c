@@ -53,7 +53,7 @@ void app_tune_poll(app_t *a)
     invalid = !a->tune_locked || a->tune.state != SENSE_TUNE_OK;
   }
   if (disc_invalid(a, a->tune_locked)) invalid = true;
-  const bool was_invalid = g->tune_bits != 0u;
+  const bool was_invalid = (g->bg_bits & RATE_INVALID_TUNE) != 0u;
   if (code != a->dac.code[HAL_DAC_TUNE] || invalid != was_invalid)
     (void)app_request_word(a, APP_REQ_TUNE_WORD(code, invalid)); /* the queue is empty */
 }

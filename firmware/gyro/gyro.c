@@ -66,7 +66,9 @@ int gyro_init_from_design(gyro_t *g, const gyro_design_t *d)
   t.fr_on = d->sense_mode;
   t.fb_off_v = d->fb_off_v;
   gyro_fr_off(&t);
-  t.tune_bits = d->tune.mode != SENSE_TUNE_OFF ? RATE_INVALID_TUNE : 0u; /* not tuned yet */
+  t.bg_bits = d->tune.mode != SENSE_TUNE_OFF ? RATE_INVALID_TUNE : 0u; /* not tuned yet */
+  /* the board thermometer's verdict comes with the background's first pass */
+  t.bg_bits |= d->board.on != 0u ? RATE_INVALID_BOARD_TEMP : 0u;
   *g = t;
   if (d->autostart != 0u) {
     gyro_start(g);
@@ -173,9 +175,14 @@ void gyro_apply(gyro_t *g, const gyro_design_t *d)
 
 void gyro_set_tune(gyro_t *g, uint16_t code, uint32_t bits)
 {
-  g->tune_bits = bits & RATE_INVALID_TUNE;
+  g->bg_bits = (g->bg_bits & ~RATE_INVALID_TUNE) | (bits & RATE_INVALID_TUNE);
   if (g->sup.mode != GYRO_MODE_SWEEP && code <= HAL_DAC_CODE_MAX)
     g->dac_frame->code[HAL_DAC_TUNE] = code;
+}
+
+void gyro_set_board(gyro_t *g, uint32_t bits)
+{
+  g->bg_bits = (g->bg_bits & ~RATE_INVALID_BOARD_TEMP) | (bits & RATE_INVALID_BOARD_TEMP);
 }
 
 void gyro_start(gyro_t *g)

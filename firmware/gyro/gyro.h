@@ -72,6 +72,10 @@ void gyro_attach_lost_counter(gyro_t *g, const volatile uint32_t *count);
  * taken. A code beyond the converter's is ignored. */
 void gyro_set_tune(gyro_t *g, uint16_t code, uint32_t bits);
 
+/* The board thermometer's verdict (RATE_INVALID_BOARD_TEMP or 0, board_therm.h), from
+ * the application's request (ISR, at a tick boundary). */
+void gyro_set_board(gyro_t *g, uint32_t bits);
+
 void gyro_start(gyro_t *g);
 void gyro_stop(gyro_t *g);
 

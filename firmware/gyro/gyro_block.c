@@ -535,6 +535,11 @@ GYRO_RAMFUNC GYRO_NOINLINE static void p_shadow(gyro_t *g)
 GYRO_RAMFUNC GYRO_NOINLINE static void p_refresh(gyro_t *g)
 {
   rate_channel_comp_refresh(&g->design->rate, &g->rate);
+  /* The board thermometer's share of the bias (board_therm.h), as the background
+   * handed it; kept beside it, so that the background reads the bias in P alone. */
+  const float corr = g->board_corr_dps;
+  g->rate.comp_bias_dps += corr;
+  g->board_corr_applied_dps = corr;
   p_low_pass(g);
 }
 
@@ -590,7 +595,7 @@ GYRO_RAMFUNC void gyro_block_output(gyro_t *g, float u1_v, float u2_v)
                               (g->rate.ref_wide_left != 0u ? RATE_INVALID_SETTLING : 0u) |
                               g->quad_bits | /* nulling on and not (yet) nulled */
                               g->fr_bits |   /* force rebalance on and not balanced */
-                              g->tune_bits;  /* mode tuning on and not at its target */
+                              g->bg_bits;    /* the background's: tuning, board thermometer */
   const uint32_t invalid = rate_valid_verdict(&g->valid, block_bits);
   /* Never a valid-looking wrong rate: the analog output goes to the fault level in the
    * same sample as the verdict, without a slew. */

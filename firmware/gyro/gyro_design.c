@@ -564,6 +564,18 @@ static gyro_design_status_t design_tune(const param_values_t *v, gyro_design_t *
                                                                     : GYRO_DESIGN_OK;
 }
 
+/* The board thermometer (board_therm.h): every value the table accepts designs. */
+static void design_board(const param_values_t *v, gyro_design_t *t)
+{
+  const float tz[2] = {v->board_tz1_s, v->board_tz2_s};
+  const float tp[2] = {v->board_tp1_s, v->board_tp2_s};
+  const float c[4] = {v->board_c0_dps, v->board_c1_dps_per_c, v->board_c2_dps_per_c2,
+                      v->board_c3_dps_per_c3};
+  board_therm_design(&t->board, v->board_fuse, tz, tp, v->board_ref_c, c, v->board_min_c,
+                     v->board_max_c, v->board_crossover_s, v->board_start_s, v->board_fade_s,
+                     v->board_stale_s, v->board_agree_dps);
+}
+
 /* Each part in turn; the first that fails names the reason. */
 /* The demodulation phase, the scale and the compensation are measured at one drive
  * frequency: at another, the phase of the drive against its resonance, and with it P
@@ -619,6 +631,7 @@ static gyro_design_status_t design_parts(const param_values_t *v, gyro_design_t 
   if (s == GYRO_DESIGN_OK) s = design_fb(v, t);
   if (s == GYRO_DESIGN_OK) s = design_fr_rate(v, t);
   if (s == GYRO_DESIGN_OK) s = design_tune(v, t);
+  design_board(v, t);
   t->autostart = v->sys_autostart;
   t->cal_state = cal_state(v, &t->tune);
   t->track_uncal = v->drive_track != 0u && v->cal_ref_track == 0u ? 1u : 0u;

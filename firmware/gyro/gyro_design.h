@@ -10,6 +10,7 @@
 
 #include "dsp/lmsd.h"
 #include "dsp/nco.h"
+#include "gyro/board_therm.h"
 #include "gyro/drive_loop.h"
 #include "gyro/drive_synth.h"
 #include "gyro/drive_track.h"
@@ -72,6 +73,9 @@ typedef struct {
   sense_tune_cfg_t tune;
   /* Its lost-match monitor (sense_tune.h): the background's too. */
   sense_tune_disc_cfg_t tune_disc;
+  /* The board thermometer (board.*, board_therm.h): the background's (app_board.c); the
+   * sample path adds the correction it hands over (gyro_t.board_in). */
+  board_therm_cfg_t board;
   /* The sweep's sense demodulator step (demod.mu_sense, open loop's in every sense mode):
    * its sense jobs' means and back-off threshold are designed for it, and force
    * rebalance's sense.fr_mu (a pole at 1.2 kHz, for the loop) passes enough of the 2 wc

@@ -51,6 +51,7 @@ typedef struct {
   float rate_out_v;           /* voltage commanded on the analog rate output this block */
   uint32_t rate_valid; /* 1 when the rate output can be trusted (output integrity), else 0 */
   float f_drive_hz;    /* drive (NCO) frequency: the tracked resonance in tracking mode */
+  float board_c;       /* board sensor's latest reading, NaN before one (the background's) */
 } gyro_out_t;
 
 #define GYRO_FLAG_LOCKED (1u << 0)
@@ -93,9 +94,12 @@ typedef struct gyro_s {
   gyro_quad_step_t quad_job; /* the nulling loop's next step (GYRO_SLOT_COMMAND), or NULL */
   uint32_t fr_on;   /* force rebalance (the design's sense_mode 1): its steps and waveform */
   uint32_t fr_bits; /* RATE_INVALID_SENSE_FR while it is on and not balanced */
-  /* RATE_INVALID_TUNE while mode tuning is on and not at its target: the background's
-   * verdict (app.c, sense_tune.h), set with the tuning voltage by gyro_set_tune */
-  uint32_t tune_bits;
+  /* The background's verdicts, each set by its request at a tick boundary:
+   * RATE_INVALID_TUNE while mode tuning is on and not at its target (app_tune.c,
+   * sense_tune.h; with the tuning voltage by gyro_set_tune), RATE_INVALID_BOARD_TEMP
+   * while the board thermometer weighs in and is not trusted (app_board.c,
+   * board_therm.h; gyro_set_board) */
+  uint32_t bg_bits;
   float fb_off_v; /* what the board adds to the feedback converters' voltages (design) */
   uint32_t rate_clear_due; /* the loop-state clear's rate half is due (GYRO_SLOT_RATE; a
                             * fault's clear, a start from OFF): GYRO_RATE_CLEAR_RESTART,
@@ -123,6 +127,11 @@ typedef struct gyro_s {
   drive_synth_t fb_synth;
   drive_synth_phasor_t fb_root; /* the force's root, for the synthesis a block later */
   sense_fr_t fr;
+  /* The board thermometer's correction of the compensation's bias (board_therm.h),
+   * written whole by the background (app_board.c), read by the sample path when it
+   * refreshes the compensation; last, as it is read once per P update only. */
+  volatile float board_corr_dps;
+  float board_corr_applied_dps; /* the one in rate.comp_bias_dps now */
 } gyro_t;
 
 #endif /* GYRO_STATE_H */

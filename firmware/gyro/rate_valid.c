@@ -370,9 +370,9 @@ GYRO_RAMFUNC void rate_valid_drive(const rate_valid_cfg_t *restrict c, rate_vali
 const char *rate_valid_reason_name(uint32_t kind)
 {
   static const char *const names[RATE_INVALID_KINDS] = {
-      "MODE",         "SELFTEST",      "SETTLING",      "CLIP",
-      "SENSE_RANGE",  "OVER_RANGE",    "PHASE",         "THERMO_RANGE",
-      "THERMO_SLEW",  "THERMO_SETTLE", "CONT_SELFTEST", "TRACKING",
-      "UNCALIBRATED", "QUAD_NULL",     "SENSE_FR",      "TUNE"};
+      "MODE",          "SELFTEST",  "SETTLING",     "CLIP",        "SENSE_RANGE",
+      "OVER_RANGE",    "PHASE",     "THERMO_RANGE", "THERMO_SLEW", "THERMO_SETTLE",
+      "CONT_SELFTEST", "TRACKING",  "UNCALIBRATED", "QUAD_NULL",   "SENSE_FR",
+      "TUNE",          "BOARD_TEMP"};
   return kind < RATE_INVALID_KINDS ? names[kind] : "?";
 }

@@ -108,7 +108,8 @@
 #define RATE_INVALID_QUAD_NULL (1u << 13)
 #define RATE_INVALID_SENSE_FR (1u << 14)
 #define RATE_INVALID_TUNE (1u << 15)
-#define RATE_INVALID_KINDS 16u
+#define RATE_INVALID_BOARD_TEMP (1u << 16)
+#define RATE_INVALID_KINDS 17u
 
 /* Blocks in a row inside the settling tolerance (2 ms): longer than the noise's
  * correlation time at the filters' 100 Hz, far shorter than their settling. */
