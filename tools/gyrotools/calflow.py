@@ -47,7 +47,7 @@ import zlib
 
 import numpy as np
 
-from . import csvlog, demodcal, fields, lincal, paramset, scalefactor, thermcal
+from . import boardcal, compstudy, csvlog, demodcal, fields, lincal, paramset, scalefactor, thermcal
 from .errors import InputError
 
 # Rate-table iterations: the demodulation is linear in the phasors, so one pass is exact
@@ -112,6 +112,9 @@ class SimPart:
     # the sense configuration calibrated (sense_config): firmware name -> value, set
     # before the sweep; the later stages inherit it through the param sets
     config: dict = dataclasses.field(default_factory=dict)
+    # the board thermometer (tools/calibrate --board-temp): its model of the bias fitted
+    # on the chamber run and fused with P (board.fuse 1, gyrotools/boardcal.py)
+    board: bool = False
 
 
 # The sense configurations the flow calibrates (tools/calibrate --sense, --fb-scheme,
@@ -446,7 +449,7 @@ def thermal(part, values):
         temps, part.protocol.dwell_s,
         {"description": "thermal calibration: chamber plateaus with rate steps at their ends"}))
     log, _, cmd = _sim(part, path, scen, part.seed + THERMAL_SEED_OFFSET, "thermal", csv=True,
-                       columns=THERMAL_COLUMNS)
+                       columns=THERMAL_COLUMNS + (["board_c"] if part.board else []))
     # The compensation acts on the linearised output L(u) (rate_channel.h).
     log.data["rate_unc_dps"] = lincal.linearise(log["rate_unc_dps"],
                                                 values.get("rate.lin_c2_per_dps", 0.0),
@@ -462,9 +465,33 @@ def thermal(part, values):
     v.update(comp)
     v["rate.scale_dps"] = values["rate.scale_dps"] * s0
     v["rate.p_rate_deg_per_dps"] = values["rate.p_rate_deg_per_dps"] + figs["p_turn_c0_deg_per_dps"]
+    if part.board:
+        v, figs["board"] = board_model(log, v, cmd)
     figs["command"] = cmd
     figs["seed"] = part.seed + THERMAL_SEED_OFFSET
     return v, figs
+
+
+def board_model(log, v, cmd):
+    """The board thermometer's model of the bias (gyrotools/boardcal.py) on the chamber
+    run at rest, the target the bias the compensation removes there: u SF(x), u the
+    linearised output (the compensation in P, v, with its bias terms taken out, gives
+    u SF). Returns (values with the fusion on, its figures)."""
+    no_bias = dict(v, **{k: 0.0 for k in v if k.startswith("rate.bias_c") or
+                         k in ("rate.bias_grad_dps_per_deg", "rate.grad_fast_dps_per_deg")})
+    target = compstudy.compensate(log, no_bias, v["rate.comp_tau_s"], v["rate.comp_stages"])
+    rest = (np.abs(log["rate_true_dps"]) < 1e-9) & (log["rate_valid"] > 0.5)
+    try:
+        model = boardcal.fit(log["t_s"], log["board_c"], target, rest)
+    except InputError as e:
+        raise FlowError(f"board thermometer: {e} ({cmd})") from None
+    # the bias in P as the firmware's compensation makes it: u SF - (u SF - B_P)
+    bias_p = target - compstudy.compensate(log, v, v["rate.comp_tau_s"], v["rate.comp_stages"])
+    parting = boardcal.parting_dps(log["t_s"], log["board_c"], bias_p, model)
+    out = dict(v, **boardcal.values(model, parting))
+    return out, dict(boardcal.doc(model), start_s=out["board.start_s"],
+                     crossover_s=out["board.crossover_s"], parting_dps=parting,
+                     agree_dps=out["board.agree_dps"])
 
 
 def p_rate_turn(log):
@@ -718,16 +745,33 @@ def verify(part, cal_path):
             "checks": checks, "passed": all(checks.values())}
 
 
-def _thermal_runs(part, cal_path):
-    """The thermal verification's runs, as (name, function of nothing -> figures)."""
+def powered(part, cal_path):
+    """The set the simulator's warm runs verify: every run but the cold start begins with
+    the part's thermal network in its steady state, the board's own dissipation in it, as
+    a part powered for long, whose firmware handed over to the board thermometer long
+    since (board.start_s after power-on, board_therm.h); its uptime starts at 0 in the
+    run, so those runs set board.start_s 0. The cold start runs the set as written. On a
+    port, or without the fusion, the set itself."""
+    vals = paramset.read(cal_path).values()
+    if part.port is not None or int(vals.get("board.fuse", 0)) != 1:
+        return cal_path
+    path = os.path.join(part.work, "calibration_powered.json")
+    paramset.write(path, paramset.from_values(dict(vals, **{"board.start_s": 0.0}), meta={
+        "stage": "verify: the calibration as a part powered for long runs it"}))
+    return path
+
+
+def _thermal_runs(part, cal_path, warm):
+    """The thermal verification's runs, as (name, function of nothing -> figures); warm
+    the set the warm runs take (powered)."""
     seed = part.seed + VERIFY_SEED_OFFSET
     proto = part.protocol
     temps = proto.verify_plateaus_c
 
     def run(name, doc, k, judge):
         scen = _scenario(part, "calibrate_" + name, doc)
-        log, _, cmd = _sim(part, cal_path, scen, seed + k, name, csv=True,
-                           columns=THERMAL_COLUMNS)
+        log, _, cmd = _sim(part, cal_path if name == "verify_warmup" else warm, scen, seed + k,
+                           name, csv=True, columns=THERMAL_COLUMNS)
         return dict(judge(log), command=cmd, seed=seed + k,
                     invalid_s_by_reason=fields.invalid_time_s(log["t_s"], log["rate_invalid"]))
 
@@ -760,7 +804,8 @@ def _thermal_runs(part, cal_path):
 def verify_all(part, cal_path, workers=None):
     """Every verification run side by side (one gyro-sim process each): a dict of their
     figures, each with "ok" or "passed"."""
-    jobs = [("rate", lambda: verify(part, cal_path))] + _thermal_runs(part, cal_path)
+    warm = powered(part, cal_path)
+    jobs = [("rate", lambda: verify(part, warm))] + _thermal_runs(part, cal_path, warm)
     n = 1 if part.port is not None else workers or os.cpu_count() or 1  # one part, one bench
     with concurrent.futures.ThreadPoolExecutor(max_workers=n) as pool:
         futs = {name: pool.submit(fn) for name, fn in jobs}

@@ -101,13 +101,19 @@ def _conversion_message(path, header_line, numpy_msg):
     return f"{path}:{lineno}: malformed value '{value}' (not a number)"
 
 
+# Columns whose nan is a value: "none yet" (the board sensor's reading before its first
+# conversion); inf is refused in them as anywhere.
+NAN_MEANS_NONE = ("board_c",)
+
+
 def read_log(path, need=(), want=(), time_column=TIME_COLUMN, min_rows=2, purpose=""):
     """Load the columns `need` (required) and `want` (optional) of a CSV log.
 
     time_column (default t_s) is always required unless None, and must be strictly
-    increasing. Every loaded value must be finite. Raises InputError for an unreadable,
-    empty, malformed, non-monotonic or too short (< min_rows data rows) file; `purpose`
-    (e.g. "the Allan deviation") is quoted in the messages.
+    increasing. Every loaded value must be finite (nan allowed in NAN_MEANS_NONE).
+    Raises InputError for an unreadable, empty, malformed, non-monotonic or too short
+    (< min_rows data rows) file; `purpose` (e.g. "the Allan deviation") is quoted in the
+    messages.
     """
     need = list(need)
     if time_column is not None and time_column not in need:
@@ -161,7 +167,7 @@ def read_log(path, need=(), want=(), time_column=TIME_COLUMN, min_rows=2, purpos
     for i, n in enumerate(names):
         data[n] = arr[:, i]
     for n in names:
-        bad = ~np.isfinite(data[n])
+        bad = ~np.isfinite(data[n]) & ~(np.isnan(data[n]) if n in NAN_MEANS_NONE else False)
         if bad.any():
             raise InputError(
                 f"{path}: non-finite value in column '{n}' at data row {int(np.argmax(bad)) + 1}")

@@ -19,7 +19,7 @@ ALIASES = {"drive_amp": "drive_amp_v", "drive_amp_v": "drive_amp"}
 # and `status`); tests/test_fields.py holds them to the header.
 RATE_INVALID = ("MODE", "SELFTEST", "SETTLING", "CLIP", "SENSE_RANGE", "OVER_RANGE", "PHASE",
                 "THERMO_RANGE", "THERMO_SLEW", "THERMO_SETTLE", "CONT_SELFTEST", "TRACKING",
-                "UNCALIBRATED", "QUAD_NULL", "SENSE_FR", "TUNE")
+                "UNCALIBRATED", "QUAD_NULL", "SENSE_FR", "TUNE", "BOARD_TEMP")
 
 
 def invalid_time_s(t_s, rate_invalid):
@@ -73,7 +73,10 @@ CSV_MEANING = {
              "tracked frequency, p_init - (2Q/f0)(f - f_cal) (tracking drive) (firmware)",
     "t_ambient_c": "ambient temperature (truth)",
     "t_struct_c": "sensor structure temperature (truth)",
-    "t_board_c": "board temperature sensor (truth)",
+    "t_board_c": "the board's thermal node, where its temperature sensor sits (truth)",
+    "board_c": "the board temperature sensor's latest reading (a TMP117: 1 s conversions, "
+               "7.8125 mdegC steps, its accuracy error and noise), as the firmware took it; "
+               "nan before the first (firmware)",
     "u1_v": "drive electrode 1 voltage written this tick (firmware)",
     "u2_v": "drive electrode 2 voltage written this tick (firmware)",
     "adc_drive_v": "drive pickoff at the ADC input (truth)",
