@@ -2,7 +2,8 @@
  * the plant: a result every 1 s at a phase drawn once, the node's temperature at the
  * middle of the 124 ms of averaging before it, the accuracy error, the averaged noise,
  * the register's rounding, held in between; a fault time and an absent sensor; and the
- * plant's other samples unchanged by it (its random numbers are its own). */
+ * plant's other samples unchanged by it (its random numbers are its own). Through the
+ * host HAL stub (hal/host/hal_host.h) the firmware sees each result once. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -14,6 +15,8 @@
 #include <cmocka.h>
 
 #include "hal/hal_board_temp.h"
+#include "hal/hal_sample_timer.h"
+#include "hal_host.h"
 #include "plant/board_sensor.h"
 #include "plant/plant.h"
 
@@ -396,6 +399,73 @@ static void test_plant_parameters(void **state)
   assert_int_equal(ideal.board_sensor, BOARD_SENSOR_TMP117);
 }
 
+/* ------------------------------------------------------ through the host HAL ----- */
+
+static void quiet_isr(void *ctx)
+{
+  (void)ctx;
+  hal_dac_frame_t f;
+  hal_dac_frame_midscale(&f);
+  hal_dac_write_frame(&f);
+}
+
+/* The firmware's view: the plant attached to the host HAL, polled every 20 ms as a
+ * background loop would: each result NEW exactly once, its code the plant's; NONE in
+ * between; FAULT once per missed result from board_sensor_fault_s on; ABSENT with the
+ * sensor off or nothing attached. */
+static void test_hal_host_sees_each_result_once(void **state)
+{
+  (void)state;
+  static plant_t p;
+  plant_cfg_t c;
+  plant_default_cfg(&c);
+  c.board_sensor_fault_s = 3.3;
+  assert_int_equal(plant_init(&p, &c, 5u), 0);
+  hal_host_attach(plant_step_hal, &p);
+  hal_host_attach_board_temp(plant_board_temp_hal, &p);
+  assert_int_equal(hal_sample_timer_start(50000u, quiet_isr, NULL), 0);
+  int16_t code = 0;
+  assert_int_equal(hal_board_temp_poll(&code), HAL_BOARD_TEMP_NONE); /* not started */
+  assert_int_equal(hal_board_temp_start(), 0);
+  int news = 0, faults = 0, nones = 0;
+  for (int poll = 0; poll < 250; poll++) { /* 5 s */
+    hal_host_run(1000u);
+    const hal_board_temp_event_t ev = hal_board_temp_poll(&code);
+    if (ev == HAL_BOARD_TEMP_NEW) {
+      news++;
+      assert_true(code * kLsb == plant_truth(&p)->board_meas_c);
+      assert_true((double)hal_host_ticks() / 50000.0 < 3.3);
+    } else if (ev == HAL_BOARD_TEMP_FAULT) {
+      faults++;
+      assert_true((double)hal_host_ticks() / 50000.0 >= 3.3);
+    } else {
+      assert_int_equal(ev, HAL_BOARD_TEMP_NONE);
+      nones++;
+    }
+    assert_int_equal(hal_board_temp_poll(&code), HAL_BOARD_TEMP_NONE); /* once only */
+  }
+  uint64_t conv = 0u;
+  (void)plant_board_temp_hal(&p, (double)hal_host_ticks() / 50000.0, NULL, &conv);
+  print_message("5 s polled every 20 ms: %d NEW, %d FAULT, %d NONE (%llu results)\n", news,
+                faults, nones, (unsigned long long)conv);
+  assert_int_equal(news + faults, (int)conv);
+  assert_true(news >= 3 && news <= 4);
+  assert_true(faults >= 1 && faults <= 2);
+  /* a restart reads the latest result afresh: here the sensor does not answer */
+  assert_int_equal(hal_board_temp_start(), 0);
+  assert_int_equal(hal_board_temp_poll(&code), HAL_BOARD_TEMP_FAULT);
+
+  c.board_sensor = BOARD_SENSOR_NONE;
+  assert_int_equal(plant_init(&p, &c, 5u), 0);
+  hal_host_attach(plant_step_hal, &p);
+  hal_host_attach_board_temp(plant_board_temp_hal, &p);
+  hal_host_run(60000u);
+  assert_int_equal(hal_board_temp_poll(&code), HAL_BOARD_TEMP_ABSENT);
+  hal_host_attach_board_temp(NULL, NULL);
+  assert_int_equal(hal_board_temp_poll(&code), HAL_BOARD_TEMP_ABSENT);
+  hal_sample_timer_stop();
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -407,6 +477,7 @@ int main(void)
       cmocka_unit_test(test_fault_and_absent),
       cmocka_unit_test(test_plant_samples_unchanged),
       cmocka_unit_test(test_plant_parameters),
+      cmocka_unit_test(test_hal_host_sees_each_result_once),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
