@@ -74,6 +74,11 @@ CSV_MEANING = {
     "t_ambient_c": "ambient temperature (truth)",
     "t_struct_c": "sensor structure temperature (truth)",
     "t_board_c": "board temperature sensor (truth)",
+    "t_board_meas_c": "the board temperature sensor's latest result as the firmware reads it "
+                      "(the TMP117's code times 7.8125 mdegC: t_board_c 62 ms before the 1 s "
+                      "conversion ended, with the sensor's accuracy error and noise, "
+                      "plant.board_sensor_*); nan before its first conversion, without a sensor "
+                      "and while it does not answer",
     "u1_v": "drive electrode 1 voltage written this tick (firmware)",
     "u2_v": "drive electrode 2 voltage written this tick (firmware)",
     "adc_drive_v": "drive pickoff at the ADC input (truth)",
