@@ -2,6 +2,7 @@
 
 #include <stddef.h>
 
+#include "hal/hal_board_temp.h"
 #include "hal/hal_critical.h"
 #include "hal/hal_sample_timer.h"
 
@@ -91,6 +92,47 @@ void hal_sample_isr_cycles(uint32_t *last, uint32_t *max)
 {
   if (last != NULL) *last = 0u;
   if (max != NULL) *max = 0u;
+}
+
+/* The board temperature sensor: the host program's callback, and which of its results the
+ * firmware has had (hal_host.h). */
+static struct {
+  hal_host_board_temp_fn fn;
+  void *ctx;
+  uint64_t last; /* number of the result (or the missed one) returned last; 0: none */
+  int started;
+} s_temp;
+
+void hal_host_attach_board_temp(hal_host_board_temp_fn fn, void *ctx)
+{
+  s_temp.fn = fn;
+  s_temp.ctx = ctx;
+  s_temp.last = 0u;
+}
+
+/* The board's bus always comes up on the host; a board without a sensor says so on every
+ * poll. A restart (start again) reads the sensor's latest result afresh. */
+int hal_board_temp_start(void)
+{
+  s_temp.started = 1;
+  s_temp.last = 0u;
+  return 0;
+}
+
+hal_board_temp_event_t hal_board_temp_poll(int16_t *code)
+{
+  if (s_temp.fn == NULL) return HAL_BOARD_TEMP_ABSENT;
+  if (!s_temp.started) return HAL_BOARD_TEMP_NONE;
+  const double t_s = host.rate_hz ? (double)host.ticks / (double)host.rate_hz : 0.0;
+  int16_t c = 0;
+  uint64_t n = 0u;
+  const hal_board_temp_event_t ev = s_temp.fn(s_temp.ctx, t_s, &c, &n);
+  if (ev == HAL_BOARD_TEMP_ABSENT) return ev;
+  if ((ev != HAL_BOARD_TEMP_NEW && ev != HAL_BOARD_TEMP_FAULT) || n == s_temp.last)
+    return HAL_BOARD_TEMP_NONE;
+  s_temp.last = n;
+  if (ev == HAL_BOARD_TEMP_NEW && code != NULL) *code = c;
+  return ev;
 }
 
 uint32_t hal_critical_enter(void) { return 0u; }

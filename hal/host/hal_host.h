@@ -11,6 +11,12 @@
  * No firmware code knows it runs on a host. The stub is single-threaded: the background
  * loop is called by the host program between ticks, so the critical-section calls are
  * no-ops here.
+ *
+ * The board temperature sensor (hal_board_temp.h) is a second, optional attachment
+ * (hal_host_attach_board_temp): a callback that says what the sensor holds at the
+ * simulated time hal_host_ticks() / hal_host_rate_hz(). hal_board_temp_poll returns each
+ * of its results as NEW once (each missed one as FAULT once), NONE in between; with
+ * nothing attached the board has no sensor (ABSENT).
  */
 #ifndef HAL_HOST_H
 #define HAL_HOST_H
@@ -18,6 +24,7 @@
 #include <stdint.h>
 
 #include "hal/hal_adc.h"
+#include "hal/hal_board_temp.h"
 #include "hal/hal_dac.h"
 
 /* Advance the plant over one sample period with dac held; sample the ADC at its end. */
@@ -37,6 +44,20 @@ uint32_t hal_host_rate_hz(void);
 
 /* The frame the firmware wrote at the latest tick (for traces). */
 const hal_dac_frame_t *hal_host_last_dac(void);
+
+/* The board temperature sensor at simulated time t_s: HAL_BOARD_TEMP_NEW with *code its
+ * latest finished result and *conversion that result's number (1, 2, ... in order);
+ * HAL_BOARD_TEMP_NONE before its first result; HAL_BOARD_TEMP_FAULT when it does not
+ * answer, *conversion the number of the result that could not be read (the results go on
+ * being counted); HAL_BOARD_TEMP_ABSENT when there is none. plant_board_temp_hal
+ * (host_sim/plant/plant.h) has this shape. */
+typedef hal_board_temp_event_t (*hal_host_board_temp_fn)(void *ctx, double t_s, int16_t *code,
+                                                         uint64_t *conversion);
+
+/* Attach the board temperature sensor (NULL: none, hal_board_temp_poll says ABSENT), and
+ * forget which result was returned last. Attach it again, or NULL, before its context
+ * goes away. */
+void hal_host_attach_board_temp(hal_host_board_temp_fn fn, void *ctx);
 
 /* Count one lost sample, as the board's converters report an overrun (hal_sample_lost). */
 void hal_host_lose_sample(void);

@@ -204,6 +204,7 @@ static void cl_release(cl_run_t *r)
   if (r->pty.master_fd >= 0) uart_pty_close(&r->pty);
   sim_csv_close(&r->csv);
   hal_sample_timer_stop();
+  hal_host_attach_board_temp(NULL, NULL); /* before its plant goes */
   free(r->truth.amp);
   free(r->truth.ph);
   free(r->truth.rerr);
@@ -281,6 +282,7 @@ static int cl_start(cl_run_t *r, const sim_scenario_t *sc, const sim_opts_t *opt
   if (warm == NULL) (void)hal_flash_host_configure(NULL);
   hal_uart_host_reset();
   hal_host_attach(plant_step_hal, r->plant);
+  hal_host_attach_board_temp(plant_board_temp_hal, r->plant); /* the board's TMP117 */
   if ((warm != NULL ? app_init(r->app) : app_init_with(r->app, fw)) != 0 ||
       hal_sample_timer_start(fw->sys_fs_hz, app_sample_isr, r->app) != 0) {
     snprintf(err, err_len, "firmware: application did not start");
@@ -513,6 +515,7 @@ static int selfcal_run(const sim_scenario_t *sc, const plant_cfg_t *pc,
     (void)hal_flash_host_configure(NULL);
     hal_uart_host_reset();
     hal_host_attach(plant_step_hal, p);
+    hal_host_attach_board_temp(plant_board_temp_hal, p);
     if (app_init_with(a, fw) != 0 ||
         hal_sample_timer_start(fw->sys_fs_hz, app_sample_isr, a) != 0) {
       snprintf(err, err_len, "firmware: application did not start");
@@ -522,6 +525,7 @@ static int selfcal_run(const sim_scenario_t *sc, const plant_cfg_t *pc,
       for (int i = 0; i < THERMAL_NODES; i++) warm->t_k[i] = thermal_temp(&p->thermal, i);
     }
     hal_sample_timer_stop();
+    hal_host_attach_board_temp(NULL, NULL); /* before p goes */
   }
   if (rc == -2) snprintf(err, err_len, "self-calibration failed: %s", out->why);
   free(p);

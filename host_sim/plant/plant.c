@@ -243,6 +243,14 @@ static void make_accel_cfg(const plant_cfg_t *c, accel_cfg_t *a)
   a->sense_mps2_per_g[ACCEL_AXIS_NORMAL] = c->gs_sense_from_normal_mps2_per_g;
 }
 
+static void make_board_sensor_cfg(const plant_cfg_t *c, board_sensor_cfg_t *b)
+{
+  b->kind = c->board_sensor;
+  b->offset_c = c->board_sensor_offset_c;
+  b->slope = c->board_sensor_slope;
+  b->fault_s = c->board_sensor_fault_s;
+}
+
 static int pick_node(const plant_cfg_t *c, int axis) { return PLANT_PICK(c, axis, temp_node); }
 
 /* ------------------------------------------------------------- warnings ------ */
@@ -383,6 +391,8 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   make_accel_cfg(c, &gc);
   vref_cfg_t vc;
   make_vref_cfg(c, &vc);
+  board_sensor_cfg_t bc;
+  make_board_sensor_cfg(c, &bc);
 
   int out_mech = 0;
   /* cold_start: power-on after a long power-off, every node at the ambient (thermal.h) */
@@ -399,6 +409,8 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   else if (accel_init(&p->accel, &gc) != 0) what = "g-sensitivity (gs_*)";
   else if (vref_init(&p->vref, &vc, c->fs_hz, seed) != 0) what = "reference (vref_noise_*)";
   else if (init_drifts(p, seed) != 0) what = "coupling drift (*_drift_*)";
+  else if (board_sensor_init(&p->board_sensor, &bc, seed) != 0)
+    what = "board temperature sensor (board_sensor*)";
   for (int i = 0; what == NULL && i < 2; i++) {
     if (pickoff_init(&p->pick[i], &pc[i], thermal_temp(&p->thermal, pick_node(c, i)), seed) != 0)
       what = i == 0 ? "drive pickoff (pick_drive_*)" : "sense pickoff (pick_sense_*)";
@@ -431,6 +443,7 @@ int plant_init(plant_t *p, const plant_cfg_t *cfg, uint64_t seed)
   clock_update(p, 0.0);
   truth_temps(p, c->temp_k);
   truth_sense(p);
+  p->truth.board_meas_c = NAN; /* no result before the sensor's first */
   if (out_mech) warn(p, PLANT_LAW_RESONANCE);
   for (int i = 0; i < 2; i++) warn_pickoff(p, i, p->pick[i].out_of_range);
   warn_amplitude_laws(p);
@@ -636,6 +649,12 @@ void plant_step(plant_t *p, const hal_dac_frame_t *dac, hal_adc_frame_t *adc_out
     p->thermal_countdown = p->thermal_every;
   }
   p->thermal_countdown--;
+  /* the board sensor's conversions (board_sensor.h): due once or twice per 1 s result */
+  if (board_sensor_due(&p->board_sensor, t0)) {
+    board_sensor_step(&p->board_sensor, t0,
+                      thermal_temp(&p->thermal, THERMAL_BOARD) - PLANT_K_AT_0_C);
+    t->board_meas_c = board_sensor_reading_c(&p->board_sensor, t0);
+  }
 
   /* The frame passed in is on the outputs during this interval (the host HAL applies
    * the board's latency), so it is latched now: dac_write validates it, then the
@@ -739,6 +758,12 @@ int plant_set_electrodes(plant_t *p, const plant_electrodes_t *v)
 void plant_step_hal(void *plant, const hal_dac_frame_t *dac, hal_adc_frame_t *adc)
 {
   plant_step((plant_t *)plant, dac, adc);
+}
+
+hal_board_temp_event_t plant_board_temp_hal(void *plant, double t_s, int16_t *code,
+                                            uint64_t *conversion)
+{
+  return board_sensor_read(&((const plant_t *)plant)->board_sensor, t_s, code, conversion);
 }
 
 const plant_truth_t *plant_truth(const plant_t *p) { return &p->truth; }

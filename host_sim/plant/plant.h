@@ -35,6 +35,10 @@
  *      sampled at t_k+1 (+ delay, jitter, the ADC's aperture jitter);
  *   6. ADC (adc.h): 16-bit quantiser (INL), clip and fault counters -> the frame
  *      returned, which the firmware reads at tick k+1.
+ * Beside the chain, the board's temperature sensor (board_sensor.h, plant.board_sensor*)
+ * reads the board node once per 1 s conversion, from random numbers of its own: the
+ * chain's samples are the same with it and without it. The host HAL reads it through
+ * plant_board_temp_hal.
  *
  * Every imperfection beyond the thesis's linear gyro (the q_temp_law, k3_*,
  * nl_damp_drive_per_m2, *_drift_*, fb_gap_m, pick_*_gap_*, pick_*_flicker_*, adc_inl_*,
@@ -71,6 +75,7 @@
 #include "plant/accel.h"
 #include "plant/actuator.h"
 #include "plant/adc.h"
+#include "plant/board_sensor.h"
 #include "plant/dac.h"
 #include "plant/drift.h"
 #include "plant/mech.h"
@@ -328,6 +333,15 @@
     "sample clock's change with the board node's temperature (linear about 25 degC)") \
   X(double, clock_ageing_ppm_per_day, DOUBLE, -10.0, 10.0, "ppm/day", \
     "sample clock's drift with time since power-on (ageing, linear)") \
+  /* the board's temperature sensor (board_sensor.h): a TMP117 reading the board node */ \
+  X(double, board_sensor_offset_c, DOUBLE, -1.0, 1.0, "degC", \
+    "board temperature sensor's accuracy error at 25 degC (TMP117: +-0.1 degC over " \
+    "-20..50 degC, SNOSD82D 6.5)") \
+  X(double, board_sensor_slope, DOUBLE, -0.01, 0.01, "K/K", \
+    "that error's change per K away from 25 degC (TMP117: +-0.2 degC over -40..100 degC)") \
+  X(double, board_sensor_fault_s, DOUBLE, -1.0, 1e9, "s", \
+    "time from which the board temperature sensor stops answering (the HAL reports FAULT " \
+    "at each result it misses), negative = never") \
   /* switches (kept at the end so the struct has no padding between fields) */ \
   X(int, truth_decim, INT, 1, 1000000, "", "phasor truth (amplitudes, phases) every n samples") \
   X(int, fb_mode, INT, 0, 3, "", \
@@ -343,6 +357,9 @@
   X(int, q_temp_law, INT, 0, 2, "", \
     "Q against structure temperature: 0 constant, 1 gas damping (air), 2 thermoelastic " \
     "(vacuum) (qlaw.h)") \
+  X(int, board_sensor, INT, 0, 1, "", \
+    "board temperature sensor: 0 none (the HAL reports ABSENT), 1 a TMP117 on the board " \
+    "node, a result every 1 s (board_sensor.h)") \
   X(bool, full_kinematics, BOOL, 0, 1, "", \
     "reciprocal Coriolis, centrifugal and Euler terms of (2-20)") \
   X(bool, brownian, BOOL, 0, 1, "", "Brownian force noise on both axes (4-20)") \
@@ -393,6 +410,9 @@ typedef struct {
   double accel_g[3]; /* mean over the last sample */
   /* temperatures */
   double ambient_k, struct_k, circuit_k, board_k;
+  double board_meas_c;   /* the board temperature sensor's latest result (board_sensor.h), as
+                          the firmware reads it: a whole number of LSB, degC; NaN before
+                          its first result, without a sensor, and while it does not answer */
   double wn_drive_rad_s; /* drive resonance now (2-32), per second of the sample clock */
   double clock_ppm;      /* the sample clock's error now (+: fast; plant_cfg_t clock_*) */
   double q_drive;        /* drive quality factor now (q_temp_law) */
@@ -495,6 +515,7 @@ typedef struct {
   uint8_t elec_has[PLANT_ELECTRODES];     /* the part has that electrode (fb U3, U4, V1,
                                              V2, Vt) */
   drift_t drift[2];                       /* slow drift of k_q and d_q */
+  board_sensor_t board_sensor;            /* the board's temperature sensor (board_sensor.h) */
   double drift_kq_per_s2, drift_dq_per_s; /* per unit of the drifts' values (deg/s) */
   uint64_t seed;
   double T;                     /* sample period */
@@ -586,6 +607,15 @@ int plant_set_electrodes(plant_t *p, const plant_electrodes_t *v);
 /* The same step in the shape of hal_host_plant_step_fn (hal/host/hal_host.h), so the
  * host HAL stub can attach a plant_t without a cast: plant is a plant_t *. */
 void plant_step_hal(void *plant, const hal_dac_frame_t *dac, hal_adc_frame_t *adc);
+
+/* The board temperature sensor (board_sensor.h) as the HAL reads it at time t_s, in the
+ * shape of hal_host_board_temp_fn (hal/host/hal_host.h): plant is a plant_t *. NEW with
+ * *code the latest finished result and *conversion its number; NONE before the first;
+ * FAULT from board_sensor_fault_s on; ABSENT with board_sensor 0. t_s not before the
+ * start of the last sample run (the host HAL passes its ticks over the rate: the plant
+ * has run one sample more). */
+hal_board_temp_event_t plant_board_temp_hal(void *plant, double t_s, int16_t *code,
+                                            uint64_t *conversion);
 
 /* The truth of the last completed sample. */
 const plant_truth_t *plant_truth(const plant_t *p);

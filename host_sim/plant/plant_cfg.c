@@ -153,6 +153,19 @@ static void set_ideal_actuators(plant_cfg_t *c)
   c->tune_noise_fmin_hz = 1e-3;
 }
 
+/* The board's temperature sensor (board.h, board_sensor.h): a TMP117, one part's
+ * accuracy error well inside its data sheet's (SNOSD82D 6.5: +-0.1 degC over -20..50 degC,
+ * +-0.2 over -40..100): +0.04 degC at 25 degC, -0.8 mK/K, so +0.092 degC at -40 and
+ * -0.008 degC at 85 degC. It is the board's sensor, not the gyro's imperfection: both
+ * presets have it (random numbers of its own, so the gyro's samples do not move). */
+static void set_board_sensor(plant_cfg_t *c)
+{
+  c->board_sensor = BOARD_SENSOR_TMP117;
+  c->board_sensor_offset_c = 0.04;
+  c->board_sensor_slope = -0.0008;
+  c->board_sensor_fault_s = -1.0; /* answers for the whole run */
+}
+
 void plant_ideal_cfg(plant_cfg_t *c)
 {
   memset(c, 0, sizeof *c);
@@ -290,6 +303,7 @@ void plant_ideal_cfg(plant_cfg_t *c)
   thermal_preset(&th, THERMAL_PRESET_DEFAULT);
   set_thermal(c, &th);
   c->thermal_dt_s = th.dt_s;
+  set_board_sensor(c);
 }
 
 /* The default part: the ideal part plus the imperfections that make it measure, with

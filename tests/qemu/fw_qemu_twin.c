@@ -31,6 +31,7 @@ int main(void)
     return 1;
   }
   hal_host_attach(plant_step_hal, &plant);
+  hal_host_attach_board_temp(plant_board_temp_hal, &plant); /* the image's board sensor */
   param_values_t v;
   param_values_defaults(&v);
   char err[256];

@@ -27,6 +27,7 @@ static inline void app_plant_start(const plant_cfg_t *pc, uint64_t seed, const p
   assert_int_equal(hal_flash_host_configure(NULL), 0);
   hal_uart_host_reset();
   hal_host_attach(plant_step_hal, &plant);
+  hal_host_attach_board_temp(plant_board_temp_hal, &plant); /* the board's TMP117 */
   param_values_t def;
   if (v == NULL) {
     default_part_values(&def);

@@ -7,12 +7,14 @@ comma separated (spaces around fields are allowed; lines starting with '#' are c
     t_s, rate_true_dps, rate_dps, quad_dps, drive_amp, drive_phase_deg, p_deg,
     t_ambient_c, t_struct_c, t_board_c, u1_v, u2_v, adc_drive_v, adc_sense_v, flags
 
-More columns may follow. A column may be asked for by its gyro-sim name or its
-telemetry name (drive_amp / drive_amp_v, fields.ALIASES): the one the file has is read
-and returned under the name asked for. A `gyroctl` log of real hardware has no truth columns
-(rate_true_dps, t_ambient_c, t_struct_c). Every tool asks only for the columns it uses,
-and a missing one is reported by name, so a gyroctl log works wherever the truth is not
-needed.
+More columns may follow. Every loaded value must be finite, except in the columns of
+NAN_COLUMNS, where "nan" means "no value at this row" (t_board_meas_c, board_c: the
+board temperature sensor before its first conversion, absent or not answering). A column may
+be asked for by its gyro-sim name or its telemetry name (drive_amp / drive_amp_v,
+fields.ALIASES): the one the file has is read and returned under the name asked for. A
+`gyroctl` log of real hardware has no truth columns (rate_true_dps, t_ambient_c,
+t_struct_c). Every tool asks only for the columns it uses, and a missing one is reported
+by name, so a gyroctl log works wherever the truth is not needed.
 
 The frequency-sweep CSV (see freqresp) uses the same reader with no time column.
 
@@ -34,6 +36,8 @@ from .fields import ALIASES
 
 TIME_COLUMN = "t_s"
 TRUTH_COLUMNS = ("rate_true_dps", "t_ambient_c", "t_struct_c")
+# Columns where nan is a value ("no reading"), not a malformed row; inf still is refused.
+NAN_COLUMNS = ("t_board_meas_c", "board_c")
 LOG_COLUMNS = (
     "t_s", "rate_true_dps", "rate_dps", "quad_dps", "drive_amp", "drive_phase_deg",
     "p_deg", "t_ambient_c", "t_struct_c", "t_board_c", "u1_v", "u2_v", "adc_drive_v",
@@ -101,16 +105,11 @@ def _conversion_message(path, header_line, numpy_msg):
     return f"{path}:{lineno}: malformed value '{value}' (not a number)"
 
 
-# Columns whose nan is a value: "none yet" (the board sensor's reading before its first
-# conversion); inf is refused in them as anywhere.
-NAN_MEANS_NONE = ("board_c",)
-
-
 def read_log(path, need=(), want=(), time_column=TIME_COLUMN, min_rows=2, purpose=""):
     """Load the columns `need` (required) and `want` (optional) of a CSV log.
 
     time_column (default t_s) is always required unless None, and must be strictly
-    increasing. Every loaded value must be finite (nan allowed in NAN_MEANS_NONE).
+    increasing. Every loaded value must be finite (nan allowed in NAN_COLUMNS).
     Raises InputError for an unreadable, empty, malformed, non-monotonic or too short
     (< min_rows data rows) file; `purpose` (e.g. "the Allan deviation") is quoted in the
     messages.
@@ -167,7 +166,7 @@ def read_log(path, need=(), want=(), time_column=TIME_COLUMN, min_rows=2, purpos
     for i, n in enumerate(names):
         data[n] = arr[:, i]
     for n in names:
-        bad = ~np.isfinite(data[n]) & ~(np.isnan(data[n]) if n in NAN_MEANS_NONE else False)
+        bad = np.isinf(data[n]) if n in NAN_COLUMNS else ~np.isfinite(data[n])
         if bad.any():
             raise InputError(
                 f"{path}: non-finite value in column '{n}' at data row {int(np.argmax(bad)) + 1}")

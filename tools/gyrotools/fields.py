@@ -74,9 +74,14 @@ CSV_MEANING = {
     "t_ambient_c": "ambient temperature (truth)",
     "t_struct_c": "sensor structure temperature (truth)",
     "t_board_c": "the board's thermal node, where its temperature sensor sits (truth)",
-    "board_c": "the board temperature sensor's latest reading (a TMP117: 1 s conversions, "
-               "7.8125 mdegC steps, its accuracy error and noise), as the firmware took it; "
-               "nan before the first (firmware)",
+    "t_board_meas_c": "the board temperature sensor's latest result as the firmware reads it "
+                      "(the TMP117's code times 7.8125 mdegC: t_board_c 62 ms before the 1 s "
+                      "conversion ended, with the sensor's accuracy error and noise, "
+                      "plant.board_sensor_*); nan before its first conversion, without a sensor "
+                      "and while it does not answer",
+    "board_c": "the board temperature sensor's latest result as the firmware took it "
+               "(hal_board_temp.h; t_board_meas_c a background pass later); nan before its "
+               "first (firmware)",
     "u1_v": "drive electrode 1 voltage written this tick (firmware)",
     "u2_v": "drive electrode 2 voltage written this tick (firmware)",
     "adc_drive_v": "drive pickoff at the ADC input (truth)",

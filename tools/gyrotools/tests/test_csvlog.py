@@ -70,6 +70,21 @@ def test_bad_files_are_refused_with_a_located_message(tmp_path, text, msg):
         csvlog.read_log(p, need=["rate_dps"])
 
 
+def test_board_sensor_column_may_hold_nan_where_it_has_no_reading(tmp_path):
+    text = HEADER + ", t_board_meas_c\n" + "".join(
+        f"{i * 0.5:.6f},0,0,0,1,-99,0.1,25,25,25,1,1,0,0,0x0,{v}\n"
+        for i, v in enumerate(("nan", "25.0390625", "25.0468750", "nan")))
+    log = csvlog.read_log(write(tmp_path, text), need=["t_board_meas_c"])
+    np.testing.assert_array_equal(np.isnan(log["t_board_meas_c"]), [True, False, False, True])
+    assert log["t_board_meas_c"][1] == 25.0390625
+    bad = write(tmp_path, HEADER + ", t_board_meas_c\n" + rows(2).replace("\n", ",inf\n"),
+                "inf.csv")
+    with pytest.raises(InputError, match="non-finite value in column 't_board_meas_c'"):
+        csvlog.read_log(bad, need=["t_board_meas_c"])
+    with pytest.raises(InputError, match="non-finite value in column 'p_deg'"):
+        csvlog.read_log(write(tmp_path, text.replace(",0.1,", ",nan,"), "p.csv"), need=["p_deg"])
+
+
 def test_windows_line_ends_and_byte_order_mark(tmp_path):
     p = tmp_path / "win.csv"
     p.write_bytes(("\ufeff" + HEADER + "\r\n" + rows(4).replace("\n", "\r\n"))

@@ -10,8 +10,9 @@
  * at 0.5 s), which the host twin shares. The input rate can be changed at run time
  * (stm32f4_qemu_plant_set_rate, the image's `emu rate` command): a rate-table move
  * applied at the next tick. A trace of the firmware's rate output (qemu_plant_setup.h)
- * is recorded from the first tick for the equivalence test. Never linked into the
- * product image. */
+ * is recorded from the first tick for the equivalence test. The board temperature
+ * sensor (hal_board_temp.h) is the plant's (plant_board_temp_hal), read as the host HAL
+ * stub reads it. Never linked into the product image. */
 #ifndef STM32F4_QEMU_PLANT_H
 #define STM32F4_QEMU_PLANT_H
 
