@@ -13,11 +13,11 @@
 #include <stdint.h>
 
 typedef enum {
-  HAL_BOARD_TEMP_NONE = 0,   /* nothing new: a conversion or a bus transfer is under way */
-  HAL_BOARD_TEMP_NEW = 1,    /* *code holds a result not returned before */
-  HAL_BOARD_TEMP_FAULT = 2,  /* the sensor did not answer, or the bus failed; the HAL has
+  HAL_BOARD_TEMP_NONE = 0,  /* nothing new: a conversion or a bus transfer is under way */
+  HAL_BOARD_TEMP_NEW = 1,   /* *code holds a result not returned before */
+  HAL_BOARD_TEMP_FAULT = 2, /* the sensor did not answer, or the bus failed; the HAL has
                               * reset the bus and tries again on the next calls */
-  HAL_BOARD_TEMP_ABSENT = 3  /* the board (or the host's plant) has no sensor */
+  HAL_BOARD_TEMP_ABSENT = 3 /* the board (or the host's plant) has no sensor */
 } hal_board_temp_event_t;
 
 /* Set up the bus and the sensor. Non-blocking; 0, or a negative value if the bus cannot
