@@ -43,7 +43,9 @@ static struct {
   uint32_t cr1_last;
   fake_ev_t q[8];
   uint32_t qn;
-  uint32_t accesses, swrst, reads[16], bytes_sent, protocol_errors;
+  uint32_t accesses, swrst, reads[16], bytes_sent, protocol_errors, stops;
+  uint8_t written[8]; /* data bytes written (after the address) since the last START */
+  uint32_t written_n;
 } f;
 
 static void push(fake_ev_t ev)
@@ -78,7 +80,8 @@ static void on_dr_write(uint32_t v)
     push(((v >> 1) != BOARD_TEMP_I2C_ADDR || f.nack_addr) ? EV_AF : EV_ADDR);
   } else if (!f.reading && (I2C1->SR2 & I2C_SR2_MSL) != 0u) {
     I2C1->SR1 &= ~(I2C_SR1_TXE | I2C_SR1_BTF);
-    f.ptr = (uint8_t)(v & 0xFu); /* the pointer register (SNOSD82D 7.5.2) */
+    if (f.written_n == 0u) f.ptr = (uint8_t)(v & 0xFu); /* pointer (SNOSD82D 7.5.2) */
+    if (f.written_n < 8u) f.written[f.written_n++] = (uint8_t)v;
     push(EV_TXDONE);
   } else {
     ++f.protocol_errors;
@@ -157,6 +160,7 @@ static void fake_tick(void)
   --f.qn;
   switch (ev) {
   case EV_SB:
+    f.written_n = 0u;
     I2C1->CR1 &= ~I2C_CR1_START;
     f.cr1_last &= ~I2C_CR1_START;
     I2C1->SR1 = I2C_SR1_SB;
@@ -171,6 +175,7 @@ static void fake_tick(void)
     I2C1->CR1 &= ~I2C_CR1_STOP;
     f.cr1_last &= ~I2C_CR1_STOP;
     I2C1->SR2 = 0u;
+    ++f.stops;
     break;
   }
 }
@@ -402,6 +407,76 @@ static void test_start_failure_is_absent(void **state)
   assert_int_equal(hal_board_temp_poll(&code), HAL_BOARD_TEMP_ABSENT);
 }
 
+/* The master alone, on the same fake: a transfer run to its end, one step per pass. */
+static stm32f4_i2c_status_t run_master(stm32f4_i2c_master_t *m, uint32_t max_steps)
+{
+  for (uint32_t i = 0u; i < max_steps; ++i) {
+    fake_tick();
+    DWT->CYCCNT += STEP_CYCLES;
+    const stm32f4_i2c_status_t st = stm32f4_i2c_poll(m, DWT->CYCCNT);
+    if (st != STM32F4_I2C_BUSY) return st;
+  }
+  return STM32F4_I2C_BUSY;
+}
+
+static void master_init(stm32f4_i2c_master_t *m)
+{
+  const stm32f4_i2c_config_t cfg = {.regs = I2C1,
+                                    .rcc_apb1enr_bit = RCC_APB1ENR_I2C1EN,
+                                    .pclk1_hz = PCLK1_HZ,
+                                    .scl_hz = 400000u,
+                                    .timeout_cycles = 10u * CYCLES_PER_MS};
+  assert_int_equal(stm32f4_i2c_init(m, &cfg), 0);
+}
+
+/* A 1-byte read (RM0090 §27.3.3 Method 2, N = 1: ACK cleared before ADDR is, STOP right
+ * after): the sensor sends one byte, NACKed; a write-only transfer ends with a STOP after
+ * the last byte's BTF. */
+static void test_master_one_byte_read_and_write(void **state)
+{
+  (void)state;
+  stm32f4_i2c_master_t m;
+  master_init(&m);
+  const uint8_t ptr = TMP117_REG_DEVICE_ID;
+  assert_int_equal(stm32f4_i2c_begin(&m, BOARD_TEMP_I2C_ADDR, &ptr, 1u, 1u, DWT->CYCCNT), 0);
+  assert_int_equal(run_master(&m, 100u), STM32F4_I2C_DONE);
+  assert_int_equal(stm32f4_i2c_rx(&m)[0], 0x01);
+  assert_int_equal(f.bytes_sent, 1);
+  assert_int_equal(f.send_more, 0);
+  assert_int_equal(stm32f4_i2c_poll(&m, DWT->CYCCNT), STM32F4_I2C_IDLE);
+  fake_tick(); /* the STOP goes out */
+  assert_int_equal(f.stops, 1);
+  assert_int_equal(I2C1->CR1 & (I2C_CR1_POS | I2C_CR1_ACK | I2C_CR1_STOP), 0);
+
+  const uint8_t wr[3] = {0x02u, 0x60u, 0x00u}; /* THigh_Limit = 6000h */
+  assert_int_equal(stm32f4_i2c_begin(&m, BOARD_TEMP_I2C_ADDR, wr, 3u, 0u, DWT->CYCCNT), 0);
+  assert_int_equal(run_master(&m, 100u), STM32F4_I2C_DONE);
+  assert_int_equal(f.written_n, 3);
+  assert_memory_equal(f.written, wr, 3u);
+  fake_tick();
+  assert_int_equal(f.stops, 2);
+  assert_int_equal(f.protocol_errors, 0);
+  assert_int_equal(m.resets, 0);
+}
+
+static void test_master_begin_rejects(void **state)
+{
+  (void)state;
+  stm32f4_i2c_master_t m;
+  master_init(&m);
+  const uint8_t tx[5] = {0};
+  assert_int_equal(stm32f4_i2c_begin(&m, 0x48u, tx, 0u, 0u, 0u), -1); /* nothing to do */
+  assert_int_equal(stm32f4_i2c_begin(&m, 0x48u, tx, 5u, 0u, 0u), -1); /* > TX_MAX */
+  assert_int_equal(stm32f4_i2c_begin(&m, 0x48u, tx, 1u, 3u, 0u), -1); /* > RX_MAX */
+  assert_int_equal(stm32f4_i2c_begin(&m, 0x48u, NULL, 1u, 0u, 0u), -1);
+  assert_int_equal(stm32f4_i2c_begin(&m, 0x80u, tx, 1u, 0u, 0u), -1); /* not 7-bit */
+  assert_int_equal(stm32f4_i2c_begin(&m, 0x48u, tx, 1u, 2u, 0u), 0);
+  assert_int_equal(stm32f4_i2c_begin(&m, 0x48u, tx, 1u, 2u, 0u), -1); /* one at a time */
+  stm32f4_i2c_config_t bad = m.cfg;
+  bad.pclk1_hz = 1000000u;
+  assert_int_equal(stm32f4_i2c_init(&m, &bad), -1);
+}
+
 int main(void)
 {
   const struct CMUnitTest tests[] = {
@@ -413,6 +488,8 @@ int main(void)
       cmocka_unit_test_setup(test_stuck_bus_times_out, setup),
       cmocka_unit_test_setup(test_wrong_device_id_is_absent, setup),
       cmocka_unit_test_setup(test_start_failure_is_absent, setup),
+      cmocka_unit_test_setup(test_master_one_byte_read_and_write, setup),
+      cmocka_unit_test_setup(test_master_begin_rejects, setup),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
