@@ -11,4 +11,8 @@
 void stm32f4_gpio_config(stm32f4_gpio_t *gpio, uint32_t pin, uint32_t mode, uint32_t af,
                          int pull_up);
 
+/* Configure one pin as an open-drain alternate function af (an I2C line: the board's
+ * resistors pull it up), very-high speed, no internal pull. */
+void stm32f4_gpio_config_open_drain(stm32f4_gpio_t *gpio, uint32_t pin, uint32_t af);
+
 #endif /* STM32F4_GPIO_H */

@@ -2,13 +2,18 @@
  * core's registers are in hal/cortex_m4/cm4_regs.h, included here).
  * Addresses and bit positions from RM0090 (STM32F405/415/407/417 reference manual):
  * memory map §2.3 table 1, RCC §7.3, PWR §5.4, FLASH §3.8, GPIO §8.4, TIM1/TIM8 §17.4,
- * TIM2-TIM5 §18.4, SPI §28.5, DMA §10.5, USART §30.6, IWDG §21.4.
+ * TIM2-TIM5 §18.4, SPI §28.5, DMA §10.5, USART §30.6, IWDG §21.4, I2C §27.6.
  *
  * Host builds (STM32F4_HOST_TEST defined) see every peripheral through a pointer in
  * stm32f4_host_map, which a unit test points at RAM structs: the drivers then run their
  * real register sequences against a fake register file. Busy-wait loops call
  * STM32F4_POLL_HOOK() so that a test can play the hardware's part (set a ready flag,
- * snapshot a control register at the moment the driver waits for it). */
+ * snapshot a control register at the moment the driver waits for it).
+ *
+ * Registers whose access itself has an effect in hardware (the I2C's: reading SR2 or DR,
+ * writing DR or CR1 clears or raises status flags, RM0090 §27.6.6-27.6.7) are accessed
+ * with STM32F4_RD / STM32F4_WR: plain accesses on the target; on the host the access
+ * calls access_hook afterwards, so that a test can play the peripheral's answer. */
 #ifndef STM32F4_REGS_H
 #define STM32F4_REGS_H
 
@@ -64,6 +69,10 @@ typedef struct {
   STM32F4_REG KR, PR, RLR, SR;
 } stm32f4_iwdg_t;
 
+typedef struct {
+  STM32F4_REG CR1, CR2, OAR1, OAR2, DR, SR1, SR2, CCR, TRISE, FLTR;
+} stm32f4_i2c_t;
+
 /* Base addresses (RM0090 table 1; ARMv7-M system address map). */
 #define STM32F4_TIM2_BASE 0x40000000UL
 #define STM32F4_TIM4_BASE 0x40000800UL
@@ -71,6 +80,7 @@ typedef struct {
 #define STM32F4_IWDG_BASE 0x40003000UL
 #define STM32F4_SPI2_BASE 0x40003800UL
 #define STM32F4_SPI3_BASE 0x40003C00UL
+#define STM32F4_I2C1_BASE 0x40005400UL
 #define STM32F4_TIM1_BASE 0x40010000UL
 #define STM32F4_TIM8_BASE 0x40010400UL
 #define STM32F4_USART1_BASE 0x40011000UL
@@ -99,10 +109,26 @@ typedef struct {
   stm32f4_dma_t *dma2;
   stm32f4_usart_t *usart1;
   stm32f4_iwdg_t *iwdg;
+  stm32f4_i2c_t *i2c1;
   volatile uint8_t *param_flash; /* STM32F4_PARAM_NUM_SECTORS * SECTOR_BYTES bytes */
   void (*poll_hook)(void);       /* the "hardware": called from every busy-wait loop */
+  /* the "hardware" of registers accessed with STM32F4_RD/WR: called after the access */
+  void (*access_hook)(volatile uint32_t *reg, int is_write, uint32_t value);
 } stm32f4_host_map_t;
 extern stm32f4_host_map_t stm32f4_host_map;
+static inline uint32_t stm32f4_host_rd(volatile uint32_t *reg)
+{
+  const uint32_t v = *reg;
+  if (stm32f4_host_map.access_hook != 0) stm32f4_host_map.access_hook(reg, 0, v);
+  return v;
+}
+static inline void stm32f4_host_wr(volatile uint32_t *reg, uint32_t v)
+{
+  *reg = v;
+  if (stm32f4_host_map.access_hook != 0) stm32f4_host_map.access_hook(reg, 1, v);
+}
+#define STM32F4_RD(reg) stm32f4_host_rd(&(reg))
+#define STM32F4_WR(reg, v) stm32f4_host_wr(&(reg), (v))
 #define STM32F4_PERIPH(field, type, addr) (stm32f4_host_map.field)
 #define STM32F4_PARAM_FLASH ((volatile uint8_t *)stm32f4_host_map.param_flash)
 #define STM32F4_POLL_HOOK() \
@@ -113,6 +139,8 @@ extern stm32f4_host_map_t stm32f4_host_map;
 #define STM32F4_PERIPH(field, type, addr) ((type *)(addr))
 #define STM32F4_PARAM_FLASH ((volatile uint8_t *)STM32F4_PARAM_FLASH_ADDR)
 #define STM32F4_POLL_HOOK() ((void)0)
+#define STM32F4_RD(reg) (reg)
+#define STM32F4_WR(reg, v) ((reg) = (v))
 #endif
 
 #define RCC STM32F4_PERIPH(rcc, stm32f4_rcc_t, STM32F4_RCC_BASE)
@@ -146,6 +174,7 @@ void stm32f4_qemu_flash_controller(void);
 #define DMA2 STM32F4_PERIPH(dma2, stm32f4_dma_t, STM32F4_DMA2_BASE)
 #define USART1 STM32F4_PERIPH(usart1, stm32f4_usart_t, STM32F4_USART1_BASE)
 #define IWDG STM32F4_PERIPH(iwdg, stm32f4_iwdg_t, STM32F4_IWDG_BASE)
+#define I2C1 STM32F4_PERIPH(i2c1, stm32f4_i2c_t, STM32F4_I2C1_BASE)
 
 /* ---- RCC (RM0090 §7.3) ---- */
 #define RCC_CR_HSION (1u << 0)
@@ -182,6 +211,7 @@ void stm32f4_qemu_flash_controller(void);
 #define RCC_APB1ENR_TIM4EN (1u << 2)
 #define RCC_APB1ENR_SPI2EN (1u << 14)
 #define RCC_APB1ENR_SPI3EN (1u << 15)
+#define RCC_APB1ENR_I2C1EN (1u << 21)
 #define RCC_APB1ENR_PWREN (1u << 28)
 #define RCC_APB2ENR_TIM1EN (1u << 0)
 #define RCC_APB2ENR_TIM8EN (1u << 1)
@@ -311,6 +341,31 @@ void stm32f4_qemu_flash_controller(void);
 #define USART_CR1_RXNEIE (1u << 5)
 #define USART_CR1_TXEIE (1u << 7)
 #define USART_CR1_UE (1u << 13)
+
+/* ---- I2C (RM0090 §27.6; the F4's I2C v1) ---- */
+#define I2C_CR1_PE (1u << 0)
+#define I2C_CR1_START (1u << 8)
+#define I2C_CR1_STOP (1u << 9)
+#define I2C_CR1_ACK (1u << 10)
+#define I2C_CR1_POS (1u << 11)
+#define I2C_CR1_SWRST (1u << 15)
+#define I2C_CR2_FREQ_MASK 0x3Fu /* PCLK1 in MHz, 2..42 */
+#define I2C_SR1_SB (1u << 0)
+#define I2C_SR1_ADDR (1u << 1)
+#define I2C_SR1_BTF (1u << 2)
+#define I2C_SR1_STOPF (1u << 4)
+#define I2C_SR1_RXNE (1u << 6)
+#define I2C_SR1_TXE (1u << 7)
+#define I2C_SR1_BERR (1u << 8)
+#define I2C_SR1_ARLO (1u << 9)
+#define I2C_SR1_AF (1u << 10)
+#define I2C_SR1_OVR (1u << 11)
+#define I2C_SR2_MSL (1u << 0)
+#define I2C_SR2_BUSY (1u << 1)
+#define I2C_CCR_MASK 0xFFFu
+#define I2C_CCR_DUTY (1u << 14) /* fast mode: 0 = Tlow/Thigh 2, 1 = 16/9 */
+#define I2C_CCR_FS (1u << 15)   /* fast mode (up to 400 kHz) */
+#define I2C_TRISE_MASK 0x3Fu
 
 /* ---- IWDG (RM0090 §21.4) ---- */
 #define IWDG_KEY_RELOAD 0xAAAAu

@@ -13,6 +13,7 @@ static stm32f4_spi_t s_spi1, s_spi2, s_spi3;
 static stm32f4_dma_t s_dma2;
 static stm32f4_usart_t s_usart1;
 static stm32f4_iwdg_t s_iwdg;
+static stm32f4_i2c_t s_i2c1;
 static uint8_t s_param_flash[STM32F4_PARAM_NUM_SECTORS * STM32F4_PARAM_SECTOR_BYTES]
     __attribute__((aligned(4)));
 
@@ -32,8 +33,10 @@ stm32f4_host_map_t stm32f4_host_map = {.rcc = &s_rcc,
                                        .dma2 = &s_dma2,
                                        .usart1 = &s_usart1,
                                        .iwdg = &s_iwdg,
+                                       .i2c1 = &s_i2c1,
                                        .param_flash = s_param_flash,
-                                       .poll_hook = 0};
+                                       .poll_hook = 0,
+                                       .access_hook = 0};
 
 #define ZERO(x) memset((void *)&(x), 0, sizeof(x))
 
@@ -55,9 +58,11 @@ void stm32f4_host_reset(void)
   ZERO(s_dma2);
   ZERO(s_usart1);
   ZERO(s_iwdg);
+  ZERO(s_i2c1);
   memset(s_param_flash, 0xFF, sizeof(s_param_flash));
   s_flash.CR = FLASH_CR_LOCK; /* RM0090: FLASH_CR reset value 0x8000_0000 */
   stm32f4_host_map.poll_hook = 0;
+  stm32f4_host_map.access_hook = 0;
   cm4_host_reset();
 }
 

@@ -7,7 +7,7 @@
 #include "stm32f4_regs.h"
 
 /* Zero every fake register (the core's too: cm4_host_reset), fill the parameter flash with 0xFF (erased), apply the
- * reset values the drivers rely on (FLASH_CR.LOCK), clear the hook. */
+ * reset values the drivers rely on (FLASH_CR.LOCK), clear the hooks. */
 void stm32f4_host_reset(void);
 
 /* Direct access to the RAM flash (STM32F4_PARAM_NUM_SECTORS * SECTOR_BYTES bytes). */

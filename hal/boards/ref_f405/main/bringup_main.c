@@ -14,6 +14,9 @@
  *                sense electrodes, hal_dac.h; mid-scale when left out)
  *   clk          clock status, frequencies and the reset cause
  *   fault        the fault record kept across the last reset ("fault clear" erases it)
+ *   temp         the board temperature sensor (TMP117 on I2C1; not in QEMU): its state,
+ *                the last result (code and mdegC), results and faults counted; the
+ *                background loop reads it (hal_board_temp_poll), never the ISR
  *   crash        execute an undefined instruction (tests the fault record path)
  *   reset        software reset
  *
@@ -23,6 +26,7 @@
 #include <stdint.h>
 
 #include "hal/hal_adc.h"
+#include "hal/hal_board_temp.h"
 #include "hal/hal_critical.h"
 #include "hal/hal_dac.h"
 #include "board.h"
@@ -56,6 +60,9 @@ typedef struct {
   /* background only */
   char line[LINE_MAX];
   uint32_t line_len;
+  hal_board_temp_event_t temp_last; /* the last event other than NONE */
+  int16_t temp_code;
+  uint32_t temp_results, temp_faults;
 } bringup_t;
 
 static bringup_t s_bringup;
@@ -267,6 +274,36 @@ static void cmd_clk(out_t *o)
   out_kx(o, "reset_flags", info->reset_flags);
 }
 
+#ifndef STM32F4_QEMU
+static void poll_temp(bringup_t *b)
+{
+  int16_t code;
+  const hal_board_temp_event_t ev = hal_board_temp_poll(&code);
+  if (ev == HAL_BOARD_TEMP_NONE) return;
+  b->temp_last = ev;
+  if (ev == HAL_BOARD_TEMP_NEW) {
+    b->temp_code = code;
+    ++b->temp_results;
+  } else if (ev == HAL_BOARD_TEMP_FAULT) {
+    ++b->temp_faults;
+  }
+}
+
+/* mdegC = code x 7.8125 = code x 125 / 16 (BOARD_TEMP_LSB_C), in integers. */
+static void cmd_temp(const bringup_t *b, out_t *o)
+{
+  static const char *const names[] = {"none", "ok", "fault", "absent"};
+  out_str(o, "temp state=");
+  out_str(o, names[(uint32_t)b->temp_last & 3u]);
+  out_str(o, " code=");
+  out_i32(o, b->temp_code);
+  out_str(o, " mdegc=");
+  out_i32(o, (int32_t)b->temp_code * 125 / 16);
+  out_kv(o, "results", b->temp_results);
+  out_kv(o, "faults", b->temp_faults);
+}
+#endif
+
 static void run_command(bringup_t *b, const char *line, out_t *o)
 {
   if (starts_with(line, "stat")) {
@@ -288,12 +325,20 @@ static void run_command(bringup_t *b, const char *line, out_t *o)
     cmd_clk(o);
   } else if (starts_with(line, "fault")) {
     cmd_fault(o, line + 5);
+#ifndef STM32F4_QEMU
+  } else if (starts_with(line, "temp")) {
+    cmd_temp(b, o);
+#endif
   } else if (starts_with(line, "crash")) {
     __builtin_trap();
   } else if (starts_with(line, "reset")) {
     cm4_system_reset();
   } else if (starts_with(line, "help") || line[0] == '\0') {
+#ifdef STM32F4_QEMU
     out_str(o, "commands: stat clear adc dac clk fault crash reset");
+#else
+    out_str(o, "commands: stat clear adc dac clk fault temp crash reset");
+#endif
   } else {
     out_str(o, "error: unknown command (help)");
   }
@@ -327,6 +372,9 @@ int main(void)
   b->period_min = 0xFFFFFFFFu;
   (void)stm32f4_board_init();
   stm32f4_uptime_init();
+#ifndef STM32F4_QEMU
+  b->temp_last = hal_board_temp_start() == 0 ? HAL_BOARD_TEMP_NONE : HAL_BOARD_TEMP_ABSENT;
+#endif
 
   stm32f4_iwdg_plan_t wd;
   if (stm32f4_iwdg_plan(BOARD_LSI_HZ, WATCHDOG_MS, &wd) == 0) {
@@ -345,6 +393,8 @@ int main(void)
     poll_uart(b);
 #ifdef STM32F4_QEMU
     stm32f4_uart_poll_tx();
+#else
+    poll_temp(b);
 #endif
     stm32f4_iwdg_kick();
 #ifndef STM32F4_QEMU
