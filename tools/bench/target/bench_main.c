@@ -48,6 +48,7 @@
 #include "bench_now.h"
 #include "bench_plant.h"
 #include "dsp/ramfunc.h"
+#include "hal/hal_board_temp.h"
 #include "hal/hal_sample_timer.h"
 #include "stm32f4_board.h"
 #include "stm32f4_core.h"
@@ -167,6 +168,16 @@ static bench_mode_t bench_mode(void)
 /* ---- board bring-up for the bench: QEMU has no RCC, so no clock tree; no DWT ---- */
 
 void board_system_init(void) { cm4_fault_enable(); }
+
+/* QEMU's netduinoplus2 has no I2C peripheral behind its register window, and the bench
+ * measures the sample interrupt: the board temperature sensor is absent here (the
+ * fusion is background work, board_therm.h). */
+int hal_board_temp_start(void) { return -1; }
+hal_board_temp_event_t hal_board_temp_poll(int16_t *code)
+{
+  (void)code;
+  return HAL_BOARD_TEMP_ABSENT;
+}
 
 static void counter_init(void)
 {
