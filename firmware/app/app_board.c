@@ -44,23 +44,30 @@ static void take_conversion(app_t *a)
   }
 }
 
-/* The compensation's bias in P: what the sample path refreshed, less the correction it
- * added. A tick between the reads: read again (the interrupt takes a few per cent of the
- * reads' window, never two ticks running). */
+/* The compensation in P as the sample path refreshed it: its bias less the correction it
+ * added, its static part (the cubic in x = P_c - cal.ref_p_deg, rate_channel.h) and its
+ * scale factor. A tick between the reads: read again (the interrupt takes a few per cent
+ * of the reads' window, never two ticks running). */
 static board_therm_bias_t bias_p(const app_t *a)
 {
   const gyro_t *g = &a->gyro;
+  const rate_channel_cfg_t *rc = &g->design->rate;
   const volatile uint32_t *tick = &g->out.tick;
   for (uint32_t k = 0u; k < 3u; k++) {
     const uint32_t t = *tick;
     atomic_signal_fence(memory_order_seq_cst);
     const float b = g->rate.comp_bias_dps - g->board_corr_applied_dps;
+    const float x = (g->rate.p_dev_deg + rc->p_poly_off_deg) - g->rate.p_comp_lag_deg;
+    const float sf = g->rate.comp_sf;
     const uint32_t reasons = g->valid.reasons;
     atomic_signal_fence(memory_order_seq_cst);
-    if (*tick == t)
-      return (board_therm_bias_t){b, (reasons & BOARD_BIAS_P_UNSETTLED) == 0u ? 1u : 0u};
+    if (*tick == t) {
+      const float *c = rc->bias_c_dps;
+      const float bs = c[0] + x * (c[1] + x * (c[2] + x * c[3]));
+      return (board_therm_bias_t){b, bs, sf, (reasons & BOARD_BIAS_P_UNSETTLED) == 0u ? 1u : 0u};
+    }
   }
-  return (board_therm_bias_t){0.0f, BOARD_THERM_BIAS_HOLD};
+  return (board_therm_bias_t){0.0f, 0.0f, 1.0f, BOARD_THERM_BIAS_HOLD};
 }
 
 void app_board_poll(app_t *a)

@@ -99,18 +99,20 @@ static void model_step(const board_therm_cfg_t *c, board_therm_t *s)
   s->have = 1u;
 }
 
-/* The crossover's low-pass of B_P - M: it starts at the disagreement of its first
- * settled step (the fused bias is then the model's), and again after an unsettled one. */
-static void cross_step(const board_therm_cfg_t *c, board_therm_t *s, board_therm_bias_t b)
+/* The crossover's low-pass of B_s - sf M: it starts at the disagreement of its first
+ * settled step (the fused bias is then the model's), and again after an unsettled one.
+ * Returns whether it took this step. */
+static int cross_step(const board_therm_cfg_t *c, board_therm_t *s, board_therm_bias_t b)
 {
-  if (b.settled == BOARD_THERM_BIAS_HOLD || s->have == 0u) return;
-  if (b.settled == 0u || !fm_isfinite(b.dps)) {
+  if (b.settled == BOARD_THERM_BIAS_HOLD || s->have == 0u) return 0;
+  if (b.settled == 0u || !fm_isfinite(b.dps) || !fm_isfinite(b.static_dps) || !fm_isfinite(b.sf)) {
     s->d_on = 0u;
-    return;
+    return 0;
   }
-  const float dis = b.dps - s->model_dps;
+  const float dis = b.static_dps - b.sf * s->model_dps;
   s->d_dps = s->d_on == 0u ? dis : s->d_dps + c->lp_a * (dis - s->d_dps);
   s->d_on = 1u;
+  return 1;
 }
 
 void board_therm_step(const board_therm_cfg_t *c, board_therm_t *s, board_therm_bias_t b)
@@ -124,11 +126,15 @@ void board_therm_step(const board_therm_cfg_t *c, board_therm_t *s, board_therm_
     return;
   }
   if (s->readings > 0u) model_step(c, s);
-  cross_step(c, s, b);
+  const int took = cross_step(c, s, b);
   s->w = weight(c, s->steps);
   s->state = judge(c, s);
-  /* Not trusted: the correction holds its last value (the rate is not valid then). */
-  if (s->state == BOARD_THERM_OK || s->w == 0.0f) s->corr_dps = -s->w * s->d_dps;
+  /* B - B_P = (B_s - d) - B_P. Not trusted, or nothing new to take it from: the
+   * correction holds its last value (the rate is not valid then, or the step is the
+   * one the interrupt fell into). */
+  if (s->w == 0.0f) s->corr_dps = 0.0f;
+  else if (took && s->state == BOARD_THERM_OK)
+    s->corr_dps = s->w * ((b.static_dps - s->d_dps) - b.dps);
 }
 
 const char *board_therm_state_name(board_therm_state_t st)

@@ -21,7 +21,7 @@ static board_therm_cfg_t cfg(const float tz[2], const float tp[2], float start_s
   return k;
 }
 
-static const board_therm_bias_t SETTLED0 = {0.0f, 1u};
+static const board_therm_bias_t SETTLED0 = {0.0f, 0.0f, 1.0f, 1u};
 
 /* n steps with a reading every second (the sensor's cycle) */
 static void run_s(const board_therm_cfg_t *c, board_therm_t *s, float x_c, float seconds,
@@ -79,18 +79,38 @@ static void test_crossover_starts_at_the_disagreement(void **state)
   board_therm_t s;
   board_therm_init(&s);
   board_therm_reading(&c, &s, 25.0f); /* M = c0 = 1 deg/s */
-  const board_therm_bias_t b = {4.0f, 1u};
+  const board_therm_bias_t b = {4.0f, 4.0f, 1.0f, 1u};
   board_therm_step(&c, &s, b);
   assert_int_equal(s.state, BOARD_THERM_OK);
   assert_float_equal(s.w, 1.0f, 0.0f);
   /* the fused bias B_P + corr is the model's from the first settled step */
   assert_float_equal(b.dps + s.corr_dps, 1.0f, 1e-6f);
   /* B_P steps by 1 deg/s: the fused bias follows it by 1 - e^-1 in one crossover (3 s) */
-  const board_therm_bias_t b2 = {5.0f, 1u};
+  const board_therm_bias_t b2 = {5.0f, 5.0f, 1.0f, 1u};
   run_s(&c, &s, 25.0f, 3.0f, b2);
   assert_float_equal(b2.dps + s.corr_dps, 1.0f + expf(-1.0f), 2e-3f);
   run_s(&c, &s, 25.0f, 60.0f, b2);
   assert_float_equal(b2.dps + s.corr_dps, 1.0f, 1e-4f);
+}
+
+/* The fused bias is sf M below the crossover, whatever the sample path's gradient term
+ * and fast path add to B_P (they are P's, above the crossover they would be its flicker):
+ * B_P + corr = B_s - LP_T(B_s - sf M). */
+static void test_fused_bias_leaves_the_gradient_term_out(void **state)
+{
+  (void)state;
+  const float t[2] = {100.0f, 100.0f};
+  const board_therm_cfg_t c = cfg(t, t, 0.0f, 0.0f);
+  board_therm_t s;
+  board_therm_init(&s);
+  board_therm_reading(&c, &s, 25.0f);                    /* M = 1 */
+  const board_therm_bias_t b = {7.0f, 4.0f, 1.001f, 1u}; /* a gradient term of 3 */
+  run_s(&c, &s, 25.0f, 60.0f, b);
+  assert_float_equal(b.dps + s.corr_dps, 1.001f, 1e-5f);
+  /* B_s steps by 1 deg/s: the fused bias takes it and lets it go over the crossover */
+  const board_therm_bias_t b2 = {7.0f, 5.0f, 1.001f, 1u};
+  board_therm_step(&c, &s, b2);
+  assert_float_equal(b2.dps + s.corr_dps, 1.001f + 1.0f - c.lp_a, 1e-4f);
 }
 
 static void test_unsettled_restarts_hold_keeps(void **state)
@@ -101,15 +121,15 @@ static void test_unsettled_restarts_hold_keeps(void **state)
   board_therm_t s;
   board_therm_init(&s);
   board_therm_reading(&c, &s, 25.0f);
-  const board_therm_bias_t b = {4.0f, 1u};
+  const board_therm_bias_t b = {4.0f, 4.0f, 1.0f, 1u};
   run_s(&c, &s, 25.0f, 1.0f, b);
   const float d = s.d_dps;
-  const board_therm_bias_t hold = {100.0f, BOARD_THERM_BIAS_HOLD};
+  const board_therm_bias_t hold = {100.0f, 100.0f, 1.0f, BOARD_THERM_BIAS_HOLD};
   board_therm_step(&c, &s, hold);
   assert_float_equal(s.d_dps, d, 0.0f);
-  const board_therm_bias_t unsettled = {100.0f, 0u};
+  const board_therm_bias_t unsettled = {100.0f, 100.0f, 1.0f, 0u};
   board_therm_step(&c, &s, unsettled);
-  const board_therm_bias_t b7 = {7.0f, 1u};
+  const board_therm_bias_t b7 = {7.0f, 7.0f, 1.0f, 1u};
   board_therm_step(&c, &s, b7); /* starts again at 7 - 1 */
   assert_float_equal(s.d_dps, 6.0f, 1e-6f);
 }
@@ -121,7 +141,7 @@ static void test_hand_over_weight(void **state)
   const board_therm_cfg_t c = cfg(t, t, 10.0f, 20.0f);
   board_therm_t s;
   board_therm_init(&s);
-  const board_therm_bias_t b = {4.0f, 1u};
+  const board_therm_bias_t b = {4.0f, 4.0f, 1.0f, 1u};
   run_s(&c, &s, 25.0f, 9.9f, b);
   assert_float_equal(s.w, 0.0f, 0.0f);
   assert_float_equal(s.corr_dps, 0.0f, 0.0f);
@@ -139,13 +159,13 @@ static void test_stale_sensor(void **state)
   const board_therm_cfg_t c = cfg(t, t, 0.0f, 0.0f);
   board_therm_t s;
   board_therm_init(&s);
-  const board_therm_bias_t b = {4.0f, 1u};
+  const board_therm_bias_t b = {4.0f, 4.0f, 1.0f, 1u};
   board_therm_step(&c, &s, b);
   assert_int_equal(s.state, BOARD_THERM_WAIT); /* no reading yet: not trusted */
   assert_true(board_therm_invalid(&s));
   run_s(&c, &s, 25.0f, 5.0f, b);
   assert_false(board_therm_invalid(&s));
-  const board_therm_bias_t b2 = {9.0f, 1u};
+  const board_therm_bias_t b2 = {9.0f, 9.0f, 1.0f, 1u};
   board_therm_reading(&c, &s, 25.0f);                               /* the last one */
   for (uint32_t k = 0u; k < 30u; k++) board_therm_step(&c, &s, b2); /* 3 s, no reading */
   assert_int_equal(s.state, BOARD_THERM_OK);
@@ -153,7 +173,7 @@ static void test_stale_sensor(void **state)
   assert_int_equal(s.state, BOARD_THERM_STALE);
   assert_true(board_therm_invalid(&s));
   const float corr = s.corr_dps;
-  const board_therm_bias_t b3 = {20.0f, 1u};
+  const board_therm_bias_t b3 = {20.0f, 20.0f, 1.0f, 1u};
   for (uint32_t k = 0u; k < 10u; k++) board_therm_step(&c, &s, b3);
   assert_float_equal(s.corr_dps, corr, 0.0f); /* held while not trusted */
   run_s(&c, &s, 25.0f, 0.1f, b2);             /* a reading again */
@@ -196,10 +216,10 @@ static void test_stuck_sensor_disagrees(void **state)
   const board_therm_cfg_t c = cfg(t, t, 0.0f, 0.0f);
   board_therm_t s;
   board_therm_init(&s);
-  const board_therm_bias_t b = {1.0f, 1u};
+  const board_therm_bias_t b = {1.0f, 1.0f, 1.0f, 1u};
   run_s(&c, &s, 25.0f, 10.0f, b);
   assert_int_equal(s.state, BOARD_THERM_OK);
-  const board_therm_bias_t warm = {12.0f, 1u}; /* 11 deg/s from the stuck model */
+  const board_therm_bias_t warm = {12.0f, 12.0f, 1.0f, 1u}; /* 11 deg/s from the stuck model */
   run_s(&c, &s, 25.0f, 30.0f, warm);
   assert_int_equal(s.state, BOARD_THERM_DISAGREE);
   assert_true(board_therm_invalid(&s));
@@ -214,7 +234,7 @@ static void test_off_and_bad_readings(void **state)
   board_therm_design(&c, 0u, t, t, 25.0f, c0, -40.0f, 85.0f, 3.0f, 0.0f, 0.0f, 3.0f, 10.0f);
   board_therm_t s;
   board_therm_init(&s);
-  const board_therm_bias_t b = {4.0f, 1u};
+  const board_therm_bias_t b = {4.0f, 4.0f, 1.0f, 1u};
   run_s(&c, &s, 25.0f, 5.0f, b);
   assert_int_equal(s.state, BOARD_THERM_OFF);
   assert_false(board_therm_invalid(&s));
@@ -231,6 +251,7 @@ int main(void)
       cmocka_unit_test(test_identity_model),
       cmocka_unit_test(test_section_step_response),
       cmocka_unit_test(test_crossover_starts_at_the_disagreement),
+      cmocka_unit_test(test_fused_bias_leaves_the_gradient_term_out),
       cmocka_unit_test(test_unsettled_restarts_hold_keeps),
       cmocka_unit_test(test_hand_over_weight),
       cmocka_unit_test(test_stale_sensor),

@@ -6,16 +6,16 @@ sensor (board.fuse 1):
 
     y = H(s) b,  H = (1 + s tz1)(1 + s tz2) / ((1 + s tp1)(1 + s tp2))
     M = c0 + c1 (y - ref) + c2 (y - ref)^2 + c3 (y - ref)^3
-    B = B_P - w LP_T(B_P - M)
+    B = B_s - LP_T(B_s - sf M)       (weighed in by w after power-on)
 
-b the sensor's reading (the log's board_c, as the firmware took it), B_P the
-compensation's bias in P, T the crossover (board.crossover_s). In a network of lumped
-thermal nodes driven by the surroundings alone every node is the board's temperature
-through two zeros over two poles, and the bias a static law of the nodes: H and the cubic
-are fitted by least squares on the 1 s means of the chamber run at rest (scipy
-least_squares on the logarithms of the four time constants, the cubic by linear least
-squares inside), the target the bias as the compensation removes it, u SF(x) at rest (u
-the linearised output, SF the scale factor's polynomial in P). H runs here exactly as the
+b the sensor's reading (the log's board_c, as the firmware took it), B_s and sf the
+compensation's static bias and scale factor in P, T the crossover (board.crossover_s). In a network of
+lumped thermal nodes driven by the surroundings alone every node is the board's
+temperature through two zeros over two poles, and the bias a static law of the nodes: H
+and the cubic are fitted by least squares on the 1 s means of the chamber run at rest
+(scipy least_squares on the logarithms of the four time constants, the cubic by linear
+least squares inside), the target the linearised output u at rest, the bias as the
+pickoff delivers it (the firmware scales M by the compensation's scale factor). H runs here exactly as the
 firmware runs it: in its lag form, one step every BOARD_STEP_S on the reading held.
 
 The model knows one heat input; the board's own warm-up after a power-on is another, so
@@ -142,12 +142,14 @@ def fit(t_s, board_c, bias_dps, rest, start_s=thermcal.START_S):
                       float(np.sqrt(np.mean(r ** 2))))
 
 
-def parting_dps(t_s, board_c, bias_p_dps, model, start_s=thermcal.START_S):
-    """The most the bias in P (bias_p_dps, at each row) and the model part by on a run:
-    the largest |1 s mean of B_P - M| after start_s (deg/s)."""
+def parting_dps(t_s, board_c, bias_s_dps, model, sf, start_s=thermcal.START_S):
+    """The most the compensation's static bias in P (bias_s_dps, at each row) and the
+    model (times the scale factor sf at each row) part by on a run: the largest |1 s
+    mean of B_s - sf M| after start_s (deg/s)."""
     grid, b = held_grid(t_s, board_c)
-    d = np.interp(grid, np.asarray(t_s, float), np.asarray(bias_p_dps, float)) - \
-        model_bias(model, b)
+    t = np.asarray(t_s, float)
+    d = np.interp(grid, t, np.asarray(bias_s_dps, float)) - \
+        np.interp(grid, t, np.asarray(sf, float)) * model_bias(model, b)
     bins = _bins(grid, {"d": d})
     keep = bins["t_s"] >= start_s
     return float(np.max(np.abs(bins["d"][keep]))) if np.any(keep) else 0.0

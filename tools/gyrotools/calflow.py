@@ -474,20 +474,17 @@ def thermal(part, values):
 
 def board_model(log, v, cmd):
     """The board thermometer's model of the bias (gyrotools/boardcal.py) on the chamber
-    run at rest, the target the bias the compensation removes there: u SF(x), u the
-    linearised output (the compensation in P, v, with its bias terms taken out, gives
-    u SF). Returns (values with the fusion on, its figures)."""
-    no_bias = dict(v, **{k: 0.0 for k in v if k.startswith("rate.bias_c") or
-                         k in ("rate.bias_grad_dps_per_deg", "rate.grad_fast_dps_per_deg")})
-    target = compstudy.compensate(log, no_bias, v["rate.comp_tau_s"], v["rate.comp_stages"])
-    rest = (np.abs(log["rate_true_dps"]) < 1e-9) & (log["rate_valid"] > 0.5)
+    run at rest, its target the linearised output u there (log["rate_unc_dps"], already
+    linearised), the bias as the pickoff delivers it: the firmware scales it by the
+    compensation's scale factor (board_therm.h). Returns (values with the fusion on, its
+    figures)."""
+    rest = np.abs(log["rate_true_dps"]) < 1e-9  # (not calibrated yet: never valid here)
     try:
-        model = boardcal.fit(log["t_s"], log["board_c"], target, rest)
+        model = boardcal.fit(log["t_s"], log["board_c"], log["rate_unc_dps"], rest)
     except InputError as e:
         raise FlowError(f"board thermometer: {e} ({cmd})") from None
-    # the bias in P as the firmware's compensation makes it: u SF - (u SF - B_P)
-    bias_p = target - compstudy.compensate(log, v, v["rate.comp_tau_s"], v["rate.comp_stages"])
-    parting = boardcal.parting_dps(log["t_s"], log["board_c"], bias_p, model)
+    sf, b_s = compstudy.static_parts(log, v, v["rate.comp_tau_s"], v["rate.comp_stages"])
+    parting = boardcal.parting_dps(log["t_s"], log["board_c"], b_s, model, sf)
     out = dict(v, **boardcal.values(model, parting))
     return out, dict(boardcal.doc(model), start_s=out["board.start_s"],
                      crossover_s=out["board.crossover_s"], parting_dps=parting,

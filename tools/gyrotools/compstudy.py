@@ -32,6 +32,16 @@ def _bias(v, x):
         v["rate.bias_c2_dps_per_deg2"] + x * v["rate.bias_c3_dps_per_deg3"]))
 
 
+def static_parts(log, v, comp_tau_s, comp_stages):
+    """The compensation's scale factor and static bias (its cubic in x = P_c -
+    cal.ref_p_deg, without the gradient term and the fast path) at each row: (sf, b)."""
+    p_c = thermcal.comp_thermometer(log["t_s"], log["p_f_deg"], comp_tau_s, comp_stages)
+    x = p_c - v["cal.ref_p_deg"]
+    sf = 1.0 + x * (v["rate.sf_c1_per_deg"] + x * (v["rate.sf_c2_per_deg2"] + x * (
+        v["rate.sf_c3_per_deg3"] + x * v["rate.sf_c4_per_deg4"])))
+    return sf, _bias(v, x)
+
+
 def compensate(log, v, comp_tau_s, comp_stages):
     """The firmware's output from a log's rate_unc_dps and P_f for the values v
     (rate.*, cal.ref_p_deg) and the filter (comp_tau_s, comp_stages); with

@@ -94,3 +94,15 @@ def test_a_log_without_a_model_is_refused(case, match):
         rest = np.zeros_like(t)
     with pytest.raises(InputError, match=match):
         boardcal.fit(t, held, bias, rest)
+
+
+def test_parting_is_the_largest_disagreement(fitted):
+    t, held, bias, m = fitted
+    sf = np.full_like(t, 1.002)
+    own = boardcal.parting_dps(t, held, sf * bias, m, sf)
+    assert own < 0.1  # the largest 1 s miss of the fit itself, at a step of the chamber
+    shifted = boardcal.parting_dps(t, held, sf * bias + 0.7, m, sf)
+    assert shifted == pytest.approx(0.7, abs=0.1)
+    v = boardcal.values(m, shifted)
+    assert v["board.agree_dps"] == pytest.approx(boardcal.AGREE_FACTOR * shifted)
+    assert boardcal.values(m, 0.0)["board.agree_dps"] == boardcal.AGREE_MIN_DPS
