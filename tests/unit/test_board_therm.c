@@ -21,6 +21,13 @@ static board_therm_cfg_t cfg(const float tz[2], const float tp[2], float start_s
   return k;
 }
 
+/* H = 1: the model's variable is the reading */
+static board_therm_cfg_t identity(float start_s, float fade_s)
+{
+  const float t[2] = {100.0f, 100.0f};
+  return cfg(t, t, start_s, fade_s);
+}
+
 static const board_therm_bias_t SETTLED0 = {0.0f, 0.0f, 1.0f, 1u};
 
 /* n steps with a reading every second (the sensor's cycle) */
@@ -37,8 +44,7 @@ static void run_s(const board_therm_cfg_t *c, board_therm_t *s, float x_c, float
 static void test_identity_model(void **state)
 {
   (void)state;
-  const float t[2] = {100.0f, 100.0f};
-  const board_therm_cfg_t c = cfg(t, t, 0.0f, 0.0f);
+  const board_therm_cfg_t c = identity(0.0f, 0.0f);
   board_therm_t s;
   board_therm_init(&s);
   run_s(&c, &s, 30.0f, 2.0f, SETTLED0);
@@ -74,8 +80,7 @@ static void test_section_step_response(void **state)
 static void test_crossover_starts_at_the_disagreement(void **state)
 {
   (void)state;
-  const float t[2] = {100.0f, 100.0f};
-  const board_therm_cfg_t c = cfg(t, t, 0.0f, 0.0f);
+  const board_therm_cfg_t c = identity(0.0f, 0.0f);
   board_therm_t s;
   board_therm_init(&s);
   board_therm_reading(&c, &s, 25.0f); /* M = c0 = 1 deg/s */
@@ -99,8 +104,7 @@ static void test_crossover_starts_at_the_disagreement(void **state)
 static void test_fused_bias_leaves_the_gradient_term_out(void **state)
 {
   (void)state;
-  const float t[2] = {100.0f, 100.0f};
-  const board_therm_cfg_t c = cfg(t, t, 0.0f, 0.0f);
+  const board_therm_cfg_t c = identity(0.0f, 0.0f);
   board_therm_t s;
   board_therm_init(&s);
   board_therm_reading(&c, &s, 25.0f);                    /* M = 1 */
@@ -116,8 +120,7 @@ static void test_fused_bias_leaves_the_gradient_term_out(void **state)
 static void test_unsettled_restarts_hold_keeps(void **state)
 {
   (void)state;
-  const float t[2] = {100.0f, 100.0f};
-  const board_therm_cfg_t c = cfg(t, t, 0.0f, 0.0f);
+  const board_therm_cfg_t c = identity(0.0f, 0.0f);
   board_therm_t s;
   board_therm_init(&s);
   board_therm_reading(&c, &s, 25.0f);
@@ -137,8 +140,7 @@ static void test_unsettled_restarts_hold_keeps(void **state)
 static void test_hand_over_weight(void **state)
 {
   (void)state;
-  const float t[2] = {100.0f, 100.0f};
-  const board_therm_cfg_t c = cfg(t, t, 10.0f, 20.0f);
+  const board_therm_cfg_t c = identity(10.0f, 20.0f);
   board_therm_t s;
   board_therm_init(&s);
   const board_therm_bias_t b = {4.0f, 4.0f, 1.0f, 1u};
@@ -155,8 +157,7 @@ static void test_hand_over_weight(void **state)
 static void test_stale_sensor(void **state)
 {
   (void)state;
-  const float t[2] = {100.0f, 100.0f};
-  const board_therm_cfg_t c = cfg(t, t, 0.0f, 0.0f);
+  const board_therm_cfg_t c = identity(0.0f, 0.0f);
   board_therm_t s;
   board_therm_init(&s);
   const board_therm_bias_t b = {4.0f, 4.0f, 1.0f, 1u};
@@ -183,8 +184,7 @@ static void test_stale_sensor(void **state)
 static void test_stale_before_the_hand_over_is_valid(void **state)
 {
   (void)state;
-  const float t[2] = {100.0f, 100.0f};
-  const board_therm_cfg_t c = cfg(t, t, 100.0f, 10.0f);
+  const board_therm_cfg_t c = identity(100.0f, 10.0f);
   board_therm_t s;
   board_therm_init(&s);
   for (uint32_t k = 0u; k < 50u; k++) board_therm_step(&c, &s, SETTLED0);
@@ -195,8 +195,7 @@ static void test_stale_before_the_hand_over_is_valid(void **state)
 static void test_out_of_span(void **state)
 {
   (void)state;
-  const float t[2] = {100.0f, 100.0f};
-  const board_therm_cfg_t c = cfg(t, t, 0.0f, 0.0f);
+  const board_therm_cfg_t c = identity(0.0f, 0.0f);
   board_therm_t s;
   board_therm_init(&s);
   run_s(&c, &s, 86.0f, 1.0f, SETTLED0);
@@ -212,8 +211,7 @@ static void test_out_of_span(void **state)
 static void test_stuck_sensor_disagrees(void **state)
 {
   (void)state;
-  const float t[2] = {100.0f, 100.0f};
-  const board_therm_cfg_t c = cfg(t, t, 0.0f, 0.0f);
+  const board_therm_cfg_t c = identity(0.0f, 0.0f);
   board_therm_t s;
   board_therm_init(&s);
   const board_therm_bias_t b = {1.0f, 1.0f, 1.0f, 1u};

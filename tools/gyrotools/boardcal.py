@@ -19,8 +19,10 @@ pickoff delivers it (the firmware scales M by the compensation's scale factor). 
 firmware runs it: in its lag form, one step every BOARD_STEP_S on the reading held.
 
 The model knows one heat input; the board's own warm-up after a power-on is another, so
-the firmware hands over to the fusion board.start_s after power-on (START_POLES times
-the model's slowest pole) over board.fade_s.
+the firmware hands over to the fusion board.start_s after power-on (when H's step
+response has settled within SETTLE_REL for good: the time the model takes to forget a
+disagreement it started with; a pole its zero nearly cancels does not count) over
+board.fade_s.
 """
 
 from __future__ import annotations
@@ -38,7 +40,7 @@ BOARD_STEP_S = 0.1        # firmware/gyro/board_therm.h BOARD_THERM_STEP_S
 TC_MIN_S, TC_MAX_S = 1.0, 20000.0   # the parameters' range (board.tz1_s ...)
 GUESS_S = (300.0, 30.0, 600.0, 60.0)
 CROSSOVER_S = 3.0         # P's flicker is in excess from 10 s on (docs/compensation-noise.md)
-START_POLES = 5.0         # the hand-over after power-on: five of the slowest pole
+SETTLE_REL = 0.01          # the hand-over after power-on: H's step response settled to this
 START_MIN_S = 300.0
 FADE_S = 300.0
 SPAN_MARGIN = 0.05        # of the fitted span of y, each side (as rate.p_range_deg's)
@@ -155,12 +157,22 @@ def parting_dps(t_s, board_c, bias_s_dps, model, sf, start_s=thermcal.START_S):
     return float(np.max(np.abs(bins["d"][keep]))) if np.any(keep) else 0.0
 
 
+def settle_s(model, rel=SETTLE_REL):
+    """When H's unit step response stays within rel of 1 for good (s)."""
+    n = int(min(20.0 * max(model.tp_s), 2e5) / BOARD_STEP_S)
+    step = np.ones(n)
+    step[0] = 0.0
+    err = np.abs(lead_lag(step, model.tz_s, model.tp_s, 0.0) - 1.0)
+    out = np.flatnonzero(err > rel)
+    return float((out[-1] + 1) * BOARD_STEP_S) if out.size else 0.0
+
+
 def values(model, parting=0.0, crossover_s=CROSSOVER_S, fade_s=FADE_S):
     """The firmware's board.* values of a model (the fusion on); parting the most the bias
     in P and the model parted by on the calibration (parting_dps)."""
     span = model.y_max_c - model.y_min_c
     margin = max(SPAN_MARGIN * span, SPAN_MARGIN_MIN_C)
-    start = max(START_POLES * max(model.tp_s), START_MIN_S)
+    start = max(settle_s(model), START_MIN_S)
     return {"board.fuse": 1,
             "board.tz1_s": model.tz_s[0], "board.tz2_s": model.tz_s[1],
             "board.tp1_s": model.tp_s[0], "board.tp2_s": model.tp_s[1],

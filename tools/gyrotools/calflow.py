@@ -466,21 +466,23 @@ def thermal(part, values):
     v["rate.scale_dps"] = values["rate.scale_dps"] * s0
     v["rate.p_rate_deg_per_dps"] = values["rate.p_rate_deg_per_dps"] + figs["p_turn_c0_deg_per_dps"]
     if part.board:
-        v, figs["board"] = board_model(log, v, cmd)
+        v, figs["board"] = board_model(log, v, s0, cmd)
     figs["command"] = cmd
     figs["seed"] = part.seed + THERMAL_SEED_OFFSET
     return v, figs
 
 
-def board_model(log, v, cmd):
+def board_model(log, v, s0, cmd):
     """The board thermometer's model of the bias (gyrotools/boardcal.py) on the chamber
-    run at rest, its target the linearised output u there (log["rate_unc_dps"], already
-    linearised), the bias as the pickoff delivers it: the firmware scales it by the
-    compensation's scale factor (board_therm.h). Returns (values with the fusion on, its
-    figures)."""
+    run at rest, its target the linearised output there in the calibrated scale, u s0
+    (log["rate_unc_dps"] is u, linearised, at the scale the run had; the stage folds
+    SF's constant s0 into rate.scale_dps), the bias as the pickoff delivers it: the
+    firmware scales it by the compensation's scale factor (board_therm.h). Returns
+    (values with the fusion on, its figures)."""
     rest = np.abs(log["rate_true_dps"]) < 1e-9  # (not calibrated yet: never valid here)
+    u = np.asarray(log["rate_unc_dps"]) * s0
     try:
-        model = boardcal.fit(log["t_s"], log["board_c"], log["rate_unc_dps"], rest)
+        model = boardcal.fit(log["t_s"], log["board_c"], u, rest)
     except InputError as e:
         raise FlowError(f"board thermometer: {e} ({cmd})") from None
     sf, b_s = compstudy.static_parts(log, v, v["rate.comp_tau_s"], v["rate.comp_stages"])
@@ -746,14 +748,16 @@ def powered(part, cal_path):
     """The set the simulator's warm runs verify: every run but the cold start begins with
     the part's thermal network in its steady state, the board's own dissipation in it, as
     a part powered for long, whose firmware handed over to the board thermometer long
-    since (board.start_s after power-on, board_therm.h); its uptime starts at 0 in the
-    run, so those runs set board.start_s 0. The cold start runs the set as written. On a
+    since (board.start_s, then board.fade_s, after power-on, board_therm.h); its uptime
+    starts at 0 in the run, so those runs set both 0. The cold start runs the set as
+    written. On a
     port, or without the fusion, the set itself."""
     vals = paramset.read(cal_path).values()
     if part.port is not None or int(vals.get("board.fuse", 0)) != 1:
         return cal_path
     path = os.path.join(part.work, "calibration_powered.json")
-    paramset.write(path, paramset.from_values(dict(vals, **{"board.start_s": 0.0}), meta={
+    paramset.write(path, paramset.from_values(dict(vals, **{"board.start_s": 0.0,
+                                                             "board.fade_s": 0.0}), meta={
         "stage": "verify: the calibration as a part powered for long runs it"}))
     return path
 

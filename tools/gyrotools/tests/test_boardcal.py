@@ -59,7 +59,7 @@ def test_fit_recovers_a_known_network(fitted):
     v = boardcal.values(m)
     assert v["board.fuse"] == 1
     assert v["board.min_c"] < -9.0 and v["board.max_c"] > 59.0
-    assert v["board.start_s"] == pytest.approx(boardcal.START_POLES * max(m.tp_s))
+    assert v["board.start_s"] == pytest.approx(max(boardcal.settle_s(m), boardcal.START_MIN_S))
     assert boardcal.TC_MIN_S <= min(m.tz_s + m.tp_s) and max(m.tz_s + m.tp_s) <= boardcal.TC_MAX_S
 
 
@@ -106,3 +106,12 @@ def test_parting_is_the_largest_disagreement(fitted):
     v = boardcal.values(m, shifted)
     assert v["board.agree_dps"] == pytest.approx(boardcal.AGREE_FACTOR * shifted)
     assert boardcal.values(m, 0.0)["board.agree_dps"] == boardcal.AGREE_MIN_DPS
+
+
+def test_settle_time_of_the_lead_lag():
+    # one lag section: the error (1 - r) e^(-t / tp) falls below 1 % at tp ln(100 (1 - r))
+    m = boardcal.BoardModel((50.0, 30.0), (200.0, 30.0), 25.0, np.zeros(4), 0.0, 0.0, 0.0)
+    assert boardcal.settle_s(m) == pytest.approx(200.0 * np.log(100.0 * 0.75), abs=0.5)
+    # a pole its zero nearly cancels (a residue under 1 %) does not count
+    m2 = boardcal.BoardModel((50.0, 1243.0), (200.0, 1255.0), 25.0, np.zeros(4), 0.0, 0.0, 0.0)
+    assert boardcal.settle_s(m2) < 1.2 * boardcal.settle_s(m)
