@@ -24,7 +24,8 @@
  * fast path left out: they turn P's flicker into rate above the crossover, 1.13 times the
  * uncompensated noise at 10 s on a loose part when they stayed in), LP_T a first-order
  * low-pass of board.crossover_s. P's flicker is in excess from 10 s on, so the crossover
- * lies below that (3 s: the study's scan). The sample path keeps its bias B_P (gradient
+ * lies below that; above it the fused bias passes T times the rate of change of P's
+ * disagreement with the model (1 s: gyrotools/boardcal.py, CROSSOVER_S, the trade). The sample path keeps its bias B_P (gradient
  * term and fast path included); the correction is w (B - B_P).
  *
  * The model knows one heat input, the surroundings; after a power-on the board's own

@@ -498,8 +498,10 @@
   X(board_max_c, 0x0B0Cu, "board.max_c", F32, "degC", -60.0f, 150.0f, 85.0f, 0u, \
     PF_PERSIST | PF_LIVE, "board model: highest y it holds for") \
   /* P's phase flicker is in excess from 10 s on (docs/compensation-noise.md): the
-   * crossover lies below that */ \
-  X(board_crossover_s, 0x0B0Du, "board.crossover_s", F32, "s", 0.5f, 1000.0f, 3.0f, 0u, \
+   * crossover lies below that; above it the fused bias passes T times the rate of
+   * change of P's disagreement with the model, below it the sensor's 1 s steps and noise
+   * (gyrotools/boardcal.py CROSSOVER_S: the measured trade) */ \
+  X(board_crossover_s, 0x0B0Du, "board.crossover_s", F32, "s", 0.2f, 1000.0f, 1.0f, 0u, \
     PF_PERSIST | PF_LIVE, "the fusion's crossover: P's compensation above 1 / (2 pi T), the board model's below") \
   /* The board's own warm-up after power-on is a heat input the model does not know: an
    * hour, generic, until the flow sets five of the part's slowest thermal pole */ \
