@@ -43,8 +43,7 @@
   X(tick,            U32, "-") \
   X(rate_valid,      U32, "-") \
   X(f_drive_hz,      F32, "Hz") \
-  X(rate_invalid,    U32, "-") \
-  X(board_c,         F32, "degC")
+  X(rate_invalid,    U32, "-")
 /* clang-format on */
 
 typedef enum {

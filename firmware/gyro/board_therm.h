@@ -43,8 +43,8 @@
  * it refreshes it (gyro_block.c, p_refresh). The lead-lag runs in its lag form,
  * e = u - LP(u) (comp_filters.h's reason: a low-pass of minutes on a temperature in float
  * would have a dead band). */
-#ifndef BOARD_THERM_H
-#define BOARD_THERM_H
+#ifndef GYRO_BOARD_THERM_H
+#define GYRO_BOARD_THERM_H
 
 #include <stdint.h>
 
@@ -127,4 +127,4 @@ static inline uint32_t board_therm_invalid(const board_therm_t *s)
 
 const char *board_therm_state_name(board_therm_state_t st);
 
-#endif /* BOARD_THERM_H */
+#endif /* GYRO_BOARD_THERM_H */

@@ -469,54 +469,54 @@
    * fused with the compensation in P below board.crossover_s. Off until the calibration
    * flow has fitted the model on the part (tools/calibrate --board-temp) */ \
   X(board_fuse, 0x0B01u, "board.fuse", ENUM, "-", 0u, 1u, 0u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
-    PF_PERSIST | PF_LIVE, "fuse the board sensor's model of the bias with the compensation in P (0 off)") \
+    PF_PERSIST | PF_LIVE, "fuse the board sensor's model of the bias with P (0 off)") \
   /* The model's lead-lag (1 + s tz1)(1 + s tz2) / ((1 + s tp1)(1 + s tp2)): the board
    * node to the bias through the part's thermal network. Uncalibrated: all equal, H = 1 */ \
   X(board_tz1_s, 0x0B02u, "board.tz1_s", F32, "s", 1.0f, 20000.0f, 100.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "board model: first zero's time constant") \
+    PF_PERSIST | PF_LIVE, "board model: zero 1") \
   X(board_tz2_s, 0x0B03u, "board.tz2_s", F32, "s", 1.0f, 20000.0f, 100.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "board model: second zero's time constant") \
+    PF_PERSIST | PF_LIVE, "board model: zero 2") \
   X(board_tp1_s, 0x0B04u, "board.tp1_s", F32, "s", 1.0f, 20000.0f, 100.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "board model: first pole's time constant") \
+    PF_PERSIST | PF_LIVE, "board model: pole 1") \
   X(board_tp2_s, 0x0B05u, "board.tp2_s", F32, "s", 1.0f, 20000.0f, 100.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "board model: second pole's time constant") \
+    PF_PERSIST | PF_LIVE, "board model: pole 2") \
   /* The cubic's reference and coefficients: uncalibrated 25 degC and 0 */ \
   X(board_ref_c, 0x0B06u, "board.ref_c", F32, "degC", -60.0f, 150.0f, 25.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "board model: the cubic is in y - board.ref_c, y the lead-lag's output") \
+    PF_PERSIST | PF_LIVE, "board model: the cubic's reference") \
   X(board_c0_dps, 0x0B07u, "board.c0_dps", F32, "deg/s", -10000.0f, 10000.0f, 0.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "board model of the bias: constant") \
+    PF_PERSIST | PF_LIVE, "board model: c0") \
   X(board_c1_dps_per_c, 0x0B08u, "board.c1_dps_per_c", F32, "deg/s/degC", -1000.0f, 1000.0f, 0.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "board model of the bias: linear term") \
+    PF_PERSIST | PF_LIVE, "board model: c1") \
   X(board_c2_dps_per_c2, 0x0B09u, "board.c2_dps_per_c2", F32, "deg/s/degC^2", -100.0f, 100.0f, 0.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "board model of the bias: quadratic term") \
+    PF_PERSIST | PF_LIVE, "board model: c2") \
   X(board_c3_dps_per_c3, 0x0B0Au, "board.c3_dps_per_c3", F32, "deg/s/degC^3", -10.0f, 10.0f, 0.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "board model of the bias: cubic term") \
+    PF_PERSIST | PF_LIVE, "board model: c3") \
   /* The span of y the model was fitted on (the flow widens it by a margin): beyond it,
    * with the fusion weighing in, the rate is not valid (BOARD_TEMP) */ \
   X(board_min_c, 0x0B0Bu, "board.min_c", F32, "degC", -60.0f, 150.0f, -40.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "board model: lowest y it holds for") \
+    PF_PERSIST | PF_LIVE, "board model: lowest y fitted") \
   X(board_max_c, 0x0B0Cu, "board.max_c", F32, "degC", -60.0f, 150.0f, 85.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "board model: highest y it holds for") \
+    PF_PERSIST | PF_LIVE, "board model: highest y fitted") \
   /* P's phase flicker is in excess from 10 s on (docs/compensation-noise.md): the
    * crossover lies below that; above it the fused bias passes T times the rate of
    * change of P's disagreement with the model, below it the sensor's 1 s steps and noise
    * (gyrotools/boardcal.py CROSSOVER_S: the measured trade) */ \
   X(board_crossover_s, 0x0B0Du, "board.crossover_s", F32, "s", 0.2f, 1000.0f, 1.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "the fusion's crossover: P's compensation above 1 / (2 pi T), the board model's below") \
+    PF_PERSIST | PF_LIVE, "fusion crossover: P above, the board model below") \
   /* The board's own warm-up after power-on is a heat input the model does not know: an
    * hour, generic, until the flow sets five of the part's slowest thermal pole */ \
   X(board_start_s, 0x0B0Eu, "board.start_s", F32, "s", 0.0f, 100000.0f, 3600.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "the fusion starts this long after power-on (P's compensation alone until then)") \
+    PF_PERSIST | PF_LIVE, "fusion starts this long after power-on") \
   X(board_fade_s, 0x0B0Fu, "board.fade_s", F32, "s", 0.0f, 10000.0f, 300.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "the fusion's weight rises from 0 to 1 over this") \
+    PF_PERSIST | PF_LIVE, "fusion weight rises 0 -> 1 over this") \
   /* Three of the sensor's 1 s cycles */ \
   X(board_stale_s, 0x0B10u, "board.stale_s", F32, "s", 1.5f, 60.0f, 3.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "no reading for this long: the sensor is stale (rate not valid while fused)") \
+    PF_PERSIST | PF_LIVE, "no reading this long: sensor stale") \
   /* A sensor that reads but is wrong (stuck, off the board): the bias in P and the
    * model part by more than either misses the part by. The flow sets three times the
    * most they parted on its chamber run; generic: 10 deg/s */ \
   X(board_agree_dps, 0x0B11u, "board.agree_dps", F32, "deg/s", 0.01f, 10000.0f, 10.0f, 0u, \
-    PF_PERSIST | PF_LIVE, "the bias in P and the board model low-passed part by more: not trusted (rate not valid while fused)") \
+    PF_PERSIST | PF_LIVE, "P and the board model part by more: not trusted") \
   /* start the drive at power-on */ \
   X(sys_autostart, 0x0602u, "sys.autostart", ENUM, "-", 0u, 1u, 1u, PARAM_CHOICE(0) | PARAM_CHOICE(1), \
     PF_PERSIST | PF_RESTART, "start acquiring at power-on") \
