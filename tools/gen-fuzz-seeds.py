@@ -49,7 +49,7 @@ def f32(x):
     return struct.unpack("<I", struct.pack("<f", x))[0]
 
 
-SLOT = 1024
+SLOT = 2048  # tests/fuzz/fuzz_param_store.c SECTOR: an image of every parameter fits
 recs_a = [(0x0101, 0, f32(1500.0)), (0x0303, 2, 6), (0x0501, 1, 250), (0x7777, 0, 0)]
 recs_b = [(0x0101, 0, f32(1600.0)), (0x0103, 0, f32(9.0)), (0x0102, 1, 1), (0x0501, 1, 250)]
 

@@ -8,12 +8,13 @@
 #include "hal/hal_board_temp.h"
 
 /* Sample ticks per step of the fusion. */
-#define BOARD_STEP_TICKS ((uint32_t)((float)BOARD_SAMPLE_RATE_HZ * BOARD_THERM_STEP_S + 0.5f))
+#define BOARD_STEP_TICKS (BOARD_SAMPLE_RATE_HZ / BOARD_THERM_STEPS_PER_S)
 /* A background stalled this many steps (a flash erase) catches up no further: the
  * filters' time is the sample clock's, a gap of the background's is not the part's. */
 #define BOARD_CATCH_UP_STEPS 50u
 
-_Static_assert(BOARD_STEP_TICKS > 0u, "a step of the fusion is whole ticks");
+_Static_assert(BOARD_SAMPLE_RATE_HZ % BOARD_THERM_STEPS_PER_S == 0u && BOARD_STEP_TICKS > 0u,
+               "a step of the fusion is whole ticks");
 
 /* What makes the compensation's bias in P not the part's yet: its disagreement with the
  * model is not to be low-passed (the fusion starts it again from the next good step). */

@@ -49,7 +49,8 @@
 #include <stdint.h>
 
 /* The step of the background's filters: a tenth of the sensor's 1 s cycle. */
-#define BOARD_THERM_STEP_S 0.1f
+#define BOARD_THERM_STEPS_PER_S 10u
+#define BOARD_THERM_STEP_S (1.0f / (float)BOARD_THERM_STEPS_PER_S)
 
 typedef enum {
   BOARD_THERM_OFF = 0, /* board.fuse 0: P's compensation alone */

@@ -101,7 +101,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
   memset(&g, 0, sizeof g);
-  const hal_flash_host_cfg_t fc = {2u, 1024u, NULL, 0u, 0u, 0u};
+  const hal_flash_host_cfg_t fc = {2u, 2048u, NULL,
+                                   0u, 0u,    0u}; /* an image of every parameter */
   FUZZ_CHECK(hal_flash_host_configure(&fc) == 0);
   const param_store_cfg_t sc = {0u, 1u};
   FUZZ_CHECK(param_store_init(&g.store, &sc) == PARAM_STORE_OK);

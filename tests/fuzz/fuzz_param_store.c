@@ -13,7 +13,7 @@
 #include "hal_flash_host.h"
 #include "params/param_store.h"
 
-#define SECTOR 1024u
+#define SECTOR 2048u /* holds an image of every parameter (param_store_init) */
 
 static uint32_t le32(const uint8_t *p)
 {
