@@ -101,6 +101,8 @@ def usage(sim):
         (["--sim", "--tune", "matched", "--out", "X"], "needs --sense fr"),
         (["--sim", "--sense", "closed", "--out", "X"], "invalid choice"),
         (["--sim", "--sense", "fr", "--verify-only", CAL, "--out", "X"], "its own configuration"),
+        (["--sim", "--board-temp", "--verify-only", CAL, "--out", "X"], "no --board-temp"),
+        (["--port", "/dev/null", "--part-id", "1", "--board-temp", "--out", "X"], "--sim only"),
     ]
     bad = 0
     with tempfile.TemporaryDirectory() as d:
