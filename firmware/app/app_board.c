@@ -58,15 +58,13 @@ static board_therm_bias_t bias_p(const app_t *a)
     const uint32_t t = *tick;
     atomic_signal_fence(memory_order_seq_cst);
     const float b = g->rate.comp_bias_dps - g->board_corr_applied_dps;
-    const float x = (g->rate.p_dev_deg + rc->p_poly_off_deg) - g->rate.p_comp_lag_deg;
+    const float x = rate_channel_comp_x_deg(rc, &g->rate);
     const float sf = g->rate.comp_sf;
     const uint32_t reasons = g->valid.reasons;
     atomic_signal_fence(memory_order_seq_cst);
-    if (*tick == t) {
-      const float *c = rc->bias_c_dps;
-      const float bs = c[0] + x * (c[1] + x * (c[2] + x * c[3]));
-      return (board_therm_bias_t){b, bs, sf, (reasons & BOARD_BIAS_P_UNSETTLED) == 0u ? 1u : 0u};
-    }
+    if (*tick == t)
+      return (board_therm_bias_t){b, rate_channel_bias_static_dps(rc, x), sf,
+                                  (reasons & BOARD_BIAS_P_UNSETTLED) == 0u ? 1u : 0u};
   }
   return (board_therm_bias_t){0.0f, 0.0f, 1.0f, BOARD_THERM_BIAS_HOLD};
 }

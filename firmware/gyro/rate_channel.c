@@ -325,8 +325,7 @@ GYRO_RAMFUNC int rate_channel_update_p(const rate_channel_cfg_t *restrict cfg,
 GYRO_RAMFUNC static inline float comp_bias(const rate_channel_cfg_t *restrict cfg, float x,
                                            float grad_k, float hp_deg)
 {
-  const float *b3 = cfg->bias_c_dps;
-  return b3[0] + x * (b3[1] + x * (b3[2] + x * b3[3])) + grad_k * hp_deg;
+  return rate_channel_bias_static_dps(cfg, x) + grad_k * hp_deg;
 }
 
 GYRO_RAMFUNC void rate_channel_comp_refresh(const rate_channel_cfg_t *restrict cfg,

@@ -270,6 +270,21 @@ static inline void rate_channel_fast_hold(const rate_channel_cfg_t *cfg, rate_ch
  * the fast one than blend_dps in between. */
 void rate_channel_comp_refresh(const rate_channel_cfg_t *cfg, rate_channel_t *rc);
 
+/* The compensation's variable at the filters' state: x = P_c - cal.ref_p_deg. */
+static inline float rate_channel_comp_x_deg(const rate_channel_cfg_t *cfg,
+                                            const rate_channel_t *rc)
+{
+  return (rc->p_dev_deg + cfg->p_poly_off_deg) - rc->p_comp_lag_deg;
+}
+
+/* The compensation's static bias B(x), its cubic alone (no gradient term, no fast path):
+ * rate_channel_comp_refresh's, and the board thermometer's B_s (board_therm.h). */
+static inline float rate_channel_bias_static_dps(const rate_channel_cfg_t *cfg, float x)
+{
+  const float *b3 = cfg->bias_c_dps;
+  return b3[0] + x * (b3[1] + x * (b3[2] + x * b3[3]));
+}
+
 /* Once per RATE_DECIM ticks, after the block's last accumulate. (w_i, w_q): the drive
  * LMSD's weights (only to tell that the drive runs); p_rad: force phase (the phase loop
  * holds it over the block) and e_rad: the phase loop's error set - arg D, for the
